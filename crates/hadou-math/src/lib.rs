@@ -1,0 +1,17 @@
+//! # hadou-math
+//!
+//! The single source of truth for hadou's formulas: energy fields of the analytic wave shapes and
+//! their exact line integrals, curved waves and their integrators, quadrature, and the small vector
+//! and matrix types everything else uses. No GPU, no window, no I/O.
+//!
+//! Every public formula names the thesis equation it implements and any SPEC.md correction.
+
+pub mod curve;
+pub mod energy;
+mod mat4;
+mod real;
+mod vec3;
+
+pub use mat4::Mat4;
+pub use real::Real;
+pub use vec3::{Vec3, Vec3d, Vec3f};

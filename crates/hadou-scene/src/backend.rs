@@ -1,0 +1,34 @@
+//! The [`Backend`] trait both renderers implement.
+
+use crate::{Frame, Image};
+
+/// A renderer: turns a [`Frame`] into an [`Image`].
+pub trait Backend {
+    /// Short name (`"cpu"`, `"gpu"`).
+    fn name(&self) -> &str;
+    /// Renders one frame.
+    fn render(&mut self, frame: &Frame) -> Result<Image, RenderError>;
+}
+
+/// Why a backend could not render.
+#[derive(Debug)]
+pub enum RenderError {
+    /// No usable device (e.g. no GPU adapter).
+    NoDevice(String),
+    /// The device was lost or ran out of memory.
+    Device(String),
+    /// Anything else, with a message for the user.
+    Other(String),
+}
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RenderError::NoDevice(m) => write!(f, "no usable device: {m}"),
+            RenderError::Device(m) => write!(f, "device error: {m}"),
+            RenderError::Other(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
