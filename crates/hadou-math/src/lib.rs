@@ -9,7 +9,9 @@
 pub mod curve;
 pub mod energy;
 mod mat4;
+pub mod quadrature;
 mod real;
+pub mod shade;
 mod vec3;
 
 pub use mat4::Mat4;

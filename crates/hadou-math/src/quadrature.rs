@@ -1,0 +1,2 @@
+//! Numerical quadrature: the converged references that tests and the curve integrators compare
+//! against.
