@@ -150,7 +150,8 @@ mod tests {
 
     #[test]
     fn trs_moves_points_and_normal_matrix_keeps_normals_perpendicular() {
-        let m = Mat4::from_trs(Vec3::new(1.0, 2.0, 3.0), Vec3::new(30.0, 45.0, 60.0), Vec3::new(2.0, 1.0, 0.5));
+        let m =
+            Mat4::from_trs(Vec3::new(1.0, 2.0, 3.0), Vec3::new(30.0, 45.0, 60.0), Vec3::new(2.0, 1.0, 0.5));
         let p = m.transform_point(Vec3::ZERO);
         assert_eq!(p, Vec3::new(1.0, 2.0, 3.0));
         // A tangent and a normal of the unit plane z=0 stay perpendicular after transform.

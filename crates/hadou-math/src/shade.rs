@@ -8,7 +8,13 @@ use crate::Vec3f;
 /// `normal` need not be unit (it is normalised; a zero normal shades with ambient only);
 /// `light_dir` is the unit direction the light travels.
 #[inline]
-pub fn diffuse(albedo: [f32; 3], normal: Vec3f, light_dir: Vec3f, light: [f32; 3], ambient: [f32; 3]) -> [f32; 3] {
+pub fn diffuse(
+    albedo: [f32; 3],
+    normal: Vec3f,
+    light_dir: Vec3f,
+    light: [f32; 3],
+    ambient: [f32; 3],
+) -> [f32; 3] {
     let n = normal.normalize_or(Vec3f::ZERO);
     let lambert = n.dot(-light_dir).max(0.0);
     [
