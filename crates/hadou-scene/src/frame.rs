@@ -2,7 +2,7 @@
 //! to parse. Produced by `Scene::at`, consumed by every backend.
 
 use hadou_math::curve::CurveWave;
-use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
+use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use std::sync::Arc;
 
@@ -92,12 +92,62 @@ impl CameraBasis {
             + self.up * (ndc_y * self.tan_half_fov)
     }
 
+    /// The integration ray of pixel `(px, py)` for a wave with the given falloff (002 §3.3.3 and
+    /// §3.3.5, eq. 3.12–3.13): the eye `S`, the far point `E` on the far plane, and the span
+    /// clipped at the visible surface. `surface` is the eye distance of the visible opaque surface,
+    /// or `None` where nothing is drawn.
+    ///
+    /// - [`Falloff::Faithful`]: `dir = Q = E − S`, `t ∈ [0, g]`, `g = d / |E − S|` (eq. 3.12),
+    ///   `t_far = 1`.
+    /// - [`Falloff::InverseSquare`]: `dir` unit, `t ∈ [0, d]` (or `[0, ∞)` with nothing drawn),
+    ///   `t_far = |E − S|` (used only by attenuation).
+    ///
+    /// Both backends build their rays with exactly this construction.
+    #[inline]
+    pub fn wave_ray(
+        &self,
+        falloff: Falloff,
+        far: f32,
+        px: f32,
+        py: f32,
+        width: u32,
+        height: u32,
+        surface: Option<f32>,
+    ) -> WaveRay {
+        let dir = self.pixel_dir(px, py, width, height);
+        let len = dir.length();
+        let far_dist = far * len;
+        match falloff {
+            Falloff::Faithful => {
+                let g = surface.map_or(1.0, |d| (d / far_dist).min(1.0));
+                WaveRay { ray: Ray { origin: self.eye, dir: dir * far }, t0: 0.0, t1: g, t_far: 1.0 }
+            }
+            Falloff::InverseSquare => {
+                let t1 = surface.unwrap_or(f32::INFINITY);
+                WaveRay { ray: Ray { origin: self.eye, dir: dir / len }, t0: 0.0, t1, t_far: far_dist }
+            }
+        }
+    }
+
     /// World → view space: `(x right, y up, z forward depth)`.
     #[inline]
     pub fn to_view(&self, p: Vec3f) -> Vec3f {
         let d = p - self.eye;
         Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.forward))
     }
+}
+
+/// A pixel's wave-integration ray and span; see [`CameraBasis::wave_ray`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaveRay {
+    /// The ray `S + t·dir`.
+    pub ray: Ray<f32>,
+    /// Start of the span (the eye).
+    pub t0: f32,
+    /// End of the span: the visible surface, the far point, or `+∞`.
+    pub t1: f32,
+    /// Parameter of the far point (normalises attenuation).
+    pub t_far: f32,
 }
 
 /// The scene's directional light for the simple diffuse shading of opaque objects.
