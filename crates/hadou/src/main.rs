@@ -1,1 +1,320 @@
-fn main() {}
+//! The `hadou` command-line tool: render, validate, probe, bench.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use hadou::output;
+use hadou::{Backend, CpuBackend, Frame, Image, RenderError, Scene};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Real-time anime energy waves from formulas.
+#[derive(Parser, Debug)]
+#[command(name = "hadou", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene to a PNG/EXR image, or a numbered PNG sequence with --frames.
+    Render(RenderArgs),
+    /// Check a scene file; exit 0 if valid, 2 with `file:line:col: message` if not.
+    Validate {
+        /// The scene file (TOML).
+        scene: PathBuf,
+    },
+    /// Print, as JSON, each wave's energy, the final colour and the depth at one pixel.
+    Probe(ProbeArgs),
+    /// Measure rendering speed in the layout of the thesis's tables.
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Output file (.png or .exr), or a directory (ending in `/`) with --frames.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Scene time in seconds.
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+    /// Frame range `A..B` (B excluded) or `A..=B`, rendered at times `frame / fps`.
+    #[arg(long)]
+    frames: Option<String>,
+    /// Frames per second for --frames.
+    #[arg(long, default_value_t = 24.0)]
+    fps: f32,
+    /// Override the image width.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Override the image height.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Which backend renders.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
+    backend: BackendChoice,
+}
+
+#[derive(Args, Debug)]
+struct ProbeArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// The pixel `X,Y` (0,0 is the top-left).
+    #[arg(long)]
+    pixel: String,
+    /// Scene time in seconds.
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+    /// Override the image width.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Override the image height.
+    #[arg(long)]
+    height: Option<u32>,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Image sizes (square), comma-separated.
+    #[arg(long, default_value = "512,1024,2048", value_delimiter = ',')]
+    sizes: Vec<u32>,
+    /// Timed repetitions per cell (after one warm-up).
+    #[arg(long, default_value_t = 5)]
+    iterations: u32,
+    /// Which backend to measure.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
+    backend: BackendChoice,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum BackendChoice {
+    /// The CPU reference backend.
+    Cpu,
+}
+
+/// A failure with the exit code it maps to: 2 for bad input, 1 for everything else.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+impl Failure {
+    fn input(message: impl Into<String>) -> Self {
+        Failure { code: 2, message: message.into() }
+    }
+    fn runtime(message: impl Into<String>) -> Self {
+        Failure { code: 1, message: message.into() }
+    }
+}
+
+impl From<hadou::SceneError> for Failure {
+    fn from(e: hadou::SceneError) -> Self {
+        Failure::input(e.to_string())
+    }
+}
+
+impl From<output::OutputError> for Failure {
+    fn from(e: output::OutputError) -> Self {
+        match e {
+            output::OutputError::BadPath(m) => Failure::input(m),
+            output::OutputError::Io(m) => Failure::runtime(m),
+        }
+    }
+}
+
+impl From<RenderError> for Failure {
+    fn from(e: RenderError) -> Self {
+        Failure::runtime(format!("render failed: {e}"))
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(a) => render(a),
+        Command::Validate { scene } => Scene::load(&scene).map(|_| ()).map_err(Failure::from),
+        Command::Probe(a) => probe(a),
+        Command::Bench(a) => bench(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {}", f.message);
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+fn size_override(w: Option<u32>, h: Option<u32>) -> Result<(), Failure> {
+    for (name, v) in [("--width", w), ("--height", h)] {
+        if let Some(v) = v {
+            if v == 0 || v > 16384 {
+                return Err(Failure::input(format!("{name} {v}: image size must be in 1..=16384")));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>) -> Result<Frame, Failure> {
+    if !t.is_finite() {
+        return Err(Failure::input(format!("--time {t}: must be a finite number of seconds")));
+    }
+    let mut frame = scene.at(t);
+    if let Some(w) = w {
+        frame.width = w;
+    }
+    if let Some(h) = h {
+        frame.height = h;
+    }
+    Ok(frame)
+}
+
+fn make_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, Failure> {
+    match choice {
+        BackendChoice::Cpu => Ok(Box::new(CpuBackend::new())),
+    }
+}
+
+/// Parses `A..B` (B excluded) or `A..=B`.
+fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, Failure> {
+    let bad = || {
+        Failure::input(format!(
+            "--frames {s}: expected a range of frame numbers like `0..48` (48 excluded) or `0..=47`"
+        ))
+    };
+    let (a, b, inclusive) = if let Some((a, b)) = s.split_once("..=") {
+        (a, b, true)
+    } else if let Some((a, b)) = s.split_once("..") {
+        (a, b, false)
+    } else {
+        return Err(bad());
+    };
+    let a: u32 = a.trim().parse().map_err(|_| bad())?;
+    let b: u32 = b.trim().parse().map_err(|_| bad())?;
+    let end = if inclusive { b.checked_add(1).ok_or_else(bad)? } else { b };
+    if end <= a {
+        return Err(Failure::input(format!("--frames {s}: the range is empty")));
+    }
+    Ok(a..end)
+}
+
+fn render(a: RenderArgs) -> Result<(), Failure> {
+    size_override(a.width, a.height)?;
+    let scene = Scene::load(&a.scene)?;
+    let mut backend = make_backend(a.backend)?;
+    let Some(frames) = &a.frames else {
+        output::check_writable(&a.output)?;
+        let frame = frame_at(&scene, a.time, a.width, a.height)?;
+        let image = backend.render(&frame)?;
+        check_finite(&image)?;
+        output::write(&image, &a.output)?;
+        eprintln!("wrote {} ({}×{}, {} backend)", a.output.display(), image.width, image.height, backend.name());
+        return Ok(());
+    };
+    let range = parse_frames(frames)?;
+    if !(a.fps.is_finite() && a.fps > 0.0) {
+        return Err(Failure::input(format!("--fps {}: must be a positive number", a.fps)));
+    }
+    let dir = &a.output;
+    if !dir.is_dir() {
+        return Err(Failure::input(format!(
+            "{}: with --frames the output must be an existing directory; create it first",
+            dir.display()
+        )));
+    }
+    let first = dir.join(format!("frame_{:05}.png", range.start));
+    output::check_writable(&first)?;
+    let bar = indicatif::ProgressBar::new(range.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, eta {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    for f in range.clone() {
+        let frame = frame_at(&scene, f as f32 / a.fps, a.width, a.height)?;
+        let image = backend.render(&frame)?;
+        check_finite(&image)?;
+        output::write_png(&image, &dir.join(format!("frame_{f:05}.png")))?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    eprintln!("wrote {} frames to {} ({} backend)", range.len(), dir.display(), backend.name());
+    Ok(())
+}
+
+/// The last line of defence of the invariant that no NaN or infinity reaches an image.
+fn check_finite(image: &Image) -> Result<(), Failure> {
+    let ok = image.color.iter().all(|c| c.iter().all(|v| v.is_finite()))
+        && image.energy.iter().all(|v| v.is_finite())
+        && image.depth.iter().all(|v| v.is_finite());
+    if ok {
+        Ok(())
+    } else {
+        Err(Failure::runtime("internal error: the renderer produced a non-finite value; nothing was written"))
+    }
+}
+
+fn parse_pixel(s: &str) -> Result<(u32, u32), Failure> {
+    let bad = || Failure::input(format!("--pixel {s}: expected `X,Y` with non-negative integers, e.g. 256,128"));
+    let (x, y) = s.split_once(',').ok_or_else(bad)?;
+    Ok((x.trim().parse().map_err(|_| bad())?, y.trim().parse().map_err(|_| bad())?))
+}
+
+fn probe(a: ProbeArgs) -> Result<(), Failure> {
+    size_override(a.width, a.height)?;
+    let (x, y) = parse_pixel(&a.pixel)?;
+    let scene = Scene::load(&a.scene)?;
+    let frame = frame_at(&scene, a.time, a.width, a.height)?;
+    let p = hadou::probe(&frame, x, y).ok_or_else(|| {
+        Failure::input(format!(
+            "--pixel {x},{y}: outside the {}×{} image (x < {}, y < {})",
+            frame.width, frame.height, frame.width, frame.height
+        ))
+    })?;
+    let waves: Vec<_> = p
+        .waves
+        .iter()
+        .map(|w| serde_json::json!({"name": w.name, "energy": w.energy, "evaluations": w.evaluations}))
+        .collect();
+    let j = serde_json::json!({
+        "scene": a.scene.display().to_string(),
+        "time": a.time,
+        "pixel": [x, y],
+        "size": [frame.width, frame.height],
+        "waves": waves,
+        "energy": p.waves.iter().map(|w| w.energy).sum::<f32>(),
+        "color": p.color,
+        "depth": p.depth,
+        "object": p.object,
+    });
+    println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+    Ok(())
+}
+
+fn bench(a: BenchArgs) -> Result<(), Failure> {
+    for &s in &a.sizes {
+        size_override(Some(s), Some(s))?;
+    }
+    if a.iterations == 0 {
+        return Err(Failure::input("--iterations 0: need at least one timed repetition"));
+    }
+    let mut backend = make_backend(a.backend)?;
+    let name = backend.name().to_string();
+    let mut time = |frame: &Frame| -> Result<f64, RenderError> {
+        let t = std::time::Instant::now();
+        backend.render(frame)?;
+        Ok(t.elapsed().as_secs_f64() * 1e3)
+    };
+    let table = hadou::bench::analytic_table(&mut time, &a.sizes, a.iterations, &name, "wall clock, whole render")?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&table.to_json()).unwrap_or_default());
+    } else {
+        print!("{}", table.to_text());
+    }
+    Ok(())
+}
+

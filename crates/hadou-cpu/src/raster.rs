@@ -1,0 +1,289 @@
+//! The opaque pass: a deterministic scanline-free triangle rasterizer with a depth buffer and the
+//! simple diffuse light (`hadou_math::shade::diffuse`).
+//!
+//! Conventions (the GPU backend's raster pass matches them): pixel `(px, py)` has its centre at
+//! `(px + ½, py + ½)`, `py = 0` is the top row; projection from [`CameraBasis`]; triangles are
+//! clipped at the near plane in view space, drawn double-sided, with the top-left fill rule;
+//! the depth test is `z < stored z` in submission order, so ties keep the earlier triangle and
+//! the result does not depend on the number of threads.
+
+use hadou_math::{shade, Vec3, Vec3f};
+use hadou_scene::{CameraBasis, Frame};
+use rayon::prelude::*;
+
+/// Rows per parallel band.
+const BAND: usize = 16;
+
+/// One vertex after transform: view-space position (for clipping/projection) and world-space
+/// attributes (for shading).
+#[derive(Clone, Copy, Debug)]
+struct Vert {
+    view: Vec3f,
+    world: Vec3f,
+    normal: Vec3f,
+}
+
+/// A projected triangle ready to rasterize.
+#[derive(Clone, Copy, Debug)]
+struct ScreenTri {
+    /// Continuous screen coordinates (x right, y down).
+    sx: [f32; 3],
+    sy: [f32; 3],
+    /// `1 / view z` per vertex.
+    inv_z: [f32; 3],
+    world: [Vec3f; 3],
+    normal: [Vec3f; 3],
+    object: u32,
+}
+
+/// What the opaque pass leaves per pixel.
+pub(crate) struct OpaqueBuffers {
+    /// Shaded linear RGB, background where nothing is drawn.
+    pub color: Vec<[f32; 3]>,
+    /// Eye distance to the visible surface, `None` where nothing is drawn.
+    pub surface: Vec<Option<f32>>,
+    /// Index into `frame.objects` of the visible object, if any.
+    pub object: Vec<Option<u32>>,
+}
+
+/// Runs the opaque pass over the whole frame.
+pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis) -> OpaqueBuffers {
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let tris = project_all(frame, basis);
+    let far = frame.camera.far;
+    // Bin triangles into horizontal bands, keeping submission order inside each band.
+    let bands = h.div_ceil(BAND);
+    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
+    for (i, t) in tris.iter().enumerate() {
+        let (y0, y1) = y_range(t, h);
+        if y0 > y1 {
+            continue;
+        }
+        for b in (y0 / BAND)..=(y1 / BAND) {
+            bins[b].push(i as u32);
+        }
+    }
+    let mut color = vec![[0.0f32; 3]; w * h];
+    let mut surface = vec![None; w * h];
+    let mut object = vec![None; w * h];
+    color
+        .par_chunks_mut(BAND * w)
+        .zip(surface.par_chunks_mut(BAND * w))
+        .zip(object.par_chunks_mut(BAND * w))
+        .enumerate()
+        .for_each(|(b, ((col, surf), obj))| {
+            let y_start = b * BAND;
+            let rows = col.len() / w;
+            let mut zbuf = vec![f32::INFINITY; rows * w];
+            let mut tri_id = vec![u32::MAX; rows * w];
+            for &ti in &bins[b] {
+                raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, &mut zbuf, &mut tri_id);
+            }
+            for r in 0..rows {
+                for x in 0..w {
+                    let i = r * w + x;
+                    let py = (y_start + r) as f32;
+                    if tri_id[i] == u32::MAX {
+                        col[i] = frame.background;
+                        continue;
+                    }
+                    let t = &tris[tri_id[i] as usize];
+                    let (world, normal) = interpolate(t, x as f32 + 0.5, py + 0.5);
+                    let l = &frame.light;
+                    let albedo = frame.objects[t.object as usize].color;
+                    col[i] = shade::diffuse(albedo, normal, l.direction, l.color, l.ambient);
+                    let d = (world - basis.eye).length();
+                    surf[i] = Some(if d.is_finite() { d } else { 0.0 });
+                    obj[i] = Some(t.object);
+                }
+            }
+        });
+    OpaqueBuffers { color, surface, object }
+}
+
+fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
+    let (w, h) = (frame.width as f32, frame.height as f32);
+    let near = frame.camera.near;
+    let sx_scale = 1.0 / (basis.tan_half_fov * basis.aspect);
+    let sy_scale = 1.0 / basis.tan_half_fov;
+    let mut out = Vec::new();
+    for (oi, obj) in frame.objects.iter().enumerate() {
+        let nm = obj.transform.normal_matrix();
+        let verts: Vec<Vert> = obj
+            .mesh
+            .positions
+            .iter()
+            .zip(obj.mesh.normals.iter())
+            .map(|(p, n)| {
+                let world = obj.transform.transform_point(Vec3::from_array(*p));
+                let normal = nm.transform_vector(Vec3::from_array(*n));
+                Vert { view: basis.to_view(world), world, normal }
+            })
+            .collect();
+        for tri in obj.mesh.indices.chunks_exact(3) {
+            let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+            let [Some(a), Some(b), Some(c)] = v else { continue };
+            let mut poly = [a; 4];
+            let n = clip_near([a, b, c], near, &mut poly);
+            for k in 1..n.saturating_sub(1) {
+                let pv = [poly[0], poly[k], poly[k + 1]];
+                let mut t = ScreenTri {
+                    sx: [0.0; 3],
+                    sy: [0.0; 3],
+                    inv_z: [0.0; 3],
+                    world: pv.map(|v| v.world),
+                    normal: pv.map(|v| v.normal),
+                    object: oi as u32,
+                };
+                let mut ok = true;
+                for j in 0..3 {
+                    let z = pv[j].view.z;
+                    let iz = 1.0 / z;
+                    t.inv_z[j] = iz;
+                    t.sx[j] = (pv[j].view.x * iz * sx_scale + 1.0) * 0.5 * w;
+                    t.sy[j] = (1.0 - pv[j].view.y * iz * sy_scale) * 0.5 * h;
+                    ok &= t.sx[j].is_finite() && t.sy[j].is_finite() && iz.is_finite();
+                }
+                if ok {
+                    out.push(t);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Sutherland–Hodgman against the plane `z = near` (keeping `z ≥ near`). Returns the vertex count
+/// (0, 3 or 4) written to `out`.
+fn clip_near(tri: [Vert; 3], near: f32, out: &mut [Vert; 4]) -> usize {
+    let mut n = 0;
+    for i in 0..3 {
+        let a = tri[i];
+        let b = tri[(i + 1) % 3];
+        let ina = a.view.z >= near;
+        let inb = b.view.z >= near;
+        if ina {
+            out[n] = a;
+            n += 1;
+        }
+        if ina != inb {
+            let s = (near - a.view.z) / (b.view.z - a.view.z);
+            let lerp = |p: Vec3f, q: Vec3f| p + (q - p) * s;
+            let mut v = Vert {
+                view: lerp(a.view, b.view),
+                world: lerp(a.world, b.world),
+                normal: lerp(a.normal, b.normal),
+            };
+            v.view.z = near;
+            if n < 4 {
+                out[n] = v;
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+/// Rows (inclusive) whose pixel centres the triangle may cover, clamped to the image.
+fn y_range(t: &ScreenTri, h: usize) -> (usize, usize) {
+    let lo = t.sy[0].min(t.sy[1]).min(t.sy[2]);
+    let hi = t.sy[0].max(t.sy[1]).max(t.sy[2]);
+    if hi < 0.0 || lo > h as f32 {
+        return (1, 0);
+    }
+    let y0 = (lo - 0.5).ceil().max(0.0) as usize;
+    let y1 = ((hi - 0.5).floor().min(h as f32 - 1.0)).max(0.0) as usize;
+    (y0, y1)
+}
+
+/// Twice the signed area of `(a, b, p)`.
+#[inline(always)]
+fn edge(ax: f32, ay: f32, bx: f32, by: f32, px: f32, py: f32) -> f32 {
+    (bx - ax) * (py - ay) - (by - ay) * (px - ax)
+}
+
+/// Whether an edge owns pixel centres lying exactly on it (the top-left rule, for the triangle
+/// orientation given by `sign`).
+#[inline(always)]
+fn owns_boundary(ax: f32, ay: f32, bx: f32, by: f32, sign: f32) -> bool {
+    let (dx, dy) = ((bx - ax) * sign, (by - ay) * sign);
+    // With y down and positive orientation: a top edge is horizontal going right... expressed
+    // for the normalised (positive) orientation.
+    (dy == 0.0 && dx > 0.0) || dy < 0.0
+}
+
+fn raster_tri(
+    t: &ScreenTri,
+    id: u32,
+    y_start: usize,
+    rows: usize,
+    w: usize,
+    far: f32,
+    zbuf: &mut [f32],
+    tri_id: &mut [u32],
+) {
+    let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
+    if area == 0.0 || !area.is_finite() {
+        return;
+    }
+    let sign = area.signum();
+    let inv_area = 1.0 / area;
+    let xmin = t.sx[0].min(t.sx[1]).min(t.sx[2]);
+    let xmax = t.sx[0].max(t.sx[1]).max(t.sx[2]);
+    if xmax < 0.0 || xmin > w as f32 {
+        return;
+    }
+    let x0 = (xmin - 0.5).ceil().max(0.0) as usize;
+    let x1 = ((xmax - 0.5).floor()).min(w as f32 - 1.0);
+    if x1 < 0.0 {
+        return;
+    }
+    let x1 = x1 as usize;
+    let ylo = t.sy[0].min(t.sy[1]).min(t.sy[2]);
+    let yhi = t.sy[0].max(t.sy[1]).max(t.sy[2]);
+    let own = [
+        owns_boundary(t.sx[1], t.sy[1], t.sx[2], t.sy[2], sign),
+        owns_boundary(t.sx[2], t.sy[2], t.sx[0], t.sy[0], sign),
+        owns_boundary(t.sx[0], t.sy[0], t.sx[1], t.sy[1], sign),
+    ];
+    for r in 0..rows {
+        let py = (y_start + r) as f32 + 0.5;
+        if py < ylo || py > yhi {
+            continue;
+        }
+        for x in x0..=x1 {
+            let px = x as f32 + 0.5;
+            let e0 = edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) * sign;
+            let e1 = edge(t.sx[2], t.sy[2], t.sx[0], t.sy[0], px, py) * sign;
+            let e2 = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], px, py) * sign;
+            let inside = |e: f32, o: bool| e > 0.0 || (e == 0.0 && o);
+            if !(inside(e0, own[0]) && inside(e1, own[1]) && inside(e2, own[2])) {
+                continue;
+            }
+            let (b0, b1, b2) = (e0 * inv_area * sign, e1 * inv_area * sign, e2 * inv_area * sign);
+            let iz = b0 * t.inv_z[0] + b1 * t.inv_z[1] + b2 * t.inv_z[2];
+            let z = 1.0 / iz;
+            let i = r * w + x;
+            if z < zbuf[i] && z <= far {
+                zbuf[i] = z;
+                tri_id[i] = id;
+            }
+        }
+    }
+}
+
+/// Perspective-correct world position and normal at screen point `(px, py)`.
+fn interpolate(t: &ScreenTri, px: f32, py: f32) -> (Vec3f, Vec3f) {
+    let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
+    let b = [
+        edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) / area,
+        edge(t.sx[2], t.sy[2], t.sx[0], t.sy[0], px, py) / area,
+        edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], px, py) / area,
+    ];
+    let wts = [b[0] * t.inv_z[0], b[1] * t.inv_z[1], b[2] * t.inv_z[2]];
+    let s = wts[0] + wts[1] + wts[2];
+    let wts = wts.map(|v| v / s);
+    let world = t.world[0] * wts[0] + t.world[1] * wts[1] + t.world[2] * wts[2];
+    let normal = t.normal[0] * wts[0] + t.normal[1] * wts[1] + t.normal[2] * wts[2];
+    (world, normal)
+}

@@ -1,0 +1,51 @@
+//! The wave pass: each pixel's energy integrals, clipped at the visible surface (002 §3.3.5), and
+//! the colour mapping.
+
+use hadou_math::energy::{self, FieldParams};
+use hadou_math::shade;
+use hadou_scene::{CameraBasis, Frame, ToneMode, Wave, WaveShape};
+
+/// Energy of one wave along pixel `(px, py)`'s ray, and the number of integrand evaluations it
+/// took (1 per closed-form piece family for the analytic shapes).
+#[inline]
+pub(crate) fn wave_energy(
+    frame: &Frame,
+    basis: &CameraBasis,
+    wave: &Wave,
+    px: f32,
+    py: f32,
+    surface: Option<f32>,
+) -> (f32, u32) {
+    let wr = basis.wave_ray(wave.falloff, frame.camera.far, px, py, frame.width, frame.height, surface);
+    let p = FieldParams { falloff: wave.falloff, core_radius: wave.core_radius };
+    let (ray, t0, t1) = (&wr.ray, wr.t0, wr.t1);
+    let (e, n) = match &wave.shape {
+        WaveShape::Sphere(f) => (energy::sphere_energy(&p, ray, t0, t1, f), 1),
+        WaveShape::Cylinder(f) => (energy::cylinder_energy(&p, ray, t0, t1, f), 1),
+        WaveShape::Capsule(f) => (energy::capsule_energy(&p, ray, t0, t1, f), 3),
+        WaveShape::Beam(f) => (energy::beam_energy(&p, ray, t0, t1, f), 5),
+        WaveShape::Curve(_) => (0.0, 0),
+    };
+    (if e.is_finite() { e.max(0.0) } else { 0.0 }, n)
+}
+
+/// Final linear RGBA of a pixel: `scene + exposure · Σ rgb·a·I`, then the frame's mapping.
+#[inline]
+pub(crate) fn compose(frame: &Frame, scene_rgb: [f32; 3], wave_rgb: [f32; 3]) -> [f32; 4] {
+    let k = frame.color_mapping.exposure;
+    let c = [0, 1, 2].map(|i| scene_rgb[i] + k * wave_rgb[i]);
+    let m = match frame.color_mapping.mode {
+        ToneMode::Faithful => shade::map_faithful(c),
+        ToneMode::Filmic => shade::map_filmic(c),
+    };
+    [m[0], m[1], m[2], 1.0]
+}
+
+/// Adds one wave's light `rgb · a · I` to `acc`.
+#[inline(always)]
+pub(crate) fn accumulate(acc: &mut [f32; 3], wave: &Wave, e: f32) {
+    let [r, g, b, a] = wave.color;
+    acc[0] += r * a * e;
+    acc[1] += g * a * e;
+    acc[2] += b * a * e;
+}

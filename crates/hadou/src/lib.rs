@@ -1,0 +1,20 @@
+//! # hadou
+//!
+//! Real-time anime-style energy waves from formulas. This crate is the facade over the workspace:
+//! load a [`Scene`], evaluate it at a time into a [`Frame`], render it with a [`Backend`], and
+//! write the [`Image`].
+//!
+//! ```no_run
+//! use hadou::{Backend, CpuBackend, Scene};
+//! let scene = Scene::load("scenes/kamehameha.toml").expect("valid scene");
+//! let frame = scene.at(1.0);
+//! let image = CpuBackend::new().render(&frame).expect("render");
+//! hadou::output::write_png(&image, "kamehameha.png".as_ref()).expect("written");
+//! ```
+
+pub mod bench;
+pub mod output;
+
+pub use hadou_cpu::{probe, CpuBackend, Probe, WaveProbe};
+pub use hadou_math as math;
+pub use hadou_scene::*;
