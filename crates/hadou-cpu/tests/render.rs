@@ -94,7 +94,10 @@ fn a_cube_in_front_hides_the_beam_and_one_behind_does_not() {
         let limit = if falloff == Falloff::Faithful { 0.2 } else { 0.05 };
         assert!(e(&front) < limit * e(&free), "front {} free {}", e(&front), e(&free));
         // Behind: the beam is in front of the cube; nearly all its energy remains.
-        assert!(e(&behind) > 0.9 * e(&free), "behind {} free {}", e(&behind), e(&free));
+        // (Faithful's 1/r tail beyond the cube, up to the far plane, is a sizeable share.)
+        let keep = if falloff == Falloff::Faithful { 0.7 } else { 0.9 };
+        assert!(e(&behind) > keep * e(&free), "behind {} free {}", e(&behind), e(&free));
+        assert!(e(&behind) < e(&free) && e(&front) < e(&behind));
         // The depth is the eye distance to the cube's front face (z = 15 + 3 = 18 → 22).
         assert!((front.depth - 22.0).abs() < 0.05, "{}", front.depth);
     }
