@@ -1,11 +1,57 @@
 //! Energy fields of the analytic wave shapes and their exact line integrals (thesis 002 §3.3,
-//! SPEC.md §1.2).
+//! eq. 3.4–3.11, with the corrections of SPEC.md §1.2).
 //!
-//! PLACEHOLDER BODIES: the naive formulas below are being replaced by the stable closed forms;
-//! the public types and signatures are the contract the backends build against.
+//! # The two density laws
+//! Distances are regularised with the core radius `r_c`: `ρ = sqrt(r² + r_c²)`.
+//! - [`Falloff::Faithful`] (the thesis): density `α/ρ`, `I = ∫ F(S + tQ) dt` over the normalized
+//!   parameter `t` with `Q = E − S` (002 eq. 3.6–3.11), so `I` scales with `1/|Q|`.
+//! - [`Falloff::InverseSquare`] (hadou's default): density `α/ρ²`, `I = ∫ F(S + t·dir) dt` with a
+//!   unit `dir`, i.e. over arc length; `t1 = +∞` integrates to infinity.
+//!
+//! # One reduced integral
+//! Along a ray both the sphere's radicand `U(t) = At² + 2Bt + C` (eq. 3.6) and the cylinder's
+//! `W(t) = D't² + 2Et + F` (eq. 3.7), plus `r_c²`, are a squared distance `|v + t·u|² + r_c²`
+//! (sphere: `u = Q`, `v = S − M`; cylinder: `u = Q × D`, `v = (S − M) × D`). Completing the square
+//! with `s = |u|`, `û = u/s`:
+//!
+//! `|v + t·u|² + r_c² = Y(t)² + H`, `Y = s·t + û·v`, `H = |û × v|² + r_c²`,
+//!
+//! where `H = (AC − B²)/A` is the squared closest distance plus `r_c²`. Computing it as a cross
+//! product (SPEC.md §1.2: `AC − B² = |Q × w|²`) avoids the cancellation of `AC − B²`; `H` is then
+//! floored at [`H_FLOOR`] so that a ray exactly through a centre or along an axis with `r_c = 0`
+//! (where the true integral diverges) stays finite. Both laws then need one antiderivative:
+//!
+//! - faithful: `∫ dt/sqrt(Y² + H) = asinh(Y/√H)/s` — SPEC.md's corrected form of eq. 3.8–3.9
+//!   (the thesis prints `asinh(2(tA+B)/(4AC − (2B)²))`, lacking the square root);
+//! - inverse square: `∫ dt/(Y² + H) = atan(Y/√H)/(s√H)`.
+//!
+//! # Stable evaluation
+//! A difference of two `asinh` (or `atan`) values is never formed. With `P = Y + sqrt(Y² + H)`,
+//! `asinh(Y₁/√H) − asinh(Y₀/√H) = ln(P₁/P₀)`: `H` cancels in the ratio, and `P₁/P₀ − 1` is built
+//! from positive terms only and passed to `ln_1p` — with `P₀ = H/(sqrt(Y₀²+H) − Y₀)` where
+//! `Y₀ < 0`, and the mirrored branch `asinh(x) = −asinh(−x)` (`N = sqrt(Y² + H) − Y`) where the
+//! interval lies mostly at negative `Y`. The naive `ln((Y₁ + R₁)/(Y₀ + R₀))` instead loses every
+//! digit of `Y₀ + R₀` (or returns infinity) in `f32` for rays that pass close to a centre lying far
+//! ahead, which is most of a wide image. The `atan` difference is one
+//! `atan2(√H·s·Δt, H + Y₀Y₁)`, valid for all signs. Both forms tend to `Δt/sqrt(Y² + H)` resp.
+//! `Δt/(Y² + H)` as `s → 0` (a ray parallel to a cylinder's axis) without dividing by `s`.
+//! See [`RayQuadratic`] for the details.
+//!
+//! # Capsule and beam
+//! The capsule (eq. 3.10–3.11) splits the ray at the planes through `M` and `M₂` with normal `D`,
+//! `t_i = (D·M_i − D·S)/(D·Q)`, and adds sphere / cylinder / sphere pieces in ray order, each its
+//! own closed form. `D·Q = 0` puts the whole ray in the region of its offset `D·(S − M)`. On the
+//! planes the sphere and cylinder distances coincide, so with `α_s = α_c` the field (and hence the
+//! energy) is continuous across them. The bulged beam adds sphere fields at `M₂` and `M`.
+//!
+//! Every function is generic over [`Real`]: `f32` renders, `f64` is what tests compare against.
+//! For finite inputs (and `|α|` below about 10⁷ in `f32`) the results are finite.
+
+mod kernel;
+
+pub use kernel::{RayAxis, RayQuadratic, ENERGY_MAX, H_FLOOR, T_LIMIT};
 
 use crate::{Real, Vec3};
-
 /// How energy density falls off with distance and what measure the ray integral uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Falloff {
@@ -94,86 +140,101 @@ pub struct BeamField<R> {
     pub muzzle_alpha: R,
 }
 
-/// `∫_{t0}^{t1}` of the sphere field along `ray`.
+/// `∫_{t0}^{t1}` of the sphere field `α_s/ρ` (faithful) or `α_s/ρ²` (inverse square) along `ray`,
+/// `ρ² = |V(t) − M|² + r_c²` (002 eq. 3.4, 3.6, 3.8–3.9 with SPEC.md §1.2's corrected `asinh`
+/// denominator; see the [module docs](self) for both laws and the stable forms).
+#[inline]
 pub fn sphere_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &SphereField<R>) -> R {
-    let w = ray.origin - f.center;
-    let a = ray.dir.length_squared();
-    let b = ray.dir.dot(w);
-    let c = w.length_squared();
-    quad_integral(p, a, b, c, t0, t1) * f.alpha
+    let axis = RayAxis::new(ray.dir);
+    let q = RayQuadratic::new(&axis, ray.origin - f.center, p.core_radius * p.core_radius);
+    q.integral(p.falloff, t0, t1) * f.alpha
 }
 
-/// `∫_{t0}^{t1}` of the cylinder field along `ray`.
+/// `∫_{t0}^{t1}` of the infinite cylinder field `α_c/ρ` (faithful) or `α_c/ρ²` (inverse square)
+/// along `ray`, `ρ²` = squared distance to the axis `+ r_c²` (002 eq. 3.5, 3.7–3.9, SPEC.md §1.2:
+/// `D' = |Q × D|²` and `D'F − E² = ((Q × w)·D)²` from cross products; a ray parallel to the axis,
+/// `D' = 0`, integrates the constant density). Inverse square to `t1 = ∞` along the axis diverges
+/// and returns [`ENERGY_MAX`]`·α`.
+#[inline]
 pub fn cylinder_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &CylinderField<R>) -> R {
-    let w = ray.origin - f.point;
-    let qd = ray.dir.dot(f.dir);
-    let wd = w.dot(f.dir);
-    let a = ray.dir.length_squared() - qd * qd;
-    let b = ray.dir.dot(w) - qd * wd;
-    let c = w.length_squared() - wd * wd;
-    quad_integral(p, a, b, c, t0, t1) * f.alpha
+    let axis = RayAxis::new(ray.dir.cross(f.dir));
+    let v = (ray.origin - f.point).cross(f.dir);
+    let q = RayQuadratic::new(&axis, v, p.core_radius * p.core_radius);
+    q.integral(p.falloff, t0, t1) * f.alpha
 }
 
-/// `∫_{t0}^{t1}` of the capsule field along `ray`.
+/// The capsule's pieces along a ray, kept so the beam can reuse the end spheres' quadratics.
+struct CapsuleParts<R> {
+    /// Sphere around `M`.
+    at_m: RayQuadratic<R>,
+    /// Sphere around `M₂`.
+    at_m2: RayQuadratic<R>,
+    /// The capsule's energy.
+    energy: R,
+}
+
+#[inline(always)]
+fn capsule_parts<R: Real>(
+    p: &FieldParams<R>,
+    ray: &Ray<R>,
+    t0: R,
+    t1: R,
+    f: &CapsuleField<R>,
+) -> CapsuleParts<R> {
+    let rc2 = p.core_radius * p.core_radius;
+    let q = ray.dir;
+    let w = ray.origin - f.m;
+    let sphere_axis = RayAxis::new(q);
+    let at_m = RayQuadratic::new(&sphere_axis, w, rc2);
+    let at_m2 = RayQuadratic::new(&sphere_axis, w - f.d * f.length, rc2);
+    let cyl = RayQuadratic::new(&RayAxis::new(q.cross(f.d)), w.cross(f.d), rc2);
+    // Axial coordinate along the ray: z(t) = ds + t·dq; the planes are z = 0 (M) and z = length (M₂).
+    let dq = q.dot(f.d);
+    let ds = w.dot(f.d);
+    let inf = R::INFINITY;
+    // (first plane crossed, second plane crossed, sphere before the first, sphere after the second)
+    let (lo, hi, first, last) = if dq > R::ZERO {
+        (-ds / dq, (f.length - ds) / dq, &at_m, &at_m2)
+    } else if dq < R::ZERO {
+        ((f.length - ds) / dq, -ds / dq, &at_m2, &at_m)
+    } else if ds < R::ZERO {
+        (inf, inf, &at_m, &at_m2)
+    } else if ds > f.length {
+        (-inf, -inf, &at_m, &at_m2)
+    } else {
+        (-inf, inf, &at_m, &at_m2)
+    };
+    let lo = lo.clamp(t0, t1);
+    let hi = hi.clamp(lo, t1);
+    let fo = p.falloff;
+    let spheres = first.integral(fo, t0, lo) + last.integral(fo, hi, t1);
+    let energy = spheres * f.alpha_s + cyl.integral(fo, lo, hi) * f.alpha_c;
+    CapsuleParts { at_m, at_m2, energy }
+}
+
+/// `∫_{t0}^{t1}` of the capsule ("straight beam") field along `ray` (002 eq. 3.10–3.11, SPEC.md
+/// §1.2): the sphere field around `M` before the plane through `M` with normal `D`, the cylinder
+/// field between the planes, the sphere field around `M₂` after, split at
+/// `t_i = (D·M_i − D·S)/(D·Q)` and summed in ray order, each piece in the closed form of
+/// [`sphere_energy`] / [`cylinder_energy`] (faithful `α/ρ`, or inverse square `α/ρ²`).
+/// `D·Q = 0` keeps the whole ray in one region; `length = 0` is the sphere field around `M`.
+#[inline]
 pub fn capsule_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &CapsuleField<R>) -> R {
-    let dq = ray.dir.dot(f.d);
-    let ds = (ray.origin - f.m).dot(f.d);
-    let s1 = SphereField { center: f.m, alpha: f.alpha_s };
-    let s2 = SphereField { center: f.m2(), alpha: f.alpha_s };
-    let cyl = CylinderField { point: f.m, dir: f.d, alpha: f.alpha_c };
-    if dq == R::ZERO {
-        return if ds < R::ZERO {
-            sphere_energy(p, ray, t0, t1, &s1)
-        } else if ds > f.length {
-            sphere_energy(p, ray, t0, t1, &s2)
-        } else {
-            cylinder_energy(p, ray, t0, t1, &cyl)
-        };
-    }
-    let ta = -ds / dq;
-    let tb = (f.length - ds) / dq;
-    let (lo, hi, first, last) = if dq > R::ZERO { (ta, tb, s1, s2) } else { (tb, ta, s2, s1) };
-    let c = |x: R| x.clamp(t0, t1);
-    sphere_energy(p, ray, t0, c(lo), &first)
-        + cylinder_energy(p, ray, c(lo), c(hi), &cyl)
-        + sphere_energy(p, ray, c(hi), t1, &last)
+    capsule_parts(p, ray, t0, t1, f).energy
 }
 
-/// `∫_{t0}^{t1}` of the bulged-beam field along `ray`.
+/// `∫_{t0}^{t1}` of the bulged-beam ("端点膨張型") field along `ray`: [`capsule_energy`] plus sphere
+/// fields of strength `head_alpha` at `M₂` and `muzzle_alpha` at `M` over the whole interval
+/// (002 §3.3.3, eq. 3.4 and 3.11; SPEC.md §1.2), faithful `α/ρ` or inverse square `α/ρ²`.
+#[inline]
 pub fn beam_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &BeamField<R>) -> R {
-    let mut e = capsule_energy(p, ray, t0, t1, &f.capsule);
+    let parts = capsule_parts(p, ray, t0, t1, &f.capsule);
+    let mut e = parts.energy;
     if f.head_alpha != R::ZERO {
-        e += sphere_energy(p, ray, t0, t1, &SphereField { center: f.capsule.m2(), alpha: f.head_alpha });
+        e += parts.at_m2.integral(p.falloff, t0, t1) * f.head_alpha;
     }
     if f.muzzle_alpha != R::ZERO {
-        e += sphere_energy(p, ray, t0, t1, &SphereField { center: f.capsule.m, alpha: f.muzzle_alpha });
+        e += parts.at_m.integral(p.falloff, t0, t1) * f.muzzle_alpha;
     }
     e
-}
-
-fn quad_integral<R: Real>(p: &FieldParams<R>, a: R, b: R, c: R, t0: R, t1: R) -> R {
-    if t1 <= t0 {
-        return R::ZERO;
-    }
-    let rc2 = p.core_radius * p.core_radius;
-    let c = c + rc2;
-    let h = (a * c - b * b).max(R::MIN_POSITIVE);
-    match p.falloff {
-        Falloff::Faithful => {
-            if a <= R::EPSILON {
-                return (t1 - t0) / c.sqrt();
-            }
-            let sa = a.sqrt();
-            let sh = h.sqrt();
-            (((a * t1 + b) / sh).asinh() - ((a * t0 + b) / sh).asinh()) / sa
-        }
-        Falloff::InverseSquare => {
-            if a <= R::EPSILON {
-                return (t1 - t0) / c;
-            }
-            let sh = h.sqrt();
-            let x1 = if t1.is_finite() { ((a * t1 + b) / sh).atan() } else { R::PI * R::HALF };
-            (x1 - ((a * t0 + b) / sh).atan()) / sh
-        }
-    }
 }
