@@ -1,1 +1,84 @@
-//! GPU backend.
+//! # hadou-gpu
+//!
+//! hadou's wgpu backend: the real-time path, drawing the same picture as the CPU reference.
+//!
+//! [`GpuBackend`] renders a [`Frame`] headlessly (no window or surface) in two passes per tile:
+//! 1. **raster** (`shaders/raster.wgsl`): the opaque meshes, depth-tested, shaded with the WGSL
+//!    twin of `hadou_math::shade::diffuse`, writing the scene colour and the Euclidean eye distance
+//!    of the visible surface;
+//! 2. **wave** (`shaders/wave.wgsl`, a compute shader): per pixel, the ray of
+//!    `hadou_scene::CameraBasis::wave_ray` clipped at that distance (002 §3.3.5), the exact energy
+//!    integral of every analytic wave (`shaders/energy.wgsl`, twins of `hadou_math::energy`),
+//!    `scene + exposure·Σ rgb·a·I` and the colour mapping.
+//!
+//! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next,
+//! so GPU memory stays bounded whatever the image size.
+//!
+//! Curved waves (`WaveShape::Curve`) are not drawn yet: a frame containing one is refused with
+//! [`RenderError::Other`] (marked `GAP(curves)` in the code).
+//!
+//! Failures never panic: no adapter is [`RenderError::NoDevice`]; a lost device, out-of-memory or
+//! a GPU that does not answer within a timeout is [`RenderError::Device`]; a shader that fails to
+//! compile is [`RenderError::Other`] naming the shader.
+
+mod device;
+pub mod layout;
+mod pipelines;
+mod render;
+pub mod shaders;
+mod timing;
+
+pub use render::MAX_TILE;
+pub use timing::{FrameTiming, TimingMethod};
+
+use hadou_scene::{Backend, Frame, Image, RenderError};
+
+/// The wgpu backend. Create once and reuse: meshes stay uploaded between frames (cached by the
+/// address of their `Arc`), and tile resources are reused while the tile size stays the same.
+pub struct GpuBackend {
+    renderer: render::Renderer,
+}
+
+impl GpuBackend {
+    /// Opens the best GPU adapter wgpu finds (honouring `WGPU_BACKEND`, `WGPU_ADAPTER_NAME`) and
+    /// compiles the shaders. [`RenderError::NoDevice`] when there is no adapter.
+    pub fn new() -> Result<GpuBackend, RenderError> {
+        Ok(Self { renderer: render::Renderer::new()? })
+    }
+
+    /// The adapter's name (e.g. `"llvmpipe (LLVM 15.0.6, 256 bits)"`).
+    pub fn adapter_name(&self) -> &str {
+        &self.renderer.ctx.info.name
+    }
+
+    /// The adapter's full description from wgpu (backend, driver, device type).
+    pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
+        &self.renderer.ctx.info
+    }
+
+    /// Whether the adapter is a software rasterizer on the CPU (device type `Cpu`, e.g. lavapipe).
+    pub fn is_software(&self) -> bool {
+        self.renderer.ctx.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Whether the device supports GPU timestamps (then [`GpuBackend::time_frame`] uses them).
+    pub fn has_timestamps(&self) -> bool {
+        self.renderer.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Measures the GPU time of drawing `frame` (both passes over every tile, no read-back),
+    /// `iterations` times after one untimed warm-up; see [`FrameTiming`].
+    pub fn time_frame(&mut self, frame: &Frame, iterations: u32) -> Result<FrameTiming, RenderError> {
+        timing::time_frame(&mut self.renderer, frame, iterations)
+    }
+}
+
+impl Backend for GpuBackend {
+    fn name(&self) -> &str {
+        "gpu"
+    }
+
+    fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
+        self.renderer.render(frame)
+    }
+}

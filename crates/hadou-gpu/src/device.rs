@@ -1,0 +1,194 @@
+//! Adapter and device set-up, and the failure story: every wgpu error is captured (error scopes
+//! plus an uncaptured-error handler that records instead of panicking), device loss is recorded
+//! by a callback, and every wait on the GPU has a timeout. All of it ends in a [`RenderError`].
+
+use hadou_scene::RenderError;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// How long one wait for submitted work may take before the device is declared hung.
+pub(crate) const WAIT_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// Errors the device reported outside any error scope, and the reason it was lost, if it was.
+#[derive(Default)]
+struct Reports {
+    uncaptured: Vec<String>,
+    lost: Option<String>,
+}
+
+/// Error scopes pushed by [`GpuContext::open_scopes`].
+pub(crate) struct ErrorScopes {
+    oom: wgpu::ErrorScopeGuard,
+    internal: wgpu::ErrorScopeGuard,
+    validation: wgpu::ErrorScopeGuard,
+}
+
+/// An open device with its queue and error bookkeeping.
+pub(crate) struct GpuContext {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
+    pub(crate) info: wgpu::AdapterInfo,
+    pub(crate) limits: wgpu::Limits,
+    pub(crate) features: wgpu::Features,
+    reports: Arc<Mutex<Reports>>,
+}
+
+fn lock(reports: &Mutex<Reports>) -> std::sync::MutexGuard<'_, Reports> {
+    // A poisoned lock only means a callback panicked mid-push; the data is still usable.
+    reports.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// The best adapter: the primary backends (Vulkan, Metal, DX12) first, OpenGL only if none of
+/// those has one. `WGPU_BACKEND` (e.g. `gl`, `vulkan`) overrides the choice.
+fn request_adapter() -> Result<wgpu::Adapter, String> {
+    let options = wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: None,
+    };
+    let from_env = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    let tries = if std::env::var_os("WGPU_BACKEND").is_some() {
+        vec![from_env.backends]
+    } else {
+        vec![wgpu::Backends::PRIMARY, wgpu::Backends::SECONDARY]
+    };
+    let mut errors = Vec::new();
+    for backends in tries {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        match pollster::block_on(instance.request_adapter(&options)) {
+            Ok(a) => return Ok(a),
+            Err(e) => errors.push(e.to_string()),
+        }
+    }
+    Err(errors.join("; "))
+}
+
+impl GpuContext {
+    /// Opens the best adapter wgpu finds (no surface; `WGPU_BACKEND` and friends are honoured).
+    pub(crate) fn new() -> Result<Self, RenderError> {
+        let adapter = request_adapter().map_err(|e| {
+            RenderError::NoDevice(format!(
+                "no GPU adapter found ({e}); install a Vulkan driver (on machines without a GPU, \
+                 Mesa's lavapipe: package mesa-vulkan-drivers) or use the CPU backend"
+            ))
+        })?;
+        let info = adapter.get_info();
+        let adapter_features = adapter.features();
+        // Timestamps are optional: used by `time_frame` when present.
+        let features = adapter_features & wgpu::Features::TIMESTAMP_QUERY;
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("hadou-gpu"),
+            required_features: features,
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::MemoryUsage,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| RenderError::NoDevice(format!("adapter `{}` refused a device: {e}", info.name)))?;
+
+        let reports = Arc::new(Mutex::new(Reports::default()));
+        let r = reports.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| lock(&r).uncaptured.push(e.to_string())));
+        let r = reports.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            lock(&r).lost = Some(format!("{reason:?}: {message}"));
+        });
+        Ok(Self { device, queue, info, limits, features, reports })
+    }
+
+    /// `Err` if the device was lost or reported an error nobody caught.
+    pub(crate) fn check(&self) -> Result<(), RenderError> {
+        let mut r = lock(&self.reports);
+        if let Some(lost) = &r.lost {
+            return Err(RenderError::Device(format!("the GPU device was lost ({lost})")));
+        }
+        if !r.uncaptured.is_empty() {
+            let all = std::mem::take(&mut r.uncaptured).join("; ");
+            return Err(RenderError::Device(format!("the GPU reported: {all}")));
+        }
+        Ok(())
+    }
+
+    /// Opens out-of-memory, internal and validation error scopes; close them with
+    /// [`GpuContext::close_scopes`] on the same thread.
+    pub(crate) fn open_scopes(&self) -> ErrorScopes {
+        ErrorScopes {
+            oom: self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory),
+            internal: self.device.push_error_scope(wgpu::ErrorFilter::Internal),
+            validation: self.device.push_error_scope(wgpu::ErrorFilter::Validation),
+        }
+    }
+
+    /// Closes scopes from [`GpuContext::open_scopes`]; any error they caught becomes a
+    /// [`RenderError`] (`what` says what was being done).
+    pub(crate) fn close_scopes(&self, scopes: ErrorScopes, what: &str) -> Result<(), RenderError> {
+        // Pop in reverse order of pushing.
+        let validation = pollster::block_on(scopes.validation.pop());
+        let internal = pollster::block_on(scopes.internal.pop());
+        let oom = pollster::block_on(scopes.oom.pop());
+        if let Some(e) = oom {
+            return Err(RenderError::Device(format!("out of GPU memory while {what}: {e}")));
+        }
+        if let Some(e) = internal {
+            return Err(RenderError::Device(format!("GPU internal error while {what}: {e}")));
+        }
+        if let Some(e) = validation {
+            return Err(RenderError::Other(format!("GPU rejected the work while {what}: {e}")));
+        }
+        self.check()
+    }
+
+    /// Runs `f` inside [`GpuContext::open_scopes`] / [`GpuContext::close_scopes`].
+    pub(crate) fn scoped<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T, RenderError> {
+        let scopes = self.open_scopes();
+        let value = f();
+        self.close_scopes(scopes, what)?;
+        Ok(value)
+    }
+
+    /// Waits (with [`WAIT_TIMEOUT`]) until `submission` has finished on the GPU.
+    pub(crate) fn wait(&self, submission: wgpu::SubmissionIndex) -> Result<(), RenderError> {
+        self.device
+            .poll(wgpu::PollType::Wait { submission_index: Some(submission), timeout: Some(WAIT_TIMEOUT) })
+            .map_err(|e| {
+                RenderError::Device(format!("waiting for the GPU failed after {WAIT_TIMEOUT:?}: {e}"))
+            })?;
+        self.check()
+    }
+
+    /// Maps `buffer` for reading after `submission`, waiting with a timeout, and hands its bytes
+    /// to `read`; unmaps afterwards.
+    pub(crate) fn read_buffer<T>(
+        &self,
+        buffer: &wgpu::Buffer,
+        size: u64,
+        submission: wgpu::SubmissionIndex,
+        read: impl FnOnce(&[u8]) -> T,
+    ) -> Result<T, RenderError> {
+        let slot: Arc<Mutex<Option<Result<(), wgpu::BufferAsyncError>>>> = Arc::new(Mutex::new(None));
+        let s = slot.clone();
+        buffer.slice(..size).map_async(wgpu::MapMode::Read, move |r| {
+            *s.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
+        });
+        self.wait(submission)?;
+        // The callback runs during the poll above; poll once more in case it was queued after.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        let outcome = slot.lock().unwrap_or_else(|p| p.into_inner()).take();
+        match outcome {
+            Some(Ok(())) => {}
+            Some(Err(e)) => return Err(RenderError::Device(format!("reading back the image failed: {e}"))),
+            None => {
+                return Err(RenderError::Device("the GPU never finished mapping the read-back buffer".into()))
+            }
+        }
+        let value = {
+            let view = buffer.slice(..size).get_mapped_range();
+            read(&view)
+        };
+        buffer.unmap();
+        Ok(value)
+    }
+}

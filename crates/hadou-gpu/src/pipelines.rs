@@ -1,0 +1,182 @@
+//! Shader modules, bind group layouts and the two pipelines (raster, wave).
+
+use crate::device::GpuContext;
+use crate::layout::GpuVertex;
+use crate::shaders;
+use hadou_scene::RenderError;
+
+/// Colour target of the raster pass (linear scene colour; read by the wave pass).
+pub(crate) const SCENE_COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Eye-distance target of the raster pass (−1 where nothing is drawn).
+pub(crate) const SCENE_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Depth buffer of the raster pass.
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Workgroup edge of the wave pass (keep in sync with `@workgroup_size` in wave.wgsl).
+pub(crate) const WAVE_WORKGROUP: u32 = 8;
+
+/// The compiled pipelines of the backend.
+pub(crate) struct Pipelines {
+    pub(crate) raster: wgpu::RenderPipeline,
+    pub(crate) raster_layout: wgpu::BindGroupLayout,
+    pub(crate) wave: wgpu::ComputePipeline,
+    pub(crate) wave_layout: wgpu::BindGroupLayout,
+}
+
+/// Compiles WGSL into a module; a compile error becomes [`RenderError::Other`] naming the module.
+pub(crate) fn compile_module(
+    ctx: &GpuContext,
+    label: &str,
+    source: &str,
+) -> Result<wgpu::ShaderModule, RenderError> {
+    let module = ctx
+        .scoped(&format!("compiling shader `{label}`"), || {
+            ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            })
+        })
+        .map_err(|e| match e {
+            RenderError::Other(m) | RenderError::Device(m) => {
+                RenderError::Other(format!("shader `{label}` failed to compile: {m}"))
+            }
+            other => other,
+        })?;
+    Ok(module)
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+impl Pipelines {
+    /// Compiles both modules and builds the pipelines.
+    pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
+        let raster_module = compile_module(ctx, "raster", &shaders::compose(shaders::RASTER_PARTS))?;
+        let wave_module = compile_module(ctx, "wave", &shaders::compose(shaders::WAVE_PARTS))?;
+        ctx.scoped("building pipelines", || {
+            let d = &ctx.device;
+            let vs_fs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+            let raster_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("raster"),
+                entries: &[uniform_entry(0, vs_fs), storage_entry(1, vs_fs, true)],
+            });
+            let cs = wgpu::ShaderStages::COMPUTE;
+            let wave_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("wave"),
+                entries: &[
+                    uniform_entry(0, cs),
+                    storage_entry(1, cs, true),
+                    texture_entry(2),
+                    texture_entry(3),
+                    storage_entry(4, cs, false),
+                ],
+            });
+            let raster_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("raster"),
+                bind_group_layouts: &[Some(&raster_layout)],
+                immediate_size: 0,
+            });
+            let wave_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("wave"),
+                bind_group_layouts: &[Some(&wave_layout)],
+                immediate_size: 0,
+            });
+            let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+            let raster = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("raster"),
+                layout: Some(&raster_pl),
+                vertex: wgpu::VertexState {
+                    module: &raster_module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<GpuVertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &attributes,
+                    }],
+                },
+                // No culling: open meshes (planes) are visible from both sides, as on the CPU.
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &raster_module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[
+                        Some(wgpu::ColorTargetState {
+                            format: SCENE_COLOR_FORMAT,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        }),
+                        Some(wgpu::ColorTargetState {
+                            format: SCENE_DISTANCE_FORMAT,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        }),
+                    ],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+            let wave = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("wave"),
+                layout: Some(&wave_pl),
+                module: &wave_module,
+                entry_point: Some("cs_main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            Self { raster, raster_layout, wave, wave_layout }
+        })
+    }
+}

@@ -1,0 +1,457 @@
+//! Rendering a [`Frame`]: mesh upload (cached per mesh `Arc`), per-frame object and wave buffers,
+//! and the tile loop — each tile is rasterized, integrated and read back on its own, so GPU memory
+//! is bounded by the tile size whatever the image size.
+
+use crate::device::GpuContext;
+use crate::layout::{FrameUniforms, GpuObject, GpuVertex, GpuWave};
+use crate::pipelines::{self, Pipelines};
+use bytemuck::Zeroable;
+use hadou_scene::{Frame, Image, Mesh, RenderError, WaveShape};
+use std::collections::HashMap;
+use std::sync::{Arc, Weak};
+use wgpu::util::DeviceExt;
+
+/// Largest tile edge in pixels (smaller when the device's limits demand it).
+pub const MAX_TILE: u32 = 1024;
+/// Floats per pixel in the tile output buffer: colour (4), energy, eye distance.
+const FLOATS_PER_PIXEL: u64 = 6;
+
+/// A mesh on the GPU, with a weak handle to the `Arc<Mesh>` it came from (so a freed mesh whose
+/// address is reused is never mistaken for the cached one).
+struct CachedMesh {
+    source: Weak<Mesh>,
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+}
+
+/// The per-tile GPU resources, sized for one tile edge pair.
+pub(crate) struct TileTargets {
+    size: [u32; 2],
+    color_view: wgpu::TextureView,
+    distance_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    uniforms: wgpu::Buffer,
+    output: wgpu::Buffer,
+    staging: wgpu::Buffer,
+}
+
+/// Everything a frame's tiles share: buffers of this frame and the tile grid.
+pub(crate) struct Prepared {
+    pub(crate) tile: [u32; 2],
+    pub(crate) tiles: Vec<([u32; 2], [u32; 2])>,
+    objects: wgpu::Buffer,
+    waves: wgpu::Buffer,
+    draws: Vec<(usize, u32)>,
+}
+
+/// The renderer's state between frames.
+pub(crate) struct Renderer {
+    pub(crate) ctx: GpuContext,
+    pipelines: Pipelines,
+    meshes: HashMap<usize, CachedMesh>,
+    targets: Option<TileTargets>,
+}
+
+fn other(msg: String) -> RenderError {
+    RenderError::Other(msg)
+}
+
+/// Checks that a frame can be drawn at all, before any GPU work.
+fn validate_frame(frame: &Frame) -> Result<(), RenderError> {
+    if !(1..=16384).contains(&frame.width) || !(1..=16384).contains(&frame.height) {
+        return Err(other(format!(
+            "image size {}×{} is outside 1..=16384 in each dimension",
+            frame.width, frame.height
+        )));
+    }
+    let c = &frame.camera;
+    if !(c.near > 0.0 && c.far > c.near && c.far.is_finite()) {
+        return Err(other(format!(
+            "camera near/far must satisfy 0 < near < far (got {}, {})",
+            c.near, c.far
+        )));
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err(other(format!("camera fov must be in (0, 180) degrees (got {})", c.fov_y_deg)));
+    }
+    // GAP(curves): curved waves have no WGSL twin yet (hadou_math::curve's integrator is to be
+    // mirrored once its flat table layout is final). Refuse rather than draw a wrong picture.
+    if let Some(w) = frame.waves.iter().find(|w| matches!(w.shape, WaveShape::Curve(_))) {
+        return Err(other(format!(
+            "wave `{}` is a curved wave, which the GPU backend does not draw yet; use the CPU backend",
+            w.name
+        )));
+    }
+    for o in &frame.objects {
+        let m = &o.mesh;
+        if m.normals.len() != m.positions.len() {
+            return Err(other(format!(
+                "object `{}`: {} normals for {} positions",
+                o.name,
+                m.normals.len(),
+                m.positions.len()
+            )));
+        }
+        if m.indices.len() % 3 != 0 {
+            return Err(other(format!(
+                "object `{}`: {} indices is not a triangle list",
+                o.name,
+                m.indices.len()
+            )));
+        }
+        if let Some(bad) = m.indices.iter().find(|&&i| i as usize >= m.positions.len()) {
+            return Err(other(format!(
+                "object `{}`: index {bad} out of range ({} vertices)",
+                o.name,
+                m.positions.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Allocates the host image, reporting (not aborting on) a failed allocation.
+fn alloc_image(width: u32, height: u32) -> Result<Image, RenderError> {
+    let n = width as usize * height as usize;
+    let oom = |_| RenderError::Device(format!("out of host memory for a {width}×{height} image"));
+    let mut color: Vec<[f32; 4]> = Vec::new();
+    color.try_reserve_exact(n).map_err(oom)?;
+    let mut energy: Vec<f32> = Vec::new();
+    energy.try_reserve_exact(n).map_err(oom)?;
+    let mut depth: Vec<f32> = Vec::new();
+    depth.try_reserve_exact(n).map_err(oom)?;
+    color.resize(n, [0.0; 4]);
+    energy.resize(n, 0.0);
+    depth.resize(n, 0.0);
+    Ok(Image { width, height, color, energy, depth })
+}
+
+/// The tile edge pair for an image: at most [`MAX_TILE`], within the device's texture and buffer
+/// limits.
+fn tile_size(limits: &wgpu::Limits, width: u32, height: u32) -> Result<[u32; 2], RenderError> {
+    let mut edge = MAX_TILE.min(limits.max_texture_dimension_2d);
+    let max_bytes = limits.max_buffer_size.min(limits.max_storage_buffer_binding_size);
+    while edge > 16 && (edge as u64).pow(2) * FLOATS_PER_PIXEL * 4 > max_bytes {
+        edge /= 2;
+    }
+    if (edge as u64).pow(2) * FLOATS_PER_PIXEL * 4 > max_bytes || edge < 16 {
+        return Err(RenderError::Device(format!(
+            "device limits too small for the renderer (max texture {}, max buffer {} bytes)",
+            limits.max_texture_dimension_2d, max_bytes
+        )));
+    }
+    Ok([edge.min(width), edge.min(height)])
+}
+
+impl Renderer {
+    /// Opens the device and compiles the pipelines.
+    pub(crate) fn new() -> Result<Self, RenderError> {
+        let ctx = GpuContext::new()?;
+        let pipelines = Pipelines::new(&ctx)?;
+        Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None })
+    }
+
+    fn upload_meshes(&mut self, frame: &Frame) {
+        self.meshes.retain(|_, m| m.source.strong_count() > 0);
+        for o in &frame.objects {
+            if o.mesh.indices.is_empty() {
+                continue;
+            }
+            let key = Arc::as_ptr(&o.mesh) as usize;
+            let fresh = self
+                .meshes
+                .get(&key)
+                .is_some_and(|c| c.source.upgrade().is_some_and(|a| Arc::ptr_eq(&a, &o.mesh)));
+            if fresh {
+                continue;
+            }
+            let m = &o.mesh;
+            let vertices: Vec<GpuVertex> = m
+                .positions
+                .iter()
+                .zip(&m.normals)
+                .map(|(&position, &normal)| GpuVertex { position, normal })
+                .collect();
+            let d = &self.ctx.device;
+            let vb = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&o.name),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            let ib = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&o.name),
+                contents: bytemuck::cast_slice(&m.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            });
+            self.meshes.insert(
+                key,
+                CachedMesh {
+                    source: Arc::downgrade(&o.mesh),
+                    vertices: vb,
+                    indices: ib,
+                    index_count: m.indices.len() as u32,
+                },
+            );
+        }
+    }
+
+    fn ensure_targets(&mut self, size: [u32; 2]) {
+        if self.targets.as_ref().is_some_and(|t| t.size == size) {
+            return;
+        }
+        self.targets = None; // free the old ones first
+        let d = &self.ctx.device;
+        let extent = wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 };
+        let texture = |label, format, usage| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: extent,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+        };
+        let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let color_view = texture("scene color", pipelines::SCENE_COLOR_FORMAT, attach_and_read);
+        let distance_view = texture("scene distance", pipelines::SCENE_DISTANCE_FORMAT, attach_and_read);
+        let depth_view = texture("depth", pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
+        let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniforms"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let output = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tile output"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tile read-back"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.targets =
+            Some(TileTargets { size, color_view, distance_view, depth_view, uniforms, output, staging });
+    }
+
+    /// Validates the frame, uploads what it needs and plans the tiles.
+    pub(crate) fn prepare(&mut self, frame: &Frame) -> Result<Prepared, RenderError> {
+        self.ctx.check()?;
+        validate_frame(frame)?;
+        let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
+        let objects: Vec<GpuObject> = frame.objects.iter().map(GpuObject::new).collect();
+        let waves: Vec<GpuWave> = frame.waves.iter().filter_map(GpuWave::new).collect();
+        let (zero_object, zero_wave) = (GpuObject::zeroed(), GpuWave::zeroed());
+        let scopes = self.ctx.open_scopes();
+        let prepared = {
+            self.upload_meshes(frame);
+            self.ensure_targets(tile);
+            let d = &self.ctx.device;
+            // Storage bindings may not be empty: pad with one zeroed element.
+            let objects = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("objects"),
+                contents: if objects.is_empty() {
+                    bytemuck::bytes_of(&zero_object)
+                } else {
+                    bytemuck::cast_slice(&objects)
+                },
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let waves = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("waves"),
+                contents: if waves.is_empty() {
+                    bytemuck::bytes_of(&zero_wave)
+                } else {
+                    bytemuck::cast_slice(&waves)
+                },
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let draws = frame
+                .objects
+                .iter()
+                .enumerate()
+                .filter_map(|(i, o)| {
+                    let c = self.meshes.get(&(Arc::as_ptr(&o.mesh) as usize))?;
+                    Some((i, c.index_count))
+                })
+                .collect();
+            let mut tiles = Vec::new();
+            for y in (0..frame.height).step_by(tile[1] as usize) {
+                for x in (0..frame.width).step_by(tile[0] as usize) {
+                    tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(frame.height - y)]));
+                }
+            }
+            Prepared { tile, tiles, objects, waves, draws }
+        };
+        self.ctx.close_scopes(scopes, "uploading the frame")?;
+        Ok(prepared)
+    }
+
+    /// Records one tile's raster and wave passes (and, when `readback`, the copy to the staging
+    /// buffer) after writing its uniforms. `timestamps`: query set and the index of the pair.
+    pub(crate) fn encode_tile(
+        &self,
+        frame: &Frame,
+        prepared: &Prepared,
+        tile: ([u32; 2], [u32; 2]),
+        readback: bool,
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
+    ) -> wgpu::CommandEncoder {
+        let t = self.targets.as_ref().expect("targets are created in prepare");
+        let basis = frame.camera.basis(frame.width, frame.height);
+        let (origin, size) = tile;
+        let uniforms = FrameUniforms::new(frame, &basis, origin, size);
+        self.ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let d = &self.ctx.device;
+        let raster_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raster"),
+            layout: &self.pipelines.raster_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: t.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
+            ],
+        });
+        let wave_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wave"),
+            layout: &self.pipelines.wave_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: t.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: prepared.waves.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&t.color_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&t.distance_view),
+                },
+                wgpu::BindGroupEntry { binding: 4, resource: t.output.as_entire_binding() },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("tile") });
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("raster"),
+                color_attachments: &[
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &t.color_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &t.distance_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color { r: -1.0, g: 0.0, b: 0.0, a: 0.0 }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                ],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &t.depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: timestamps.map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(2 * i),
+                    end_of_pass_write_index: None,
+                }),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_viewport(0.0, 0.0, size[0] as f32, size[1] as f32, 0.0, 1.0);
+            pass.set_pipeline(&self.pipelines.raster);
+            pass.set_bind_group(0, &raster_bg, &[]);
+            for &(object, index_count) in &prepared.draws {
+                let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
+                let Some(mesh) = self.meshes.get(&key) else { continue };
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
+            }
+        }
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wave"),
+                timestamp_writes: timestamps.map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: None,
+                    end_of_pass_write_index: Some(2 * i + 1),
+                }),
+            });
+            pass.set_pipeline(&self.pipelines.wave);
+            pass.set_bind_group(0, &wave_bg, &[]);
+            let g = pipelines::WAVE_WORKGROUP;
+            pass.dispatch_workgroups(size[0].div_ceil(g), size[1].div_ceil(g), 1);
+        }
+        if readback {
+            let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
+            enc.copy_buffer_to_buffer(&t.output, 0, &t.staging, 0, bytes);
+        }
+        enc
+    }
+
+    /// Renders `frame` into a new [`Image`].
+    pub(crate) fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
+        let prepared = self.prepare(frame)?;
+        let mut image = alloc_image(frame.width, frame.height)?;
+        for &tile in &prepared.tiles {
+            let submission = self.ctx.scoped("rendering a tile", || {
+                let enc = self.encode_tile(frame, &prepared, tile, true, None);
+                self.ctx.queue.submit([enc.finish()])
+            })?;
+            let (origin, size) = tile;
+            let n = size[0] as usize * size[1] as usize;
+            let bytes = n as u64 * FLOATS_PER_PIXEL * 4;
+            let staging = &self.targets.as_ref().expect("targets exist").staging;
+            self.ctx.read_buffer(staging, bytes, submission, |raw| {
+                copy_tile(&mut image, raw, origin, size);
+            })?;
+        }
+        let _ = prepared.tile;
+        Ok(image)
+    }
+}
+
+/// Copies one tile's read-back bytes (layout: see the output binding in wave.wgsl) into `image`.
+fn copy_tile(image: &mut Image, raw: &[u8], origin: [u32; 2], size: [u32; 2]) {
+    let n = size[0] as usize * size[1] as usize;
+    let floats: Vec<f32>;
+    let data: &[f32] = match bytemuck::try_cast_slice(raw) {
+        Ok(f) => f,
+        Err(_) => {
+            floats = raw.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+            &floats
+        }
+    };
+    let (color, rest) = data.split_at(4 * n);
+    let (energy, depth) = rest.split_at(n);
+    let w = size[0] as usize;
+    for row in 0..size[1] as usize {
+        let dst = image.index(origin[0], origin[1] + row as u32);
+        let src = row * w;
+        for (k, px) in image.color[dst..dst + w].iter_mut().enumerate() {
+            px.copy_from_slice(&color[4 * (src + k)..4 * (src + k) + 4]);
+        }
+        image.energy[dst..dst + w].copy_from_slice(&energy[src..src + w]);
+        image.depth[dst..dst + w].copy_from_slice(&depth[src..src + w]);
+    }
+}

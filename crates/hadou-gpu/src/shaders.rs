@@ -1,0 +1,179 @@
+//! WGSL sources and how they are composed into shader modules.
+//!
+//! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
+//! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
+//! - wave module: `common.wgsl` + `energy.wgsl` + `wave.wgsl` (energy integration, colour mapping).
+//!
+//! A unit test parses and validates every composed module with naga (no adapter needed) and
+//! checks that the struct layouts naga computes equal the Rust ones in [`crate::layout`].
+
+/// Shared structs, pixel rays, shading and colour mapping.
+pub const COMMON: &str = include_str!("shaders/common.wgsl");
+/// WGSL twins of `hadou_math::energy`.
+pub const ENERGY: &str = include_str!("shaders/energy.wgsl");
+/// The opaque geometry pass.
+pub const RASTER: &str = include_str!("shaders/raster.wgsl");
+/// The wave pass.
+pub const WAVE: &str = include_str!("shaders/wave.wgsl");
+
+/// Every `.wgsl` file in `src/shaders/`, by file name.
+pub const FILES: &[(&str, &str)] =
+    &[("common.wgsl", COMMON), ("energy.wgsl", ENERGY), ("raster.wgsl", RASTER), ("wave.wgsl", WAVE)];
+
+/// The parts of the raster module, in order.
+pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
+/// The parts of the wave module, in order.
+pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, WAVE];
+
+/// Concatenates module parts.
+pub fn compose(parts: &[&str]) -> String {
+    parts.join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::{FrameUniforms, GpuObject, GpuWave};
+    use std::mem::{offset_of, size_of};
+
+    fn validate(name: &str, source: &str) -> naga::Module {
+        let module = naga::front::wgsl::parse_str(source)
+            .unwrap_or_else(|e| panic!("{name}: WGSL parse error:\n{}", e.emit_to_string(source)));
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        );
+        if let Err(e) = validator.validate(&module) {
+            panic!("{name}: WGSL validation error:\n{}", e.emit_to_string(source));
+        }
+        module
+    }
+
+    fn modules() -> Vec<(&'static str, naga::Module)> {
+        vec![
+            ("raster module", validate("raster module", &compose(RASTER_PARTS))),
+            ("wave module", validate("wave module", &compose(WAVE_PARTS))),
+        ]
+    }
+
+    #[test]
+    fn every_wgsl_file_parses_and_validates() {
+        // Standalone files validate alone; pass files only after their prefix.
+        validate("common.wgsl", COMMON);
+        validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
+        let modules = modules();
+        assert_eq!(modules.len(), 2);
+        // Every file on disk is listed in FILES and used by a module.
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
+        let mut on_disk: Vec<String> = std::fs::read_dir(dir)
+            .expect("shader dir")
+            .map(|e| e.expect("dir entry").file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".wgsl"))
+            .collect();
+        on_disk.sort();
+        let mut listed: Vec<String> = FILES.iter().map(|(n, _)| n.to_string()).collect();
+        listed.sort();
+        assert_eq!(on_disk, listed, "src/shaders/*.wgsl and shaders::FILES differ");
+        for (name, text) in FILES {
+            let used = RASTER_PARTS.iter().chain(WAVE_PARTS).any(|p| std::ptr::eq(*p, *text));
+            assert!(used, "{name} is not part of any module");
+        }
+    }
+
+    #[test]
+    fn broken_wgsl_is_reported_not_accepted() {
+        // The validator must catch a type error in a pass (guards the test above against vacuity).
+        let broken = compose(&[COMMON, "fn f() -> f32 { return vec3<f32>(1.0); }"]);
+        let module = naga::front::wgsl::parse_str(&broken).expect("parses");
+        let mut v = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::empty(),
+        );
+        assert!(v.validate(&module).is_err());
+    }
+
+    /// Member offsets and size of the WGSL struct `name` as naga lays it out.
+    fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
+        let ty = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("struct {name} not found"))
+            .1;
+        match &ty.inner {
+            naga::TypeInner::Struct { members, span } => {
+                (members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(), *span)
+            }
+            _ => panic!("{name} is not a struct"),
+        }
+    }
+
+    #[test]
+    fn gpu_structs_match_their_rust_definitions() {
+        let module = validate("wave module", &compose(WAVE_PARTS));
+        macro_rules! check {
+            ($ty:ty, $name:literal, [$($field:ident),* $(,)?]) => {{
+                let (members, span) = wgsl_layout(&module, $name);
+                let rust: Vec<(String, u32)> =
+                    vec![$((stringify!($field).to_string(), offset_of!($ty, $field) as u32)),*];
+                assert_eq!(members, rust, "{} member offsets", $name);
+                assert_eq!(span as usize, size_of::<$ty>(), "{} size", $name);
+            }};
+        }
+        check!(
+            FrameUniforms,
+            "FrameUniforms",
+            [
+                eye,
+                tan_half_fov,
+                right,
+                aspect,
+                up,
+                near,
+                forward,
+                far,
+                background,
+                exposure,
+                light_dir,
+                tone_mode,
+                light_color,
+                wave_count,
+                ambient,
+                _pad0,
+                image_size,
+                tile_origin,
+                tile_size,
+                _pad1,
+                ndc_scale,
+                ndc_offset,
+            ]
+        );
+        check!(GpuObject, "GpuObject", [model, normal_matrix, color, _pad]);
+        check!(GpuWave, "GpuWave", [color, kind, falloff, core_radius, _pad, p0, p1, p2]);
+    }
+
+    #[test]
+    fn constants_match() {
+        use crate::layout::*;
+        let module = validate("wave module", &compose(WAVE_PARTS));
+        let value = |name: &str| -> u32 {
+            let (_, c) = module
+                .constants
+                .iter()
+                .find(|(_, c)| c.name.as_deref() == Some(name))
+                .unwrap_or_else(|| panic!("const {name} not found"));
+            match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v,
+                ref e => panic!("{name}: unexpected {e:?}"),
+            }
+        };
+        assert_eq!(value("WAVE_SPHERE"), WAVE_SPHERE);
+        assert_eq!(value("WAVE_CYLINDER"), WAVE_CYLINDER);
+        assert_eq!(value("WAVE_CAPSULE"), WAVE_CAPSULE);
+        assert_eq!(value("WAVE_BEAM"), WAVE_BEAM);
+        assert_eq!(value("FALLOFF_FAITHFUL"), FALLOFF_FAITHFUL);
+        assert_eq!(value("FALLOFF_INVERSE_SQUARE"), FALLOFF_INVERSE_SQUARE);
+        assert_eq!(value("TONE_FAITHFUL"), TONE_FAITHFUL);
+        assert_eq!(value("TONE_FILMIC"), TONE_FILMIC);
+    }
+}

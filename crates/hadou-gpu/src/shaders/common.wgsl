@@ -1,0 +1,103 @@
+// Shared declarations of the hadou GPU backend: the GPU-visible structs, pixel rays, shading and
+// colour mapping. Prepended to raster.wgsl and wave.wgsl (see crates/hadou-gpu/src/shaders.rs).
+//
+// Every struct here has exactly one Rust definition in crates/hadou-gpu/src/layout.rs:
+// keep in sync with layout.rs (same field order, same explicit padding).
+
+// Keep in sync with layout.rs `FrameUniforms`.
+struct FrameUniforms {
+    eye: vec3<f32>,
+    tan_half_fov: f32,
+    right: vec3<f32>,
+    aspect: f32,
+    up: vec3<f32>,
+    near: f32,
+    forward: vec3<f32>,
+    far: f32,
+    background: vec3<f32>,
+    exposure: f32,
+    light_dir: vec3<f32>,
+    tone_mode: u32,
+    light_color: vec3<f32>,
+    wave_count: u32,
+    ambient: vec3<f32>,
+    _pad0: u32,
+    image_size: vec2<u32>,
+    tile_origin: vec2<u32>,
+    tile_size: vec2<u32>,
+    _pad1: vec2<u32>,
+    ndc_scale: vec2<f32>,
+    ndc_offset: vec2<f32>,
+}
+
+// Keep in sync with layout.rs `GpuObject`.
+struct GpuObject {
+    model: mat4x4<f32>,
+    normal_matrix: mat4x4<f32>,
+    color: vec3<f32>,
+    _pad: f32,
+}
+
+// Keep in sync with layout.rs `GpuWave` (the meaning of p0/p1/p2 per kind is documented there).
+struct GpuWave {
+    color: vec4<f32>,
+    kind: u32,
+    falloff: u32,
+    core_radius: f32,
+    _pad: u32,
+    p0: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+}
+
+// Keep in sync with layout.rs: wave kinds and falloff/tone codes.
+const WAVE_SPHERE: u32 = 0u;
+const WAVE_CYLINDER: u32 = 1u;
+const WAVE_CAPSULE: u32 = 2u;
+const WAVE_BEAM: u32 = 3u;
+const FALLOFF_FAITHFUL: u32 = 0u;
+const FALLOFF_INVERSE_SQUARE: u32 = 1u;
+const TONE_FAITHFUL: u32 = 0u;
+const TONE_FILMIC: u32 = 1u;
+
+// Mirrors hadou_scene::CameraBasis::pixel_dir: direction through the centre of the global pixel
+// (px, py) (py = 0 is the top row), with unit component along `forward`.
+fn pixel_dir(u: FrameUniforms, px: u32, py: u32) -> vec3<f32> {
+    let ndc_x = 2.0 * (f32(px) + 0.5) / f32(u.image_size.x) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(py) + 0.5) / f32(u.image_size.y);
+    return u.forward + u.right * (ndc_x * u.tan_half_fov * u.aspect) + u.up * (ndc_y * u.tan_half_fov);
+}
+
+// Mirrors hadou_math::shade::diffuse: albedo · (ambient + light · max(0, N·(−L))); a zero or
+// non-finite normal shades with ambient only.
+fn diffuse(albedo: vec3<f32>, normal: vec3<f32>, light_dir: vec3<f32>, light: vec3<f32>, ambient: vec3<f32>) -> vec3<f32> {
+    let len = length(normal);
+    var n = vec3<f32>(0.0);
+    if (len > 0.0 && len < 3.0e38) {
+        n = normal / len;
+    }
+    let lambert = max(dot(n, -light_dir), 0.0);
+    return albedo * (ambient + light * lambert);
+}
+
+// Mirrors hadou_math::shade::map_faithful: clamp to [0, 1] per channel (002 §3.3).
+fn map_faithful(c: vec3<f32>) -> vec3<f32> {
+    return clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// 1 − exp(−x) for x ≥ 0 without losing the small values (the Rust twin uses exp_m1).
+fn one_minus_exp_neg(x: f32) -> f32 {
+    if (x < 1.0e-3) {
+        return x * (1.0 - x * (0.5 - x * (1.0 / 6.0)));
+    }
+    return 1.0 - exp(-x);
+}
+
+// Mirrors hadou_math::shade::map_filmic: 1 − exp(−(c + w)), w = ½·max(0, max(c) − 1).
+fn map_filmic(c_in: vec3<f32>) -> vec3<f32> {
+    let c = max(c_in, vec3<f32>(0.0));
+    let m = max(c.x, max(c.y, c.z));
+    let w = 0.5 * max(m - 1.0, 0.0);
+    let x = min(c + vec3<f32>(w), vec3<f32>(80.0));
+    return vec3<f32>(one_minus_exp_neg(x.x), one_minus_exp_neg(x.y), one_minus_exp_neg(x.z));
+}

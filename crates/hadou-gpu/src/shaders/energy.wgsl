@@ -1,0 +1,243 @@
+// WGSL twins of hadou_math::energy (thesis 002 §3.3, eq. 3.4–3.11, with SPEC.md §1.2's corrected
+// asinh antiderivative and its stable single-logarithm evaluation). Each function names the Rust
+// function it mirrors and follows it line by line, so the two agree to f32 rounding; read the Rust
+// doc comments (crates/hadou-math/src/energy/{mod,kernel}.rs) for the derivations.
+// Prepended by common.wgsl.
+//
+// Infinity: WGSL has no infinity literal and lets implementations assume values are finite, so
+// ±T_OPEN stands for ±∞ (a ray that hits nothing in the inverse-square measure, and the unbounded
+// capsule regions). Every use compares it against T_LIMIT (1e12), exactly as the Rust code treats
+// infinity.
+
+const T_OPEN: f32 = 3.0e38;
+// Mirrors hadou_math::energy::T_LIMIT.
+const T_LIMIT: f32 = 1.0e12;
+// Mirrors hadou_math::energy::H_FLOOR.
+const H_FLOOR: f32 = 1.0e-24;
+// Mirrors hadou_math::energy::ENERGY_MAX.
+const ENERGY_MAX: f32 = 1.0e30;
+// f32::EPSILON and f32::MIN_POSITIVE.
+const F32_EPSILON: f32 = 1.1920929e-7;
+const F32_MIN_POSITIVE: f32 = 1.17549435e-38;
+
+// Mirrors hadou_math::energy::FieldParams<f32>.
+struct FieldParams {
+    falloff: u32,
+    core_radius: f32,
+}
+
+// Mirrors hadou_math::energy::Ray<f32>.
+struct Ray {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+// Mirrors hadou_math::energy::RayAxis<f32>.
+struct RayAxis {
+    s: f32,
+    unit: vec3<f32>,
+}
+
+// Mirrors hadou_math::energy::RayQuadratic<f32>: |v + t·u|² + r_c² = Y(t)² + H, Y = s·t + β.
+struct RayQuadratic {
+    s: f32,
+    beta: f32,
+    h: f32,
+}
+
+// Mirrors RayAxis::new.
+fn ray_axis(u: vec3<f32>) -> RayAxis {
+    let a = dot(u, u);
+    if (a >= F32_MIN_POSITIVE) {
+        let s = sqrt(a);
+        return RayAxis(s, u * (1.0 / s));
+    }
+    return RayAxis(0.0, vec3<f32>(0.0));
+}
+
+// Mirrors RayQuadratic::new.
+fn ray_quadratic(axis: RayAxis, v: vec3<f32>, rc2: f32) -> RayQuadratic {
+    let beta = dot(axis.unit, v);
+    var d2 = dot(v, v);
+    if (axis.s > 0.0) {
+        let c = cross(axis.unit, v);
+        d2 = dot(c, c);
+    }
+    return RayQuadratic(axis.s, beta, max(d2 + rc2, H_FLOOR));
+}
+
+// f32::ln_1p for z > f32::EPSILON (WGSL has no log1p): a 5-term series below 1e-2 (relative
+// error < 2e-11), log(1 + z) above (relative error < 1.2e-5, far inside the backends' 1e-3).
+fn ln_1p(z: f32) -> f32 {
+    if (z < 1.0e-2) {
+        return z * (1.0 - z * (0.5 - z * (1.0 / 3.0 - z * (0.25 - z * 0.2))));
+    }
+    return log(1.0 + z);
+}
+
+// Mirrors RayQuadratic::faithful: ∫ dt / sqrt(Y² + H) as one ln_1p (002 eq. 3.8–3.9, corrected).
+fn rq_faithful(q: RayQuadratic, t0_in: f32, t1_in: f32) -> f32 {
+    let t0 = max(t0_in, -T_LIMIT);
+    let t1 = min(t1_in, T_LIMIT);
+    if (!(t1 > t0)) {
+        return 0.0;
+    }
+    let s = q.s;
+    let h = q.h;
+    let dt = t1 - t0;
+    let y0 = s * t0 + q.beta;
+    let y1 = s * t1 + q.beta;
+    let r0 = sqrt(y0 * y0 + h);
+    let r1 = sqrt(y1 * y1 + h);
+    let sum = y0 + y1;
+    let qq = sum / (r0 + r1);
+    var k = 0.0;
+    if (sum >= 0.0) {
+        var p0 = y0 + r0;
+        if (y0 < 0.0) {
+            p0 = h / (r0 - y0);
+        }
+        k = dt * (1.0 + qq) / p0;
+    } else {
+        var n1 = r1 - y1;
+        if (y1 > 0.0) {
+            n1 = h / (r1 + y1);
+        }
+        k = dt * (1.0 - qq) / n1;
+    }
+    let z = s * k;
+    var v = k;
+    if (z > F32_EPSILON) {
+        v = ln_1p(z) / s;
+    }
+    return min(max(v, 0.0), ENERGY_MAX);
+}
+
+// Mirrors RayQuadratic::inverse_square: ∫ dt / (Y² + H) as one atan2; t1 ≥ T_LIMIT means +∞.
+fn rq_inverse_square(q: RayQuadratic, t0: f32, t1: f32) -> f32 {
+    if (!(t1 > t0)) {
+        return 0.0;
+    }
+    let s = q.s;
+    let h = q.h;
+    let sh = sqrt(h);
+    let y0 = s * t0 + q.beta;
+    var v = 0.0;
+    if (t1 < T_LIMIT && t0 > -T_LIMIT) {
+        let y1 = s * t1 + q.beta;
+        let dt = t1 - t0;
+        let num = sh * s * dt;
+        let den = h + y0 * y1;
+        if (num <= F32_EPSILON * den) {
+            v = dt / den;
+        } else {
+            v = atan2(num, den) / (s * sh);
+        }
+    } else {
+        var num = 0.0;
+        var den = -1.0;
+        if (t0 > -T_LIMIT) {
+            num = sh;
+            den = y0;
+        } else if (t1 < T_LIMIT) {
+            num = sh;
+            den = -(s * t1 + q.beta);
+        }
+        v = atan2(num, den) / (s * sh);
+    }
+    return min(max(v, 0.0), ENERGY_MAX);
+}
+
+// Mirrors RayQuadratic::integral.
+fn rq_integral(q: RayQuadratic, falloff: u32, t0: f32, t1: f32) -> f32 {
+    if (falloff == FALLOFF_FAITHFUL) {
+        return rq_faithful(q, t0, t1);
+    }
+    return rq_inverse_square(q, t0, t1);
+}
+
+// Mirrors hadou_math::energy::sphere_energy (002 eq. 3.4, 3.6, 3.8).
+fn sphere_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, center: vec3<f32>, alpha: f32) -> f32 {
+    let axis = ray_axis(ray.dir);
+    let q = ray_quadratic(axis, ray.origin - center, p.core_radius * p.core_radius);
+    return rq_integral(q, p.falloff, t0, t1) * alpha;
+}
+
+// Mirrors hadou_math::energy::cylinder_energy (002 eq. 3.5, 3.7, 3.9).
+fn cylinder_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, point: vec3<f32>, dir: vec3<f32>, alpha: f32) -> f32 {
+    let axis = ray_axis(cross(ray.dir, dir));
+    let v = cross(ray.origin - point, dir);
+    let q = ray_quadratic(axis, v, p.core_radius * p.core_radius);
+    return rq_integral(q, p.falloff, t0, t1) * alpha;
+}
+
+// Mirrors hadou_math::energy::CapsuleParts (private).
+struct CapsuleParts {
+    at_m: RayQuadratic,
+    at_m2: RayQuadratic,
+    energy: f32,
+}
+
+// Mirrors hadou_math::energy::capsule_parts (private; 002 eq. 3.10–3.11): sphere around the first
+// end crossed, cylinder between the planes through M and M₂ with normal D, sphere around the other.
+fn capsule_parts(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> CapsuleParts {
+    let rc2 = p.core_radius * p.core_radius;
+    let q = ray.dir;
+    let w = ray.origin - m;
+    let sphere_axis = ray_axis(q);
+    let at_m = ray_quadratic(sphere_axis, w, rc2);
+    let at_m2 = ray_quadratic(sphere_axis, w - d * length, rc2);
+    let cyl = ray_quadratic(ray_axis(cross(q, d)), cross(w, d), rc2);
+    let dq = dot(q, d);
+    let ds = dot(w, d);
+    var lo = 0.0;
+    var hi = 0.0;
+    var first_is_m = true;
+    if (dq > 0.0) {
+        lo = -ds / dq;
+        hi = (length - ds) / dq;
+    } else if (dq < 0.0) {
+        lo = (length - ds) / dq;
+        hi = -ds / dq;
+        first_is_m = false;
+    } else if (ds < 0.0) {
+        lo = T_OPEN;
+        hi = T_OPEN;
+    } else if (ds > length) {
+        lo = -T_OPEN;
+        hi = -T_OPEN;
+    } else {
+        lo = -T_OPEN;
+        hi = T_OPEN;
+    }
+    var first = at_m;
+    var last = at_m2;
+    if (!first_is_m) {
+        first = at_m2;
+        last = at_m;
+    }
+    lo = clamp(lo, t0, t1);
+    hi = clamp(hi, lo, t1);
+    let fo = p.falloff;
+    let spheres = rq_integral(first, fo, t0, lo) + rq_integral(last, fo, hi, t1);
+    let energy = spheres * alpha_s + rq_integral(cyl, fo, lo, hi) * alpha_c;
+    return CapsuleParts(at_m, at_m2, energy);
+}
+
+// Mirrors hadou_math::energy::capsule_energy.
+fn capsule_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> f32 {
+    return capsule_parts(p, ray, t0, t1, m, d, length, alpha_s, alpha_c).energy;
+}
+
+// Mirrors hadou_math::energy::beam_energy (SPEC.md §1.2, bulged beam): capsule plus bulbs at M₂, M.
+fn beam_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32, head_alpha: f32, muzzle_alpha: f32) -> f32 {
+    let parts = capsule_parts(p, ray, t0, t1, m, d, length, alpha_s, alpha_c);
+    var e = parts.energy;
+    if (head_alpha != 0.0) {
+        e += rq_integral(parts.at_m2, p.falloff, t0, t1) * head_alpha;
+    }
+    if (muzzle_alpha != 0.0) {
+        e += rq_integral(parts.at_m, p.falloff, t0, t1) * muzzle_alpha;
+    }
+    return e;
+}

@@ -1,0 +1,105 @@
+// Wave pass: per pixel, the integration ray of hadou_scene::CameraBasis::wave_ray (002 eq. 3.12–3.13,
+// clipped at the visible surface), the energy of every wave (energy.wgsl), the colour
+// scene + exposure·Σ rgb·a·I and the colour mapping (common.wgsl). Prepended by common.wgsl and
+// energy.wgsl.
+
+@group(0) @binding(0) var<uniform> frame: FrameUniforms;
+@group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
+@group(0) @binding(2) var scene_color: texture_2d<f32>;
+@group(0) @binding(3) var scene_distance: texture_2d<f32>;
+// Tile output, n = tile_size.x · tile_size.y pixels, row-major: colour (4 floats per pixel) in
+// [0, 4n), energy in [4n, 5n), eye distance in [5n, 6n). Keep in sync with readback in render.rs.
+@group(0) @binding(4) var<storage, read_write> out_buf: array<f32>;
+
+// Mirrors hadou_scene::CameraBasis::wave_ray: the ray and span of one pixel for one falloff.
+// `surface < 0` means nothing was drawn (None).
+fn wave_ray(falloff: u32, dir: vec3<f32>, surface: f32, span: ptr<function, vec2<f32>>) -> Ray {
+    let len = length(dir);
+    let far_dist = frame.far * len;
+    if (falloff == FALLOFF_FAITHFUL) {
+        var g = 1.0;
+        if (surface >= 0.0) {
+            g = min(surface / far_dist, 1.0);
+        }
+        *span = vec2<f32>(0.0, g);
+        return Ray(frame.eye, dir * frame.far);
+    }
+    var t1 = T_OPEN;
+    if (surface >= 0.0) {
+        t1 = surface;
+    }
+    *span = vec2<f32>(0.0, t1);
+    return Ray(frame.eye, dir / len);
+}
+
+// Energy of one wave on one pixel; the dispatch over hadou_scene::WaveShape.
+fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
+    var span = vec2<f32>(0.0, 0.0);
+    let ray = wave_ray(w.falloff, dir, surface, &span);
+    let p = FieldParams(w.falloff, w.core_radius);
+    switch w.kind {
+        case WAVE_SPHERE: {
+            return sphere_energy(p, ray, span.x, span.y, w.p0.xyz, w.p0.w);
+        }
+        case WAVE_CYLINDER: {
+            return cylinder_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p0.w);
+        }
+        case WAVE_CAPSULE: {
+            return capsule_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
+        }
+        case WAVE_BEAM: {
+            return beam_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
+        }
+        // GAP(curves): WaveShape::Curve has no WGSL twin yet; the Rust side refuses frames with
+        // curved waves before dispatch (see render.rs), so no other kind reaches this shader.
+        default: {
+            return 0.0;
+        }
+    }
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= frame.tile_size.x || id.y >= frame.tile_size.y) {
+        return;
+    }
+    let px = frame.tile_origin.x + id.x;
+    let py = frame.tile_origin.y + id.y;
+    let n = frame.tile_size.x * frame.tile_size.y;
+    let i = id.y * frame.tile_size.x + id.x;
+
+    let surface = textureLoad(scene_distance, vec2<i32>(id.xy), 0).x;
+    let drawn = surface >= 0.0;
+    var scene = frame.background;
+    if (drawn) {
+        scene = textureLoad(scene_color, vec2<i32>(id.xy), 0).xyz;
+    }
+    let dir = pixel_dir(frame, px, py);
+
+    var total = 0.0;
+    var light = vec3<f32>(0.0);
+    for (var k = 0u; k < frame.wave_count; k++) {
+        let w = waves[k];
+        // As hadou-cpu's wave pass: negative or non-finite energies count as 0.
+        let e = clamp(wave_energy(w, dir, surface), 0.0, ENERGY_MAX);
+        total += e;
+        light += (w.color.xyz * w.color.w) * e;
+    }
+    let rgb_in = scene + light * frame.exposure;
+    var rgb = vec3<f32>(0.0);
+    if (frame.tone_mode == TONE_FAITHFUL) {
+        rgb = map_faithful(rgb_in);
+    } else {
+        rgb = map_filmic(rgb_in);
+    }
+    var depth = frame.far * length(dir);
+    if (drawn) {
+        depth = surface;
+    }
+    out_buf[4u * i] = rgb.x;
+    out_buf[4u * i + 1u] = rgb.y;
+    out_buf[4u * i + 2u] = rgb.z;
+    out_buf[4u * i + 3u] = 1.0;
+    out_buf[4u * n + i] = min(total, 3.0e38);
+    out_buf[5u * n + i] = depth;
+}
