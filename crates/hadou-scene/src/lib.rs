@@ -2,11 +2,31 @@
 //!
 //! Scene files (TOML) → typed, validated [`Scene`] with animation tracks → [`Frame`] at any time.
 //! Also the [`Image`] every backend returns and the [`Backend`] trait.
+//!
+//! ```text
+//! scene.toml ──Scene::load──▶ Scene ──scene.at(t)──▶ Frame ──Backend::render──▶ Image
+//! ```
+//!
+//! All validation happens in [`Scene::load`]/[`Scene::parse`]; errors are [`SceneError`]s whose
+//! `Display` is `path:line:col: message`. [`Scene::at`] never fails. The file format is described
+//! key by key in `docs/scene-format.md`.
 
+mod anim;
 mod backend;
+mod error;
 mod frame;
+mod gltf_load;
 mod image;
+pub mod mesh;
+mod params;
+mod scene;
+mod schema;
+mod toml_read;
 
+pub use anim::Interpolation;
 pub use backend::{Backend, RenderError};
+pub use error::{Location, SceneError};
 pub use frame::*;
+pub use gltf_load::{gltf_from_bytes, load_gltf};
 pub use image::Image;
+pub use scene::Scene;

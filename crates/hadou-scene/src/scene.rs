@@ -1,0 +1,323 @@
+//! [`Scene`]: a loaded, validated scene file with its animation tracks; [`Scene::at`] evaluates
+//! it into a [`Frame`].
+
+use crate::anim::Track;
+use crate::error::SceneError;
+use crate::frame::{
+    Camera, ColorMapping, Frame, Light, Mesh, Object, ToneMode, Wave, WaveShape,
+};
+use crate::params::ParamSet;
+use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
+use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
+use hadou_math::{Mat4, Vec3, Vec3f};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// A scene loaded from a TOML file: typed, range-checked, with animation tracks.
+///
+/// Loading does all validation; [`Scene::at`] never fails.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub(crate) path: PathBuf,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    /// Every numeric parameter as written in the file (the store tracks write into).
+    pub(crate) values: Vec<f32>,
+    pub(crate) camera: ParamSet,
+    pub(crate) light: ParamSet,
+    pub(crate) color: ParamSet,
+    /// Holds `background`.
+    pub(crate) globals: ParamSet,
+    pub(crate) tone: ToneMode,
+    pub(crate) objects: Vec<ObjectDef>,
+    pub(crate) waves: Vec<WaveDef>,
+    pub(crate) tracks: Vec<Track>,
+}
+
+/// An `[[object]]`: its mesh (built once) and its animatable placement and colour.
+#[derive(Clone, Debug)]
+pub(crate) struct ObjectDef {
+    pub name: String,
+    pub mesh: Arc<Mesh>,
+    pub params: ParamSet,
+}
+
+/// The wave kinds of the schema.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum WaveKind {
+    Sphere,
+    Cylinder,
+    Capsule,
+    Beam,
+    Helix,
+    Trig,
+    Bezier,
+    BSpline,
+}
+
+/// How a curve is integrated (the structural, non-animatable part).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum IntegratorDef {
+    Default,
+    Simpson { m: u32, n: Option<u32> },
+}
+
+/// A `[[wave]]`.
+#[derive(Clone, Debug)]
+pub(crate) struct WaveDef {
+    pub name: String,
+    pub kind: WaveKind,
+    pub falloff: Falloff,
+    pub params: ParamSet,
+    /// Capsule/beam given by `M2` (else by `D` + `length`).
+    pub uses_m2: bool,
+    pub integrator: IntegratorDef,
+    /// B-spline order.
+    pub order: u32,
+    /// B-spline has an explicit knot vector.
+    pub has_knots: bool,
+}
+
+impl Scene {
+    /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path)
+            .map_err(|e| SceneError::Io { path: path.to_path_buf(), message: format!("cannot read the scene file: {e}") })?;
+        let text = String::from_utf8(bytes).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses scene `text`; `path` names the file in messages and anchors relative asset paths.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        crate::schema::parse_scene(text, path)
+    }
+
+    /// Image width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Image height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Time of the last key of any track in seconds (0 for a static scene).
+    pub fn duration(&self) -> f32 {
+        self.tracks.iter().map(Track::end).fold(0.0, f32::max)
+    }
+
+    /// The scene file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Wave names in file order.
+    pub fn wave_names(&self) -> Vec<&str> {
+        self.waves.iter().map(|w| w.name.as_str()).collect()
+    }
+
+    /// Object names in file order.
+    pub fn object_names(&self) -> Vec<&str> {
+        self.objects.iter().map(|o| o.name.as_str()).collect()
+    }
+
+    /// The animated targets (`wave.beam.M2.z`, …) in file order.
+    pub fn track_targets(&self) -> Vec<&str> {
+        self.tracks.iter().map(|t| t.target.as_str()).collect()
+    }
+
+    /// The scene at `time` seconds. Never fails: animated values are clamped into their valid
+    /// ranges (smooth interpolation may overshoot) and degenerate directions fall back to the
+    /// values written in the file, so every frame is renderable. A non-finite `time` reads as 0.
+    pub fn at(&self, time: f32) -> Frame {
+        let time = if time.is_finite() { time } else { 0.0 };
+        let vals = self.values_at(time);
+        self.build(&vals, time)
+    }
+
+    /// The value store at `time`: tracks applied, then every parameter clamped into range.
+    pub(crate) fn values_at(&self, time: f32) -> Vec<f32> {
+        let mut vals = self.values.clone();
+        if self.tracks.is_empty() {
+            return vals;
+        }
+        for t in &self.tracks {
+            if let Some(out) = vals.get_mut(t.offset..t.offset + t.len) {
+                t.eval(time, out);
+            }
+        }
+        let sets = [&self.camera, &self.light, &self.color, &self.globals]
+            .into_iter()
+            .chain(self.objects.iter().map(|o| &o.params))
+            .chain(self.waves.iter().map(|w| &w.params));
+        for set in sets {
+            for p in &set.params {
+                let r = p.offset..p.offset + p.len;
+                if let (Some(v), Some(base)) = (vals.get(r.clone()).map(|s| s.to_vec()), self.values.get(r.clone())) {
+                    let mut v = v;
+                    p.rule.clamp(&mut v, base);
+                    vals[r].copy_from_slice(&v);
+                }
+            }
+        }
+        vals
+    }
+
+    /// Builds the frame from a (valid) value store.
+    pub(crate) fn build(&self, vals: &[f32], time: f32) -> Frame {
+        let base = &self.values;
+        let v3 = |set: &ParamSet, vals: &[f32], key: &str| Vec3f::from_array(set.arr::<3>(vals, key));
+        // Direction `key`, unit; falls back to the file's value, then to `fallback`.
+        let dir = |set: &ParamSet, key: &str, fallback: Vec3f| {
+            v3(set, vals, key).try_normalize().unwrap_or_else(|| v3(set, base, key).normalize_or(fallback))
+        };
+
+        let c = &self.camera;
+        let near = c.f(vals, "near");
+        let far = c.f(vals, "far").max(near * 1.001 + 1e-6);
+        let camera = Camera {
+            position: v3(c, vals, "position"),
+            target: v3(c, vals, "target"),
+            up: v3(c, vals, "up"),
+            fov_y_deg: c.f(vals, "fov"),
+            near,
+            far,
+        };
+        let l = &self.light;
+        let light = Light {
+            direction: dir(l, "direction", Vec3::new(0.0, -1.0, 0.0)),
+            color: l.arr(vals, "color"),
+            ambient: l.arr(vals, "ambient"),
+        };
+        let color_mapping = ColorMapping { mode: self.tone, exposure: self.color.f(vals, "exposure") };
+        let objects = self
+            .objects
+            .iter()
+            .map(|o| {
+                let p = &o.params;
+                Object {
+                    name: o.name.clone(),
+                    mesh: o.mesh.clone(),
+                    transform: Mat4::from_trs(v3(p, vals, "position"), v3(p, vals, "rotation"), v3(p, vals, "scale")),
+                    color: p.arr(vals, "color"),
+                }
+            })
+            .collect();
+        let waves = self.waves.iter().map(|w| self.build_wave(w, vals)).collect();
+        Frame {
+            width: self.width,
+            height: self.height,
+            time,
+            camera,
+            background: self.globals.arr(vals, "background"),
+            light,
+            objects,
+            waves,
+            color_mapping,
+        }
+    }
+
+    fn build_wave(&self, w: &WaveDef, vals: &[f32]) -> Wave {
+        let p = &w.params;
+        let base = &self.values;
+        let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));
+        let unit = |key: &str| {
+            v3(vals, key).try_normalize().unwrap_or_else(|| v3(base, key).normalize_or(Vec3f::X))
+        };
+        let capsule = || {
+            let m = v3(vals, "M");
+            let (d, length) = if w.uses_m2 {
+                let span = v3(vals, "M2") - m;
+                let fallback = (v3(base, "M2") - v3(base, "M")).normalize_or(Vec3f::X);
+                (span.normalize_or(fallback), span.length())
+            } else {
+                (unit("D"), p.f(vals, "length"))
+            };
+            CapsuleField { m, d, length, alpha_s: p.f(vals, "alpha_s"), alpha_c: p.f(vals, "alpha_c") }
+        };
+        let shape = match w.kind {
+            WaveKind::Sphere => WaveShape::Sphere(SphereField { center: v3(vals, "M"), alpha: p.f(vals, "alpha_s") }),
+            WaveKind::Cylinder => {
+                WaveShape::Cylinder(CylinderField { point: v3(vals, "M"), dir: unit("D"), alpha: p.f(vals, "alpha_c") })
+            }
+            WaveKind::Capsule => WaveShape::Capsule(capsule()),
+            WaveKind::Beam => WaveShape::Beam(BeamField {
+                capsule: capsule(),
+                head_alpha: p.f(vals, "head_alpha"),
+                muzzle_alpha: p.f(vals, "muzzle_alpha"),
+            }),
+            _ => WaveShape::Curve(self.build_curve(w, vals)),
+        };
+        Wave {
+            name: w.name.clone(),
+            color: p.arr(vals, "rgba"),
+            falloff: w.falloff,
+            core_radius: p.f(vals, "core_radius"),
+            shape,
+        }
+    }
+
+    fn build_curve(&self, w: &WaveDef, vals: &[f32]) -> CurveWave {
+        let p = &w.params;
+        let base = &self.values;
+        let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));
+        let axis = v3(vals, "D").try_normalize().unwrap_or_else(|| v3(base, "D").normalize_or(Vec3f::X));
+        let mut up = v3(vals, "up");
+        if !crate::schema::up_is_usable(up, axis) {
+            up = v3(base, "up");
+            if !crate::schema::up_is_usable(up, axis) {
+                up = axis.orthonormal_basis().0;
+            }
+        }
+        let shape = match w.kind {
+            WaveKind::Helix => CurveShape::Helix {
+                radius: p.f(vals, "radius"),
+                rate: p.f(vals, "rate"),
+                phase: p.f(vals, "phase"),
+                length: p.f(vals, "length"),
+            },
+            WaveKind::Trig => CurveShape::TrigSum {
+                rate: p.f(vals, "rate"),
+                y_terms: p.pairs(vals, "y_terms"),
+                z_terms: p.pairs(vals, "z_terms"),
+                length: p.f(vals, "length"),
+            },
+            WaveKind::Bezier => CurveShape::Bezier { points: p.pairs(vals, "points") },
+            _ => {
+                let knots = w.has_knots.then(|| {
+                    let k = p.raw(vals, "knots").to_vec();
+                    let np = p.raw(vals, "points").len() / 2;
+                    let lo = w.order as usize - 1;
+                    // An animated knot vector whose valid range collapsed falls back to the file's.
+                    if k.get(lo) < k.get(np) {
+                        k
+                    } else {
+                        p.raw(base, "knots").to_vec()
+                    }
+                });
+                CurveShape::BSpline { points: p.pairs(vals, "points"), order: w.order, knots }
+            }
+        };
+        let integrator = match w.integrator {
+            IntegratorDef::Default => Integrator::Default,
+            IntegratorDef::Simpson { m, n } => Integrator::Simpson {
+                m,
+                reduction: n.map(|n| Reduction { n, epsilon: p.f(vals, "epsilon") }),
+            },
+        };
+        CurveWave {
+            frame: CurveFrame { origin: v3(vals, "O"), axis, up },
+            shape,
+            gamma: p.f(vals, "gamma"),
+            extension: p.f(vals, "k"),
+            attenuation: p.f(vals, "j"),
+            alpha: p.f(vals, "alpha"),
+            integrator,
+        }
+    }
+}

@@ -1,0 +1,740 @@
+//! The scene schema: TOML tables → [`Scene`], with every value range-checked at load and every
+//! error pointing at the offending key or value. The schema is documented key by key in
+//! `docs/scene-format.md`.
+
+use crate::anim::{Interpolation, Track};
+use crate::error::{hint, Location, SceneError};
+use crate::frame::{Mesh, ToneMode};
+use crate::mesh::{box_mesh, plane_mesh, sphere_mesh};
+use crate::params::{Constraint, ParamSet, Shape};
+use crate::scene::{IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
+use crate::toml_read::{number, read_numbers, type_name, Fallback, ParamReader, Res, Span, Src, Table, Val};
+use hadou_math::energy::Falloff;
+use hadou_math::Vec3f;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::de::{DeTable, DeValue};
+
+const ROOT_KEYS: &[&str] = &["image", "camera", "background", "light", "color", "object", "wave", "track"];
+const CAMERA_KEYS: &[&str] = &["position", "target", "up", "fov", "near", "far"];
+const LIGHT_KEYS: &[&str] = &["direction", "color", "ambient"];
+const COLOR_KEYS: &[&str] = &["mode", "exposure"];
+const OBJECT_KINDS: &[&str] = &["box", "sphere", "plane", "gltf"];
+const OBJECT_COMMON: &[&str] = &["name", "kind", "position", "rotation", "scale", "color"];
+const WAVE_KINDS: &[&str] = &["sphere", "cylinder", "capsule", "beam", "helix", "trig", "bezier", "bspline"];
+const WAVE_COMMON: &[&str] = &["name", "kind", "rgba", "falloff", "core_radius"];
+const CURVE_COMMON: &[&str] = &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
+const TRACK_KEYS: &[&str] = &["target", "interpolation", "keys"];
+
+/// Default base colour of a wave: the yellow of 002 Fig. 4.1.
+pub(crate) const DEFAULT_RGBA: [f32; 4] = [0.8, 0.8, 0.2, 1.0];
+/// Default core radius (world units): small against the shapes of the thesis figures.
+pub(crate) const DEFAULT_CORE_RADIUS: f32 = 0.02;
+
+const POSITIVE: Constraint = Constraint::Positive;
+const NONNEG: Constraint = Constraint::NonNeg;
+const ANY: Constraint = Constraint::Any;
+const V3: Shape = Shape::Vector(3);
+const S: Shape = Shape::Scalar;
+
+/// Whether `up` fixes a frame around unit `axis`: not zero and not parallel to it.
+pub(crate) fn up_is_usable(up: Vec3f, axis: Vec3f) -> bool {
+    let l = up.length();
+    l > 0.0 && l.is_finite() && up.cross(axis).length() > 1e-4 * l
+}
+
+/// Parses a whole scene.
+pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
+    let src = Src { text, path };
+    let doc = DeTable::parse(text).map_err(|e| SceneError::Syntax {
+        at: Location::from_offset(path, text, e.span().map_or(0, |s| s.start)),
+        message: format!("invalid TOML: {}", e.message().trim().replace('\n', "; ")),
+    })?;
+    let root = Table { src, t: doc.get_ref(), span: 0..0, what: "the top level".into() };
+    root.check_keys(ROOT_KEYS)?;
+
+    let mut values = Vec::new();
+    let mut spans = Vec::new();
+    let mut rd = ParamReader { values: &mut values, spans: &mut spans };
+
+    // [image]
+    let (mut width, mut height) = (512, 512);
+    if let Some(t) = root.sub("image", "[image]")? {
+        t.check_keys(&["width", "height"])?;
+        width = t.opt_int("width", 1, 16384)?.map_or(width, |v| v.0 as u32);
+        height = t.opt_int("height", 1, 16384)?.map_or(height, |v| v.0 as u32);
+    }
+
+    // [camera]
+    let empty = DeTable::new();
+    let sub_or_empty = |key: &str, what: &str| -> Res<Table<'_, '_>> {
+        Ok(root.sub(key, what)?.unwrap_or(Table { src, t: &empty, span: 0..0, what: what.into() }))
+    };
+    let mut camera = ParamSet::default();
+    {
+        let t = sub_or_empty("camera", "[camera]")?;
+        t.check_keys(CAMERA_KEYS)?;
+        let fov = Constraint::Range { lo: 0.0, hi: 180.0, lo_open: true, hi_open: true };
+        rd.add(&t, &mut camera, "position", V3, ANY, Fallback::Value(&[0.0, 0.0, 10.0]), false)?;
+        rd.add(&t, &mut camera, "target", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
+        rd.add(&t, &mut camera, "up", V3, Constraint::NonZero, Fallback::Value(&[0.0, 1.0, 0.0]), false)?;
+        rd.add(&t, &mut camera, "fov", S, fov, Fallback::Value(&[45.0]), false)?;
+        rd.add(&t, &mut camera, "near", S, POSITIVE, Fallback::Value(&[0.1]), false)?;
+        rd.add(&t, &mut camera, "far", S, POSITIVE, Fallback::Value(&[100.0]), false)?;
+        if let Err((key, msg)) = check_camera(&camera, rd.values) {
+            return Err(src.value_err(&t.key_span(key), format!("{msg} in [camera]")));
+        }
+    }
+
+    // [light]
+    let mut light = ParamSet::default();
+    {
+        let t = sub_or_empty("light", "[light]")?;
+        t.check_keys(LIGHT_KEYS)?;
+        let dir = Fallback::Value(&[-0.4, -1.0, -0.3]);
+        rd.add(&t, &mut light, "direction", V3, Constraint::NonZero, dir, false)?;
+        rd.add(&t, &mut light, "color", V3, NONNEG, Fallback::Value(&[1.0; 3]), false)?;
+        rd.add(&t, &mut light, "ambient", V3, NONNEG, Fallback::Value(&[0.15; 3]), false)?;
+    }
+
+    // [color]
+    let mut color = ParamSet::default();
+    let tone = {
+        let t = sub_or_empty("color", "[color]")?;
+        t.check_keys(COLOR_KEYS)?;
+        let mode = t.choice("mode", &["faithful", "filmic"], Some("filmic"))?;
+        rd.add(&t, &mut color, "exposure", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
+        if mode == "faithful" {
+            ToneMode::Faithful
+        } else {
+            ToneMode::Filmic
+        }
+    };
+
+    // background (top level)
+    let mut globals = ParamSet::default();
+    rd.add(&root, &mut globals, "background", V3, NONNEG, Fallback::Value(&[0.0; 3]), false)?;
+
+    // [[object]]
+    let mut objects: Vec<ObjectDef> = Vec::new();
+    let mut names: HashMap<String, Span> = HashMap::new();
+    let mut mesh_cache: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
+    for (i, (t, span)) in root.array_of_tables("object")?.into_iter().enumerate() {
+        let table = Table { src, t, span, what: format!("[[object]] #{}", i + 1) };
+        let name = entity_name(&table, &mut names, "object")?;
+        let table = Table { what: format!("[[object]] \"{name}\""), ..table };
+        objects.push(parse_object(&table, name, &mut rd, &mut mesh_cache)?);
+    }
+
+    // [[wave]]
+    let mut waves: Vec<WaveDef> = Vec::new();
+    let mut names: HashMap<String, Span> = HashMap::new();
+    for (i, (t, span)) in root.array_of_tables("wave")?.into_iter().enumerate() {
+        let table = Table { src, t, span, what: format!("[[wave]] #{}", i + 1) };
+        let name = entity_name(&table, &mut names, "wave")?;
+        let table = Table { what: format!("[[wave]] \"{name}\""), ..table };
+        waves.push(parse_wave(&table, name, &mut rd)?);
+    }
+
+    let mut scene = Scene {
+        path: path.to_path_buf(),
+        width,
+        height,
+        values,
+        camera,
+        light,
+        color,
+        globals,
+        tone,
+        objects,
+        waves,
+        tracks: Vec::new(),
+    };
+
+    // [[track]]
+    let mut targets: HashMap<String, Span> = HashMap::new();
+    let mut key_spans: Vec<Vec<Span>> = Vec::new();
+    for (i, (t, span)) in root.array_of_tables("track")?.into_iter().enumerate() {
+        let table = Table { src, t, span, what: format!("[[track]] #{}", i + 1) };
+        let (track, spans) = parse_track(&table, &scene, &mut targets)?;
+        scene.tracks.push(track);
+        key_spans.push(spans);
+    }
+    // Rules that tie several values together, at every key time of every track.
+    for (track, spans) in scene.tracks.iter().zip(&key_spans) {
+        for (&time, span) in track.times.iter().zip(spans) {
+            let vals = scene.values_at(time);
+            if let Err(msg) = check_all(&scene, &vals) {
+                return Err(src.track(span, format!("at t = {time} s (this key of `{}`): {msg}", track.target)));
+            }
+        }
+    }
+    Ok(scene)
+}
+
+/// Reads and checks `name`: present, a string of letters, digits, `_` and `-`, unique.
+fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &str) -> Res<String> {
+    let (name, span) = table.req_str("name", &format!("a unique name, used by tracks as `{what}.<name>.<key>`"))?;
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Err(table.src.value_err(
+            &span,
+            format!("{what} name \"{name}\" may contain only letters, digits, `_` and `-` (it is used in track targets)"),
+        ));
+    }
+    if let Some(first) = names.get(name) {
+        let at = table.src.loc(first);
+        return Err(table.src.duplicate(
+            &span,
+            format!("duplicate {what} name \"{name}\" (first used at line {}); names must be unique", at.line),
+        ));
+    }
+    names.insert(name.to_string(), span);
+    Ok(name.to_string())
+}
+
+fn parse_object(
+    t: &Table<'_, '_>,
+    name: String,
+    rd: &mut ParamReader<'_>,
+    cache: &mut HashMap<PathBuf, Arc<Mesh>>,
+) -> Res<ObjectDef> {
+    let kind = t.choice("kind", OBJECT_KINDS, None)?;
+    let extra: &[&str] = match kind {
+        "box" => &["size"],
+        "sphere" => &["radius", "segments"],
+        "plane" => &["size"],
+        _ => &["path"],
+    };
+    let allowed: Vec<&str> = OBJECT_COMMON.iter().chain(extra).copied().collect();
+    t.check_keys(&allowed)?;
+
+    // Structural values: read through a scratch store.
+    let mut scratch_v = Vec::new();
+    let mut scratch_s = Vec::new();
+    let mut scratch = ParamReader { values: &mut scratch_v, spans: &mut scratch_s };
+    let mut shape_set = ParamSet::default();
+    let mesh = match kind {
+        "box" => {
+            scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
+            Arc::new(box_mesh(shape_set.arr(&scratch_v, "size")))
+        }
+        "plane" => {
+            scratch.add(t, &mut shape_set, "size", Shape::Vector(2), POSITIVE, Fallback::Value(&[10.0, 10.0]), false)?;
+            Arc::new(plane_mesh(shape_set.arr(&scratch_v, "size")))
+        }
+        "sphere" => {
+            scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
+            let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
+            Arc::new(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments))
+        }
+        _ => {
+            let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
+            let dir = t.src.path.parent().unwrap_or(Path::new(""));
+            let file = dir.join(rel);
+            match cache.get(&file) {
+                Some(m) => m.clone(),
+                None => {
+                    let mesh = crate::gltf_load::load_gltf(&file).map_err(|message| SceneError::Gltf {
+                        at: t.src.loc(&span),
+                        file: file.clone(),
+                        message,
+                    })?;
+                    let mesh = Arc::new(mesh);
+                    cache.insert(file, mesh.clone());
+                    mesh
+                }
+            }
+        }
+    };
+
+    let mut params = ParamSet::default();
+    rd.add(t, &mut params, "position", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
+    rd.add(t, &mut params, "rotation", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
+    rd.add(t, &mut params, "scale", V3, POSITIVE, Fallback::Value(&[1.0; 3]), true)?;
+    rd.add(t, &mut params, "color", V3, NONNEG, Fallback::Value(&[0.8; 3]), false)?;
+    Ok(ObjectDef { name, mesh, params })
+}
+
+fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<WaveDef> {
+    let kind_s = t.choice("kind", WAVE_KINDS, None)?;
+    let kind = match kind_s {
+        "sphere" => WaveKind::Sphere,
+        "cylinder" => WaveKind::Cylinder,
+        "capsule" => WaveKind::Capsule,
+        "beam" => WaveKind::Beam,
+        "helix" => WaveKind::Helix,
+        "trig" => WaveKind::Trig,
+        "bezier" => WaveKind::Bezier,
+        _ => WaveKind::BSpline,
+    };
+    let extra: &[&str] = match kind {
+        WaveKind::Sphere => &["M", "alpha_s"],
+        WaveKind::Cylinder => &["M", "D", "alpha_c"],
+        WaveKind::Capsule => &["M", "M2", "D", "length", "alpha_s", "alpha_c"],
+        WaveKind::Beam => &["M", "M2", "D", "length", "alpha_s", "alpha_c", "head_alpha", "muzzle_alpha"],
+        WaveKind::Helix => &["radius", "rate", "phase", "length"],
+        WaveKind::Trig => &["rate", "y_terms", "z_terms", "length"],
+        WaveKind::Bezier => &["points"],
+        WaveKind::BSpline => &["points", "order", "knots"],
+    };
+    let is_curve = matches!(kind, WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline);
+    let allowed: Vec<&str> = WAVE_COMMON
+        .iter()
+        .chain(if is_curve { CURVE_COMMON } else { &[] })
+        .chain(extra)
+        .copied()
+        .collect();
+    t.check_keys(&allowed)?;
+
+    let falloff = match t.choice("falloff", &["faithful", "inverse-square"], Some("inverse-square"))? {
+        "faithful" => Falloff::Faithful,
+        _ => Falloff::InverseSquare,
+    };
+    let mut p = ParamSet::default();
+    rd.add(t, &mut p, "rgba", Shape::Vector(4), Constraint::Rgba, Fallback::Value(&DEFAULT_RGBA), false)?;
+    rd.add(t, &mut p, "core_radius", S, NONNEG, Fallback::Value(&[DEFAULT_CORE_RADIUS]), false)?;
+    let dir = Constraint::NonZero;
+    let mut def = WaveDef {
+        name,
+        kind,
+        falloff,
+        params: ParamSet::default(),
+        uses_m2: false,
+        integrator: IntegratorDef::Default,
+        order: 0,
+        has_knots: false,
+    };
+    match kind {
+        WaveKind::Sphere => {
+            rd.add(t, &mut p, "M", V3, ANY, Fallback::Required("the centre"), false)?;
+            rd.add(t, &mut p, "alpha_s", S, NONNEG, Fallback::Required("the strength α_s"), false)?;
+        }
+        WaveKind::Cylinder => {
+            rd.add(t, &mut p, "M", V3, ANY, Fallback::Required("a point on the axis"), false)?;
+            rd.add(t, &mut p, "D", V3, dir, Fallback::Required("the axis direction"), false)?;
+            rd.add(t, &mut p, "alpha_c", S, NONNEG, Fallback::Required("the strength α_c"), false)?;
+        }
+        WaveKind::Capsule | WaveKind::Beam => {
+            rd.add(t, &mut p, "M", V3, ANY, Fallback::Required("the muzzle end"), false)?;
+            def.uses_m2 = t.get("M2").is_some();
+            if def.uses_m2 {
+                for other in ["D", "length"] {
+                    if t.get(other).is_some() {
+                        return Err(t.src.value_err(
+                            &t.key_span(other),
+                            format!("{} gives `M2`; give either `M2` or `D` + `length`, not both", t.what),
+                        ));
+                    }
+                }
+                rd.add(t, &mut p, "M2", V3, ANY, Fallback::Required("the head end"), false)?;
+            } else {
+                let need = "the direction from M to the head; or give the head `M2` instead of `D` + `length`";
+                rd.add(t, &mut p, "D", V3, dir, Fallback::Required(need), false)?;
+                rd.add(t, &mut p, "length", S, NONNEG, Fallback::Required("the distance from M to the head"), false)?;
+            }
+            rd.add(t, &mut p, "alpha_s", S, NONNEG, Fallback::Required("the strength of the end spheres α_s"), false)?;
+            rd.add(t, &mut p, "alpha_c", S, NONNEG, Fallback::Required("the strength of the cylinder α_c"), false)?;
+            if kind == WaveKind::Beam {
+                rd.add(t, &mut p, "head_alpha", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+                rd.add(t, &mut p, "muzzle_alpha", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+            }
+        }
+        _ => parse_curve(t, &mut def, &mut p, rd)?,
+    }
+    def.params = p;
+    Ok(def)
+}
+
+fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut ParamReader<'_>) -> Res<()> {
+    let k_rule = Constraint::Range { lo: 0.0, hi: 1.0, lo_open: true, hi_open: false };
+    rd.add(t, p, "O", V3, ANY, Fallback::Required("the launch point"), false)?;
+    rd.add(t, p, "D", V3, Constraint::NonZero, Fallback::Required("the travel axis"), false)?;
+    rd.add(t, p, "up", V3, Constraint::NonZero, Fallback::Value(&[0.0, 1.0, 0.0]), false)?;
+    rd.add(t, p, "alpha", S, NONNEG, Fallback::Required("the strength α"), false)?;
+    rd.add(t, p, "gamma", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
+    rd.add(t, p, "k", S, k_rule, Fallback::Value(&[1.0]), false)?;
+    rd.add(t, p, "j", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+    match def.kind {
+        WaveKind::Helix => {
+            rd.add(t, p, "radius", S, NONNEG, Fallback::Required("the helix radius r"), false)?;
+            rd.add(t, p, "rate", S, ANY, Fallback::Required("the angular rate θ in radians per unit s"), false)?;
+            rd.add(t, p, "phase", S, ANY, Fallback::Value(&[0.0]), false)?;
+            rd.add(t, p, "length", S, POSITIVE, Fallback::Required("the parameter range s_end"), false)?;
+        }
+        WaveKind::Trig => {
+            rd.add(t, p, "rate", S, ANY, Fallback::Required("the base angular rate θ"), false)?;
+            rd.add(t, p, "y_terms", Shape::List(2), ANY, Fallback::Value(&[]), false)?;
+            rd.add(t, p, "z_terms", Shape::List(2), ANY, Fallback::Value(&[]), false)?;
+            rd.add(t, p, "length", S, POSITIVE, Fallback::Required("the parameter range s_end"), false)?;
+        }
+        _ => {
+            let meaning = "control points [[y, z], …] across the axis";
+            rd.add(t, p, "points", Shape::List(2), ANY, Fallback::Required(meaning), false)?;
+            let n_points = p.find("points").map_or(0, |q| q.len / 2);
+            if n_points < 2 {
+                let span = t.get("points").map_or(t.span.clone(), |v| v.span());
+                return Err(t.src.value_err(
+                    &span,
+                    format!("`points` in {} needs at least 2 control points, got {n_points}", t.what),
+                ));
+            }
+            if def.kind == WaveKind::BSpline {
+                let order = t.opt_int("order", 2, n_points as i64)?.map_or(n_points.min(4), |v| v.0 as usize);
+                def.order = order as u32;
+                if let Some(v) = t.get("knots") {
+                    rd.add(t, p, "knots", Shape::List(1), Constraint::NonDecreasing, Fallback::Value(&[]), false)?;
+                    let want = n_points + order;
+                    let got = p.find("knots").map_or(0, |q| q.len);
+                    if got != want {
+                        return Err(t.src.value_err(
+                            &v.span(),
+                            format!(
+                                "`knots` in {} needs {want} values ({n_points} points + order {order}), got {got}",
+                                t.what
+                            ),
+                        ));
+                    }
+                    def.has_knots = true;
+                }
+            }
+        }
+    }
+    // Integrator.
+    let simpson = t.choice("integrator", &["default", "simpson"], Some("default"))? == "simpson";
+    let m = t.opt_int("m", 2, 100_000)?;
+    let n = t.opt_int("n", 1, 100_000)?;
+    if !simpson {
+        if let Some(key) = ["m", "n", "epsilon"].into_iter().find(|k| t.get(k).is_some()) {
+            return Err(t.src.value_err(
+                &t.key_span(key),
+                format!("`{key}` in {} applies only with integrator = \"simpson\"", t.what),
+            ));
+        }
+    }
+    if let Some((m, span)) = &m {
+        if m % 2 != 0 {
+            return Err(t.src.value_err(
+                span,
+                format!("`m` in {} must be even (composite Simpson), got {m}; try {}", t.what, m + 1),
+            ));
+        }
+    }
+    if n.is_none() && t.get("epsilon").is_some() {
+        return Err(t.src.value_err(
+            &t.key_span("epsilon"),
+            format!("`epsilon` in {} applies only with the reduction `n`", t.what),
+        ));
+    }
+    rd.add(t, p, "epsilon", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+    if simpson {
+        def.integrator = IntegratorDef::Simpson { m: m.map_or(100, |v| v.0 as u32), n: n.map(|v| v.0 as u32) };
+    }
+    if let Err((key, msg)) = check_curve(def, p, rd.values) {
+        return Err(t.src.value_err(&t.key_span(key), format!("{msg} in {}", t.what)));
+    }
+    Ok(())
+}
+
+/// Camera rules across keys: `near < far`, eye ≠ target, `up` not parallel to the view.
+fn check_camera(c: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)> {
+    let (near, far) = (c.f(vals, "near"), c.f(vals, "far"));
+    if near >= far {
+        return Err(("far", format!("`far` ({far}) must be greater than `near` ({near})")));
+    }
+    let eye = Vec3f::from_array(c.arr(vals, "position"));
+    let target = Vec3f::from_array(c.arr(vals, "target"));
+    let Some(view) = (target - eye).try_normalize() else {
+        return Err(("target", "`target` must differ from `position`".into()));
+    };
+    if !up_is_usable(Vec3f::from_array(c.arr(vals, "up")), view) {
+        return Err(("up", "`up` must not be parallel to the view direction (target − position)".into()));
+    }
+    Ok(())
+}
+
+/// Curve rules across keys: `up` not parallel to `D`; a B-spline knot vector with a non-empty
+/// valid range.
+fn check_curve(w: &WaveDef, p: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)> {
+    let axis = Vec3f::from_array(p.arr(vals, "D"));
+    let Some(axis) = axis.try_normalize() else {
+        return Err(("D", "`D` must not be the zero vector".into()));
+    };
+    if !up_is_usable(Vec3f::from_array(p.arr(vals, "up")), axis) {
+        return Err(("up", "`up` must not be parallel to `D` (it fixes the cross-section axes)".into()));
+    }
+    if w.has_knots {
+        let k = p.raw(vals, "knots");
+        let n_points = p.raw(vals, "points").len() / 2;
+        let lo = w.order as usize - 1;
+        if k.get(lo) >= k.get(n_points) {
+            return Err((
+                "knots",
+                format!("`knots` must increase somewhere between entries {lo} and {n_points} (the curve's range)"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every cross-key rule of the scene, for the values at one time.
+fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
+    check_camera(&scene.camera, vals).map_err(|e| format!("{} in [camera]", e.1))?;
+    if Vec3f::from_array(scene.light.arr(vals, "direction")).try_normalize().is_none() {
+        return Err("`direction` in [light] must not be the zero vector".into());
+    }
+    for w in &scene.waves {
+        let what = format!("[[wave]] \"{}\"", w.name);
+        match w.kind {
+            WaveKind::Sphere => {}
+            WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => {
+                if w.params.find("D").is_some()
+                    && Vec3f::from_array(w.params.arr(vals, "D")).try_normalize().is_none()
+                {
+                    return Err(format!("`D` in {what} must not be the zero vector"));
+                }
+            }
+            _ => check_curve(w, &w.params, vals).map_err(|e| format!("{} in {what}", e.1))?,
+        }
+    }
+    Ok(())
+}
+
+/// A parameter slice selected by a track target.
+struct Selection {
+    offset: usize,
+    len: usize,
+    shape: Shape,
+    rule: Constraint,
+    /// Component index of the first selected float within its vector (for per-component rules).
+    first: usize,
+    whole: bool,
+    broadcast: bool,
+}
+
+/// Resolves `target` (`wave.<name>.<key>[i].c`, `object.<name>.<key>`, `camera.<key>`,
+/// `light.<key>`, `color.exposure`, `background`) against the scene.
+fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
+    let segs: Vec<&str> = target.split('.').collect();
+    let head = segs[0];
+    let (set, rest, ent): (&ParamSet, &[&str], String) = match head.split('[').next().unwrap_or("") {
+        "background" => (&scene.globals, &segs[..], "the scene".into()),
+        "camera" | "light" | "color" if segs.len() >= 2 => {
+            let set = match head {
+                "camera" => &scene.camera,
+                "light" => &scene.light,
+                _ => &scene.color,
+            };
+            (set, &segs[1..], format!("[{head}]"))
+        }
+        "wave" | "object" if segs.len() >= 3 => {
+            let name = segs[1];
+            let (set, names) = if head == "wave" {
+                (scene.waves.iter().find(|w| w.name == name).map(|w| &w.params), scene.wave_names())
+            } else {
+                (scene.objects.iter().find(|o| o.name == name).map(|o| &o.params), scene.object_names())
+            };
+            match set {
+                Some(s) => (s, &segs[2..], format!("[[{head}]] \"{name}\"")),
+                None => {
+                    return Err(format!("no {head} is named \"{name}\"{}", hint(name, &names, "names")));
+                }
+            }
+        }
+        "camera" | "light" | "color" => {
+            return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
+        }
+        "wave" | "object" => {
+            return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
+        }
+        other => {
+            let heads = ["wave", "object", "camera", "light", "color", "background"];
+            return Err(format!(
+                "target \"{target}\" must start with `wave.`, `object.`, `camera.`, `light.`, `color.` or be \
+                 `background`{}",
+                hint(other, &heads, "targets")
+            ));
+        }
+    };
+    if rest.is_empty() || rest.len() > 2 {
+        return Err(format!("target \"{target}\" is not of the form `<entity>.<key>[index].<component>`"));
+    }
+    // key[i][j]
+    let (key, mut indices) = split_indices(rest[0]).ok_or_else(|| format!("bad index in target \"{target}\""))?;
+    let Some(param) = set.find(key) else {
+        let keys = set.keys();
+        return Err(format!("{ent} has no animatable key `{key}`{}", hint(key, &keys, "keys")));
+    };
+    if let Some(comp) = rest.get(1) {
+        let i = match *comp {
+            "x" | "r" => 0,
+            "y" | "g" => 1,
+            "z" | "b" => 2,
+            "w" | "a" => 3,
+            _ => return Err(format!("unknown component `.{comp}` in \"{target}\"; use .x/.y/.z/.w, .r/.g/.b/.a or [i]")),
+        };
+        if !matches!(param.shape, Shape::Vector(_)) {
+            return Err(format!("`.{comp}` applies to vectors; select elements of `{key}` with [i]"));
+        }
+        indices.push(i);
+    }
+    let mut sel = Selection {
+        offset: param.offset,
+        len: param.len,
+        shape: param.shape,
+        rule: param.rule,
+        first: 0,
+        whole: true,
+        broadcast: param.broadcast,
+    };
+    for &i in &indices {
+        let (n, width, next) = match sel.shape {
+            Shape::Scalar => return Err(format!("`{key}` is a number; it has no components to select")),
+            Shape::Vector(n) => (n, 1, Shape::Scalar),
+            Shape::List(w) => (sel.len / w.max(1), w, if w == 1 { Shape::Scalar } else { Shape::Vector(w) }),
+        };
+        if i >= n {
+            return Err(format!("index {i} is out of range for `{key}` ({n} element(s))"));
+        }
+        sel = Selection {
+            offset: sel.offset + i * width,
+            len: width,
+            shape: next,
+            rule: sel.rule,
+            first: if width == 1 { i } else { 0 },
+            whole: false,
+            broadcast: false,
+        };
+    }
+    Ok(sel)
+}
+
+/// `"points[2][1]"` → `("points", [2, 1])`.
+fn split_indices(s: &str) -> Option<(&str, Vec<usize>)> {
+    let (key, mut rest) = match s.find('[') {
+        Some(i) => (&s[..i], &s[i..]),
+        None => return Some((s, Vec::new())),
+    };
+    let mut out = Vec::new();
+    while !rest.is_empty() {
+        let inner = rest.strip_prefix('[')?;
+        let close = inner.find(']')?;
+        out.push(inner[..close].trim().parse().ok()?);
+        rest = &inner[close + 1..];
+    }
+    Some((key, out))
+}
+
+fn parse_track(
+    t: &Table<'_, '_>,
+    scene: &Scene,
+    targets: &mut HashMap<String, Span>,
+) -> Res<(Track, Vec<Span>)> {
+    t.check_keys(TRACK_KEYS)?;
+    let (target, tspan) = t.req_str("target", "what to animate, e.g. \"wave.beam.M2\"")?;
+    let sel = resolve_target(scene, target).map_err(|m| t.src.track(&tspan, m))?;
+    if let Some(first) = targets.get(target) {
+        let line = t.src.loc(first).line;
+        return Err(t.src.duplicate(
+            &tspan,
+            format!("a track for \"{target}\" already exists (line {line}); merge their keys into one track"),
+        ));
+    }
+    targets.insert(target.to_string(), tspan.clone());
+    let what = format!("[[track]] \"{target}\"");
+    let interpolation = match t.choice("interpolation", &["linear", "smooth"], Some("linear"))? {
+        "smooth" => Interpolation::Smooth,
+        _ => Interpolation::Linear,
+    };
+    let keys_v: &Val<'_> =
+        t.get("keys").ok_or_else(|| t.src.missing(&t.span, format!("{what} needs `keys = [[time, value], …]`")))?;
+    let DeValue::Array(keys) = keys_v.get_ref() else {
+        return Err(t.src.type_err(
+            &keys_v.span(),
+            format!("`keys` in {what} must be an array of [time, value] pairs, got {}", type_name(keys_v.get_ref())),
+        ));
+    };
+    if keys.is_empty() {
+        return Err(t.src.track(&keys_v.span(), format!("`keys` in {what} needs at least one [time, value] pair")));
+    }
+    let mut times = Vec::new();
+    let mut values = Vec::new();
+    let mut spans = Vec::new();
+    for key in keys.iter() {
+        let pair = match key.get_ref() {
+            DeValue::Array(a) if a.len() == 2 => a,
+            _ => {
+                return Err(t.src.track(
+                    &key.span(),
+                    format!("each key of {what} must be a pair [time, value], e.g. [0.5, {}]", example(sel.shape)),
+                ))
+            }
+        };
+        let time = match number(pair[0].get_ref()) {
+            Some(x) if x.is_finite() && x >= 0.0 => x as f32,
+            Some(x) => {
+                return Err(t.src.value_err(&pair[0].span(), format!("key time in {what} must be finite and ≥ 0, got {x}")))
+            }
+            None => {
+                return Err(t.src.type_err(
+                    &pair[0].span(),
+                    format!("key time in {what} must be a number of seconds, got {}", type_name(pair[0].get_ref())),
+                ))
+            }
+        };
+        if let Some(&prev) = times.last() {
+            if time <= prev {
+                return Err(t.src.track(
+                    &pair[0].span(),
+                    format!("key times in {what} must increase strictly: {time} follows {prev}"),
+                ));
+            }
+        }
+        let vwhat = format!("key value in {what}");
+        let nums = read_numbers(&t.src, &pair[1], sel.shape, sel.broadcast, &vwhat)?;
+        if nums.len() != sel.len {
+            return Err(t.src.type_err(
+                &pair[1].span(),
+                format!("{vwhat} must be {}, like the scene's value", sel.shape.describe(sel.len)),
+            ));
+        }
+        let plain: Vec<f32> = nums.iter().map(|x| x.0).collect();
+        if let Err((i, msg)) = sel.rule.check(&plain, sel.first, sel.whole) {
+            let span = if matches!(sel.rule, Constraint::NonZero) { pair[1].span() } else { nums[i].1.clone() };
+            return Err(t.src.value_err(&span, format!("{vwhat} {msg}")));
+        }
+        times.push(time);
+        values.extend(plain);
+        spans.push(key.span());
+    }
+    let track = Track {
+        target: target.to_string(),
+        offset: sel.offset,
+        len: sel.len,
+        interpolation,
+        times,
+        values,
+    };
+    Ok((track, spans))
+}
+
+fn example(shape: Shape) -> &'static str {
+    match shape {
+        Shape::Scalar => "1.0",
+        Shape::Vector(_) => "[0.0, 1.0, 0.0]",
+        Shape::List(_) => "[[0.0, 1.0], …]",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn index_suffixes_split() {
+        assert_eq!(split_indices("points[2][1]"), Some(("points", vec![2, 1])));
+        assert_eq!(split_indices("M2"), Some(("M2", vec![])));
+        assert_eq!(split_indices("points[x]"), None);
+        assert_eq!(split_indices("points[1"), None);
+    }
+}
