@@ -455,3 +455,135 @@ fn copy_tile(image: &mut Image, raw: &[u8], origin: [u32; 2], size: [u32; 2]) {
         image.depth[dst..dst + w].copy_from_slice(&depth[src..src + w]);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipelines::compile_module;
+
+    /// A renderer, or `None` with a skip message (a failure under `HADOU_REQUIRE_GPU=1`).
+    fn renderer_or_skip(test: &str) -> Option<Renderer> {
+        match Renderer::new() {
+            Ok(r) => Some(r),
+            Err(RenderError::NoDevice(m)) => {
+                assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{test}: {m}");
+                eprintln!("SKIPPED {test}: no GPU adapter ({m})");
+                None
+            }
+            Err(e) => panic!("{test}: {e}"),
+        }
+    }
+
+    #[test]
+    fn tile_size_follows_the_device_limits() {
+        let mut limits = wgpu::Limits::downlevel_defaults();
+        assert_eq!(tile_size(&limits, 5000, 300).unwrap(), [MAX_TILE, 300]);
+        assert_eq!(tile_size(&limits, 7, 5).unwrap(), [7, 5]);
+        limits.max_texture_dimension_2d = 512;
+        assert_eq!(tile_size(&limits, 5000, 5000).unwrap(), [512, 512]);
+        // A 1 MiB buffer limit: 6 floats per pixel fit a 128² tile, not 256².
+        limits.max_buffer_size = 1 << 20;
+        assert_eq!(tile_size(&limits, 5000, 5000).unwrap(), [128, 128]);
+        limits.max_buffer_size = 1000;
+        assert!(matches!(tile_size(&limits, 5000, 5000), Err(RenderError::Device(_))));
+    }
+
+    #[test]
+    fn shader_compile_failure_is_an_error_naming_the_shader() {
+        let Some(r) = renderer_or_skip("shader compile failure") else { return };
+        match compile_module(&r.ctx, "deliberately broken", "fn f( -> { let }") {
+            Err(RenderError::Other(m)) => assert!(m.contains("deliberately broken"), "{m}"),
+            other => panic!("expected a compile error, got {:?}", other.map(|_| ())),
+        }
+        // A valid module still compiles afterwards.
+        assert!(compile_module(&r.ctx, "fine", "fn f() -> f32 { return 1.0; }").is_ok());
+    }
+
+    #[test]
+    fn rejected_gpu_work_is_captured_not_panicking() {
+        let Some(r) = renderer_or_skip("captured validation error") else { return };
+        let too_big = r.ctx.limits.max_buffer_size.saturating_add(4);
+        let result = r.ctx.scoped("allocating an impossible buffer", || {
+            r.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("too big"),
+                size: too_big,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        });
+        match result {
+            Err(RenderError::Other(m) | RenderError::Device(m)) => {
+                assert!(m.contains("impossible buffer"), "{m}")
+            }
+            other => panic!("expected an error, got {:?}", other.map(|_| ())),
+        }
+        assert!(r.ctx.check().is_ok(), "the error was captured by the scope, not left over");
+    }
+
+    fn small_frame() -> Frame {
+        hadou_scene::Frame {
+            width: 8,
+            height: 8,
+            time: 0.0,
+            camera: hadou_scene::Camera {
+                position: hadou_math::Vec3::new(0.0, 0.0, 5.0),
+                target: hadou_math::Vec3::ZERO,
+                up: hadou_math::Vec3::Y,
+                fov_y_deg: 45.0,
+                near: 0.1,
+                far: 100.0,
+            },
+            background: [0.0; 3],
+            light: hadou_scene::Light { direction: -hadou_math::Vec3::Y, color: [1.0; 3], ambient: [0.0; 3] },
+            objects: Vec::new(),
+            waves: Vec::new(),
+            color_mapping: hadou_scene::ColorMapping { mode: hadou_scene::ToneMode::Filmic, exposure: 1.0 },
+        }
+    }
+
+    #[test]
+    fn meshes_upload_once_per_arc_and_are_dropped_with_it() {
+        let Some(mut r) = renderer_or_skip("mesh cache") else { return };
+        let mesh = Arc::new(Mesh {
+            positions: vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
+            normals: vec![[0.0, 0.0, 1.0]; 3],
+            indices: vec![0, 1, 2],
+        });
+        let object = |name: &str, mesh: &Arc<Mesh>| hadou_scene::Object {
+            name: name.into(),
+            mesh: mesh.clone(),
+            transform: hadou_math::Mat4::IDENTITY,
+            color: [1.0; 3],
+        };
+        let mut frame = small_frame();
+        frame.objects = vec![object("a", &mesh), object("b", &mesh)];
+        let first = r.render(&frame).unwrap();
+        assert_eq!(r.meshes.len(), 1, "two objects sharing one Arc<Mesh> share one upload");
+        let key = Arc::as_ptr(&mesh) as usize;
+        let buffer_id = format!("{:?}", r.meshes[&key].vertices);
+        assert_eq!(r.render(&frame).unwrap(), first);
+        assert_eq!(format!("{:?}", r.meshes[&key].vertices), buffer_id, "not re-uploaded");
+        // The triangle is visible in the centre.
+        assert!(first.depth[first.index(4, 4)] < 6.0);
+        drop(frame);
+        drop(mesh);
+        let other = Arc::new(Mesh::default());
+        let mut frame = small_frame();
+        frame.objects = vec![object("empty", &other)];
+        r.render(&frame).unwrap();
+        assert!(r.meshes.is_empty(), "the freed mesh's upload is released; empty meshes are not uploaded");
+    }
+
+    #[test]
+    fn lost_device_is_a_device_error() {
+        let Some(mut r) = renderer_or_skip("device loss") else { return };
+        let frame = small_frame();
+        assert!(r.render(&frame).is_ok());
+        r.ctx.device.destroy();
+        let _ = r.ctx.device.poll(wgpu::PollType::Poll);
+        match r.render(&frame) {
+            Err(RenderError::Device(m)) => assert!(m.contains("lost") || m.contains("GPU"), "{m}"),
+            other => panic!("expected a device error, got {:?}", other.map(|_| ())),
+        }
+    }
+}

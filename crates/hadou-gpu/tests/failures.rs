@@ -1,0 +1,73 @@
+//! The failure story: bad frames and device trouble end in a `RenderError`, never a panic or hang.
+//! (No adapter → `NoDevice` is tested in tests/no_device.rs, which needs its own process.)
+
+mod common;
+
+use common::*;
+use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator};
+use hadou_math::energy::Falloff;
+use hadou_math::Vec3;
+use hadou_scene::{Backend, Mesh, RenderError, ToneMode, WaveShape};
+use std::sync::Arc;
+
+#[test]
+fn image_size_outside_the_frame_contract_is_an_error() {
+    let Some(mut gpu) = gpu_or_skip("image size") else { return };
+    for (w, h) in [(0, 10), (10, 0), (16385, 4)] {
+        let f = base_frame(w, h, Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, ToneMode::Filmic);
+        match gpu.render(&f) {
+            Err(RenderError::Other(m)) => assert!(m.contains("16384"), "{m}"),
+            other => panic!("{w}×{h}: expected a size error, got {other:?}"),
+        }
+    }
+    // The backend is still usable afterwards.
+    let f = occlusion_frame(32, 24);
+    assert!(gpu.render(&f).is_ok());
+}
+
+#[test]
+fn bad_camera_is_an_error() {
+    let Some(mut gpu) = gpu_or_skip("bad camera") else { return };
+    let mut f = occlusion_frame(32, 24);
+    f.camera.near = 200.0; // beyond far
+    assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("near")));
+}
+
+#[test]
+fn malformed_mesh_is_an_error_naming_the_object() {
+    let Some(mut gpu) = gpu_or_skip("malformed mesh") else { return };
+    let mut f = occlusion_frame(32, 24);
+    let bad =
+        Mesh { positions: vec![[0.0; 3]; 3], normals: vec![[0.0, 1.0, 0.0]; 3], indices: vec![0, 1, 7] };
+    f.objects[0].mesh = Arc::new(bad);
+    f.objects[0].name = "broken box".into();
+    match gpu.render(&f) {
+        Err(RenderError::Other(m)) => assert!(m.contains("broken box") && m.contains('7'), "{m}"),
+        other => panic!("expected a mesh error, got {other:?}"),
+    }
+    let mut f = occlusion_frame(32, 24);
+    f.objects[1].mesh =
+        Arc::new(Mesh { positions: vec![[0.0; 3]; 3], normals: vec![], indices: vec![0, 1, 2] });
+    assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("normals")));
+}
+
+#[test]
+fn curved_waves_are_refused_until_ported() {
+    // GAP(curves): the GPU backend has no WGSL twin of the curve integrator yet.
+    let Some(mut gpu) = gpu_or_skip("curved wave") else { return };
+    let mut f = occlusion_frame(32, 24);
+    let curve = CurveWave {
+        frame: CurveFrame { origin: Vec3::ZERO, axis: Vec3::X, up: Vec3::Y },
+        shape: CurveShape::Helix { radius: 1.0, rate: 1.0, phase: 0.0, length: 10.0 },
+        gamma: 1.0,
+        extension: 1.0,
+        attenuation: 0.0,
+        alpha: 1.0,
+        integrator: Integrator::Default,
+    };
+    f.waves.push(wave("drill", [1.0; 4], Falloff::InverseSquare, 0.05, WaveShape::Curve(curve)));
+    match gpu.render(&f) {
+        Err(RenderError::Other(m)) => assert!(m.contains("drill") && m.contains("CPU"), "{m}"),
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+}
