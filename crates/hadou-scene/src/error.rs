@@ -146,7 +146,9 @@ impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             SceneError::Io { path, message } => write!(f, "{}: {message}", path.display()),
-            SceneError::Gltf { at, file, message } => write!(f, "{at}: glTF file {}: {message}", file.display()),
+            SceneError::Gltf { at, file, message } => {
+                write!(f, "{at}: glTF file {}: {message}", file.display())
+            }
             other => {
                 // every remaining variant has a location
                 let at = other.location().expect("positioned variant");
@@ -187,7 +189,7 @@ pub(crate) fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a s
 }
 
 /// `"; did you mean `x`?"` or, without a close match, `"; valid keys: a, b, c"`.
-pub(crate) fn hint<'a>(word: &str, candidates: &[&'a str], noun: &str) -> String {
+pub(crate) fn hint(word: &str, candidates: &[&str], noun: &str) -> String {
     match suggest(word, candidates.iter().copied()) {
         Some(s) => format!("; did you mean `{s}`?"),
         None if candidates.is_empty() => String::new(),

@@ -104,6 +104,7 @@ impl CameraBasis {
     ///
     /// Both backends build their rays with exactly this construction.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn wave_ray(
         &self,
         falloff: Falloff,

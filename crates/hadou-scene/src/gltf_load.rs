@@ -27,11 +27,12 @@ pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
-            Source::Bin => gltf
-                .blob
-                .clone()
-                .ok_or_else(|| format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index()))?,
-            Source::Uri(uri) => resolve_uri(uri, dir).map_err(|e| format!("buffer {}: {e}", buffer.index()))?,
+            Source::Bin => gltf.blob.clone().ok_or_else(|| {
+                format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index())
+            })?,
+            Source::Uri(uri) => {
+                resolve_uri(uri, dir).map_err(|e| format!("buffer {}: {e}", buffer.index()))?
+            }
         };
         if data.len() < buffer.length() {
             return Err(format!(
@@ -58,9 +59,18 @@ pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
     Ok(out)
 }
 
-fn add_node(node: &gltf::Node<'_>, parent: Mat4, buffers: &[Vec<u8>], out: &mut Mesh, depth: usize) -> Result<(), String> {
+fn add_node(
+    node: &gltf::Node<'_>,
+    parent: Mat4,
+    buffers: &[Vec<u8>],
+    out: &mut Mesh,
+    depth: usize,
+) -> Result<(), String> {
     if depth > MAX_DEPTH {
-        return Err(format!("node hierarchy deeper than {MAX_DEPTH} levels (a cycle?) at node {}", node.index()));
+        return Err(format!(
+            "node hierarchy deeper than {MAX_DEPTH} levels (a cycle?) at node {}",
+            node.index()
+        ));
     }
     let local = Mat4 { cols: node.transform().matrix() };
     if local.cols.iter().flatten().any(|v| !v.is_finite()) {
@@ -89,7 +99,8 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
     let reader = prim.reader(get);
 
     let pos_acc = prim.get(&Semantic::Positions).ok_or("has no POSITION attribute")?;
-    check_accessor(&pos_acc, Dimensions::Vec3, &[DataType::F32], buffers).map_err(|e| format!("POSITION: {e}"))?;
+    check_accessor(&pos_acc, Dimensions::Vec3, &[DataType::F32], buffers)
+        .map_err(|e| format!("POSITION: {e}"))?;
     let positions: Vec<[f32; 3]> = reader.read_positions().ok_or("POSITION data cannot be read")?.collect();
     if positions.iter().flatten().any(|v| !v.is_finite()) {
         return Err("POSITION contains NaN or infinite values".into());
@@ -108,7 +119,7 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
         }
         None => (0..n as u32).collect(),
     };
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return Err(format!("{} indices is not a multiple of 3", indices.len()));
     }
 
@@ -162,7 +173,10 @@ fn check_accessor(
     let size = acc.size();
     let stride = view.stride().unwrap_or(size);
     if stride < size {
-        return Err(format!("bufferView {} stride {stride} is smaller than an element ({size} bytes)", view.index()));
+        return Err(format!(
+            "bufferView {} stride {stride} is smaller than an element ({size} bytes)",
+            view.index()
+        ));
     }
     let end = stride
         .checked_mul(acc.count() - 1)
@@ -173,7 +187,11 @@ fn check_accessor(
     }
     let data_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
     if view.offset().checked_add(view.length()).is_none_or(|e| e > data_len) {
-        return Err(format!("bufferView {} reads past the end of buffer {}", view.index(), view.buffer().index()));
+        return Err(format!(
+            "bufferView {} reads past the end of buffer {}",
+            view.index(),
+            view.buffer().index()
+        ));
     }
     Ok(())
 }
@@ -181,9 +199,8 @@ fn check_accessor(
 /// The bytes of a buffer URI: a `data:` URI with base64 payload, or a relative file path.
 fn resolve_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
-        let (_, payload) = rest
-            .split_once(";base64,")
-            .ok_or("only base64 data URIs are supported (`data:…;base64,…`)")?;
+        let (_, payload) =
+            rest.split_once(";base64,").ok_or("only base64 data URIs are supported (`data:…;base64,…`)")?;
         return base64_decode(payload).ok_or_else(|| "invalid base64 in data URI".to_string());
     }
     if uri.contains("://") {

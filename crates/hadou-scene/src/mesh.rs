@@ -92,7 +92,7 @@ pub fn smooth_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> 
         let n = (b - a).cross(c - a);
         if n.is_finite() {
             for i in idx {
-                acc[i] = acc[i] + n;
+                acc[i] += n;
             }
         }
     }
@@ -104,7 +104,8 @@ pub fn smooth_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> 
 /// faces stay counter-clockwise.
 pub fn transform_mesh(mesh: &Mesh, m: &Mat4) -> Mesh {
     let nm = m.normal_matrix();
-    let positions = mesh.positions.iter().map(|&p| m.transform_point(Vec3f::from_array(p)).to_array()).collect();
+    let positions =
+        mesh.positions.iter().map(|&p| m.transform_point(Vec3f::from_array(p)).to_array()).collect();
     let normals = mesh
         .normals
         .iter()

@@ -3,9 +3,7 @@
 
 use crate::anim::Track;
 use crate::error::SceneError;
-use crate::frame::{
-    Camera, ColorMapping, Frame, Light, Mesh, Object, ToneMode, Wave, WaveShape,
-};
+use crate::frame::{Camera, ColorMapping, Frame, Light, Mesh, Object, ToneMode, Wave, WaveShape};
 use crate::params::ParamSet;
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
@@ -82,8 +80,10 @@ impl Scene {
     /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path)
-            .map_err(|e| SceneError::Io { path: path.to_path_buf(), message: format!("cannot read the scene file: {e}") })?;
+        let bytes = std::fs::read(path).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: format!("cannot read the scene file: {e}"),
+        })?;
         let text = String::from_utf8(bytes).map_err(|e| SceneError::Io {
             path: path.to_path_buf(),
             message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
@@ -158,7 +158,9 @@ impl Scene {
         for set in sets {
             for p in &set.params {
                 let r = p.offset..p.offset + p.len;
-                if let (Some(v), Some(base)) = (vals.get(r.clone()).map(|s| s.to_vec()), self.values.get(r.clone())) {
+                if let (Some(v), Some(base)) =
+                    (vals.get(r.clone()).map(|s| s.to_vec()), self.values.get(r.clone()))
+                {
                     let mut v = v;
                     p.rule.clamp(&mut v, base);
                     vals[r].copy_from_slice(&v);
@@ -203,7 +205,11 @@ impl Scene {
                 Object {
                     name: o.name.clone(),
                     mesh: o.mesh.clone(),
-                    transform: Mat4::from_trs(v3(p, vals, "position"), v3(p, vals, "rotation"), v3(p, vals, "scale")),
+                    transform: Mat4::from_trs(
+                        v3(p, vals, "position"),
+                        v3(p, vals, "rotation"),
+                        v3(p, vals, "scale"),
+                    ),
                     color: p.arr(vals, "color"),
                 }
             })
@@ -226,9 +232,8 @@ impl Scene {
         let p = &w.params;
         let base = &self.values;
         let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));
-        let unit = |key: &str| {
-            v3(vals, key).try_normalize().unwrap_or_else(|| v3(base, key).normalize_or(Vec3f::X))
-        };
+        let unit =
+            |key: &str| v3(vals, key).try_normalize().unwrap_or_else(|| v3(base, key).normalize_or(Vec3f::X));
         let capsule = || {
             let m = v3(vals, "M");
             let (d, length) = if w.uses_m2 {
@@ -241,10 +246,14 @@ impl Scene {
             CapsuleField { m, d, length, alpha_s: p.f(vals, "alpha_s"), alpha_c: p.f(vals, "alpha_c") }
         };
         let shape = match w.kind {
-            WaveKind::Sphere => WaveShape::Sphere(SphereField { center: v3(vals, "M"), alpha: p.f(vals, "alpha_s") }),
-            WaveKind::Cylinder => {
-                WaveShape::Cylinder(CylinderField { point: v3(vals, "M"), dir: unit("D"), alpha: p.f(vals, "alpha_c") })
+            WaveKind::Sphere => {
+                WaveShape::Sphere(SphereField { center: v3(vals, "M"), alpha: p.f(vals, "alpha_s") })
             }
+            WaveKind::Cylinder => WaveShape::Cylinder(CylinderField {
+                point: v3(vals, "M"),
+                dir: unit("D"),
+                alpha: p.f(vals, "alpha_c"),
+            }),
             WaveKind::Capsule => WaveShape::Capsule(capsule()),
             WaveKind::Beam => WaveShape::Beam(BeamField {
                 capsule: capsule(),

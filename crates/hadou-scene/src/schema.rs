@@ -24,7 +24,8 @@ const OBJECT_KINDS: &[&str] = &["box", "sphere", "plane", "gltf"];
 const OBJECT_COMMON: &[&str] = &["name", "kind", "position", "rotation", "scale", "color"];
 const WAVE_KINDS: &[&str] = &["sphere", "cylinder", "capsule", "beam", "helix", "trig", "bezier", "bspline"];
 const WAVE_COMMON: &[&str] = &["name", "kind", "rgba", "falloff", "core_radius"];
-const CURVE_COMMON: &[&str] = &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
+const CURVE_COMMON: &[&str] =
+    &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
 const TRACK_KEYS: &[&str] = &["target", "interpolation", "keys"];
 
 /// Default base colour of a wave: the yellow of 002 Fig. 4.1.
@@ -166,7 +167,9 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         for (&time, span) in track.times.iter().zip(spans) {
             let vals = scene.values_at(time);
             if let Err(msg) = check_all(&scene, &vals) {
-                return Err(src.track(span, format!("at t = {time} s (this key of `{}`): {msg}", track.target)));
+                return Err(
+                    src.track(span, format!("at t = {time} s (this key of `{}`): {msg}", track.target))
+                );
             }
         }
     }
@@ -175,7 +178,8 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
 
 /// Reads and checks `name`: present, a string of letters, digits, `_` and `-`, unique.
 fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &str) -> Res<String> {
-    let (name, span) = table.req_str("name", &format!("a unique name, used by tracks as `{what}.<name>.<key>`"))?;
+    let (name, span) =
+        table.req_str("name", &format!("a unique name, used by tracks as `{what}.<name>.<key>`"))?;
     if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
         return Err(table.src.value_err(
             &span,
@@ -186,7 +190,10 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
         let at = table.src.loc(first);
         return Err(table.src.duplicate(
             &span,
-            format!("duplicate {what} name \"{name}\" (first used at line {}); names must be unique", at.line),
+            format!(
+                "duplicate {what} name \"{name}\" (first used at line {}); names must be unique",
+                at.line
+            ),
         ));
     }
     names.insert(name.to_string(), span);
@@ -214,39 +221,46 @@ fn parse_object(
     let mut scratch_s = Vec::new();
     let mut scratch = ParamReader { values: &mut scratch_v, spans: &mut scratch_s };
     let mut shape_set = ParamSet::default();
-    let mesh = match kind {
-        "box" => {
-            scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
-            Arc::new(box_mesh(shape_set.arr(&scratch_v, "size")))
-        }
-        "plane" => {
-            scratch.add(t, &mut shape_set, "size", Shape::Vector(2), POSITIVE, Fallback::Value(&[10.0, 10.0]), false)?;
-            Arc::new(plane_mesh(shape_set.arr(&scratch_v, "size")))
-        }
-        "sphere" => {
-            scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
-            let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
-            Arc::new(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments))
-        }
-        _ => {
-            let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
-            let dir = t.src.path.parent().unwrap_or(Path::new(""));
-            let file = dir.join(rel);
-            match cache.get(&file) {
-                Some(m) => m.clone(),
-                None => {
-                    let mesh = crate::gltf_load::load_gltf(&file).map_err(|message| SceneError::Gltf {
-                        at: t.src.loc(&span),
-                        file: file.clone(),
-                        message,
-                    })?;
-                    let mesh = Arc::new(mesh);
-                    cache.insert(file, mesh.clone());
-                    mesh
+    let mesh =
+        match kind {
+            "box" => {
+                scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
+                Arc::new(box_mesh(shape_set.arr(&scratch_v, "size")))
+            }
+            "plane" => {
+                scratch.add(
+                    t,
+                    &mut shape_set,
+                    "size",
+                    Shape::Vector(2),
+                    POSITIVE,
+                    Fallback::Value(&[10.0, 10.0]),
+                    false,
+                )?;
+                Arc::new(plane_mesh(shape_set.arr(&scratch_v, "size")))
+            }
+            "sphere" => {
+                scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
+                let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
+                Arc::new(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments))
+            }
+            _ => {
+                let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
+                let dir = t.src.path.parent().unwrap_or(Path::new(""));
+                let file = dir.join(rel);
+                match cache.get(&file) {
+                    Some(m) => m.clone(),
+                    None => {
+                        let mesh = crate::gltf_load::load_gltf(&file).map_err(|message| {
+                            SceneError::Gltf { at: t.src.loc(&span), file: file.clone(), message }
+                        })?;
+                        let mesh = Arc::new(mesh);
+                        cache.insert(file, mesh.clone());
+                        mesh
+                    }
                 }
             }
-        }
-    };
+        };
 
     let mut params = ParamSet::default();
     rd.add(t, &mut params, "position", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
@@ -279,12 +293,8 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
         WaveKind::BSpline => &["points", "order", "knots"],
     };
     let is_curve = matches!(kind, WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline);
-    let allowed: Vec<&str> = WAVE_COMMON
-        .iter()
-        .chain(if is_curve { CURVE_COMMON } else { &[] })
-        .chain(extra)
-        .copied()
-        .collect();
+    let allowed: Vec<&str> =
+        WAVE_COMMON.iter().chain(if is_curve { CURVE_COMMON } else { &[] }).chain(extra).copied().collect();
     t.check_keys(&allowed)?;
 
     let falloff = match t.choice("falloff", &["faithful", "inverse-square"], Some("inverse-square"))? {
@@ -329,12 +339,37 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
                 }
                 rd.add(t, &mut p, "M2", V3, ANY, Fallback::Required("the head end"), false)?;
             } else {
-                let need = "the direction from M to the head; or give the head `M2` instead of `D` + `length`";
+                let need =
+                    "the direction from M to the head; or give the head `M2` instead of `D` + `length`";
                 rd.add(t, &mut p, "D", V3, dir, Fallback::Required(need), false)?;
-                rd.add(t, &mut p, "length", S, NONNEG, Fallback::Required("the distance from M to the head"), false)?;
+                rd.add(
+                    t,
+                    &mut p,
+                    "length",
+                    S,
+                    NONNEG,
+                    Fallback::Required("the distance from M to the head"),
+                    false,
+                )?;
             }
-            rd.add(t, &mut p, "alpha_s", S, NONNEG, Fallback::Required("the strength of the end spheres α_s"), false)?;
-            rd.add(t, &mut p, "alpha_c", S, NONNEG, Fallback::Required("the strength of the cylinder α_c"), false)?;
+            rd.add(
+                t,
+                &mut p,
+                "alpha_s",
+                S,
+                NONNEG,
+                Fallback::Required("the strength of the end spheres α_s"),
+                false,
+            )?;
+            rd.add(
+                t,
+                &mut p,
+                "alpha_c",
+                S,
+                NONNEG,
+                Fallback::Required("the strength of the cylinder α_c"),
+                false,
+            )?;
             if kind == WaveKind::Beam {
                 rd.add(t, &mut p, "head_alpha", S, NONNEG, Fallback::Value(&[0.0]), false)?;
                 rd.add(t, &mut p, "muzzle_alpha", S, NONNEG, Fallback::Value(&[0.0]), false)?;
@@ -358,7 +393,15 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
     match def.kind {
         WaveKind::Helix => {
             rd.add(t, p, "radius", S, NONNEG, Fallback::Required("the helix radius r"), false)?;
-            rd.add(t, p, "rate", S, ANY, Fallback::Required("the angular rate θ in radians per unit s"), false)?;
+            rd.add(
+                t,
+                p,
+                "rate",
+                S,
+                ANY,
+                Fallback::Required("the angular rate θ in radians per unit s"),
+                false,
+            )?;
             rd.add(t, p, "phase", S, ANY, Fallback::Value(&[0.0]), false)?;
             rd.add(t, p, "length", S, POSITIVE, Fallback::Required("the parameter range s_end"), false)?;
         }
@@ -383,7 +426,15 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
                 let order = t.opt_int("order", 2, n_points as i64)?.map_or(n_points.min(4), |v| v.0 as usize);
                 def.order = order as u32;
                 if let Some(v) = t.get("knots") {
-                    rd.add(t, p, "knots", Shape::List(1), Constraint::NonDecreasing, Fallback::Value(&[]), false)?;
+                    rd.add(
+                        t,
+                        p,
+                        "knots",
+                        Shape::List(1),
+                        Constraint::NonDecreasing,
+                        Fallback::Value(&[]),
+                        false,
+                    )?;
                     let want = n_points + order;
                     let got = p.find("knots").map_or(0, |q| q.len);
                     if got != want {
@@ -428,7 +479,8 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
     }
     rd.add(t, p, "epsilon", S, NONNEG, Fallback::Value(&[0.0]), false)?;
     if simpson {
-        def.integrator = IntegratorDef::Simpson { m: m.map_or(100, |v| v.0 as u32), n: n.map(|v| v.0 as u32) };
+        def.integrator =
+            IntegratorDef::Simpson { m: m.map_or(100, |v| v.0 as u32), n: n.map(|v| v.0 as u32) };
     }
     if let Err((key, msg)) = check_curve(def, p, rd.values) {
         return Err(t.src.value_err(&t.key_span(key), format!("{msg} in {}", t.what)));
@@ -470,7 +522,9 @@ fn check_curve(w: &WaveDef, p: &ParamSet, vals: &[f32]) -> Result<(), (&'static 
         if k.get(lo) >= k.get(n_points) {
             return Err((
                 "knots",
-                format!("`knots` must increase somewhere between entries {lo} and {n_points} (the curve's range)"),
+                format!(
+                    "`knots` must increase somewhere between entries {lo} and {n_points} (the curve's range)"
+                ),
             ));
         }
     }
@@ -560,7 +614,8 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
         return Err(format!("target \"{target}\" is not of the form `<entity>.<key>[index].<component>`"));
     }
     // key[i][j]
-    let (key, mut indices) = split_indices(rest[0]).ok_or_else(|| format!("bad index in target \"{target}\""))?;
+    let (key, mut indices) =
+        split_indices(rest[0]).ok_or_else(|| format!("bad index in target \"{target}\""))?;
     let Some(param) = set.find(key) else {
         let keys = set.keys();
         return Err(format!("{ent} has no animatable key `{key}`{}", hint(key, &keys, "keys")));
@@ -571,7 +626,11 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
             "y" | "g" => 1,
             "z" | "b" => 2,
             "w" | "a" => 3,
-            _ => return Err(format!("unknown component `.{comp}` in \"{target}\"; use .x/.y/.z/.w, .r/.g/.b/.a or [i]")),
+            _ => {
+                return Err(format!(
+                    "unknown component `.{comp}` in \"{target}\"; use .x/.y/.z/.w, .r/.g/.b/.a or [i]"
+                ))
+            }
         };
         if !matches!(param.shape, Shape::Vector(_)) {
             return Err(format!("`.{comp}` applies to vectors; select elements of `{key}` with [i]"));
@@ -646,16 +705,22 @@ fn parse_track(
         "smooth" => Interpolation::Smooth,
         _ => Interpolation::Linear,
     };
-    let keys_v: &Val<'_> =
-        t.get("keys").ok_or_else(|| t.src.missing(&t.span, format!("{what} needs `keys = [[time, value], …]`")))?;
+    let keys_v: &Val<'_> = t
+        .get("keys")
+        .ok_or_else(|| t.src.missing(&t.span, format!("{what} needs `keys = [[time, value], …]`")))?;
     let DeValue::Array(keys) = keys_v.get_ref() else {
         return Err(t.src.type_err(
             &keys_v.span(),
-            format!("`keys` in {what} must be an array of [time, value] pairs, got {}", type_name(keys_v.get_ref())),
+            format!(
+                "`keys` in {what} must be an array of [time, value] pairs, got {}",
+                type_name(keys_v.get_ref())
+            ),
         ));
     };
     if keys.is_empty() {
-        return Err(t.src.track(&keys_v.span(), format!("`keys` in {what} needs at least one [time, value] pair")));
+        return Err(t
+            .src
+            .track(&keys_v.span(), format!("`keys` in {what} needs at least one [time, value] pair")));
     }
     let mut times = Vec::new();
     let mut values = Vec::new();
@@ -666,19 +731,28 @@ fn parse_track(
             _ => {
                 return Err(t.src.track(
                     &key.span(),
-                    format!("each key of {what} must be a pair [time, value], e.g. [0.5, {}]", example(sel.shape)),
+                    format!(
+                        "each key of {what} must be a pair [time, value], e.g. [0.5, {}]",
+                        example(sel.shape)
+                    ),
                 ))
             }
         };
         let time = match number(pair[0].get_ref()) {
             Some(x) if x.is_finite() && x >= 0.0 => x as f32,
             Some(x) => {
-                return Err(t.src.value_err(&pair[0].span(), format!("key time in {what} must be finite and ≥ 0, got {x}")))
+                return Err(t.src.value_err(
+                    &pair[0].span(),
+                    format!("key time in {what} must be finite and ≥ 0, got {x}"),
+                ))
             }
             None => {
                 return Err(t.src.type_err(
                     &pair[0].span(),
-                    format!("key time in {what} must be a number of seconds, got {}", type_name(pair[0].get_ref())),
+                    format!(
+                        "key time in {what} must be a number of seconds, got {}",
+                        type_name(pair[0].get_ref())
+                    ),
                 ))
             }
         };
@@ -700,21 +774,16 @@ fn parse_track(
         }
         let plain: Vec<f32> = nums.iter().map(|x| x.0).collect();
         if let Err((i, msg)) = sel.rule.check(&plain, sel.first, sel.whole) {
-            let span = if matches!(sel.rule, Constraint::NonZero) { pair[1].span() } else { nums[i].1.clone() };
+            let span =
+                if matches!(sel.rule, Constraint::NonZero) { pair[1].span() } else { nums[i].1.clone() };
             return Err(t.src.value_err(&span, format!("{vwhat} {msg}")));
         }
         times.push(time);
         values.extend(plain);
         spans.push(key.span());
     }
-    let track = Track {
-        target: target.to_string(),
-        offset: sel.offset,
-        len: sel.len,
-        interpolation,
-        times,
-        values,
-    };
+    let track =
+        Track { target: target.to_string(), offset: sel.offset, len: sel.len, interpolation, times, values };
     Ok((track, spans))
 }
 

@@ -63,7 +63,9 @@ pub(crate) fn type_name(v: &DeValue<'_>) -> &'static str {
 /// The number a value holds, if it is an integer or a float (`nan`/`inf` come back non-finite).
 pub(crate) fn number(v: &DeValue<'_>) -> Option<f64> {
     match v {
-        DeValue::Integer(i) => i64::from_str_radix(&i.as_str().replace('_', ""), i.radix()).ok().map(|x| x as f64),
+        DeValue::Integer(i) => {
+            i64::from_str_radix(&i.as_str().replace('_', ""), i.radix()).ok().map(|x| x as f64)
+        }
         DeValue::Float(f) => Some(f.as_str().replace('_', "").parse::<f64>().unwrap_or(f64::NAN)),
         _ => None,
     }
@@ -78,21 +80,22 @@ pub(crate) fn read_numbers(
     broadcast: bool,
     what: &str,
 ) -> Res<Vec<(f32, Span)>> {
-    let one = |v: &Val<'_>, what: &str| -> Res<(f32, Span)> {
-        match number(v.get_ref()) {
-            Some(x) => {
-                let f = x as f32;
-                if x.is_finite() && !f.is_finite() {
-                    return Err(src.value_err(&v.span(), format!("{what} is too large for 32-bit floats: {x}")));
+    let one =
+        |v: &Val<'_>, what: &str| -> Res<(f32, Span)> {
+            match number(v.get_ref()) {
+                Some(x) => {
+                    let f = x as f32;
+                    if x.is_finite() && !f.is_finite() {
+                        return Err(
+                            src.value_err(&v.span(), format!("{what} is too large for 32-bit floats: {x}"))
+                        );
+                    }
+                    Ok((f, v.span()))
                 }
-                Ok((f, v.span()))
+                None => Err(src
+                    .type_err(&v.span(), format!("{what} must be a number, got {}", type_name(v.get_ref())))),
             }
-            None => Err(src.type_err(
-                &v.span(),
-                format!("{what} must be a number, got {}", type_name(v.get_ref())),
-            )),
-        }
-    };
+        };
     let vector = |v: &Val<'_>, n: usize, what: &str| -> Res<Vec<(f32, Span)>> {
         match v.get_ref() {
             DeValue::Array(a) if a.len() == n => a.iter().map(|x| one(x, what)).collect(),
@@ -187,13 +190,17 @@ impl<'t, 'i> Table<'t, 'i> {
 
     /// A required string.
     pub(crate) fn req_str(&self, key: &str, meaning: &str) -> Res<(&'t str, Span)> {
-        self.opt_str(key)?.ok_or_else(|| {
-            self.src.missing(&self.span, format!("{} needs `{key}` ({meaning})", self.what))
-        })
+        self.opt_str(key)?
+            .ok_or_else(|| self.src.missing(&self.span, format!("{} needs `{key}` ({meaning})", self.what)))
     }
 
     /// A string that must be one of `options`; `default` when absent (`None`: required).
-    pub(crate) fn choice(&self, key: &str, options: &[&'static str], default: Option<&'static str>) -> Res<&'static str> {
+    pub(crate) fn choice(
+        &self,
+        key: &str,
+        options: &[&'static str],
+        default: Option<&'static str>,
+    ) -> Res<&'static str> {
         let got = match (self.opt_str(key)?, default) {
             (Some(s), _) => s,
             (None, Some(d)) => return Ok(d),
@@ -334,7 +341,9 @@ impl ParamReader<'_> {
             }
             (None, Fallback::Value(d)) => d.iter().map(|&x| (x, table.span.clone())).collect(),
             (None, Fallback::Required(meaning)) => {
-                return Err(table.src.missing(&table.span, format!("{} needs `{key}` ({meaning})", table.what)))
+                return Err(table
+                    .src
+                    .missing(&table.span, format!("{} needs `{key}` ({meaning})", table.what)))
             }
         };
         let offset = self.values.len();

@@ -15,7 +15,8 @@ fn at(e: &SceneError) -> (usize, usize) {
     (l.line, l.col)
 }
 
-const WAVE: &str = "[[wave]]\nname = \"beam\"\nkind = \"capsule\"\nM = [0.0, 0.0, 0.0]\nM2 = [1.0, 0.0, 0.0]\n";
+const WAVE: &str =
+    "[[wave]]\nname = \"beam\"\nkind = \"capsule\"\nM = [0.0, 0.0, 0.0]\nM2 = [1.0, 0.0, 0.0]\n";
 
 #[test]
 fn unknown_key_suggests_the_nearest() {
@@ -78,13 +79,15 @@ fn non_finite_and_negative_values_are_rejected() {
     assert!(e.to_string().contains("must be ≥ 0, got -2"), "{e}");
     let e = err("[camera]\nposition = [0.0, inf, 1.0]\n");
     assert_eq!(at(&e), (2, 18));
-    let e = err("[[wave]]\nname = \"s\"\nkind = \"sphere\"\nM = [0, 0, 0]\nalpha_s = 1\nrgba = [1, 1, 1, 1.5]\n");
+    let e =
+        err("[[wave]]\nname = \"s\"\nkind = \"sphere\"\nM = [0, 0, 0]\nalpha_s = 1\nrgba = [1, 1, 1, 1.5]\n");
     assert_eq!(at(&e), (6, 18));
 }
 
 #[test]
 fn zero_vectors_are_rejected() {
-    let e = err("[[wave]]\nname = \"c\"\nkind = \"cylinder\"\nM = [0, 0, 0]\nD = [0.0, 0.0, 0.0]\nalpha_c = 1\n");
+    let e =
+        err("[[wave]]\nname = \"c\"\nkind = \"cylinder\"\nM = [0, 0, 0]\nD = [0.0, 0.0, 0.0]\nalpha_c = 1\n");
     assert_eq!(at(&e), (5, 5));
     assert!(e.to_string().contains("zero vector"), "{e}");
     let e = err("[light]\ndirection = [0, 0, 0]\n");
@@ -125,7 +128,9 @@ fn missing_keys_point_at_the_table() {
     assert!(e.to_string().contains("needs `alpha_s`"), "{e}");
     let e = err("[[wave]]\nname = \"s\"\n");
     assert!(e.to_string().contains("needs `kind`, one of \"sphere\""), "{e}");
-    let e = err("[[wave]]\nname = \"b\"\nkind = \"beam\"\nM = [0, 0, 0]\nD = [1, 0, 0]\nalpha_s = 1\nalpha_c = 1\n");
+    let e = err(
+        "[[wave]]\nname = \"b\"\nkind = \"beam\"\nM = [0, 0, 0]\nD = [1, 0, 0]\nalpha_s = 1\nalpha_c = 1\n",
+    );
     assert!(e.to_string().contains("needs `length`"), "{e}");
 }
 
@@ -191,7 +196,8 @@ fn track_errors() {
     let e = err(&format!("{base}[[track]]\ntarget = \"wave.beam.M2\"\nkeys = [[0, 1.0]]\n"));
     assert!(matches!(e, SceneError::Type { .. }), "{e:?}");
     assert_eq!(at(&e), (10, 13));
-    let e = err(&format!("{base}[[track]]\ntarget = \"wave.beam.M2.z\"\nkeys = [[0, 1.0], [2, 3], [1, 2]]\n"));
+    let e =
+        err(&format!("{base}[[track]]\ntarget = \"wave.beam.M2.z\"\nkeys = [[0, 1.0], [2, 3], [1, 2]]\n"));
     assert_eq!(at(&e), (10, 28));
     assert!(e.to_string().contains("increase strictly: 1 follows 2"), "{e}");
     let e = err(&format!("{base}[[track]]\ntarget = \"wave.beam.alpha_s\"\nkeys = [[0, 1.0], [1, -3]]\n"));
@@ -220,8 +226,9 @@ fn missing_files_have_no_position() {
 #[test]
 fn garbage_never_panics() {
     // Every prefix of a valid scene either parses or errors.
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/fig4-14-occlusion.toml"))
-        .expect("scene file");
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/fig4-14-occlusion.toml"))
+            .expect("scene file");
     for cut in (0..text.len()).filter(|&i| text.is_char_boundary(i)) {
         let _ = Scene::parse(&text[..cut], Path::new("cut.toml"));
     }
