@@ -42,3 +42,45 @@ fn tiled_wide_image_matches_cpu() {
     // Wider than one tile: two tiles side by side, odd sizes, so tile seams and edges are covered.
     check("tiled", &occlusion_frame(hadou_gpu::MAX_TILE + 77, 37));
 }
+
+/// Every example scene, at the start, middle and end of its animation, at 128×96.
+///
+/// GAP(curves): the GPU backend does not draw curved waves yet, so they are left out of both
+/// renders (the scenery and the analytic waves of those scenes are still compared); the test says
+/// how many it left out.
+#[test]
+fn every_example_scene_matches_cpu() {
+    let Some(mut gpu) = gpu_or_skip("example scenes") else { return };
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    assert!(!paths.is_empty(), "no scenes in {dir}");
+    let mut cpu = CpuBackend::new();
+    for path in paths {
+        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+        let d = scene.duration();
+        for t in [0.0, 0.5 * d, d] {
+            let mut frame = scene.at(t);
+            frame.width = 128;
+            frame.height = 96;
+            let before = frame.waves.len();
+            frame.waves.retain(|w| !matches!(w.shape, hadou_scene::WaveShape::Curve(_)));
+            let left_out = before - frame.waves.len();
+            let label = format!("{name} t={t}");
+            if left_out > 0 {
+                eprintln!("{label}: {left_out} curved wave(s) left out (not drawn on the GPU yet)");
+            }
+            let g = gpu.render(&frame).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
+            let c = cpu.render(&frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
+            assert_close(&label, &compare(&g, &c));
+            if d == 0.0 {
+                break;
+            }
+        }
+    }
+}
