@@ -99,3 +99,17 @@ fn figure_scenes_use_the_thesis_colours_and_modes() {
     assert_eq!(pos[1], hadou_math::Vec3f::new(10.0, 0.0, 10.0));
     assert!(s.duration() > 1.0);
 }
+
+#[test]
+fn the_documented_example_parses() {
+    let root = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+    let doc = std::fs::read_to_string(root.join("docs/scene-format.md")).expect("docs/scene-format.md");
+    let start = doc.rfind("```toml\n").expect("a toml example") + "```toml\n".len();
+    let len = doc[start..].find("```").expect("closed block");
+    // As if it lived in scenes/, so the glTF path resolves.
+    let scene = Scene::parse(&doc[start..start + len], &root.join("scenes/doc-example.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.wave_names(), vec!["beam", "spiral"]);
+    assert_eq!(scene.duration(), 2.0);
+    check_finite(&scene.at(1.0), "doc example");
+}
