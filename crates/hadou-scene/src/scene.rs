@@ -271,7 +271,7 @@ impl Scene {
         }
     }
 
-    fn build_curve(&self, w: &WaveDef, vals: &[f32]) -> CurveWave {
+    pub(crate) fn build_curve(&self, w: &WaveDef, vals: &[f32]) -> CurveWave {
         let p = &w.params;
         let base = &self.values;
         let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));

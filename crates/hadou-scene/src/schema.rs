@@ -130,12 +130,14 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
 
     // [[wave]]
     let mut waves: Vec<WaveDef> = Vec::new();
+    let mut wave_tables = Vec::new();
     let mut names: HashMap<String, Span> = HashMap::new();
     for (i, (t, span)) in root.array_of_tables("wave")?.into_iter().enumerate() {
         let table = Table { src, t, span, what: format!("[[wave]] #{}", i + 1) };
         let name = entity_name(&table, &mut names, "wave")?;
         let table = Table { what: format!("[[wave]] \"{name}\""), ..table };
         waves.push(parse_wave(&table, name, &mut rd)?);
+        wave_tables.push(table);
     }
 
     let mut scene = Scene {
@@ -152,6 +154,13 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         waves,
         tracks: Vec::new(),
     };
+
+    // The curve maths' own rules (limits on control points, order, terms, …), on the file's values.
+    for (w, table) in scene.waves.iter().zip(&wave_tables) {
+        if let Err((key, msg)) = validate_curve(&scene, w, &scene.values) {
+            return Err(src.value_err(&table.key_span(key), format!("`{key}` in {} {msg}", table.what)));
+        }
+    }
 
     // [[track]]
     let mut targets: HashMap<String, Span> = HashMap::new();
@@ -531,6 +540,24 @@ fn check_curve(w: &WaveDef, p: &ParamSet, vals: &[f32]) -> Result<(), (&'static 
     Ok(())
 }
 
+/// [`hadou_math::curve::CurveWave::validate`] on the curve built from `vals` (a no-op for analytic
+/// waves); the error names the scene-file key.
+fn validate_curve(scene: &Scene, w: &WaveDef, vals: &[f32]) -> Result<(), (&'static str, String)> {
+    if matches!(w.kind, WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam) {
+        return Ok(());
+    }
+    scene.build_curve(w, vals).validate().map_err(|e| {
+        let key = match e.field {
+            "origin" => "O",
+            "axis" => "D",
+            "extension" => "k",
+            "attenuation" => "j",
+            other => other,
+        };
+        (key, e.message)
+    })
+}
+
 /// Every cross-key rule of the scene, for the values at one time.
 fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
     check_camera(&scene.camera, vals).map_err(|e| format!("{} in [camera]", e.1))?;
@@ -548,7 +575,10 @@ fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
                     return Err(format!("`D` in {what} must not be the zero vector"));
                 }
             }
-            _ => check_curve(w, &w.params, vals).map_err(|e| format!("{} in {what}", e.1))?,
+            _ => {
+                check_curve(w, &w.params, vals).map_err(|e| format!("{} in {what}", e.1))?;
+                validate_curve(scene, w, vals).map_err(|(key, msg)| format!("`{key}` in {what} {msg}"))?;
+            }
         }
     }
     Ok(())

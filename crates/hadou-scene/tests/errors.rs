@@ -233,3 +233,17 @@ fn garbage_never_panics() {
         let _ = Scene::parse(&text[..cut], Path::new("cut.toml"));
     }
 }
+
+#[test]
+fn curve_limits_of_the_maths_are_reported_at_the_key() {
+    let pts: Vec<String> = (0..65).map(|i| format!("[{i}, 0]")).collect();
+    let text = format!(
+        "[[wave]]\nname = \"z\"\nkind = \"bezier\"\nO = [0, 0, 0]\nD = [1, 0, 0]\nalpha = 1\npoints = [{}]\n",
+        pts.join(", ")
+    );
+    let e = err(&text);
+    assert!(matches!(e, SceneError::Value { .. }), "{e:?}");
+    assert_eq!(at(&e), (7, 1));
+    assert!(e.to_string().contains("`points` in [[wave]] \"z\""), "{e}");
+    assert!(e.to_string().contains("64"), "{e}");
+}
