@@ -2,12 +2,60 @@
 //! with the view ray by cross-section, integrated numerically.
 //!
 //! The public types here are the contract the scene and the backends build against.
+//!
+//! # Model (SPEC.md §1.4)
+//! A curve lives in a local frame ([`CurveFrame`]): `c(s) = O + γ s·D + y(s)·ŷ + z(s)·ẑ`
+//! (002 eq. 3.14). A ray point `P` with axial coordinate `x = (P − O)·D` is paired with the curve
+//! point in the same cross-section, `c(x/γ)` (002 §3.4.2, SPEC.md reading note); with the
+//! extension `k` (002 eq. 3.24) only `s ∈ [0, k·s_end]` exists, so with `X = γ k s_end` points
+//! with `x > X` pair with the head `c(k·s_end)` and points with `x < 0` with `c(0)`: round ends.
+//! The density is `α / sqrt(r² + r_c²)` ([`Falloff::Faithful`], 002 eq. 3.17) or
+//! `α / (r² + r_c²)` ([`Falloff::InverseSquare`]), `r = |P − paired point|`, times the attenuation
+//! `(1 − u)^j`, `u = t / t_far` (002 eq. 3.23; 0 for `u ≥ 1` when `j > 0`).
+//!
+//! Inside the slab `0 ≤ x ≤ X` the paired point lies in `P`'s own cross-section, so `r` is the 2-D
+//! distance `|P_⊥ − c_⊥(x/γ)|`; outside it is the 3-D distance to an end point. The field is
+//! continuous across both end planes.
+//!
+//! # Integrators
+//! - [`Integrator::Simpson`]: the thesis's composite Simpson rule with optional bounding-cylinder
+//!   reduction ([`simpson`]); reproduces its banding.
+//! - [`Integrator::Default`]: exact integrals over straight pieces chosen adaptively per ray from
+//!   a precomputed tree of polylines ([`integrate`], [`PieceTable`]).
+//! - [`curve_energy_reference`]: converged `f64` adaptive Gauss–Kronrod on the exact field.
+//!
+//! [`Falloff::Faithful`]: crate::energy::Falloff::Faithful
+//! [`Falloff::InverseSquare`]: crate::energy::Falloff::InverseSquare
+
+mod closed;
+pub mod integrate;
+mod prepare;
+mod reference;
+mod shape;
+pub mod simpson;
+mod validate;
+
+pub use integrate::{curve_energy, CurveSample};
+pub use prepare::{prepare, try_prepare, PieceTable, PreparedCurve};
+pub use reference::curve_energy_reference;
+pub use shape::clamped_uniform_knots;
+pub use validate::CurveError;
 
 use crate::{Real, Vec3};
 
+/// Highest B-spline order `k` supported (per-ray evaluation keeps the basis in fixed-size arrays).
+pub const MAX_ORDER: usize = 16;
+/// Most control points of a Bézier curve (degree ≤ 63).
+pub const MAX_BEZIER_POINTS: usize = 64;
+/// Most control points of a B-spline.
+pub const MAX_BSPLINE_POINTS: usize = 4096;
+/// Most terms in each trigonometric sum.
+pub const MAX_TRIG_TERMS: usize = 1024;
+/// Largest number of Simpson subintervals `m`.
+pub const MAX_SIMPSON_M: u32 = 100_000;
+
 /// The local frame of a curve: launch point `O`, unit travel axis `D`, and an up vector that fixes
-/// the cross-section axes (`y` = the part of `up` perpendicular to `D`, `z = D × y`... see
-/// [`CurveFrame::axes`]).
+/// the cross-section axes; see [`CurveFrame::axes`] for the exact construction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CurveFrame<R> {
     /// Launch point `O`.
@@ -16,6 +64,31 @@ pub struct CurveFrame<R> {
     pub axis: Vec3<R>,
     /// Up vector (need not be unit or perpendicular to `D`; must not be parallel to it).
     pub up: Vec3<R>,
+}
+
+impl<R: Real> CurveFrame<R> {
+    /// The orthonormal, right-handed frame `(D, ŷ, ẑ)`: `D = axis/|axis|`,
+    /// `ŷ = normalize(up − (up·D)·D)` (Gram–Schmidt), `ẑ = D × ŷ`. A curve point with local
+    /// coordinates `(x, y, z)` is `O + x·D + y·ŷ + z·ẑ`.
+    ///
+    /// `None` when the axis is zero or not finite, or `up` is parallel to it (see
+    /// [`CurveWave::validate`]).
+    pub fn axes(&self) -> Option<[Vec3<R>; 3]> {
+        let d = self.axis.try_normalize()?;
+        let up = self.up;
+        let upl = up.length();
+        if !(upl > R::ZERO && upl.is_finite()) {
+            return None;
+        }
+        let perp = up - d * up.dot(d);
+        // Parallel (within ~1e-6 rad in f64, ~1e-3 in f32): the cross-section axes are undefined.
+        if perp.length() <= upl * R::from_f64(1e-6).max(R::EPSILON * R::from_f64(64.0)) {
+            return None;
+        }
+        let y = perp.try_normalize()?;
+        let z = d.cross(y);
+        Some([d, y, z])
+    }
 }
 
 /// The shape of a curve across its axis: `c(s) = (γ s, y(s), z(s))` in the local frame.
@@ -106,6 +179,3 @@ pub struct CurveWave {
     /// Integration method.
     pub integrator: Integrator,
 }
-
-#[allow(dead_code)]
-fn _assert_real<R: Real>() {}

@@ -1,0 +1,504 @@
+//! hadou's default curve integrator, and the per-ray entry point [`curve_energy`] that dispatches
+//! on [`Integrator`].
+//!
+//! # Method
+//! The ray `P(t) = S + t·Q` is split where its axial coordinate `x(t)` crosses the end planes
+//! `x = 0` and `x = X` (002 eq. 3.24): before and after the slab the paired point is fixed (`c(0)`
+//! or the head), so those parts are exact sphere integrals. Inside the slab the curve is replaced
+//! by straight chords in `x`; on a chord both `P_⊥(t)` and the paired chord point are linear in
+//! `t`, so `|P − C|² + r_c²` is a quadratic in `t` and the chord's integral is exact in closed form
+//! (asinh/log for faithful `1/r`, atan for `1/r²`; see `closed.rs`): the same forms as the
+//! analytic fields (002 eq. 3.9, SPEC.md §1.2).
+//!
+//! Which chords: the [`PieceTable`] is a binary tree of polylines. The walk starts at the root
+//! chord and, for each chord overlapping the ray's `x`-range, accepts it if its deviation bound
+//! `δ` satisfies `δ ≤ τ·√(d_min² + r_c²)`, where `d_min` is the chord's closest approach to the
+//! ray over the overlap (the quadratic's clamped minimum): the relative error of a piece is about
+//! `δ/d`, so accepting at `τ` keeps every piece, and hence the sum, within `≈ τ` relative.
+//! Otherwise it descends to the two half-chords. Near the curve the walk reaches fine leaves,
+//! far from it a few coarse chords cover everything: the bounding-cylinder distinction of the
+//! thesis (002 §3.4.4) becomes continuous, and since every accepted piece is within tolerance
+//! there is no band where the resolution changes.
+//!
+//! The walk is stackless (the tree is implicit in the piece indices), iterates in a loop bounded
+//! by the table size, and touches only flat arrays: the form the GPU mirrors.
+//!
+//! Attenuation `(1 − t/t_far)^j` (002 eq. 3.23) is integrated on every piece by Gauss–Legendre
+//! nodes placed uniformly in the piece's own cumulative weight (see `closed.rs`).
+//!
+//! # Counting evaluations
+//! [`CurveSample::evaluations`] counts, per ray: 1 for every chord or end piece whose quadratic
+//! is formed (whether accepted or refined), plus 1 per attenuation node (each is a
+//! transcendental evaluation of its own). Simpson counts one per integrand sample.
+
+use super::closed::Segment;
+use super::prepare::PreparedCurve;
+use super::shape::ShapeEval;
+use super::{simpson, Integrator};
+use crate::energy::{Falloff, FieldParams, Ray};
+use crate::{Real, Vec3};
+
+/// One ray's curve energy and the work it took.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurveSample {
+    /// `α ∫ w(r(t))·(1 − t/t_far)^j dt` over the span.
+    pub energy: f32,
+    /// Integrand evaluations (see the module docs for the count rule).
+    pub evaluations: u32,
+}
+
+/// Tuning of the default integrator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DefaultSettings {
+    /// Relative deviation `τ` a chord may have from the curve, measured against its distance to
+    /// the ray (see the module docs).
+    pub tolerance: f64,
+    /// Most Gauss–Legendre nodes per piece for the attenuation factor (1–3).
+    pub attenuation_nodes: u32,
+    /// Grid step in `u = t/t_far` at which pieces are split when attenuating (`1/64 ..= 1`).
+    pub attenuation_grid: f64,
+}
+
+/// The settings [`Integrator::Default`] uses, chosen by measurement (see the crate's benchmark
+/// notes): `τ = 2·10⁻³`, 2 attenuation nodes.
+pub const DEFAULT_SETTINGS: DefaultSettings =
+    DefaultSettings { tolerance: 5e-4, attenuation_nodes: 3, attenuation_grid: 0.125 };
+
+/// The energy of one ray through a prepared curve, by the wave's integrator (002 §3.4).
+///
+/// `ray`, `t0`, `t1`, `t_far` come from the scene's wave-ray construction: for
+/// [`Falloff::Faithful`] `ray.dir = Q = E − S` and `t_far = 1`; for [`Falloff::InverseSquare`]
+/// `ray.dir` is a unit vector, `t_far` the far point's distance, and `t1` may be `+∞`.
+/// `[t0, t1]` is the span clipped at the visible surface (002 §3.3.5). Non-finite or empty input
+/// gives 0; the result is always finite.
+pub fn curve_energy(
+    c: &PreparedCurve,
+    p: &FieldParams<f32>,
+    ray: &Ray<f32>,
+    t0: f32,
+    t1: f32,
+    t_far: f32,
+) -> CurveSample {
+    let (e, n) = curve_energy_generic(c, p, ray, t0, t1, t_far);
+    CurveSample { energy: e, evaluations: n }
+}
+
+/// [`curve_energy`] in `f64`: the same algorithm, for tests that separate its own error from
+/// `f32` rounding.
+pub fn curve_energy_f64(
+    c: &PreparedCurve,
+    p: &FieldParams<f64>,
+    ray: &Ray<f64>,
+    t0: f64,
+    t1: f64,
+    t_far: f64,
+) -> (f64, u32) {
+    curve_energy_generic(c, p, ray, t0, t1, t_far)
+}
+
+fn curve_energy_generic<R: CurveReal>(
+    c: &PreparedCurve,
+    p: &FieldParams<R>,
+    ray: &Ray<R>,
+    t0: R,
+    t1: R,
+    t_far: R,
+) -> (R, u32) {
+    match c.wave.integrator {
+        Integrator::Simpson { m, reduction } => {
+            simpson::simpson_generic(c, p, ray, t0, t1, t_far, m, reduction)
+        }
+        Integrator::Default => default_generic(c, p, ray, t0, t1, t_far, &DEFAULT_SETTINGS),
+    }
+}
+
+/// The default integrator with explicit settings, in `f32` (for measurements and tuning).
+pub fn default_energy(
+    c: &PreparedCurve,
+    p: &FieldParams<f32>,
+    ray: &Ray<f32>,
+    t0: f32,
+    t1: f32,
+    t_far: f32,
+    settings: &DefaultSettings,
+) -> CurveSample {
+    let (e, n) = default_generic(c, p, ray, t0, t1, t_far, settings);
+    CurveSample { energy: e, evaluations: n }
+}
+
+/// The precisions the curve integrators run in (`f32` renders, `f64` checks).
+pub(crate) trait CurveReal: Real {
+    /// The shape evaluator in this precision.
+    fn shape(c: &PreparedCurve) -> &ShapeEval<Self>;
+}
+impl CurveReal for f32 {
+    fn shape(c: &PreparedCurve) -> &ShapeEval<f32> {
+        &c.shape32
+    }
+}
+impl CurveReal for f64 {
+    fn shape(c: &PreparedCurve) -> &ShapeEval<f64> {
+        &c.shape64
+    }
+}
+
+/// A ray in the curve's local frame, with the span and the attenuation resolved.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LocalRay<R> {
+    /// Eye in local coordinates `(x, y, z)`.
+    pub o: Vec3<R>,
+    /// Direction in local coordinates.
+    pub q: Vec3<R>,
+    /// Span start.
+    pub t0: R,
+    /// Span end (finite unless inverse square without attenuation).
+    pub t1: R,
+    /// Far point parameter (`> 0`).
+    pub t_far: R,
+    /// Attenuation exponent `j` (0: none).
+    pub j: R,
+    /// Effective core radius squared.
+    pub rc2: R,
+    /// Density law.
+    pub falloff: Falloff,
+    /// Strength `α`.
+    pub alpha: R,
+    /// Axial length `X`.
+    pub x_head: R,
+}
+
+impl<R: Real> LocalRay<R> {
+    /// Resolves the span: `None` if it is empty or the input is not finite.
+    ///
+    /// Faithful mode integrates at most to the far point (`t1 = ∞` means `t_far`); with attenuation
+    /// `j > 0` the factor is 0 from the far point on, so the span ends there.
+    pub(crate) fn new(
+        c: &PreparedCurve,
+        p: &FieldParams<R>,
+        ray: &Ray<R>,
+        t0: R,
+        t1: R,
+        t_far: R,
+    ) -> Option<Self> {
+        if !(ray.origin.is_finite() && ray.dir.is_finite() && t0.is_finite() && !t1.to_f64().is_nan()) {
+            return None;
+        }
+        let t_far = if t_far.is_finite() && t_far > R::ZERO { t_far } else { R::ONE };
+        let j = R::from_f64(f64::from(c.wave.attenuation));
+        let mut t1 = t1;
+        if p.falloff == Falloff::Faithful && !t1.is_finite() {
+            t1 = t_far;
+        }
+        if j > R::ZERO {
+            t1 = t1.min(t_far);
+        }
+        if !(t1 > t0) {
+            return None;
+        }
+        let o64 = c.origin;
+        let conv = |v: Vec3<f64>| Vec3::new(R::from_f64(v.x), R::from_f64(v.y), R::from_f64(v.z));
+        let [d, y, z] = c.axes.map(conv);
+        let w = ray.origin - conv(o64);
+        Some(LocalRay {
+            o: Vec3::new(w.dot(d), w.dot(y), w.dot(z)),
+            q: Vec3::new(ray.dir.dot(d), ray.dir.dot(y), ray.dir.dot(z)),
+            t0,
+            t1,
+            t_far,
+            j,
+            rc2: {
+                let rc = c.effective_core_radius(p.core_radius);
+                rc * rc
+            },
+            falloff: p.falloff,
+            alpha: R::from_f64(f64::from(c.wave.alpha)),
+            x_head: R::from_f64(c.x_head),
+        })
+    }
+
+    /// Local point at `t`.
+    #[inline]
+    pub(crate) fn at(&self, t: R) -> Vec3<R> {
+        self.o + self.q * t
+    }
+
+    /// Attenuation `(1 − t/t_far)^j` (002 eq. 3.23), 0 beyond the far point, 1 for `j = 0`.
+    #[inline]
+    pub(crate) fn attenuation(&self, t: R) -> R {
+        if self.j == R::ZERO {
+            return R::ONE;
+        }
+        let u = R::ONE - t / self.t_far;
+        if u <= R::ZERO {
+            R::ZERO
+        } else {
+            u.powf(self.j)
+        }
+    }
+
+    /// The `t` where the ray crosses the end planes, in ray order, with the end point met before
+    /// the slab (`false` = `c(0)`, `true` = the head) — or `None` when `x` is constant.
+    #[inline]
+    pub(crate) fn slab(&self) -> Option<(R, R, bool)> {
+        let qx = self.q.x;
+        if qx == R::ZERO {
+            return None;
+        }
+        let ta = -self.o.x / qx;
+        let tb = (self.x_head - self.o.x) / qx;
+        Some(if qx > R::ZERO { (ta, tb, false) } else { (tb, ta, true) })
+    }
+}
+
+/// Accumulates pieces: energy and evaluation count.
+struct Acc<R> {
+    sum: R,
+    evals: u32,
+    /// Most attenuation nodes per piece.
+    nodes: usize,
+    /// Attenuation grid step in `u = t/t_far` (pieces are split at its multiples).
+    grid: R,
+}
+
+impl<R: Real> Acc<R> {
+    /// Adds the piece `d(τ) = p + vτ`, `τ ∈ [0, dt]`, starting at ray parameter `ts`.
+    ///
+    /// With attenuation, the piece is split where `u = t/t_far` crosses a multiple of the grid
+    /// step, so that no part sees a large change of `(1 − u)^j`. On each part the attenuation's
+    /// linear interpolant is integrated exactly (weight centroid) and the remainder by 0 to
+    /// `nodes` Gauss–Legendre nodes in the weight's measure, chosen by the relative change of the
+    /// attenuation over the part, `ν = j·Δu / max(1 − u_end, Δu)`: none below 0.02, 1 below 0.2,
+    /// else `nodes`. A part counts `3 + nodes` evaluations (closed form, two ends, nodes).
+    #[inline]
+    fn piece(&mut self, r: &LocalRay<R>, ts: R, p: Vec3<R>, v: Vec3<R>, dt: R) {
+        if r.j == R::ZERO {
+            self.sum += Segment::new(r.falloff, p, v, dt, r.rc2).value;
+            self.evals += 1;
+            return;
+        }
+        // j > 0: the span ends at the far point, so the piece is finite.
+        let te = ts + dt;
+        let step = self.grid * r.t_far;
+        let mut k = R::from_f64((ts / step).to_f64().floor()) + R::ONE;
+        let mut a = ts;
+        // j > 0 ends the span at the far point, so at most 1/grid + 1 grid lines lie inside a
+        // span starting at t ≥ 0; the bound also ends any other span, with one last long part.
+        for i in 0..70 {
+            let line = k * step;
+            let b = if line < te && i < 69 { line } else { te };
+            let sub = b - a;
+            if sub > R::ZERO {
+                let seg = Segment::new(r.falloff, p + v * (a - ts), v, sub, r.rc2);
+                let du = sub / r.t_far;
+                let nu = r.j * du / (R::ONE - b / r.t_far).max(du);
+                let n = if nu < R::from_f64(0.02) {
+                    0
+                } else if nu < R::from_f64(0.2) {
+                    1.min(self.nodes)
+                } else {
+                    self.nodes
+                };
+                self.sum += seg.attenuated(a, n, |t| r.attenuation(t));
+                self.evals += 3 + n as u32;
+                a = b;
+            }
+            if b >= te {
+                break;
+            }
+            k += R::ONE;
+        }
+    }
+}
+
+/// The default integrator, generic over the precision.
+pub(crate) fn default_generic<R: CurveReal>(
+    c: &PreparedCurve,
+    p: &FieldParams<R>,
+    ray: &Ray<R>,
+    t0: R,
+    t1: R,
+    t_far: R,
+    settings: &DefaultSettings,
+) -> (R, u32) {
+    let Some(r) = LocalRay::new(c, p, ray, t0, t1, t_far) else {
+        return (R::ZERO, 0);
+    };
+    let mut acc = Acc {
+        sum: R::ZERO,
+        evals: 0,
+        nodes: settings.attenuation_nodes.clamp(1, 3) as usize,
+        grid: R::from_f64(settings.attenuation_grid.clamp(1.0 / 64.0, 1.0)),
+    };
+    integrate_span(c, &r, r.t0, r.t1, settings, &mut acc);
+    let e = acc.sum * r.alpha;
+    (if e.is_finite() { e } else { R::ZERO }, acc.evals)
+}
+
+/// `∫_{ta}^{tb}` of the (unscaled) density, by end pieces and the chord walk.
+fn integrate_span<R: Real>(
+    c: &PreparedCurve,
+    r: &LocalRay<R>,
+    ta: R,
+    tb: R,
+    settings: &DefaultSettings,
+    acc: &mut Acc<R>,
+) {
+    let table = &c.table;
+    let n = table.nodes.len() - 1;
+    let end_point = |head: bool| {
+        let nd = if head { table.nodes[n] } else { table.nodes[0] };
+        let x = if head { r.x_head } else { R::ZERO };
+        Vec3::new(x, R::from_f64(f64::from(nd[1])), R::from_f64(f64::from(nd[2])))
+    };
+    let sphere = |head: bool, a: R, b: R, acc: &mut Acc<R>| {
+        if b > a {
+            acc.piece(r, a, r.at(a) - end_point(head), r.q, b - a);
+        }
+    };
+    match r.slab() {
+        None => {
+            if r.o.x < R::ZERO {
+                sphere(false, ta, tb, acc);
+            } else if r.o.x > r.x_head {
+                sphere(true, ta, tb, acc);
+            } else {
+                walk(c, r, ta, tb, settings, acc);
+            }
+        }
+        Some((tin, tout, head_first)) => {
+            sphere(head_first, ta, tb.min(tin), acc);
+            let (a, b) = (ta.max(tin), tb.min(tout));
+            if b > a {
+                walk(c, r, a, b, settings, acc);
+            }
+            sphere(!head_first, ta.max(tout), tb, acc);
+        }
+    }
+}
+
+/// Node `i` as `(x, y, z)`.
+#[inline]
+fn node<R: Real>(c: &PreparedCurve, i: usize) -> [R; 3] {
+    let nd = c.table.nodes[i];
+    [R::from_f64(f64::from(nd[0])), R::from_f64(f64::from(nd[1])), R::from_f64(f64::from(nd[2]))]
+}
+
+/// The leaf containing `x` (binary search over the nodes).
+#[inline]
+pub(crate) fn leaf_of<R: Real>(c: &PreparedCurve, x: R) -> usize {
+    let n = c.table.nodes.len() - 1;
+    let (mut lo, mut hi) = (0usize, n - 1);
+    while hi > lo {
+        let mid = (lo + hi).div_ceil(2);
+        if node::<R>(c, mid)[0] <= x {
+            lo = mid;
+        } else {
+            hi = mid - 1;
+        }
+    }
+    lo
+}
+
+/// The chord walk over the slab part `[ta, tb]` of the span (see the module docs).
+fn walk<R: Real>(
+    c: &PreparedCurve,
+    r: &LocalRay<R>,
+    ta: R,
+    tb: R,
+    settings: &DefaultSettings,
+    acc: &mut Acc<R>,
+) {
+    let table = &c.table;
+    let n = table.nodes.len() - 1;
+    let levels = table.levels();
+    let xh = r.x_head;
+    let xa = (r.o.x + r.q.x * ta).clamp(R::ZERO, xh);
+    let xb = (r.o.x + r.q.x * tb).clamp(R::ZERO, xh);
+    let (lo, hi, t_lo, t_hi) = if xa <= xb { (xa, xb, ta, tb) } else { (xb, xa, tb, ta) };
+    let tol = R::from_f64(settings.tolerance);
+    let yz = |t: R| (r.o.y + r.q.y * t, r.o.z + r.q.z * t);
+
+    // x (nearly) constant along the span: one piece against the fixed paired point.
+    if !(hi - lo > xh * R::from_f64(1e-6)) || !(tb - ta).is_finite() {
+        let xm = (lo + hi) * R::HALF;
+        let i = leaf_of(c, xm);
+        let (a, b) = (node::<R>(c, i), node::<R>(c, i + 1));
+        let f = ((xm - a[0]) / (b[0] - a[0])).clamp(R::ZERO, R::ONE);
+        let (py, pz) = yz(ta);
+        let p = Vec3::new(R::ZERO, py - (a[1] + (b[1] - a[1]) * f), pz - (a[2] + (b[2] - a[2]) * f));
+        acc.piece(r, ta, p, Vec3::new(R::ZERO, r.q.y, r.q.z), tb - ta);
+        return;
+    }
+
+    let t_of = |x: R| {
+        if x == lo {
+            t_lo
+        } else if x == hi {
+            t_hi
+        } else {
+            t_lo + (x - lo) / r.q.x
+        }
+    };
+    let (mut l, mut j) = (levels - 1, 0usize);
+    // Each piece is visited at most once and refined at most once: a hard bound for the loop.
+    let max_steps = 4 * (table.errors.len() + levels);
+    for _ in 0..max_steps {
+        let a = j << l;
+        let b = ((j + 1) << l).min(n);
+        let na = node::<R>(c, a);
+        let nb = node::<R>(c, b);
+        if na[0] >= hi {
+            break;
+        }
+        let mut descend = false;
+        if nb[0] > lo {
+            let x0 = lo.max(na[0]);
+            let x1 = hi.min(nb[0]);
+            let (tx0, tx1) = (t_of(x0), t_of(x1));
+            let (ts, te) = if tx0 <= tx1 { (tx0, tx1) } else { (tx1, tx0) };
+            let ln = table.line(l, j);
+            let f = |k: usize| R::from_f64(f64::from(ln[k]));
+            let (ly, lz, my, mz) = (f(0), f(1), f(2), f(3));
+            let xs = r.o.x + r.q.x * ts - (na[0] + nb[0]) * R::HALF;
+            let (py, pz) = yz(ts);
+            let p = Vec3::new(R::ZERO, py - (ly + xs * my), pz - (lz + xs * mz));
+            let v = Vec3::new(R::ZERO, r.q.y - r.q.x * my, r.q.z - r.q.x * mz);
+            let dt = te - ts;
+            let err = R::from_f64(f64::from(table.error(l, j)));
+            let accept = l == 0 || {
+                // Closest approach d over the piece, the change ℓ = |v|Δt of the relative
+                // position, and the error estimate (δ/D)·min(1, (ℓ/D)²) + (δ/D)², D² = d² + r_c².
+                let vv = v.dot(v);
+                let tau = if vv > R::ZERO { (-p.dot(v) / vv).clamp(R::ZERO, dt) } else { R::ZERO };
+                let d = p + v * tau;
+                let d2 = d.dot(d) + r.rc2;
+                let e2 = err * err / d2;
+                let ell2 = vv * dt * dt / d2;
+                e2.sqrt() * ell2.min(R::ONE) + e2 <= tol
+            };
+            if accept {
+                acc.piece(r, ts, p, v, dt);
+            } else {
+                acc.evals += 1;
+                descend = true;
+            }
+        }
+        if descend {
+            l -= 1;
+            j *= 2;
+            continue;
+        }
+        // Advance to the next piece in x order: the right sibling, or up until there is one.
+        loop {
+            if l + 1 >= levels {
+                return;
+            }
+            if j & 1 == 0 && ((j + 1) << l) < n {
+                j += 1;
+                break;
+            }
+            j >>= 1;
+            l += 1;
+        }
+    }
+}
