@@ -3,7 +3,7 @@
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use hadou::output;
 use hadou::{Backend, CpuBackend, Frame, Image, RenderError, Scene};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Real-time anime energy waves from formulas.

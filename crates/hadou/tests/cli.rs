@@ -171,7 +171,7 @@ fn zero_length_vectors_are_rejected() {
 fn camera_ranges_are_checked() {
     assert_rejected("fov0", &GOOD.replace("fov = 45.0", "fov = 0.0"), 9, "fov");
     assert_rejected("fov180", &GOOD.replace("fov = 45.0", "fov = 180.0"), 9, "fov");
-    assert_rejected("nearfar", &GOOD.replace("near = 0.1", "near = 200.0"), 10, "near");
+    assert_rejected("nearfar", &GOOD.replace("near = 0.1", "near = 200.0"), 11, "near");
 }
 
 #[test]
