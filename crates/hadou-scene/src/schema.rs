@@ -501,7 +501,7 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
 fn check_camera(c: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)> {
     let (near, far) = (c.f(vals, "near"), c.f(vals, "far"));
     if near >= far {
-        return Err(("near", format!("`near` ({near}) must be less than `far` ({far})")));
+        return Err(("far", format!("`far` ({far}) must be greater than `near` ({near})")));
     }
     let eye = Vec3f::from_array(c.arr(vals, "position"));
     let target = Vec3f::from_array(c.arr(vals, "target"));

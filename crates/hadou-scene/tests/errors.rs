@@ -101,8 +101,8 @@ fn camera_ranges() {
     assert!(e.to_string().contains("must be in (0, 180)"), "{e}");
     assert_eq!(at(&err("[camera]\nfov = 0.0\n")), (2, 7));
     let e = err("[camera]\nnear = 5.0\nfar = 5.0\n");
-    assert_eq!(at(&e), (2, 1));
-    assert!(e.to_string().contains("`near` (5) must be less than `far` (5)"), "{e}");
+    assert_eq!(at(&e), (3, 1));
+    assert!(e.to_string().contains("`far` (5) must be greater than `near` (5)"), "{e}");
     let e = err("[camera]\nposition = [0, 0, 5]\ntarget = [0, 0, 5]\n");
     assert_eq!(at(&e), (3, 1));
     let e = err("[camera]\nposition = [0, 5, 0]\ntarget = [0, 0, 0]\nup = [0, 2, 0]\n");
