@@ -230,15 +230,15 @@ impl<R: Real> Segment<R> {
     }
 
     /// `∫₀^{Δt} w(τ)·g(t_start + τ) dτ`: the linear interpolant of `g` between the piece's ends
-    /// exactly (by the weight's [`centroid`](Self::centroid)), the remainder `g − g_lin` by
-    /// `nodes`-point Gauss–Legendre in the weight's cumulative measure (none for `nodes = 0`).
-    /// Costs `2 + nodes` evaluations of `g`. Finite pieces only.
+    /// (`ga = g(t_start)`, `gb = g(t_start + Δt)`) exactly, by the weight's
+    /// [`centroid`](Self::centroid), and the remainder `g − g_lin` by `nodes`-point
+    /// Gauss–Legendre in the weight's cumulative measure (none for `nodes = 0`), which costs
+    /// `nodes` evaluations of `g`. Finite pieces only.
     #[inline]
-    pub(crate) fn attenuated(&self, t_start: R, nodes: usize, g: impl Fn(R) -> R) -> R {
+    pub(crate) fn attenuated(&self, t_start: R, nodes: usize, ga: R, gb: R, g: impl Fn(R) -> R) -> R {
         if !(self.value > R::ZERO) {
             return R::ZERO;
         }
-        let (ga, gb) = (g(t_start), g(t_start + self.dt));
         let lin = |lam: R| ga + (gb - ga) * lam;
         let tbar = self.centroid();
         let mut acc = lin(if self.dt > R::ZERO { tbar / self.dt } else { R::HALF });

@@ -27,6 +27,12 @@
 //! [`Falloff::Faithful`]: crate::energy::Falloff::Faithful
 //! [`Falloff::InverseSquare`]: crate::energy::Falloff::InverseSquare
 
+#![allow(
+    clippy::neg_cmp_op_on_partial_ord,
+    reason = "`!(a > b)` is deliberate throughout: it is also true when a value is NaN, which must \
+              take the empty or fallback path"
+)]
+
 mod closed;
 pub mod integrate;
 mod prepare;
@@ -35,8 +41,8 @@ mod shape;
 pub mod simpson;
 mod validate;
 
-pub use integrate::{curve_energy, CurveSample};
-pub use prepare::{prepare, try_prepare, PieceTable, PreparedCurve};
+pub use integrate::{curve_energy, CurveSample, DefaultSettings, DEFAULT_SETTINGS};
+pub use prepare::{prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, MAX_PIECES, MIN_CORE};
 pub use reference::curve_energy_reference;
 pub use shape::clamped_uniform_knots;
 pub use validate::CurveError;

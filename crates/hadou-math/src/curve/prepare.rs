@@ -273,9 +273,9 @@ fn build_table(wave: &CurveWave, shape: &ShapeEval<f64>, s_head: f64, x_head: f6
             };
             let mut e: f64 = 0.0;
             let mut prev = node_dev(a);
-            for i in a..b {
+            for (i, leaf) in leaves.iter().enumerate().take(b).skip(a) {
                 let next = node_dev(i + 1);
-                e = e.max(leaves[i].2 + f64::max(prev, next));
+                e = e.max(leaf.2 + f64::max(prev, next));
                 prev = next;
             }
             errors.push((e + slack) as f32);
