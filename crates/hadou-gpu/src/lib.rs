@@ -27,6 +27,8 @@ mod pipelines;
 mod render;
 pub mod shaders;
 mod timing;
+#[cfg(test)]
+mod twins;
 
 pub use render::MAX_TILE;
 pub use timing::{FrameTiming, TimingMethod};

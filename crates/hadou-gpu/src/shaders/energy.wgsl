@@ -66,20 +66,21 @@ fn ray_quadratic(axis: RayAxis, v: vec3<f32>, rc2: f32) -> RayQuadratic {
     return RayQuadratic(axis.s, beta, max(d2 + rc2, H_FLOOR));
 }
 
-// f32::ln_1p for z > f32::EPSILON (WGSL has no log1p): a 5-term series below 1e-2 (relative
-// error < 2e-11), log(1 + z) above (relative error < 1.2e-5, far inside the backends' 1e-3).
-fn ln_1p(z: f32) -> f32 {
-    if (z < 1.0e-2) {
-        return z * (1.0 - z * (0.5 - z * (1.0 / 3.0 - z * (0.25 - z * 0.2))));
-    }
-    return log(1.0 + z);
+// f32::ln_1p for EPSILON < z < 1/16, where RayQuadratic::faithful uses it (WGSL has no log1p):
+// the alternating series to z⁸, relative error below z⁸/9 < 3e-11.
+fn ln_1p_small(z: f32) -> f32 {
+    return z * (1.0 - z * (0.5 - z * (1.0 / 3.0 - z * (0.25 - z * (0.2 - z * (1.0 / 6.0 - z * (1.0 / 7.0 - z * 0.125)))))));
 }
 
-// Mirrors RayQuadratic::faithful: ∫ dt / sqrt(Y² + H) as one ln_1p (002 eq. 3.8–3.9, corrected).
+// Mirrors RayQuadratic::faithful: ∫ dt / sqrt(Y² + H) as one logarithm (002 eq. 3.8–3.9,
+// corrected asinh antiderivative; the stable single-log form of the Rust doc comment).
 fn rq_faithful(q: RayQuadratic, t0_in: f32, t1_in: f32) -> f32 {
+    if (!(t1_in > t0_in)) {
+        return 0.0;
+    }
     let t0 = max(t0_in, -T_LIMIT);
     let t1 = min(t1_in, T_LIMIT);
-    if (!(t1 > t0)) {
+    if (t1 <= t0) {
         return 0.0;
     }
     let s = q.s;
@@ -90,25 +91,36 @@ fn rq_faithful(q: RayQuadratic, t0_in: f32, t1_in: f32) -> f32 {
     let r0 = sqrt(y0 * y0 + h);
     let r1 = sqrt(y1 * y1 + h);
     let sum = y0 + y1;
-    let qq = sum / (r0 + r1);
-    var k = 0.0;
+    let rs = r0 + r1;
+    // k = Δt·(1 ± q)/P with q = sum/rs, as one division: P₀ = y₀ + r₀ = H/(r₀ − y₀),
+    // N₁ = r₁ − y₁ = H/(r₁ + y₁).
+    var num = 0.0;
+    var a = 1.0;
+    var b = 0.0;
     if (sum >= 0.0) {
-        var p0 = y0 + r0;
-        if (y0 < 0.0) {
-            p0 = h / (r0 - y0);
+        if (y0 >= 0.0) {
+            b = y0 + r0;
+        } else {
+            a = r0 - y0;
+            b = h;
         }
-        k = dt * (1.0 + qq) / p0;
+        num = rs + sum;
     } else {
-        var n1 = r1 - y1;
-        if (y1 > 0.0) {
-            n1 = h / (r1 + y1);
+        if (y1 <= 0.0) {
+            b = r1 - y1;
+        } else {
+            a = r1 + y1;
+            b = h;
         }
-        k = dt * (1.0 - qq) / n1;
+        num = rs - sum;
     }
+    let k = dt * num * a / (rs * b);
     let z = s * k;
     var v = k;
-    if (z > F32_EPSILON) {
-        v = ln_1p(z) / s;
+    if (z >= 0.0625) {
+        v = log(1.0 + z) / s;
+    } else if (z > F32_EPSILON) {
+        v = ln_1p_small(z) / s;
     }
     return min(max(v, 0.0), ENERGY_MAX);
 }
@@ -180,7 +192,14 @@ struct CapsuleParts {
 
 // Mirrors hadou_math::energy::capsule_parts (private; 002 eq. 3.10–3.11): sphere around the first
 // end crossed, cylinder between the planes through M and M₂ with normal D, sphere around the other.
-fn capsule_parts(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> CapsuleParts {
+fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> CapsuleParts {
+    // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an end).
+    var t0 = 0.0;
+    var t1 = 0.0;
+    if (t1_in > t0_in) {
+        t0 = t0_in;
+        t1 = t1_in;
+    }
     let rc2 = p.core_radius * p.core_radius;
     let q = ray.dir;
     let w = ray.origin - m;

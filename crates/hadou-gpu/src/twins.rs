@@ -1,0 +1,271 @@
+//! The WGSL energy functions against their Rust twins, ray by ray, including the degenerate rays
+//! whole frames rarely hit exactly (through a centre, along or parallel to an axis, on a capsule's
+//! splitting plane, perpendicular to its axis, zero-length capsules, rays open to infinity).
+
+use crate::device::GpuContext;
+use crate::layout::{GpuWave, FALLOFF_FAITHFUL, WAVE_BEAM, WAVE_CAPSULE, WAVE_CYLINDER, WAVE_SPHERE};
+use crate::pipelines::compile_module;
+use crate::shaders;
+use bytemuck::{Pod, Zeroable};
+use hadou_math::energy::{
+    self, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
+};
+use hadou_math::{Vec3, Vec3f};
+use hadou_scene::RenderError;
+
+/// One test ray for one wave. `span = [t0, t1, open_end, 0]`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Case {
+    wave: GpuWave,
+    origin: [f32; 4],
+    dir: [f32; 4],
+    span: [f32; 4],
+}
+
+const KERNEL: &str = r#"
+struct Case {
+    wave: GpuWave,
+    origin: vec4<f32>,
+    dir: vec4<f32>,
+    span: vec4<f32>,
+}
+@group(0) @binding(0) var<storage, read> cases: array<Case>;
+@group(0) @binding(1) var<storage, read_write> results: array<f32>;
+
+@compute @workgroup_size(64, 1, 1)
+fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= arrayLength(&cases)) {
+        return;
+    }
+    let c = cases[id.x];
+    let w = c.wave;
+    let p = FieldParams(w.falloff, w.core_radius);
+    let ray = Ray(c.origin.xyz, c.dir.xyz);
+    let t0 = c.span.x;
+    var t1 = c.span.y;
+    if (c.span.z != 0.0) {
+        t1 = T_OPEN;
+    }
+    var e = 0.0;
+    switch w.kind {
+        case WAVE_SPHERE: { e = sphere_energy(p, ray, t0, t1, w.p0.xyz, w.p0.w); }
+        case WAVE_CYLINDER: { e = cylinder_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p0.w); }
+        case WAVE_CAPSULE: { e = capsule_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w); }
+        default: { e = beam_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z); }
+    }
+    results[id.x] = e;
+}
+"#;
+
+/// Runs the WGSL energy functions on `cases`.
+fn run_gpu(ctx: &GpuContext, cases: &[Case]) -> Result<Vec<f32>, RenderError> {
+    use wgpu::util::DeviceExt;
+    let source = shaders::compose(&[shaders::COMMON, shaders::ENERGY, KERNEL]);
+    let module = compile_module(ctx, "energy twins", &source)?;
+    let bytes = (cases.len() * 4) as u64;
+    let (pipeline, input, output, staging) = ctx.scoped("setting up the twin test", || {
+        let d = &ctx.device;
+        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("energy twins"),
+            layout: None,
+            module: &module,
+            entry_point: Some("twin_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("cases"),
+            contents: bytemuck::cast_slice(cases),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let buffer = |usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size: bytes,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let staging = buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        (pipeline, input, output, staging)
+    })?;
+    let submission = ctx.scoped("running the twin test", || {
+        let d = &ctx.device;
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
+        }
+        enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
+        ctx.queue.submit([enc.finish()])
+    })?;
+    ctx.read_buffer(&staging, bytes, submission, |raw| {
+        raw.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
+    })
+}
+
+/// The Rust twin of one case.
+fn run_cpu(c: &Case) -> f32 {
+    let w = &c.wave;
+    let v = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+    let falloff = if w.falloff == FALLOFF_FAITHFUL { Falloff::Faithful } else { Falloff::InverseSquare };
+    let p = FieldParams { falloff, core_radius: w.core_radius };
+    let ray = Ray { origin: v(c.origin), dir: v(c.dir) };
+    let t0 = c.span[0];
+    let t1 = if c.span[2] != 0.0 { f32::INFINITY } else { c.span[1] };
+    let capsule =
+        CapsuleField { m: v(w.p0), d: v(w.p1), length: w.p2[0], alpha_s: w.p0[3], alpha_c: w.p1[3] };
+    match w.kind {
+        WAVE_SPHERE => {
+            energy::sphere_energy(&p, &ray, t0, t1, &SphereField { center: v(w.p0), alpha: w.p0[3] })
+        }
+        WAVE_CYLINDER => {
+            let f = CylinderField { point: v(w.p0), dir: v(w.p1), alpha: w.p0[3] };
+            energy::cylinder_energy(&p, &ray, t0, t1, &f)
+        }
+        WAVE_CAPSULE => energy::capsule_energy(&p, &ray, t0, t1, &capsule),
+        _ => {
+            let f = BeamField { capsule, head_alpha: w.p2[1], muzzle_alpha: w.p2[2] };
+            energy::beam_energy(&p, &ray, t0, t1, &f)
+        }
+    }
+}
+
+/// A deterministic generator (splitmix64) for the random part of the cases.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.next()
+    }
+    fn vec(&mut self, r: f32) -> Vec3f {
+        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
+    }
+}
+
+fn wave(kind: u32, falloff: u32, core: f32, p0: [f32; 4], p1: [f32; 4], p2: [f32; 4]) -> GpuWave {
+    GpuWave { color: [1.0; 4], kind, falloff, core_radius: core, _pad: 0, p0, p1, p2 }
+}
+
+fn cases() -> Vec<Case> {
+    let mut out = Vec::new();
+    let mut add = |w: GpuWave, o: Vec3f, d: Vec3f, t0: f32, t1: Option<f32>| {
+        out.push(Case {
+            wave: w,
+            origin: [o.x, o.y, o.z, 0.0],
+            dir: [d.x, d.y, d.z, 0.0],
+            span: [t0, t1.unwrap_or(0.0), if t1.is_none() { 1.0 } else { 0.0 }, 0.0],
+        })
+    };
+    let eye = Vec3::new(0.0, 0.0, 20.0);
+    let x = Vec3f::X;
+    for falloff in [FALLOFF_FAITHFUL, 1] {
+        // Faithful rays are Q = E − S (|Q| ~ far); inverse-square rays are unit, maybe open-ended.
+        let scale = if falloff == FALLOFF_FAITHFUL { 100.0 } else { 1.0 };
+        let t1 = |g: f32| if falloff == FALLOFF_FAITHFUL { Some(g) } else { Some(g * 100.0) };
+        let open = if falloff == FALLOFF_FAITHFUL { Some(1.0) } else { None };
+        let toward = |p: Vec3f| (p - eye).normalize_or(x) * scale;
+        for core in [0.0, 0.02] {
+            // Through a sphere's centre, and just beside it.
+            let sph = wave(WAVE_SPHERE, falloff, core, [0.0, 0.0, 0.0, 2.0], [0.0; 4], [0.0; 4]);
+            add(sph, eye, toward(Vec3::ZERO), 0.0, open);
+            add(sph, eye, toward(Vec3::new(1e-4, 0.0, 0.0)), 0.0, open);
+            add(sph, eye, toward(Vec3::ZERO), 0.0, t1(0.1));
+            // Along, and parallel to, a cylinder's axis (the integrand is constant); perpendicular.
+            let cyl =
+                wave(WAVE_CYLINDER, falloff, core, [0.0, 0.0, 0.0, 1.5], [0.0, 0.0, 1.0, 0.0], [0.0; 4]);
+            add(cyl, eye, Vec3::new(0.0, 0.0, -scale), 0.0, t1(0.3));
+            add(cyl, eye + Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, 0.0, -scale), 0.0, t1(0.3));
+            add(cyl, eye, toward(Vec3::new(3.0, 1.0, 0.0)), 0.0, open);
+            // Capsule along x from (−5, 0, 0), length 10: ray perpendicular to D (D·Q = 0) inside,
+            // before and beyond the ends; a ray in a splitting plane; a zero-length capsule.
+            let cap = wave(
+                WAVE_CAPSULE,
+                falloff,
+                core,
+                [-5.0, 0.0, 0.0, 3.0],
+                [1.0, 0.0, 0.0, 3.0],
+                [10.0, 0.0, 0.0, 0.0],
+            );
+            for px in [0.0, -8.0, 9.0, -5.0, 5.0] {
+                let o = Vec3::new(px, 2.0, 20.0);
+                add(cap, o, Vec3::new(0.0, -0.1, -1.0).normalize_or(x) * scale, 0.0, open);
+            }
+            add(cap, eye, toward(Vec3::new(-5.0, 0.0, 0.0)), 0.0, open);
+            let point =
+                wave(WAVE_CAPSULE, falloff, core, [1.0, 1.0, 0.0, 3.0], [0.0, 1.0, 0.0, 3.0], [0.0; 4]);
+            add(point, eye, toward(Vec3::new(1.0, 1.0, 0.0)), 0.0, open);
+            add(point, eye, toward(Vec3::new(1.3, 1.0, 0.0)), 0.0, open);
+            // Empty span.
+            add(cap, eye, toward(Vec3::ZERO), 0.0, Some(0.0));
+        }
+        // Random rays and shapes.
+        let mut rng = Rng(0x5EED + falloff as u64);
+        for i in 0..400 {
+            let core = if i % 3 == 0 { 0.0 } else { rng.range(0.0, 0.2) };
+            let m = rng.vec(5.0);
+            let d = rng.vec(1.0).normalize_or(x);
+            let len = rng.range(0.0, 12.0);
+            let kind = [WAVE_SPHERE, WAVE_CYLINDER, WAVE_CAPSULE, WAVE_BEAM][i % 4];
+            let w = wave(
+                kind,
+                falloff,
+                core,
+                [m.x, m.y, m.z, rng.range(0.1, 20.0)],
+                [d.x, d.y, d.z, rng.range(0.1, 20.0)],
+                [len, rng.range(0.0, 5.0), rng.range(0.0, 5.0), 0.0],
+            );
+            let o = eye + rng.vec(3.0);
+            let target = m + d * rng.range(-2.0, len + 2.0) + rng.vec(1.0);
+            let end = if rng.next() < 0.5 { open } else { t1(rng.range(0.05, 0.5)) };
+            add(w, o, (target - o).normalize_or(x) * scale, 0.0, end);
+        }
+    }
+    out
+}
+
+#[test]
+fn wgsl_energy_functions_match_their_rust_twins() {
+    let ctx = match GpuContext::new() {
+        Ok(c) => c,
+        Err(RenderError::NoDevice(m)) => {
+            assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{m}");
+            eprintln!("SKIPPED energy twins: no GPU adapter ({m})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    let cases = cases();
+    let gpu = run_gpu(&ctx, &cases).expect("GPU twin run");
+    let mut worst = 0.0f32;
+    let mut lit = 0;
+    for (i, (c, g)) in cases.iter().zip(&gpu).enumerate() {
+        let r = run_cpu(c);
+        assert!(g.is_finite() && r.is_finite(), "case {i}: gpu {g} cpu {r} ({c:?})");
+        // 1e-3 relative (the backends' energy tolerance), absolute below 1e-6.
+        let err = (g - r).abs() / r.abs().max(1e-6);
+        assert!(err <= 1e-3, "case {i}: gpu {g} cpu {r}, rel {err:.2e} ({c:?})");
+        worst = worst.max(err);
+        lit += usize::from(r > 1e-3);
+    }
+    assert!(lit * 2 > cases.len(), "most cases must carry real energy ({lit} of {})", cases.len());
+    eprintln!("{} cases, worst relative difference {worst:.2e}", cases.len());
+}
