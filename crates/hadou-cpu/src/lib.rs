@@ -44,6 +44,7 @@ pub fn render(frame: &Frame) -> Image {
     let mut img = Image::new(frame.width, frame.height);
     let w = frame.width as usize;
     let far = frame.camera.far;
+    let curves = waves::prepare_curves(frame);
     img.color
         .par_chunks_mut(w)
         .zip(img.energy.par_chunks_mut(w))
@@ -57,14 +58,15 @@ pub fn render(frame: &Frame) -> Image {
                 let surface = opaque.surface[i];
                 let mut light = [0.0f32; 3];
                 let mut total = 0.0f32;
-                for wave in &frame.waves {
-                    let (e, _) = waves::wave_energy(frame, &basis, wave, px, py, surface);
+                for (wave, prep) in frame.waves.iter().zip(&curves) {
+                    let (e, _) = waves::wave_energy(frame, &basis, wave, prep.as_ref(), px, py, surface);
                     waves::accumulate(&mut light, wave, e);
                     total += e;
                 }
                 col[x] = waves::compose(frame, opaque.color[i], light);
                 en[x] = total;
-                dep[x] = surface.unwrap_or_else(|| far * basis.pixel_dir(px, py, frame.width, frame.height).length());
+                dep[x] = surface
+                    .unwrap_or_else(|| far * basis.pixel_dir(px, py, frame.width, frame.height).length());
             }
         });
     img
@@ -110,8 +112,9 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();
-    for wave in &frame.waves {
-        let (e, n) = waves::wave_energy(frame, &basis, wave, x as f32, y as f32, surface);
+    let curves = waves::prepare_curves(frame);
+    for (wave, prep) in frame.waves.iter().zip(&curves) {
+        let (e, n) = waves::wave_energy(frame, &basis, wave, prep.as_ref(), x as f32, y as f32, surface);
         waves::accumulate(&mut light, wave, e);
         out.push(WaveProbe { name: wave.name.clone(), energy: e, evaluations: n });
     }

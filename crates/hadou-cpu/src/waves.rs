@@ -1,17 +1,32 @@
 //! The wave pass: each pixel's energy integrals, clipped at the visible surface (002 §3.3.5), and
 //! the colour mapping.
 
+use hadou_math::curve::{self, PreparedCurve};
 use hadou_math::energy::{self, FieldParams};
 use hadou_math::shade;
 use hadou_scene::{CameraBasis, Frame, ToneMode, Wave, WaveShape};
 
+/// Per-frame preparation of the curved waves (piece tables, bounds), one entry per wave, `None`
+/// for analytic waves.
+pub(crate) fn prepare_curves(frame: &Frame) -> Vec<Option<PreparedCurve>> {
+    frame
+        .waves
+        .iter()
+        .map(|w| match &w.shape {
+            WaveShape::Curve(c) => Some(curve::prepare(c)),
+            _ => None,
+        })
+        .collect()
+}
+
 /// Energy of one wave along pixel `(px, py)`'s ray, and the number of integrand evaluations it
-/// took (1 per closed-form piece family for the analytic shapes).
+/// took (closed-form pieces count one each for the analytic shapes).
 #[inline]
 pub(crate) fn wave_energy(
     frame: &Frame,
     basis: &CameraBasis,
     wave: &Wave,
+    prepared: Option<&PreparedCurve>,
     px: f32,
     py: f32,
     surface: Option<f32>,
@@ -24,7 +39,18 @@ pub(crate) fn wave_energy(
         WaveShape::Cylinder(f) => (energy::cylinder_energy(&p, ray, t0, t1, f), 1),
         WaveShape::Capsule(f) => (energy::capsule_energy(&p, ray, t0, t1, f), 3),
         WaveShape::Beam(f) => (energy::beam_energy(&p, ray, t0, t1, f), 5),
-        WaveShape::Curve(_) => (0.0, 0),
+        WaveShape::Curve(c) => {
+            let owned;
+            let prep = match prepared {
+                Some(p) => p,
+                None => {
+                    owned = curve::prepare(c);
+                    &owned
+                }
+            };
+            let r = curve::curve_energy(prep, &p, ray, t0, t1, wr.t_far);
+            (r.energy, r.evaluations)
+        }
     };
     (if e.is_finite() { e.max(0.0) } else { 0.0 }, n)
 }

@@ -81,7 +81,8 @@ mode = "filmic"
              rgba = [0.8, 0.8, 0.2, 1.0]\n{extra}"
         )
     };
-    let capsule = format!("M = [-10.0, 0.0, 0.0]\nM2 = [10.0, 0.0, 0.0]\nalpha_s = {alpha}\nalpha_c = {alpha}\n");
+    let capsule =
+        format!("M = [-10.0, 0.0, 0.0]\nM2 = [10.0, 0.0, 0.0]\nalpha_s = {alpha}\nalpha_c = {alpha}\n");
     match shape {
         "sphere" => s += &wave("sphere", &format!("M = [0.0, 0.0, 0.0]\nalpha_s = {alpha}\n")),
         "capsule" => s += &wave("capsule", &capsule),
@@ -122,11 +123,14 @@ pub fn analytic_frame(shape: &str, falloff: &str, size: u32, occlusion: bool) ->
     Ok(scene.at(0.0))
 }
 
+/// A timer: renders `frame` once untimed, then `iterations` timed times, and returns the median
+/// milliseconds per frame.
+pub type Timer<'a> = dyn FnMut(&Frame, u32) -> Result<f64, RenderError> + 'a;
+
 /// Measures the analytic table: for each shape and falloff, each size, plus occlusion at the
-/// largest size. `time` renders a frame and returns milliseconds; the median of `iterations`
-/// timed runs after one warm-up is kept.
+/// largest size.
 pub fn analytic_table(
-    time: &mut dyn FnMut(&Frame) -> Result<f64, RenderError>,
+    time: &mut Timer<'_>,
     sizes: &[u32],
     iterations: u32,
     backend: &str,
@@ -141,7 +145,7 @@ pub fn analytic_table(
             cases.push((largest, true));
             for (size, occlusion) in cases {
                 let frame = analytic_frame(shape, falloff, size, occlusion)?;
-                let ms = median_ms(time, &frame, iterations)?;
+                let ms = time(&frame, iterations)?;
                 cells.push(Cell { size, occlusion, ms });
             }
             rows.push(Row { shape: shape.into(), falloff: falloff.into(), cells });
@@ -150,16 +154,18 @@ pub fn analytic_table(
     Ok(Table { backend: backend.into(), method: method.into(), iterations, rows })
 }
 
-/// Median of `iterations` timed calls after one warm-up.
+/// Median wall-clock milliseconds of `iterations` calls of `render` after one warm-up.
 pub fn median_ms(
-    time: &mut dyn FnMut(&Frame) -> Result<f64, RenderError>,
+    render: &mut dyn FnMut(&Frame) -> Result<(), RenderError>,
     frame: &Frame,
     iterations: u32,
 ) -> Result<f64, RenderError> {
-    time(frame)?;
+    render(frame)?;
     let mut v = Vec::with_capacity(iterations as usize);
     for _ in 0..iterations.max(1) {
-        v.push(time(frame)?);
+        let t = std::time::Instant::now();
+        render(frame)?;
+        v.push(t.elapsed().as_secs_f64() * 1e3);
     }
     v.sort_by(|a, b| a.total_cmp(b));
     Ok(v[v.len() / 2])
@@ -175,8 +181,7 @@ impl Table {
         if let Some(r) = self.rows.first() {
             out += &format!("{:<16} {:<15}", "shape", "falloff");
             for c in &r.cells {
-                let label =
-                    if c.occlusion { format!("occl. {}²", c.size) } else { format!("{}²", c.size) };
+                let label = if c.occlusion { format!("occl. {}²", c.size) } else { format!("{}²", c.size) };
                 out += &format!(" {:>22}", label);
             }
             out += "\n";

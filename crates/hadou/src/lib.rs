@@ -16,5 +16,6 @@ pub mod bench;
 pub mod output;
 
 pub use hadou_cpu::{probe, CpuBackend, Probe, WaveProbe};
+pub use hadou_gpu::GpuBackend;
 pub use hadou_math as math;
 pub use hadou_scene::*;

@@ -2,7 +2,7 @@
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use hadou::output;
-use hadou::{Backend, CpuBackend, Frame, Image, RenderError, Scene};
+use hadou::{Backend, CpuBackend, Frame, GpuBackend, Image, RenderError, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -52,7 +52,7 @@ struct RenderArgs {
     #[arg(long)]
     height: Option<u32>,
     /// Which backend renders.
-    #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
+    #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
 }
 
@@ -92,8 +92,12 @@ struct BenchArgs {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum BackendChoice {
+    /// A hardware GPU if there is one, otherwise the CPU reference (faster than a software GPU).
+    Auto,
     /// The CPU reference backend.
     Cpu,
+    /// The wgpu backend (any adapter, including software Vulkan).
+    Gpu,
 }
 
 /// A failure with the exit code it maps to: 2 for bad input, 1 for everything else.
@@ -177,7 +181,46 @@ fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>) -> Result<Fra
 fn make_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, Failure> {
     match choice {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new())),
+        BackendChoice::Gpu => Ok(Box::new(GpuBackend::new()?)),
+        BackendChoice::Auto => Ok(match GpuBackend::new() {
+            Ok(g) if !g.is_software() => Box::new(g),
+            Ok(g) => {
+                eprintln!(
+                    "note: only a software GPU adapter ({}) is available; using the faster CPU backend",
+                    g.adapter_name()
+                );
+                Box::new(CpuBackend::new())
+            }
+            Err(e) => {
+                eprintln!("note: no GPU backend ({e}); falling back to the CPU backend");
+                Box::new(CpuBackend::new())
+            }
+        }),
     }
+}
+
+/// A bench timer for the chosen backend, its name and how it measures.
+fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>>, String, String), Failure> {
+    let gpu = match choice {
+        BackendChoice::Cpu => None,
+        BackendChoice::Gpu => Some(GpuBackend::new()?),
+        BackendChoice::Auto => GpuBackend::new().ok().filter(|g| !g.is_software()),
+    };
+    if let Some(mut gpu) = gpu {
+        let name = format!("gpu ({})", gpu.adapter_name());
+        let method = if gpu.has_timestamps() {
+            "GPU timestamp queries, excluding read-back"
+        } else {
+            "submit-and-wait wall clock (no timestamp queries on this adapter), excluding read-back"
+        };
+        let timer = move |f: &Frame, n: u32| gpu.time_frame(f, n).map(|t| t.median_ms);
+        return Ok((Box::new(timer), name, method.into()));
+    }
+    let mut cpu = CpuBackend::new();
+    let timer =
+        move |f: &Frame, n: u32| hadou::bench::median_ms(&mut |f: &Frame| cpu.render(f).map(|_| ()), f, n);
+    let threads = rayon::current_num_threads();
+    Ok((Box::new(timer), format!("cpu ({threads} threads)"), "wall clock, whole render".into()))
 }
 
 /// Parses `A..B` (B excluded) or `A..=B`.
@@ -213,7 +256,13 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         let image = backend.render(&frame)?;
         check_finite(&image)?;
         output::write(&image, &a.output)?;
-        eprintln!("wrote {} ({}×{}, {} backend)", a.output.display(), image.width, image.height, backend.name());
+        eprintln!(
+            "wrote {} ({}×{}, {} backend)",
+            a.output.display(),
+            image.width,
+            image.height,
+            backend.name()
+        );
         return Ok(());
     };
     let range = parse_frames(frames)?;
@@ -259,7 +308,8 @@ fn check_finite(image: &Image) -> Result<(), Failure> {
 }
 
 fn parse_pixel(s: &str) -> Result<(u32, u32), Failure> {
-    let bad = || Failure::input(format!("--pixel {s}: expected `X,Y` with non-negative integers, e.g. 256,128"));
+    let bad =
+        || Failure::input(format!("--pixel {s}: expected `X,Y` with non-negative integers, e.g. 256,128"));
     let (x, y) = s.split_once(',').ok_or_else(bad)?;
     Ok((x.trim().parse().map_err(|_| bad())?, y.trim().parse().map_err(|_| bad())?))
 }
@@ -302,14 +352,8 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
     if a.iterations == 0 {
         return Err(Failure::input("--iterations 0: need at least one timed repetition"));
     }
-    let mut backend = make_backend(a.backend)?;
-    let name = backend.name().to_string();
-    let mut time = |frame: &Frame| -> Result<f64, RenderError> {
-        let t = std::time::Instant::now();
-        backend.render(frame)?;
-        Ok(t.elapsed().as_secs_f64() * 1e3)
-    };
-    let table = hadou::bench::analytic_table(&mut time, &a.sizes, a.iterations, &name, "wall clock, whole render")?;
+    let (mut timer, name, method) = make_timer(a.backend)?;
+    let table = hadou::bench::analytic_table(&mut *timer, &a.sizes, a.iterations, &name, &method)?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&table.to_json()).unwrap_or_default());
     } else {
@@ -317,4 +361,3 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
     }
     Ok(())
 }
-

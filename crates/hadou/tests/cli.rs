@@ -92,8 +92,7 @@ fn the_good_scene_validates_renders_png_and_exr_and_probes() {
     let o = hadou(&["render", s, "-o", exr.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let img = exr::prelude::read_all_flat_layers_from_file(&exr).unwrap();
-    let names: Vec<String> =
-        img.layer_data[0].channel_data.list.iter().map(|c| c.name.to_string()).collect();
+    let names: Vec<String> = img.layer_data[0].channel_data.list.iter().map(|c| c.name.to_string()).collect();
     for n in ["R", "G", "B", "A", "energy", "depth"] {
         assert!(names.iter().any(|m| m == n), "{names:?}");
     }
