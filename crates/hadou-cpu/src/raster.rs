@@ -59,8 +59,8 @@ pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis) -> OpaqueBuffers {
         if y0 > y1 {
             continue;
         }
-        for b in (y0 / BAND)..=(y1 / BAND) {
-            bins[b].push(i as u32);
+        for bin in &mut bins[(y0 / BAND)..=(y1 / BAND)] {
+            bin.push(i as u32);
         }
     }
     let mut color = vec![[0.0f32; 3]; w * h];
@@ -136,12 +136,11 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
                     object: oi as u32,
                 };
                 let mut ok = true;
-                for j in 0..3 {
-                    let z = pv[j].view.z;
-                    let iz = 1.0 / z;
+                for (j, v) in pv.iter().enumerate() {
+                    let iz = 1.0 / v.view.z;
                     t.inv_z[j] = iz;
-                    t.sx[j] = (pv[j].view.x * iz * sx_scale + 1.0) * 0.5 * w;
-                    t.sy[j] = (1.0 - pv[j].view.y * iz * sy_scale) * 0.5 * h;
+                    t.sx[j] = (v.view.x * iz * sx_scale + 1.0) * 0.5 * w;
+                    t.sy[j] = (1.0 - v.view.y * iz * sy_scale) * 0.5 * h;
                     ok &= t.sx[j].is_finite() && t.sy[j].is_finite() && iz.is_finite();
                 }
                 if ok {
@@ -212,6 +211,7 @@ fn owns_boundary(ax: f32, ay: f32, bx: f32, by: f32, sign: f32) -> bool {
     (dy == 0.0 && dx > 0.0) || dy < 0.0
 }
 
+#[allow(clippy::too_many_arguments)] // a hot inner routine: plain slices beat a bundling struct
 fn raster_tri(
     t: &ScreenTri,
     id: u32,
