@@ -2,7 +2,8 @@
 //!
 //! The scenes are built from scene-file text, so the bench measures exactly what users render.
 
-use hadou_scene::{Frame, RenderError, Scene};
+use hadou_math::curve::{self, Integrator, Reduction};
+use hadou_scene::{Frame, RenderError, Scene, WaveShape};
 use std::path::Path;
 
 /// One measured cell.
@@ -213,6 +214,206 @@ impl Table {
                     "fps": c.fps(),
                     "mpix_per_s": c.mpix_per_s(),
                 })).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// The curve shapes of the curve table and the example scene each is taken from (002 Fig. 4.2).
+pub const CURVE_SCENES: [(&str, &str); 4] = [
+    ("helix", "fig4-2-helix.toml"),
+    ("trig sum", "fig4-2-trig.toml"),
+    ("Bézier deg 4", "fig4-2-bezier.toml"),
+    ("B-spline", "fig4-2-bspline.toml"),
+];
+
+/// The integrators of the curve table: the thesis's Simpson at m = 100, 300, 500 without
+/// reduction and with reduction n = 2, 4 (ε = 0.25), then hadou's default.
+pub fn curve_integrators() -> Vec<(String, Integrator)> {
+    let mut v = Vec::new();
+    for m in [100, 300, 500] {
+        v.push((format!("simpson m={m}"), Integrator::Simpson { m, reduction: None }));
+        for n in [2, 4] {
+            let reduction = Some(Reduction { n, epsilon: 0.25 });
+            v.push((format!("simpson m={m} n={n}"), Integrator::Simpson { m, reduction }));
+        }
+    }
+    v.push(("default".into(), Integrator::Default));
+    v
+}
+
+/// One row of the curve table.
+#[derive(Clone, Debug)]
+pub struct CurveRow {
+    /// Shape label.
+    pub shape: String,
+    /// Integrator label.
+    pub integrator: String,
+    /// Median milliseconds per frame, per size.
+    pub ms: Vec<(u32, f64)>,
+    /// Mean integrand evaluations per sampled pixel.
+    pub evals_per_pixel: f64,
+    /// 99th-percentile relative energy error of sampled pixels against the converged reference.
+    pub p99_error: f64,
+}
+
+/// The curve table (SPEC.md §1.5's second table with evaluation and error columns).
+#[derive(Clone, Debug)]
+pub struct CurveTable {
+    /// Backend name.
+    pub backend: String,
+    /// How time was measured.
+    pub method: String,
+    /// Rows.
+    pub rows: Vec<CurveRow>,
+}
+
+/// Replaces the integrator of every curved wave of `frame`.
+pub fn with_integrator(frame: &Frame, integrator: Integrator) -> Frame {
+    let mut f = frame.clone();
+    for w in &mut f.waves {
+        if let WaveShape::Curve(c) = &mut w.shape {
+            c.integrator = integrator;
+        }
+    }
+    f
+}
+
+/// Evaluations per pixel and p99 relative error of `frame`'s curved waves on a 64 × 64 grid of
+/// pixels, against the f64 adaptive reference (relative tolerance 1e-9). Pixels whose reference
+/// energy is below 1e-4 of the grid's largest are left out of the error percentile (their
+/// relative error says nothing visible). The example curve scenes have no occluders, so rays run
+/// unclipped.
+pub fn curve_accuracy(frame: &Frame, reference: &[f64]) -> (f64, f64) {
+    let samples = sample_curve_energies(frame, None);
+    let evals = samples.iter().map(|s| s.1 as f64).sum::<f64>() / samples.len().max(1) as f64;
+    let peak = reference.iter().copied().fold(0.0, f64::max);
+    let mut errs: Vec<f64> = samples
+        .iter()
+        .zip(reference)
+        .filter(|(_, &r)| r > 1e-4 * peak)
+        .map(|((e, _, _), &r)| (*e as f64 - r).abs() / r)
+        .collect();
+    errs.sort_by(f64::total_cmp);
+    let p99 = if errs.is_empty() { 0.0 } else { errs[((errs.len() - 1) as f64 * 0.99).round() as usize] };
+    (evals, p99)
+}
+
+/// The converged f64 reference energy of `frame`'s curved waves on the 64 × 64 sample grid.
+pub fn curve_reference(frame: &Frame) -> Vec<f64> {
+    sample_curve_energies(frame, Some(1e-9)).into_iter().map(|s| s.2).collect()
+}
+
+/// Per sampled pixel: (f32 energy, evaluations, f64 reference energy if `reference_tol`).
+fn sample_curve_energies(frame: &Frame, reference_tol: Option<f64>) -> Vec<(f32, u32, f64)> {
+    use hadou_math::energy::{FieldParams, Ray};
+    let basis = frame.camera.basis(frame.width, frame.height);
+    let prepared: Vec<_> = frame
+        .waves
+        .iter()
+        .filter_map(|w| match &w.shape {
+            WaveShape::Curve(c) => Some((w, curve::prepare(c))),
+            _ => None,
+        })
+        .collect();
+    let grid = 64u32;
+    let mut out = Vec::with_capacity((grid * grid) as usize);
+    for gy in 0..grid {
+        for gx in 0..grid {
+            let px = ((gx as f32 + 0.5) * frame.width as f32 / grid as f32).floor();
+            let py = ((gy as f32 + 0.5) * frame.height as f32 / grid as f32).floor();
+            let (mut e, mut n, mut r) = (0.0f32, 0u32, 0.0f64);
+            for (w, c) in &prepared {
+                let wr = basis.wave_ray(w.falloff, frame.camera.far, px, py, frame.width, frame.height, None);
+                let p = FieldParams { falloff: w.falloff, core_radius: w.core_radius };
+                if let Some(tol) = reference_tol {
+                    let p64 = FieldParams { falloff: w.falloff, core_radius: w.core_radius as f64 };
+                    let ray = Ray { origin: wr.ray.origin.as_f64(), dir: wr.ray.dir.as_f64() };
+                    let (t0, t1, tf) = (wr.t0 as f64, wr.t1 as f64, wr.t_far as f64);
+                    r += curve::curve_energy_reference(c, &p64, &ray, t0, t1, tf, tol);
+                } else {
+                    let s = curve::curve_energy(c, &p, &wr.ray, wr.t0, wr.t1, wr.t_far);
+                    e += s.energy;
+                    n += s.evaluations;
+                }
+            }
+            out.push((e, n, r));
+        }
+    }
+    out
+}
+
+/// Measures the curve table on the example curve scenes found in `scenes_dir`.
+pub fn curve_table(
+    time: &mut Timer<'_>,
+    scenes_dir: &Path,
+    sizes: &[u32],
+    iterations: u32,
+    backend: &str,
+    method: &str,
+    progress: &mut dyn FnMut(&str),
+) -> Result<CurveTable, RenderError> {
+    let mut rows = Vec::new();
+    for (shape, file) in CURVE_SCENES {
+        let path = scenes_dir.join(file);
+        let scene = Scene::load(&path)
+            .map_err(|e| RenderError::Other(format!("curve bench needs the example scenes: {e}")))?;
+        let base = scene.at(0.0);
+        let reference = curve_reference(&base);
+        for (label, integrator) in curve_integrators() {
+            progress(&format!("{shape}: {label}"));
+            let frame = with_integrator(&base, integrator);
+            let (evals_per_pixel, p99_error) = curve_accuracy(&frame, &reference);
+            let mut ms = Vec::new();
+            for &size in sizes {
+                let mut f = frame.clone();
+                f.width = size;
+                f.height = size;
+                ms.push((size, time(&f, iterations)?));
+            }
+            rows.push(CurveRow { shape: shape.into(), integrator: label, ms, evals_per_pixel, p99_error });
+        }
+    }
+    Ok(CurveTable { backend: backend.into(), method: method.into(), rows })
+}
+
+impl CurveTable {
+    /// The table as plain text.
+    pub fn to_text(&self) -> String {
+        let mut out = format!(
+            "curves — backend {}, {}; evals/pixel and p99 error on a 64×64 pixel grid vs f64 adaptive reference\n",
+            self.backend, self.method
+        );
+        if let Some(r) = self.rows.first() {
+            out += &format!("{:<14} {:<20}", "shape", "integrator");
+            for (s, _) in &r.ms {
+                out += &format!(" {:>18}", format!("{s}² ms (fps)"));
+            }
+            out += &format!(" {:>12} {:>10}\n", "evals/pixel", "p99 error");
+        }
+        for r in &self.rows {
+            out += &format!("{:<14} {:<20}", r.shape, r.integrator);
+            for (_, ms) in &r.ms {
+                out += &format!(" {:>18}", format!("{ms:.1} ({:.2})", 1e3 / ms));
+            }
+            out += &format!(" {:>12.1} {:>10.2e}\n", r.evals_per_pixel, r.p99_error);
+        }
+        out
+    }
+
+    /// The table as JSON.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "table": "curves",
+            "backend": self.backend,
+            "method": self.method,
+            "rows": self.rows.iter().map(|r| serde_json::json!({
+                "shape": r.shape,
+                "integrator": r.integrator,
+                "ms": r.ms.iter().map(|(s, ms)| serde_json::json!({"size": s, "ms": ms, "fps": 1e3 / ms}))
+                    .collect::<Vec<_>>(),
+                "evals_per_pixel": r.evals_per_pixel,
+                "p99_error": r.p99_error,
             })).collect::<Vec<_>>(),
         })
     }

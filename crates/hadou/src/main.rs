@@ -74,17 +74,31 @@ struct ProbeArgs {
     height: Option<u32>,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum BenchTable {
+    /// Sphere, capsule, sphere+capsule and bulged beam, with and without occlusion.
+    Analytic,
+    /// Helix, trig sum, Bézier and B-spline: faithful Simpson against the default integrator.
+    Curves,
+}
+
 #[derive(Args, Debug)]
 struct BenchArgs {
+    /// Which table to measure.
+    #[arg(value_enum, default_value_t = BenchTable::Analytic)]
+    table: BenchTable,
+    /// Directory holding the example scenes (for the curve table).
+    #[arg(long, default_value = "scenes")]
+    scenes: PathBuf,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
-    /// Image sizes (square), comma-separated.
-    #[arg(long, default_value = "512,1024,2048", value_delimiter = ',')]
+    /// Image sizes (square), comma-separated [default: 512,1024,2048 for analytic, 512 for curves].
+    #[arg(long, value_delimiter = ',')]
     sizes: Vec<u32>,
-    /// Timed repetitions per cell (after one warm-up).
-    #[arg(long, default_value_t = 5)]
-    iterations: u32,
+    /// Timed repetitions per cell (after one warm-up) [default: 5 for analytic, 1 for curves].
+    #[arg(long)]
+    iterations: Option<u32>,
     /// Which backend to measure.
     #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
     backend: BackendChoice,
@@ -346,18 +360,52 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
 }
 
 fn bench(a: BenchArgs) -> Result<(), Failure> {
-    for &s in &a.sizes {
+    let curves = a.table == BenchTable::Curves;
+    let sizes = match (a.sizes.is_empty(), curves) {
+        (false, _) => a.sizes.clone(),
+        (true, false) => vec![512, 1024, 2048],
+        (true, true) => vec![512],
+    };
+    for &s in &sizes {
         size_override(Some(s), Some(s))?;
     }
-    if a.iterations == 0 {
+    let iterations = a.iterations.unwrap_or(if curves { 1 } else { 5 });
+    if iterations == 0 {
         return Err(Failure::input("--iterations 0: need at least one timed repetition"));
     }
+    if curves && !a.scenes.is_dir() {
+        return Err(Failure::input(format!(
+            "--scenes {}: not a directory; run from the repository root or pass --scenes DIR",
+            a.scenes.display()
+        )));
+    }
     let (mut timer, name, method) = make_timer(a.backend)?;
-    let table = hadou::bench::analytic_table(&mut *timer, &a.sizes, a.iterations, &name, &method)?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&table.to_json()).unwrap_or_default());
+    let json = if curves {
+        let bar = indicatif::ProgressBar::new_spinner();
+        let mut progress = |m: &str| bar.set_message(m.to_string());
+        let t = hadou::bench::curve_table(
+            &mut *timer,
+            &a.scenes,
+            &sizes,
+            iterations,
+            &name,
+            &method,
+            &mut progress,
+        )?;
+        bar.finish_and_clear();
+        if !a.json {
+            print!("{}", t.to_text());
+        }
+        t.to_json()
     } else {
-        print!("{}", table.to_text());
+        let t = hadou::bench::analytic_table(&mut *timer, &sizes, iterations, &name, &method)?;
+        if !a.json {
+            print!("{}", t.to_text());
+        }
+        t.to_json()
+    };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&json).unwrap_or_default());
     }
     Ok(())
 }

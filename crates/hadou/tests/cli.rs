@@ -249,3 +249,20 @@ fn every_example_scene_validates() {
     }
     assert!(n >= 6, "only {n} example scenes");
 }
+
+#[test]
+fn probe_reports_curve_energy_and_evaluations() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/spiral-drill.toml");
+    let o = hadou(&["probe", scene.to_str().unwrap(), "--pixel", "300,180", "--time", "1.0"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let waves = j["waves"].as_array().unwrap();
+    assert!(waves.len() >= 2, "{j}");
+    // Every wave reports its energy; curved waves report how many integrand evaluations it took.
+    for w in waves {
+        assert!(w["energy"].as_f64().unwrap() >= 0.0);
+        assert!(w["evaluations"].as_u64().unwrap() >= 1, "{w}");
+    }
+    let total: f64 = waves.iter().map(|w| w["energy"].as_f64().unwrap()).sum();
+    assert!((total - j["energy"].as_f64().unwrap()).abs() <= 1e-6 * total.max(1.0));
+}
