@@ -6,26 +6,9 @@ use hadou_math::{Mat4, Vec3};
 use hadou_scene::{Camera, ColorMapping, Frame, Light, Mesh, Object, ToneMode, Wave, WaveShape};
 use std::sync::Arc;
 
-/// An axis-aligned cube of side 2 centred at the origin, 12 triangles, outward normals.
+/// An axis-aligned cube of side 2 centred at the origin.
 fn cube() -> Mesh {
-    let mut m = Mesh::default();
-    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
-        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
-        ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
-        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
-        ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
-        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
-        ([0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
-    ];
-    for (n, u, v) in faces {
-        let base = m.positions.len() as u32;
-        for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-            m.positions.push([0, 1, 2].map(|k| n[k] + su * u[k] + sv * v[k]));
-            m.normals.push(n);
-        }
-        m.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
-    }
-    m
+    hadou_scene::mesh::box_mesh([2.0; 3])
 }
 
 fn frame(objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
