@@ -72,6 +72,9 @@ struct ProbeArgs {
     /// Override the image height.
     #[arg(long)]
     height: Option<u32>,
+    /// Which backend evaluates the pixel (the CPU also counts integrand evaluations).
+    #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
+    backend: BackendChoice,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -333,12 +336,21 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     let (x, y) = parse_pixel(&a.pixel)?;
     let scene = Scene::load(&a.scene)?;
     let frame = frame_at(&scene, a.time, a.width, a.height)?;
-    let p = hadou::probe(&frame, x, y).ok_or_else(|| {
+    let outside = || {
         Failure::input(format!(
             "--pixel {x},{y}: outside the {}×{} image (x < {}, y < {})",
             frame.width, frame.height, frame.width, frame.height
         ))
-    })?;
+    };
+    let mut backend = make_backend(a.backend)?;
+    let p = if backend.name() == "cpu" {
+        hadou::probe(&frame, x, y).ok_or_else(outside)?
+    } else {
+        if x >= frame.width || y >= frame.height {
+            return Err(outside());
+        }
+        gpu_probe(&mut *backend, &frame, x, y)?
+    };
     let waves: Vec<_> = p
         .waves
         .iter()
@@ -354,9 +366,26 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
         "color": p.color,
         "depth": p.depth,
         "object": p.object,
+        "backend": backend.name(),
     });
     println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
     Ok(())
+}
+
+/// Probes a pixel with a whole-frame backend: one render for colour and depth, then one render per
+/// wave alone for its energy. Integrand evaluations are not counted there (reported as 0).
+fn gpu_probe(backend: &mut dyn Backend, frame: &Frame, x: u32, y: u32) -> Result<hadou::Probe, Failure> {
+    let img = backend.render(frame)?;
+    let i = img.index(x, y);
+    let mut waves = Vec::new();
+    for w in &frame.waves {
+        let mut single = frame.clone();
+        single.waves = vec![w.clone()];
+        let e = backend.render(&single)?.energy[i];
+        waves.push(hadou::WaveProbe { name: w.name.clone(), energy: e, evaluations: 0 });
+    }
+    let object = hadou::probe(frame, x, y).and_then(|p| p.object);
+    Ok(hadou::Probe { x, y, waves, color: img.color[i], depth: img.depth[i], object })
 }
 
 fn bench(a: BenchArgs) -> Result<(), Failure> {

@@ -266,3 +266,38 @@ fn probe_reports_curve_energy_and_evaluations() {
     let total: f64 = waves.iter().map(|w| w["energy"].as_f64().unwrap()).sum();
     assert!((total - j["energy"].as_f64().unwrap()).abs() <= 1e-6 * total.max(1.0));
 }
+
+/// Whether a GPU adapter can be opened; in CI (`HADOU_REQUIRE_GPU=1`) its absence is a failure.
+fn gpu_available() -> bool {
+    match hadou::GpuBackend::new() {
+        Ok(_) => true,
+        Err(e) => {
+            assert!(std::env::var("HADOU_REQUIRE_GPU").is_err(), "HADOU_REQUIRE_GPU is set but: {e}");
+            eprintln!("SKIPPED: no GPU adapter ({e}); set HADOU_REQUIRE_GPU=1 to make this a failure");
+            false
+        }
+    }
+}
+
+#[test]
+fn probe_and_render_agree_across_backends() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tmpdir("backends");
+    let scene = write_scene(&dir, GOOD);
+    let s = scene.to_str().unwrap();
+    let run = |backend: &str| {
+        let o = hadou(&["probe", s, "--pixel", "20,24", "--backend", backend]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let (cpu, gpu) = (run("cpu"), run("gpu"));
+    assert_eq!(gpu["backend"], "gpu");
+    let (ec, eg) = (cpu["energy"].as_f64().unwrap(), gpu["energy"].as_f64().unwrap());
+    assert!(ec > 0.0 && (ec - eg).abs() <= 1e-3 * ec, "cpu {ec} gpu {eg}");
+    let out = dir.join("g.png");
+    let o = hadou(&["render", s, "-o", out.to_str().unwrap(), "--backend", "gpu"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(out.exists());
+}
