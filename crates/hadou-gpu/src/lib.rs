@@ -8,19 +8,23 @@
 //!    of the visible surface;
 //! 2. **wave** (`shaders/wave.wgsl`, a compute shader): per pixel, the ray of
 //!    `hadou_scene::CameraBasis::wave_ray` clipped at that distance (002 §3.3.5), the exact energy
-//!    integral of every analytic wave (`shaders/energy.wgsl`, twins of `hadou_math::energy`),
+//!    integral of every analytic wave (`shaders/energy.wgsl`, twins of `hadou_math::energy`) and
+//!    of every curved wave (`shaders/curve.wgsl`, twins of `hadou_math::curve`: the default
+//!    chord-walk integrator over the uploaded `PieceTable` and the faithful Simpson integrator),
 //!    `scene + exposure·Σ rgb·a·I` and the colour mapping.
 //!
 //! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next,
 //! so GPU memory stays bounded whatever the image size.
 //!
-//! Curved waves (`WaveShape::Curve`) are not drawn yet: a frame containing one is refused with
-//! [`RenderError::Other`] (marked `GAP(curves)` in the code).
+//! Curved waves are prepared once per frame with `hadou_math::curve::prepare` (as the CPU backend
+//! does) and uploaded as storage buffers ([`layout::CurveBuffers`]).
 //!
 //! Failures never panic: no adapter is [`RenderError::NoDevice`]; a lost device, out-of-memory or
 //! a GPU that does not answer within a timeout is [`RenderError::Device`]; a shader that fails to
 //! compile is [`RenderError::Other`] naming the shader.
 
+#[cfg(test)]
+mod curve_twins;
 mod device;
 pub mod layout;
 mod pipelines;

@@ -108,6 +108,10 @@ impl Pipelines {
                     texture_entry(2),
                     texture_entry(3),
                     storage_entry(4, cs, false),
+                    // Curve buffers; keep in sync with curve.wgsl and layout::CurveBuffers.
+                    storage_entry(5, cs, true),
+                    storage_entry(6, cs, true),
+                    storage_entry(7, cs, true),
                 ],
             });
             let raster_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -3,10 +3,10 @@
 //! is bounded by the tile size whatever the image size.
 
 use crate::device::GpuContext;
-use crate::layout::{FrameUniforms, GpuObject, GpuVertex, GpuWave};
+use crate::layout::{self, FrameUniforms, GpuCurve, GpuObject, GpuVertex, GpuWave};
 use crate::pipelines::{self, Pipelines};
 use bytemuck::Zeroable;
-use hadou_scene::{Frame, Image, Mesh, RenderError, WaveShape};
+use hadou_scene::{Frame, Image, Mesh, RenderError};
 use std::collections::HashMap;
 use std::sync::{Arc, Weak};
 use wgpu::util::DeviceExt;
@@ -42,6 +42,8 @@ pub(crate) struct Prepared {
     pub(crate) tiles: Vec<([u32; 2], [u32; 2])>,
     objects: wgpu::Buffer,
     waves: wgpu::Buffer,
+    /// Curve buffers (bindings 5–7 of the wave pass; see `layout::CurveBuffers`).
+    curves: [wgpu::Buffer; 3],
     draws: Vec<(usize, u32)>,
 }
 
@@ -74,14 +76,6 @@ fn validate_frame(frame: &Frame) -> Result<(), RenderError> {
     }
     if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
         return Err(other(format!("camera fov must be in (0, 180) degrees (got {})", c.fov_y_deg)));
-    }
-    // GAP(curves): curved waves have no WGSL twin yet (hadou_math::curve's integrator is to be
-    // mirrored once its flat table layout is final). Refuse rather than draw a wrong picture.
-    if let Some(w) = frame.waves.iter().find(|w| matches!(w.shape, WaveShape::Curve(_))) {
-        return Err(other(format!(
-            "wave `{}` is a curved wave, which the GPU backend does not draw yet; use the CPU backend",
-            w.name
-        )));
     }
     for o in &frame.objects {
         let m = &o.mesh;
@@ -249,7 +243,19 @@ impl Renderer {
         validate_frame(frame)?;
         let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
         let objects: Vec<GpuObject> = frame.objects.iter().map(GpuObject::new).collect();
-        let waves: Vec<GpuWave> = frame.waves.iter().filter_map(GpuWave::new).collect();
+        let (waves, curve_data) = layout::frame_waves(frame).map_err(other)?;
+        let max_binding =
+            self.ctx.limits.max_storage_buffer_binding_size.min(self.ctx.limits.max_buffer_size);
+        let curve_bytes = [
+            std::mem::size_of_val(curve_data.curves.as_slice()),
+            std::mem::size_of_val(curve_data.vec4s.as_slice()),
+            std::mem::size_of_val(curve_data.scalars.as_slice()),
+        ];
+        if let Some(&big) = curve_bytes.iter().find(|&&b| b as u64 > max_binding) {
+            return Err(RenderError::Device(format!(
+                "curve data of {big} bytes exceeds the device's storage buffer limit of {max_binding} bytes"
+            )));
+        }
         let (zero_object, zero_wave) = (GpuObject::zeroed(), GpuWave::zeroed());
         let scopes = self.ctx.open_scopes();
         let prepared = {
@@ -275,6 +281,27 @@ impl Renderer {
                 },
                 usage: wgpu::BufferUsages::STORAGE,
             });
+            let storage = |label: &str, bytes: &[u8]| {
+                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    // Storage bindings may not be empty: one zeroed 16-byte element instead.
+                    contents: if bytes.is_empty() { &[0u8; 16] } else { bytes },
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+            };
+            let zero_curve = [GpuCurve::zeroed()];
+            let curves = [
+                storage(
+                    "curves",
+                    bytemuck::cast_slice(if curve_data.curves.is_empty() {
+                        &zero_curve[..]
+                    } else {
+                        &curve_data.curves[..]
+                    }),
+                ),
+                storage("curve vec4s", bytemuck::cast_slice(&curve_data.vec4s)),
+                storage("curve scalars", bytemuck::cast_slice(&curve_data.scalars)),
+            ];
             let draws = frame
                 .objects
                 .iter()
@@ -290,7 +317,7 @@ impl Renderer {
                     tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(frame.height - y)]));
                 }
             }
-            Prepared { tile, tiles, objects, waves, draws }
+            Prepared { tile, tiles, objects, waves, curves, draws }
         };
         self.ctx.close_scopes(scopes, "uploading the frame")?;
         Ok(prepared)
@@ -335,6 +362,9 @@ impl Renderer {
                     resource: wgpu::BindingResource::TextureView(&t.distance_view),
                 },
                 wgpu::BindGroupEntry { binding: 4, resource: t.output.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: prepared.curves[0].as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: prepared.curves[1].as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: prepared.curves[2].as_entire_binding() },
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("tile") });

@@ -2,7 +2,8 @@
 //!
 //! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
 //! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
-//! - wave module: `common.wgsl` + `energy.wgsl` + `wave.wgsl` (energy integration, colour mapping).
+//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave.wgsl` (energy integration,
+//!   colour mapping).
 //!
 //! A unit test parses and validates every composed module with naga (no adapter needed) and
 //! checks that the struct layouts naga computes equal the Rust ones in [`crate::layout`].
@@ -11,19 +12,26 @@
 pub const COMMON: &str = include_str!("shaders/common.wgsl");
 /// WGSL twins of `hadou_math::energy`.
 pub const ENERGY: &str = include_str!("shaders/energy.wgsl");
+/// WGSL twins of `hadou_math::curve` (shape evaluation, default and Simpson integrators).
+pub const CURVE: &str = include_str!("shaders/curve.wgsl");
 /// The opaque geometry pass.
 pub const RASTER: &str = include_str!("shaders/raster.wgsl");
 /// The wave pass.
 pub const WAVE: &str = include_str!("shaders/wave.wgsl");
 
 /// Every `.wgsl` file in `src/shaders/`, by file name.
-pub const FILES: &[(&str, &str)] =
-    &[("common.wgsl", COMMON), ("energy.wgsl", ENERGY), ("raster.wgsl", RASTER), ("wave.wgsl", WAVE)];
+pub const FILES: &[(&str, &str)] = &[
+    ("common.wgsl", COMMON),
+    ("curve.wgsl", CURVE),
+    ("energy.wgsl", ENERGY),
+    ("raster.wgsl", RASTER),
+    ("wave.wgsl", WAVE),
+];
 
 /// The parts of the raster module, in order.
 pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
-pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, WAVE];
+pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -33,7 +41,7 @@ pub fn compose(parts: &[&str]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layout::{FrameUniforms, GpuObject, GpuWave};
+    use crate::layout::{FrameUniforms, GpuCurve, GpuObject, GpuWave};
     use std::mem::{offset_of, size_of};
 
     fn validate(name: &str, source: &str) -> naga::Module {
@@ -61,6 +69,7 @@ mod tests {
         // Standalone files validate alone; pass files only after their prefix.
         validate("common.wgsl", COMMON);
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
+        validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
         assert_eq!(modules.len(), 2);
         // Every file on disk is listed in FILES and used by a module.
@@ -150,6 +159,48 @@ mod tests {
         );
         check!(GpuObject, "GpuObject", [model, normal_matrix, color, _pad]);
         check!(GpuWave, "GpuWave", [color, kind, falloff, core_radius, _pad, p0, p1, p2]);
+        check!(
+            GpuCurve,
+            "GpuCurve",
+            [
+                origin,
+                alpha,
+                axis_d,
+                x_head,
+                axis_y,
+                attenuation,
+                axis_z,
+                gamma,
+                s_head,
+                core_floor,
+                cylinder_radius,
+                integrator,
+                m,
+                m_reduced,
+                reduce,
+                shape,
+                order,
+                points,
+                point_count,
+                knots,
+                lo,
+                hi,
+                rate,
+                radius,
+                phase,
+                y_terms,
+                z_terms,
+                nodes,
+                node_count,
+                lines,
+                errors,
+                level_offsets,
+                levels,
+                tolerance,
+                att_grid,
+                att_nodes,
+            ]
+        );
     }
 
     #[test]
@@ -171,6 +222,13 @@ mod tests {
         assert_eq!(value("WAVE_CYLINDER"), WAVE_CYLINDER);
         assert_eq!(value("WAVE_CAPSULE"), WAVE_CAPSULE);
         assert_eq!(value("WAVE_BEAM"), WAVE_BEAM);
+        assert_eq!(value("WAVE_CURVE"), WAVE_CURVE);
+        assert_eq!(value("INTEGRATOR_DEFAULT"), INTEGRATOR_DEFAULT);
+        assert_eq!(value("INTEGRATOR_SIMPSON"), INTEGRATOR_SIMPSON);
+        assert_eq!(value("SHAPE_HELIX"), SHAPE_HELIX);
+        assert_eq!(value("SHAPE_TRIG"), SHAPE_TRIG);
+        assert_eq!(value("SHAPE_BEZIER"), SHAPE_BEZIER);
+        assert_eq!(value("SHAPE_BSPLINE"), SHAPE_BSPLINE);
         assert_eq!(value("FALLOFF_FAITHFUL"), FALLOFF_FAITHFUL);
         assert_eq!(value("FALLOFF_INVERSE_SQUARE"), FALLOFF_INVERSE_SQUARE);
         assert_eq!(value("TONE_FAITHFUL"), TONE_FAITHFUL);

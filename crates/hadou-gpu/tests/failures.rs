@@ -4,10 +4,8 @@
 mod common;
 
 use common::*;
-use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator};
-use hadou_math::energy::Falloff;
 use hadou_math::Vec3;
-use hadou_scene::{Backend, Mesh, RenderError, ToneMode, WaveShape};
+use hadou_scene::{Backend, Mesh, RenderError, ToneMode};
 use std::sync::Arc;
 
 #[test]
@@ -49,25 +47,4 @@ fn malformed_mesh_is_an_error_naming_the_object() {
     f.objects[1].mesh =
         Arc::new(Mesh { positions: vec![[0.0; 3]; 3], normals: vec![], indices: vec![0, 1, 2] });
     assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("normals")));
-}
-
-#[test]
-fn curved_waves_are_refused_until_ported() {
-    // GAP(curves): the GPU backend has no WGSL twin of the curve integrator yet.
-    let Some(mut gpu) = gpu_or_skip("curved wave") else { return };
-    let mut f = occlusion_frame(32, 24);
-    let curve = CurveWave {
-        frame: CurveFrame { origin: Vec3::ZERO, axis: Vec3::X, up: Vec3::Y },
-        shape: CurveShape::Helix { radius: 1.0, rate: 1.0, phase: 0.0, length: 10.0 },
-        gamma: 1.0,
-        extension: 1.0,
-        attenuation: 0.0,
-        alpha: 1.0,
-        integrator: Integrator::Default,
-    };
-    f.waves.push(wave("drill", [1.0; 4], Falloff::InverseSquare, 0.05, WaveShape::Curve(curve)));
-    match gpu.render(&f) {
-        Err(RenderError::Other(m)) => assert!(m.contains("drill") && m.contains("CPU"), "{m}"),
-        other => panic!("expected a refusal, got {other:?}"),
-    }
 }

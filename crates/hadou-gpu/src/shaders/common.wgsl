@@ -50,11 +50,59 @@ struct GpuWave {
     p2: vec4<f32>,
 }
 
+// One prepared curved wave (hadou_math::curve::PreparedCurve); offsets index the curve_vec4 and
+// curve_f32 storage buffers of curve.wgsl. Keep in sync with layout.rs `GpuCurve`.
+struct GpuCurve {
+    origin: vec3<f32>,
+    alpha: f32,
+    axis_d: vec3<f32>,
+    x_head: f32,
+    axis_y: vec3<f32>,
+    attenuation: f32,
+    axis_z: vec3<f32>,
+    gamma: f32,
+    s_head: f32,
+    core_floor: f32,
+    cylinder_radius: f32,
+    integrator: u32,
+    m: u32,
+    m_reduced: u32,
+    reduce: u32,
+    shape: u32,
+    order: u32,
+    points: u32,
+    point_count: u32,
+    knots: u32,
+    lo: f32,
+    hi: f32,
+    rate: f32,
+    radius: f32,
+    phase: f32,
+    y_terms: u32,
+    z_terms: u32,
+    nodes: u32,
+    node_count: u32,
+    lines: u32,
+    errors: u32,
+    level_offsets: u32,
+    levels: u32,
+    tolerance: f32,
+    att_grid: f32,
+    att_nodes: u32,
+}
+
 // Keep in sync with layout.rs: wave kinds and falloff/tone codes.
 const WAVE_SPHERE: u32 = 0u;
 const WAVE_CYLINDER: u32 = 1u;
 const WAVE_CAPSULE: u32 = 2u;
 const WAVE_BEAM: u32 = 3u;
+const WAVE_CURVE: u32 = 4u;
+const INTEGRATOR_DEFAULT: u32 = 0u;
+const INTEGRATOR_SIMPSON: u32 = 1u;
+const SHAPE_HELIX: u32 = 0u;
+const SHAPE_TRIG: u32 = 1u;
+const SHAPE_BEZIER: u32 = 2u;
+const SHAPE_BSPLINE: u32 = 3u;
 const FALLOFF_FAITHFUL: u32 = 0u;
 const FALLOFF_INVERSE_SQUARE: u32 = 1u;
 const TONE_FAITHFUL: u32 = 0u;

@@ -1,7 +1,7 @@
 // Wave pass: per pixel, the integration ray of hadou_scene::CameraBasis::wave_ray (002 eq. 3.12–3.13,
 // clipped at the visible surface), the energy of every wave (energy.wgsl), the colour
 // scene + exposure·Σ rgb·a·I and the colour mapping (common.wgsl). Prepended by common.wgsl and
-// energy.wgsl.
+// energy.wgsl and curve.wgsl (whose curve buffers are bindings 5–7).
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
@@ -50,8 +50,15 @@ fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
         case WAVE_BEAM: {
             return beam_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
         }
-        // GAP(curves): WaveShape::Curve has no WGSL twin yet; the Rust side refuses frames with
-        // curved waves before dispatch (see render.rs), so no other kind reaches this shader.
+        case WAVE_CURVE: {
+            // t_far of hadou_scene::WaveRay: 1 (faithful, t ∈ [0, 1] to the far point) or the
+            // far point's distance (inverse square, unit direction).
+            var t_far = 1.0;
+            if (w.falloff != FALLOFF_FAITHFUL) {
+                t_far = frame.far * length(dir);
+            }
+            return curve_energy(curves[u32(w.p0.x)], w.falloff, w.core_radius, ray, span.x, span.y, t_far);
+        }
         default: {
             return 0.0;
         }
