@@ -159,3 +159,33 @@ pub fn quantile(values: &[f64], q: f64) -> f64 {
     let i = ((v.len() - 1) as f64 * q).round() as usize;
     v[i]
 }
+
+/// Known bug, found by the GPU twin test: an inverse-square ray exactly perpendicular to the
+/// curve's axis with an open span (nothing drawn behind) paired with the wrong cross-section
+/// (`0·∞ = NaN` in the walk's far end), about 10 % off. It must match the converged reference.
+#[test]
+fn perpendicular_open_ray_pairs_with_its_own_cross_section() {
+    use hadou_math::curve::{curve_energy, curve_energy_reference, prepare, CurveFrame, CurveShape};
+    use hadou_math::curve::{CurveWave, Integrator};
+    use hadou_math::energy::{Falloff, FieldParams, Ray};
+    use hadou_math::Vec3;
+    let wave = CurveWave {
+        frame: CurveFrame { origin: Vec3::new(-5.0, 0.0, 0.0), axis: Vec3::X, up: Vec3::Y },
+        shape: CurveShape::Helix { radius: 1.5, rate: 2.5, phase: 0.0, length: 10.0 },
+        gamma: 1.0,
+        extension: 1.0,
+        attenuation: 0.0,
+        alpha: 5.0,
+        integrator: Integrator::Default,
+    };
+    let c = prepare(&wave);
+    for x in [-3.7f32, 0.3, 2.9] {
+        let ray = Ray { origin: Vec3::new(x, 0.4, 12.0), dir: Vec3::new(0.0, 0.0, -1.0) };
+        let p = FieldParams { falloff: Falloff::InverseSquare, core_radius: 0.02 };
+        let got = curve_energy(&c, &p, &ray, 0.0, f32::INFINITY, 100.0).energy as f64;
+        let p64 = FieldParams { falloff: Falloff::InverseSquare, core_radius: 0.02f64 };
+        let ray64 = Ray { origin: ray.origin.as_f64(), dir: ray.dir.as_f64() };
+        let want = curve_energy_reference(&c, &p64, &ray64, 0.0, f64::INFINITY, 100.0, 1e-10);
+        assert!((got - want).abs() <= 5e-3 * want, "x = {x}: {got} vs {want}");
+    }
+}

@@ -453,8 +453,10 @@ fn walk<R: Real>(
     let n = table.nodes.len() - 1;
     let levels = table.levels();
     let xh = r.x_head;
-    let xa = (r.o.x + r.q.x * ta).clamp(R::ZERO, xh);
-    let xb = (r.o.x + r.q.x * tb).clamp(R::ZERO, xh);
+    // A ray perpendicular to the axis keeps x = o.x even on an open span (avoids 0·∞ = NaN).
+    let x_at = |t: R| if r.q.x == R::ZERO { r.o.x } else { r.o.x + r.q.x * t };
+    let xa = x_at(ta).clamp(R::ZERO, xh);
+    let xb = x_at(tb).clamp(R::ZERO, xh);
     let (lo, hi, t_lo, t_hi) = if xa <= xb { (xa, xb, ta, tb) } else { (xb, xa, tb, ta) };
     let tol = R::from_f64(settings.tolerance);
     let yz = |t: R| (r.o.y + r.q.y * t, r.o.z + r.q.z * t);
