@@ -7,7 +7,6 @@
 
 use crate::device::GpuContext;
 use crate::layout::{CurveBuffers, FALLOFF_FAITHFUL, FALLOFF_INVERSE_SQUARE};
-use crate::pipelines::compile_module;
 use crate::shaders;
 use bytemuck::{Pod, Zeroable};
 use hadou_math::curve::{self, CurveFrame, CurveShape, CurveWave, Integrator, PreparedCurve, Reduction};
@@ -58,71 +57,14 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 /// Runs the WGSL curve integrators on `cases` with the curve data `data`.
 fn run_gpu(ctx: &GpuContext, data: &CurveBuffers, cases: &[CurveCase]) -> Result<Vec<f32>, RenderError> {
-    use wgpu::util::DeviceExt;
     let source = shaders::compose(&[shaders::COMMON, shaders::ENERGY, shaders::CURVE, KERNEL]);
-    let module = compile_module(ctx, "curve twins", &source)?;
-    let bytes = (cases.len() * 4) as u64;
-    let (pipeline, buffers, output, staging) = ctx.scoped("setting up the curve twin test", || {
-        let d = &ctx.device;
-        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("curve twins"),
-            layout: None,
-            module: &module,
-            entry_point: Some("twin_main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let storage = |contents: &[u8]| {
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: None,
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        let buffers = [
-            storage(bytemuck::cast_slice(cases)),
-            storage(bytemuck::cast_slice(&data.curves)),
-            storage(bytemuck::cast_slice(&data.vec4s)),
-            storage(bytemuck::cast_slice(&data.scalars)),
-        ];
-        let buffer = |usage| {
-            d.create_buffer(&wgpu::BufferDescriptor {
-                label: None,
-                size: bytes,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let staging = buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-        (pipeline, buffers, output, staging)
-    })?;
-    let submission = ctx.scoped("running the curve twin test", || {
-        let d = &ctx.device;
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: buffers[0].as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: buffers[1].as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: buffers[2].as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: buffers[3].as_entire_binding() },
-            ],
-        });
-        let mut enc = d.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
-        }
-        enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
-        ctx.queue.submit([enc.finish()])
-    })?;
-    ctx.read_buffer(&staging, bytes, submission, |raw| {
-        raw.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
-    })
+    let inputs: [(u32, &[u8]); 4] = [
+        (0, bytemuck::cast_slice(cases)),
+        (5, bytemuck::cast_slice(&data.curves)),
+        (6, bytemuck::cast_slice(&data.vec4s)),
+        (7, bytemuck::cast_slice(&data.scalars)),
+    ];
+    crate::twins::run_twin_kernel(ctx, "curve twins", &source, &inputs, cases.len())
 }
 
 /// The Rust twin of one case: `hadou_math::curve::curve_energy`.

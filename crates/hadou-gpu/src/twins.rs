@@ -60,25 +60,43 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 /// Runs the WGSL energy functions on `cases`.
 fn run_gpu(ctx: &GpuContext, cases: &[Case]) -> Result<Vec<f32>, RenderError> {
-    use wgpu::util::DeviceExt;
     let source = shaders::compose(&[shaders::COMMON, shaders::ENERGY, KERNEL]);
-    let module = compile_module(ctx, "energy twins", &source)?;
-    let bytes = (cases.len() * 4) as u64;
-    let (pipeline, input, output, staging) = ctx.scoped("setting up the twin test", || {
+    run_twin_kernel(ctx, "energy twins", &source, &[(0, bytemuck::cast_slice(cases))], cases.len())
+}
+
+/// Runs a twin-test compute kernel: `twin_main` over `count` cases in workgroups of 64, with each
+/// `(binding, bytes)` of `inputs` as a read-only storage buffer in group 0 and one `f32` result per
+/// case read back from binding 1. Shared by the energy and curve twin tests.
+pub(crate) fn run_twin_kernel(
+    ctx: &GpuContext,
+    label: &str,
+    source: &str,
+    inputs: &[(u32, &[u8])],
+    count: usize,
+) -> Result<Vec<f32>, RenderError> {
+    use wgpu::util::DeviceExt;
+    let module = compile_module(ctx, label, source)?;
+    let bytes = (count * 4) as u64;
+    let (pipeline, buffers, output, staging) = ctx.scoped(&format!("setting up {label}"), || {
         let d = &ctx.device;
         let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("energy twins"),
+            label: Some(label),
             layout: None,
             module: &module,
             entry_point: Some("twin_main"),
             compilation_options: Default::default(),
             cache: None,
         });
-        let input = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("cases"),
-            contents: bytemuck::cast_slice(cases),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let buffers: Vec<(u32, wgpu::Buffer)> = inputs
+            .iter()
+            .map(|&(binding, contents)| {
+                let usage = wgpu::BufferUsages::STORAGE;
+                (
+                    binding,
+                    d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage }),
+                )
+            })
+            .collect();
         let buffer = |usage| {
             d.create_buffer(&wgpu::BufferDescriptor {
                 label: None,
@@ -89,28 +107,31 @@ fn run_gpu(ctx: &GpuContext, cases: &[Case]) -> Result<Vec<f32>, RenderError> {
         };
         let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
         let staging = buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-        (pipeline, input, output, staging)
+        (pipeline, buffers, output, staging)
     })?;
-    let submission = ctx.scoped("running the twin test", || {
-        let d = &ctx.device;
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-            ],
-        });
-        let mut enc = d.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
-        }
-        enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
-        ctx.queue.submit([enc.finish()])
-    })?;
+    let submission =
+        ctx.scoped(&format!("running {label}"), || {
+            let d = &ctx.device;
+            let mut entries = vec![wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() }];
+            entries.extend(buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry {
+                binding: *binding,
+                resource: b.as_entire_binding(),
+            }));
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            });
+            let mut enc = d.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &bg, &[]);
+                pass.dispatch_workgroups((count as u32).div_ceil(64), 1, 1);
+            }
+            enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
+            ctx.queue.submit([enc.finish()])
+        })?;
     ctx.read_buffer(&staging, bytes, submission, |raw| {
         raw.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
     })
