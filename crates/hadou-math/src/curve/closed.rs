@@ -79,56 +79,96 @@ impl<R: Real> Segment<R> {
     /// `τ ∈ [0, dt]`. `rc2 > 0`; `dt ≥ 0` may be `+∞` for the inverse square (then `v ≠ 0`).
     #[inline]
     pub(crate) fn new(falloff: Falloff, p: Vec3<R>, v: Vec3<R>, dt: R, rc2: R) -> Self {
-        let s = v.length();
-        let (y0, e) = if s > R::ZERO {
-            let vh = v / s;
-            let c = p.cross(vh);
-            (p.dot(vh), c.length_squared() + rc2)
-        } else {
-            (R::ZERO, p.length_squared() + rc2)
+        Self::with_dots(falloff, p, v, v.dot(v), p.dot(v), dt, rc2)
+    }
+
+    /// [`new`](Self::new) with `vv = v·v` and `pv = p·v` already formed (the chord walk has them
+    /// from its acceptance test).
+    ///
+    /// Computed in `s`-scaled quantities (`s = |v|`): `Y = s·y` (`Y₀ = p·v`, `Y₁ = Y₀ + s²Δt`),
+    /// `E = s²e = |p × v|² + r_c²s²`, `R = s·√Q = √(Y² + E)`, so that no division by `s` sits
+    /// between the square roots and the logarithm: the faithful argument is
+    /// `x = s²Δt·f/G₀` with `f = 1 + (Y₀+Y₁)/(R₀+R₁)` and `G₀ = s·g₀` (one division), and the
+    /// inverse-square angle is `atan2(s²Δt√E, E + Y₀Y₁)` over `√E`, with no `s` at all. `1/s`
+    /// is formed beside them, off the critical path.
+    #[inline]
+    pub(crate) fn with_dots(falloff: Falloff, p: Vec3<R>, v: Vec3<R>, vv: R, pv: R, dt: R, rc2: R) -> Self {
+        let mut seg = Segment {
+            value: R::ZERO,
+            falloff,
+            dt,
+            y0: R::ZERO,
+            y1: R::ZERO,
+            flipped: false,
+            e: rc2,
+            delta: R::ZERO,
         };
-        let mut seg = Segment { value: R::ZERO, falloff, dt, y0, y1: y0, flipped: false, e, delta: R::ZERO };
+        if !(vv > R::ZERO) {
+            // Constant integrand.
+            let e = p.length_squared() + rc2;
+            seg.e = e;
+            if dt > R::ZERO && dt.is_finite() {
+                seg.value = match falloff {
+                    Falloff::Faithful => dt / e.sqrt(),
+                    Falloff::InverseSquare => dt / e,
+                };
+            }
+            return seg;
+        }
+        let inv_s = R::ONE / vv.sqrt();
+        // |p × v̂|² = |p × v|²/|v|²: a cross product, so E never cancels.
+        let big_e = p.cross(v).length_squared() + rc2 * vv;
+        seg.e = big_e * inv_s * inv_s;
+        seg.y0 = pv * inv_s;
+        seg.y1 = seg.y0;
         if !(dt > R::ZERO) {
             return seg;
         }
         match falloff {
             Falloff::Faithful => {
                 let dt = if dt.is_finite() { dt } else { R::ZERO };
-                let mut y0 = y0;
-                let mut y1 = y0 + s * dt;
+                let span = vv * dt;
+                let (mut y0, mut y1) = (pv, pv + span);
                 if y0 + y1 < R::ZERO {
                     (y0, y1) = (-y1, -y0);
                     seg.flipped = true;
                 }
-                let q0 = (y0 * y0 + e).sqrt();
-                let q1 = (y1 * y1 + e).sqrt();
-                let g0 = if y0 >= R::ZERO { y0 + q0 } else { e / (q0 - y0) };
-                let f = R::ONE + (y0 + y1) / (q0 + q1);
-                let a = dt * f / g0;
-                let x = s * a;
-                seg.value = a * ln1p_over(x);
-                seg.delta = x.ln_1p();
-                seg.y0 = y0;
-                seg.y1 = y1;
+                let r0 = (y0 * y0 + big_e).sqrt();
+                let r1 = (y1 * y1 + big_e).sqrt();
+                let rs = r0 + r1;
+                // x = s²Δt·(R₀+R₁+Y₀+Y₁)/((R₀+R₁)·G₀), G₀ = Y₀ + R₀ = E/(R₀ − Y₀).
+                let x = if y0 >= R::ZERO {
+                    span * (rs + y0 + y1) / (rs * (y0 + r0))
+                } else {
+                    span * (rs + y0 + y1) * (r0 - y0) / (rs * big_e)
+                };
+                // One logarithm: Δψ = ln(1 + x), by ln(1 + x) once x ≥ 1/16 (the rounding of
+                // 1 + x then costs at most ε/2 against a value ≥ 0.06, and logf is much cheaper
+                // than log1pf), by ln_1p below; the value is Δψ/s.
+                let delta = if x >= R::from_f64(0.0625) { (R::ONE + x).ln() } else { x.ln_1p() };
+                seg.value = delta * inv_s;
+                seg.delta = delta;
+                seg.y0 = y0 * inv_s;
+                seg.y1 = y1 * inv_s;
             }
             Falloff::InverseSquare => {
-                let se = e.sqrt();
+                let se = big_e.sqrt();
                 if dt.is_finite() {
-                    let y1 = y0 + s * dt;
-                    let z = s * dt * se;
-                    let k = e + y0 * y1;
+                    let span = vv * dt;
+                    let z = span * se;
+                    let k = big_e + pv * (pv + span);
                     let th = z.atan2(k);
                     seg.value = if k > R::ZERO && z < R::from_f64(1e-4) * k {
                         let r = z / k;
-                        dt / k * (R::ONE - r * r / R::from_f64(3.0))
+                        span / k * (R::ONE - r * r / R::from_f64(3.0))
                     } else {
-                        th / (s * se)
+                        th / se
                     };
                     seg.delta = th;
-                    seg.y1 = y1;
-                } else if s > R::ZERO {
-                    let th = se.atan2(y0);
-                    seg.value = th / (s * se);
+                    seg.y1 = (pv + span) * inv_s;
+                } else {
+                    let th = se.atan2(pv);
+                    seg.value = th / se;
                     seg.delta = th;
                     seg.y1 = R::INFINITY;
                 }

@@ -81,7 +81,7 @@ pub struct DefaultSettings {
 /// 99th-percentile relative error of 1–5·10⁻⁴; the attenuation grid of ¼ with up to 3 nodes keeps
 /// the attenuated error at the same level (a grid of ½ doubles it).
 pub const DEFAULT_SETTINGS: DefaultSettings =
-    DefaultSettings { tolerance: 1e-3, attenuation_nodes: 3, attenuation_grid: 0.25 };
+    DefaultSettings { tolerance: 2e-3, attenuation_nodes: 3, attenuation_grid: 0.25 };
 
 /// The energy of one ray through a prepared curve, by the wave's integrator (002 §3.4).
 ///
@@ -309,8 +309,15 @@ impl<R: Real> Acc<R> {
     /// not shared with the previous piece.
     #[inline]
     fn piece(&mut self, r: &LocalRay<R>, ts: R, p: Vec3<R>, v: Vec3<R>, dt: R) {
+        self.piece_dots(r, ts, p, v, v.dot(v), p.dot(v), dt);
+    }
+
+    /// [`piece`](Self::piece) with `vv = v·v` and `pv = p·v` already formed.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn piece_dots(&mut self, r: &LocalRay<R>, ts: R, p: Vec3<R>, v: Vec3<R>, vv: R, pv: R, dt: R) {
         if r.j == R::ZERO {
-            self.sum += Segment::new(r.falloff, p, v, dt, r.rc2).value;
+            self.sum += Segment::with_dots(r.falloff, p, v, vv, pv, dt, r.rc2).value;
             self.evals += 1;
             return;
         }
@@ -347,6 +354,96 @@ impl<R: Real> Acc<R> {
             }
             k += R::ONE;
         }
+    }
+}
+
+/// The chord walk's error model for one density law (see the module docs).
+///
+/// A piece whose line deviates from the curve by at most `δ` (cross-section distance at equal
+/// `x`), passed at closest distance `D` (softened by the core radius) while the relative position
+/// moves by `ℓ`, and whose `x`-range the ray covers only in part (fraction `κ`), is estimated to be
+/// off by the relative amount
+/// `(δ/D)·(min(S, c₁·(ℓ/D)²) + P·(1 − κ)) + c₂·(δ/D)²`:
+/// - first order, `∫∇w·e`: the least-squares deviation `e` has zero mean and zero first moment
+///   over the piece, so where the ray covers the whole piece only the part of `∇w` beyond linear
+///   counts, `½·ℓ²·|∇³w|·λ²`; against `e` (`|e| ≤ δ`) the best linear fit of `λ²` leaves at most
+///   `1/16` in the mean. With `|∇³(1/r)| ≤ 6/r⁴` and `|∇³(1/r²)| ≤ 24/r⁵` this gives
+///   `c₁ = 3/16` (faithful) and `3/4` (inverse square), relative to `w(D)`;
+/// - where the ray sweeps past the piece (`ℓ ≳ D`) there is no cancellation and the first-order
+///   term saturates at about `δ/D` (`S = 1`);
+/// - where the ray covers only part of the piece's range (its start inside the slab, or a ray
+///   nearly across the axis), `e` need not average out: `|∇w|/w` is `1/D` (faithful) or `2/D`
+///   (inverse square), so `P = 1` or `2`;
+/// - second order, `½·δ²·|∇²w|`: `c₂ = 1` (faithful, `|∇²(1/r)| ≤ 2/r³`), `3` (inverse square).
+///
+/// `chord_model_is_conservative` (below) checks the estimate against the exact error of single
+/// pieces on random rays.
+#[derive(Clone, Copy, Debug)]
+struct ChordModel<R> {
+    first: R,
+    saturation: R,
+    partial: R,
+    second: R,
+}
+
+impl<R: Real> ChordModel<R> {
+    fn new(falloff: Falloff) -> Self {
+        let (first, partial, second) = match falloff {
+            Falloff::Faithful => (3.0 / 16.0, 1.0, 1.0),
+            Falloff::InverseSquare => (0.75, 2.0, 3.0),
+        };
+        ChordModel {
+            first: R::from_f64(first),
+            saturation: R::ONE,
+            partial: R::from_f64(partial),
+            second: R::from_f64(second),
+        }
+    }
+
+    /// `(x², a)`: the squared relative deviation `x² = δ²/D²` and the first-order factor
+    /// `a = min(S, c₁(ℓ/D)²) + P·uncovered` of the piece `d(τ) = p + vτ`, `τ ∈ [0, dt]`, with
+    /// deviation bound `err`; `uncovered = 1 − κ`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn terms(&self, err: R, p: Vec3<R>, v: Vec3<R>, vv: R, pv: R, dt: R, rc2: R, uncovered: R) -> (R, R) {
+        let tau = if vv > R::ZERO { (-pv / vv).clamp(R::ZERO, dt) } else { R::ZERO };
+        let d = p + v * tau;
+        let inv = R::ONE / (d.dot(d) + rc2);
+        let x2 = err * err * inv;
+        let a = (self.first * vv * dt * dt * inv).min(self.saturation) + self.partial * uncovered;
+        (x2, a)
+    }
+
+    /// The estimate `x·a + c₂x²`.
+    #[inline]
+    fn estimate(&self, x2: R, a: R) -> R {
+        x2.sqrt() * a + self.second * x2
+    }
+
+    /// 0 if the estimate meets the tolerance; otherwise how many levels to descend
+    /// (1 to `level`).
+    ///
+    /// The test is free of square roots: with `b = τ − c₂x²`, `x·a + c₂x² ≤ τ` iff `b ≥ 0` and
+    /// `x²a² ≤ b²`. A rejected piece descends `max(1, ⌊log₈(estimate/τ)⌋)` levels at once
+    /// instead of one: halving a piece that is short against the curve's features divides `δ` by
+    /// 4 and `ℓ` by 2, so the estimate falls 16× per level in the `(ℓ/D)²` regime and 4× where
+    /// saturated, but a piece spanning whole turns barely improves when halved. 8× per level was
+    /// measured best on the example curves (1.2–1.3× fewer evaluations than descending one level
+    /// at a time, against 16× or 4×); descending too far costs pieces, never accuracy.
+    #[inline]
+    fn refinement(&self, x2: R, a: R, tol: R, level: usize) -> usize {
+        let b = tol - self.second * x2;
+        if b >= R::ZERO && x2 * a * a <= b * b {
+            return 0;
+        }
+        let per_level = R::from_f64(8.0);
+        let mut ratio = self.estimate(x2, a) / (tol * per_level);
+        let mut k = 1;
+        while k < level && ratio > per_level {
+            ratio = ratio / per_level;
+            k += 1;
+        }
+        k
     }
 }
 
@@ -459,6 +556,7 @@ fn walk<R: Real>(
     let xb = x_at(tb).clamp(R::ZERO, xh);
     let (lo, hi, t_lo, t_hi) = if xa <= xb { (xa, xb, ta, tb) } else { (xb, xa, tb, ta) };
     let tol = R::from_f64(settings.tolerance);
+    let model = ChordModel::new(r.falloff);
     let yz = |t: R| (r.o.y + r.q.y * t, r.o.z + r.q.z * t);
 
     // x (nearly) constant along the span: one piece against the fixed paired point.
@@ -493,7 +591,8 @@ fn walk<R: Real>(
         if na[0] >= hi {
             break;
         }
-        let mut descend = false;
+        // Levels to descend (0: the piece was accepted or lies outside the range).
+        let mut descend = 0usize;
         if nb[0] > lo {
             let x0 = lo.max(na[0]);
             let x1 = hi.min(nb[0]);
@@ -508,27 +607,26 @@ fn walk<R: Real>(
             let v = Vec3::new(R::ZERO, r.q.y - r.q.x * my, r.q.z - r.q.x * mz);
             let dt = te - ts;
             let err = R::from_f64(f64::from(table.error(l, j)));
-            let accept = l == 0 || {
-                // Closest approach d over the piece, the change ℓ = |v|Δt of the relative
-                // position, and the error estimate (δ/D)·min(1, (ℓ/D)²) + (δ/D)², D² = d² + r_c².
-                let vv = v.dot(v);
-                let tau = if vv > R::ZERO { (-p.dot(v) / vv).clamp(R::ZERO, dt) } else { R::ZERO };
-                let d = p + v * tau;
-                let d2 = d.dot(d) + r.rc2;
-                let e2 = err * err / d2;
-                let ell2 = vv * dt * dt / d2;
-                e2.sqrt() * ell2.min(R::ONE) + e2 <= tol
+            let (vv, pv) = (v.dot(v), p.dot(v));
+            let refine = if l == 0 {
+                0
+            } else {
+                // The part of the piece's x-range the ray does not cover (0 but at the ray's ends).
+                let uncovered =
+                    if x0 > na[0] || x1 < nb[0] { R::ONE - (x1 - x0) / (nb[0] - na[0]) } else { R::ZERO };
+                let (x2, a) = model.terms(err, p, v, vv, pv, dt, r.rc2, uncovered);
+                model.refinement(x2, a, tol, l)
             };
-            if accept {
-                acc.piece(r, ts, p, v, dt);
+            if refine == 0 {
+                acc.piece_dots(r, ts, p, v, vv, pv, dt);
             } else {
                 acc.evals += 1;
-                descend = true;
+                descend = refine;
             }
         }
-        if descend {
-            l -= 1;
-            j *= 2;
+        if descend > 0 {
+            l -= descend;
+            j <<= descend;
             continue;
         }
         // Advance to the next piece in x order: the right sibling, or up until there is one.
@@ -542,6 +640,190 @@ fn walk<R: Real>(
             }
             j >>= 1;
             l += 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod model_tests {
+    use super::*;
+    use crate::curve::{prepare, CurveFrame, CurveShape, CurveWave};
+    use crate::quadrature::integrate_adaptive;
+
+    fn wave(shape: CurveShape, gamma: f32) -> CurveWave {
+        CurveWave {
+            frame: CurveFrame { origin: Vec3::new(-10.0, 0.0, 0.0), axis: Vec3::X, up: Vec3::Y },
+            shape,
+            gamma,
+            extension: 1.0,
+            attenuation: 0.0,
+            alpha: 1.0,
+            integrator: Integrator::Default,
+        }
+    }
+
+    fn shapes() -> Vec<(&'static str, CurveWave)> {
+        vec![
+            (
+                "helix",
+                wave(
+                    CurveShape::Helix {
+                        radius: 2.0,
+                        rate: std::f32::consts::TAU / 4.0,
+                        phase: 0.3,
+                        length: 20.0,
+                    },
+                    1.0,
+                ),
+            ),
+            (
+                "bspline",
+                wave(
+                    CurveShape::BSpline {
+                        points: vec![
+                            [0.0, 0.0],
+                            [3.0, 2.0],
+                            [-2.0, 3.0],
+                            [-3.0, -2.0],
+                            [2.0, -3.0],
+                            [3.0, 2.0],
+                            [-1.0, 1.0],
+                            [0.0, 0.0],
+                        ],
+                        order: 4,
+                        knots: None,
+                    },
+                    20.0,
+                ),
+            ),
+        ]
+    }
+
+    /// Rays per shape and falloff (300 for a calibration run in release mode).
+    const RAYS: usize = 60;
+
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// The chord model never underestimates: on random rays past a helix and a B-spline, every
+    /// piece of every level whose estimate lies near the tolerances in use (1e-4 to 1e-2) is
+    /// off by less than its estimate, against the exact (adaptive) integral of the curve it
+    /// replaces. Prints the ratio actual/estimate binned by ℓ/D (`--nocapture`); the model is
+    /// 3–10× conservative in the median.
+    #[test]
+    fn chord_model_is_conservative() {
+        let edges = [0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, f64::INFINITY];
+        for (name, w) in shapes() {
+            for falloff in [Falloff::Faithful, Falloff::InverseSquare] {
+                let c = prepare(&w);
+                let table = &c.table;
+                let n = table.nodes.len() - 1;
+                let model = ChordModel::<f64>::new(falloff);
+                let rc = if falloff == Falloff::Faithful { 0.0 } else { 0.05 };
+                let fp = FieldParams { falloff, core_radius: rc };
+                let gamma = f64::from(w.gamma);
+                let mut rng = Rng(0x1234_5678_9abc_def1);
+                let mut bins: Vec<Vec<f64>> = vec![Vec::new(); edges.len() - 1];
+                for _ in 0..RAYS {
+                    let u = [rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0];
+                    let dirn = Vec3::new(u[0], u[1], u[2]).normalize_or(Vec3::X);
+                    let target = c.point(rng.next() * c.s_head)
+                        + Vec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5)
+                            * (4.0 * rng.next());
+                    let eye = target + dirn * (5.0 + 35.0 * rng.next());
+                    let ray = Ray { origin: eye, dir: (target - eye).normalize_or(Vec3::X) };
+                    let Some(r) = LocalRay::new(&c, &fp, &ray, 0.0, 80.0, 100.0) else { continue };
+                    if r.q.x.abs() < 1e-6 {
+                        continue;
+                    }
+                    let (xa, xb) = (r.o.x, r.o.x + r.q.x * 80.0);
+                    let (lo, hi) = (xa.min(xb), xa.max(xb));
+                    let rc2 = r.rc2;
+                    for l in 1..table.levels() {
+                        for j in 0..n.div_ceil(1 << l) {
+                            let a = j << l;
+                            let b = ((j + 1) << l).min(n);
+                            let (na, nb) = (node::<f64>(&c, a), node::<f64>(&c, b));
+                            let x0 = lo.max(na[0]);
+                            let x1 = hi.min(nb[0]);
+                            if !(x1 > x0) {
+                                continue;
+                            }
+                            let (t0, t1) = ((x0 - r.o.x) / r.q.x, (x1 - r.o.x) / r.q.x);
+                            let (ts, te) = (t0.min(t1), t0.max(t1));
+                            let ln = table.line(l, j);
+                            let f = |k: usize| f64::from(ln[k]);
+                            let xs = r.o.x + r.q.x * ts - (na[0] + nb[0]) * 0.5;
+                            let p = Vec3::new(
+                                0.0,
+                                r.o.y + r.q.y * ts - (f(0) + xs * f(2)),
+                                r.o.z + r.q.z * ts - (f(1) + xs * f(3)),
+                            );
+                            let v = Vec3::new(0.0, r.q.y - r.q.x * f(2), r.q.z - r.q.x * f(3));
+                            let dt = te - ts;
+                            let err = f64::from(table.error(l, j));
+                            let (vv, pv) = (v.dot(v), p.dot(v));
+                            let tau = if vv > 0.0 { (-pv / vv).clamp(0.0, dt) } else { 0.0 };
+                            let d = p + v * tau;
+                            let ell = (vv * dt * dt / (d.dot(d) + rc2)).sqrt();
+                            let (x2m, am) =
+                                model.terms(err, p, v, vv, pv, dt, rc2, 1.0 - (x1 - x0) / (nb[0] - na[0]));
+                            let est = model.estimate(x2m, am);
+                            let line = Segment::new(falloff, p, v, dt, rc2).value;
+                            let k = if falloff == Falloff::Faithful { 0.5 } else { 1.0 };
+                            let exact = integrate_adaptive(
+                                |t| {
+                                    let x = r.o.x + r.q.x * t;
+                                    let cc = c.cross_section(x / gamma);
+                                    let dy = r.o.y + r.q.y * t - cc[0];
+                                    let dz = r.o.z + r.q.z * t - cc[1];
+                                    (dy * dy + dz * dz + rc2).powf(-k)
+                                },
+                                ts,
+                                te,
+                                1e-11,
+                                0.0,
+                            )
+                            .value;
+                            let actual = (line - exact).abs() / exact;
+                            if est > 1e-4 && est < 1e-2 {
+                                let bin = edges.windows(2).position(|e| ell >= e[0] && ell < e[1]).unwrap();
+                                bins[bin].push(actual / est);
+                            }
+                        }
+                    }
+                }
+                let worst = bins.iter().flatten().copied().fold(0.0, f64::max);
+                println!("{name} {falloff:?}: actual/estimate by ℓ/D (worst {worst:.3})");
+                for (i, b) in bins.iter_mut().enumerate() {
+                    b.sort_by(f64::total_cmp);
+                    if b.is_empty() {
+                        continue;
+                    }
+                    let q = |f: f64| b[((b.len() - 1) as f64 * f) as usize];
+                    println!(
+                        "  [{:>5}, {:>5}) n={:6} median {:.3} p99 {:.3} max {:.3}",
+                        edges[i],
+                        edges[i + 1],
+                        b.len(),
+                        q(0.5),
+                        q(0.99),
+                        q(1.0)
+                    );
+                }
+                assert!(
+                    bins.iter().map(Vec::len).sum::<usize>() > 1000,
+                    "{name} {falloff:?}: too few pieces"
+                );
+                assert!(worst < 1.0, "{name} {falloff:?}: a piece is off by {worst} times its estimate");
+            }
         }
     }
 }
