@@ -324,10 +324,10 @@ pub struct GpuCurve {
     pub levels: u32,
     /// [`DEFAULT_SETTINGS`] tolerance `τ`.
     pub tolerance: f32,
-    /// [`DEFAULT_SETTINGS`] attenuation grid step (clamped as the integrator does).
-    pub att_grid: f32,
-    /// [`DEFAULT_SETTINGS`] attenuation nodes (clamped to 1..=3).
-    pub att_nodes: u32,
+    /// Part ratio `q` of [`curve::attenuation_split`] for this wave's `j` (0.5 when `j = 0`).
+    pub att_q: f32,
+    /// Attenuation floor `h_floor` of [`curve::attenuation_split`].
+    pub att_floor: f32,
 }
 
 /// The storage buffers of a frame's curved waves: one [`GpuCurve`] per curve, the piece-table
@@ -362,6 +362,9 @@ impl CurveBuffers {
             CurveShape::Bezier { .. } | CurveShape::BSpline { .. } => 1.0,
         };
         let settings = DEFAULT_SETTINGS;
+        let j = f64::from(wave.attenuation);
+        let (att_q, att_floor) =
+            if j > 0.0 { curve::attenuation_split(j, settings.tolerance) } else { (0.5, 0.0) };
         let mut g = GpuCurve {
             origin: origin.to_array(),
             alpha: wave.alpha,
@@ -397,8 +400,8 @@ impl CurveBuffers {
             level_offsets: 0,
             levels: 0,
             tolerance: settings.tolerance as f32,
-            att_grid: settings.attenuation_grid.clamp(1.0 / 64.0, 1.0) as f32,
-            att_nodes: settings.attenuation_nodes.clamp(1, 3),
+            att_q: att_q as f32,
+            att_floor: att_floor as f32,
         };
         if let Integrator::Simpson { m, reduction } = wave.integrator {
             let m = m.clamp(2, curve::MAX_SIMPSON_M);

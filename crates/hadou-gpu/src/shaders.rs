@@ -197,8 +197,8 @@ mod tests {
                 level_offsets,
                 levels,
                 tolerance,
-                att_grid,
-                att_nodes,
+                att_q,
+                att_floor,
             ]
         );
     }

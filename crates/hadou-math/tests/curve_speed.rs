@@ -27,10 +27,8 @@ fn curve_speed_report() {
     };
     let j: f32 = env("CURVE_J", 0.0);
     let tol: f64 = env("CURVE_TOL", DEFAULT_SETTINGS.tolerance);
-    let nodes: u32 = env("CURVE_NODES", DEFAULT_SETTINGS.attenuation_nodes);
     let only: String = env("CURVE_SHAPE", String::new());
-    let grid: f64 = env("CURVE_GRID", DEFAULT_SETTINGS.attenuation_grid);
-    let settings = DefaultSettings { tolerance: tol, attenuation_nodes: nodes, attenuation_grid: grid };
+    let settings = DefaultSettings { tolerance: tol };
     let p = params(falloff);
     let p32 = params32(&p);
     let pixels = sample_pixels(step);

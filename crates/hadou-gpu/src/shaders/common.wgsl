@@ -87,8 +87,8 @@ struct GpuCurve {
     level_offsets: u32,
     levels: u32,
     tolerance: f32,
-    att_grid: f32,
-    att_nodes: u32,
+    att_q: f32,
+    att_floor: f32,
 }
 
 // Keep in sync with layout.rs: wave kinds and falloff/tone codes.

@@ -39,15 +39,6 @@ fn curve_ln1p_over(x: f32) -> f32 {
     return curve_ln_1p(x) / x;
 }
 
-// Mirrors closed.rs `sinh` (x ≥ 0).
-fn curve_sinh(x: f32) -> f32 {
-    if (x < 0.1) {
-        let x2 = x * x;
-        return x * (1.0 + x2 / 6.0 * (1.0 + x2 / 20.0));
-    }
-    return (exp(x) - exp(-x)) * 0.5;
-}
-
 // ---- shape.rs ----
 
 // Control point / term pair `i` of curve `c`.
@@ -237,19 +228,29 @@ struct Segment {
     delta: f32,
 }
 
-// Mirrors `Segment::new`: ∫₀^dt of (|p + vτ|² + rc2)^{-1/2} or ^{-1} in closed form (002 eq.
-// 3.9, corrected single-log / atan2 forms of SPEC.md §1.2). dt > CURVE_INF is an open end.
-fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, dt: f32, rc2: f32) -> Segment {
-    let s = length(v);
-    var y0 = 0.0;
-    var e = dot(p, p) + rc2;
-    if (s > 0.0) {
-        let vh = v / s;
-        let cr = cross(p, vh);
-        y0 = dot(p, vh);
-        e = dot(cr, cr) + rc2;
+// Mirrors `Segment::with_dots` (vv = v·v, pv = p·v): ∫₀^dt of (|p + vτ|² + rc2)^{-1/2} or
+// ^{-1} in closed form (002 eq. 3.9, corrected single-log / atan2 forms of SPEC.md §1.2), in
+// s-scaled quantities Y = s·y, E = s²e. dt > CURVE_INF is an open end.
+fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, rc2: f32) -> Segment {
+    var seg = Segment(0.0, falloff, dt, 0.0, 0.0, false, rc2, 0.0);
+    if (!(vv > 0.0)) {
+        let e0 = dot(p, p) + rc2;
+        seg.e = e0;
+        if (dt > 0.0 && dt <= CURVE_INF) {
+            if (falloff == FALLOFF_FAITHFUL) {
+                seg.value = dt / sqrt(e0);
+            } else {
+                seg.value = dt / e0;
+            }
+        }
+        return seg;
     }
-    var seg = Segment(0.0, falloff, dt, y0, y0, false, e, 0.0);
+    let inv_s = 1.0 / sqrt(vv);
+    let cr = cross(p, v);
+    let big_e = dot(cr, cr) + rc2 * vv;
+    seg.e = big_e * inv_s * inv_s;
+    seg.y0 = pv * inv_s;
+    seg.y1 = seg.y0;
     if (!(dt > 0.0)) {
         return seg;
     }
@@ -258,99 +259,53 @@ fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, dt: f32, rc2: f32) -> S
         if (dt > CURVE_INF) {
             dtf = 0.0;
         }
-        var a0 = y0;
-        var a1 = y0 + s * dtf;
+        let span = vv * dtf;
+        var a0 = pv;
+        var a1 = pv + span;
         if (a0 + a1 < 0.0) {
             let tmp = a0;
             a0 = -a1;
             a1 = -tmp;
             seg.flipped = true;
         }
-        let q0 = sqrt(a0 * a0 + e);
-        let q1 = sqrt(a1 * a1 + e);
-        var g0 = e / (q0 - a0);
+        let r0 = sqrt(a0 * a0 + big_e);
+        let r1 = sqrt(a1 * a1 + big_e);
+        let rs = r0 + r1;
+        var x = span * (rs + a0 + a1) * (r0 - a0) / (rs * big_e);
         if (a0 >= 0.0) {
-            g0 = a0 + q0;
+            x = span * (rs + a0 + a1) / (rs * (a0 + r0));
         }
-        let f = 1.0 + (a0 + a1) / (q0 + q1);
-        let a = dtf * f / g0;
-        let x = s * a;
-        seg.value = a * curve_ln1p_over(x);
-        seg.delta = curve_ln_1p(x);
-        seg.y0 = a0;
-        seg.y1 = a1;
+        var delta = curve_ln_1p(x);
+        if (x >= 0.0625) {
+            delta = log(1.0 + x);
+        }
+        seg.value = delta * inv_s;
+        seg.delta = delta;
+        seg.y0 = a0 * inv_s;
+        seg.y1 = a1 * inv_s;
     } else {
-        let se = sqrt(e);
+        let se = sqrt(big_e);
         if (dt <= CURVE_INF) {
-            let y1 = y0 + s * dt;
-            let z = s * dt * se;
-            let k = e + y0 * y1;
+            let span = vv * dt;
+            let z = span * se;
+            let k = big_e + pv * (pv + span);
             let th = atan2(z, k);
             if (k > 0.0 && z < 1.0e-4 * k) {
                 let r = z / k;
-                seg.value = dt / k * (1.0 - r * r / 3.0);
+                seg.value = span / k * (1.0 - r * r / 3.0);
             } else {
-                seg.value = th / (s * se);
+                seg.value = th / se;
             }
             seg.delta = th;
-            seg.y1 = y1;
-        } else if (s > 0.0) {
-            let th = atan2(se, y0);
-            seg.value = th / (s * se);
+            seg.y1 = (pv + span) * inv_s;
+        } else {
+            let th = atan2(se, pv);
+            seg.value = th / se;
             seg.delta = th;
             seg.y1 = T_OPEN;
         }
     }
     return seg;
-}
-
-// Mirrors `Segment::fraction_at`.
-fn segment_fraction_at(seg: Segment, mu: f32) -> f32 {
-    let y0 = seg.y0;
-    let e = seg.e;
-    let span = seg.y1 - y0;
-    if (!(span > F32_EPSILON * (abs(y0) + sqrt(e)))) {
-        return mu;
-    }
-    var lambda = 1.0;
-    if (seg.falloff == FALLOFF_FAITHFUL) {
-        var m = mu;
-        if (seg.flipped) {
-            m = 1.0 - mu;
-        }
-        let phi = m * seg.delta;
-        let q0 = sqrt(y0 * y0 + e);
-        let sh = curve_sinh(phi);
-        var num = 0.0;
-        if (y0 >= 0.0) {
-            let h = curve_sinh(phi * 0.5);
-            num = y0 * 2.0 * h * h + q0 * sh;
-        } else {
-            let g0 = e / (q0 - y0);
-            var ome = 1.0 - exp(-phi);
-            if (phi < 1.0e-3) {
-                ome = phi * (1.0 - phi * 0.5);
-            }
-            num = -y0 * ome + g0 * sh;
-        }
-        let l = num / span;
-        lambda = l;
-        if (seg.flipped) {
-            lambda = 1.0 - l;
-        }
-    } else {
-        let phi = mu * seg.delta;
-        let sp = sin(phi);
-        let cp = cos(phi);
-        let den = sqrt(e) * cp - y0 * sp;
-        if (den > 0.0) {
-            lambda = (y0 * y0 + e) * sp / (den * span);
-        }
-    }
-    if (curve_finite(lambda)) {
-        return clamp(lambda, 0.0, 1.0);
-    }
-    return mu;
 }
 
 // Mirrors `Segment::centroid`.
@@ -383,82 +338,115 @@ fn segment_centroid(seg: Segment) -> f32 {
     return dt * 0.5;
 }
 
-// Mirrors closed.rs `gauss_legendre`: node k of the n-point rule on [0, 1] as (x, w).
-fn gauss_legendre(n: u32, k: u32) -> vec2<f32> {
-    if (n <= 1u) {
-        return vec2<f32>(0.5, 1.0);
+// Mirrors `Segment::variance`.
+fn segment_variance(seg: Segment) -> f32 {
+    let y0 = seg.y0;
+    let y1 = seg.y1;
+    let e = seg.e;
+    let dt = seg.dt;
+    let span = y1 - y0;
+    let uniform = dt * dt / 12.0;
+    let q0 = y0 * y0 + e;
+    if (!(seg.value > 0.0) || !(span * (max(abs(y0), abs(y1)) + span) > 0.01 * q0)) {
+        return uniform;
     }
-    if (n == 2u) {
-        return select(vec2<f32>(0.21132487, 0.5), vec2<f32>(0.7886751, 0.5), k == 1u);
+    var m0 = 0.0;
+    var m1 = 0.0;
+    var s2 = 0.0;
+    if (seg.falloff == FALLOFF_FAITHFUL) {
+        let r0 = sqrt(y0 * y0 + e);
+        let r1 = sqrt(y1 * y1 + e);
+        m0 = seg.delta;
+        m1 = span * (y0 + y1) / (r0 + r1);
+        s2 = 0.5 * (y1 * r1 - y0 * r0) - 2.0 * y0 * m1 + (y0 * y0 - 0.5 * e) * m0;
+    } else {
+        m0 = seg.delta / sqrt(e);
+        m1 = 0.5 * curve_ln_1p(span * (y0 + y1) / (y0 * y0 + e));
+        s2 = span - 2.0 * y0 * m1 + (y0 * y0 - e) * m0;
     }
-    if (k == 0u) {
-        return vec2<f32>(0.11270167, 5.0 / 18.0);
+    let mu = m1 / m0 - y0;
+    let var_y = clamp(s2 / m0 - mu * mu, 0.0, span * span * 0.25);
+    let v = var_y * (dt / span) * (dt / span);
+    if (curve_finite(v)) {
+        return v;
     }
-    if (k == 1u) {
-        return vec2<f32>(0.5, 8.0 / 18.0);
-    }
-    return vec2<f32>(0.8872983, 5.0 / 18.0);
+    return uniform;
 }
 
-// Mirrors `Segment::attenuated`, with g = `LocalRay::attenuation`.
-fn segment_attenuated(seg: Segment, r: LocalRay, t_start: f32, nodes: u32, ga: f32, gb: f32) -> f32 {
+// Mirrors `Segment::attenuated`: second order about the weight's centroid.
+fn segment_attenuated(seg: Segment, t_start: f32, t_far: f32, j: f32) -> f32 {
     if (!(seg.value > 0.0)) {
         return 0.0;
     }
-    let tbar = segment_centroid(seg);
-    var lam0 = 0.5;
-    if (seg.dt > 0.0) {
-        lam0 = tbar / seg.dt;
+    let h = 1.0 - (t_start + segment_centroid(seg)) / t_far;
+    if (!(h > 0.0)) {
+        return 0.0;
     }
-    var acc = ga + (gb - ga) * lam0;
-    for (var k = 0u; k < nodes; k++) {
-        let xw = gauss_legendre(nodes, k);
-        let lam = segment_fraction_at(seg, xw.x);
-        acc += xw.y * (curve_attenuation(r, t_start + lam * seg.dt) - (ga + (gb - ga) * lam));
-    }
-    return acc * seg.value;
+    let ht = h * t_far;
+    let z = min(segment_variance(seg) / (ht * ht), 1.0);
+    let factor = max(1.0 + 0.5 * j * (j - 1.0) * z, 0.0);
+    return seg.value * pow(h, j) * factor;
 }
 
 // ---- integrate.rs: the default integrator ----
 
-// Mirrors integrate.rs `Acc::piece`: adds the piece d(τ) = p + vτ, τ ∈ [0, dt], from ray
-// parameter ts, split on the attenuation grid when j > 0.
-fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, p: vec3<f32>, v: vec3<f32>, dt: f32, acc: ptr<function, f32>) {
+// Mirrors integrate.rs `Acc::piece_dots`: adds the piece d(τ) = p + vτ, τ ∈ [0, dt], from ray
+// parameter ts; with j > 0 cut into parts whose 1 − u shrinks by att_q, down to att_floor.
+fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, acc: ptr<function, f32>) {
     if (r.j == 0.0) {
-        *acc += segment_new(r.falloff, p, v, dt, r.rc2).value;
+        *acc += segment_new(r.falloff, p, v, vv, pv, dt, r.rc2).value;
         return;
     }
     let te = ts + dt;
-    let step = c.att_grid * r.t_far;
-    var k = floor(ts / step) + 1.0;
     var a = ts;
-    for (var i = 0u; i < 70u; i++) {
-        let line = k * step;
+    for (var i = 0u; i < CURVE_MAX_PARTS; i++) {
+        let ha = 1.0 - a / r.t_far;
         var b = te;
-        if (line < te && i < 69u) {
-            b = line;
+        if (!(ha <= c.att_floor) && i + 1u < CURVE_MAX_PARTS) {
+            b = min(te, r.t_far * (1.0 - ha * c.att_q));
         }
-        let sub = b - a;
-        if (sub > 0.0) {
-            let seg = segment_new(r.falloff, p + v * (a - ts), v, sub, r.rc2);
-            let du = sub / r.t_far;
-            let nu = r.j * du / max(1.0 - b / r.t_far, du);
-            var n = c.att_nodes;
-            if (nu < 0.02) {
-                n = 0u;
-            } else if (nu < 0.2) {
-                n = min(1u, c.att_nodes);
-            }
-            let ga = curve_attenuation(r, a);
-            let gb = curve_attenuation(r, b);
-            *acc += segment_attenuated(seg, r, a, n, ga, gb);
-            a = b;
-        }
-        if (b >= te) {
+        let off = a - ts;
+        let seg = segment_new(r.falloff, p + v * off, v, vv, pv + vv * off, b - a, r.rc2);
+        *acc += segment_attenuated(seg, a, r.t_far, r.j);
+        if (!(b < te)) {
             break;
         }
-        k += 1.0;
+        a = b;
     }
+}
+
+// Mirrors integrate.rs `MAX_PARTS`.
+const CURVE_MAX_PARTS: u32 = 64u;
+
+// Mirrors integrate.rs `ChordModel::new(falloff)`: (first, saturation, partial, second).
+fn chord_model(falloff: u32) -> vec4<f32> {
+    if (falloff == FALLOFF_FAITHFUL) {
+        return vec4<f32>(3.0 / 16.0, 1.0, 1.0, 1.0);
+    }
+    return vec4<f32>(0.75, 1.0, 2.0, 3.0);
+}
+
+// Mirrors `ChordModel::terms` then `ChordModel::refinement`: 0 to accept, else levels to descend.
+fn chord_refinement(m: vec4<f32>, err: f32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, rc2: f32, uncovered: f32, tol: f32, level: u32) -> u32 {
+    var tau = 0.0;
+    if (vv > 0.0) {
+        tau = clamp(-pv / vv, 0.0, dt);
+    }
+    let d = p + v * tau;
+    let inv = 1.0 / (dot(d, d) + rc2);
+    let x2 = err * err * inv;
+    let a = min(m.x * vv * dt * dt * inv, m.y) + m.z * uncovered;
+    let b = tol - m.w * x2;
+    if (b >= 0.0 && x2 * a * a <= b * b) {
+        return 0u;
+    }
+    var ratio = (sqrt(x2) * a + m.w * x2) / (tol * 8.0);
+    var k = 1u;
+    while (k < level && ratio > 8.0) {
+        ratio = ratio / 8.0;
+        k += 1u;
+    }
+    return k;
 }
 
 // PieceTable::nodes[i] as (x, y, z).
@@ -512,9 +500,11 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
         let py = r.o.y + r.q.y * ta;
         let pz = r.o.z + r.q.z * ta;
         let p = vec3<f32>(0.0, py - (a.y + (b.y - a.y) * f), pz - (a.z + (b.z - a.z) * f));
-        curve_piece(c, r, ta, p, vec3<f32>(0.0, r.q.y, r.q.z), tb - ta, acc);
+        let v = vec3<f32>(0.0, r.q.y, r.q.z);
+        curve_piece(c, r, ta, p, v, dot(v, v), dot(p, v), tb - ta, acc);
         return;
     }
+    let model = chord_model(r.falloff);
     var l = levels - 1u;
     var j = 0u;
     let max_steps = 4u * (curve_level_offset(c, levels) + levels);
@@ -526,7 +516,7 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
         if (na.x >= hi) {
             break;
         }
-        var descend = false;
+        var descend = 0u;
         if (nb.x > lo) {
             let x0 = max(lo, na.x);
             let x1 = min(hi, nb.x);
@@ -553,28 +543,25 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
             let v = vec3<f32>(0.0, r.q.y - r.q.x * ln.z, r.q.z - r.q.x * ln.w);
             let dt = te - ts;
             let err = curve_f32[c.errors + idx];
-            var accept = l == 0u;
-            if (!accept) {
-                let vv = dot(v, v);
-                var tau = 0.0;
-                if (vv > 0.0) {
-                    tau = clamp(-dot(p, v) / vv, 0.0, dt);
+            let vv = dot(v, v);
+            let pv = dot(p, v);
+            var refine = 0u;
+            if (l > 0u) {
+                var uncovered = 0.0;
+                if (x0 > na.x || x1 < nb.x) {
+                    uncovered = 1.0 - (x1 - x0) / (nb.x - na.x);
                 }
-                let d = p + v * tau;
-                let d2 = dot(d, d) + r.rc2;
-                let e2 = err * err / d2;
-                let ell2 = vv * dt * dt / d2;
-                accept = sqrt(e2) * min(ell2, 1.0) + e2 <= c.tolerance;
+                refine = chord_refinement(model, err, p, v, vv, pv, dt, r.rc2, uncovered, c.tolerance, l);
             }
-            if (accept) {
-                curve_piece(c, r, ts, p, v, dt, acc);
+            if (refine == 0u) {
+                curve_piece(c, r, ts, p, v, vv, pv, dt, acc);
             } else {
-                descend = true;
+                descend = refine;
             }
         }
-        if (descend) {
-            l -= 1u;
-            j *= 2u;
+        if (descend > 0u) {
+            l -= descend;
+            j = j << descend;
             continue;
         }
         loop {
@@ -604,7 +591,8 @@ fn curve_end_point(c: GpuCurve, r: LocalRay, head: bool) -> vec3<f32> {
 // The exact sphere piece against an end point over [a, b] (`sphere` in integrate_span).
 fn curve_end_piece(c: GpuCurve, r: LocalRay, head: bool, a: f32, b: f32, acc: ptr<function, f32>) {
     if (b > a) {
-        curve_piece(c, r, a, r.o + r.q * a - curve_end_point(c, r, head), r.q, b - a, acc);
+        let p = r.o + r.q * a - curve_end_point(c, r, head);
+        curve_piece(c, r, a, p, r.q, dot(r.q, r.q), dot(p, r.q), b - a, acc);
     }
 }
 

@@ -13,28 +13,14 @@
 //!   (the difference of the two `atan`s folded into one `atan2`), `→ Δt/(e + y₀²)` as `s → 0`.
 //!
 //! Attenuation `(1 − t/t_far)^j` (002 eq. 3.23) is smooth where the piece's weight `w(τ)` is
-//! sharp, so it is integrated against that weight by substitution: with `W(τ) = ∫₀^τ w` the
-//! integral is `∫₀^{W(Δt)} g(τ(W)) dW`, and Gauss–Legendre nodes are placed uniformly in `W`
-//! (in `ψ = asinh(y/√e)` or `θ = atan(y/√e)`, which are proportional to `W`). The rule is exact
-//! for attenuation linear in `W` and needs no moments.
+//! sharp, so it is integrated against that weight by its moments: with the weight's centroid `t̄`
+//! and variance `σ²` (both closed forms), `∫w·g = ∫w·[g(t̄) + ½g''(t̄)σ²] + R₃`, where `R₃`
+//! involves the third central moment and `g'''`. For `j ∈ {1, 2}` the rule is exact; otherwise
+//! the caller keeps `Δu/(1 − u)` small enough that `R₃` is below its tolerance (see
+//! `integrate.rs`). One power per piece: `g''/g = j(j−1)/((1−ū)·t_far)²`.
 
 use crate::energy::Falloff;
 use crate::{Real, Vec3};
-
-/// Gauss–Legendre nodes on `[0, 1]` and their weights (summing to 1), for 1, 2 and 3 points.
-pub(crate) fn gauss_legendre(n: usize) -> (&'static [f64], &'static [f64]) {
-    const X1: [f64; 1] = [0.5];
-    const W1: [f64; 1] = [1.0];
-    const X2: [f64; 2] = [0.211_324_865_405_187_1, 0.788_675_134_594_812_9];
-    const W2: [f64; 2] = [0.5, 0.5];
-    const X3: [f64; 3] = [0.112_701_665_379_258_3, 0.5, 0.887_298_334_620_741_7];
-    const W3: [f64; 3] = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
-    match n {
-        0 | 1 => (&X1, &W1),
-        2 => (&X2, &W2),
-        _ => (&X3, &W3),
-    }
-}
 
 /// `ln(1 + x)/x`, 1 at `x = 0`.
 #[inline]
@@ -43,17 +29,6 @@ fn ln1p_over<R: Real>(x: R) -> R {
         R::ONE - x * (R::HALF - x / R::from_f64(3.0))
     } else {
         x.ln_1p() / x
-    }
-}
-
-/// `sinh(x)` for `x ≥ 0`, accurate for small `x`.
-#[inline]
-fn sinh<R: Real>(x: R) -> R {
-    if x < R::from_f64(0.1) {
-        let x2 = x * x;
-        x * (R::ONE + x2 / R::from_f64(6.0) * (R::ONE + x2 / R::from_f64(20.0)))
-    } else {
-        (x.exp() - (-x).exp()) * R::HALF
     }
 }
 
@@ -77,7 +52,7 @@ pub(crate) struct Segment<R> {
 impl<R: Real> Segment<R> {
     /// The integral of `w = (|p + vτ|² + rc2)^{-1/2}` (faithful) or `^{-1}` (inverse square) over
     /// `τ ∈ [0, dt]`. `rc2 > 0`; `dt ≥ 0` may be `+∞` for the inverse square (then `v ≠ 0`).
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn new(falloff: Falloff, p: Vec3<R>, v: Vec3<R>, dt: R, rc2: R) -> Self {
         Self::with_dots(falloff, p, v, v.dot(v), p.dot(v), dt, rc2)
     }
@@ -177,65 +152,6 @@ impl<R: Real> Segment<R> {
         seg
     }
 
-    /// The `τ`-fraction (in `[0, 1]` of `Δt`) at which the weight's cumulative integral reaches the
-    /// fraction `mu` of the total. Finite pieces only.
-    ///
-    /// With `φ = μΔψ` (faithful) or `φ = μΔθ` (inverse square) the node's `y_k` follows from the
-    /// addition theorems, written in the exact quantities `y₀`, `√Q₀` and `y₁ − y₀ = sΔt` so that
-    /// no angle near `±π/2` (or large `ψ`) is ever converted back:
-    /// - faithful: `λ·sΔt = y₀(cosh φ − 1) + √Q₀ sinh φ`, for `y₀ < 0` rearranged as
-    ///   `|y₀|(1 − e^{−φ}) + g₀ sinh φ` (both terms positive);
-    /// - inverse square: `λ·sΔt = Q₀ sin φ / (√e cos φ − y₀ sin φ)`.
-    #[inline]
-    pub(crate) fn fraction_at(&self, mu: R) -> R {
-        let (y0, y1, e, d) = (self.y0, self.y1, self.e, self.delta);
-        let span = y1 - y0;
-        if !(span > R::EPSILON * (y0.abs() + e.sqrt())) {
-            return mu;
-        }
-        let lambda = match self.falloff {
-            Falloff::Faithful => {
-                let mu = if self.flipped { R::ONE - mu } else { mu };
-                let phi = mu * d;
-                let q0 = (y0 * y0 + e).sqrt();
-                let sh = sinh(phi);
-                let num = if y0 >= R::ZERO {
-                    let h = sinh(phi * R::HALF);
-                    y0 * R::TWO * h * h + q0 * sh
-                } else {
-                    let g0 = e / (q0 - y0);
-                    let one_minus_exp = if phi < R::from_f64(1e-3) {
-                        phi * (R::ONE - phi * R::HALF)
-                    } else {
-                        R::ONE - (-phi).exp()
-                    };
-                    -y0 * one_minus_exp + g0 * sh
-                };
-                let l = num / span;
-                if self.flipped {
-                    R::ONE - l
-                } else {
-                    l
-                }
-            }
-            Falloff::InverseSquare => {
-                let phi = mu * d;
-                let (sp, cp) = (phi.sin(), phi.cos());
-                let den = e.sqrt() * cp - y0 * sp;
-                if den > R::ZERO {
-                    (y0 * y0 + e) * sp / (den * span)
-                } else {
-                    R::ONE
-                }
-            }
-        };
-        if lambda.is_finite() {
-            lambda.clamp(R::ZERO, R::ONE)
-        } else {
-            mu
-        }
-    }
-
     /// The weight's centroid `τ̄ = ∫τw/∫w` in `[0, Δt]`, from the closed-form first moment
     /// `∫y w dτ` (faithful: `Δt(y₀+y₁)/(√Q₀+√Q₁)`; inverse square: `ln(Q₁/Q₀)/(2s)` through
     /// `ln_1p`) as `τ̄ = (∫yw/∫w − y₀)/s`; the midpoint where the weight is constant to `10⁻⁴`.
@@ -269,33 +185,72 @@ impl<R: Real> Segment<R> {
         }
     }
 
-    /// `∫₀^{Δt} w(τ)·g(t_start + τ) dτ`: the linear interpolant of `g` between the piece's ends
-    /// (`ga = g(t_start)`, `gb = g(t_start + Δt)`) exactly, by the weight's
-    /// [`centroid`](Self::centroid), and the remainder `g − g_lin` by `nodes`-point
-    /// Gauss–Legendre in the weight's cumulative measure (none for `nodes = 0`), which costs
-    /// `nodes` evaluations of `g`. Finite pieces only.
+    /// The weight's variance `σ² = ∫(τ − τ̄)²w/∫w` over the piece, in closed form; `Δt²/12`
+    /// where the weight is constant. Finite pieces only.
+    ///
+    /// From the moments about the piece's start in `y` (mirroring leaves a variance unchanged):
+    /// with `m₀ = ∫w dy`, `m₁ = ∫y w dy`, `S₂ = ∫(y − y₀)²w dy`,
+    /// - faithful: `m₀ = Δψ`, `m₁ = √Q₁ − √Q₀ = Δy(y₀+y₁)/(√Q₀+√Q₁)`,
+    ///   `S₂ = ½(y₁√Q₁ − y₀√Q₀) − 2y₀m₁ + (y₀² − ½e)m₀`;
+    /// - inverse square: `m₀ = Δθ/√e`, `m₁ = ½ln(Q₁/Q₀)` (through `ln_1p`),
+    ///   `S₂ = Δy − 2y₀m₁ + (y₀² − e)m₀`;
+    ///
+    /// then `σ_y² = S₂/m₀ − (m₁/m₀ − y₀)²`, clamped to `[0, Δy²/4]` (the most any weight on the
+    /// interval allows) so that rounding can never make it negative, and `σ² = σ_y²(Δt/Δy)²`.
     #[inline]
-    pub(crate) fn attenuated(&self, t_start: R, nodes: usize, ga: R, gb: R, g: impl Fn(R) -> R) -> R {
+    pub(crate) fn variance(&self) -> R {
+        let (y0, y1, e, dt) = (self.y0, self.y1, self.e, self.dt);
+        let span = y1 - y0;
+        let uniform = dt * dt / R::from_f64(12.0);
+        // Where the weight changes by less than 1 % over the piece (ν = Δy(|y|max + Δy)/Q₀), its
+        // variance is Δt²/12 to better than 10⁻³, while the moments below would lose about
+        // ε/ν² to cancellation.
+        let q0 = y0 * y0 + e;
+        if !(self.value > R::ZERO) || !(span * (y0.abs().max(y1.abs()) + span) > R::from_f64(0.01) * q0) {
+            return uniform;
+        }
+        let (m0, m1, s2) = match self.falloff {
+            Falloff::Faithful => {
+                let (r0, r1) = ((y0 * y0 + e).sqrt(), (y1 * y1 + e).sqrt());
+                let m0 = self.delta;
+                let m1 = span * (y0 + y1) / (r0 + r1);
+                (m0, m1, R::HALF * (y1 * r1 - y0 * r0) - R::TWO * y0 * m1 + (y0 * y0 - R::HALF * e) * m0)
+            }
+            Falloff::InverseSquare => {
+                let m0 = self.delta / e.sqrt();
+                let m1 = R::HALF * (span * (y0 + y1) / (y0 * y0 + e)).ln_1p();
+                (m0, m1, span - R::TWO * y0 * m1 + (y0 * y0 - e) * m0)
+            }
+        };
+        let mu = m1 / m0 - y0;
+        let var = (s2 / m0 - mu * mu).clamp(R::ZERO, span * span * R::from_f64(0.25));
+        let v = var * (dt / span) * (dt / span);
+        if v.is_finite() {
+            v
+        } else {
+            uniform
+        }
+    }
+
+    /// `∫₀^{Δt} w(τ)·g(t_start + τ) dτ` for the attenuation `g(t) = (1 − t/t_far)^j`
+    /// (002 eq. 3.23), to second order about the weight's centroid `t̄`:
+    /// `∫w·g(t̄)·(1 + ½j(j−1)·z)`, `z = σ²/((1 − t̄/t_far)·t_far)²` clamped to 1 (a spread
+    /// beyond the distance to the far point only occurs where `g` is already below the
+    /// attenuation floor). Exact for `j ∈ {1, 2}` (up to the variance's own rounding); never
+    /// negative. Finite pieces only.
+    #[inline]
+    pub(crate) fn attenuated(&self, t_start: R, t_far: R, j: R) -> R {
         if !(self.value > R::ZERO) {
             return R::ZERO;
         }
-        let lin = |lam: R| ga + (gb - ga) * lam;
-        let tbar = self.centroid();
-        let mut acc = lin(if self.dt > R::ZERO { tbar / self.dt } else { R::HALF });
-        if nodes > 0 {
-            let (xs, ws) = gauss_legendre(nodes);
-            for (x, w) in xs.iter().zip(ws) {
-                let lam = self.fraction_at(R::from_f64(*x));
-                acc += R::from_f64(*w) * (g(t_start + lam * self.dt) - lin(lam));
-            }
+        let h = R::ONE - (t_start + self.centroid()) / t_far;
+        if !(h > R::ZERO) {
+            return R::ZERO;
         }
-        acc * self.value
-    }
-
-    /// `y` range and `e` (for tests of the completed square).
-    #[cfg(test)]
-    pub(crate) fn parts(&self) -> (R, R, R) {
-        (self.y0, self.y1, self.e)
+        let ht = h * t_far;
+        let z = (self.variance() / (ht * ht)).min(R::ONE);
+        let factor = (R::ONE + R::HALF * j * (j - R::ONE) * z).max(R::ZERO);
+        self.value * h.powf(j) * factor
     }
 }
 
@@ -348,48 +303,81 @@ mod tests {
         assert!((got - exact.value).abs() < 1e-10 * exact.value, "{got} vs {}", exact.value);
     }
 
+    fn moment(falloff: Falloff, p: Vec3<f64>, v: Vec3<f64>, dt: f64, k: i32, f: impl Fn(f64) -> f64) -> f64 {
+        let pw = if falloff == Falloff::Faithful { -0.5 } else { -1.0 };
+        integrate_adaptive(
+            |t| t.powi(k) * f(t) * ((p + v * t).length_squared() + 1e-4).powf(pw),
+            0.0,
+            dt,
+            1e-13,
+            0.0,
+        )
+        .value
+    }
+
+    const PIECES: [(Vec3<f64>, Vec3<f64>, f64); 6] = [
+        (Vec3 { x: 0.1, y: -2.0, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 4.0), // through the closest approach
+        (Vec3 { x: 0.1, y: -20.0, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 1.0), // far, nearly uniform
+        (Vec3 { x: 0.1, y: 2.0, z: 0.0 }, Vec3 { x: 0.0, y: 1e-4, z: 0.0 }, 1.0), // almost constant
+        (Vec3 { x: 0.01, y: -0.5, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 1.0), // sharp peak inside
+        (Vec3 { x: 0.02, y: 0.0, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 30.0), // peak at the start, long tail
+        (Vec3 { x: 0.0, y: -300.0, z: 1.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 0.5), // far, short
+    ];
+
     #[test]
-    fn weight_fractions_split_the_integral() {
-        // The weight's integral over [0, λ(μ)Δt] must be μ times the total.
+    fn centroid_and_variance_match_quadrature() {
         for falloff in [Falloff::Faithful, Falloff::InverseSquare] {
-            for &(p, v, dt) in &[
-                (Vec3::new(0.1, -2.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 4.0),
-                (Vec3::new(0.1, -20.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 1.0),
-                (Vec3::new(0.1, 2.0, 0.0), Vec3::new(0.0, 1e-4, 0.0), 1.0),
-                (Vec3::new(0.01, -0.5, 0.0), Vec3::new(0.0, 1.0, 0.0), 1.0),
-            ] {
+            for &(p, v, dt) in &PIECES {
                 let seg = Segment::new(falloff, p, v, dt, 1e-4);
-                for mu in [0.1, 0.5, 0.8] {
-                    let lam = seg.fraction_at(mu);
-                    let part = Segment::new(falloff, p, v, lam * dt, 1e-4).value;
+                let m0 = moment(falloff, p, v, dt, 0, |_| 1.0);
+                let m1 = moment(falloff, p, v, dt, 1, |_| 1.0);
+                let m2 = moment(falloff, p, v, dt, 2, |_| 1.0);
+                let tbar = m1 / m0;
+                let var = m2 / m0 - tbar * tbar;
+                assert!((seg.value - m0).abs() < 1e-10 * m0, "{falloff:?} {p:?}: value");
+                assert!(
+                    (seg.centroid() - tbar).abs() < 2e-5 * dt,
+                    "{falloff:?} {p:?}: centroid {} vs {tbar}",
+                    seg.centroid()
+                );
+                let got = seg.variance();
+                assert!(
+                    (got - var).abs() < 1e-6 * dt * dt + 1e-4 * var,
+                    "{falloff:?} {p:?}: variance {got} vs {var}"
+                );
+                // f32 keeps the variance to a fraction of the piece's squared length.
+                let g32 = Segment::new(falloff, p.as_f32(), v.as_f32(), dt as f32, 1e-4).variance();
+                assert!(
+                    (f64::from(g32) - var).abs() < 1e-3 * dt * dt,
+                    "f32 {falloff:?} {p:?}: {g32} vs {var}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn attenuation_by_moments() {
+        let t_far = 40.0;
+        for falloff in [Falloff::Faithful, Falloff::InverseSquare] {
+            for &(p, v, dt) in &PIECES {
+                for (t_start, j) in [(1.0, 2.0), (5.0, 1.0), (2.0, 0.5), (3.0, 3.0), (2.0, 6.0)] {
+                    let g = |t: f64| (1.0 - (t_start + t) / t_far).max(0.0).powf(j);
+                    let exact = moment(falloff, p, v, dt, 0, g);
+                    let got = Segment::new(falloff, p, v, dt, 1e-4).attenuated(t_start, t_far, j);
+                    // Second order about the centroid: exact for j ≤ 2, else off by the third
+                    // moment term, ~j³·(Δt/(t_far − t))³/100 at most.
+                    let x = dt / (t_far - t_start - dt);
+                    let bound = if j == 1.0 || j == 2.0 {
+                        1e-6
+                    } else {
+                        (j * (j - 1.0) * (j - 2.0)).abs() * x * x * x / 50.0 + 1e-9
+                    };
                     assert!(
-                        (part / seg.value - mu).abs() < 1e-9,
-                        "{falloff:?} {p:?} μ={mu}: {}",
-                        part / seg.value
+                        (got - exact).abs() <= bound * exact,
+                        "{falloff:?} {p:?} j={j}: {got} vs {exact} (rel {:.2e}, bound {bound:.1e})",
+                        (got - exact).abs() / exact
                     );
                 }
-                let tbar = seg.centroid();
-                let m1 = integrate_adaptive(
-                    |t| {
-                        t * ((p + v * t).length_squared() + 1e-4).powf(if falloff == Falloff::Faithful {
-                            -0.5
-                        } else {
-                            -1.0
-                        })
-                    },
-                    0.0,
-                    dt,
-                    1e-13,
-                    0.0,
-                )
-                .value;
-                assert!(
-                    (tbar - m1 / seg.value).abs() < 2e-5 * dt,
-                    "{falloff:?} {p:?} centroid {tbar} vs {}",
-                    m1 / seg.value
-                );
-                let (y0, y1, e) = seg.parts();
-                assert!(y0.is_finite() && y1.is_finite() && e > 0.0);
             }
         }
     }
