@@ -426,7 +426,7 @@ impl<R: Real> ChordModel<R> {
         let mut ratio = self.estimate(x2, a) / (tol * per_level);
         let mut k = 1;
         while k < level && ratio > per_level {
-            ratio = ratio / per_level;
+            ratio /= per_level;
             k += 1;
         }
         k
