@@ -105,7 +105,11 @@ fn main() {
             let (e, n) = run(x, y);
             evals.push(n);
             if r > 1e-4 * peak {
-                errs.push((f64::from(e) - r).abs() / r);
+                let err = (f64::from(e) - r).abs() / r;
+                if err > 5e-4 {
+                    eprintln!("pixel ({x}, {y}): energy {e} reference {r} ({err:.1e}), {n} evaluations");
+                }
+                errs.push(err);
             }
         }
         let start = Instant::now();

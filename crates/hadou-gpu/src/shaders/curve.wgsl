@@ -31,14 +31,6 @@ fn curve_ln_1p(x: f32) -> f32 {
     return log(u) - ((u - 1.0) - x) / u;
 }
 
-// Mirrors closed.rs `ln1p_over`: ln(1 + x)/x, 1 at x = 0.
-fn curve_ln1p_over(x: f32) -> f32 {
-    if (abs(x) < 1.0e-3) {
-        return 1.0 - x * (0.5 - x / 3.0);
-    }
-    return curve_ln_1p(x) / x;
-}
-
 // ---- shape.rs ----
 
 // Control point / term pair `i` of curve `c`.
@@ -223,6 +215,7 @@ struct Segment {
     dt: f32,
     y0: f32,
     y1: f32,
+    span: f32,
     flipped: bool,
     e: f32,
     delta: f32,
@@ -232,7 +225,7 @@ struct Segment {
 // ^{-1} in closed form (002 eq. 3.9, corrected single-log / atan2 forms of SPEC.md §1.2), in
 // s-scaled quantities Y = s·y, E = s²e. dt > CURVE_INF is an open end.
 fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, rc2: f32) -> Segment {
-    var seg = Segment(0.0, falloff, dt, 0.0, 0.0, false, rc2, 0.0);
+    var seg = Segment(0.0, falloff, dt, 0.0, 0.0, 0.0, false, rc2, 0.0);
     if (!(vv > 0.0)) {
         let e0 = dot(p, p) + rc2;
         seg.e = e0;
@@ -260,6 +253,7 @@ fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f
             dtf = 0.0;
         }
         let span = vv * dtf;
+        seg.span = span * inv_s;
         var a0 = pv;
         var a1 = pv + span;
         if (a0 + a1 < 0.0) {
@@ -287,6 +281,7 @@ fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f
         let se = sqrt(big_e);
         if (dt <= CURVE_INF) {
             let span = vv * dt;
+            seg.span = span * inv_s;
             let z = span * se;
             let k = big_e + pv * (pv + span);
             let th = atan2(z, k);
@@ -308,69 +303,53 @@ fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f
     return seg;
 }
 
-// Mirrors `Segment::centroid`.
-fn segment_centroid(seg: Segment) -> f32 {
+// Mirrors `Segment::moments`: (centroid τ̄, variance σ²) of the weight over the piece.
+fn segment_moments(seg: Segment) -> vec2<f32> {
     let y0 = seg.y0;
     let y1 = seg.y1;
     let e = seg.e;
     let dt = seg.dt;
-    let span = y1 - y0;
-    let q0 = y0 * y0 + e;
-    if (!(seg.value > 0.0) || !(span * (max(abs(y0), abs(y1)) + span) > 1.0e-4 * q0)) {
-        return dt * 0.5;
-    }
-    var n1 = 0.0;
-    if (seg.falloff == FALLOFF_FAITHFUL) {
-        let q1 = y1 * y1 + e;
-        n1 = dt * (y0 + y1) / (sqrt(q0) + sqrt(q1));
-    } else {
-        let x = span * (y0 + y1) / q0;
-        n1 = dt * (y0 + y1) / (2.0 * q0) * curve_ln1p_over(x);
-    }
-    let s = span / dt;
-    var tbar = (n1 / seg.value - y0) / s;
-    if (seg.flipped) {
-        tbar = dt - tbar;
-    }
-    if (curve_finite(tbar)) {
-        return clamp(tbar, 0.0, dt);
-    }
-    return dt * 0.5;
-}
-
-// Mirrors `Segment::variance`.
-fn segment_variance(seg: Segment) -> f32 {
-    let y0 = seg.y0;
-    let y1 = seg.y1;
-    let e = seg.e;
-    let dt = seg.dt;
-    let span = y1 - y0;
+    let span = seg.span;
+    let mid = dt * 0.5;
     let uniform = dt * dt / 12.0;
     let q0 = y0 * y0 + e;
-    if (!(seg.value > 0.0) || !(span * (max(abs(y0), abs(y1)) + span) > 0.01 * q0)) {
-        return uniform;
+    let nu = span * (max(abs(y0), abs(y1)) + span);
+    if (!(seg.value > 0.0) || !(nu > 1.0e-4 * q0)) {
+        return vec2<f32>(mid, uniform);
     }
     var m0 = 0.0;
     var m1 = 0.0;
     var s2 = 0.0;
     if (seg.falloff == FALLOFF_FAITHFUL) {
-        let r0 = sqrt(y0 * y0 + e);
+        let r0 = sqrt(q0);
         let r1 = sqrt(y1 * y1 + e);
         m0 = seg.delta;
         m1 = span * (y0 + y1) / (r0 + r1);
         s2 = 0.5 * (y1 * r1 - y0 * r0) - 2.0 * y0 * m1 + (y0 * y0 - 0.5 * e) * m0;
     } else {
         m0 = seg.delta / sqrt(e);
-        m1 = 0.5 * curve_ln_1p(span * (y0 + y1) / (y0 * y0 + e));
+        m1 = 0.5 * curve_ln_1p(span * (y0 + y1) / q0);
         s2 = span - 2.0 * y0 * m1 + (y0 * y0 - e) * m0;
     }
     let mu = m1 / m0 - y0;
-    let var_y = clamp(s2 / m0 - mu * mu, 0.0, span * span * 0.25);
-    let v = var_y * (dt / span) * (dt / span);
-    if (curve_finite(v)) {
-        return v;
+    let scale = dt / span;
+    var tbar = mu * scale;
+    if (seg.flipped) {
+        tbar = dt - tbar;
     }
-    return uniform;
+    if (curve_finite(tbar)) {
+        tbar = clamp(tbar, 0.0, dt);
+    } else {
+        tbar = mid;
+    }
+    if (!(nu > 0.01 * q0)) {
+        return vec2<f32>(tbar, uniform);
+    }
+    let v = clamp(s2 / m0 - mu * mu, 0.0, span * span * 0.25) * scale * scale;
+    if (curve_finite(v)) {
+        return vec2<f32>(tbar, v);
+    }
+    return vec2<f32>(tbar, uniform);
 }
 
 // Mirrors `Segment::attenuated`: second order about the weight's centroid.
@@ -378,12 +357,13 @@ fn segment_attenuated(seg: Segment, t_start: f32, t_far: f32, j: f32) -> f32 {
     if (!(seg.value > 0.0)) {
         return 0.0;
     }
-    let h = 1.0 - (t_start + segment_centroid(seg)) / t_far;
+    let mv = segment_moments(seg);
+    let h = 1.0 - (t_start + mv.x) / t_far;
     if (!(h > 0.0)) {
         return 0.0;
     }
     let ht = h * t_far;
-    let z = min(segment_variance(seg) / (ht * ht), 1.0);
+    let z = min(mv.y / (ht * ht), 1.0);
     let factor = max(1.0 + 0.5 * j * (j - 1.0) * z, 0.0);
     return seg.value * pow(h, j) * factor;
 }

@@ -22,17 +22,7 @@
 use crate::energy::Falloff;
 use crate::{Real, Vec3};
 
-/// `ln(1 + x)/x`, 1 at `x = 0`.
-#[inline]
-fn ln1p_over<R: Real>(x: R) -> R {
-    if x.abs() < R::from_f64(1e-3) {
-        R::ONE - x * (R::HALF - x / R::from_f64(3.0))
-    } else {
-        x.ln_1p() / x
-    }
-}
-
-/// One straight piece's integral and what its attenuation nodes need.
+/// One straight piece's integral and what its attenuation rule needs.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Segment<R> {
     /// `∫₀^{Δt} w(τ) dτ`.
@@ -42,6 +32,8 @@ pub(crate) struct Segment<R> {
     /// `y₀`, `y₁` after the mirroring (faithful) that makes `y₀ + y₁ ≥ 0`.
     y0: R,
     y1: R,
+    /// `y₁ − y₀ = sΔt`, formed directly (not as a difference of the rounded `y₀`, `y₁`).
+    span: R,
     /// Whether `y` was mirrored.
     flipped: bool,
     e: R,
@@ -74,6 +66,7 @@ impl<R: Real> Segment<R> {
             dt,
             y0: R::ZERO,
             y1: R::ZERO,
+            span: R::ZERO,
             flipped: false,
             e: rc2,
             delta: R::ZERO,
@@ -103,6 +96,7 @@ impl<R: Real> Segment<R> {
             Falloff::Faithful => {
                 let dt = if dt.is_finite() { dt } else { R::ZERO };
                 let span = vv * dt;
+                seg.span = span * inv_s;
                 let (mut y0, mut y1) = (pv, pv + span);
                 if y0 + y1 < R::ZERO {
                     (y0, y1) = (-y1, -y0);
@@ -130,6 +124,7 @@ impl<R: Real> Segment<R> {
                 let se = big_e.sqrt();
                 if dt.is_finite() {
                     let span = vv * dt;
+                    seg.span = span * inv_s;
                     let z = span * se;
                     let k = big_e + pv * (pv + span);
                     let th = z.atan2(k);
@@ -152,84 +147,67 @@ impl<R: Real> Segment<R> {
         seg
     }
 
-    /// The weight's centroid `τ̄ = ∫τw/∫w` in `[0, Δt]`, from the closed-form first moment
-    /// `∫y w dτ` (faithful: `Δt(y₀+y₁)/(√Q₀+√Q₁)`; inverse square: `ln(Q₁/Q₀)/(2s)` through
-    /// `ln_1p`) as `τ̄ = (∫yw/∫w − y₀)/s`; the midpoint where the weight is constant to `10⁻⁴`.
-    /// Finite pieces only.
-    #[inline]
-    pub(crate) fn centroid(&self) -> R {
-        let (y0, y1, e, dt) = (self.y0, self.y1, self.e, self.dt);
-        let span = y1 - y0;
-        let q0 = y0 * y0 + e;
-        // Relative change of the weight over the piece ≈ span·|y|/Q.
-        if !(self.value > R::ZERO) || !(span * (y0.abs().max(y1.abs()) + span) > R::from_f64(1e-4) * q0) {
-            return dt * R::HALF;
-        }
-        let n1 = match self.falloff {
-            Falloff::Faithful => {
-                let q1 = y1 * y1 + e;
-                dt * (y0 + y1) / (q0.sqrt() + q1.sqrt())
-            }
-            Falloff::InverseSquare => {
-                let x = span * (y0 + y1) / q0;
-                dt * (y0 + y1) / (R::TWO * q0) * ln1p_over(x)
-            }
-        };
-        let s = span / dt;
-        let tbar = (n1 / self.value - y0) / s;
-        let tbar = if self.flipped { dt - tbar } else { tbar };
-        if tbar.is_finite() {
-            tbar.clamp(R::ZERO, dt)
-        } else {
-            dt * R::HALF
-        }
-    }
-
-    /// The weight's variance `σ² = ∫(τ − τ̄)²w/∫w` over the piece, in closed form; `Δt²/12`
-    /// where the weight is constant. Finite pieces only.
+    /// The weight's centroid `τ̄ = ∫τw/∫w` in `[0, Δt]` and its variance
+    /// `σ² = ∫(τ − τ̄)²w/∫w`, in closed form, for the attenuation's second-order rule. Finite
+    /// pieces only.
     ///
-    /// From the moments about the piece's start in `y` (mirroring leaves a variance unchanged):
-    /// with `m₀ = ∫w dy`, `m₁ = ∫y w dy`, `S₂ = ∫(y − y₀)²w dy`,
+    /// From the moments in `y` (`τ = (y − y₀)/s`; mirroring flips the centroid and leaves the
+    /// variance): with `m₀ = ∫w dy`, `m₁ = ∫y w dy`, `S₂ = ∫(y − y₀)²w dy`,
     /// - faithful: `m₀ = Δψ`, `m₁ = √Q₁ − √Q₀ = Δy(y₀+y₁)/(√Q₀+√Q₁)`,
     ///   `S₂ = ½(y₁√Q₁ − y₀√Q₀) − 2y₀m₁ + (y₀² − ½e)m₀`;
     /// - inverse square: `m₀ = Δθ/√e`, `m₁ = ½ln(Q₁/Q₀)` (through `ln_1p`),
     ///   `S₂ = Δy − 2y₀m₁ + (y₀² − e)m₀`;
     ///
-    /// then `σ_y² = S₂/m₀ − (m₁/m₀ − y₀)²`, clamped to `[0, Δy²/4]` (the most any weight on the
-    /// interval allows) so that rounding can never make it negative, and `σ² = σ_y²(Δt/Δy)²`.
+    /// the centroid is `μ = m₁/m₀ − y₀` (as `τ̄ = μΔt/Δy`) and `σ_y² = S₂/m₀ − μ²`, clamped to
+    /// `[0, Δy²/4]` (the most any weight on the interval allows) so that rounding can never make
+    /// it negative, `σ² = σ_y²(Δt/Δy)²`. Where the weight is constant to `10⁻⁴` over the piece
+    /// (`ν = Δy(|y|max + Δy)/Q₀`) the centroid is the midpoint; where it is constant to 1 % the
+    /// variance is `Δt²/12`, which is then good to `10⁻³` while `S₂` would lose about `ε/ν²`
+    /// to cancellation.
     #[inline]
-    pub(crate) fn variance(&self) -> R {
-        let (y0, y1, e, dt) = (self.y0, self.y1, self.e, self.dt);
-        let span = y1 - y0;
-        let uniform = dt * dt / R::from_f64(12.0);
-        // Where the weight changes by less than 1 % over the piece (ν = Δy(|y|max + Δy)/Q₀), its
-        // variance is Δt²/12 to better than 10⁻³, while the moments below would lose about
-        // ε/ν² to cancellation.
+    pub(crate) fn moments(&self) -> (R, R) {
+        let (y0, y1, e, dt, span) = (self.y0, self.y1, self.e, self.dt, self.span);
+        let (mid, uniform) = (dt * R::HALF, dt * dt / R::from_f64(12.0));
         let q0 = y0 * y0 + e;
-        if !(self.value > R::ZERO) || !(span * (y0.abs().max(y1.abs()) + span) > R::from_f64(0.01) * q0) {
-            return uniform;
+        let nu = span * (y0.abs().max(y1.abs()) + span);
+        if !(self.value > R::ZERO) || !(nu > R::from_f64(1e-4) * q0) {
+            return (mid, uniform);
         }
         let (m0, m1, s2) = match self.falloff {
             Falloff::Faithful => {
-                let (r0, r1) = ((y0 * y0 + e).sqrt(), (y1 * y1 + e).sqrt());
+                let (r0, r1) = (q0.sqrt(), (y1 * y1 + e).sqrt());
                 let m0 = self.delta;
                 let m1 = span * (y0 + y1) / (r0 + r1);
                 (m0, m1, R::HALF * (y1 * r1 - y0 * r0) - R::TWO * y0 * m1 + (y0 * y0 - R::HALF * e) * m0)
             }
             Falloff::InverseSquare => {
                 let m0 = self.delta / e.sqrt();
-                let m1 = R::HALF * (span * (y0 + y1) / (y0 * y0 + e)).ln_1p();
+                let m1 = R::HALF * (span * (y0 + y1) / q0).ln_1p();
                 (m0, m1, span - R::TWO * y0 * m1 + (y0 * y0 - e) * m0)
             }
         };
         let mu = m1 / m0 - y0;
-        let var = (s2 / m0 - mu * mu).clamp(R::ZERO, span * span * R::from_f64(0.25));
-        let v = var * (dt / span) * (dt / span);
-        if v.is_finite() {
-            v
-        } else {
-            uniform
+        let scale = dt / span;
+        let tbar = mu * scale;
+        let tbar = if self.flipped { dt - tbar } else { tbar };
+        let tbar = if tbar.is_finite() { tbar.clamp(R::ZERO, dt) } else { mid };
+        if !(nu > R::from_f64(0.01) * q0) {
+            return (tbar, uniform);
         }
+        let var = (s2 / m0 - mu * mu).clamp(R::ZERO, span * span * R::from_f64(0.25)) * scale * scale;
+        (tbar, if var.is_finite() { var } else { uniform })
+    }
+
+    /// The centroid alone (see [`moments`](Self::moments)).
+    #[cfg(test)]
+    pub(crate) fn centroid(&self) -> R {
+        self.moments().0
+    }
+
+    /// The variance alone (see [`moments`](Self::moments)).
+    #[cfg(test)]
+    pub(crate) fn variance(&self) -> R {
+        self.moments().1
     }
 
     /// `∫₀^{Δt} w(τ)·g(t_start + τ) dτ` for the attenuation `g(t) = (1 − t/t_far)^j`
@@ -243,12 +221,13 @@ impl<R: Real> Segment<R> {
         if !(self.value > R::ZERO) {
             return R::ZERO;
         }
-        let h = R::ONE - (t_start + self.centroid()) / t_far;
+        let (tbar, var) = self.moments();
+        let h = R::ONE - (t_start + tbar) / t_far;
         if !(h > R::ZERO) {
             return R::ZERO;
         }
         let ht = h * t_far;
-        let z = (self.variance() / (ht * ht)).min(R::ONE);
+        let z = (var / (ht * ht)).min(R::ONE);
         let factor = (R::ONE + R::HALF * j * (j - R::ONE) * z).max(R::ZERO);
         self.value * h.powf(j) * factor
     }

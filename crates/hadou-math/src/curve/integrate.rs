@@ -87,8 +87,11 @@ pub const DEFAULT_SETTINGS: DefaultSettings = DefaultSettings { tolerance: 2e-3 
 /// `x = Δu/(1 − u)`, a skewness bound `|μ₃| ≤ 0.05Δt³` and `μ₄ ≤ Δt⁴/80` this is at most
 /// `|j(j−1)(j−2)|·x³/120 + |j(j−1)(j−2)(j−3)|·x⁴/1920`. Each term is held below `τ/2`, which
 /// gives `x_max` (at most 4; unbounded for `j ∈ {1, 2}`, where the rule is exact), and parts
-/// shrink `1 − u` by `q = 1/(1 + x_max)`. Splitting stops where `(1 − u)^j ≤ τ/2`, i.e. below
-/// `h_floor = (τ/2)^{1/j}`.
+/// shrink `1 − u` by `q = 1/(1 + x_max)`. Splitting stops where the last part, up to the far
+/// point, cannot be off by more than `τ/2`: that part's rule error is at most
+/// `E = |(j+1)·2^{−j}·(1 + j(j−1)/6) − 1| + 0.05` of its share (the exact error for a uniform
+/// weight, plus an allowance for skew), and its share at most `(1 − u)^j`, so
+/// `h_floor = (τ/(2E))^{1/j}`.
 pub fn attenuation_split(j: f64, tolerance: f64) -> (f64, f64) {
     let ta = 0.5 * tolerance.clamp(1e-9, 0.5);
     let c3 = (j * (j - 1.0) * (j - 2.0)).abs() / 120.0;
@@ -96,7 +99,10 @@ pub fn attenuation_split(j: f64, tolerance: f64) -> (f64, f64) {
     let x3 = if c3 > 0.0 { (ta / c3).cbrt() } else { f64::INFINITY };
     let x4 = if c4 > 0.0 { (ta / c4).powf(0.25) } else { f64::INFINITY };
     let x_max = x3.min(x4).min(4.0);
-    let h_floor = if j > 0.0 { ta.powf(1.0 / j) } else { 0.0 };
+    // The last part, [a, t_far], has x = ∞: the rule is then off by the factor
+    // (j+1)·2^{−j}·(1 + j(j−1)/6) for a uniform weight, plus an allowance for skew.
+    let last = ((j + 1.0) * (-j).exp2() * (1.0 + j * (j - 1.0) / 6.0) - 1.0).abs() + 0.05;
+    let h_floor = if j > 0.0 { (ta / last.min(1.0)).min(1.0).powf(1.0 / j) } else { 0.0 };
     (1.0 / (1.0 + x_max), h_floor)
 }
 
