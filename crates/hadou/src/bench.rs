@@ -266,6 +266,8 @@ pub struct CurveTable {
     pub method: String,
     /// Rows.
     pub rows: Vec<CurveRow>,
+    /// Default against Simpson `m = 500` on every example curve scene.
+    pub acceptance: Vec<AcceptanceRow>,
 }
 
 /// Replaces the integrator of every curved wave of `frame`.
@@ -279,13 +281,16 @@ pub fn with_integrator(frame: &Frame, integrator: Integrator) -> Frame {
     f
 }
 
-/// Evaluations per pixel and p99 relative error of `frame`'s curved waves on a 64 × 64 grid of
-/// pixels, against the f64 adaptive reference (relative tolerance 1e-9). Pixels whose reference
-/// energy is below 1e-4 of the grid's largest are left out of the error percentile (their
-/// relative error says nothing visible). The example curve scenes have no occluders, so rays run
+/// Pixels per side of the grid on which `hadou bench curves` measures evaluations and error.
+pub const ACCURACY_GRID: u32 = 64;
+
+/// Evaluations per pixel and p99 relative error of `frame`'s curved waves on a `grid × grid`
+/// grid of pixels, against [`curve_reference`] on the same grid. Pixels whose reference energy
+/// is below 1e-4 of the grid's largest are left out of the error percentile (their relative
+/// error says nothing visible). The example curve scenes have no occluders, so rays run
 /// unclipped.
-pub fn curve_accuracy(frame: &Frame, reference: &[f64]) -> (f64, f64) {
-    let samples = sample_curve_energies(frame, None);
+pub fn curve_accuracy(frame: &Frame, reference: &[f64], grid: u32) -> (f64, f64) {
+    let samples = sample_curve_energies(frame, None, grid);
     let evals = samples.iter().map(|s| s.1 as f64).sum::<f64>() / samples.len().max(1) as f64;
     let peak = reference.iter().copied().fold(0.0, f64::max);
     let mut errs: Vec<f64> = samples
@@ -299,13 +304,14 @@ pub fn curve_accuracy(frame: &Frame, reference: &[f64]) -> (f64, f64) {
     (evals, p99)
 }
 
-/// The converged f64 reference energy of `frame`'s curved waves on the 64 × 64 sample grid.
-pub fn curve_reference(frame: &Frame) -> Vec<f64> {
-    sample_curve_energies(frame, Some(1e-9)).into_iter().map(|s| s.2).collect()
+/// The converged f64 reference energy (adaptive quadrature, relative tolerance 1e-9) of
+/// `frame`'s curved waves on a `grid × grid` grid of pixel centres.
+pub fn curve_reference(frame: &Frame, grid: u32) -> Vec<f64> {
+    sample_curve_energies(frame, Some(1e-9), grid).into_iter().map(|s| s.2).collect()
 }
 
 /// Per sampled pixel: (f32 energy, evaluations, f64 reference energy if `reference_tol`).
-fn sample_curve_energies(frame: &Frame, reference_tol: Option<f64>) -> Vec<(f32, u32, f64)> {
+fn sample_curve_energies(frame: &Frame, reference_tol: Option<f64>, grid: u32) -> Vec<(f32, u32, f64)> {
     use hadou_math::energy::{FieldParams, Ray};
     let basis = frame.camera.basis(frame.width, frame.height);
     let prepared: Vec<_> = frame
@@ -316,7 +322,6 @@ fn sample_curve_energies(frame: &Frame, reference_tol: Option<f64>) -> Vec<(f32,
             _ => None,
         })
         .collect();
-    let grid = 64u32;
     let mut out = Vec::with_capacity((grid * grid) as usize);
     for gy in 0..grid {
         for gx in 0..grid {
@@ -359,11 +364,11 @@ pub fn curve_table(
         let scene = Scene::load(&path)
             .map_err(|e| RenderError::Other(format!("curve bench needs the example scenes: {e}")))?;
         let base = scene.at(0.0);
-        let reference = curve_reference(&base);
+        let reference = curve_reference(&base, ACCURACY_GRID);
         for (label, integrator) in curve_integrators() {
             progress(&format!("{shape}: {label}"));
             let frame = with_integrator(&base, integrator);
-            let (evals_per_pixel, p99_error) = curve_accuracy(&frame, &reference);
+            let (evals_per_pixel, p99_error) = curve_accuracy(&frame, &reference, ACCURACY_GRID);
             let mut ms = Vec::new();
             for &size in sizes {
                 let mut f = frame.clone();
@@ -374,7 +379,87 @@ pub fn curve_table(
             rows.push(CurveRow { shape: shape.into(), integrator: label, ms, evals_per_pixel, p99_error });
         }
     }
-    Ok(CurveTable { backend: backend.into(), method: method.into(), rows })
+    let mut acceptance = Vec::new();
+    for &(label, file, t) in &ACCEPTANCE_SCENES {
+        progress(&format!("acceptance: {label}"));
+        let scene = Scene::load(&scenes_dir.join(file))
+            .map_err(|e| RenderError::Other(format!("curve bench needs the example scenes: {e}")))?;
+        let base = scene.at(t);
+        let reference = curve_reference(&base, ACCURACY_GRID);
+        let simpson = with_integrator(&base, Integrator::Simpson { m: 500, reduction: None });
+        let default = with_integrator(&base, Integrator::Default);
+        let (simpson_evals, simpson_p99) = curve_accuracy(&simpson, &reference, ACCURACY_GRID);
+        let (default_evals, default_p99) = curve_accuracy(&default, &reference, ACCURACY_GRID);
+        let simpson_ms = time(&simpson, iterations)?;
+        let default_ms = time(&default, iterations)?;
+        acceptance.push(AcceptanceRow {
+            scene: label.into(),
+            size: (base.width, base.height),
+            simpson_ms,
+            default_ms,
+            simpson_evals,
+            default_evals,
+            simpson_p99,
+            default_p99,
+        });
+    }
+    Ok(CurveTable { backend: backend.into(), method: method.into(), rows, acceptance })
+}
+
+/// Every example scene with curved waves, at the times its animation shows something new: the
+/// scenes on which the default integrator's bars are stated (label, file, time in seconds).
+pub const ACCEPTANCE_SCENES: [(&str, &str, f32); 11] = [
+    ("Fig. 4.2 helix", "fig4-2-helix.toml", 0.0),
+    ("Fig. 4.2 trig sum", "fig4-2-trig.toml", 0.0),
+    ("Fig. 4.2 Bézier", "fig4-2-bezier.toml", 0.0),
+    ("Fig. 4.2 B-spline", "fig4-2-bspline.toml", 0.0),
+    ("Fig. 4.9 two curves", "fig4-9-two-curves.toml", 0.0),
+    ("Fig. 4.10 j=0.5", "fig4-10-attenuation.toml", 1.0),
+    ("Fig. 4.10 j=2", "fig4-10-attenuation.toml", 3.0),
+    ("Fig. 4.10 j=6", "fig4-10-attenuation.toml", 5.0),
+    ("Fig. 4.13 k=0.1", "fig4-13-extension.toml", 0.0),
+    ("Fig. 4.13 k=0.8", "fig4-13-extension.toml", 2.0),
+    ("spiral drill", "spiral-drill.toml", 1.8),
+];
+
+/// One example scene: faithful Simpson `m = 500` against the default integrator, both measured
+/// in the same run.
+#[derive(Clone, Debug)]
+pub struct AcceptanceRow {
+    /// Scene label.
+    pub scene: String,
+    /// The scene's own image size.
+    pub size: (u32, u32),
+    /// Median ms per frame, Simpson `m = 500`.
+    pub simpson_ms: f64,
+    /// Median ms per frame, default integrator.
+    pub default_ms: f64,
+    /// Curve evaluations per pixel, Simpson.
+    pub simpson_evals: f64,
+    /// Curve evaluations per pixel, default.
+    pub default_evals: f64,
+    /// 99th-percentile relative error, Simpson.
+    pub simpson_p99: f64,
+    /// 99th-percentile relative error, default.
+    pub default_p99: f64,
+}
+
+impl AcceptanceRow {
+    /// How many times fewer evaluations the default takes.
+    pub fn eval_ratio(&self) -> f64 {
+        self.simpson_evals / self.default_evals.max(1e-9)
+    }
+    /// How many times less time the default takes.
+    pub fn time_ratio(&self) -> f64 {
+        self.simpson_ms / self.default_ms.max(1e-9)
+    }
+    /// The bars: p99 ≤ 0.5 %, ≥ 10× fewer evaluations, ≥ 5× less time, Simpson further off.
+    pub fn meets_bars(&self) -> bool {
+        self.default_p99 <= 5e-3
+            && self.eval_ratio() >= 10.0
+            && self.time_ratio() >= 5.0
+            && self.simpson_p99 > self.default_p99
+    }
 }
 
 impl CurveTable {
@@ -398,6 +483,35 @@ impl CurveTable {
             }
             out += &format!(" {:>12.1} {:>10.2e}\n", r.evals_per_pixel, r.p99_error);
         }
+        if !self.acceptance.is_empty() {
+            out += "\nexample scenes at their own size: default integrator against faithful Simpson m=500\n";
+            out += &format!(
+                "{:<20} {:>9} {:>19} {:>19} {:>8} {:>8} {:>10} {:>10}  {}\n",
+                "scene",
+                "size",
+                "ms Simpson/default",
+                "evals Simp./def.",
+                "evals ×",
+                "time ×",
+                "p99 Simp.",
+                "p99 def.",
+                "bars"
+            );
+            for a in &self.acceptance {
+                out += &format!(
+                    "{:<20} {:>9} {:>19} {:>19} {:>8.1} {:>8.1} {:>10.2e} {:>10.2e}  {}\n",
+                    a.scene,
+                    format!("{}×{}", a.size.0, a.size.1),
+                    format!("{:.1}/{:.1}", a.simpson_ms, a.default_ms),
+                    format!("{:.1}/{:.1}", a.simpson_evals, a.default_evals),
+                    a.eval_ratio(),
+                    a.time_ratio(),
+                    a.simpson_p99,
+                    a.default_p99,
+                    if a.meets_bars() { "met" } else { "NOT met" }
+                );
+            }
+        }
         out
     }
 
@@ -414,6 +528,20 @@ impl CurveTable {
                     .collect::<Vec<_>>(),
                 "evals_per_pixel": r.evals_per_pixel,
                 "p99_error": r.p99_error,
+            })).collect::<Vec<_>>(),
+            "acceptance": self.acceptance.iter().map(|a| serde_json::json!({
+                "scene": a.scene,
+                "width": a.size.0,
+                "height": a.size.1,
+                "simpson_m500_ms": a.simpson_ms,
+                "default_ms": a.default_ms,
+                "simpson_m500_evals_per_pixel": a.simpson_evals,
+                "default_evals_per_pixel": a.default_evals,
+                "simpson_m500_p99_error": a.simpson_p99,
+                "default_p99_error": a.default_p99,
+                "eval_ratio": a.eval_ratio(),
+                "time_ratio": a.time_ratio(),
+                "meets_bars": a.meets_bars(),
             })).collect::<Vec<_>>(),
         })
     }

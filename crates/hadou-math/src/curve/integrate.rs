@@ -14,12 +14,14 @@
 //! with deviation bounds `δ`. The walk starts at the root and, for each piece overlapping the
 //! ray's `x`-range, forms its quadratic, finds the closest approach `d` over the overlap (the
 //! quadratic's clamped minimum) and the change `ℓ = |v|Δt` of the relative position along it,
-//! and accepts the piece if its estimated relative error `(δ/D)·min(1, (ℓ/D)²) + (δ/D)²`,
-//! `D² = d² + r_c²`, is at most the tolerance `τ`; otherwise it descends to the two halves
-//! (leaves are always accepted). The first term is the first-order error `∇w·δ`: it cancels to
-//! `O((ℓ/D)²)` because a least-squares line leaves a deviation with zero mean and zero first
-//! moment, and does not cancel where the ray passes close to the piece (`ℓ ≳ D`); the second is
-//! the second-order term. Near the curve the walk reaches fine leaves, far from it a few coarse
+//! and accepts the piece if its estimated relative error (the `ChordModel`:
+//! `(δ/D)·(min(1, c₁(ℓ/D)²) + P·(1 − κ)) + c₂(δ/D)²`, `D² = d² + r_c²`, `κ` the part of the
+//! piece's `x`-range the ray covers) is at most the tolerance `τ`; otherwise it descends as many
+//! levels as the estimate predicts (leaves are always accepted). The first term is the
+//! first-order error `∇w·δ`: it cancels to `O((ℓ/D)²)` because a least-squares line leaves a
+//! deviation with zero mean and zero first moment over the piece, and does not cancel where the
+//! ray passes close to the piece (`ℓ ≳ D`) or covers only part of it; the second is the
+//! second-order term. Near the curve the walk reaches fine leaves, far from it a few coarse
 //! lines cover whole turns: the bounding-cylinder distinction of the thesis (002 §3.4.4) becomes
 //! continuous, and since every accepted piece is within tolerance there is no band where the
 //! resolution changes.
@@ -41,8 +43,9 @@
 //! 4. Slab: if the `x`-range is below `10⁻⁶X`, one piece against the interpolated leaf point;
 //!    else the stackless walk over `(ℓ, j)`: piece range `[nodes[j·2^ℓ].x,
 //!    nodes[min((j+1)·2^ℓ, N)].x]` ∩ the ray's range, line `lines[level_offsets[ℓ]+j]`, bound
-//!    `errors[…]`; accept, or go to `(ℓ−1, 2j)`; after a piece, `j += 1` if `j` is even and has a
-//!    sibling, else climb (`j >>= 1`, `ℓ += 1`) and retry; stop past the range or after the root.
+//!    `errors[…]`; accept, or go to `(ℓ−k, j·2^k)` with `k` from `ChordModel::refinement`; after
+//!    a piece, `j += 1` if `j` is even and has a sibling, else climb (`j >>= 1`, `ℓ += 1`) and
+//!    retry; stop past the range or after the root.
 //! 5. End piece after the slab. Energy `= α·Σ`.
 //!
 //! # Counting evaluations
