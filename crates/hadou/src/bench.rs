@@ -382,7 +382,7 @@ pub fn curve_table(
     let mut acceptance = Vec::new();
     for &(label, file, t) in &ACCEPTANCE_SCENES {
         progress(&format!("acceptance: {label}"));
-        let scene = Scene::load(&scenes_dir.join(file))
+        let scene = Scene::load(scenes_dir.join(file))
             .map_err(|e| RenderError::Other(format!("curve bench needs the example scenes: {e}")))?;
         let base = scene.at(t);
         let reference = curve_reference(&base, ACCURACY_GRID);
