@@ -17,7 +17,7 @@ fn default_integrator_meets_the_bars_on_every_example_scene() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut failures = Vec::new();
     for &(label, file, t) in &ACCEPTANCE_SCENES {
-        let scene = Scene::load(&dir.join(file)).unwrap_or_else(|e| panic!("{e}"));
+        let scene = Scene::load(dir.join(file)).unwrap_or_else(|e| panic!("{e}"));
         let base = scene.at(t);
         let reference = curve_reference(&base, GRID);
         assert!(reference.iter().any(|&r| r > 0.0), "{label}: the curve is not in view");
