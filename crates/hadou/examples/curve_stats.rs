@@ -101,16 +101,19 @@ fn main() {
         };
         let mut evals = Vec::new();
         let mut errs = Vec::new();
+        let mut worst = Vec::new();
         for (&(x, y), &r) in pixels.iter().zip(&reference) {
             let (e, n) = run(x, y);
             evals.push(n);
             if r > 1e-4 * peak {
                 let err = (f64::from(e) - r).abs() / r;
-                if err > 5e-4 {
-                    eprintln!("pixel ({x}, {y}): energy {e} reference {r} ({err:.1e}), {n} evaluations");
-                }
+                worst.push((err, x, y, e, r, n));
                 errs.push(err);
             }
+        }
+        worst.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for &(err, x, y, e, r, n) in worst.iter().take(3) {
+            eprintln!("  worst: pixel ({x}, {y}) energy {e} reference {r:.6e} ({err:.1e}), {n} evaluations");
         }
         let start = Instant::now();
         let mut sink = 0.0f32;

@@ -221,13 +221,40 @@ struct Segment {
     delta: f32,
 }
 
-// Mirrors `Segment::with_dots` (vv = v·v, pv = p·v): ∫₀^dt of (|p + vτ|² + rc2)^{-1/2} or
-// ^{-1} in closed form (002 eq. 3.9, corrected single-log / atan2 forms of SPEC.md §1.2), in
-// s-scaled quantities Y = s·y, E = s²e. dt > CURVE_INF is an open end.
-fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, rc2: f32) -> Segment {
+// Mirrors closed.rs `Quad`: (pp, vv, pv, E) of |p + vτ|² + rc2, E = |p × v|² + rc2·vv.
+fn quad_new(p: vec3<f32>, v: vec3<f32>, rc2: f32) -> vec4<f32> {
+    let vv = dot(v, v);
+    let cr = cross(p, v);
+    return vec4<f32>(dot(p, p), vv, dot(p, v), dot(cr, cr) + rc2 * vv);
+}
+
+// Mirrors `Quad::planar`: p = (0, py, pz), v = (0, vy, vz).
+fn quad_planar(py: f32, pz: f32, vy: f32, vz: f32, rc2: f32) -> vec4<f32> {
+    let vv = vy * vy + vz * vz;
+    let c = py * vz - pz * vy;
+    return vec4<f32>(py * py + pz * pz, vv, py * vy + pz * vz, c * c + rc2 * vv);
+}
+
+// Mirrors `Quad::end_squared`.
+fn quad_end_squared(q: vec4<f32>, dt: f32) -> f32 {
+    return max(q.x + dt * (2.0 * q.z + q.y * dt), 0.0);
+}
+
+// Mirrors `Quad::shifted`.
+fn quad_shifted(q: vec4<f32>, off: f32) -> vec4<f32> {
+    return vec4<f32>(quad_end_squared(q, off), q.y, q.z + q.y * off, q.w);
+}
+
+// Mirrors `Segment::from_quad`: ∫₀^dt of (|p + vτ|² + rc2)^{-1/2} or ^{-1} in closed form (002
+// eq. 3.9, corrected single-log / atan2 forms of SPEC.md §1.2), in s-scaled quantities Y = s·y,
+// E = s²e. dt > CURVE_INF is an open end.
+fn segment_new(falloff: u32, q: vec4<f32>, dt: f32, rc2: f32) -> Segment {
+    let vv = q.y;
+    let pv = q.z;
+    let big_e = q.w;
     var seg = Segment(0.0, falloff, dt, 0.0, 0.0, 0.0, false, rc2, 0.0);
     if (!(vv > 0.0)) {
-        let e0 = dot(p, p) + rc2;
+        let e0 = q.x + rc2;
         seg.e = e0;
         if (dt > 0.0 && dt <= CURVE_INF) {
             if (falloff == FALLOFF_FAITHFUL) {
@@ -239,8 +266,6 @@ fn segment_new(falloff: u32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f
         return seg;
     }
     let inv_s = 1.0 / sqrt(vv);
-    let cr = cross(p, v);
-    let big_e = dot(cr, cr) + rc2 * vv;
     seg.e = big_e * inv_s * inv_s;
     seg.y0 = pv * inv_s;
     seg.y1 = seg.y0;
@@ -370,11 +395,11 @@ fn segment_attenuated(seg: Segment, t_start: f32, t_far: f32, j: f32) -> f32 {
 
 // ---- integrate.rs: the default integrator ----
 
-// Mirrors integrate.rs `Acc::piece_dots`: adds the piece d(τ) = p + vτ, τ ∈ [0, dt], from ray
+// Mirrors integrate.rs `Acc::piece_quad`: adds the piece d(τ) = p + vτ, τ ∈ [0, dt], from ray
 // parameter ts; with j > 0 cut into parts whose 1 − u shrinks by att_q, down to att_floor.
-fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, acc: ptr<function, f32>) {
+fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, q: vec4<f32>, dt: f32, acc: ptr<function, f32>) {
     if (r.j == 0.0) {
-        *acc += segment_new(r.falloff, p, v, vv, pv, dt, r.rc2).value;
+        *acc += segment_new(r.falloff, q, dt, r.rc2).value;
         return;
     }
     let te = ts + dt;
@@ -385,8 +410,7 @@ fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, p: vec3<f32>, v: vec3<f32>, vv
         if (!(ha <= c.att_floor) && i + 1u < CURVE_MAX_PARTS) {
             b = min(te, r.t_far * (1.0 - ha * c.att_q));
         }
-        let off = a - ts;
-        let seg = segment_new(r.falloff, p + v * off, v, vv, pv + vv * off, b - a, r.rc2);
+        let seg = segment_new(r.falloff, quad_shifted(q, a - ts), b - a, r.rc2);
         *acc += segment_attenuated(seg, a, r.t_far, r.j);
         if (!(b < te)) {
             break;
@@ -407,15 +431,15 @@ fn chord_model(falloff: u32) -> vec4<f32> {
 }
 
 // Mirrors `ChordModel::terms` then `ChordModel::refinement`: 0 to accept, else levels to descend.
-fn chord_refinement(m: vec4<f32>, err: f32, p: vec3<f32>, v: vec3<f32>, vv: f32, pv: f32, dt: f32, rc2: f32, uncovered: f32, tol: f32, level: u32) -> u32 {
-    var tau = 0.0;
-    if (vv > 0.0) {
-        tau = clamp(-pv / vv, 0.0, dt);
+fn chord_refinement(m: vec4<f32>, err: f32, q: vec4<f32>, dt: f32, rc2: f32, uncovered: f32, tol: f32, level: u32) -> u32 {
+    var inv = q.y / q.w;
+    if (q.z >= 0.0) {
+        inv = 1.0 / (q.x + rc2);
+    } else if (q.z + q.y * dt <= 0.0) {
+        inv = 1.0 / (quad_end_squared(q, dt) + rc2);
     }
-    let d = p + v * tau;
-    let inv = 1.0 / (dot(d, d) + rc2);
     let x2 = err * err * inv;
-    let a = min(m.x * vv * dt * dt * inv, m.y) + m.z * uncovered;
+    let a = min(m.x * q.y * dt * dt * inv, m.y) + m.z * uncovered;
     let b = tol - m.w * x2;
     if (b >= 0.0 && x2 * a * a <= b * b) {
         return 0u;
@@ -480,11 +504,11 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
         let py = r.o.y + r.q.y * ta;
         let pz = r.o.z + r.q.z * ta;
         let p = vec3<f32>(0.0, py - (a.y + (b.y - a.y) * f), pz - (a.z + (b.z - a.z) * f));
-        let v = vec3<f32>(0.0, r.q.y, r.q.z);
-        curve_piece(c, r, ta, p, v, dot(v, v), dot(p, v), tb - ta, acc);
+        curve_piece(c, r, ta, quad_new(p, vec3<f32>(0.0, r.q.y, r.q.z), r.rc2), tb - ta, acc);
         return;
     }
     let model = chord_model(r.falloff);
+    let inv_qx = 1.0 / r.q.x;
     var l = levels - 1u;
     var j = 0u;
     let max_steps = 4u * (curve_level_offset(c, levels) + levels);
@@ -500,13 +524,13 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
         if (nb.x > lo) {
             let x0 = max(lo, na.x);
             let x1 = min(hi, nb.x);
-            var tx0 = t_lo + (x0 - lo) / r.q.x;
+            var tx0 = t_lo + (x0 - lo) * inv_qx;
             if (x0 == lo) {
                 tx0 = t_lo;
             } else if (x0 == hi) {
                 tx0 = t_hi;
             }
-            var tx1 = t_lo + (x1 - lo) / r.q.x;
+            var tx1 = t_lo + (x1 - lo) * inv_qx;
             if (x1 == lo) {
                 tx1 = t_lo;
             } else if (x1 == hi) {
@@ -519,22 +543,19 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
             let xs = r.o.x + r.q.x * ts - (na.x + nb.x) * 0.5;
             let py = r.o.y + r.q.y * ts;
             let pz = r.o.z + r.q.z * ts;
-            let p = vec3<f32>(0.0, py - (ln.x + xs * ln.z), pz - (ln.y + xs * ln.w));
-            let v = vec3<f32>(0.0, r.q.y - r.q.x * ln.z, r.q.z - r.q.x * ln.w);
+            let quad = quad_planar(py - (ln.x + xs * ln.z), pz - (ln.y + xs * ln.w), r.q.y - r.q.x * ln.z, r.q.z - r.q.x * ln.w, r.rc2);
             let dt = te - ts;
             let err = curve_f32[c.errors + idx];
-            let vv = dot(v, v);
-            let pv = dot(p, v);
             var refine = 0u;
             if (l > 0u) {
                 var uncovered = 0.0;
                 if (x0 > na.x || x1 < nb.x) {
                     uncovered = 1.0 - (x1 - x0) / (nb.x - na.x);
                 }
-                refine = chord_refinement(model, err, p, v, vv, pv, dt, r.rc2, uncovered, c.tolerance, l);
+                refine = chord_refinement(model, err, quad, dt, r.rc2, uncovered, c.tolerance, l);
             }
             if (refine == 0u) {
-                curve_piece(c, r, ts, p, v, vv, pv, dt, acc);
+                curve_piece(c, r, ts, quad, dt, acc);
             } else {
                 descend = refine;
             }
@@ -571,8 +592,7 @@ fn curve_end_point(c: GpuCurve, r: LocalRay, head: bool) -> vec3<f32> {
 // The exact sphere piece against an end point over [a, b] (`sphere` in integrate_span).
 fn curve_end_piece(c: GpuCurve, r: LocalRay, head: bool, a: f32, b: f32, acc: ptr<function, f32>) {
     if (b > a) {
-        let p = r.o + r.q * a - curve_end_point(c, r, head);
-        curve_piece(c, r, a, p, r.q, dot(r.q, r.q), dot(p, r.q), b - a, acc);
+        curve_piece(c, r, a, quad_new(r.o + r.q * a - curve_end_point(c, r, head), r.q, r.rc2), b - a, acc);
     }
 }
 

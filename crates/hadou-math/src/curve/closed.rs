@@ -22,6 +22,46 @@
 use crate::energy::Falloff;
 use crate::{Real, Vec3};
 
+/// The quadratic `|p + vτ|² + r_c²` of one piece, by its dot products: `pp = p·p`, `vv = v·v`,
+/// `pv = p·v` and `E = |p × v|² + r_c²·vv` (`= vv·e`; a cross product, so it never cancels).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Quad<R> {
+    pub pp: R,
+    pub vv: R,
+    pub pv: R,
+    pub big_e: R,
+}
+
+impl<R: Real> Quad<R> {
+    /// The quadratic of `d(τ) = p + vτ` in 3-D.
+    #[inline]
+    pub(crate) fn new(p: Vec3<R>, v: Vec3<R>, rc2: R) -> Self {
+        let vv = v.dot(v);
+        Quad { pp: p.dot(p), vv, pv: p.dot(v), big_e: p.cross(v).length_squared() + rc2 * vv }
+    }
+
+    /// The quadratic of a piece inside the slab, where `d` has no axial component:
+    /// `p = (0, py, pz)`, `v = (0, vy, vz)`, so `p × v` is the single term `py·vz − pz·vy`.
+    #[inline]
+    pub(crate) fn planar(py: R, pz: R, vy: R, vz: R, rc2: R) -> Self {
+        let vv = vy * vy + vz * vz;
+        let c = py * vz - pz * vy;
+        Quad { pp: py * py + pz * pz, vv, pv: py * vy + pz * vz, big_e: c * c + rc2 * vv }
+    }
+
+    /// `|d(τ)|²` at `τ = dt`.
+    #[inline]
+    pub(crate) fn end_squared(&self, dt: R) -> R {
+        (self.pp + dt * (R::TWO * self.pv + self.vv * dt)).max(R::ZERO)
+    }
+
+    /// The quadratic of the same line from `τ = off` on.
+    #[inline]
+    pub(crate) fn shifted(&self, off: R) -> Self {
+        Quad { pp: self.end_squared(off), vv: self.vv, pv: self.pv + self.vv * off, big_e: self.big_e }
+    }
+}
+
 /// One straight piece's integral and what its attenuation rule needs.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Segment<R> {
@@ -46,11 +86,11 @@ impl<R: Real> Segment<R> {
     /// `τ ∈ [0, dt]`. `rc2 > 0`; `dt ≥ 0` may be `+∞` for the inverse square (then `v ≠ 0`).
     #[cfg(test)]
     pub(crate) fn new(falloff: Falloff, p: Vec3<R>, v: Vec3<R>, dt: R, rc2: R) -> Self {
-        Self::with_dots(falloff, p, v, v.dot(v), p.dot(v), dt, rc2)
+        Self::from_quad(falloff, &Quad::new(p, v, rc2), dt, rc2)
     }
 
-    /// [`new`](Self::new) with `vv = v·v` and `pv = p·v` already formed (the chord walk has them
-    /// from its acceptance test).
+    /// [`new`](Self::new) from the piece's [`Quad`] (the chord walk has it from its acceptance
+    /// test).
     ///
     /// Computed in `s`-scaled quantities (`s = |v|`): `Y = s·y` (`Y₀ = p·v`, `Y₁ = Y₀ + s²Δt`),
     /// `E = s²e = |p × v|² + r_c²s²`, `R = s·√Q = √(Y² + E)`, so that no division by `s` sits
@@ -59,7 +99,8 @@ impl<R: Real> Segment<R> {
     /// inverse-square angle is `atan2(s²Δt√E, E + Y₀Y₁)` over `√E`, with no `s` at all. `1/s`
     /// is formed beside them, off the critical path.
     #[inline]
-    pub(crate) fn with_dots(falloff: Falloff, p: Vec3<R>, v: Vec3<R>, vv: R, pv: R, dt: R, rc2: R) -> Self {
+    pub(crate) fn from_quad(falloff: Falloff, q: &Quad<R>, dt: R, rc2: R) -> Self {
+        let (vv, pv, big_e) = (q.vv, q.pv, q.big_e);
         let mut seg = Segment {
             value: R::ZERO,
             falloff,
@@ -73,7 +114,7 @@ impl<R: Real> Segment<R> {
         };
         if !(vv > R::ZERO) {
             // Constant integrand.
-            let e = p.length_squared() + rc2;
+            let e = q.pp + rc2;
             seg.e = e;
             if dt > R::ZERO && dt.is_finite() {
                 seg.value = match falloff {
@@ -84,8 +125,6 @@ impl<R: Real> Segment<R> {
             return seg;
         }
         let inv_s = R::ONE / vv.sqrt();
-        // |p × v̂|² = |p × v|²/|v|²: a cross product, so E never cancels.
-        let big_e = p.cross(v).length_squared() + rc2 * vv;
         seg.e = big_e * inv_s * inv_s;
         seg.y0 = pv * inv_s;
         seg.y1 = seg.y0;

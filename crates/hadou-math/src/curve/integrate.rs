@@ -54,7 +54,7 @@
 //! `(1 − u)^j` once, at its centroid, within that count (as a Simpson sample evaluates density
 //! and attenuation together). Simpson counts one per integrand sample.
 
-use super::closed::Segment;
+use super::closed::{Quad, Segment};
 use super::prepare::PreparedCurve;
 use super::shape::ShapeEval;
 use super::{simpson, Integrator};
@@ -314,15 +314,14 @@ impl<R: Real> Acc<R> {
     /// `h_floor` the rest is one part. Each part counts 1.
     #[inline]
     fn piece(&mut self, r: &LocalRay<R>, ts: R, p: Vec3<R>, v: Vec3<R>, dt: R) {
-        self.piece_dots(r, ts, p, v, v.dot(v), p.dot(v), dt);
+        self.piece_quad(r, ts, &Quad::new(p, v, r.rc2), dt);
     }
 
-    /// [`piece`](Self::piece) with `vv = v·v` and `pv = p·v` already formed.
-    #[allow(clippy::too_many_arguments)]
+    /// [`piece`](Self::piece) from the piece's [`Quad`].
     #[inline]
-    fn piece_dots(&mut self, r: &LocalRay<R>, ts: R, p: Vec3<R>, v: Vec3<R>, vv: R, pv: R, dt: R) {
+    fn piece_quad(&mut self, r: &LocalRay<R>, ts: R, q: &Quad<R>, dt: R) {
         if r.j == R::ZERO {
-            self.sum += Segment::with_dots(r.falloff, p, v, vv, pv, dt, r.rc2).value;
+            self.sum += Segment::from_quad(r.falloff, q, dt, r.rc2).value;
             self.evals += 1;
             return;
         }
@@ -337,8 +336,7 @@ impl<R: Real> Acc<R> {
             } else {
                 te.min(r.t_far * (R::ONE - ha * self.q))
             };
-            let off = a - ts;
-            let seg = Segment::with_dots(r.falloff, p + v * off, v, vv, pv + vv * off, b - a, r.rc2);
+            let seg = Segment::from_quad(r.falloff, &q.shifted(a - ts), b - a, r.rc2);
             self.sum += seg.attenuated(a, r.t_far, r.j);
             self.evals += 1;
             if !(b < te) {
@@ -396,16 +394,20 @@ impl<R: Real> ChordModel<R> {
     }
 
     /// `(x², a)`: the squared relative deviation `x² = δ²/D²` and the first-order factor
-    /// `a = min(S, c₁(ℓ/D)²) + P·uncovered` of the piece `d(τ) = p + vτ`, `τ ∈ [0, dt]`, with
-    /// deviation bound `err`; `uncovered = 1 − κ`.
-    #[allow(clippy::too_many_arguments)]
+    /// `a = min(S, c₁(ℓ/D)²) + P·uncovered` of the piece with quadratic `q` over `τ ∈ [0, dt]`
+    /// and deviation bound `err`; `uncovered = 1 − κ`. `D²` is the quadratic's minimum over the
+    /// piece: at an end, or inside at `E/vv` (one division either way).
     #[inline]
-    fn terms(&self, err: R, p: Vec3<R>, v: Vec3<R>, vv: R, pv: R, dt: R, rc2: R, uncovered: R) -> (R, R) {
-        let tau = if vv > R::ZERO { (-pv / vv).clamp(R::ZERO, dt) } else { R::ZERO };
-        let d = p + v * tau;
-        let inv = R::ONE / (d.dot(d) + rc2);
+    fn terms(&self, err: R, q: &Quad<R>, dt: R, rc2: R, uncovered: R) -> (R, R) {
+        let inv = if q.pv >= R::ZERO {
+            R::ONE / (q.pp + rc2)
+        } else if q.pv + q.vv * dt <= R::ZERO {
+            R::ONE / (q.end_squared(dt) + rc2)
+        } else {
+            q.vv / q.big_e
+        };
         let x2 = err * err * inv;
-        let a = (self.first * vv * dt * dt * inv).min(self.saturation) + self.partial * uncovered;
+        let a = (self.first * q.vv * dt * dt * inv).min(self.saturation) + self.partial * uncovered;
         (x2, a)
     }
 
@@ -562,13 +564,14 @@ fn walk<R: Real>(
         return;
     }
 
+    let inv_qx = R::ONE / r.q.x;
     let t_of = |x: R| {
         if x == lo {
             t_lo
         } else if x == hi {
             t_hi
         } else {
-            t_lo + (x - lo) / r.q.x
+            t_lo + (x - lo) * inv_qx
         }
     };
     let (mut l, mut j) = (levels - 1, 0usize);
@@ -594,22 +597,26 @@ fn walk<R: Real>(
             let (ly, lz, my, mz) = (f(0), f(1), f(2), f(3));
             let xs = r.o.x + r.q.x * ts - (na[0] + nb[0]) * R::HALF;
             let (py, pz) = yz(ts);
-            let p = Vec3::new(R::ZERO, py - (ly + xs * my), pz - (lz + xs * mz));
-            let v = Vec3::new(R::ZERO, r.q.y - r.q.x * my, r.q.z - r.q.x * mz);
+            let quad = Quad::planar(
+                py - (ly + xs * my),
+                pz - (lz + xs * mz),
+                r.q.y - r.q.x * my,
+                r.q.z - r.q.x * mz,
+                r.rc2,
+            );
             let dt = te - ts;
             let err = R::from_f64(f64::from(table.error(l, j)));
-            let (vv, pv) = (v.dot(v), p.dot(v));
             let refine = if l == 0 {
                 0
             } else {
                 // The part of the piece's x-range the ray does not cover (0 but at the ray's ends).
                 let uncovered =
                     if x0 > na[0] || x1 < nb[0] { R::ONE - (x1 - x0) / (nb[0] - na[0]) } else { R::ZERO };
-                let (x2, a) = model.terms(err, p, v, vv, pv, dt, r.rc2, uncovered);
+                let (x2, a) = model.terms(err, &quad, dt, r.rc2, uncovered);
                 model.refinement(x2, a, tol, l)
             };
             if refine == 0 {
-                acc.piece_dots(r, ts, p, v, vv, pv, dt);
+                acc.piece_quad(r, ts, &quad, dt);
             } else {
                 acc.evals += 1;
                 descend = refine;
@@ -764,8 +771,13 @@ mod model_tests {
                             let tau = if vv > 0.0 { (-pv / vv).clamp(0.0, dt) } else { 0.0 };
                             let d = p + v * tau;
                             let ell = (vv * dt * dt / (d.dot(d) + rc2)).sqrt();
-                            let (x2m, am) =
-                                model.terms(err, p, v, vv, pv, dt, rc2, 1.0 - (x1 - x0) / (nb[0] - na[0]));
+                            let (x2m, am) = model.terms(
+                                err,
+                                &Quad::new(p, v, rc2),
+                                dt,
+                                rc2,
+                                1.0 - (x1 - x0) / (nb[0] - na[0]),
+                            );
                             let est = model.estimate(x2m, am);
                             let line = Segment::new(falloff, p, v, dt, rc2).value;
                             let k = if falloff == Falloff::Faithful { 0.5 } else { 1.0 };
