@@ -6,6 +6,10 @@
 //!
 //! Every public formula names the thesis equation it implements and any SPEC.md correction.
 
+// Lets the unit tests share `tests/curve_common/mod.rs`, which names the crate `hadou_math`.
+#[cfg(test)]
+extern crate self as hadou_math;
+
 pub mod curve;
 pub mod energy;
 mod mat4;

@@ -2,7 +2,8 @@
 //! against de Casteljau, B-spline against the literal Cox–de Boor recursion (eq. 3.34), partition
 //! of unity, clamped end interpolation, the frame construction and the extension clamp.
 
-#[path = "curve_support.rs"]
+#[allow(dead_code)]
+#[path = "curve_common/mod.rs"]
 mod support;
 
 use hadou_math::curve::{clamped_uniform_knots, prepare, CurveFrame, CurveShape};

@@ -5,7 +5,8 @@
 //! further from the reference) and shows no band at the bounding cylinder, where the thesis's
 //! reduction does.
 
-#[path = "curve_support.rs"]
+#[allow(dead_code)]
+#[path = "curve_common/mod.rs"]
 mod support;
 
 use hadou_math::curve::{curve_energy, curve_energy_reference, prepare, CurveWave, Integrator, Reduction};

@@ -4,7 +4,8 @@
 //! Environment: `CURVE_STEP` (pixel stride, default 4), `CURVE_FALLOFF` (`faithful`/`inverse`),
 //! `CURVE_J` (attenuation exponent), `CURVE_TOL` (default-integrator tolerance).
 
-#[path = "curve_support.rs"]
+#[allow(dead_code)]
+#[path = "curve_common/mod.rs"]
 mod support;
 
 use hadou_math::curve::integrate::{default_energy, DefaultSettings, DEFAULT_SETTINGS};

@@ -1,7 +1,8 @@
 //! Validation errors name their scene-file key; degenerate but legal shapes and degenerate rays
 //! give finite energies with every integrator; invalid input never panics.
 
-#[path = "curve_support.rs"]
+#[allow(dead_code)]
+#[path = "curve_common/mod.rs"]
 mod support;
 
 use hadou_math::curve::{

@@ -645,57 +645,13 @@ fn walk<R: Real>(
 #[cfg(test)]
 mod model_tests {
     use super::*;
-    use crate::curve::{prepare, CurveFrame, CurveShape, CurveWave};
+    use crate::curve::prepare;
+
+    #[allow(dead_code)]
+    mod support {
+        include!("../../tests/curve_common/mod.rs");
+    }
     use crate::quadrature::integrate_adaptive;
-
-    fn wave(shape: CurveShape, gamma: f32) -> CurveWave {
-        CurveWave {
-            frame: CurveFrame { origin: Vec3::new(-10.0, 0.0, 0.0), axis: Vec3::X, up: Vec3::Y },
-            shape,
-            gamma,
-            extension: 1.0,
-            attenuation: 0.0,
-            alpha: 1.0,
-            integrator: Integrator::Default,
-        }
-    }
-
-    fn shapes() -> Vec<(&'static str, CurveWave)> {
-        vec![
-            (
-                "helix",
-                wave(
-                    CurveShape::Helix {
-                        radius: 2.0,
-                        rate: std::f32::consts::TAU / 4.0,
-                        phase: 0.3,
-                        length: 20.0,
-                    },
-                    1.0,
-                ),
-            ),
-            (
-                "bspline",
-                wave(
-                    CurveShape::BSpline {
-                        points: vec![
-                            [0.0, 0.0],
-                            [3.0, 2.0],
-                            [-2.0, 3.0],
-                            [-3.0, -2.0],
-                            [2.0, -3.0],
-                            [3.0, 2.0],
-                            [-1.0, 1.0],
-                            [0.0, 0.0],
-                        ],
-                        order: 4,
-                        knots: None,
-                    },
-                    20.0,
-                ),
-            ),
-        ]
-    }
 
     /// Rays per shape and falloff (300 for a calibration run in release mode).
     const RAYS: usize = 60;
@@ -710,7 +666,7 @@ mod model_tests {
         }
     }
 
-    /// The chord model never underestimates: on random rays past a helix and a B-spline, every
+    /// The chord model never underestimates: on random rays past the four test curves, every
     /// piece of every level whose estimate lies near the tolerances in use (1e-4 to 1e-2) is
     /// off by less than its estimate, against the exact (adaptive) integral of the curve it
     /// replaces. Prints the ratio actual/estimate binned by ℓ/D (`--nocapture`); the model is
@@ -718,7 +674,7 @@ mod model_tests {
     #[test]
     fn chord_model_is_conservative() {
         let edges = [0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, f64::INFINITY];
-        for (name, w) in shapes() {
+        for (name, w) in support::shapes() {
             for falloff in [Falloff::Faithful, Falloff::InverseSquare] {
                 let c = prepare(&w);
                 let table = &c.table;

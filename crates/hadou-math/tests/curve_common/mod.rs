@@ -1,10 +1,10 @@
-//! Shared fixtures for the curve tests: configurations resembling thesis 002 Fig. 4.2 (a helix, a
-//! trigonometric sum, a degree-4 Bézier curve and a cubic B-spline, each about 20 units long),
-//! seen from the side by a pinhole camera at 40 units with a 45° field of view, and the per-pixel
-//! wave rays built exactly as the scene's `CameraBasis::wave_ray` builds them.
-//!
-//! Included by the other `curve_*` test files with `#[path]`; on its own it has no tests.
-#![allow(dead_code)]
+// Shared fixtures for the curve tests: configurations resembling thesis 002 Fig. 4.2 (a helix, a
+// trigonometric sum, a degree-4 Bézier curve and a cubic B-spline, each about 20 units long),
+// seen from the side by a pinhole camera at 40 units with a 45° field of view, and the per-pixel
+// wave rays built exactly as the scene's `CameraBasis::wave_ray` builds them.
+//
+// Included by the other `curve_*` test files with `#[path]`, and by the unit tests of
+// `src/curve/integrate.rs` with `include!` (hence plain comments: no inner attributes here).
 
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator};
 use hadou_math::energy::{Falloff, FieldParams, Ray};
