@@ -425,9 +425,9 @@ const CURVE_MAX_PARTS: u32 = 64u;
 // Mirrors integrate.rs `ChordModel::new(falloff)`: (first, saturation, partial, second).
 fn chord_model(falloff: u32) -> vec4<f32> {
     if (falloff == FALLOFF_FAITHFUL) {
-        return vec4<f32>(3.0 / 16.0, 1.0, 1.0, 1.0);
+        return vec4<f32>(3.0 / 16.0, 1.0, 1.25, 1.0);
     }
-    return vec4<f32>(0.75, 1.0, 2.0, 3.0);
+    return vec4<f32>(0.75, 1.0, 2.5, 3.0);
 }
 
 // Mirrors `ChordModel::terms` then `ChordModel::refinement`: 0 to accept, else levels to descend.
