@@ -31,10 +31,10 @@
 //!
 //! Attenuation `(1 − t/t_far)^j` (002 eq. 3.23): each piece's integral is taken to second order
 //! about the weight's closed-form centroid, with its closed-form variance (see `closed.rs`): one
-//! power per piece, exact for `j ≤ 2`. The third-order remainder is bounded by keeping
+//! power per piece, exact for `j ∈ {1, 2}`. The third-order remainder is bounded by keeping
 //! `x = Δu/(1 − u_end)` of every part below `x_max(j, τ)` ([`attenuation_split`]): a piece
-//! longer than that is cut into parts whose `1 − u` shrinks geometrically, until the attenuation
-//! itself falls below the tolerance (the rest is one last part).
+//! longer than that is cut into parts whose `1 − u` shrinks geometrically, until what the rule
+//! could get wrong on the rest falls below `τ/2` (the rest is one last part).
 //!
 //! # Per-ray algorithm (what the GPU mirrors)
 //! 1. Local ray: `o = ((S−O)·D, (S−O)·ŷ, (S−O)·ẑ)`, `q` likewise; resolve the span.
@@ -49,8 +49,8 @@
 //! 5. End piece after the slab. Energy `= α·Σ`.
 //!
 //! # Counting evaluations
-//! [`CurveSample::evaluations`] counts, per ray, 1 for every piece or part whose closed form is
-//! formed, whether accepted or refined; with attenuation an accepted part also evaluates
+//! [`CurveSample::evaluations`] counts, per ray, 1 for every piece whose quadratic is formed
+//! (whether then integrated or refined) and 1 per attenuated part; with attenuation an accepted part also evaluates
 //! `(1 − u)^j` once, at its centroid, within that count (as a Simpson sample evaluates density
 //! and attenuation together). Simpson counts one per integrand sample.
 
