@@ -49,8 +49,8 @@
 //! 5. End piece after the slab. Energy `= α·Σ`.
 //!
 //! # Counting evaluations
-//! [`CurveSample::evaluations`] counts, per ray, 1 for every piece whose quadratic is formed
-//! (whether then integrated or refined) and 1 per attenuated part; with attenuation an accepted part also evaluates
+//! [`CurveSample::evaluations`] counts, per ray, 1 for every piece refined and 1 for every piece
+//! integrated (with attenuation, 1 for every part it is cut into); with attenuation an accepted part also evaluates
 //! `(1 − u)^j` once, at its centroid, within that count (as a Simpson sample evaluates density
 //! and attenuation together). Simpson counts one per integrand sample.
 
