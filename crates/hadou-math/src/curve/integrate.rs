@@ -50,9 +50,9 @@
 //!
 //! # Counting evaluations
 //! [`CurveSample::evaluations`] counts, per ray, 1 for every piece refined and 1 for every piece
-//! integrated (with attenuation, 1 for every part it is cut into); with attenuation an accepted part also evaluates
-//! `(1 − u)^j` once, at its centroid, within that count (as a Simpson sample evaluates density
-//! and attenuation together). Simpson counts one per integrand sample.
+//! integrated (with attenuation, 1 for every part it is cut into); a part's single evaluation of
+//! `(1 − u)^j` at its centroid is within that count, as a Simpson sample evaluates density and
+//! attenuation together. Simpson counts one per integrand sample.
 
 use super::closed::{Quad, Segment};
 use super::prepare::PreparedCurve;
