@@ -3,6 +3,10 @@
 //! alone over every pixel, for the default integrator (with optional settings) and Simpson m = 500.
 //!
 //! `cargo run --release -p hadou --example curve_stats -- SCENE [TIME] [TOLERANCE]`
+//!
+//! TIME is the scene time in seconds (default 0), TOLERANCE the default integrator's `τ`
+//! (default [`DEFAULT_SETTINGS`]). With `ONLY_DEFAULT` set in the environment the Simpson line is
+//! skipped. The three worst pixels of each integrator go to stderr.
 
 use hadou_math::curve::{self, integrate::default_energy, CurveWave, Integrator, DEFAULT_SETTINGS};
 use hadou_math::energy::{FieldParams, Ray};
@@ -15,9 +19,19 @@ fn main() {
         eprintln!("usage: curve_stats SCENE [TIME] [TOLERANCE]");
         std::process::exit(2);
     };
-    let time: f32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(0.0);
+    let number = |i: usize, what: &str| -> Option<f64> {
+        let s = args.get(i)?;
+        match s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Some(v),
+            _ => {
+                eprintln!("{what} {s:?}: not a number");
+                std::process::exit(2);
+            }
+        }
+    };
+    let time = number(2, "TIME").unwrap_or(0.0) as f32;
     let mut settings = DEFAULT_SETTINGS;
-    if let Some(t) = args.get(3).and_then(|s| s.parse().ok()) {
+    if let Some(t) = number(3, "TOLERANCE") {
         settings.tolerance = t;
     }
     let scene = match Scene::load(std::path::Path::new(path)) {
@@ -37,6 +51,10 @@ fn main() {
             _ => None,
         })
         .collect();
+    if waves.is_empty() {
+        eprintln!("{path}: no curved wave in the scene at t = {time}");
+        std::process::exit(2);
+    }
     let (w, h) = (frame.width, frame.height);
     let step = 4u32;
     let pixels: Vec<(u32, u32)> = (0..h)
