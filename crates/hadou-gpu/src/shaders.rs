@@ -233,5 +233,6 @@ mod tests {
         assert_eq!(value("FALLOFF_INVERSE_SQUARE"), FALLOFF_INVERSE_SQUARE);
         assert_eq!(value("TONE_FAITHFUL"), TONE_FAITHFUL);
         assert_eq!(value("TONE_FILMIC"), TONE_FILMIC);
+        assert_eq!(value("CURVE_MAX_PARTS") as usize, hadou_math::curve::MAX_ATTENUATION_PARTS);
     }
 }

@@ -328,6 +328,36 @@ fn segment_new(falloff: u32, q: vec4<f32>, dt: f32, rc2: f32) -> Segment {
     return seg;
 }
 
+// Mirrors `Segment::fitted_variance`: the variance of the weight's quadratic interpolant.
+fn segment_fitted_variance(seg: Segment, uniform: f32) -> f32 {
+    let y0 = seg.y0;
+    let e = seg.e;
+    let span = seg.span;
+    let ym = y0 + span * 0.5;
+    let y1 = y0 + span;
+    var w0 = 1.0 / (y0 * y0 + e);
+    var wm = 1.0 / (ym * ym + e);
+    var w1 = 1.0 / (y1 * y1 + e);
+    if (seg.falloff == FALLOFF_FAITHFUL) {
+        w0 = 1.0 / sqrt(y0 * y0 + e);
+        wm = 1.0 / sqrt(ym * ym + e);
+        w1 = 1.0 / sqrt(y1 * y1 + e);
+    }
+    let gamma = 2.0 * (w1 - 2.0 * wm + w0) / wm;
+    let beta = (w1 - w0) / wm - gamma;
+    let a = w0 / wm;
+    let m0 = a + beta * 0.5 + gamma / 3.0;
+    let m1 = a * 0.5 + beta / 3.0 + gamma * 0.25;
+    let m2 = a / 3.0 + beta * 0.25 + gamma / 5.0;
+    let c1 = m1 / m0;
+    let c2 = m2 / m0;
+    let v = clamp(c2 - c1 * c1, 0.0, 0.25) * seg.dt * seg.dt;
+    if (curve_finite(v)) {
+        return v;
+    }
+    return uniform;
+}
+
 // Mirrors `Segment::moments`: (centroid τ̄, variance σ²) of the weight over the piece.
 fn segment_moments(seg: Segment) -> vec2<f32> {
     let y0 = seg.y0;
@@ -367,8 +397,8 @@ fn segment_moments(seg: Segment) -> vec2<f32> {
     } else {
         tbar = mid;
     }
-    if (!(nu > 0.01 * q0)) {
-        return vec2<f32>(tbar, uniform);
+    if (!(nu > 0.1 * q0)) {
+        return vec2<f32>(tbar, segment_fitted_variance(seg, uniform));
     }
     let v = clamp(s2 / m0 - mu * mu, 0.0, span * span * 0.25) * scale * scale;
     if (curve_finite(v)) {
@@ -419,7 +449,7 @@ fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, q: vec4<f32>, dt: f32, acc: pt
     }
 }
 
-// Mirrors integrate.rs `MAX_PARTS`.
+// Mirrors hadou_math::curve::MAX_ATTENUATION_PARTS (checked by shaders.rs `constants_match`).
 const CURVE_MAX_PARTS: u32 = 64u;
 
 // Mirrors integrate.rs `ChordModel::new(falloff)`: (first, saturation, partial, second).

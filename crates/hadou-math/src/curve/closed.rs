@@ -18,6 +18,10 @@
 //! involves the third central moment and `g'''`. For `j ∈ {1, 2}` the rule is exact; otherwise
 //! the caller keeps `Δu/(1 − u)` small enough that `R₃` is below its tolerance (see
 //! `integrate.rs`). One power per piece: `g''/g = j(j−1)/((1−ū)·t_far)²`.
+//!
+//! Every function here has a WGSL twin of the same name in snake case in
+//! `crates/hadou-gpu/src/shaders/curve.wgsl` (`Quad` → `quad_*` on a `vec4`, `Segment` methods →
+//! `segment_*`); keep them in sync (the GPU twin tests compare them).
 
 use crate::energy::Falloff;
 use crate::{Real, Vec3};
@@ -53,6 +57,19 @@ impl<R: Real> Quad<R> {
     #[inline]
     pub(crate) fn end_squared(&self, dt: R) -> R {
         (self.pp + dt * (R::TWO * self.pv + self.vv * dt)).max(R::ZERO)
+    }
+
+    /// `1/D²`, `D²` the quadratic's minimum over `τ ∈ [0, dt]` (with `r_c²`): at an end, or
+    /// inside at `E/vv` (one division either way).
+    #[inline]
+    pub(crate) fn inv_closest(&self, dt: R, rc2: R) -> R {
+        if self.pv >= R::ZERO {
+            R::ONE / (self.pp + rc2)
+        } else if self.pv + self.vv * dt <= R::ZERO {
+            R::ONE / (self.end_squared(dt) + rc2)
+        } else {
+            self.vv / self.big_e
+        }
     }
 
     /// The quadratic of the same line from `τ = off` on.
@@ -200,9 +217,10 @@ impl<R: Real> Segment<R> {
     /// the centroid is `μ = m₁/m₀ − y₀` (as `τ̄ = μΔt/Δy`) and `σ_y² = S₂/m₀ − μ²`, clamped to
     /// `[0, Δy²/4]` (the most any weight on the interval allows) so that rounding can never make
     /// it negative, `σ² = σ_y²(Δt/Δy)²`. Where the weight is constant to `10⁻⁴` over the piece
-    /// (`ν = Δy(|y|max + Δy)/Q₀`) the centroid is the midpoint; where it is constant to 1 % the
-    /// variance is `Δt²/12`, which is then good to `10⁻³` while `S₂` would lose about `ε/ν²`
-    /// to cancellation.
+    /// (`ν = Δy(|y|max + Δy)/Q₀`) the centroid is the midpoint and the variance `Δt²/12`; where
+    /// it changes by less than 10 % the variance is that of its quadratic interpolant
+    /// ([`fitted_variance`](Self::fitted_variance)): `S₂` is a small difference of terms of size
+    /// `y²Δy` there, and in `f32` a far piece at `ν ≈ 0.01` came out 3× too large.
     #[inline]
     pub(crate) fn moments(&self) -> (R, R) {
         let (y0, y1, e, dt, span) = (self.y0, self.y1, self.e, self.dt, self.span);
@@ -230,11 +248,39 @@ impl<R: Real> Segment<R> {
         let tbar = mu * scale;
         let tbar = if self.flipped { dt - tbar } else { tbar };
         let tbar = if tbar.is_finite() { tbar.clamp(R::ZERO, dt) } else { mid };
-        if !(nu > R::from_f64(0.01) * q0) {
-            return (tbar, uniform);
+        if !(nu > R::from_f64(0.1) * q0) {
+            return (tbar, self.fitted_variance(uniform));
         }
         let var = (s2 / m0 - mu * mu).clamp(R::ZERO, span * span * R::from_f64(0.25)) * scale * scale;
         (tbar, if var.is_finite() { var } else { uniform })
+    }
+
+    /// The variance of the weight's quadratic interpolant through `y₀`, the midpoint and `y₁`,
+    /// `w ∝ 1 + βλ + γλ²` on `λ ∈ [0, 1]`: `M_k = ∫λ^k w` are `1 + β/2 + γ/3`, `½ + β/3 + γ/4`,
+    /// `⅓ + β/4 + γ/5`, and `σ² = (M₂/M₀ − (M₁/M₀)²)·Δt²` (`uniform = Δt²/12` at `β = γ = 0`).
+    /// Used where the weight changes by less than 10 % over the piece: the interpolant is then
+    /// good to `O(ν³)`, and nothing cancels worse than `1/12` against `1/3`.
+    #[inline]
+    fn fitted_variance(&self, uniform: R) -> R {
+        let (y0, e, span) = (self.y0, self.e, self.span);
+        let w = |y: R| match self.falloff {
+            Falloff::Faithful => R::ONE / (y * y + e).sqrt(),
+            Falloff::InverseSquare => R::ONE / (y * y + e),
+        };
+        let (w0, wm, w1) = (w(y0), w(y0 + span * R::HALF), w(y0 + span));
+        let gamma = R::TWO * (w1 - R::TWO * wm + w0) / wm;
+        let beta = (w1 - w0) / wm - gamma;
+        let a = w0 / wm;
+        let m0 = a + beta * R::HALF + gamma / R::from_f64(3.0);
+        let m1 = a * R::HALF + beta / R::from_f64(3.0) + gamma * R::from_f64(0.25);
+        let m2 = a / R::from_f64(3.0) + beta * R::from_f64(0.25) + gamma / R::from_f64(5.0);
+        let (c1, c2) = (m1 / m0, m2 / m0);
+        let v = (c2 - c1 * c1).clamp(R::ZERO, R::from_f64(0.25)) * self.dt * self.dt;
+        if v.is_finite() {
+            v
+        } else {
+            uniform
+        }
     }
 
     /// The centroid alone (see [`moments`](Self::moments)).
@@ -333,13 +379,22 @@ mod tests {
         .value
     }
 
-    const PIECES: [(Vec3<f64>, Vec3<f64>, f64); 6] = [
+    const PIECES: [(Vec3<f64>, Vec3<f64>, f64); 8] = [
         (Vec3 { x: 0.1, y: -2.0, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 4.0), // through the closest approach
         (Vec3 { x: 0.1, y: -20.0, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 1.0), // far, nearly uniform
         (Vec3 { x: 0.1, y: 2.0, z: 0.0 }, Vec3 { x: 0.0, y: 1e-4, z: 0.0 }, 1.0), // almost constant
         (Vec3 { x: 0.01, y: -0.5, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 1.0), // sharp peak inside
         (Vec3 { x: 0.02, y: 0.0, z: 0.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 30.0), // peak at the start, long tail
         (Vec3 { x: 0.0, y: -300.0, z: 1.0 }, Vec3 { x: 0.0, y: 1.0, z: 0.0 }, 0.5), // far, short
+        // Far and short, moving away: the centroid was half the piece off in f32 while the
+        // moments took the span as y₁ − y₀ of two rounded values.
+        (Vec3 { x: 0.0, y: -131.381_07, z: -0.351_25 }, Vec3 { x: 0.0, y: -0.2149, z: -0.004_37 }, 0.2911),
+        // Far, the weight changing by 1 %: the variance from S₂ came out 3× too large in f32.
+        (
+            Vec3 { x: 0.0, y: 139.972_365, z: -1.083_002 },
+            Vec3 { x: 0.0, y: 0.460_856, z: 0.028_523 },
+            2.983_01,
+        ),
     ];
 
     #[test]
@@ -363,8 +418,14 @@ mod tests {
                     (got - var).abs() < 1e-6 * dt * dt + 1e-4 * var,
                     "{falloff:?} {p:?}: variance {got} vs {var}"
                 );
+                // f32 keeps the centroid to a small fraction of the piece, also far from the
+                // closest approach: the moments use the exact span sΔt, not y₁ − y₀ of two rounded
+                // large values.
+                let s32 = Segment::new(falloff, p.as_f32(), v.as_f32(), dt as f32, 1e-4);
+                let c32 = f64::from(s32.centroid());
+                assert!((c32 - tbar).abs() < 1e-2 * dt, "f32 {falloff:?} {p:?}: centroid {c32} vs {tbar}");
                 // f32 keeps the variance to a fraction of the piece's squared length.
-                let g32 = Segment::new(falloff, p.as_f32(), v.as_f32(), dt as f32, 1e-4).variance();
+                let g32 = s32.variance();
                 assert!(
                     (f64::from(g32) - var).abs() < 1e-3 * dt * dt,
                     "f32 {falloff:?} {p:?}: {g32} vs {var}"

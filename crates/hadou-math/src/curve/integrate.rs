@@ -329,9 +329,9 @@ impl<R: Real> Acc<R> {
         let mut a = ts;
         // Parts shrink 1 − u geometrically down to h_floor: at most log(h_floor)/log(q) + 1 of
         // them; the bound ends any other case with one last long part.
-        for i in 0..MAX_PARTS {
+        for i in 0..MAX_ATTENUATION_PARTS {
             let ha = R::ONE - a / r.t_far;
-            let b = if ha <= self.h_floor || i + 1 == MAX_PARTS {
+            let b = if ha <= self.h_floor || i + 1 == MAX_ATTENUATION_PARTS {
                 te
             } else {
                 te.min(r.t_far * (R::ONE - ha * self.q))
@@ -347,8 +347,8 @@ impl<R: Real> Acc<R> {
     }
 }
 
-/// Most parts an attenuated piece is cut into.
-const MAX_PARTS: usize = 64;
+/// Most parts an attenuated piece is cut into (`CURVE_MAX_PARTS` in curve.wgsl).
+pub const MAX_ATTENUATION_PARTS: usize = 64;
 
 /// The chord walk's error model for one density law (see the module docs).
 ///
@@ -371,7 +371,9 @@ const MAX_PARTS: usize = 64;
 /// - second order, `½·δ²·|∇²w|`: `c₂ = 1` (faithful, `|∇²(1/r)| ≤ 2/r³`), `3` (inverse square).
 ///
 /// `chord_model_is_conservative` (below) checks the estimate against the exact error of single
-/// pieces on random rays.
+/// pieces on random rays. The constants are repeated in curve.wgsl `chord_model`, and the
+/// walk, [`Acc`] and `slab_quad` in `curve_walk`, `curve_piece` and `quad_planar` there: keep
+/// them in sync (the GPU twin test compares the two on 1704 rays).
 #[derive(Clone, Copy, Debug)]
 struct ChordModel<R> {
     first: R,
@@ -397,16 +399,10 @@ impl<R: Real> ChordModel<R> {
     /// `(x², a)`: the squared relative deviation `x² = δ²/D²` and the first-order factor
     /// `a = min(S, c₁(ℓ/D)²) + P·uncovered` of the piece with quadratic `q` over `τ ∈ [0, dt]`
     /// and deviation bound `err`; `uncovered = 1 − κ`. `D²` is the quadratic's minimum over the
-    /// piece: at an end, or inside at `E/vv` (one division either way).
+    /// piece ([`Quad::inv_closest`]).
     #[inline]
     fn terms(&self, err: R, q: &Quad<R>, dt: R, rc2: R, uncovered: R) -> (R, R) {
-        let inv = if q.pv >= R::ZERO {
-            R::ONE / (q.pp + rc2)
-        } else if q.pv + q.vv * dt <= R::ZERO {
-            R::ONE / (q.end_squared(dt) + rc2)
-        } else {
-            q.vv / q.big_e
-        };
+        let inv = q.inv_closest(dt, rc2);
         let x2 = err * err * inv;
         let a = (self.first * q.vv * dt * dt * inv).min(self.saturation) + self.partial * uncovered;
         (x2, a)
@@ -531,6 +527,23 @@ pub(crate) fn leaf_of<R: Real>(c: &PreparedCurve, x: R) -> usize {
     lo
 }
 
+/// The quadratic of piece `j` of level `l` (centred at `x = xm`) along the ray from `t = ts` on:
+/// the relative position `P_⊥(t) − L(x(t))` and its rate, both without an axial component.
+#[inline]
+fn slab_quad<R: Real>(c: &PreparedCurve, r: &LocalRay<R>, l: usize, j: usize, xm: R, ts: R) -> Quad<R> {
+    let ln = c.table.line(l, j);
+    let f = |k: usize| R::from_f64(f64::from(ln[k]));
+    let (ly, lz, my, mz) = (f(0), f(1), f(2), f(3));
+    let xs = r.o.x + r.q.x * ts - xm;
+    Quad::planar(
+        r.o.y + r.q.y * ts - (ly + xs * my),
+        r.o.z + r.q.z * ts - (lz + xs * mz),
+        r.q.y - r.q.x * my,
+        r.q.z - r.q.x * mz,
+        r.rc2,
+    )
+}
+
 /// The chord walk over the slab part `[ta, tb]` of the span (see the module docs).
 fn walk<R: Real>(
     c: &PreparedCurve,
@@ -551,7 +564,6 @@ fn walk<R: Real>(
     let (lo, hi, t_lo, t_hi) = if xa <= xb { (xa, xb, ta, tb) } else { (xb, xa, tb, ta) };
     let tol = R::from_f64(settings.tolerance);
     let model = ChordModel::new(r.falloff);
-    let yz = |t: R| (r.o.y + r.q.y * t, r.o.z + r.q.z * t);
 
     // x (nearly) constant along the span: one piece against the fixed paired point.
     if !(hi - lo > xh * R::from_f64(1e-6)) || !(tb - ta).is_finite() {
@@ -559,7 +571,7 @@ fn walk<R: Real>(
         let i = leaf_of(c, xm);
         let (a, b) = (node::<R>(c, i), node::<R>(c, i + 1));
         let f = ((xm - a[0]) / (b[0] - a[0])).clamp(R::ZERO, R::ONE);
-        let (py, pz) = yz(ta);
+        let (py, pz) = (r.o.y + r.q.y * ta, r.o.z + r.q.z * ta);
         let p = Vec3::new(R::ZERO, py - (a[1] + (b[1] - a[1]) * f), pz - (a[2] + (b[2] - a[2]) * f));
         acc.piece(r, ta, p, Vec3::new(R::ZERO, r.q.y, r.q.z), tb - ta);
         return;
@@ -593,18 +605,7 @@ fn walk<R: Real>(
             let x1 = hi.min(nb[0]);
             let (tx0, tx1) = (t_of(x0), t_of(x1));
             let (ts, te) = if tx0 <= tx1 { (tx0, tx1) } else { (tx1, tx0) };
-            let ln = table.line(l, j);
-            let f = |k: usize| R::from_f64(f64::from(ln[k]));
-            let (ly, lz, my, mz) = (f(0), f(1), f(2), f(3));
-            let xs = r.o.x + r.q.x * ts - (na[0] + nb[0]) * R::HALF;
-            let (py, pz) = yz(ts);
-            let quad = Quad::planar(
-                py - (ly + xs * my),
-                pz - (lz + xs * mz),
-                r.q.y - r.q.x * my,
-                r.q.z - r.q.x * mz,
-                r.rc2,
-            );
+            let quad = slab_quad(c, r, l, j, (na[0] + nb[0]) * R::HALF, ts);
             let dt = te - ts;
             let err = R::from_f64(f64::from(table.error(l, j)));
             let refine = if l == 0 {
@@ -713,30 +714,14 @@ mod model_tests {
                             }
                             let (t0, t1) = ((x0 - r.o.x) / r.q.x, (x1 - r.o.x) / r.q.x);
                             let (ts, te) = (t0.min(t1), t0.max(t1));
-                            let ln = table.line(l, j);
-                            let f = |k: usize| f64::from(ln[k]);
-                            let xs = r.o.x + r.q.x * ts - (na[0] + nb[0]) * 0.5;
-                            let p = Vec3::new(
-                                0.0,
-                                r.o.y + r.q.y * ts - (f(0) + xs * f(2)),
-                                r.o.z + r.q.z * ts - (f(1) + xs * f(3)),
-                            );
-                            let v = Vec3::new(0.0, r.q.y - r.q.x * f(2), r.q.z - r.q.x * f(3));
+                            let quad = slab_quad(&c, &r, l, j, (na[0] + nb[0]) * 0.5, ts);
                             let dt = te - ts;
                             let err = f64::from(table.error(l, j));
-                            let (vv, pv) = (v.dot(v), p.dot(v));
-                            let tau = if vv > 0.0 { (-pv / vv).clamp(0.0, dt) } else { 0.0 };
-                            let d = p + v * tau;
-                            let ell = (vv * dt * dt / (d.dot(d) + rc2)).sqrt();
-                            let (x2m, am) = model.terms(
-                                err,
-                                &Quad::new(p, v, rc2),
-                                dt,
-                                rc2,
-                                1.0 - (x1 - x0) / (nb[0] - na[0]),
-                            );
+                            let ell = (quad.vv * dt * dt * quad.inv_closest(dt, rc2)).sqrt();
+                            let uncovered = 1.0 - (x1 - x0) / (nb[0] - na[0]);
+                            let (x2m, am) = model.terms(err, &quad, dt, rc2, uncovered);
                             let est = model.estimate(x2m, am);
-                            let line = Segment::new(falloff, p, v, dt, rc2).value;
+                            let line = Segment::from_quad(falloff, &quad, dt, rc2).value;
                             let k = if falloff == Falloff::Faithful { 0.5 } else { 1.0 };
                             let exact = integrate_adaptive(
                                 |t| {

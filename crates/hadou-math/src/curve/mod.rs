@@ -41,7 +41,9 @@ mod shape;
 pub mod simpson;
 mod validate;
 
-pub use integrate::{attenuation_split, curve_energy, CurveSample, DefaultSettings, DEFAULT_SETTINGS};
+pub use integrate::{
+    attenuation_split, curve_energy, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
+};
 pub use prepare::{prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, MAX_PIECES, MIN_CORE};
 pub use reference::curve_energy_reference;
 pub use shape::clamped_uniform_knots;
