@@ -1,39 +1,155 @@
 //! glTF 2.0 (`.gltf` with external or data-URI buffers, and `.glb`) → one [`Mesh`]: every
 //! TRIANGLES primitive of the default scene's nodes, with node transforms composed and baked in.
-//! Buffers are resolved here (no image decoding is pulled in); every accessor is bounds-checked
-//! before it is read, so a malformed file is an error, never a panic.
+//! Buffers are resolved here (no image decoding is pulled in).
+//!
+//! The file is untrusted: before the gltf crate's wrapper types are used, every index in the raw
+//! JSON is checked against the array it points into, the node graph is checked to be a forest
+//! (the glTF spec requires one; a node listed twice would otherwise multiply the instances
+//! exponentially), and the triangles the default scene instantiates are counted against the
+//! scene's budget before any data is copied. Every accessor is bounds-checked before it is read.
+//! Calls into the gltf crate run under [`guarded`], so even an unforeseen panic there is an
+//! error, never a crash.
 
+use crate::files::{describe_bytes, read_regular_file, GLTF_MAX_BYTES};
 use crate::frame::Mesh;
+use crate::guard::guarded;
+use crate::limits::{fmt_f32, COORD_MAX, MAX_TRIANGLES, MAX_VERTICES};
 use crate::mesh::{append_mesh, smooth_normals, transform_mesh};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::buffer::Source;
+use gltf::json;
 use gltf::mesh::{Mode, Semantic};
 use hadou_math::Mat4;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// Deepest node hierarchy followed (guards against cyclic node graphs).
+/// Deepest node hierarchy followed (the recursion that bakes the transforms stays shallow).
 const MAX_DEPTH: usize = 64;
 
-/// Loads the glTF/GLB file at `path` into one mesh in the file's scene space.
-pub fn load_gltf(path: &Path) -> Result<Mesh, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    gltf_from_bytes(&bytes, dir)
+/// Triangles and vertices still allowed in the scene being loaded (every instance counted).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Budget {
+    /// Triangles left.
+    pub triangles: u64,
+    /// glTF vertices left.
+    pub vertices: u64,
 }
 
-/// Parses glTF or GLB `bytes`; external buffers are resolved relative to `dir`.
+impl Budget {
+    /// The whole budget of one scene.
+    pub(crate) const FULL: Budget = Budget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES };
+}
+
+/// The directory of `path`, `.` for a bare file name.
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// Loads the glTF/GLB file at `path` into one mesh in the file's scene space. External buffers
+/// must lie inside the file's own directory tree.
+pub fn load_gltf(path: &Path) -> Result<Mesh, String> {
+    let mut budget = Budget::FULL;
+    load_gltf_in(path, parent_dir(path), &mut budget)
+}
+
+/// [`load_gltf`] with external buffers confined to the directory tree of `root`, and the
+/// instanced triangles taken from `budget`.
+pub(crate) fn load_gltf_in(path: &Path, root: &Path, budget: &mut Budget) -> Result<Mesh, String> {
+    let bytes = read_regular_file(path, GLTF_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
+    from_bytes_in(&bytes, parent_dir(path), root, budget)
+}
+
+/// Parses glTF or GLB `bytes`; external buffers are resolved relative to `dir` and must lie inside
+/// its directory tree.
 pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+    let mut budget = Budget::FULL;
+    from_bytes_in(bytes, dir, dir, &mut budget)
+}
+
+/// The JSON text of a `.gltf` (a UTF-8 byte-order mark dropped) or the whole `.glb`; anything
+/// else is "not a glTF or GLB file".
+fn sniff(bytes: &[u8]) -> Result<&[u8], String> {
+    if bytes.starts_with(b"glTF") {
+        return Ok(bytes);
+    }
+    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    match text.iter().find(|b| !b.is_ascii_whitespace()) {
+        Some(b'{') => Ok(text),
+        None => Err("the file is empty; it is not a glTF or GLB file".into()),
+        Some(_) => Err("not a glTF or GLB file (a .gltf file is JSON text starting with `{`, a .glb file \
+                        starts with the bytes `glTF`)"
+            .into()),
+    }
+}
+
+fn from_bytes_in(bytes: &[u8], dir: &Path, root: &Path, budget: &mut Budget) -> Result<Mesh, String> {
+    let body = sniff(bytes)?;
+    let gltf = guarded("glTF", || gltf::Gltf::from_slice_without_validation(body))?
+        .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+    let doc = gltf.document.as_json();
+    check_indices(doc)?;
+    let parent = check_forest(doc)?;
+    let mut problems = Vec::new();
+    guarded("glTF", || {
+        use gltf::json::validation::Validate;
+        doc.validate(doc, json::Path::new, &mut |path, e| problems.push(format!("{}: {e}", path())));
+    })?;
+    if !problems.is_empty() {
+        let more =
+            if problems.len() > 3 { format!(" (and {} more)", problems.len() - 3) } else { String::new() };
+        problems.truncate(3);
+        return Err(format!("not a valid glTF 2.0 file: {}{more}", problems.join("; ")));
+    }
+
+    // The root nodes of the default scene (or the first, or every parentless node).
+    let scene = doc.scene.map(|s| s.value()).or(if doc.scenes.is_empty() { None } else { Some(0) });
+    let roots: Vec<usize> = match scene {
+        Some(s) => {
+            let roots: Vec<usize> = doc.scenes[s].nodes.iter().map(|n| n.value()).collect();
+            for (i, &r) in roots.iter().enumerate() {
+                if let Some(p) = parent[r] {
+                    return Err(format!(
+                        "scene {s} lists node {r} as a root, but node {p} has it as a child (node graphs \
+                         must be trees)"
+                    ));
+                }
+                if roots[..i].contains(&r) {
+                    return Err(format!("scene {s} lists node {r} twice (node graphs must be trees)"));
+                }
+            }
+            roots
+        }
+        None => (0..doc.nodes.len()).filter(|&n| parent[n].is_none()).collect(),
+    };
+    let need = count_instances(doc, &roots)?;
+    if need.triangles > budget.triangles {
+        return Err(format!(
+            "its default scene has {} triangles (every node instance counted), more than the {} left of \
+             the limit of {MAX_TRIANGLES} triangles per scene",
+            need.triangles, budget.triangles
+        ));
+    }
+    if need.vertices > budget.vertices {
+        return Err(format!(
+            "its default scene has {} vertices (every node instance counted), more than the {} left of \
+             the limit of {MAX_VERTICES} vertices per scene",
+            need.vertices, budget.vertices
+        ));
+    }
+
+    let mut bytes_left = GLTF_MAX_BYTES.saturating_sub(bytes.len() as u64);
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
             Source::Bin => gltf.blob.clone().ok_or_else(|| {
                 format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index())
             })?,
-            Source::Uri(uri) => {
-                resolve_uri(uri, dir).map_err(|e| format!("buffer {}: {e}", buffer.index()))?
-            }
+            Source::Uri(uri) => resolve_uri(uri, dir, root, bytes_left)
+                .map_err(|e| format!("buffer {}: {e}", buffer.index()))?,
         };
+        bytes_left = bytes_left.saturating_sub(data.len() as u64);
         if data.len() < buffer.length() {
             return Err(format!(
                 "buffer {} has {} bytes but the file declares byteLength {}",
@@ -45,18 +161,203 @@ pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
         buffers.push(data);
     }
 
-    let mut out = Mesh::default();
-    let roots: Vec<gltf::Node<'_>> = match gltf.default_scene().or_else(|| gltf.scenes().next()) {
-        Some(scene) => scene.nodes().collect(),
-        None => gltf.nodes().collect(),
-    };
-    for node in roots {
-        add_node(&node, Mat4::IDENTITY, &buffers, &mut out, 0)?;
-    }
+    let out = guarded("glTF", || -> Result<Mesh, String> {
+        let nodes: Vec<gltf::Node<'_>> = gltf.nodes().collect();
+        let mut out = Mesh::default();
+        for &r in &roots {
+            add_node(&nodes[r], Mat4::IDENTITY, &buffers, &mut out, 0)?;
+        }
+        Ok(out)
+    })??;
     if out.indices.is_empty() {
         return Err("the default scene contains no triangles".into());
     }
+    budget.triangles -= need.triangles;
+    budget.vertices -= need.vertices;
     Ok(out)
+}
+
+/// `Err` naming `from` when `index` is not below `len`.
+fn in_range<T>(
+    index: json::Index<T>,
+    len: usize,
+    kind: &str,
+    from: impl FnOnce() -> String,
+) -> Result<(), String> {
+    let i = index.value();
+    if i < len {
+        Ok(())
+    } else {
+        Err(format!("{} refers to {kind} {i}, but the file has {len} {kind} entries (0-based)", from()))
+    }
+}
+
+/// Every index in the raw JSON points into its array.
+fn check_indices(r: &json::Root) -> Result<(), String> {
+    let (n_acc, n_view, n_buf) = (r.accessors.len(), r.buffer_views.len(), r.buffers.len());
+    let (n_node, n_mesh, n_mat) = (r.nodes.len(), r.meshes.len(), r.materials.len());
+    let (n_tex, n_img, n_samp) = (r.textures.len(), r.images.len(), r.samplers.len());
+    if let Some(s) = r.scene {
+        in_range(s, r.scenes.len(), "scene", || "`scene`".into())?;
+    }
+    for (i, s) in r.scenes.iter().enumerate() {
+        for &n in &s.nodes {
+            in_range(n, n_node, "node", || format!("scene {i}"))?;
+        }
+    }
+    for (i, n) in r.nodes.iter().enumerate() {
+        for &c in n.children.iter().flatten() {
+            in_range(c, n_node, "node", || format!("node {i} (children)"))?;
+        }
+        if let Some(m) = n.mesh {
+            in_range(m, n_mesh, "mesh", || format!("node {i}"))?;
+        }
+        if let Some(c) = n.camera {
+            in_range(c, r.cameras.len(), "camera", || format!("node {i}"))?;
+        }
+        if let Some(s) = n.skin {
+            in_range(s, r.skins.len(), "skin", || format!("node {i}"))?;
+        }
+    }
+    for (i, m) in r.meshes.iter().enumerate() {
+        for (j, p) in m.primitives.iter().enumerate() {
+            let from = || format!("mesh {i} primitive {j}");
+            for &a in p.attributes.values() {
+                in_range(a, n_acc, "accessor", from)?;
+            }
+            if let Some(a) = p.indices {
+                in_range(a, n_acc, "accessor", from)?;
+            }
+            if let Some(m) = p.material {
+                in_range(m, n_mat, "material", from)?;
+            }
+            for t in p.targets.iter().flatten() {
+                for a in [t.positions, t.normals, t.tangents].into_iter().flatten() {
+                    in_range(a, n_acc, "accessor", || format!("mesh {i} primitive {j} (morph target)"))?;
+                }
+            }
+        }
+    }
+    for (i, a) in r.accessors.iter().enumerate() {
+        if let Some(v) = a.buffer_view {
+            in_range(v, n_view, "bufferView", || format!("accessor {i}"))?;
+        }
+        if let Some(sp) = &a.sparse {
+            in_range(sp.indices.buffer_view, n_view, "bufferView", || format!("accessor {i} (sparse)"))?;
+            in_range(sp.values.buffer_view, n_view, "bufferView", || format!("accessor {i} (sparse)"))?;
+        }
+    }
+    for (i, v) in r.buffer_views.iter().enumerate() {
+        in_range(v.buffer, n_buf, "buffer", || format!("bufferView {i}"))?;
+    }
+    for (i, m) in r.materials.iter().enumerate() {
+        let pbr = &m.pbr_metallic_roughness;
+        let textures = [
+            pbr.base_color_texture.as_ref().map(|t| t.index),
+            pbr.metallic_roughness_texture.as_ref().map(|t| t.index),
+            m.normal_texture.as_ref().map(|t| t.index),
+            m.occlusion_texture.as_ref().map(|t| t.index),
+            m.emissive_texture.as_ref().map(|t| t.index),
+        ];
+        for t in textures.into_iter().flatten() {
+            in_range(t, n_tex, "texture", || format!("material {i}"))?;
+        }
+    }
+    for (i, t) in r.textures.iter().enumerate() {
+        if let Some(s) = t.sampler {
+            in_range(s, n_samp, "sampler", || format!("texture {i}"))?;
+        }
+        in_range(t.source, n_img, "image", || format!("texture {i}"))?;
+    }
+    for (i, im) in r.images.iter().enumerate() {
+        if let Some(v) = im.buffer_view {
+            in_range(v, n_view, "bufferView", || format!("image {i}"))?;
+        }
+    }
+    for (i, s) in r.skins.iter().enumerate() {
+        for &j in &s.joints {
+            in_range(j, n_node, "node", || format!("skin {i} (joints)"))?;
+        }
+        if let Some(k) = s.skeleton {
+            in_range(k, n_node, "node", || format!("skin {i} (skeleton)"))?;
+        }
+        if let Some(a) = s.inverse_bind_matrices {
+            in_range(a, n_acc, "accessor", || format!("skin {i}"))?;
+        }
+    }
+    for (i, an) in r.animations.iter().enumerate() {
+        for (j, c) in an.channels.iter().enumerate() {
+            let from = || format!("animation {i} channel {j}");
+            in_range(c.sampler, an.samplers.len(), "animation sampler", from)?;
+            in_range(c.target.node, n_node, "node", from)?;
+        }
+        for (j, s) in an.samplers.iter().enumerate() {
+            let from = || format!("animation {i} sampler {j}");
+            in_range(s.input, n_acc, "accessor", from)?;
+            in_range(s.output, n_acc, "accessor", from)?;
+        }
+    }
+    Ok(())
+}
+
+/// Checks that the node graph is a forest (each node at most one parent, listed once, no cycles)
+/// and returns each node's parent.
+fn check_forest(r: &json::Root) -> Result<Vec<Option<usize>>, String> {
+    const TREES: &str = "glTF node graphs must be trees: each node has at most one parent and no cycles";
+    let n = r.nodes.len();
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for (p, node) in r.nodes.iter().enumerate() {
+        for c in node.children.iter().flatten().map(|c| c.value()) {
+            if c == p {
+                return Err(format!("node {p} lists itself as a child ({TREES})"));
+            }
+            match parent[c] {
+                Some(q) if q == p => {
+                    return Err(format!("node {p} lists node {c} twice as a child ({TREES})"))
+                }
+                Some(q) => {
+                    return Err(format!("node {c} is a child of both node {q} and node {p} ({TREES})"))
+                }
+                None => parent[c] = Some(p),
+            }
+        }
+    }
+    // With at most one parent each, a node that no parentless node reaches lies on a cycle.
+    let mut seen = vec![false; n];
+    let mut stack: Vec<usize> = (0..n).filter(|&i| parent[i].is_none()).collect();
+    while let Some(i) = stack.pop() {
+        seen[i] = true;
+        stack.extend(r.nodes[i].children.iter().flatten().map(|c| c.value()));
+    }
+    if let Some(k) = seen.iter().position(|s| !s) {
+        return Err(format!("node {k} is part of a cycle of children ({TREES})"));
+    }
+    Ok(parent)
+}
+
+/// Triangles and vertices the nodes under `roots` instantiate, from the JSON alone.
+fn count_instances(r: &json::Root, roots: &[usize]) -> Result<Budget, String> {
+    let count = |a: json::Index<json::Accessor>| r.accessors[a.value()].count.0;
+    let mut total = Budget { triangles: 0, vertices: 0 };
+    let mut stack: Vec<(usize, usize)> = roots.iter().map(|&n| (n, 0)).collect();
+    while let Some((i, depth)) = stack.pop() {
+        if depth > MAX_DEPTH {
+            return Err(format!("node hierarchy deeper than {MAX_DEPTH} levels at node {i}"));
+        }
+        let node = &r.nodes[i];
+        if let Some(m) = node.mesh {
+            for p in &r.meshes[m.value()].primitives {
+                let pos =
+                    p.attributes.get(&json::validation::Checked::Valid(json::mesh::Semantic::Positions));
+                let verts = pos.map_or(0, |&a| count(a));
+                let tris = p.indices.map_or(verts, count) / 3;
+                total.triangles = total.triangles.saturating_add(tris);
+                total.vertices = total.vertices.saturating_add(verts);
+            }
+        }
+        stack.extend(node.children.iter().flatten().map(|c| (c.value(), depth + 1)));
+    }
+    Ok(total)
 }
 
 fn add_node(
@@ -67,10 +368,7 @@ fn add_node(
     depth: usize,
 ) -> Result<(), String> {
     if depth > MAX_DEPTH {
-        return Err(format!(
-            "node hierarchy deeper than {MAX_DEPTH} levels (a cycle?) at node {}",
-            node.index()
-        ));
+        return Err(format!("node hierarchy deeper than {MAX_DEPTH} levels at node {}", node.index()));
     }
     let local = Mat4 { cols: node.transform().matrix() };
     if local.cols.iter().flatten().any(|v| !v.is_finite()) {
@@ -81,7 +379,18 @@ fn add_node(
         for prim in mesh.primitives() {
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
             let m = read_primitive(&prim, buffers).map_err(|e| format!("{what}: {e}"))?;
-            append_mesh(out, &transform_mesh(&m, &world));
+            let placed = transform_mesh(&m, &world);
+            if let Some(v) = placed.positions.iter().flatten().find(|v| !v.is_finite() || v.abs() > COORD_MAX)
+            {
+                return Err(format!(
+                    "{what} under node {}: vertex coordinates must lie within ±{} after the node \
+                     transforms, got {}",
+                    node.index(),
+                    fmt_f32(COORD_MAX),
+                    fmt_f32(*v)
+                ));
+            }
+            append_mesh(out, &placed);
         }
     }
     for child in node.children() {
@@ -196,8 +505,9 @@ fn check_accessor(
     Ok(())
 }
 
-/// The bytes of a buffer URI: a `data:` URI with base64 payload, or a relative file path.
-fn resolve_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+/// The bytes of a buffer URI: a `data:` URI with base64 payload, or a relative file path that
+/// resolves (symbolic links followed) inside the directory tree of `root`; at most `cap` bytes.
+fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) =
             rest.split_once(";base64,").ok_or("only base64 data URIs are supported (`data:…;base64,…`)")?;
@@ -206,8 +516,31 @@ fn resolve_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
     if uri.contains("://") {
         return Err(format!("cannot fetch `{uri}`: only relative file paths and data URIs are supported"));
     }
-    let file = dir.join(percent_decode(uri));
-    std::fs::read(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))
+    let rel = PathBuf::from(percent_decode(uri));
+    if rel.is_absolute() || rel.has_root() {
+        return Err(format!(
+            "`{uri}` is an absolute path; buffer files must be named relative to the glTF file and lie \
+             inside the scene file's directory"
+        ));
+    }
+    let file = dir.join(&rel);
+    let real = std::fs::canonicalize(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    let top = std::fs::canonicalize(root).map_err(|e| format!("cannot resolve {}: {e}", root.display()))?;
+    if !real.starts_with(&top) {
+        return Err(format!(
+            "`{uri}` resolves to {}, outside {}; buffer files must lie inside the scene file's directory",
+            real.display(),
+            top.display()
+        ));
+    }
+    read_regular_file(&real, cap).map_err(|e| {
+        let hint = if cap < GLTF_MAX_BYTES {
+            format!(" ({} in all per glTF file)", describe_bytes(GLTF_MAX_BYTES))
+        } else {
+            String::new()
+        };
+        format!("cannot read {}: {e}{hint}", file.display())
+    })
 }
 
 fn percent_decode(s: &str) -> String {

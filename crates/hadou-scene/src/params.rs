@@ -2,6 +2,8 @@
 //! names a slice of it, its shape and the range rule it must obey. Tracks write into the slices;
 //! the frame builder reads them back after [`Constraint::clamp`] has made them valid.
 
+use crate::limits::{fmt_f32, fmt_f64, COORD_MAX, DIR_MIN};
+
 /// The shape of a parameter's value in the scene file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Shape {
@@ -25,23 +27,31 @@ impl Shape {
 }
 
 /// The range rule of a parameter, checked at load (static values and every keyframe) and enforced
-/// by clamping at evaluation time (smooth interpolation may overshoot).
+/// by clamping at evaluation time (smooth interpolation may overshoot). Every rule also bounds
+/// the magnitude (see `limits.rs` for why each bound keeps the renderers finite).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Constraint {
-    /// Any finite number.
+    /// Any number within `±COORD_MAX`.
     Any,
-    /// `≥ 0`.
+    /// `0 ≤ v ≤ COORD_MAX`.
     NonNeg,
-    /// `> 0`.
+    /// `0 < v ≤ COORD_MAX`.
     Positive,
     /// Inside an interval; `open` bounds exclude the end.
     Range { lo: f32, hi: f32, lo_open: bool, hi_open: bool },
-    /// A vector that must not be zero (a direction).
+    /// A vector that must not be zero (a direction): components within `±COORD_MAX`, length at
+    /// least `DIR_MIN`.
     NonZero,
-    /// A colour `[r, g, b, a]`: `r, g, b ≥ 0`, `a ∈ [0, 1]`.
+    /// A colour `[r, g, b, a]`: `0 ≤ r, g, b ≤ COORD_MAX`, `a ∈ [0, 1]`.
     Rgba,
-    /// Non-decreasing values (a knot vector).
+    /// Non-decreasing values (a knot vector) within `±COORD_MAX`.
     NonDecreasing,
+}
+
+/// `[lo, hi]` with the bracket of each end, for messages.
+fn interval(lo: f32, hi: f32, lo_open: bool, hi_open: bool) -> String {
+    let (l, r) = (if lo_open { "(" } else { "[" }, if hi_open { ")" } else { "]" });
+    format!("{l}{}, {}{r}", fmt_f32(lo), fmt_f32(hi))
 }
 
 impl Constraint {
@@ -53,30 +63,45 @@ impl Constraint {
                 return Err((i, format!("must be a finite number, got {v}")));
             }
         }
-        match self {
-            Constraint::Any => Ok(()),
-            Constraint::NonNeg => match vals.iter().position(|&v| v < 0.0) {
-                Some(i) => Err((i, format!("must be ≥ 0, got {}", vals[i]))),
+        let max = COORD_MAX;
+        let within = |vals: &[f32]| -> Result<(), (usize, String)> {
+            match vals.iter().position(|v| v.abs() > max) {
+                Some(i) => Err((i, format!("must be within ±{}, got {}", fmt_f32(max), fmt_f32(vals[i])))),
                 None => Ok(()),
-            },
-            Constraint::Positive => match vals.iter().position(|&v| v <= 0.0) {
-                Some(i) => Err((i, format!("must be > 0, got {}", vals[i]))),
-                None => Ok(()),
-            },
-            Constraint::Range { lo, hi, lo_open, hi_open } => {
-                for (i, &v) in vals.iter().enumerate() {
-                    let below = if lo_open { v <= lo } else { v < lo };
-                    let above = if hi_open { v >= hi } else { v > hi };
-                    if below || above {
-                        let (l, r) = (if lo_open { "(" } else { "[" }, if hi_open { ")" } else { "]" });
-                        return Err((i, format!("must be in {l}{lo}, {hi}{r}, got {v}")));
-                    }
-                }
-                Ok(())
             }
+        };
+        let range = |vals: &[f32], lo: f32, hi: f32, lo_open: bool, hi_open: bool| {
+            for (i, &v) in vals.iter().enumerate() {
+                let below = if lo_open { v <= lo } else { v < lo };
+                let above = if hi_open { v >= hi } else { v > hi };
+                if below || above {
+                    return Err((
+                        i,
+                        format!("must be in {}, got {}", interval(lo, hi, lo_open, hi_open), fmt_f32(v)),
+                    ));
+                }
+            }
+            Ok(())
+        };
+        match self {
+            Constraint::Any => within(vals),
+            Constraint::NonNeg => range(vals, 0.0, max, false, false),
+            Constraint::Positive => range(vals, 0.0, max, true, false),
+            Constraint::Range { lo, hi, lo_open, hi_open } => range(vals, lo, hi, lo_open, hi_open),
             Constraint::NonZero => {
-                if whole && vals.iter().all(|&v| v == 0.0) {
+                within(vals)?;
+                let len = vals.iter().map(|&v| f64::from(v) * f64::from(v)).sum::<f64>().sqrt();
+                if whole && len == 0.0 {
                     Err((0, "must not be the zero vector (it is a direction)".into()))
+                } else if whole && len < DIR_MIN {
+                    Err((
+                        0,
+                        format!(
+                            "is too short to give a direction: length {}, at least {}",
+                            fmt_f64(len),
+                            fmt_f64(DIR_MIN)
+                        ),
+                    ))
                 } else {
                     Ok(())
                 }
@@ -85,18 +110,32 @@ impl Constraint {
                 for (i, &v) in vals.iter().enumerate() {
                     if first + i == 3 {
                         if !(0.0..=1.0).contains(&v) {
-                            return Err((i, format!("alpha (4th component) must be in [0, 1], got {v}")));
+                            return Err((
+                                i,
+                                format!("alpha (4th component) must be in [0, 1], got {}", fmt_f32(v)),
+                            ));
                         }
-                    } else if v < 0.0 {
-                        return Err((i, format!("colour components must be ≥ 0, got {v}")));
+                    } else if !(0.0..=max).contains(&v) {
+                        return Err((
+                            i,
+                            format!("colour components must be in [0, {}], got {}", fmt_f32(max), fmt_f32(v)),
+                        ));
                     }
                 }
                 Ok(())
             }
             Constraint::NonDecreasing => {
+                within(vals)?;
                 for i in 1..vals.len() {
                     if vals[i] < vals[i - 1] {
-                        return Err((i, format!("must not decrease: {} follows {}", vals[i], vals[i - 1])));
+                        return Err((
+                            i,
+                            format!(
+                                "must not decrease: {} follows {}",
+                                fmt_f32(vals[i]),
+                                fmt_f32(vals[i - 1])
+                            ),
+                        ));
                     }
                 }
                 Ok(())
@@ -112,22 +151,23 @@ impl Constraint {
                 *v = f;
             }
         }
+        let max = COORD_MAX;
         match self {
-            Constraint::Any | Constraint::NonZero => {}
-            Constraint::NonNeg => vals.iter_mut().for_each(|v| *v = v.max(0.0)),
-            Constraint::Positive => vals.iter_mut().for_each(|v| *v = v.max(1e-6)),
+            Constraint::Any | Constraint::NonZero => vals.iter_mut().for_each(|v| *v = v.clamp(-max, max)),
+            Constraint::NonNeg => vals.iter_mut().for_each(|v| *v = v.clamp(0.0, max)),
+            Constraint::Positive => vals.iter_mut().for_each(|v| *v = v.clamp(1e-6, max)),
             Constraint::Range { lo, hi, lo_open, hi_open } => {
-                let span = (hi - lo).abs();
-                let lo = if lo_open { lo + (span * 1e-6).max(1e-6) } else { lo };
-                let hi = if hi_open { hi - (span * 1e-6).max(1e-6) } else { hi };
+                let lo = if lo_open { lo + (lo.abs() * 1e-6).max(1e-6) } else { lo };
+                let hi = if hi_open { hi - (hi.abs() * 1e-6).max(1e-6) } else { hi };
                 vals.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
             }
             Constraint::Rgba => {
                 for (i, v) in vals.iter_mut().enumerate() {
-                    *v = if i == 3 { v.clamp(0.0, 1.0) } else { v.max(0.0) };
+                    *v = if i == 3 { v.clamp(0.0, 1.0) } else { v.clamp(0.0, max) };
                 }
             }
             Constraint::NonDecreasing => {
+                vals.iter_mut().for_each(|v| *v = v.clamp(-max, max));
                 for i in 1..vals.len() {
                     vals[i] = vals[i].max(vals[i - 1]);
                 }
@@ -217,6 +257,11 @@ mod tests {
         let mut v = [-3.0, 200.0, f32::NAN];
         fov.clamp(&mut v, &[45.0, 45.0, 45.0]);
         assert!(v[0] > 0.0 && v[1] < 180.0 && v[2] == 45.0, "{v:?}");
+        let mut big = [3e38, -3e38];
+        Constraint::Any.clamp(&mut big, &[0.0, 0.0]);
+        assert_eq!(big, [1e6, -1e6]);
+        assert!(Constraint::Any.check(&[3e38], 0, true).unwrap_err().1.contains("3e38"));
+        assert!(Constraint::NonZero.check(&[1e-30, 0.0, 0.0], 0, true).is_err());
         let mut k = [0.0, 2.0, 1.0, 3.0];
         Constraint::NonDecreasing.clamp(&mut k, &[0.0; 4]);
         assert_eq!(k, [0.0, 2.0, 2.0, 3.0]);

@@ -80,9 +80,8 @@ impl Scene {
     /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
-        let bytes = std::fs::read(path).map_err(|e| SceneError::Io {
-            path: path.to_path_buf(),
-            message: format!("cannot read the scene file: {e}"),
+        let bytes = crate::files::read_regular_file(path, crate::files::SCENE_MAX_BYTES).map_err(|e| {
+            SceneError::Io { path: path.to_path_buf(), message: format!("cannot read the scene file: {e}") }
         })?;
         let text = String::from_utf8(bytes).map_err(|e| SceneError::Io {
             path: path.to_path_buf(),

@@ -5,6 +5,11 @@
 use crate::anim::{Interpolation, Track};
 use crate::error::{hint, Location, SceneError};
 use crate::frame::{Mesh, ToneMode};
+use crate::gltf_load::Budget;
+use crate::limits::{
+    fmt_f32, fmt_f64, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_TRIANGLES, MAX_VERTICES,
+    MAX_WAVES, NEAR_MIN, SCALE_MIN,
+};
 use crate::mesh::{box_mesh, plane_mesh, sphere_mesh};
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::scene::{IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
@@ -34,6 +39,8 @@ pub(crate) const DEFAULT_RGBA: [f32; 4] = [0.8, 0.8, 0.2, 1.0];
 pub(crate) const DEFAULT_CORE_RADIUS: f32 = 0.02;
 
 const POSITIVE: Constraint = Constraint::Positive;
+/// Wave strengths: `[0, ALPHA_MAX]`.
+const ALPHA: Constraint = Constraint::Range { lo: 0.0, hi: ALPHA_MAX, lo_open: false, hi_open: false };
 const NONNEG: Constraint = Constraint::NonNeg;
 const ANY: Constraint = Constraint::Any;
 const V3: Shape = Shape::Vector(3);
@@ -48,7 +55,9 @@ pub(crate) fn up_is_usable(up: Vec3f, axis: Vec3f) -> bool {
 /// Parses a whole scene.
 pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let src = Src { text, path };
-    let doc = DeTable::parse(text).map_err(|e| SceneError::Syntax {
+    let parsed = crate::guard::guarded("TOML", || DeTable::parse(text))
+        .map_err(|message| SceneError::Syntax { at: Location::from_offset(path, text, 0), message })?;
+    let doc = parsed.map_err(|e| SceneError::Syntax {
         at: Location::from_offset(path, text, e.span().map_or(0, |s| s.start)),
         message: format!("invalid TOML: {}", e.message().trim().replace('\n', "; ")),
     })?;
@@ -76,13 +85,15 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     {
         let t = sub_or_empty("camera", "[camera]")?;
         t.check_keys(CAMERA_KEYS)?;
-        let fov = Constraint::Range { lo: 0.0, hi: 180.0, lo_open: true, hi_open: true };
+        let fov = Constraint::Range { lo: FOV_MIN, hi: FOV_MAX, lo_open: false, hi_open: false };
+        let near = Constraint::Range { lo: NEAR_MIN, hi: FAR_MAX, lo_open: false, hi_open: true };
+        let far = Constraint::Range { lo: NEAR_MIN, hi: FAR_MAX, lo_open: false, hi_open: false };
         rd.add(&t, &mut camera, "position", V3, ANY, Fallback::Value(&[0.0, 0.0, 10.0]), false)?;
         rd.add(&t, &mut camera, "target", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
         rd.add(&t, &mut camera, "up", V3, Constraint::NonZero, Fallback::Value(&[0.0, 1.0, 0.0]), false)?;
         rd.add(&t, &mut camera, "fov", S, fov, Fallback::Value(&[45.0]), false)?;
-        rd.add(&t, &mut camera, "near", S, POSITIVE, Fallback::Value(&[0.1]), false)?;
-        rd.add(&t, &mut camera, "far", S, POSITIVE, Fallback::Value(&[100.0]), false)?;
+        rd.add(&t, &mut camera, "near", S, near, Fallback::Value(&[0.1]), false)?;
+        rd.add(&t, &mut camera, "far", S, far, Fallback::Value(&[100.0]), false)?;
         if let Err((key, msg)) = check_camera(&camera, rd.values) {
             return Err(src.value_err(&t.key_span(key), format!("{msg} in [camera]")));
         }
@@ -120,12 +131,16 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     // [[object]]
     let mut objects: Vec<ObjectDef> = Vec::new();
     let mut names: HashMap<String, Span> = HashMap::new();
-    let mut mesh_cache: HashMap<PathBuf, Arc<Mesh>> = HashMap::new();
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut assets = Assets { dir, root: None, cache: HashMap::new(), budget: Budget::FULL };
     for (i, (t, span)) in root.array_of_tables("object")?.into_iter().enumerate() {
         let table = Table { src, t, span, what: format!("[[object]] #{}", i + 1) };
         let name = entity_name(&table, &mut names, "object")?;
         let table = Table { what: format!("[[object]] \"{name}\""), ..table };
-        objects.push(parse_object(&table, name, &mut rd, &mut mesh_cache)?);
+        objects.push(parse_object(&table, name, &mut rd, &mut assets)?);
     }
 
     // [[wave]]
@@ -133,6 +148,12 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut wave_tables = Vec::new();
     let mut names: HashMap<String, Span> = HashMap::new();
     for (i, (t, span)) in root.array_of_tables("wave")?.into_iter().enumerate() {
+        if i == MAX_WAVES {
+            return Err(src.value_err(
+                &span,
+                format!("a scene may have at most {MAX_WAVES} waves; this is wave #{}", i + 1),
+            ));
+        }
         let table = Table { src, t, span, what: format!("[[wave]] #{}", i + 1) };
         let name = entity_name(&table, &mut names, "wave")?;
         let table = Table { what: format!("[[wave]] \"{name}\""), ..table };
@@ -176,9 +197,10 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         for (&time, span) in track.times.iter().zip(spans) {
             let vals = scene.values_at(time);
             if let Err(msg) = check_all(&scene, &vals) {
-                return Err(
-                    src.track(span, format!("at t = {time} s (this key of `{}`): {msg}", track.target))
-                );
+                return Err(src.track(
+                    span,
+                    format!("at t = {} s (this key of `{}`): {msg}", fmt_f32(time), track.target),
+                ));
             }
         }
     }
@@ -209,11 +231,35 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
     Ok(name.to_string())
 }
 
+/// What loading the objects' meshes shares: the glTF cache (by canonical path), the scene's
+/// triangle budget and the directory tree files may be read from.
+struct Assets {
+    /// The scene file's directory (as given).
+    dir: PathBuf,
+    /// Its canonical form, once needed.
+    root: Option<PathBuf>,
+    cache: HashMap<PathBuf, Arc<Mesh>>,
+    budget: Budget,
+}
+
+impl Assets {
+    /// The canonical scene directory.
+    fn root(&mut self) -> Result<PathBuf, String> {
+        if let Some(r) = &self.root {
+            return Ok(r.clone());
+        }
+        let r = std::fs::canonicalize(&self.dir)
+            .map_err(|e| format!("cannot resolve the scene file's directory {}: {e}", self.dir.display()))?;
+        self.root = Some(r.clone());
+        Ok(r)
+    }
+}
+
 fn parse_object(
     t: &Table<'_, '_>,
     name: String,
     rd: &mut ParamReader<'_>,
-    cache: &mut HashMap<PathBuf, Arc<Mesh>>,
+    assets: &mut Assets,
 ) -> Res<ObjectDef> {
     let kind = t.choice("kind", OBJECT_KINDS, None)?;
     let extra: &[&str] = match kind {
@@ -230,51 +276,101 @@ fn parse_object(
     let mut scratch_s = Vec::new();
     let mut scratch = ParamReader { values: &mut scratch_v, spans: &mut scratch_s };
     let mut shape_set = ParamSet::default();
-    let mesh =
-        match kind {
-            "box" => {
-                scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
-                Arc::new(box_mesh(shape_set.arr(&scratch_v, "size")))
+    let mesh = match kind {
+        "box" => {
+            scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
+            Arc::new(box_mesh(shape_set.arr(&scratch_v, "size")))
+        }
+        "plane" => {
+            scratch.add(
+                t,
+                &mut shape_set,
+                "size",
+                Shape::Vector(2),
+                POSITIVE,
+                Fallback::Value(&[10.0, 10.0]),
+                false,
+            )?;
+            Arc::new(plane_mesh(shape_set.arr(&scratch_v, "size")))
+        }
+        "sphere" => {
+            scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
+            let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
+            Arc::new(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments))
+        }
+        _ => {
+            let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
+            let gltf_err =
+                |message: String, file: PathBuf| SceneError::Gltf { at: t.src.loc(&span), file, message };
+            let file = assets.dir.join(rel);
+            if Path::new(rel).is_absolute() || Path::new(rel).has_root() {
+                return Err(gltf_err(
+                    "`path` must be relative to the scene file (glTF files must lie inside the scene \
+                         file's directory)"
+                        .into(),
+                    file,
+                ));
             }
-            "plane" => {
-                scratch.add(
-                    t,
-                    &mut shape_set,
-                    "size",
-                    Shape::Vector(2),
-                    POSITIVE,
-                    Fallback::Value(&[10.0, 10.0]),
-                    false,
-                )?;
-                Arc::new(plane_mesh(shape_set.arr(&scratch_v, "size")))
+            let real = std::fs::canonicalize(&file)
+                .map_err(|e| gltf_err(format!("cannot read the file: {e}"), file.clone()))?;
+            let root = assets.root().map_err(|m| gltf_err(m, file.clone()))?;
+            if !real.starts_with(&root) {
+                return Err(gltf_err(
+                    format!(
+                        "it resolves to {}, outside the scene file's directory {}; glTF files must \
+                             lie inside the scene file's directory",
+                        real.display(),
+                        root.display()
+                    ),
+                    file,
+                ));
             }
-            "sphere" => {
-                scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
-                let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
-                Arc::new(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments))
-            }
-            _ => {
-                let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
-                let dir = t.src.path.parent().unwrap_or(Path::new(""));
-                let file = dir.join(rel);
-                match cache.get(&file) {
-                    Some(m) => m.clone(),
-                    None => {
-                        let mesh = crate::gltf_load::load_gltf(&file).map_err(|message| {
-                            SceneError::Gltf { at: t.src.loc(&span), file: file.clone(), message }
-                        })?;
-                        let mesh = Arc::new(mesh);
-                        cache.insert(file, mesh.clone());
-                        mesh
+            match assets.cache.get(&real) {
+                Some(m) => {
+                    let tris = (m.indices.len() / 3) as u64;
+                    let verts = m.positions.len() as u64;
+                    if tris > assets.budget.triangles || verts > assets.budget.vertices {
+                        return Err(gltf_err(
+                            format!(
+                                "this instance brings the scene past the limit of {MAX_TRIANGLES} \
+                                     triangles or {MAX_VERTICES} vertices"
+                            ),
+                            file,
+                        ));
                     }
+                    assets.budget.triangles -= tris;
+                    assets.budget.vertices -= verts;
+                    m.clone()
+                }
+                None => {
+                    let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget)
+                        .map_err(|message| gltf_err(message, file.clone()))?;
+                    let mesh = Arc::new(mesh);
+                    assets.cache.insert(real, mesh.clone());
+                    mesh
                 }
             }
-        };
+        }
+    };
+    if kind != "gltf" {
+        let tris = (mesh.indices.len() / 3) as u64;
+        if tris > assets.budget.triangles {
+            return Err(t.src.value_err(
+                &t.key_span("kind"),
+                format!(
+                    "{} brings the scene past the limit of {MAX_TRIANGLES} triangles of all objects together",
+                    t.what
+                ),
+            ));
+        }
+        assets.budget.triangles -= tris;
+    }
 
     let mut params = ParamSet::default();
     rd.add(t, &mut params, "position", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
     rd.add(t, &mut params, "rotation", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
-    rd.add(t, &mut params, "scale", V3, POSITIVE, Fallback::Value(&[1.0; 3]), true)?;
+    let scale = Constraint::Range { lo: SCALE_MIN, hi: COORD_MAX, lo_open: false, hi_open: false };
+    rd.add(t, &mut params, "scale", V3, scale, Fallback::Value(&[1.0; 3]), true)?;
     rd.add(t, &mut params, "color", V3, NONNEG, Fallback::Value(&[0.8; 3]), false)?;
     Ok(ObjectDef { name, mesh, params })
 }
@@ -327,12 +423,12 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
     match kind {
         WaveKind::Sphere => {
             rd.add(t, &mut p, "M", V3, ANY, Fallback::Required("the centre"), false)?;
-            rd.add(t, &mut p, "alpha_s", S, NONNEG, Fallback::Required("the strength α_s"), false)?;
+            rd.add(t, &mut p, "alpha_s", S, ALPHA, Fallback::Required("the strength α_s"), false)?;
         }
         WaveKind::Cylinder => {
             rd.add(t, &mut p, "M", V3, ANY, Fallback::Required("a point on the axis"), false)?;
             rd.add(t, &mut p, "D", V3, dir, Fallback::Required("the axis direction"), false)?;
-            rd.add(t, &mut p, "alpha_c", S, NONNEG, Fallback::Required("the strength α_c"), false)?;
+            rd.add(t, &mut p, "alpha_c", S, ALPHA, Fallback::Required("the strength α_c"), false)?;
         }
         WaveKind::Capsule | WaveKind::Beam => {
             rd.add(t, &mut p, "M", V3, ANY, Fallback::Required("the muzzle end"), false)?;
@@ -366,7 +462,7 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
                 &mut p,
                 "alpha_s",
                 S,
-                NONNEG,
+                ALPHA,
                 Fallback::Required("the strength of the end spheres α_s"),
                 false,
             )?;
@@ -375,13 +471,13 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
                 &mut p,
                 "alpha_c",
                 S,
-                NONNEG,
+                ALPHA,
                 Fallback::Required("the strength of the cylinder α_c"),
                 false,
             )?;
             if kind == WaveKind::Beam {
-                rd.add(t, &mut p, "head_alpha", S, NONNEG, Fallback::Value(&[0.0]), false)?;
-                rd.add(t, &mut p, "muzzle_alpha", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+                rd.add(t, &mut p, "head_alpha", S, ALPHA, Fallback::Value(&[0.0]), false)?;
+                rd.add(t, &mut p, "muzzle_alpha", S, ALPHA, Fallback::Value(&[0.0]), false)?;
             }
         }
         _ => parse_curve(t, &mut def, &mut p, rd)?,
@@ -395,7 +491,7 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
     rd.add(t, p, "O", V3, ANY, Fallback::Required("the launch point"), false)?;
     rd.add(t, p, "D", V3, Constraint::NonZero, Fallback::Required("the travel axis"), false)?;
     rd.add(t, p, "up", V3, Constraint::NonZero, Fallback::Value(&[0.0, 1.0, 0.0]), false)?;
-    rd.add(t, p, "alpha", S, NONNEG, Fallback::Required("the strength α"), false)?;
+    rd.add(t, p, "alpha", S, ALPHA, Fallback::Required("the strength α"), false)?;
     rd.add(t, p, "gamma", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
     rd.add(t, p, "k", S, k_rule, Fallback::Value(&[1.0]), false)?;
     rd.add(t, p, "j", S, NONNEG, Fallback::Value(&[0.0]), false)?;
@@ -501,12 +597,31 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
 fn check_camera(c: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)> {
     let (near, far) = (c.f(vals, "near"), c.f(vals, "far"));
     if near >= far {
-        return Err(("far", format!("`far` ({far}) must be greater than `near` ({near})")));
+        return Err((
+            "far",
+            format!("`far` ({}) must be greater than `near` ({})", fmt_f32(far), fmt_f32(near)),
+        ));
     }
-    let eye = Vec3f::from_array(c.arr(vals, "position"));
-    let target = Vec3f::from_array(c.arr(vals, "target"));
-    let Some(view) = (target - eye).try_normalize() else {
+    let eye = c.arr::<3>(vals, "position");
+    let target = c.arr::<3>(vals, "target");
+    // In f64: the distance of two points within ±1e6 is exact enough, and it cannot overflow.
+    let dist =
+        eye.iter().zip(&target).map(|(a, b)| (f64::from(*b) - f64::from(*a)).powi(2)).sum::<f64>().sqrt();
+    if dist == 0.0 {
         return Err(("target", "`target` must differ from `position`".into()));
+    }
+    if dist < 1e-6 {
+        return Err((
+            "target",
+            format!(
+                "`target` is only {} from `position`; keep them at least 1e-6 apart so the view \
+                 direction is defined",
+                fmt_f64(dist)
+            ),
+        ));
+    }
+    let Some(view) = (Vec3f::from_array(target) - Vec3f::from_array(eye)).try_normalize() else {
+        return Err(("target", "`target` and `position` do not give a view direction".into()));
     };
     if !up_is_usable(Vec3f::from_array(c.arr(vals, "up")), view) {
         return Err(("up", "`up` must not be parallel to the view direction (target − position)".into()));
@@ -768,12 +883,30 @@ fn parse_track(
                 ))
             }
         };
+        if crate::toml_read::too_large_integer(pair[0].get_ref()) {
+            return Err(t.src.type_err(
+                &pair[0].span(),
+                format!(
+                    "key time in {what} must be a number, got an integer that is too large (over 64 bits)"
+                ),
+            ));
+        }
         let time = match number(pair[0].get_ref()) {
-            Some(x) if x.is_finite() && x >= 0.0 => x as f32,
+            Some(x) if x.is_finite() && x >= 0.0 && x <= f64::from(COORD_MAX) => x as f32,
+            Some(x) if x.is_finite() && x >= 0.0 => {
+                return Err(t.src.value_err(
+                    &pair[0].span(),
+                    format!(
+                        "key time in {what} must be at most {} s, got {}",
+                        fmt_f32(COORD_MAX),
+                        fmt_f64(x)
+                    ),
+                ))
+            }
             Some(x) => {
                 return Err(t.src.value_err(
                     &pair[0].span(),
-                    format!("key time in {what} must be finite and ≥ 0, got {x}"),
+                    format!("key time in {what} must be finite and ≥ 0, got {}", fmt_f64(x)),
                 ))
             }
             None => {
@@ -790,7 +923,11 @@ fn parse_track(
             if time <= prev {
                 return Err(t.src.track(
                     &pair[0].span(),
-                    format!("key times in {what} must increase strictly: {time} follows {prev}"),
+                    format!(
+                        "key times in {what} must increase strictly: {} follows {}",
+                        fmt_f32(time),
+                        fmt_f32(prev)
+                    ),
                 ));
             }
         }

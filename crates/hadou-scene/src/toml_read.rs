@@ -2,6 +2,7 @@
 //! exact span of the offending key or value, and unknown-key detection with suggestions.
 
 use crate::error::{hint, Location, SceneError};
+use crate::limits::fmt_f64;
 use crate::params::{Constraint, Param, ParamSet, Shape};
 use std::ops::Range;
 use std::path::Path;
@@ -60,15 +61,21 @@ pub(crate) fn type_name(v: &DeValue<'_>) -> &'static str {
     }
 }
 
-/// The number a value holds, if it is an integer or a float (`nan`/`inf` come back non-finite).
+/// The number a value holds, if it is an integer or a float (`nan`/`inf` come back non-finite,
+/// an integer too large for 64 bits comes back NaN: see [`too_large_integer`]).
 pub(crate) fn number(v: &DeValue<'_>) -> Option<f64> {
     match v {
         DeValue::Integer(i) => {
-            i64::from_str_radix(&i.as_str().replace('_', ""), i.radix()).ok().map(|x| x as f64)
+            Some(i64::from_str_radix(&i.as_str().replace('_', ""), i.radix()).map_or(f64::NAN, |x| x as f64))
         }
         DeValue::Float(f) => Some(f.as_str().replace('_', "").parse::<f64>().unwrap_or(f64::NAN)),
         _ => None,
     }
+}
+
+/// Whether `v` is an integer literal that does not fit in 64 bits.
+pub(crate) fn too_large_integer(v: &DeValue<'_>) -> bool {
+    matches!(v, DeValue::Integer(i) if i64::from_str_radix(&i.as_str().replace('_', ""), i.radix()).is_err())
 }
 
 /// Reads a numeric value of `shape` (with `len` floats expected for vectors), returning each
@@ -82,13 +89,20 @@ pub(crate) fn read_numbers(
 ) -> Res<Vec<(f32, Span)>> {
     let one =
         |v: &Val<'_>, what: &str| -> Res<(f32, Span)> {
+            if too_large_integer(v.get_ref()) {
+                return Err(src.type_err(
+                    &v.span(),
+                    format!("{what} must be a number, got an integer that is too large (over 64 bits)"),
+                ));
+            }
             match number(v.get_ref()) {
                 Some(x) => {
                     let f = x as f32;
                     if x.is_finite() && !f.is_finite() {
-                        return Err(
-                            src.value_err(&v.span(), format!("{what} is too large for 32-bit floats: {x}"))
-                        );
+                        return Err(src.value_err(
+                            &v.span(),
+                            format!("{what} is too large for 32-bit floats: {}", fmt_f64(x)),
+                        ));
                     }
                     Ok((f, v.span()))
                 }
@@ -239,6 +253,15 @@ impl<'t, 'i> Table<'t, 'i> {
                 ))
             }
         };
+        if n.is_none() {
+            return Err(self.src.type_err(
+                &v.span(),
+                format!(
+                    "`{key}` in {} must be an integer in {lo}..={hi}, got an integer that is too large (over 64 bits)",
+                    self.what
+                ),
+            ));
+        }
         match n {
             Some(n) if (lo..=hi).contains(&n) => Ok(Some((n, v.span()))),
             _ => Err(self.src.value_err(

@@ -1,0 +1,89 @@
+//! The numeric limits of a scene, chosen so that nothing a valid scene can say makes a renderer
+//! compute a non-finite value (f32 overflows past ~3.4e38), and the number formatting of messages.
+//!
+//! Why these bounds make overflow impossible (f32 throughout, `MAX ≈ 3.4e38`):
+//!
+//! - Every position, point, length, radius, rate, phase, coefficient, colour, direction component
+//!   and the like is within `±COORD_MAX = 1e6`; glTF vertices (after node transforms) are too.
+//!   Object `scale ≤ 1e6`, so a world vertex is at most `1e6 · 1e6 · √3 + 1e6 < 2e12` from the
+//!   origin, and every squared distance the renderers form (view-space depth, `|v|²`, `|û × v|²`
+//!   in `hadou_math::energy::kernel`, the curves' squared distances) is below `(4e12)² = 1.6e25`.
+//!   Trigonometric curves sum at most 1024 terms of `≤ 1e6`: `|y|, |z| ≤ 2e9`.
+//! - `far ≤ FAR_MAX = 1e7` and `fov ≤ FOV_MAX = 179°`: `tan(fov/2) ≤ 115`, the aspect ratio is at
+//!   most 16384, so a pixel direction (`CameraBasis::pixel_dir`, forward component 1) is shorter
+//!   than `2e6`; the far distance `far · |dir|` (the depth of an empty pixel, the faithful ray
+//!   `Q = far · dir`) is below `2e13` and `Y = s·t + β` of the faithful kernel (`t ≤ 1`) below
+//!   `3e13`, `Y² < 1e27`. Inverse-square rays are unit and clamp `t` at `T_LIMIT = 1e12`.
+//! - `fov ≥ FOV_MIN = 0.001°` and `near ≥ NEAR_MIN = 1e-6`: the rasterizer's `1/tan(fov/2)`
+//!   (`≤ 1.2e5`, times the aspect ≤ 16384 gives `≤ 2e9`) and `1/z ≤ 1e6` stay finite, so a
+//!   projected vertex is below `2e12 · 1e6 · 2e9 · 16384 < 1e32`.
+//! - Each closed-form energy piece is at most `ENERGY_MAX = 1e30` (hadou-math). A wave has at most
+//!   5 analytic pieces (beam), each multiplied by a strength `α ≤ ALPHA_MAX = 1e5`: one wave's
+//!   energy is below `5e35`. Curves regularise with a core of at least `1e-6`, so each straight
+//!   piece is below `1e7 / 1e-12 = 1e19` and a wave (≤ 2^14 pieces × 64 parts) below `1e30`.
+//!   With at most `MAX_WAVES = 256` waves the summed energy of a pixel is below `1.3e38`.
+//! - Colours (`rgb`, light, ambient, albedo, background) and `exposure` are at most `1e6`, so a
+//!   product of parameters `α · rgb · exposure ≤ 1e17`; where it meets a divergent integral the
+//!   wave light may saturate to `+∞`, which the colour mappings turn into white (a finite value),
+//!   and no NaN can arise because every term is `≥ 0`.
+
+/// Bound on the magnitude of every scene number without a tighter rule.
+pub(crate) const COORD_MAX: f32 = 1e6;
+/// Largest `far`.
+pub(crate) const FAR_MAX: f32 = 1e7;
+/// Smallest `near`.
+pub(crate) const NEAR_MIN: f32 = 1e-6;
+/// Field of view range in degrees.
+pub(crate) const FOV_MIN: f32 = 1e-3;
+/// Largest field of view in degrees.
+pub(crate) const FOV_MAX: f32 = 179.0;
+/// Largest wave strength (`alpha_s`, `alpha_c`, `head_alpha`, `muzzle_alpha`, `alpha`).
+pub(crate) const ALPHA_MAX: f32 = 1e5;
+/// Smallest object scale.
+pub(crate) const SCALE_MIN: f32 = 1e-6;
+/// Shortest direction vector (before normalisation).
+pub(crate) const DIR_MIN: f64 = 1e-6;
+/// Most `[[wave]]` tables in one scene.
+pub(crate) const MAX_WAVES: usize = 256;
+/// Most triangles of all objects of one scene together, every glTF instance counted.
+pub const MAX_TRIANGLES: u64 = 20_000_000;
+/// Most vertices of all glTF primitives of one scene together, every instance counted.
+pub const MAX_VERTICES: u64 = 60_000_000;
+
+/// A number for a message: shortest round-trip digits, in scientific notation where that is
+/// clearly shorter (`3e38` rather than 39 digits, `1e5` rather than `100000`).
+pub(crate) fn fmt_f64(x: f64) -> String {
+    shorter(format!("{x}"), format!("{x:e}"))
+}
+
+/// [`fmt_f64`] for an `f32` (its own shortest digits, not those of its `f64` widening).
+pub(crate) fn fmt_f32(x: f32) -> String {
+    shorter(format!("{x}"), format!("{x:e}"))
+}
+
+fn shorter(plain: String, sci: String) -> String {
+    if sci.len() + 2 <= plain.len() {
+        sci
+    } else {
+        plain
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(fmt_f64(1e300), "1e300");
+        assert_eq!(fmt_f32(3e38), "3e38");
+        assert_eq!(fmt_f32(1e-45), "1e-45");
+        assert_eq!(fmt_f32(0.1), "0.1");
+        assert_eq!(fmt_f32(-0.0), "-0");
+        assert_eq!(fmt_f32(180.0), "180");
+        assert_eq!(fmt_f64(123456.5), "123456.5");
+        assert_eq!(fmt_f32(1e5), "1e5");
+        assert_eq!(fmt_f32(0.001), "0.001");
+        assert_eq!(fmt_f32(16384.0), "16384");
+    }
+}
