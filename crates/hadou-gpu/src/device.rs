@@ -65,6 +65,71 @@ fn request_adapter() -> Result<wgpu::Adapter, String> {
     Err(errors.join("; "))
 }
 
+/// The capabilities hadou needs beyond wgpu's downlevel (WebGL2-class) baseline, each with the
+/// words an "unsupported adapter" error uses for it.
+const NEEDED_DOWNLEVEL: [(wgpu::DownlevelFlags, &str); 3] = [
+    (wgpu::DownlevelFlags::COMPUTE_SHADERS, "compute shaders (the wave pass is one)"),
+    (wgpu::DownlevelFlags::VERTEX_STORAGE, "storage buffers in vertex shaders (per-object data)"),
+    (wgpu::DownlevelFlags::FRAGMENT_STORAGE, "storage buffers in fragment shaders (per-object data)"),
+];
+
+/// Storage buffers the wave pass binds in one compute stage (keep in sync with pipelines.rs).
+const NEEDED_COMPUTE_STORAGE_BUFFERS: u32 = 5;
+/// Invocations per workgroup the kernels use (8×8 wave pass, 64×1 twin-test kernels).
+const NEEDED_WORKGROUP_INVOCATIONS: u32 = 64;
+
+/// Checks, before a device is opened, that `adapter` can run hadou: the downlevel capabilities,
+/// the limits and the texture formats the passes use. Every shortfall is listed in one
+/// [`RenderError::NoDevice`] starting "unsupported adapter", so callers and tests treat it like a
+/// missing adapter (a skip, or a failure under `HADOU_REQUIRE_GPU=1`).
+fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<(), RenderError> {
+    let mut missing: Vec<String> = Vec::new();
+    let downlevel = adapter.get_downlevel_capabilities();
+    for (flag, what) in NEEDED_DOWNLEVEL {
+        if !downlevel.flags.contains(flag) {
+            missing.push(what.into());
+        }
+    }
+    let limits = adapter.limits();
+    if limits.max_storage_buffers_per_shader_stage < NEEDED_COMPUTE_STORAGE_BUFFERS {
+        missing.push(format!(
+            "{NEEDED_COMPUTE_STORAGE_BUFFERS} storage buffers per shader stage (it allows {})",
+            limits.max_storage_buffers_per_shader_stage
+        ));
+    }
+    if limits.max_compute_invocations_per_workgroup < NEEDED_WORKGROUP_INVOCATIONS
+        || limits.max_compute_workgroup_size_x < NEEDED_WORKGROUP_INVOCATIONS
+    {
+        missing.push(format!(
+            "{NEEDED_WORKGROUP_INVOCATIONS} compute invocations per workgroup (it allows {})",
+            limits.max_compute_invocations_per_workgroup
+        ));
+    }
+    let formats = [
+        (
+            crate::pipelines::SCENE_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        ),
+        (crate::pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
+    ];
+    for (format, usages) in formats {
+        if !adapter.get_texture_format_features(format).allowed_usages.contains(usages) {
+            missing.push(format!("{format:?} textures with usage {usages:?}"));
+        }
+    }
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(RenderError::NoDevice(format!(
+        "unsupported adapter `{}` ({:?}, driver {} {}): it lacks {}",
+        info.name,
+        info.backend,
+        info.driver,
+        info.driver_info,
+        missing.join("; ")
+    )))
+}
+
 impl GpuContext {
     /// Opens the best adapter wgpu finds (no surface; `WGPU_BACKEND` and friends are honoured).
     pub(crate) fn new() -> Result<Self, RenderError> {
@@ -75,6 +140,7 @@ impl GpuContext {
             ))
         })?;
         let info = adapter.get_info();
+        check_adapter(&adapter, &info)?;
         let adapter_features = adapter.features();
         // Timestamps are optional: used by `time_frame` when present.
         let features = adapter_features & wgpu::Features::TIMESTAMP_QUERY;

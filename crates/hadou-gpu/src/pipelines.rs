@@ -5,11 +5,15 @@ use crate::layout::GpuVertex;
 use crate::shaders;
 use hadou_scene::RenderError;
 
-/// Colour target of the raster pass (linear scene colour; read by the wave pass).
-pub(crate) const SCENE_COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-/// Eye-distance target of the raster pass (−1 where nothing is drawn).
-pub(crate) const SCENE_DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-/// Depth buffer of the raster pass.
+/// The raster pass's one colour target: the linear scene colour and the Euclidean eye distance of
+/// the visible surface, as the bit patterns of four `f32`s (`bitcast` in raster.wgsl and
+/// wave.wgsl). An integer format because `Rgba32Uint` is colour-renderable on every adapter wgpu
+/// offers (GLES 3.0 and WebGL2 included), while `Rgba32Float` and `R32Float` targets need
+/// optional extensions on GL; the bits pass through unchanged, so the wave pass reads exactly the
+/// `f32`s the fragment shader wrote. A cleared texel is all zero bits, i.e. distance 0: nothing
+/// drawn (a drawn surface is at least `near` > 0 away).
+pub(crate) const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// Depth buffer of the raster pass (renderable on every adapter).
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Workgroup edge of the wave pass (keep in sync with `@workgroup_size` in wave.wgsl).
 pub(crate) const WAVE_WORKGROUP: u32 = 8;
@@ -79,7 +83,7 @@ fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            sample_type: wgpu::TextureSampleType::Uint,
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         },
@@ -106,7 +110,6 @@ impl Pipelines {
                     uniform_entry(0, cs),
                     storage_entry(1, cs, true),
                     texture_entry(2),
-                    texture_entry(3),
                     storage_entry(4, cs, false),
                     // Curve buffers; keep in sync with curve.wgsl and layout::CurveBuffers.
                     storage_entry(5, cs, true),
@@ -156,18 +159,11 @@ impl Pipelines {
                     module: &raster_module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
-                    targets: &[
-                        Some(wgpu::ColorTargetState {
-                            format: SCENE_COLOR_FORMAT,
-                            blend: None,
-                            write_mask: wgpu::ColorWrites::ALL,
-                        }),
-                        Some(wgpu::ColorTargetState {
-                            format: SCENE_DISTANCE_FORMAT,
-                            blend: None,
-                            write_mask: wgpu::ColorWrites::ALL,
-                        }),
-                    ],
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: SCENE_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
                 }),
                 multiview_mask: None,
                 cache: None,

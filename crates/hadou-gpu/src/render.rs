@@ -28,8 +28,8 @@ struct CachedMesh {
 /// The per-tile GPU resources, sized for one tile edge pair.
 pub(crate) struct TileTargets {
     size: [u32; 2],
-    color_view: wgpu::TextureView,
-    distance_view: wgpu::TextureView,
+    /// Scene colour and eye distance, packed (see `pipelines::SCENE_FORMAT`).
+    scene_view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
     uniforms: wgpu::Buffer,
     output: wgpu::Buffer,
@@ -211,8 +211,7 @@ impl Renderer {
             .create_view(&Default::default())
         };
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let color_view = texture("scene color", pipelines::SCENE_COLOR_FORMAT, attach_and_read);
-        let distance_view = texture("scene distance", pipelines::SCENE_DISTANCE_FORMAT, attach_and_read);
+        let scene_view = texture("scene colour and distance", pipelines::SCENE_FORMAT, attach_and_read);
         let depth_view = texture("depth", pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
         let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
@@ -233,8 +232,7 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        self.targets =
-            Some(TileTargets { size, color_view, distance_view, depth_view, uniforms, output, staging });
+        self.targets = Some(TileTargets { size, scene_view, depth_view, uniforms, output, staging });
     }
 
     /// Validates the frame, uploads what it needs and plans the tiles.
@@ -355,11 +353,7 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 1, resource: prepared.waves.as_entire_binding() },
                 wgpu::BindGroupEntry {
                     binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&t.color_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&t.distance_view),
+                    resource: wgpu::BindingResource::TextureView(&t.scene_view),
                 },
                 wgpu::BindGroupEntry { binding: 4, resource: t.output.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: prepared.curves[0].as_entire_binding() },
@@ -371,26 +365,16 @@ impl Renderer {
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("raster"),
-                color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &t.color_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &t.distance_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color { r: -1.0, g: 0.0, b: 0.0, a: 0.0 }),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                ],
+                // Cleared to zero bits: distance 0 marks "nothing drawn".
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &t.scene_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &t.depth_view,
                     depth_ops: Some(wgpu::Operations {

@@ -1,7 +1,8 @@
 // Opaque geometry pass: every object's triangles, transformed by its object → world matrix and
 // projected with the camera basis exactly as the CPU rasterizer does (view-space x/z scaled by
 // 1/(tan_half·aspect), y/z by 1/tan_half), shaded with `diffuse` (hadou_math::shade::diffuse).
-// Writes the linear scene colour and the Euclidean eye distance of the visible surface.
+// Writes the linear scene colour and the Euclidean eye distance of the visible surface, as the bits
+// of four f32s in one Rgba32Uint target (pipelines::SCENE_FORMAT: renderable on every adapter).
 // Prepended by common.wgsl.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
@@ -43,17 +44,11 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     return out;
 }
 
-struct FragmentOut {
-    @location(0) color: vec4<f32>,
-    @location(1) distance: f32,
-}
-
+// (r, g, b, eye distance) as f32 bit patterns; read back by wave.wgsl's `scene_texel`.
 @fragment
-fn fs_main(in: VertexOut) -> FragmentOut {
+fn fs_main(in: VertexOut) -> @location(0) vec4<u32> {
     let o = objects[in.object];
-    var out: FragmentOut;
     let rgb = diffuse(o.color, in.normal, frame.light_dir, frame.light_color, frame.ambient);
-    out.color = vec4<f32>(rgb, 1.0);
-    out.distance = length(in.world - frame.eye);
-    return out;
+    let distance = length(in.world - frame.eye);
+    return bitcast<vec4<u32>>(vec4<f32>(rgb, distance));
 }

@@ -5,8 +5,9 @@
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
-@group(0) @binding(2) var scene_color: texture_2d<f32>;
-@group(0) @binding(3) var scene_distance: texture_2d<f32>;
+// The raster pass's output: (r, g, b, eye distance) as f32 bits; distance 0 = nothing drawn
+// (pipelines::SCENE_FORMAT).
+@group(0) @binding(2) var scene_texels: texture_2d<u32>;
 // Tile output, n = tile_size.x · tile_size.y pixels, row-major: colour (4 floats per pixel) in
 // [0, 4n), energy in [4n, 5n), eye distance in [5n, 6n). Keep in sync with readback in render.rs.
 @group(0) @binding(4) var<storage, read_write> out_buf: array<f32>;
@@ -75,11 +76,13 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = frame.tile_size.x * frame.tile_size.y;
     let i = id.y * frame.tile_size.x + id.x;
 
-    let surface = textureLoad(scene_distance, vec2<i32>(id.xy), 0).x;
-    let drawn = surface >= 0.0;
+    let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(id.xy), 0));
+    let drawn = texel.w > 0.0;
+    var surface = -1.0;
     var scene = frame.background;
     if (drawn) {
-        scene = textureLoad(scene_color, vec2<i32>(id.xy), 0).xyz;
+        surface = texel.w;
+        scene = texel.xyz;
     }
     let dir = pixel_dir(frame, px, py);
 
