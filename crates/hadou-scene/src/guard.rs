@@ -41,3 +41,17 @@ pub(crate) fn guarded<T>(what: &str, f: impl FnOnce() -> T) -> Result<T, String>
         format!("the {what} parser failed on this input ({detail})")
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_in_a_guarded_call_becomes_an_error() {
+        let e = guarded("test", || -> u32 { panic!("boom") }).unwrap_err();
+        assert!(e.contains("test parser") && e.contains("boom"), "{e}");
+        assert_eq!(guarded("test", || 7), Ok(7));
+        // The flag is reset afterwards, so later panics elsewhere are reported normally.
+        assert!(!GUARDED.with(Cell::get));
+    }
+}
