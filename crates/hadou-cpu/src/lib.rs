@@ -61,7 +61,7 @@ pub fn render(frame: &Frame) -> Image {
                 for (wave, prep) in frame.waves.iter().zip(&curves) {
                     let (e, _) = waves::wave_energy(frame, &basis, wave, prep.as_ref(), px, py, surface);
                     waves::accumulate(&mut light, wave, e);
-                    total += e;
+                    total = hadou_math::energy::saturate(total + e);
                 }
                 col[x] = waves::compose(frame, opaque.color[i], light);
                 en[x] = total;

@@ -52,7 +52,8 @@ pub(crate) fn wave_energy(
             (r.energy, r.evaluations)
         }
     };
-    (if e.is_finite() { e.max(0.0) } else { 0.0 }, n)
+    // Saturated at f32::MAX (hadou_math::energy::saturate): an overflow is full brightness, not 0.
+    (energy::saturate(e), n)
 }
 
 /// Final linear RGBA of a pixel: `scene + exposure · Σ rgb·a·I`, then the frame's mapping.

@@ -77,6 +77,25 @@ mod tests {
         assert_eq!(map_filmic([f32::NAN, f32::INFINITY, -1.0]).map(|v| v.is_finite()), [true; 3]);
     }
 
+    /// A saturated energy (`f32::MAX`, summed to `+∞` over several waves, times the exposure)
+    /// maps to full white / the saturated colour, never NaN: the colour arithmetic only adds and
+    /// multiplies non-negative values, and the mappings take `+∞`.
+    #[test]
+    fn saturated_light_maps_to_full_brightness() {
+        for light in [f32::MAX, f32::MAX + f32::MAX, f32::INFINITY] {
+            let c = [0.2 + 0.5 * light, 0.1 + 1.0 * light, 0.0];
+            assert_eq!(map_faithful(c), [1.0, 1.0, 0.0]);
+            assert_eq!(map_filmic(c), [1.0, 1.0, 1.0]);
+        }
+        let e = crate::energy::saturate(f32::MAX * 4.0);
+        assert_eq!(e, f32::MAX);
+        assert_eq!(crate::energy::saturate(f32::NAN), f32::MAX);
+        assert_eq!(crate::energy::saturate(-1.0f32), 0.0);
+        assert_eq!(crate::energy::scaled(f32::INFINITY, 0.0), 0.0);
+        assert_eq!(crate::energy::scaled(1e30f32, 1e9), f32::MAX);
+        assert_eq!(crate::energy::scaled(1e30f64, 1e9), f64::from(f32::MAX));
+    }
+
     #[test]
     fn faithful_clamps_and_srgb_endpoints() {
         assert_eq!(map_faithful([-1.0, 0.5, 7.0]), [0.0, 0.5, 1.0]);

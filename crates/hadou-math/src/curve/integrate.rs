@@ -58,7 +58,7 @@ use super::closed::{Quad, Segment};
 use super::prepare::PreparedCurve;
 use super::shape::ShapeEval;
 use super::{simpson, Integrator};
-use crate::energy::{Falloff, FieldParams, Ray};
+use crate::energy::{scaled, Falloff, FieldParams, Ray};
 use crate::{Real, Vec3};
 
 /// One ray's curve energy and the work it took.
@@ -458,12 +458,12 @@ pub(crate) fn default_generic<R: CurveReal>(
         if r.j > R::ZERO { attenuation_split(r.j.to_f64(), settings.tolerance) } else { (0.5, 0.0) };
     let mut acc = Acc { sum: R::ZERO, evals: 0, q: R::from_f64(q), h_floor: R::from_f64(h_floor) };
     integrate_span(c, &r, r.t0, r.t1, settings, &mut acc);
-    let e = acc.sum * r.alpha;
-    (if e.is_finite() { e } else { R::ZERO }, acc.evals)
+    // α·Σ saturated at f32::MAX (energy module docs): an overflow is full brightness, not 0.
+    (scaled(acc.sum, r.alpha), acc.evals)
 }
 
 /// `∫_{ta}^{tb}` of the (unscaled) density, by end pieces and the chord walk.
-fn integrate_span<R: Real>(
+fn integrate_span<R: CurveReal>(
     c: &PreparedCurve,
     r: &LocalRay<R>,
     ta: R,
@@ -533,7 +533,14 @@ pub(crate) fn leaf_of<R: Real>(c: &PreparedCurve, x: R) -> usize {
 fn slab_quad<R: Real>(c: &PreparedCurve, r: &LocalRay<R>, l: usize, j: usize, xm: R, ts: R) -> Quad<R> {
     let ln = c.table.line(l, j);
     let f = |k: usize| R::from_f64(f64::from(ln[k]));
-    let (ly, lz, my, mz) = (f(0), f(1), f(2), f(3));
+    line_quad(r, [f(0), f(1), f(2), f(3)], xm, ts)
+}
+
+/// The quadratic of the line `L(x) = (ȳ, z̄) + (x − xm)·(m_y, m_z)` (`line = [ȳ, z̄, m_y, m_z]`)
+/// along the ray from `t = ts` on (see [`slab_quad`]).
+#[inline]
+fn line_quad<R: Real>(r: &LocalRay<R>, line: [R; 4], xm: R, ts: R) -> Quad<R> {
+    let [ly, lz, my, mz] = line;
     let xs = r.o.x + r.q.x * ts - xm;
     Quad::planar(
         r.o.y + r.q.y * ts - (ly + xs * my),
@@ -545,7 +552,7 @@ fn slab_quad<R: Real>(c: &PreparedCurve, r: &LocalRay<R>, l: usize, j: usize, xm
 }
 
 /// The chord walk over the slab part `[ta, tb]` of the span (see the module docs).
-fn walk<R: Real>(
+fn walk<R: CurveReal>(
     c: &PreparedCurve,
     r: &LocalRay<R>,
     ta: R,
@@ -565,14 +572,12 @@ fn walk<R: Real>(
     let tol = R::from_f64(settings.tolerance);
     let model = ChordModel::new(r.falloff);
 
-    // x (nearly) constant along the span: one piece against the fixed paired point.
-    if !(hi - lo > xh * R::from_f64(1e-6)) || !(tb - ta).is_finite() {
-        let xm = (lo + hi) * R::HALF;
-        let i = leaf_of(c, xm);
-        let (a, b) = (node::<R>(c, i), node::<R>(c, i + 1));
-        let f = ((xm - a[0]) / (b[0] - a[0])).clamp(R::ZERO, R::ONE);
+    // x (nearly) constant along the span (within 8ε of X): one piece against the fixed paired
+    // point, evaluated exactly (a ray through the curve there meets it to rounding).
+    if !(hi - lo > xh * R::EPSILON * R::from_f64(8.0)) || !(tb - ta).is_finite() {
+        let cm = curve_at(c, (lo + hi) * R::HALF);
         let (py, pz) = (r.o.y + r.q.y * ta, r.o.z + r.q.z * ta);
-        let p = Vec3::new(R::ZERO, py - (a[1] + (b[1] - a[1]) * f), pz - (a[2] + (b[2] - a[2]) * f));
+        let p = Vec3::new(R::ZERO, py - cm[0], pz - cm[1]);
         acc.piece(r, ta, p, Vec3::new(R::ZERO, r.q.y, r.q.z), tb - ta);
         return;
     }
@@ -608,17 +613,18 @@ fn walk<R: Real>(
             let quad = slab_quad(c, r, l, j, (na[0] + nb[0]) * R::HALF, ts);
             let dt = te - ts;
             let err = R::from_f64(f64::from(table.error(l, j)));
-            let refine = if l == 0 {
-                0
-            } else {
-                // The part of the piece's x-range the ray does not cover (0 but at the ray's ends).
-                let uncovered =
-                    if x0 > na[0] || x1 < nb[0] { R::ONE - (x1 - x0) / (nb[0] - na[0]) } else { R::ZERO };
-                let (x2, a) = model.terms(err, &quad, dt, r.rc2, uncovered);
-                model.refinement(x2, a, tol, l)
-            };
+            // The part of the piece's x-range the ray does not cover (0 but at the ray's ends).
+            let uncovered =
+                if x0 > na[0] || x1 < nb[0] { R::ONE - (x1 - x0) / (nb[0] - na[0]) } else { R::ZERO };
+            let (x2, a) = model.terms(err, &quad, dt, r.rc2, uncovered);
+            let refine = model.refinement(x2, a, tol, l);
             if refine == 0 {
                 acc.piece_quad(r, ts, &quad, dt);
+            } else if l == 0 {
+                // A leaf too coarse for this ray (it passes within ~δ/τ of the curve): refine
+                // below the table on exact curve points.
+                acc.evals += 1;
+                leaf_walk(c, r, j, (x0, x1), &t_of, tol, &model, acc);
             } else {
                 acc.evals += 1;
                 descend = refine;
@@ -641,6 +647,105 @@ fn walk<R: Real>(
             j >>= 1;
             l += 1;
         }
+    }
+}
+
+/// The exact cross-section point `c_⊥(x/γ)` at axial coordinate `x` (`s` clamped to the part
+/// that exists).
+#[inline]
+fn curve_at<R: CurveReal>(c: &PreparedCurve, x: R) -> [R; 2] {
+    let s = (x / R::from_f64(f64::from(c.wave.gamma))).clamp(R::ZERO, R::from_f64(c.s_head));
+    R::shape(c).eval(s)
+}
+
+/// Most levels [`leaf_walk`] descends below a leaf (`CURVE_SUB_LEVELS` in curve.wgsl): a
+/// sub-piece is then `2⁻¹⁶` of its leaf, its deviation about `4⁻¹⁶` of the leaf's.
+pub const MAX_SUB_LEVELS: usize = 16;
+
+/// A piece below the table: `x ∈ [xa, xb]` with the exact curve points `a`, `b` at its ends.
+#[derive(Clone, Copy)]
+struct SubPiece<R> {
+    xa: R,
+    a: [R; 2],
+    xb: R,
+    b: [R; 2],
+    depth: usize,
+}
+
+/// The chord walk below leaf `i`, over the part `[x0, x1]` of its `x`-range the ray covers: for
+/// rays passing closer to the curve than the leaves resolve (`δ_leaf/D` above the tolerance,
+/// which with `r_c = 0` happens within about `δ_leaf/τ` of the curve, including rays through it).
+///
+/// Each sub-piece `[x_a, x_b]` is bisected on the exact curve: with the midpoint `c_m` and the
+/// chord's midpoint deviation `d = c_m − (c_a + c_b)/2`, its line is the chord shifted by `⅔d`,
+/// which for a parabolic arc (what a sub-piece of a leaf is, to higher order) is the
+/// least-squares line: its deviation has zero mean and zero first moment and at most `⅔|d|`, so
+/// the [`ChordModel`] applies as to the table's pieces, with the bound `δ = |d|` (a 1.5× margin
+/// for the cubic part). A piece is accepted by the same test, or split in two (depth-first, the
+/// right halves on a fixed stack of [`MAX_SUB_LEVELS`] entries), down to [`MAX_SUB_LEVELS`]
+/// levels or to where `|d|` is at the rounding level of the coordinates (`f32` then cannot do
+/// better). Every sub-piece visited costs one curve evaluation (its midpoint) and counts one.
+#[allow(clippy::too_many_arguments)]
+fn leaf_walk<R: CurveReal>(
+    c: &PreparedCurve,
+    r: &LocalRay<R>,
+    i: usize,
+    (x0, x1): (R, R),
+    t_of: &impl Fn(R) -> R,
+    tol: R,
+    model: &ChordModel<R>,
+    acc: &mut Acc<R>,
+) {
+    let (na, nb) = (node::<R>(c, i), node::<R>(c, i + 1));
+    let mut cur = SubPiece { xa: na[0], a: [na[1], na[2]], xb: nb[0], b: [nb[1], nb[2]], depth: 0 };
+    let mut stack = [cur; MAX_SUB_LEVELS];
+    let mut top = 0usize;
+    let two_thirds = R::from_f64(2.0 / 3.0);
+    let noise = R::EPSILON * R::from_f64(4.0);
+    loop {
+        if cur.xb > x0 && cur.xa < x1 {
+            let w = cur.xb - cur.xa;
+            let xm = (cur.xa + cur.xb) * R::HALF;
+            let cm = curve_at(c, xm);
+            let my = (cur.a[0] + cur.b[0]) * R::HALF;
+            let mz = (cur.a[1] + cur.b[1]) * R::HALF;
+            let (dy, dz) = (cm[0] - my, cm[1] - mz);
+            let err = (dy * dy + dz * dz).sqrt();
+            let line = [
+                my + dy * two_thirds,
+                mz + dz * two_thirds,
+                (cur.b[0] - cur.a[0]) / w,
+                (cur.b[1] - cur.a[1]) / w,
+            ];
+            let (px0, px1) = (x0.max(cur.xa), x1.min(cur.xb));
+            let (tx0, tx1) = (t_of(px0), t_of(px1));
+            let (ts, te) = if tx0 <= tx1 { (tx0, tx1) } else { (tx1, tx0) };
+            let quad = line_quad(r, line, xm, ts);
+            let dt = te - ts;
+            let uncovered = if px0 > cur.xa || px1 < cur.xb { R::ONE - (px1 - px0) / w } else { R::ZERO };
+            let split = cur.depth < MAX_SUB_LEVELS
+                && xm > cur.xa
+                && xm < cur.xb
+                && err > noise * (cm[0].abs() + cm[1].abs() + xm.abs())
+                && {
+                    let (x2, a) = model.terms(err, &quad, dt, r.rc2, uncovered);
+                    model.refinement(x2, a, tol, 1) > 0
+                };
+            if split {
+                acc.evals += 1;
+                let depth = cur.depth + 1;
+                stack[top] = SubPiece { xa: xm, a: cm, xb: cur.xb, b: cur.b, depth };
+                top += 1;
+                cur = SubPiece { xa: cur.xa, a: cur.a, xb: xm, b: cm, depth };
+                continue;
+            }
+            acc.piece_quad(r, ts, &quad, dt);
+        }
+        if top == 0 {
+            return;
+        }
+        top -= 1;
+        cur = stack[top];
     }
 }
 

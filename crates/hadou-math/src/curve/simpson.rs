@@ -8,7 +8,7 @@
 use super::integrate::{default_generic, CurveReal, LocalRay, DEFAULT_SETTINGS};
 use super::prepare::PreparedCurve;
 use super::Reduction;
-use crate::energy::{Falloff, FieldParams, Ray};
+use crate::energy::{saturate, scaled, Falloff, FieldParams, Ray};
 
 /// The exact density at ray parameter `t`, without `α`: `w(|P(t) − C(t)|)·(1 − t/t_far)^j`
 /// (002 eq. 3.17, 3.23), `C(t)` the curve point paired with `P(t)` by cross-section, clamped to
@@ -114,9 +114,7 @@ pub(crate) fn simpson_generic<R: CurveReal>(
     }
     if r.t1 > r.t_far {
         let (tail, n) = default_generic(c, p, ray, r.t_far, r.t1, r.t_far, &DEFAULT_SETTINGS);
-        let e = sum * r.alpha + tail;
-        return (if e.is_finite() { e } else { R::ZERO }, evals + n);
+        return (saturate(scaled(sum, r.alpha) + tail), evals + n);
     }
-    let e = sum * r.alpha;
-    (if e.is_finite() { e } else { R::ZERO }, evals)
+    (scaled(sum, r.alpha), evals)
 }

@@ -13,6 +13,34 @@ pub const H_FLOOR: f64 = 1e-24;
 /// `r_c = 0`). Several pieces times any sane `α` stay finite in `f32`.
 pub const ENERGY_MAX: f64 = 1e30;
 
+/// The largest energy any function of this crate returns, in either precision: `f32::MAX`
+/// (SPEC.md §1.1 leaves overflow open; hadou saturates). An energy whose true value exceeds it —
+/// `α·I` overflowing `f32` on a ray through a centre or along an axis with a huge `α` — is
+/// reported as this value, so the pixel renders at full brightness, never as 0.
+pub const ENERGY_SATURATION: f64 = f32::MAX as f64;
+
+/// `x` saturated to `[0, f32::MAX]` ([`ENERGY_SATURATION`]): `+∞` and values above become
+/// `f32::MAX`, negative values 0. A NaN can only come from an overflow here (every formula is a
+/// sum of non-negative, finite-capped pieces times `α ≥ 0`, see [`scaled`]), so it saturates too.
+#[inline(always)]
+pub fn saturate<R: Real>(x: R) -> R {
+    let max = R::from_f64(ENERGY_SATURATION);
+    if x >= R::ZERO {
+        x.min(max)
+    } else if x < R::ZERO {
+        R::ZERO
+    } else {
+        max
+    }
+}
+
+/// `α·I` saturated ([`saturate`]): `I` is first saturated, so it is finite and `α = 0` gives 0,
+/// never `0·∞ = NaN` ("no contribution" stays 0); an overflowing product gives `f32::MAX`.
+#[inline(always)]
+pub fn scaled<R: Real>(integral: R, alpha: R) -> R {
+    saturate(saturate(integral) * alpha)
+}
+
 /// `|t|` from which an end of the interval counts as infinite: [`Falloff::InverseSquare`]
 /// integrates to infinity in closed form (the tail beyond is below `10⁻¹²/s²` absolute),
 /// [`Falloff::Faithful`] clamps there (its `1/r` integral diverges at infinity). Keeps `Y²` finite

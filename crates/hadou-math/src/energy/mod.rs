@@ -46,12 +46,19 @@
 //! planes the sphere and cylinder distances coincide, so with `α_s = α_c` the field (and hence the
 //! energy) is continuous across them. The bulged beam adds sphere fields at `M₂` and `M`.
 //!
+//! # Saturation
+//! Each closed-form piece is capped at [`ENERGY_MAX`] (`10³⁰`, reached only where the true
+//! integral diverges: a ray through a centre or along an axis with `r_c = 0`), and every energy
+//! `α·I` and every sum of energies is saturated at `f32::MAX` ([`ENERGY_SATURATION`],
+//! [`scaled`], [`saturate`]) instead of overflowing: an energy too large for `f32` is reported
+//! as `f32::MAX` (full brightness), never `+∞`, NaN or 0, and `α = 0` gives exactly 0.
+//!
 //! Every function is generic over [`Real`]: `f32` renders, `f64` is what tests compare against.
-//! For finite inputs (and `|α|` below about 10⁷ in `f32`) the results are finite.
+//! For finite inputs the results are finite, in `[0, f32::MAX]`.
 
 mod kernel;
 
-pub use kernel::{RayAxis, RayQuadratic, ENERGY_MAX, H_FLOOR, T_LIMIT};
+pub use kernel::{saturate, scaled, RayAxis, RayQuadratic, ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
 
 use crate::{Real, Vec3};
 /// How energy density falls off with distance and what measure the ray integral uses.
@@ -149,7 +156,7 @@ pub struct BeamField<R> {
 pub fn sphere_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &SphereField<R>) -> R {
     let axis = RayAxis::new(ray.dir);
     let q = RayQuadratic::new(&axis, ray.origin - f.center, p.core_radius * p.core_radius);
-    q.integral(p.falloff, t0, t1) * f.alpha
+    scaled(q.integral(p.falloff, t0, t1), f.alpha)
 }
 
 /// `∫_{t0}^{t1}` of the infinite cylinder field `α_c/ρ` (faithful) or `α_c/ρ²` (inverse square)
@@ -162,7 +169,7 @@ pub fn cylinder_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, 
     let axis = RayAxis::new(ray.dir.cross(f.dir));
     let v = (ray.origin - f.point).cross(f.dir);
     let q = RayQuadratic::new(&axis, v, p.core_radius * p.core_radius);
-    q.integral(p.falloff, t0, t1) * f.alpha
+    scaled(q.integral(p.falloff, t0, t1), f.alpha)
 }
 
 /// The capsule's pieces along a ray, kept so the beam can reuse the end spheres' quadratics.
@@ -213,7 +220,7 @@ fn capsule_parts<R: Real>(
     let hi = hi.clamp(lo, t1);
     let fo = p.falloff;
     let spheres = first.integral(fo, t0, lo) + last.integral(fo, hi, t1);
-    let energy = spheres * f.alpha_s + cyl.integral(fo, lo, hi) * f.alpha_c;
+    let energy = saturate(scaled(spheres, f.alpha_s) + scaled(cyl.integral(fo, lo, hi), f.alpha_c));
     CapsuleParts { at_m, at_m2, energy }
 }
 
@@ -236,10 +243,10 @@ pub fn beam_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &
     let parts = capsule_parts(p, ray, t0, t1, &f.capsule);
     let mut e = parts.energy;
     if f.head_alpha != R::ZERO {
-        e += parts.at_m2.integral(p.falloff, t0, t1) * f.head_alpha;
+        e = saturate(e + scaled(parts.at_m2.integral(p.falloff, t0, t1), f.head_alpha));
     }
     if f.muzzle_alpha != R::ZERO {
-        e += parts.at_m.integral(p.falloff, t0, t1) * f.muzzle_alpha;
+        e = saturate(e + scaled(parts.at_m.integral(p.falloff, t0, t1), f.muzzle_alpha));
     }
     e
 }
