@@ -91,12 +91,8 @@ fn an_overflowing_energy_is_full_brightness_for_every_kind() {
                 for w in &p.waves {
                     assert!(w.energy.is_finite() && w.energy >= 1e38, "{shape:?} {falloff:?}: {}", w.energy);
                 }
-                for k in 0..3 {
-                    assert!(
-                        (p.color[k] - want[k]).abs() < 1e-6,
-                        "{shape:?} {falloff:?} {mode:?}: {:?}",
-                        p.color
-                    );
+                for (c, w) in p.color.iter().zip(want) {
+                    assert!((c - w).abs() < 1e-6, "{shape:?} {falloff:?} {mode:?}: {:?}", p.color);
                 }
                 let img = render(&frame);
                 assert!(img.color.iter().flatten().all(|v| v.is_finite()), "{shape:?}: colour");
