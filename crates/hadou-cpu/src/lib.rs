@@ -35,13 +35,25 @@ impl Backend for CpuBackend {
     fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
         Ok(render(frame))
     }
+
+    fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
+        Ok(render_rows(frame, rows))
+    }
 }
 
 /// Renders `frame` on the CPU.
 pub fn render(frame: &Frame) -> Image {
+    render_rows(frame, 0..frame.height)
+}
+
+/// Renders the rows `rows` of `frame` (clamped to the image): the same pixels as those rows of
+/// [`render`], bit for bit, in an image `frame.width` wide and `rows.len()` high.
+pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
+    let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+    let y1 = y1.max(y0);
     let basis = frame.camera.basis(frame.width, frame.height);
-    let opaque = raster::draw_opaque(frame, &basis);
-    let mut img = Image::new(frame.width, frame.height);
+    let opaque = raster::draw_opaque(frame, &basis, y0 as usize..y1 as usize);
+    let mut img = Image::new(frame.width, y1 - y0);
     let w = frame.width as usize;
     let far = frame.camera.far;
     let curves = waves::prepare_curves(frame);
@@ -50,10 +62,10 @@ pub fn render(frame: &Frame) -> Image {
         .zip(img.energy.par_chunks_mut(w))
         .zip(img.depth.par_chunks_mut(w))
         .enumerate()
-        .for_each(|(y, ((col, en), dep))| {
-            let py = y as f32;
+        .for_each(|(r, ((col, en), dep))| {
+            let py = (y0 as usize + r) as f32;
             for x in 0..w {
-                let i = y * w + x;
+                let i = r * w + x;
                 let px = x as f32;
                 let surface = opaque.surface[i];
                 let mut light = [0.0f32; 3];
@@ -107,8 +119,9 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
         return None;
     }
     let basis = frame.camera.basis(frame.width, frame.height);
-    let opaque = raster::draw_opaque(frame, &basis);
-    let i = y as usize * frame.width as usize + x as usize;
+    // The probed row alone: the opaque pass decides each pixel independently.
+    let opaque = raster::draw_opaque(frame, &basis, y as usize..y as usize + 1);
+    let i = x as usize;
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();

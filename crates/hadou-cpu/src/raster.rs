@@ -46,20 +46,23 @@ pub(crate) struct OpaqueBuffers {
     pub object: Vec<Option<u32>>,
 }
 
-/// Runs the opaque pass over the whole frame.
-pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis) -> OpaqueBuffers {
-    let (w, h) = (frame.width as usize, frame.height as usize);
+/// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
+/// Every pixel is decided by the triangles covering it alone, so a pixel's result does not depend
+/// on which rows are drawn with it.
+pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis, rows: std::ops::Range<usize>) -> OpaqueBuffers {
+    let (w, h) = (frame.width as usize, rows.len());
     let tris = project_all(frame, basis);
     let far = frame.camera.far;
-    // Bin triangles into horizontal bands, keeping submission order inside each band.
+    // Bin triangles into horizontal bands of the drawn rows, keeping submission order inside each.
     let bands = h.div_ceil(BAND);
     let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
     for (i, t) in tris.iter().enumerate() {
-        let (y0, y1) = y_range(t, h);
-        if y0 > y1 {
+        let (y0, y1) = y_range(t, frame.height as usize);
+        let (y0, y1) = (y0.max(rows.start), y1.min(rows.end.saturating_sub(1)));
+        if y0 > y1 || h == 0 {
             continue;
         }
-        for bin in &mut bins[(y0 / BAND)..=(y1 / BAND)] {
+        for bin in &mut bins[((y0 - rows.start) / BAND)..=((y1 - rows.start) / BAND)] {
             bin.push(i as u32);
         }
     }
@@ -72,7 +75,7 @@ pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis) -> OpaqueBuffers {
         .zip(object.par_chunks_mut(BAND * w))
         .enumerate()
         .for_each(|(b, ((col, surf), obj))| {
-            let y_start = b * BAND;
+            let y_start = rows.start + b * BAND;
             let rows = col.len() / w;
             let mut zbuf = vec![f32::INFINITY; rows * w];
             let mut tri_id = vec![u32::MAX; rows * w];

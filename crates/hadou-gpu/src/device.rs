@@ -130,6 +130,16 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
     )))
 }
 
+/// The adapter [`GpuContext::new`] would open, without opening a device or compiling anything:
+/// what `--backend auto` asks before deciding.
+pub(crate) fn adapter_info() -> Result<wgpu::AdapterInfo, RenderError> {
+    let adapter =
+        request_adapter().map_err(|e| RenderError::NoDevice(format!("no GPU adapter found ({e})")))?;
+    let info = adapter.get_info();
+    check_adapter(&adapter, &info)?;
+    Ok(info)
+}
+
 impl GpuContext {
     /// Opens the best adapter wgpu finds (no surface; `WGPU_BACKEND` and friends are honoured).
     pub(crate) fn new() -> Result<Self, RenderError> {

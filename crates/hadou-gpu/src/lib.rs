@@ -36,6 +36,8 @@ mod twins;
 
 pub use render::MAX_TILE;
 pub use timing::{FrameTiming, TimingMethod};
+/// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
+pub use wgpu;
 
 use hadou_scene::{Backend, Frame, Image, RenderError};
 
@@ -43,6 +45,13 @@ use hadou_scene::{Backend, Frame, Image, RenderError};
 /// address of their `Arc`), and tile resources are reused while the tile size stays the same.
 pub struct GpuBackend {
     renderer: render::Renderer,
+}
+
+/// The adapter [`GpuBackend::new`] would use, found without opening a device or compiling shaders
+/// (cheap: what `--backend auto` asks before deciding). [`RenderError::NoDevice`] when there is
+/// none or it cannot run hadou ("unsupported adapter …").
+pub fn find_adapter() -> Result<wgpu::AdapterInfo, RenderError> {
+    device::adapter_info()
 }
 
 impl GpuBackend {
@@ -86,5 +95,9 @@ impl Backend for GpuBackend {
 
     fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
         self.renderer.render(frame)
+    }
+
+    fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
+        self.renderer.render_rows(frame, rows)
     }
 }

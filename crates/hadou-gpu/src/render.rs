@@ -235,8 +235,12 @@ impl Renderer {
         self.targets = Some(TileTargets { size, scene_view, depth_view, uniforms, output, staging });
     }
 
-    /// Validates the frame, uploads what it needs and plans the tiles.
-    pub(crate) fn prepare(&mut self, frame: &Frame) -> Result<Prepared, RenderError> {
+    /// Validates the frame, uploads what it needs and plans the tiles covering the rows `rows`.
+    pub(crate) fn prepare(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Prepared, RenderError> {
         self.ctx.check()?;
         validate_frame(frame)?;
         let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
@@ -310,9 +314,9 @@ impl Renderer {
                 })
                 .collect();
             let mut tiles = Vec::new();
-            for y in (0..frame.height).step_by(tile[1] as usize) {
+            for y in rows.clone().step_by(tile[1] as usize) {
                 for x in (0..frame.width).step_by(tile[0] as usize) {
-                    tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(frame.height - y)]));
+                    tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(rows.end - y)]));
                 }
             }
             Prepared { tile, tiles, objects, waves, curves, draws }
@@ -425,14 +429,27 @@ impl Renderer {
 
     /// Renders `frame` into a new [`Image`].
     pub(crate) fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
-        let prepared = self.prepare(frame)?;
-        let mut image = alloc_image(frame.width, frame.height)?;
+        self.render_rows(frame, 0..frame.height)
+    }
+
+    /// Renders the rows `rows` of `frame` (clamped to the image) into a `frame.width ×
+    /// rows.len()` [`Image`]: only the tiles of those rows are drawn.
+    pub(crate) fn render_rows(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Image, RenderError> {
+        let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+        let rows = y0..y1.max(y0);
+        let prepared = self.prepare(frame, rows.clone())?;
+        let mut image = alloc_image(frame.width, rows.len() as u32)?;
         for &tile in &prepared.tiles {
             let submission = self.ctx.scoped("rendering a tile", || {
                 let enc = self.encode_tile(frame, &prepared, tile, true, None);
                 self.ctx.queue.submit([enc.finish()])
             })?;
             let (origin, size) = tile;
+            let origin = [origin[0], origin[1] - rows.start];
             let n = size[0] as usize * size[1] as usize;
             let bytes = n as u64 * FLOATS_PER_PIXEL * 4;
             let staging = &self.targets.as_ref().expect("targets exist").staging;

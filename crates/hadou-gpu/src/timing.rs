@@ -69,7 +69,7 @@ pub(crate) fn time_frame(
     if iterations == 0 {
         return Err(RenderError::Other("time_frame needs at least one iteration".into()));
     }
-    let prepared = r.prepare(frame)?;
+    let prepared = r.prepare(frame, 0..frame.height)?;
     let tiles = prepared.tiles.len() as u32;
     // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
     let last = r.ctx.scoped("warming up", || {

@@ -8,6 +8,14 @@ pub trait Backend {
     fn name(&self) -> &str;
     /// Renders one frame.
     fn render(&mut self, frame: &Frame) -> Result<Image, RenderError>;
+    /// Renders only the rows `rows` of `frame` (0 = top), as a `frame.width × rows.len()` image
+    /// whose pixels equal those rows of [`Backend::render`]'s image. Large outputs are rendered
+    /// band by band with it, so memory follows the band, not the image. The default renders the
+    /// whole frame and crops; both backends override it with real partial rendering.
+    fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
+        let full = self.render(frame)?;
+        Ok(full.crop_rows(rows))
+    }
 }
 
 /// Why a backend could not render.

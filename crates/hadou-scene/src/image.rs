@@ -24,6 +24,21 @@ impl Image {
         Self { width, height, color: vec![[0.0; 4]; n], energy: vec![0.0; n], depth: vec![0.0; n] }
     }
 
+    /// The rows `rows` (clamped to the image) as a new image of the same width.
+    pub fn crop_rows(&self, rows: std::ops::Range<u32>) -> Image {
+        let (y0, y1) =
+            (rows.start.min(self.height), rows.end.min(self.height).max(rows.start.min(self.height)));
+        let w = self.width as usize;
+        let span = y0 as usize * w..y1 as usize * w;
+        Image {
+            width: self.width,
+            height: y1 - y0,
+            color: self.color[span.clone()].to_vec(),
+            energy: self.energy[span.clone()].to_vec(),
+            depth: self.depth[span].to_vec(),
+        }
+    }
+
     /// Index of pixel `(x, y)`.
     #[inline]
     pub fn index(&self, x: u32, y: u32) -> usize {

@@ -16,6 +16,7 @@ pub mod bench;
 pub mod output;
 
 pub use hadou_cpu::{probe, CpuBackend, Probe, WaveProbe};
+pub use hadou_gpu as gpu;
 pub use hadou_gpu::GpuBackend;
 pub use hadou_math as math;
 pub use hadou_scene::*;

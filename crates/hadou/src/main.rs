@@ -36,20 +36,20 @@ struct RenderArgs {
     /// Output file (.png or .exr), or a directory (ending in `/`) with --frames.
     #[arg(short, long)]
     output: PathBuf,
-    /// Scene time in seconds.
-    #[arg(long, default_value_t = 0.0)]
-    time: f32,
+    /// Scene time in seconds (≥ 0).
+    #[arg(long, default_value = "0", allow_hyphen_values = true)]
+    time: String,
     /// Frame range `A..B` (B excluded) or `A..=B`, rendered at times `frame / fps`.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     frames: Option<String>,
     /// Frames per second for --frames.
-    #[arg(long, default_value_t = 24.0)]
-    fps: f32,
+    #[arg(long, default_value = "24", allow_hyphen_values = true)]
+    fps: String,
     /// Override the image width.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     width: Option<u32>,
     /// Override the image height.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     height: Option<u32>,
     /// Which backend renders.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
@@ -61,16 +61,16 @@ struct ProbeArgs {
     /// The scene file (TOML).
     scene: PathBuf,
     /// The pixel `X,Y` (0,0 is the top-left).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pixel: String,
-    /// Scene time in seconds.
-    #[arg(long, default_value_t = 0.0)]
-    time: f32,
+    /// Scene time in seconds (≥ 0).
+    #[arg(long, default_value = "0", allow_hyphen_values = true)]
+    time: String,
     /// Override the image width.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     width: Option<u32>,
     /// Override the image height.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     height: Option<u32>,
     /// Which backend evaluates the pixel (the CPU also counts integrand evaluations).
     #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
@@ -97,7 +97,7 @@ struct BenchArgs {
     #[arg(long)]
     json: bool,
     /// Image sizes (square), comma-separated [default: 512,1024,2048 for analytic, 512 for curves].
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     sizes: Vec<u32>,
     /// Timed repetitions per cell (after one warm-up) [default: 5 for analytic, 1 for curves].
     #[arg(long)]
@@ -154,6 +154,13 @@ impl From<RenderError> for Failure {
 }
 
 fn main() -> ExitCode {
+    // Mesa's Vulkan device-selection layer connects to a Wayland/X11 display to rank GPUs and
+    // prints "XDG_RUNTIME_DIR is invalid" on headless machines; hadou renders off-screen and ranks
+    // adapters itself, so the layer is switched off (unless the user set the variable). Set before
+    // any thread starts.
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(a) => render(a),
@@ -173,18 +180,56 @@ fn main() -> ExitCode {
 fn size_override(w: Option<u32>, h: Option<u32>) -> Result<(), Failure> {
     for (name, v) in [("--width", w), ("--height", h)] {
         if let Some(v) = v {
-            if v == 0 || v > 16384 {
-                return Err(Failure::input(format!("{name} {v}: image size must be in 1..=16384")));
-            }
+            check_size(name, v)?;
         }
     }
     Ok(())
 }
 
-fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>) -> Result<Frame, Failure> {
-    if !t.is_finite() {
-        return Err(Failure::input(format!("--time {t}: must be a finite number of seconds")));
+/// Image edges are 1..=16384 pixels; `flag` names the option the value came from.
+fn check_size(flag: &str, v: u32) -> Result<(), Failure> {
+    if v == 0 || v > 16384 {
+        return Err(Failure::input(format!("{flag} {v}: image size must be in 1..=16384")));
     }
+    Ok(())
+}
+
+/// Parses a time in seconds as typed after `flag`: a finite number ≥ 0. Messages echo the text
+/// as typed, never a reformatted value.
+fn parse_time(flag: &str, text: &str) -> Result<f32, Failure> {
+    let t: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| Failure::input(format!("{flag} {text}: must be a number of seconds, e.g. 1.5")))?;
+    if !t.is_finite() || t.abs() > f64::from(f32::MAX) {
+        return Err(Failure::input(format!("{flag} {text}: must be a finite number of seconds")));
+    }
+    if t < 0.0 {
+        return Err(Failure::input(format!("{flag} {text}: times are ≥ 0 seconds")));
+    }
+    Ok(t as f32)
+}
+
+/// Parses `--fps` as typed: a finite number > 0 such that every frame of `range` has a finite time.
+fn parse_fps(text: &str, range: &std::ops::Range<u32>) -> Result<f32, Failure> {
+    let bad =
+        || Failure::input(format!("--fps {text}: must be a positive number of frames per second, e.g. 24"));
+    let fps: f64 = text.trim().parse().map_err(|_| bad())?;
+    if !(fps.is_finite() && fps > 0.0 && fps <= f64::from(f32::MAX)) || (fps as f32) <= 0.0 {
+        return Err(bad());
+    }
+    let last = range.end.saturating_sub(1);
+    let t = f64::from(last) / f64::from(fps as f32);
+    if t.is_nan() || t > f64::from(f32::MAX) {
+        return Err(Failure::input(format!(
+            "--fps {text}: too small; frame {last} would be at {t:.3e} s, beyond the largest time hadou \
+             can represent (3.4e38 s)"
+        )));
+    }
+    Ok(fps as f32)
+}
+
+fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>) -> Frame {
     let mut frame = scene.at(t);
     if let Some(w) = w {
         frame.width = w;
@@ -192,24 +237,35 @@ fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>) -> Result<Fra
     if let Some(h) = h {
         frame.height = h;
     }
-    Ok(frame)
+    frame
 }
 
 fn make_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, Failure> {
     match choice {
         BackendChoice::Cpu => Ok(Box::new(CpuBackend::new())),
         BackendChoice::Gpu => Ok(Box::new(GpuBackend::new()?)),
-        BackendChoice::Auto => Ok(match GpuBackend::new() {
-            Ok(g) if !g.is_software() => Box::new(g),
-            Ok(g) => {
+        // Decided from the adapter's description alone (no device, no shader compilation), so a
+        // declined GPU costs little and says one line.
+        BackendChoice::Auto => Ok(match hadou::gpu::find_adapter() {
+            Ok(info) if info.device_type != hadou::gpu::wgpu::DeviceType::Cpu => match GpuBackend::new() {
+                Ok(g) => Box::new(g),
+                Err(e) => {
+                    eprintln!(
+                        "note: using the CPU backend; the GPU adapter {} failed to start: {e}",
+                        info.name
+                    );
+                    Box::new(CpuBackend::new())
+                }
+            },
+            Ok(info) => {
                 eprintln!(
-                    "note: only a software GPU adapter ({}) is available; using the faster CPU backend",
-                    g.adapter_name()
+                    "note: using the CPU backend; the only GPU adapter, {}, is a software rasterizer (slower here)",
+                    info.name
                 );
                 Box::new(CpuBackend::new())
             }
             Err(e) => {
-                eprintln!("note: no GPU backend ({e}); falling back to the CPU backend");
+                eprintln!("note: using the CPU backend ({e})");
                 Box::new(CpuBackend::new())
             }
         }),
@@ -221,7 +277,10 @@ fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>
     let gpu = match choice {
         BackendChoice::Cpu => None,
         BackendChoice::Gpu => Some(GpuBackend::new()?),
-        BackendChoice::Auto => GpuBackend::new().ok().filter(|g| !g.is_software()),
+        BackendChoice::Auto => match hadou::gpu::find_adapter() {
+            Ok(info) if info.device_type != hadou::gpu::wgpu::DeviceType::Cpu => GpuBackend::new().ok(),
+            _ => None,
+        },
     };
     if let Some(mut gpu) = gpu {
         let name = format!("gpu ({})", gpu.adapter_name());
@@ -244,7 +303,7 @@ fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>
 fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, Failure> {
     let bad = || {
         Failure::input(format!(
-            "--frames {s}: expected a range of frame numbers like `0..48` (48 excluded) or `0..=47`"
+            "--frames {s}: expected a range of non-negative frame numbers like `0..48` (48 excluded) or `0..=47`"
         ))
     };
     let (a, b, inclusive) = if let Some((a, b)) = s.split_once("..=") {
@@ -265,27 +324,40 @@ fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, Failure> {
 
 fn render(a: RenderArgs) -> Result<(), Failure> {
     size_override(a.width, a.height)?;
-    let scene = Scene::load(&a.scene)?;
-    let mut backend = make_backend(a.backend)?;
+    // Ctrl-C, SIGTERM and SIGHUP remove the temporary file of an output being written.
+    output::install_interrupt_cleanup().map_err(Failure::runtime)?;
     let Some(frames) = &a.frames else {
-        output::check_writable(&a.output)?;
-        let frame = frame_at(&scene, a.time, a.width, a.height)?;
-        let image = backend.render(&frame)?;
-        check_finite(&image)?;
-        output::write(&image, &a.output)?;
+        let time = parse_time("--time", &a.time)?;
+        let format = output::Format::from_path(&a.output)?;
+        output::check_directory(&a.output)?;
+        let scene = Scene::load(&a.scene)?;
+        let frame = frame_at(&scene, time, a.width, a.height);
+        let mut backend = make_backend(a.backend)?;
+        match format {
+            // PNG is rendered and encoded band by band: memory follows the band, not the image.
+            output::Format::Png => output::write_png_banded(&a.output, frame.width, frame.height, |rows| {
+                let band = backend.render_rows(&frame, rows)?;
+                check_finite(&band)?;
+                Ok::<_, Failure>(band)
+            })?,
+            output::Format::Exr => {
+                output::check_writable(&a.output)?;
+                let image = backend.render(&frame)?;
+                check_finite(&image)?;
+                output::write(&image, &a.output)?;
+            }
+        }
         eprintln!(
             "wrote {} ({}×{}, {} backend)",
             a.output.display(),
-            image.width,
-            image.height,
+            frame.width,
+            frame.height,
             backend.name()
         );
         return Ok(());
     };
     let range = parse_frames(frames)?;
-    if !(a.fps.is_finite() && a.fps > 0.0) {
-        return Err(Failure::input(format!("--fps {}: must be a positive number", a.fps)));
-    }
+    let fps = parse_fps(&a.fps, &range)?;
     let dir = &a.output;
     if !dir.is_dir() {
         return Err(Failure::input(format!(
@@ -293,18 +365,26 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
             dir.display()
         )));
     }
-    let first = dir.join(format!("frame_{:05}.png", range.start));
-    output::check_writable(&first)?;
+    // Every frame's path is checked before the first frame is rendered.
+    let paths: Vec<PathBuf> = range.clone().map(|f| dir.join(format!("frame_{f:05}.png"))).collect();
+    for p in &paths {
+        output::check_directory(p)?;
+    }
+    output::check_writable(&paths[0])?;
+    let scene = Scene::load(&a.scene)?;
+    let mut backend = make_backend(a.backend)?;
     let bar = indicatif::ProgressBar::new(range.len() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, eta {eta}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    for f in range.clone() {
-        let frame = frame_at(&scene, f as f32 / a.fps, a.width, a.height)?;
-        let image = backend.render(&frame)?;
-        check_finite(&image)?;
-        output::write_png(&image, &dir.join(format!("frame_{f:05}.png")))?;
+    for (f, path) in range.clone().zip(&paths) {
+        let frame = frame_at(&scene, f as f32 / fps, a.width, a.height);
+        output::write_png_banded(path, frame.width, frame.height, |rows| {
+            let band = backend.render_rows(&frame, rows)?;
+            check_finite(&band)?;
+            Ok::<_, Failure>(band)
+        })?;
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -324,6 +404,17 @@ fn check_finite(image: &Image) -> Result<(), Failure> {
     }
 }
 
+/// A number for JSON output: never `null` (serde_json's rendering of NaN and ±∞). Energies
+/// saturate at the largest finite `f32`, so ±∞ becomes ±`f32::MAX`; a NaN (none should reach here)
+/// becomes 0.
+fn json_number(v: f32) -> f32 {
+    if v.is_nan() {
+        0.0
+    } else {
+        v.clamp(-f32::MAX, f32::MAX)
+    }
+}
+
 fn parse_pixel(s: &str) -> Result<(u32, u32), Failure> {
     let bad =
         || Failure::input(format!("--pixel {s}: expected `X,Y` with non-negative integers, e.g. 256,128"));
@@ -334,8 +425,9 @@ fn parse_pixel(s: &str) -> Result<(u32, u32), Failure> {
 fn probe(a: ProbeArgs) -> Result<(), Failure> {
     size_override(a.width, a.height)?;
     let (x, y) = parse_pixel(&a.pixel)?;
+    let time = parse_time("--time", &a.time)?;
     let scene = Scene::load(&a.scene)?;
-    let frame = frame_at(&scene, a.time, a.width, a.height)?;
+    let frame = frame_at(&scene, time, a.width, a.height);
     let outside = || {
         Failure::input(format!(
             "--pixel {x},{y}: outside the {}×{} image (x < {}, y < {})",
@@ -354,17 +446,19 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     let waves: Vec<_> = p
         .waves
         .iter()
-        .map(|w| serde_json::json!({"name": w.name, "energy": w.energy, "evaluations": w.evaluations}))
+        .map(|w| {
+            serde_json::json!({"name": w.name, "energy": json_number(w.energy), "evaluations": w.evaluations})
+        })
         .collect();
     let j = serde_json::json!({
         "scene": a.scene.display().to_string(),
-        "time": a.time,
+        "time": time,
         "pixel": [x, y],
         "size": [frame.width, frame.height],
         "waves": waves,
-        "energy": p.waves.iter().map(|w| w.energy).sum::<f32>(),
-        "color": p.color,
-        "depth": p.depth,
+        "energy": json_number(p.waves.iter().map(|w| w.energy).sum::<f32>()),
+        "color": p.color.map(json_number),
+        "depth": json_number(p.depth),
         "object": p.object,
         "backend": backend.name(),
     });
@@ -396,7 +490,7 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         (true, true) => vec![512],
     };
     for &s in &sizes {
-        size_override(Some(s), Some(s))?;
+        check_size("--sizes", s)?;
     }
     let iterations = a.iterations.unwrap_or(if curves { 1 } else { 5 });
     if iterations == 0 {
@@ -407,6 +501,21 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
             "--scenes {}: not a directory; run from the repository root or pass --scenes DIR",
             a.scenes.display()
         )));
+    }
+    if curves {
+        // Every scene the curve table needs must be there and valid before anything is timed.
+        let files = hadou::bench::CURVE_SCENES
+            .iter()
+            .map(|&(_, f)| f)
+            .chain(hadou::bench::ACCEPTANCE_SCENES.iter().map(|&(_, f, _)| f));
+        for file in files {
+            Scene::load(a.scenes.join(file)).map_err(|e| {
+                Failure::input(format!(
+                    "--scenes {}: the curve bench needs the example scenes (scenes/ of the repository): {e}",
+                    a.scenes.display()
+                ))
+            })?;
+        }
     }
     let (mut timer, name, method) = make_timer(a.backend)?;
     let json = if curves {

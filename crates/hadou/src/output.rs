@@ -7,6 +7,7 @@ use hadou_scene::Image;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Why an output could not be written.
 #[derive(Debug)]
@@ -54,29 +55,36 @@ impl Format {
 /// directory, and accepts a new file. Returns the format.
 pub fn check_writable(path: &Path) -> Result<Format, OutputError> {
     let format = Format::from_path(path)?;
+    check_directory(path)?;
+    let probe = TempFile::create(path)?;
+    drop(probe);
+    Ok(format)
+}
+
+/// The checks of [`check_writable`] that create nothing: the directory exists (naming the real
+/// cause when a part of the path is a file), and `path` is not a directory.
+pub fn check_directory(path: &Path) -> Result<(), OutputError> {
     let dir = parent_dir(path);
     if !dir.is_dir() {
-        return Err(OutputError::BadPath(format!(
-            "{}: directory `{}` does not exist; create it first or choose another output path",
-            path.display(),
-            dir.display()
-        )));
+        // The nearest part of the path that exists says why: a file in the way, or nothing there.
+        let blocking = dir.ancestors().find(|a| !a.as_os_str().is_empty() && a.exists());
+        return Err(OutputError::BadPath(match blocking {
+            Some(f) if !f.is_dir() => format!(
+                "{}: `{}` is a file, not a directory; choose another output path",
+                path.display(),
+                f.display()
+            ),
+            _ => format!(
+                "{}: directory `{}` does not exist; create it first or choose another output path",
+                path.display(),
+                dir.display()
+            ),
+        }));
     }
     if path.is_dir() {
         return Err(OutputError::BadPath(format!("{}: is a directory; give a file name", path.display())));
     }
-    let probe = temp_path(path);
-    match File::create(&probe) {
-        Ok(_) => {
-            let _ = std::fs::remove_file(&probe);
-            Ok(format)
-        }
-        Err(e) => Err(OutputError::BadPath(format!(
-            "{}: cannot create files in `{}` ({e}); check its permissions or choose another output path",
-            path.display(),
-            dir.display()
-        ))),
-    }
+    Ok(())
 }
 
 /// Writes `image` to `path` in the format its extension names.
@@ -147,21 +155,145 @@ fn temp_path(path: &Path) -> PathBuf {
     parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()))
 }
 
+/// Temporary files that exist right now; [`remove_pending`] deletes them when the process is
+/// interrupted. An entry is added when a [`TempFile`] is created and removed, under the same lock,
+/// when it is renamed into place or deleted, so an interrupt sees either the temporary file or
+/// the finished output, never a half-renamed state.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    PENDING.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Deletes every temporary output file being written and returns how many there were. Called by
+/// the interrupt handler; it keeps the lock, so no rename can start afterwards.
+pub fn remove_pending() -> usize {
+    let mut files = pending();
+    for f in files.iter() {
+        let _ = std::fs::remove_file(f);
+    }
+    let n = files.len();
+    files.clear();
+    std::mem::forget(files); // keep the lock held until the process exits
+    n
+}
+
+/// Makes Ctrl-C, SIGTERM and SIGHUP remove partial outputs: the handler deletes every pending
+/// temporary file, says so on stderr and exits with status 130.
+pub fn install_interrupt_cleanup() -> Result<(), String> {
+    ctrlc::set_handler(|| {
+        let n = remove_pending();
+        eprintln!("\ninterrupted: removed {n} partial output file(s); nothing was written");
+        std::process::exit(130);
+    })
+    .map_err(|e| format!("cannot install the interrupt handler: {e}"))
+}
+
+/// A temporary file beside an output path, registered in [`PENDING`]; removed on drop unless
+/// [`TempFile::commit`] renamed it into place.
+struct TempFile {
+    tmp: PathBuf,
+    file: Option<File>,
+}
+
+impl TempFile {
+    fn create(path: &Path) -> Result<TempFile, OutputError> {
+        let tmp = temp_path(path);
+        let mut list = pending();
+        let file = File::create(&tmp).map_err(|e| {
+            OutputError::BadPath(format!(
+                "{}: cannot create files in `{}` ({e}); check its permissions or choose another output path",
+                path.display(),
+                parent_dir(path).display()
+            ))
+        })?;
+        list.push(tmp.clone());
+        Ok(TempFile { tmp, file: Some(file) })
+    }
+
+    /// Renames the finished file to `path`.
+    fn commit(mut self, path: &Path) -> Result<(), String> {
+        drop(self.file.take());
+        let mut list = pending();
+        std::fs::rename(&self.tmp, path).map_err(|e| e.to_string())?;
+        list.retain(|p| p != &self.tmp);
+        self.tmp = PathBuf::new();
+        Ok(())
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if self.tmp.as_os_str().is_empty() {
+            return;
+        }
+        drop(self.file.take());
+        let mut list = pending();
+        let _ = std::fs::remove_file(&self.tmp);
+        list.retain(|p| p != &self.tmp);
+    }
+}
+
 /// Runs `write` on a temporary file beside `path`, then renames it into place; on any failure the
 /// temporary file is removed and `path` is untouched.
 fn atomic_write(path: &Path, write: impl FnOnce(File) -> Result<(), String>) -> Result<(), OutputError> {
-    let tmp = temp_path(path);
-    let file = File::create(&tmp).map_err(|e| {
-        OutputError::BadPath(format!(
-            "{}: cannot create `{}` ({e}); check that the directory exists and is writable",
-            path.display(),
-            tmp.display()
-        ))
-    })?;
-    let result = write(file).and_then(|_| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(OutputError::Io(format!("{}: write failed: {e}", path.display())));
+    let mut tmp = TempFile::create(path)?;
+    let file = tmp.file.take().expect("a new temp file is open");
+    write(file)
+        .and_then(|_| tmp.commit(path))
+        .map_err(|e| OutputError::Io(format!("{}: write failed: {e}", path.display())))
+}
+
+/// Rows per band of [`write_png_banded`]: about `BAND_PIXELS` pixels (at least one row), so a band
+/// costs a few hundred MB at most on any backend whatever the image size.
+pub fn band_rows(width: u32) -> u32 {
+    (BAND_PIXELS / width.max(1)).max(1)
+}
+
+/// Pixels per band of a streamed PNG (4 Mi: about 100 MB of float image per band).
+pub const BAND_PIXELS: u32 = 1 << 22;
+
+/// Writes a `width × height` 8-bit sRGB PNG to `path`, asking `band` for the image rows
+/// `y0..y1` in turn (each at most [`band_rows`] rows) and streaming them into the encoder, so
+/// memory follows the band, not the image. The file is created (and registered for interrupt
+/// clean-up) before the first band is requested, and renamed into place after the last; on any
+/// error nothing is left behind.
+pub fn write_png_banded<E: From<OutputError>>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+) -> Result<(), E> {
+    Format::from_path(path)?;
+    check_directory(path)?;
+    let mut tmp = TempFile::create(path)?;
+    let io = |e: String| OutputError::Io(format!("{}: write failed: {e}", path.display()));
+    let file = tmp.file.take().expect("a new temp file is open");
+    let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let mut w = enc.write_header().map_err(|e| io(e.to_string()))?;
+    {
+        let mut stream = w.stream_writer().map_err(|e| io(e.to_string()))?;
+        let step = band_rows(width);
+        let mut y = 0;
+        while y < height {
+            let rows = y..(y + step).min(height);
+            let image = band(rows.clone())?;
+            if image.width != width || image.height != rows.len() as u32 {
+                return Err(io(format!(
+                    "a band of rows {}..{} came back {}×{}",
+                    rows.start, rows.end, image.width, image.height
+                ))
+                .into());
+            }
+            stream.write_all(&srgb8(&image)).map_err(|e| io(e.to_string()))?;
+            y = rows.end;
+        }
+        stream.finish().map_err(|e| io(e.to_string()))?;
     }
+    w.finish().map_err(|e| io(e.to_string()))?;
+    tmp.commit(path).map_err(io)?;
     Ok(())
 }

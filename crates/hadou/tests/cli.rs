@@ -200,7 +200,7 @@ fn bad_output_paths_are_exit_2_and_write_nothing() {
     for (out, needle) in [
         (dir.join("missing/out.png"), "does not exist"),
         (dir.join("out.jpg"), "unknown output format"),
-        (scene.join("out.png"), "does not exist"),
+        (scene.join("out.png"), "is a file, not a directory"),
         (PathBuf::from("/proc/hadou-out.png"), "cannot create"),
     ] {
         let o = hadou(&["render", s, "-o", out.to_str().unwrap()]);
@@ -300,4 +300,228 @@ fn probe_and_render_agree_across_backends() {
     let o = hadou(&["render", s, "-o", out.to_str().unwrap(), "--backend", "gpu"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(out.exists());
+}
+
+/// Runs `hadou args…`, expects exit 2, a message containing every needle, and no panic.
+fn assert_exit_2(args: &[&str], needles: &[&str]) {
+    let o = hadou(args);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+    for n in needles {
+        assert!(e.contains(n), "{args:?}: expected `{n}` in: {e}");
+    }
+    assert!(!e.contains("panicked"), "{e}");
+}
+
+#[test]
+fn negative_numbers_are_values_not_flags() {
+    let dir = tmpdir("negative");
+    let s = write_scene(&dir, GOOD);
+    let s = s.to_str().unwrap();
+    let o = dir.join("o.png");
+    let o = o.to_str().unwrap();
+    assert_exit_2(&["render", s, "-o", o, "--time", "-1"], &["--time -1", "times are ≥ 0"]);
+    assert_exit_2(&["probe", s, "--pixel", "-1,0"], &["--pixel -1,0", "non-negative"]);
+    assert_exit_2(&["render", s, "-o", o, "--frames", "-1..3"], &["--frames -1..3", "non-negative"]);
+    assert_exit_2(&["render", s, "-o", o, "--width", "-5"], &["--width", "-5"]);
+    assert!(!Path::new(o).exists());
+}
+
+#[test]
+fn numbers_are_echoed_as_typed() {
+    let dir = tmpdir("echo");
+    let s = write_scene(&dir, GOOD);
+    let s = s.to_str().unwrap();
+    let o = dir.join("o.png");
+    let o = o.to_str().unwrap();
+    for (args, typed) in [
+        (vec!["render", s, "-o", o, "--time", "1e400"], "--time 1e400:"),
+        (vec!["render", s, "-o", o, "--time", "3.4e39"], "--time 3.4e39:"),
+        (vec!["probe", s, "--pixel", "1,2", "--time", "-1e30"], "--time -1e30:"),
+    ] {
+        let r = hadou(&args);
+        let e = stderr(&r);
+        assert_eq!(r.status.code(), Some(2), "{e}");
+        assert!(e.contains(typed), "expected `{typed}` in: {e}");
+        // No number is written out digit by digit.
+        assert!(!e.contains("0000000000"), "{e}");
+    }
+}
+
+#[test]
+fn a_tiny_fps_is_blamed_on_fps_not_on_the_time() {
+    let dir = tmpdir("fps");
+    let s = write_scene(&dir, GOOD);
+    let s = s.to_str().unwrap();
+    let d = format!("{}/", dir.display());
+    let r = hadou(&["render", s, "-o", &d, "--frames", "0..3", "--fps", "1e-45"]);
+    let e = stderr(&r);
+    assert_eq!(r.status.code(), Some(2), "{e}");
+    assert!(e.contains("--fps 1e-45") && !e.contains("--time"), "{e}");
+    assert_exit_2(&["render", s, "-o", &d, "--frames", "0..3", "--fps", "0"], &["--fps 0", "positive"]);
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "nothing written");
+}
+
+#[test]
+fn bench_sizes_are_blamed_on_sizes() {
+    assert_exit_2(&["bench", "--sizes", "0"], &["--sizes 0"]);
+    assert_exit_2(&["bench", "--sizes", "512,-1"], &["--sizes"]);
+}
+
+#[test]
+fn bench_curves_without_the_example_scenes_is_exit_2() {
+    let dir = tmpdir("bench-scenes");
+    assert_exit_2(
+        &["bench", "curves", "--scenes", dir.to_str().unwrap(), "--sizes", "16"],
+        &["--scenes", "needs the example scenes"],
+    );
+}
+
+#[test]
+fn frames_check_every_output_path_before_rendering() {
+    let dir = tmpdir("frames-blocked");
+    let s = write_scene(&dir, GOOD);
+    let out = dir.join("out");
+    std::fs::create_dir_all(out.join("frame_00001.png")).unwrap();
+    let d = format!("{}/", out.display());
+    let r = hadou(&["render", s.to_str().unwrap(), "-o", &d, "--frames", "0..3"]);
+    let e = stderr(&r);
+    assert_eq!(r.status.code(), Some(2), "{e}");
+    assert!(e.contains("frame_00001.png") && e.contains("is a directory"), "{e}");
+    assert!(!out.join("frame_00000.png").exists(), "frame 0 was rendered before the check");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "only the blocking directory");
+}
+
+#[test]
+fn probe_never_prints_null() {
+    // Two spheres hit through their centres with no core: the largest energies a scene can
+    // hold; whatever they come to (saturated or huge), the JSON has a number for each.
+    let dir = tmpdir("probe-json");
+    let text = GOOD.replace(
+        "[[wave]]",
+        "[[wave]]\nname = \"s1\"\nkind = \"sphere\"\nM = [0.0, 0.0, 0.0]\nalpha_s = 1e5\ncore_radius = 0.0\n\n\
+         [[wave]]\nname = \"s2\"\nkind = \"sphere\"\nM = [0.0, 0.0, 0.0]\nalpha_s = 1e5\ncore_radius = 0.0\n\n[[wave]]",
+    );
+    let s = write_scene(&dir, &text);
+    let o = hadou(&["probe", s.to_str().unwrap(), "--pixel", "32,24", "--width", "65", "--height", "49"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!out.contains("null"), "{out}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(j["energy"].as_f64().unwrap() > 1e10, "{j}");
+}
+
+/// Decodes an 8-bit RGB PNG into its pixel bytes.
+fn decode_png(path: &Path) -> (u32, u32, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
+}
+
+#[test]
+fn a_png_rendered_in_bands_equals_the_whole_frame() {
+    use hadou::Backend;
+    let dir = tmpdir("bands");
+    let scene = write_scene(&dir, GOOD);
+    // 8192 wide: 512 rows a band, so 1100 rows take three bands, the last one partial.
+    let (w, h) = (8192u32, 1100u32);
+    assert!(hadou::output::band_rows(w) < h / 2);
+    let out = dir.join("b.png");
+    let (ws, hs) = (w.to_string(), h.to_string());
+    let o = hadou(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        &ws,
+        "--height",
+        &hs,
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let mut frame = hadou::Scene::load(&scene).unwrap().at(0.0);
+    frame.width = w;
+    frame.height = h;
+    let whole = hadou::CpuBackend::new().render(&frame).unwrap();
+    let (pw, ph, pixels) = decode_png(&out);
+    assert_eq!((pw, ph), (w, h));
+    assert!(pixels == hadou::output::srgb8(&whole), "banded PNG differs from the whole-frame render");
+}
+
+/// The peak resident memory of a child process, polled from /proc until it exits (Linux only).
+fn peak_rss_kib(mut child: std::process::Child) -> (std::process::ExitStatus, u64) {
+    let status_file = format!("/proc/{}/status", child.id());
+    let mut peak = 0;
+    loop {
+        if let Ok(text) = std::fs::read_to_string(&status_file) {
+            if let Some(line) = text.lines().find(|l| l.starts_with("VmHWM:")) {
+                let kib: u64 = line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(0);
+                peak = peak.max(kib);
+            }
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            return (status, peak);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+#[test]
+fn png_memory_follows_the_band_not_the_image() {
+    if !Path::new("/proc/self/status").exists() {
+        eprintln!("SKIPPED: no /proc to read peak memory from");
+        return;
+    }
+    let dir = tmpdir("memory");
+    // An 8192² frame: 1.6 GB as one float image, about 100 MB per band.
+    let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 8192\nheight = 8192"));
+    let out = dir.join("big.png");
+    let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (status, peak) = peak_rss_kib(child);
+    assert!(status.success());
+    assert!(out.exists());
+    // The bound: a few bands of float image and opaque buffers (~55 bytes a pixel each), never
+    // the image (8192² × 24 bytes = 1.6 GB for its floats alone).
+    assert!(peak > 0 && peak < 600 * 1024, "peak resident memory {peak} KiB");
+    eprintln!("8192² PNG: peak resident memory {} MiB", peak / 1024);
+}
+
+#[test]
+fn an_interrupted_render_leaves_no_temporary_file() {
+    let dir = tmpdir("interrupt");
+    let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 16384\nheight = 16384"));
+    let out = dir.join("slow.png");
+    for signal in ["-TERM", "-INT"] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+            .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The temporary file exists from the first band on.
+        let tmp_exists = || {
+            std::fs::read_dir(&dir)
+                .unwrap()
+                .any(|e| e.unwrap().file_name().to_string_lossy().ends_with(".tmp"))
+        };
+        let start = std::time::Instant::now();
+        while !tmp_exists() && start.elapsed().as_secs() < 30 {
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        assert!(tmp_exists(), "no temporary file appeared");
+        let kill = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap();
+        assert!(kill.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(130), "{signal}");
+        assert!(!tmp_exists(), "{signal}: the temporary file was left behind");
+        assert!(!out.exists(), "{signal}: a partial output appeared");
+    }
 }
