@@ -237,6 +237,20 @@ fn cases() -> Vec<Case> {
             add(point, eye, toward(Vec3::new(1.3, 1.0, 0.0)), 0.0, open);
             // Empty span.
             add(cap, eye, toward(Vec3::ZERO), 0.0, Some(0.0));
+            // Saturation: a huge α on a ray through a centre or along an axis overflows f32; the
+            // energy is f32::MAX on both sides (never 0 or NaN), and α = 0 there is exactly 0.
+            for a in [f32::MAX, 1e9, 0.0] {
+                let sph = wave(WAVE_SPHERE, falloff, core, [0.0, 0.0, 0.0, a], [0.0; 4], [0.0; 4]);
+                add(sph, eye, toward(Vec3::ZERO), 0.0, open);
+                let cyl =
+                    wave(WAVE_CYLINDER, falloff, core, [0.0, 0.0, 0.0, a], [0.0, 0.0, 1.0, 0.0], [0.0; 4]);
+                add(cyl, eye, Vec3::new(0.0, 0.0, -scale), 0.0, open);
+                let z = [0.0, 0.0, 1.0, a];
+                let cap = wave(WAVE_CAPSULE, falloff, core, [0.0, 0.0, -1.0, a], z, [2.0, 0.0, 0.0, 0.0]);
+                add(cap, eye, Vec3::new(0.0, 0.0, -scale), 0.0, open);
+                let beam = wave(WAVE_BEAM, falloff, core, [0.0, 0.0, -1.0, a], z, [2.0, a, a, 0.0]);
+                add(beam, eye, Vec3::new(0.0, 0.0, -scale), 0.0, open);
+            }
         }
         // Random rays and shapes.
         let mut rng = Rng(0x5EED + falloff as u64);
@@ -288,5 +302,11 @@ fn wgsl_energy_functions_match_their_rust_twins() {
         lit += usize::from(r > 1e-3);
     }
     assert!(lit * 2 > cases.len(), "most cases must carry real energy ({lit} of {})", cases.len());
+    let saturated = cases.iter().zip(&gpu).filter(|(c, _)| run_cpu(c) == f32::MAX).count();
+    assert!(
+        cases.iter().zip(&gpu).all(|(c, g)| (run_cpu(c) == f32::MAX) == (*g == f32::MAX)),
+        "saturated on one side only"
+    );
+    assert!(saturated >= 12, "only {saturated} saturated cases");
     eprintln!("{} cases, worst relative difference {worst:.2e}", cases.len());
 }

@@ -508,6 +508,96 @@ fn curve_leaf_of(c: GpuCurve, x: f32) -> u32 {
     return lo;
 }
 
+// Mirrors the `t_of` closure of integrate.rs `walk`: the ray parameter at axial coordinate x.
+fn curve_t_of(x: f32, lo: f32, hi: f32, t_lo: f32, t_hi: f32, inv_qx: f32) -> f32 {
+    if (x == lo) {
+        return t_lo;
+    } else if (x == hi) {
+        return t_hi;
+    }
+    return t_lo + (x - lo) * inv_qx;
+}
+
+// Mirrors integrate.rs `curve_at`: the exact cross-section point at axial coordinate x.
+fn curve_at(c: GpuCurve, x: f32) -> vec2<f32> {
+    return curve_eval(c, clamp(x / c.gamma, 0.0, c.s_head));
+}
+
+// Mirrors hadou_math::curve::integrate::MAX_SUB_LEVELS.
+const CURVE_SUB_LEVELS: u32 = 16u;
+
+// Mirrors integrate.rs `leaf_walk`: the chord walk below leaf i over [x0, x1], bisecting on the
+// exact curve; each sub-piece's line is its chord shifted by ⅔ of the midpoint deviation d, with
+// the bound |d|. Right halves wait on a fixed stack (x_a, y_a, z_a, depth) + (x_b, y_b, z_b).
+fn curve_leaf_walk(c: GpuCurve, r: LocalRay, i: u32, x0: f32, x1: f32, lo: f32, hi: f32, t_lo: f32, t_hi: f32, inv_qx: f32, model: vec4<f32>, acc: ptr<function, f32>) {
+    var stack_a: array<vec4<f32>, CURVE_SUB_LEVELS>;
+    var stack_b: array<vec3<f32>, CURVE_SUB_LEVELS>;
+    var top = 0u;
+    let na = curve_node(c, i);
+    let nb = curve_node(c, i + 1u);
+    var xa = na.x;
+    var pa = na.yz;
+    var xb = nb.x;
+    var pb = nb.yz;
+    var depth = 0u;
+    let noise = F32_EPSILON * 4.0;
+    // Each sub-piece is visited once: at most 2^(levels+1) − 1; the bound only guards the loop.
+    for (var step = 0u; step < 4096u; step++) {
+        if (xb > x0 && xa < x1) {
+            let w = xb - xa;
+            let xm = (xa + xb) * 0.5;
+            let cm = curve_at(c, xm);
+            let mid = (pa + pb) * 0.5;
+            let d = cm - mid;
+            let err = sqrt(d.x * d.x + d.y * d.y);
+            let ly = mid.x + d.x * (2.0 / 3.0);
+            let lz = mid.y + d.y * (2.0 / 3.0);
+            let my = (pb.x - pa.x) / w;
+            let mz = (pb.y - pa.y) / w;
+            let px0 = max(x0, xa);
+            let px1 = min(x1, xb);
+            let tx0 = curve_t_of(px0, lo, hi, t_lo, t_hi, inv_qx);
+            let tx1 = curve_t_of(px1, lo, hi, t_lo, t_hi, inv_qx);
+            let ts = select(tx1, tx0, tx0 <= tx1);
+            let te = select(tx0, tx1, tx0 <= tx1);
+            let xs = r.o.x + r.q.x * ts - xm;
+            let py = r.o.y + r.q.y * ts;
+            let pz = r.o.z + r.q.z * ts;
+            let quad = quad_planar(py - (ly + xs * my), pz - (lz + xs * mz), r.q.y - r.q.x * my, r.q.z - r.q.x * mz, r.rc2);
+            let dt = te - ts;
+            var uncovered = 0.0;
+            if (px0 > xa || px1 < xb) {
+                uncovered = 1.0 - (px1 - px0) / w;
+            }
+            var split = depth < CURVE_SUB_LEVELS && xm > xa && xm < xb && err > noise * (abs(cm.x) + abs(cm.y) + abs(xm));
+            if (split) {
+                split = chord_refinement(model, err, quad, dt, r.rc2, uncovered, c.tolerance, 1u) > 0u;
+            }
+            if (split) {
+                depth += 1u;
+                stack_a[top] = vec4<f32>(xm, cm.x, cm.y, f32(depth));
+                stack_b[top] = vec3<f32>(xb, pb.x, pb.y);
+                top += 1u;
+                xb = xm;
+                pb = cm;
+                continue;
+            }
+            curve_piece(c, r, ts, quad, dt, acc);
+        }
+        if (top == 0u) {
+            return;
+        }
+        top -= 1u;
+        let sa = stack_a[top];
+        let sb = stack_b[top];
+        xa = sa.x;
+        pa = sa.yz;
+        depth = u32(sa.w);
+        xb = sb.x;
+        pb = sb.yz;
+    }
+}
+
 // Mirrors integrate.rs `walk`: the stackless chord walk over the slab part [ta, tb].
 fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32>) {
     let n = c.node_count - 1u;
@@ -525,15 +615,11 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
         t_lo = tb;
         t_hi = ta;
     }
-    if (!(hi - lo > xh * 1.0e-6) || tb - ta > CURVE_INF) {
-        let xm = (lo + hi) * 0.5;
-        let i = curve_leaf_of(c, xm);
-        let a = curve_node(c, i);
-        let b = curve_node(c, i + 1u);
-        let f = clamp((xm - a.x) / (b.x - a.x), 0.0, 1.0);
+    if (!(hi - lo > xh * (F32_EPSILON * 8.0)) || tb - ta > CURVE_INF) {
+        let cm = curve_at(c, (lo + hi) * 0.5);
         let py = r.o.y + r.q.y * ta;
         let pz = r.o.z + r.q.z * ta;
-        let p = vec3<f32>(0.0, py - (a.y + (b.y - a.y) * f), pz - (a.z + (b.z - a.z) * f));
+        let p = vec3<f32>(0.0, py - cm.x, pz - cm.y);
         curve_piece(c, r, ta, quad_new(p, vec3<f32>(0.0, r.q.y, r.q.z), r.rc2), tb - ta, acc);
         return;
     }
@@ -554,18 +640,8 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
         if (nb.x > lo) {
             let x0 = max(lo, na.x);
             let x1 = min(hi, nb.x);
-            var tx0 = t_lo + (x0 - lo) * inv_qx;
-            if (x0 == lo) {
-                tx0 = t_lo;
-            } else if (x0 == hi) {
-                tx0 = t_hi;
-            }
-            var tx1 = t_lo + (x1 - lo) * inv_qx;
-            if (x1 == lo) {
-                tx1 = t_lo;
-            } else if (x1 == hi) {
-                tx1 = t_hi;
-            }
+            let tx0 = curve_t_of(x0, lo, hi, t_lo, t_hi, inv_qx);
+            let tx1 = curve_t_of(x1, lo, hi, t_lo, t_hi, inv_qx);
             let ts = select(tx1, tx0, tx0 <= tx1);
             let te = select(tx0, tx1, tx0 <= tx1);
             let idx = curve_level_offset(c, l) + j;
@@ -576,16 +652,15 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
             let quad = quad_planar(py - (ln.x + xs * ln.z), pz - (ln.y + xs * ln.w), r.q.y - r.q.x * ln.z, r.q.z - r.q.x * ln.w, r.rc2);
             let dt = te - ts;
             let err = curve_f32[c.errors + idx];
-            var refine = 0u;
-            if (l > 0u) {
-                var uncovered = 0.0;
-                if (x0 > na.x || x1 < nb.x) {
-                    uncovered = 1.0 - (x1 - x0) / (nb.x - na.x);
-                }
-                refine = chord_refinement(model, err, quad, dt, r.rc2, uncovered, c.tolerance, l);
+            var uncovered = 0.0;
+            if (x0 > na.x || x1 < nb.x) {
+                uncovered = 1.0 - (x1 - x0) / (nb.x - na.x);
             }
+            let refine = chord_refinement(model, err, quad, dt, r.rc2, uncovered, c.tolerance, l);
             if (refine == 0u) {
                 curve_piece(c, r, ts, quad, dt, acc);
+            } else if (l == 0u) {
+                curve_leaf_walk(c, r, j, x0, x1, lo, hi, t_lo, t_hi, inv_qx, model, acc);
             } else {
                 descend = refine;
             }
@@ -667,8 +742,7 @@ fn curve_default(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
     }
     var acc = 0.0;
     curve_integrate_span(c, r, r.t0, r.t1, &acc);
-    let e = acc * r.alpha;
-    return select(0.0, e, curve_finite(e));
+    return energy_scaled(acc, r.alpha);
 }
 
 // ---- simpson.rs ----
@@ -740,11 +814,11 @@ fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
             sum += curve_composite(c, r, r.t0, te, mo);
         }
     }
-    var e = sum * r.alpha;
+    var e = energy_scaled(sum, r.alpha);
     if (r.t1 > r.t_far) {
-        e += curve_default(c, falloff, core_radius, ray, r.t_far, r.t1, r.t_far);
+        e = energy_add(e, curve_default(c, falloff, core_radius, ray, r.t_far, r.t1, r.t_far));
     }
-    return select(0.0, e, curve_finite(e));
+    return e;
 }
 
 // Mirrors hadou_math::curve::curve_energy: dispatch on the wave's integrator.

@@ -16,6 +16,32 @@ const T_LIMIT: f32 = 1.0e12;
 const H_FLOOR: f32 = 1.0e-24;
 // Mirrors hadou_math::energy::ENERGY_MAX.
 const ENERGY_MAX: f32 = 1.0e30;
+// Mirrors hadou_math::energy::ENERGY_SATURATION (f32::MAX).
+const ENERGY_SATURATION: f32 = 3.40282347e38;
+
+// Mirrors hadou_math::energy::saturate for the values the formulas produce: x ∈ [0, ∞) clamped
+// to [0, f32::MAX]. WGSL may assume no infinity or NaN occurs, so the sums and products below are
+// formed so that they never overflow (energy_add, energy_scaled) instead of relying on it.
+fn energy_saturate(x: f32) -> f32 {
+    return clamp(x, 0.0, ENERGY_SATURATION);
+}
+
+// (x + y) saturated at f32::MAX for x, y ∈ [0, f32::MAX], without overflowing: halves are added
+// (exact for normal values) and doubled after the clamp. The Rust twin is saturate(x + y).
+fn energy_add(x: f32, y: f32) -> f32 {
+    return 2.0 * min(0.5 * x + 0.5 * y, 0.5 * ENERGY_SATURATION);
+}
+
+// Mirrors hadou_math::energy::scaled: α·I saturated, for I ∈ [0, ∞) and α ≥ 0 finite; the
+// product is only formed where it stays below f32::MAX (α ≤ 1, or I below f32::MAX/α).
+fn energy_scaled(integral: f32, alpha: f32) -> f32 {
+    let i = energy_saturate(integral);
+    if (alpha > 1.0 && i >= ENERGY_SATURATION / alpha) {
+        return ENERGY_SATURATION;
+    }
+    return energy_saturate(i * alpha);
+}
+
 // f32::EPSILON and f32::MIN_POSITIVE.
 const F32_EPSILON: f32 = 1.1920929e-7;
 const F32_MIN_POSITIVE: f32 = 1.17549435e-38;
@@ -172,7 +198,7 @@ fn rq_integral(q: RayQuadratic, falloff: u32, t0: f32, t1: f32) -> f32 {
 fn sphere_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, center: vec3<f32>, alpha: f32) -> f32 {
     let axis = ray_axis(ray.dir);
     let q = ray_quadratic(axis, ray.origin - center, p.core_radius * p.core_radius);
-    return rq_integral(q, p.falloff, t0, t1) * alpha;
+    return energy_scaled(rq_integral(q, p.falloff, t0, t1), alpha);
 }
 
 // Mirrors hadou_math::energy::cylinder_energy (002 eq. 3.5, 3.7, 3.9).
@@ -180,7 +206,7 @@ fn cylinder_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, point: vec3<f32>,
     let axis = ray_axis(cross(ray.dir, dir));
     let v = cross(ray.origin - point, dir);
     let q = ray_quadratic(axis, v, p.core_radius * p.core_radius);
-    return rq_integral(q, p.falloff, t0, t1) * alpha;
+    return energy_scaled(rq_integral(q, p.falloff, t0, t1), alpha);
 }
 
 // Mirrors hadou_math::energy::CapsuleParts (private).
@@ -239,7 +265,7 @@ fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, m: vec3<f32>,
     hi = clamp(hi, lo, t1);
     let fo = p.falloff;
     let spheres = rq_integral(first, fo, t0, lo) + rq_integral(last, fo, hi, t1);
-    let energy = spheres * alpha_s + rq_integral(cyl, fo, lo, hi) * alpha_c;
+    let energy = energy_add(energy_scaled(spheres, alpha_s), energy_scaled(rq_integral(cyl, fo, lo, hi), alpha_c));
     return CapsuleParts(at_m, at_m2, energy);
 }
 
@@ -253,10 +279,10 @@ fn beam_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3
     let parts = capsule_parts(p, ray, t0, t1, m, d, length, alpha_s, alpha_c);
     var e = parts.energy;
     if (head_alpha != 0.0) {
-        e += rq_integral(parts.at_m2, p.falloff, t0, t1) * head_alpha;
+        e = energy_add(e, energy_scaled(rq_integral(parts.at_m2, p.falloff, t0, t1), head_alpha));
     }
     if (muzzle_alpha != 0.0) {
-        e += rq_integral(parts.at_m, p.falloff, t0, t1) * muzzle_alpha;
+        e = energy_add(e, energy_scaled(rq_integral(parts.at_m, p.falloff, t0, t1), muzzle_alpha));
     }
     return e;
 }

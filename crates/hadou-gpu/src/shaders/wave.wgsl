@@ -90,12 +90,16 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     var light = vec3<f32>(0.0);
     for (var k = 0u; k < frame.wave_count; k++) {
         let w = waves[k];
-        // As hadou-cpu's wave pass: negative or non-finite energies count as 0.
-        let e = clamp(wave_energy(w, dir, surface), 0.0, ENERGY_MAX);
-        total += e;
-        light += (w.color.xyz * w.color.w) * e;
+        // As hadou-cpu's wave pass: energies saturate at f32::MAX (hadou_math::energy::saturate),
+        // and so do their sums, so a saturated pixel is full brightness, never 0 or NaN.
+        let e = energy_saturate(wave_energy(w, dir, surface));
+        total = energy_add(total, e);
+        let c = w.color.xyz * w.color.w;
+        light = vec3<f32>(energy_add(light.x, c.x * e), energy_add(light.y, c.y * e), energy_add(light.z, c.z * e));
     }
-    let rgb_in = scene + light * frame.exposure;
+    // exposure · light without overflowing (energy_scaled); the mappings then take f32::MAX to 1.
+    let lit = vec3<f32>(energy_scaled(light.x, frame.exposure), energy_scaled(light.y, frame.exposure), energy_scaled(light.z, frame.exposure));
+    let rgb_in = scene + lit;
     var rgb = vec3<f32>(0.0);
     if (frame.tone_mode == TONE_FAITHFUL) {
         rgb = map_faithful(rgb_in);
@@ -110,6 +114,6 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     out_buf[4u * i + 1u] = rgb.y;
     out_buf[4u * i + 2u] = rgb.z;
     out_buf[4u * i + 3u] = 1.0;
-    out_buf[4u * n + i] = min(total, 3.0e38);
+    out_buf[4u * n + i] = total;
     out_buf[5u * n + i] = depth;
 }
