@@ -84,3 +84,31 @@ fn near_hits_stay_within_tolerance() {
     }
     println!("worst f64 {worst64:.2e} (tolerance {})", DEFAULT_SETTINGS.tolerance);
 }
+
+/// Inverse square and `far` (docs/scene-format.md, `falloff`): without attenuation the energy of
+/// an open ray does not depend on the far point; with `j > 0` it is the arc-length integral of
+/// `α/(r² + r_c²)·(1 − t/t_far)^j` up to `t_far`, so it depends on `far` exactly through that
+/// weight (checked against the converged reference of that integrand for two far distances).
+#[test]
+fn inverse_square_depends_on_far_only_through_attenuation() {
+    let p = FieldParams { falloff: Falloff::InverseSquare, core_radius: 0.05 };
+    let ray =
+        Ray { origin: Vec3::new(1.0, 0.5, 30.0), dir: Vec3::new(-0.03, 0.01, -1.0).normalize_or(Vec3::Z) };
+    for (name, mut w) in support::shapes() {
+        let c0 = prepare(&w);
+        let a = curve_energy_f64(&c0, &p, &ray, 0.0, f64::INFINITY, 60.0).0;
+        let b = curve_energy_f64(&c0, &p, &ray, 0.0, f64::INFINITY, 600.0).0;
+        assert!((a - b).abs() <= 1e-12 * a, "{name}: j = 0 depends on far ({a} vs {b})");
+        w.attenuation = 2.0;
+        let c = prepare(&w);
+        let mut values = Vec::new();
+        for t_far in [60.0, 600.0] {
+            let got = curve_energy_f64(&c, &p, &ray, 0.0, f64::INFINITY, t_far).0;
+            // The converged reference integrates α/(r² + r_c²)·(1 − t/t_far)^j (002 eq. 3.23).
+            let want = curve_energy_reference(&c, &p, &ray, 0.0, f64::INFINITY, t_far, 1e-10);
+            assert!((got - want).abs() <= 5e-3 * want, "{name} far {t_far}: {got} vs {want}");
+            values.push(got);
+        }
+        assert!(values[1] > values[0] * 1.05, "{name}: a farther far plane attenuates less: {values:?}");
+    }
+}

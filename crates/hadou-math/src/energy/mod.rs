@@ -69,8 +69,11 @@ pub enum Falloff {
     /// `1/|E − S|`). The ray's `dir` is `Q = E − S`.
     Faithful,
     /// hadou's default: density `α / r²`, integrated over arc length from the eye to the first
-    /// occluder or to infinity, so the value never depends on where the far plane is. The ray's
-    /// `dir` is a unit vector.
+    /// occluder or to infinity, so the value does not depend on where the far plane is — with one
+    /// exception: a curve's attenuation `(1 − u)^j`, `j > 0` (002 eq. 3.23, SPEC.md §1.4), keeps
+    /// the thesis's `u = t/t_far` (`t_far` the far point's distance along the ray) in both
+    /// falloffs, so it attenuates the same points equally and ends the integral at the far plane;
+    /// `far` is then its length scale. The ray's `dir` is a unit vector.
     #[default]
     InverseSquare,
 }
