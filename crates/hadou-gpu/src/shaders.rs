@@ -64,6 +64,33 @@ mod tests {
         ]
     }
 
+    /// The builtins `dot`, `cross` and `length` round differently on different drivers (see
+    /// `dot3` in common.wgsl); the shaders use the written-out twins only.
+    #[test]
+    fn shaders_use_the_written_out_vector_products() {
+        for (name, source) in [
+            ("common.wgsl", COMMON),
+            ("energy.wgsl", ENERGY),
+            ("curve.wgsl", CURVE),
+            ("raster.wgsl", RASTER),
+            ("wave.wgsl", WAVE),
+        ] {
+            for (i, line) in source.lines().enumerate() {
+                let code = line.split("//").next().unwrap_or("");
+                for builtin in ["dot(", "cross(", "length(", "normalize(", "distance("] {
+                    let found = code
+                        .match_indices(builtin)
+                        .any(|(at, _)| !code[..at].ends_with(|c: char| c.is_alphanumeric() || c == '_'));
+                    assert!(
+                        !found,
+                        "{name}:{}: uses the builtin `{builtin}`; use dot3/cross3/length3",
+                        i + 1
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn every_wgsl_file_parses_and_validates() {
         // Standalone files validate alone; pass files only after their prefix.

@@ -310,3 +310,72 @@ fn wgsl_energy_functions_match_their_rust_twins() {
     assert!(saturated >= 12, "only {saturated} saturated cases");
     eprintln!("{} cases, worst relative difference {worst:.2e}", cases.len());
 }
+
+/// `dot3`, `cross3` and `length3` (common.wgsl) round exactly as `hadou_math::Vec3`'s `dot`,
+/// `cross` and `length` do, bit for bit, on every adapter. The WGSL builtins do not on Mesa's
+/// OpenGL path (fused multiply-adds inside `dot`/`length`), which made near-hit curve energies
+/// differ between GL and Vulkan by up to 1 %; this test fails if a backend rounds them otherwise.
+#[test]
+fn written_out_vector_products_round_like_rust() {
+    const PRODUCTS: &str = r#"
+@group(0) @binding(0) var<storage, read> xs: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> results: array<f32>;
+@compute @workgroup_size(64, 1, 1)
+fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let n = arrayLength(&xs) / 2u;
+    if (id.x >= n) {
+        return;
+    }
+    let a = xs[2u * id.x].xyz;
+    let b = xs[2u * id.x + 1u].xyz;
+    let c = cross3(a, b);
+    results[5u * id.x] = dot3(a, b);
+    results[5u * id.x + 1u] = length3(a);
+    results[5u * id.x + 2u] = c.x;
+    results[5u * id.x + 3u] = c.y;
+    results[5u * id.x + 4u] = c.z;
+}
+"#;
+    let ctx = match GpuContext::new() {
+        Ok(c) => c,
+        Err(RenderError::NoDevice(m)) => {
+            assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{m}");
+            eprintln!("SKIPPED vector products: no GPU adapter ({m})");
+            return;
+        }
+        Err(e) => panic!("{e}"),
+    };
+    // Nearly parallel and nearly orthogonal pairs, where rounding order shows most.
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32 * 60.0 - 30.0
+    };
+    let mut xs: Vec<[f32; 4]> = Vec::new();
+    for i in 0..4096 {
+        let a = [next(), next(), next(), 0.0];
+        let b = if i % 2 == 0 {
+            [a[0] * 0.999 + 1e-3, a[1], a[2] * 1.001, 0.0]
+        } else {
+            [next(), next(), next(), 0.0]
+        };
+        xs.push(a);
+        xs.push(b);
+    }
+    let source = shaders::compose(&[shaders::COMMON, PRODUCTS]);
+    let n = xs.len() / 2;
+    let gpu = run_twin_kernel(&ctx, "vector products", &source, &[(0, bytemuck::cast_slice(&xs))], 5 * n)
+        .expect("GPU vector products");
+    for i in 0..n {
+        let v = |p: [f32; 4]| Vec3f::new(p[0], p[1], p[2]);
+        let (a, b) = (v(xs[2 * i]), v(xs[2 * i + 1]));
+        let c = a.cross(b);
+        let want = [a.dot(b), a.length(), c.x, c.y, c.z];
+        for (k, w) in want.iter().enumerate() {
+            let g = gpu[5 * i + k];
+            assert!(g.to_bits() == w.to_bits(), "pair {i} product {k}: gpu {g:e} rust {w:e} ({a:?}, {b:?})");
+        }
+    }
+}

@@ -4,6 +4,25 @@
 // Every struct here has exactly one Rust definition in crates/hadou-gpu/src/layout.rs:
 // keep in sync with layout.rs (same field order, same explicit padding).
 
+// ---- Vector products, written out (twins of hadou_math::Vec3::{dot, cross, length}) ----
+// The builtins dot/cross/length leave the evaluation order and the use of fused multiply-adds
+// to the driver, and drivers differ: Mesa's OpenGL path evaluates dot() and length() with fused
+// multiply-adds (up to 1 ulp apart from the Vulkan path and from Rust on 1/3 of random inputs),
+// while its Vulkan path rounds every product. Near-hit rays with no core radius amplify one ulp
+// in a squared distance into percent-level energy differences, so every product the backends
+// share is written out in Rust's order: x·x' + y·y' + z·z' (left to right), each product rounded.
+fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+fn cross3(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
+fn length3(a: vec3<f32>) -> f32 {
+    return sqrt(dot3(a, a));
+}
+
 // Keep in sync with layout.rs `FrameUniforms`.
 struct FrameUniforms {
     eye: vec3<f32>,
@@ -119,12 +138,12 @@ fn pixel_dir(u: FrameUniforms, px: u32, py: u32) -> vec3<f32> {
 // Mirrors hadou_math::shade::diffuse: albedo · (ambient + light · max(0, N·(−L))); a zero or
 // non-finite normal shades with ambient only.
 fn diffuse(albedo: vec3<f32>, normal: vec3<f32>, light_dir: vec3<f32>, light: vec3<f32>, ambient: vec3<f32>) -> vec3<f32> {
-    let len = length(normal);
+    let len = length3(normal);
     var n = vec3<f32>(0.0);
     if (len > 0.0 && len < 3.0e38) {
         n = normal / len;
     }
-    let lambert = max(dot(n, -light_dir), 0.0);
+    let lambert = max(dot3(n, -light_dir), 0.0);
     return albedo * (ambient + light * lambert);
 }
 

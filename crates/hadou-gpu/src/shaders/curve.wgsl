@@ -189,8 +189,8 @@ fn curve_local_ray(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f3
         rc = max(abs(core_radius), c.core_floor);
     }
     let w = ray.origin - c.origin;
-    let o = vec3<f32>(dot(w, c.axis_d), dot(w, c.axis_y), dot(w, c.axis_z));
-    let q = vec3<f32>(dot(ray.dir, c.axis_d), dot(ray.dir, c.axis_y), dot(ray.dir, c.axis_z));
+    let o = vec3<f32>(dot3(w, c.axis_d), dot3(w, c.axis_y), dot3(w, c.axis_z));
+    let q = vec3<f32>(dot3(ray.dir, c.axis_d), dot3(ray.dir, c.axis_y), dot3(ray.dir, c.axis_z));
     return LocalRay(o, q, t0, t1, t_far, j, rc * rc, falloff, c.alpha, c.x_head);
 }
 
@@ -223,9 +223,9 @@ struct Segment {
 
 // Mirrors closed.rs `Quad`: (pp, vv, pv, E) of |p + vτ|² + rc2, E = |p × v|² + rc2·vv.
 fn quad_new(p: vec3<f32>, v: vec3<f32>, rc2: f32) -> vec4<f32> {
-    let vv = dot(v, v);
-    let cr = cross(p, v);
-    return vec4<f32>(dot(p, p), vv, dot(p, v), dot(cr, cr) + rc2 * vv);
+    let vv = dot3(v, v);
+    let cr = cross3(p, v);
+    return vec4<f32>(dot3(p, p), vv, dot3(p, v), dot3(cr, cr) + rc2 * vv);
 }
 
 // Mirrors `Quad::planar`: p = (0, py, pz), v = (0, vy, vz).

@@ -73,7 +73,7 @@ struct RayQuadratic {
 
 // Mirrors RayAxis::new.
 fn ray_axis(u: vec3<f32>) -> RayAxis {
-    let a = dot(u, u);
+    let a = dot3(u, u);
     if (a >= F32_MIN_POSITIVE) {
         let s = sqrt(a);
         return RayAxis(s, u * (1.0 / s));
@@ -83,11 +83,11 @@ fn ray_axis(u: vec3<f32>) -> RayAxis {
 
 // Mirrors RayQuadratic::new.
 fn ray_quadratic(axis: RayAxis, v: vec3<f32>, rc2: f32) -> RayQuadratic {
-    let beta = dot(axis.unit, v);
-    var d2 = dot(v, v);
+    let beta = dot3(axis.unit, v);
+    var d2 = dot3(v, v);
     if (axis.s > 0.0) {
-        let c = cross(axis.unit, v);
-        d2 = dot(c, c);
+        let c = cross3(axis.unit, v);
+        d2 = dot3(c, c);
     }
     return RayQuadratic(axis.s, beta, max(d2 + rc2, H_FLOOR));
 }
@@ -203,8 +203,8 @@ fn sphere_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, center: vec3<f32>, 
 
 // Mirrors hadou_math::energy::cylinder_energy (002 eq. 3.5, 3.7, 3.9).
 fn cylinder_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, point: vec3<f32>, dir: vec3<f32>, alpha: f32) -> f32 {
-    let axis = ray_axis(cross(ray.dir, dir));
-    let v = cross(ray.origin - point, dir);
+    let axis = ray_axis(cross3(ray.dir, dir));
+    let v = cross3(ray.origin - point, dir);
     let q = ray_quadratic(axis, v, p.core_radius * p.core_radius);
     return energy_scaled(rq_integral(q, p.falloff, t0, t1), alpha);
 }
@@ -232,9 +232,9 @@ fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, m: vec3<f32>,
     let sphere_axis = ray_axis(q);
     let at_m = ray_quadratic(sphere_axis, w, rc2);
     let at_m2 = ray_quadratic(sphere_axis, w - d * length, rc2);
-    let cyl = ray_quadratic(ray_axis(cross(q, d)), cross(w, d), rc2);
-    let dq = dot(q, d);
-    let ds = dot(w, d);
+    let cyl = ray_quadratic(ray_axis(cross3(q, d)), cross3(w, d), rc2);
+    let dq = dot3(q, d);
+    let ds = dot3(w, d);
     var lo = 0.0;
     var hi = 0.0;
     var first_is_m = true;

@@ -27,7 +27,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     let normal = (o.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
     // World → view space (hadou_scene::CameraBasis::to_view).
     let d = world - frame.eye;
-    let view = vec3<f32>(dot(d, frame.right), dot(d, frame.up), dot(d, frame.forward));
+    let view = vec3<f32>(dot3(d, frame.right), dot3(d, frame.up), dot3(d, frame.forward));
     // Global NDC, then this tile's part of it: ndc_tile = ndc·scale + offset (times w in clip space).
     let gx = view.x / (frame.tan_half_fov * frame.aspect);
     let gy = view.y / frame.tan_half_fov;
@@ -49,6 +49,6 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
 fn fs_main(in: VertexOut) -> @location(0) vec4<u32> {
     let o = objects[in.object];
     let rgb = diffuse(o.color, in.normal, frame.light_dir, frame.light_color, frame.ambient);
-    let distance = length(in.world - frame.eye);
+    let distance = length3(in.world - frame.eye);
     return bitcast<vec4<u32>>(vec4<f32>(rgb, distance));
 }

@@ -15,7 +15,7 @@
 // Mirrors hadou_scene::CameraBasis::wave_ray: the ray and span of one pixel for one falloff.
 // `surface < 0` means nothing was drawn (None).
 fn wave_ray(falloff: u32, dir: vec3<f32>, surface: f32, span: ptr<function, vec2<f32>>) -> Ray {
-    let len = length(dir);
+    let len = length3(dir);
     let far_dist = frame.far * len;
     if (falloff == FALLOFF_FAITHFUL) {
         var g = 1.0;
@@ -56,7 +56,7 @@ fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
             // far point's distance (inverse square, unit direction).
             var t_far = 1.0;
             if (w.falloff != FALLOFF_FAITHFUL) {
-                t_far = frame.far * length(dir);
+                t_far = frame.far * length3(dir);
             }
             return curve_energy(curves[u32(w.p0.x)], w.falloff, w.core_radius, ray, span.x, span.y, t_far);
         }
@@ -106,7 +106,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         rgb = map_filmic(rgb_in);
     }
-    var depth = frame.far * length(dir);
+    var depth = frame.far * length3(dir);
     if (drawn) {
         depth = surface;
     }
