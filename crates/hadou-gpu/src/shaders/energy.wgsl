@@ -32,14 +32,28 @@ fn energy_add(x: f32, y: f32) -> f32 {
     return 2.0 * min(0.5 * x + 0.5 * y, 0.5 * ENERGY_SATURATION);
 }
 
-// Mirrors hadou_math::energy::scaled: α·I saturated, for I ∈ [0, ∞) and α ≥ 0 finite; the
-// product is only formed where it stays below f32::MAX (α ≤ 1, or I below f32::MAX/α).
+// Mirrors hadou_math::energy::scaled: α·I saturated, for I ∈ [0, ∞) and α ≥ 0 finite, without
+// forming an overflowing product or dividing: with I = f·2^m and α = g·2^n (frexp, exact), the
+// product is f·g·2^(m+n), and a quarter of it, ldexp(f·g, m+n−2), is finite whenever the product
+// can be (m + n ≤ 129). The same rounding as I·α where that fits. (A quotient test, I ≥ MAX/α,
+// fails on GPUs: compilers divide by multiplying with an approximate reciprocal that is zero or
+// subnormal for α ≥ 2¹²⁶, and NVIDIA's saturated every energy of an α near f32::MAX.)
 fn energy_scaled(integral: f32, alpha: f32) -> f32 {
     let i = energy_saturate(integral);
-    if (alpha > 1.0 && i >= ENERGY_SATURATION / alpha) {
+    if (alpha <= 1.0) {
+        return i * alpha;
+    }
+    let a = frexp(i);
+    let b = frexp(alpha);
+    let e = a.exp + b.exp;
+    if (e > 129) {
         return ENERGY_SATURATION;
     }
-    return energy_saturate(i * alpha);
+    let quarter = ldexp(a.fract * b.fract, e - 2);
+    if (quarter >= 0.25 * ENERGY_SATURATION) {
+        return ENERGY_SATURATION;
+    }
+    return 4.0 * quarter;
 }
 
 // f32::EPSILON and f32::MIN_POSITIVE.
