@@ -1,19 +1,10 @@
 //! Every class of bad input gives `path:line:col: message` pointing at the offending key or value.
 
+mod common;
+
+use common::{at, err};
 use hadou_scene::{Scene, SceneError};
 use std::path::Path;
-
-fn err(text: &str) -> SceneError {
-    match Scene::parse(text, Path::new("scenes/x.toml")) {
-        Ok(_) => panic!("expected an error for:\n{text}"),
-        Err(e) => e,
-    }
-}
-
-fn at(e: &SceneError) -> (usize, usize) {
-    let l = e.location().unwrap_or_else(|| panic!("no location: {e}"));
-    (l.line, l.col)
-}
 
 const WAVE: &str =
     "[[wave]]\nname = \"beam\"\nkind = \"capsule\"\nM = [0.0, 0.0, 0.0]\nM2 = [1.0, 0.0, 0.0]\n";

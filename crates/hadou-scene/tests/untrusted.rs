@@ -1,6 +1,9 @@
 //! Hostile and extreme inputs: each is a located error with a plain-language message, never a
 //! panic, a hang or unbounded memory.
 
+mod common;
+
+use common::{at, err};
 use hadou_scene::{gltf_from_bytes, read_regular_file, Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -10,18 +13,6 @@ fn tmp_dir(name: &str) -> PathBuf {
     std::fs::remove_dir_all(&d).ok();
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn err(text: &str) -> SceneError {
-    match Scene::parse(text, Path::new("scenes/x.toml")) {
-        Ok(_) => panic!("expected an error for:\n{text}"),
-        Err(e) => e,
-    }
-}
-
-fn at(e: &SceneError) -> (usize, usize) {
-    let l = e.location().unwrap_or_else(|| panic!("no location: {e}"));
-    (l.line, l.col)
 }
 
 /// A one-triangle glTF (positions only, data-URI buffer) with `extra` spliced into the top level.
