@@ -24,24 +24,37 @@ impl Rng {
 /// measured in the cross-section, as the pairing does), 12 random directions each, both
 /// falloffs, core radius 0, 10⁻³ and 0.02: the algorithm (run in `f64`) stays within its tolerance
 /// `τ` of the adaptive reference. Before the chord walk refined below the leaves it was off by up
-/// to 380 % (inverse square, `r_c = 0`, `d = 10⁻⁵`). In `f32` the ray itself cannot be placed to
-/// better than about `10⁻⁶` at these coordinates, so the `f32` result is held to the same bar
-/// (against the reference for the rounded ray) only where the core radius is at least `10⁻³` or
-/// the distance `10⁻²` (the rest is printed: up to 30 % at `d = 10⁻⁵` with `r_c = 0`, the rounding
-/// of the ray's position, not the integrator); `--nocapture` prints every case.
+/// to 380 % (inverse square, `r_c = 0`, `d = 10⁻⁵`).
+///
+/// In `f32` (against the reference for the rounded ray) the result is held to the same bar where
+/// the core radius is at least `10⁻³`, and with `r_c = 0` down to the distance where the `f32`
+/// curve points allow it: `10⁻⁴` for the Bézier and B-spline curves (their points are good to
+/// about `10⁻⁶`), `10⁻³` for the trigonometric sum (`2·10⁻⁶`) and `10⁻²` for the helix
+/// (`3.5·10⁻⁶`: the phase `θs` of a 20-unit helix rounds to `2·10⁻⁶`). It was held only at
+/// `10⁻²`, with 1–2 % at `d = 10⁻⁴`, while the squared distance `E` of a piece was a cross
+/// product of its relative position at the piece's start, formed from the eye 30 units away
+/// (`line_quad` now forms it at the piece's point nearest the ray), and while sub-leaf refinement
+/// stopped at `10⁻⁵` from the curve. Below those distances (up to 85 % at `d = 10⁻⁵`) the `f32`
+/// curve points themselves are the limit. `--nocapture` prints every case.
 #[test]
 fn near_hits_stay_within_tolerance() {
     let distances = [0.0, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2];
     let mut worst64 = 0.0f64;
     for (name, w) in support::shapes() {
         let c = prepare(&w);
+        // The least distance at which f32 is held to the bar with no core radius (see above).
+        let f32_from = match name {
+            "helix" => 1e-2,
+            "trig sum" => 1e-3,
+            _ => 1e-4,
+        };
         for falloff in [Falloff::Faithful, Falloff::InverseSquare] {
             for rc in [0.0, 1e-3, 0.02] {
                 let p = FieldParams { falloff, core_radius: rc };
                 let p32 = FieldParams { falloff, core_radius: rc as f32 };
                 let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
                 for &d in &distances {
-                    let (mut w64, mut w32, mut evals) = (0.0f64, 0.0f64, 0u32);
+                    let (mut w64, mut w32, mut evals, mut evals32) = (0.0f64, 0.0f64, 0u32, 0u32);
                     for _ in 0..12 {
                         let s = (0.05 + 0.9 * rng.next()) * 20.0 / f64::from(w.gamma);
                         let s = s.min(c.axial_length() as f64 / f64::from(w.gamma));
@@ -66,16 +79,17 @@ fn near_hits_stay_within_tolerance() {
                         w64 = w64.max((got - want).abs() / want);
                         w32 = w32.max((f64::from(g32.energy) - want32).abs() / want32);
                         evals = evals.max(n);
+                        evals32 = evals32.max(g32.evaluations);
                     }
                     println!(
-                        "{name:9} {falloff:?} rc={rc:e} d={d:e}: f64 {w64:.2e} f32 {w32:.2e} max evals {evals}"
+                        "{name:9} {falloff:?} rc={rc:e} d={d:e}: f64 {w64:.2e} f32 {w32:.2e} max evals {evals} (f32 {evals32})"
                     );
                     worst64 = worst64.max(w64);
                     assert!(
                         w64 <= DEFAULT_SETTINGS.tolerance,
                         "{name} {falloff:?} rc={rc} d={d}: f64 {w64:e}"
                     );
-                    if rc >= 1e-3 || d >= 1e-2 {
+                    if rc >= 1e-3 || d >= f32_from {
                         assert!(w32 <= 5e-3, "{name} {falloff:?} rc={rc} d={d}: f32 {w32:e}");
                     }
                 }

@@ -228,13 +228,6 @@ fn quad_new(p: vec3<f32>, v: vec3<f32>, rc2: f32) -> vec4<f32> {
     return vec4<f32>(dot3(p, p), vv, dot3(p, v), dot3(cr, cr) + rc2 * vv);
 }
 
-// Mirrors `Quad::planar`: p = (0, py, pz), v = (0, vy, vz).
-fn quad_planar(py: f32, pz: f32, vy: f32, vz: f32, rc2: f32) -> vec4<f32> {
-    let vv = vy * vy + vz * vz;
-    let c = py * vz - pz * vy;
-    return vec4<f32>(py * py + pz * pz, vv, py * vy + pz * vz, c * c + rc2 * vv);
-}
-
 // Mirrors `Quad::end_squared`.
 fn quad_end_squared(q: vec4<f32>, dt: f32) -> f32 {
     return max(q.x + dt * (2.0 * q.z + q.y * dt), 0.0);
@@ -523,6 +516,55 @@ fn curve_at(c: GpuCurve, x: f32) -> vec2<f32> {
     return curve_eval(c, clamp(x / c.gamma, 0.0, c.s_head));
 }
 
+// Mirrors integrate.rs `CurveReal::split` for f32: the lower 12 of 24 significand bits cleared,
+// so that products of such values with each other or with a remainder x − split(x) are exact.
+fn curve_split(x: f32) -> f32 {
+    return bitcast<f32>(bitcast<u32>(x) & 0xfffff000u);
+}
+
+// Mirrors integrate.rs `two_sum`: (s, e) with s = a + b rounded and s + e = a + b exactly
+// (additions only, so no fused multiply-add can change it).
+fn curve_two_sum(a: f32, b: f32) -> vec2<f32> {
+    let s = a + b;
+    let bb = s - a;
+    return vec2<f32>(s, (a - (s - bb)) + (b - bb));
+}
+
+// Mirrors integrate.rs `anchored`: o + q·t − l for an anchor t = curve_split(·), good to the
+// rounding of the small result (q·t split into two exact products, the cancelling sums two-sums).
+fn curve_anchored(o: f32, q: f32, l: f32, t: f32) -> f32 {
+    let h = curve_two_sum(o, -l);
+    let qh = curve_split(q);
+    let s = curve_two_sum(h.x, qh * t);
+    return s.x + (s.y + h.y + (q - qh) * t);
+}
+
+// Mirrors integrate.rs `line_quad`: the quadratic of the line (ly, lz) + (x − xm)·(my, mz) along
+// the ray from ts on, over [0, dt]; p·p and p·v at ts, E = |p × v|² + rc2·vv from the relative
+// position at the anchor nearest the ray (a cross product of small, locally formed numbers).
+fn curve_line_quad(r: LocalRay, ly: f32, lz: f32, my: f32, mz: f32, xm: f32, ts: f32, dt: f32) -> vec4<f32> {
+    let xs = r.o.x + r.q.x * ts - xm;
+    let py = r.o.y + r.q.y * ts - (ly + xs * my);
+    let pz = r.o.z + r.q.z * ts - (lz + xs * mz);
+    let vy = r.q.y - r.q.x * my;
+    let vz = r.q.z - r.q.x * mz;
+    let vv = vy * vy + vz * vz;
+    let pv = py * vy + pz * vz;
+    var tau = -pv / vv;
+    if (!(tau > 0.0)) {
+        tau = 0.0;
+    }
+    if (tau > dt) {
+        tau = dt;
+    }
+    let ta = curve_split(ts + tau);
+    let xa = curve_anchored(r.o.x, r.q.x, xm, ta);
+    let ay = curve_anchored(r.o.y, r.q.y, ly, ta) - xa * my;
+    let az = curve_anchored(r.o.z, r.q.z, lz, ta) - xa * mz;
+    let cr = ay * vz - az * vy;
+    return vec4<f32>(py * py + pz * pz, vv, pv, cr * cr + r.rc2 * vv);
+}
+
 // Mirrors hadou_math::curve::integrate::MAX_SUB_LEVELS.
 const CURVE_SUB_LEVELS: u32 = 16u;
 
@@ -540,7 +582,7 @@ fn curve_leaf_walk(c: GpuCurve, r: LocalRay, i: u32, x0: f32, x1: f32, lo: f32, 
     var xb = nb.x;
     var pb = nb.yz;
     var depth = 0u;
-    let noise = F32_EPSILON * 4.0;
+    let noise = F32_EPSILON * 0.5;
     // Each sub-piece is visited once: at most 2^(levels+1) − 1; the bound only guards the loop.
     for (var step = 0u; step < 4096u; step++) {
         if (xb > x0 && xa < x1) {
@@ -560,11 +602,8 @@ fn curve_leaf_walk(c: GpuCurve, r: LocalRay, i: u32, x0: f32, x1: f32, lo: f32, 
             let tx1 = curve_t_of(px1, lo, hi, t_lo, t_hi, inv_qx);
             let ts = select(tx1, tx0, tx0 <= tx1);
             let te = select(tx0, tx1, tx0 <= tx1);
-            let xs = r.o.x + r.q.x * ts - xm;
-            let py = r.o.y + r.q.y * ts;
-            let pz = r.o.z + r.q.z * ts;
-            let quad = quad_planar(py - (ly + xs * my), pz - (lz + xs * mz), r.q.y - r.q.x * my, r.q.z - r.q.x * mz, r.rc2);
             let dt = te - ts;
+            let quad = curve_line_quad(r, ly, lz, my, mz, xm, ts, dt);
             var uncovered = 0.0;
             if (px0 > xa || px1 < xb) {
                 uncovered = 1.0 - (px1 - px0) / w;
@@ -646,11 +685,8 @@ fn curve_walk(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32
             let te = select(tx0, tx1, tx0 <= tx1);
             let idx = curve_level_offset(c, l) + j;
             let ln = curve_vec4[c.lines + idx];
-            let xs = r.o.x + r.q.x * ts - (na.x + nb.x) * 0.5;
-            let py = r.o.y + r.q.y * ts;
-            let pz = r.o.z + r.q.z * ts;
-            let quad = quad_planar(py - (ln.x + xs * ln.z), pz - (ln.y + xs * ln.w), r.q.y - r.q.x * ln.z, r.q.z - r.q.x * ln.w, r.rc2);
             let dt = te - ts;
+            let quad = curve_line_quad(r, ln.x, ln.y, ln.z, ln.w, (na.x + nb.x) * 0.5, ts, dt);
             let err = curve_f32[c.errors + idx];
             var uncovered = 0.0;
             if (x0 > na.x || x1 < nb.x) {

@@ -44,15 +44,6 @@ impl<R: Real> Quad<R> {
         Quad { pp: p.dot(p), vv, pv: p.dot(v), big_e: p.cross(v).length_squared() + rc2 * vv }
     }
 
-    /// The quadratic of a piece inside the slab, where `d` has no axial component:
-    /// `p = (0, py, pz)`, `v = (0, vy, vz)`, so `p × v` is the single term `py·vz − pz·vy`.
-    #[inline]
-    pub(crate) fn planar(py: R, pz: R, vy: R, vz: R, rc2: R) -> Self {
-        let vv = vy * vy + vz * vz;
-        let c = py * vz - pz * vy;
-        Quad { pp: py * py + pz * pz, vv, pv: py * vy + pz * vz, big_e: c * c + rc2 * vv }
-    }
-
     /// `|d(τ)|²` at `τ = dt`.
     #[inline]
     pub(crate) fn end_squared(&self, dt: R) -> R {
