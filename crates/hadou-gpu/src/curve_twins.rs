@@ -267,6 +267,7 @@ fn cases(preps: &[PreparedCurve]) -> Vec<CurveCase> {
 
 #[test]
 fn wgsl_curve_integrators_match_their_rust_twins() {
+    let _gpu = crate::device::test_gpu_lock();
     let ctx = match GpuContext::new() {
         Ok(c) => c,
         Err(RenderError::NoDevice(m)) => {

@@ -6,6 +6,14 @@ use hadou_scene::RenderError;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+/// Serialises the GPU work of this crate's unit tests: Mesa 22's lavapipe crashed (SIGSEGV) with
+/// several devices rendering at once from parallel test threads.
+#[cfg(test)]
+pub(crate) fn test_gpu_lock() -> std::sync::MutexGuard<'static, ()> {
+    static LOCK: Mutex<()> = Mutex::new(());
+    LOCK.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 /// How long one wait for submitted work may take before the device is declared hung.
 pub(crate) const WAIT_TIMEOUT: Duration = Duration::from_secs(120);
 

@@ -492,10 +492,12 @@ mod tests {
     use super::*;
     use crate::pipelines::compile_module;
 
-    /// A renderer, or `None` with a skip message (a failure under `HADOU_REQUIRE_GPU=1`).
-    fn renderer_or_skip(test: &str) -> Option<Renderer> {
+    /// A renderer with the crate's GPU test lock, or `None` with a skip message (a failure under
+    /// `HADOU_REQUIRE_GPU=1`).
+    fn renderer_or_skip(test: &str) -> Option<(Renderer, std::sync::MutexGuard<'static, ()>)> {
+        let lock = crate::device::test_gpu_lock();
         match Renderer::new() {
-            Ok(r) => Some(r),
+            Ok(r) => Some((r, lock)),
             Err(RenderError::NoDevice(m)) => {
                 assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{test}: {m}");
                 eprintln!("SKIPPED {test}: no GPU adapter ({m})");
@@ -521,7 +523,7 @@ mod tests {
 
     #[test]
     fn shader_compile_failure_is_an_error_naming_the_shader() {
-        let Some(r) = renderer_or_skip("shader compile failure") else { return };
+        let Some((r, _gpu)) = renderer_or_skip("shader compile failure") else { return };
         match compile_module(&r.ctx, "deliberately broken", "fn f( -> { let }") {
             Err(RenderError::Other(m)) => assert!(m.contains("deliberately broken"), "{m}"),
             other => panic!("expected a compile error, got {:?}", other.map(|_| ())),
@@ -532,7 +534,7 @@ mod tests {
 
     #[test]
     fn rejected_gpu_work_is_captured_not_panicking() {
-        let Some(r) = renderer_or_skip("captured validation error") else { return };
+        let Some((r, _gpu)) = renderer_or_skip("captured validation error") else { return };
         let too_big = r.ctx.limits.max_buffer_size.saturating_add(4);
         let result = r.ctx.scoped("allocating an impossible buffer", || {
             r.ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -574,7 +576,7 @@ mod tests {
 
     #[test]
     fn meshes_upload_once_per_arc_and_are_dropped_with_it() {
-        let Some(mut r) = renderer_or_skip("mesh cache") else { return };
+        let Some((mut r, _gpu)) = renderer_or_skip("mesh cache") else { return };
         let mesh = Arc::new(Mesh {
             positions: vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
             normals: vec![[0.0, 0.0, 1.0]; 3],
@@ -607,7 +609,7 @@ mod tests {
 
     #[test]
     fn lost_device_is_a_device_error() {
-        let Some(mut r) = renderer_or_skip("device loss") else { return };
+        let Some((mut r, _gpu)) = renderer_or_skip("device loss") else { return };
         let frame = small_frame();
         assert!(r.render(&frame).is_ok());
         r.ctx.device.destroy();

@@ -332,6 +332,7 @@ fn cases() -> Vec<Case> {
 
 #[test]
 fn wgsl_energy_functions_match_their_rust_twins() {
+    let _gpu = crate::device::test_gpu_lock();
     let ctx = match GpuContext::new() {
         Ok(c) => c,
         Err(RenderError::NoDevice(m)) => {
@@ -408,6 +409,7 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
     results[6u * id.x + 5u] = a.x * b.x - a.y * b.y;
 }
 "#;
+    let _gpu = crate::device::test_gpu_lock();
     let ctx = match GpuContext::new() {
         Ok(c) => c,
         Err(RenderError::NoDevice(m)) => {

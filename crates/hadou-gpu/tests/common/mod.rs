@@ -5,17 +5,22 @@
 use hadou_gpu::GpuBackend;
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
 use hadou_math::{Mat4, Vec3, Vec3f};
-use hadou_scene::{
-    Camera, ColorMapping, Frame, Image, Light, Mesh, Object, RenderError, ToneMode, Wave, WaveShape,
-};
-use std::sync::Arc;
+use hadou_scene::{Camera, ColorMapping, Frame, Image, Light, Mesh, Object, ToneMode, Wave, WaveShape};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
-/// The GPU backend, or `None` (with a clear message on stderr) when this machine has no adapter.
-/// With `HADOU_REQUIRE_GPU=1` a missing adapter fails the test instead.
-pub fn gpu_or_skip(test: &str) -> Option<GpuBackend> {
-    match GpuBackend::new() {
-        Ok(g) => Some(g),
-        Err(RenderError::NoDevice(msg)) => {
+/// The one GPU backend of this test binary, shared by its tests in turn, or `None` (with a clear
+/// message on stderr) when this machine has no usable adapter. With `HADOU_REQUIRE_GPU=1` a
+/// missing adapter fails the test instead.
+///
+/// Shared because opening a backend compiles the shaders (tens of seconds on a software adapter)
+/// and because Mesa 22's lavapipe crashed (SIGSEGV) with several devices rendering at once from
+/// parallel test threads; the lock serialises the GPU work of the tests.
+pub fn gpu_or_skip(test: &str) -> Option<MutexGuard<'static, GpuBackend>> {
+    static SHARED: OnceLock<Result<Mutex<GpuBackend>, String>> = OnceLock::new();
+    match SHARED.get_or_init(|| GpuBackend::new().map(Mutex::new).map_err(|e| e.to_string())) {
+        // A test that panicked while holding the lock leaves the backend usable.
+        Ok(gpu) => Some(gpu.lock().unwrap_or_else(|p| p.into_inner())),
+        Err(msg) if msg.starts_with("no usable device") => {
             if std::env::var("HADOU_REQUIRE_GPU").is_ok_and(|v| v == "1") {
                 panic!("{test}: HADOU_REQUIRE_GPU=1 but no GPU adapter: {msg}");
             }
