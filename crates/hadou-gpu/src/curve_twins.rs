@@ -267,16 +267,7 @@ fn cases(preps: &[PreparedCurve]) -> Vec<CurveCase> {
 
 #[test]
 fn wgsl_curve_integrators_match_their_rust_twins() {
-    let _gpu = crate::device::test_gpu_lock();
-    let ctx = match GpuContext::new() {
-        Ok(c) => c,
-        Err(RenderError::NoDevice(m)) => {
-            assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{m}");
-            eprintln!("SKIPPED curve twins: no GPU adapter ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
-    };
+    let Some((ctx, _gpu)) = crate::device::context_or_skip("curve twins") else { return };
     let preps: Vec<PreparedCurve> = curves()
         .iter()
         .map(|w| {

@@ -14,6 +14,22 @@ pub(crate) fn test_gpu_lock() -> std::sync::MutexGuard<'static, ()> {
     LOCK.lock().unwrap_or_else(|p| p.into_inner())
 }
 
+/// A device for one unit test, holding [`test_gpu_lock`] while the test runs, or `None` with a
+/// skip message when there is no usable adapter (a failure under `HADOU_REQUIRE_GPU=1`).
+#[cfg(test)]
+pub(crate) fn context_or_skip(test: &str) -> Option<(GpuContext, std::sync::MutexGuard<'static, ()>)> {
+    let lock = test_gpu_lock();
+    match GpuContext::new() {
+        Ok(c) => Some((c, lock)),
+        Err(RenderError::NoDevice(m)) => {
+            assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{test}: {m}");
+            eprintln!("SKIPPED {test}: no GPU adapter ({m})");
+            None
+        }
+        Err(e) => panic!("{test}: {e}"),
+    }
+}
+
 /// How long one wait for submitted work may take before the device is declared hung.
 pub(crate) const WAIT_TIMEOUT: Duration = Duration::from_secs(120);
 

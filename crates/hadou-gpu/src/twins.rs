@@ -332,16 +332,7 @@ fn cases() -> Vec<Case> {
 
 #[test]
 fn wgsl_energy_functions_match_their_rust_twins() {
-    let _gpu = crate::device::test_gpu_lock();
-    let ctx = match GpuContext::new() {
-        Ok(c) => c,
-        Err(RenderError::NoDevice(m)) => {
-            assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{m}");
-            eprintln!("SKIPPED energy twins: no GPU adapter ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
-    };
+    let Some((ctx, _gpu)) = crate::device::context_or_skip("energy twins") else { return };
     let cases = cases();
     let gpu = run_gpu(&ctx, &cases).expect("GPU twin run");
     let mut worst = 0.0f32;
@@ -409,16 +400,7 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
     results[6u * id.x + 5u] = a.x * b.x - a.y * b.y;
 }
 "#;
-    let _gpu = crate::device::test_gpu_lock();
-    let ctx = match GpuContext::new() {
-        Ok(c) => c,
-        Err(RenderError::NoDevice(m)) => {
-            assert!(std::env::var("HADOU_REQUIRE_GPU").map_or(true, |v| v != "1"), "{m}");
-            eprintln!("SKIPPED vector products: no GPU adapter ({m})");
-            return;
-        }
-        Err(e) => panic!("{e}"),
-    };
+    let Some((ctx, _gpu)) = crate::device::context_or_skip("vector products") else { return };
     // Nearly parallel and nearly orthogonal pairs, where rounding order shows most.
     let mut state = 0x9E37_79B9_7F4A_7C15u64;
     let mut next = || {

@@ -10,16 +10,6 @@ use hadou_math::curve::{curve_energy, curve_energy_reference, prepare, DEFAULT_S
 use hadou_math::energy::{Falloff, FieldParams, Ray};
 use hadou_math::Vec3;
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// Rays passing `d ∈ {0, 10⁻⁶, …, 10⁻²}` from each of the four test curves (the distance
 /// measured in the cross-section, as the pairing does), 12 random directions each, both
 /// falloffs, core radius 0, 10⁻³ and 0.02: the algorithm (run in `f64`) stays within its tolerance
@@ -52,7 +42,7 @@ fn near_hits_stay_within_tolerance() {
             for rc in [0.0, 1e-3, 0.02] {
                 let p = FieldParams { falloff, core_radius: rc };
                 let p32 = FieldParams { falloff, core_radius: rc as f32 };
-                let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+                let mut rng = support::Rng(0x9e37_79b9_7f4a_7c15);
                 for &d in &distances {
                     let (mut w64, mut w32, mut evals, mut evals32) = (0.0f64, 0.0f64, 0u32, 0u32);
                     for _ in 0..12 {

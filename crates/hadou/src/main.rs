@@ -315,7 +315,9 @@ fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, Failure> {
     };
     let a: u32 = a.trim().parse().map_err(|_| bad())?;
     let b: u32 = b.trim().parse().map_err(|_| bad())?;
-    let end = if inclusive { b.checked_add(1).ok_or_else(bad)? } else { b };
+    let too_large =
+        || Failure::input(format!("--frames {s}: frame numbers go up to 4294967294 (`A..=4294967294`)"));
+    let end = if inclusive { b.checked_add(1).ok_or_else(too_large)? } else { b };
     if end <= a {
         return Err(Failure::input(format!("--frames {s}: the range is empty")));
     }
@@ -365,12 +367,22 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
             dir.display()
         )));
     }
-    // Every frame's path is checked before the first frame is rendered.
-    let paths: Vec<PathBuf> = range.clone().map(|f| dir.join(format!("frame_{f:05}.png"))).collect();
-    for p in &paths {
-        output::check_directory(p)?;
+    // Every frame's path is checked before the first frame is rendered: the directory accepts new
+    // files, and no entry in it that a frame would replace is a directory. Read from the directory's
+    // listing (bounded by what is there), not frame by frame, so a huge range costs nothing here.
+    let frame_path = |f: u32| dir.join(format!("frame_{f:05}.png"));
+    output::check_writable(&frame_path(range.start))?;
+    let listing = std::fs::read_dir(dir)
+        .map_err(|e| Failure::input(format!("{}: cannot list the output directory: {e}", dir.display())))?;
+    for entry in listing.flatten() {
+        let name = entry.file_name();
+        let number =
+            name.to_str().and_then(|n| n.strip_prefix("frame_")?.strip_suffix(".png")?.parse::<u32>().ok());
+        if number.is_some_and(|f| range.contains(&f) && name == frame_path(f).file_name().unwrap_or_default())
+        {
+            output::check_directory(&entry.path())?;
+        }
     }
-    output::check_writable(&paths[0])?;
     let scene = Scene::load(&a.scene)?;
     let mut backend = make_backend(a.backend)?;
     let bar = indicatif::ProgressBar::new(range.len() as u64);
@@ -378,9 +390,9 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, eta {eta}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    for (f, path) in range.clone().zip(&paths) {
+    for f in range.clone() {
         let frame = frame_at(&scene, f as f32 / fps, a.width, a.height);
-        output::write_png_banded(path, frame.width, frame.height, |rows| {
+        output::write_png_banded(&frame_path(f), frame.width, frame.height, |rows| {
             let band = backend.render_rows(&frame, rows)?;
             check_finite(&band)?;
             Ok::<_, Failure>(band)
@@ -416,8 +428,11 @@ fn json_number(v: f32) -> f32 {
 }
 
 fn parse_pixel(s: &str) -> Result<(u32, u32), Failure> {
-    let bad =
-        || Failure::input(format!("--pixel {s}: expected `X,Y` with non-negative integers, e.g. 256,128"));
+    let bad = || {
+        Failure::input(format!(
+            "--pixel {s}: expected `X,Y` with non-negative integers inside the image, e.g. 256,128"
+        ))
+    };
     let (x, y) = s.split_once(',').ok_or_else(bad)?;
     Ok((x.trim().parse().map_err(|_| bad())?, y.trim().parse().map_err(|_| bad())?))
 }
@@ -546,4 +561,25 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         println!("{}", serde_json::to_string_pretty(&json).unwrap_or_default());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::json_number;
+
+    /// serde_json writes NaN and ±∞ as `null`; `probe` passes every number through
+    /// `json_number` first. (A scene file cannot make an energy overflow within its bounds, so
+    /// the CLI test `probe_never_prints_null` alone could not fail on this.)
+    #[test]
+    fn json_numbers_are_never_null() {
+        let values = [f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MAX, 1.5, -0.0];
+        let json = serde_json::to_string(&values.map(json_number)).unwrap();
+        assert!(!json.contains("null"), "{json}");
+        assert_eq!(json_number(f32::INFINITY), f32::MAX);
+        assert_eq!(json_number(f32::NEG_INFINITY), -f32::MAX);
+        assert_eq!(json_number(f32::NAN), 0.0);
+        assert_eq!(json_number(1.5), 1.5);
+        // Without it, the same values do print null.
+        assert!(serde_json::to_string(&values).unwrap().contains("null"));
+    }
 }

@@ -325,6 +325,10 @@ fn negative_numbers_are_values_not_flags() {
     assert_exit_2(&["probe", s, "--pixel", "-1,0"], &["--pixel -1,0", "non-negative"]);
     assert_exit_2(&["render", s, "-o", o, "--frames", "-1..3"], &["--frames -1..3", "non-negative"]);
     assert_exit_2(&["render", s, "-o", o, "--width", "-5"], &["--width", "-5"]);
+    assert_exit_2(
+        &["render", s, "-o", o, "--frames", "0..=4294967295"],
+        &["--frames", "go up to 4294967294"],
+    );
     assert!(!Path::new(o).exists());
 }
 
@@ -391,12 +395,23 @@ fn frames_check_every_output_path_before_rendering() {
     assert!(e.contains("frame_00001.png") && e.contains("is a directory"), "{e}");
     assert!(!out.join("frame_00000.png").exists(), "frame 0 was rendered before the check");
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "only the blocking directory");
+    // A directory far along a huge range is found at once, without listing every frame's path.
+    std::fs::create_dir_all(out.join("frame_4000000000.png")).unwrap();
+    std::fs::remove_dir(out.join("frame_00001.png")).unwrap();
+    let start = std::time::Instant::now();
+    let r = hadou(&["render", s.to_str().unwrap(), "-o", &d, "--frames", "0..=4294967294"]);
+    let e = stderr(&r);
+    assert_eq!(r.status.code(), Some(2), "{e}");
+    assert!(e.contains("frame_4000000000.png") && e.contains("is a directory"), "{e}");
+    assert!(start.elapsed().as_secs() < 10, "took {:?}", start.elapsed());
 }
 
 #[test]
 fn probe_never_prints_null() {
     // Two spheres hit through their centres with no core: the largest energies a scene can
-    // hold; whatever they come to (saturated or huge), the JSON has a number for each.
+    // hold; whatever they come to (saturated or huge), the JSON has a number for each. (Within
+    // the scene bounds they stay finite; the mapping of ±∞ and NaN itself is unit-tested in
+    // main.rs, `json_numbers_are_never_null`.)
     let dir = tmpdir("probe-json");
     let text = GOOD.replace(
         "[[wave]]",

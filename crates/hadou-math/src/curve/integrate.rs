@@ -845,16 +845,6 @@ mod model_tests {
     /// Rays per shape and falloff (300 for a calibration run in release mode).
     const RAYS: usize = 60;
 
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
-
     /// The chord model never underestimates: on random rays past the four test curves, every
     /// piece of every level whose estimate lies near the tolerances in use (1e-4 to 1e-2) is
     /// off by less than its estimate, against the exact (adaptive) integral of the curve it
@@ -872,7 +862,7 @@ mod model_tests {
                 let rc = if falloff == Falloff::Faithful { 0.0 } else { 0.05 };
                 let fp = FieldParams { falloff, core_radius: rc };
                 let gamma = f64::from(w.gamma);
-                let mut rng = Rng(0x1234_5678_9abc_def1);
+                let mut rng = support::Rng(0x1234_5678_9abc_def1);
                 let mut bins: Vec<Vec<f64>> = vec![Vec::new(); edges.len() - 1];
                 for _ in 0..RAYS {
                     let u = [rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0];
