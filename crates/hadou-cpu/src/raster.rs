@@ -93,7 +93,7 @@ pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis, rows: std::ops::Ra
                     let t = &tris[tri_id[i] as usize];
                     let (world, normal) = interpolate(t, x as f32 + 0.5, py + 0.5);
                     let l = &frame.light;
-                    let albedo = frame.objects[t.object as usize].color;
+                    let albedo = frame.objects[t.object as usize].materials[0].base_color;
                     col[i] = shade::diffuse(albedo, normal, l.direction, l.color, l.ambient);
                     let d = (world - basis.eye).length();
                     surf[i] = Some(if d.is_finite() { d } else { 0.0 });

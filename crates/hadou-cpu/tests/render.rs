@@ -33,16 +33,12 @@ fn frame(objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
 }
 
 fn cube_at(name: &str, z: f32) -> Object {
-    Object {
-        name: name.into(),
-        mesh: Arc::new(cube()),
-        transform: Mat4::from_trs(Vec3::new(0.0, 0.0, z), Vec3::ZERO, Vec3::splat(3.0)),
-        color: [0.5, 0.5, 0.5],
-    }
+    Object::new(name, Arc::new(cube()), Mat4::from_trs(Vec3::new(0.0, 0.0, z), Vec3::ZERO, Vec3::splat(3.0)), [0.5, 0.5, 0.5])
 }
 
 fn beam(falloff: Falloff) -> Wave {
     Wave {
+        light: Default::default(),
         name: "beam".into(),
         color: [0.8, 0.8, 0.2, 1.0],
         falloff,
@@ -98,6 +94,7 @@ fn rendering_is_deterministic_across_thread_counts() {
 fn degenerate_waves_and_cameras_stay_finite() {
     let mut waves = vec![
         Wave {
+            light: Default::default(),
             name: "through-eye".into(),
             color: [1.0; 4],
             falloff: Falloff::Faithful,

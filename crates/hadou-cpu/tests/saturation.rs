@@ -56,7 +56,7 @@ fn bezier(a: f32) -> CurveWave {
 /// A 3×3 frame (the centre pixel looks exactly along −z) with two copies of the wave, so the
 /// sum of two saturated energies is exercised too.
 fn frame(shape: WaveShape, falloff: Falloff, mode: ToneMode) -> Frame {
-    let wave = Wave { name: "w".into(), color: [1.0, 0.5, 0.0, 1.0], falloff, core_radius: 0.0, shape };
+    let wave = Wave::new("w", [1.0, 0.5, 0.0, 1.0], falloff, 0.0, shape);
     Frame {
         width: 3,
         height: 3,

@@ -24,6 +24,7 @@ fn quad(size: f32) -> Arc<Mesh> {
         positions: vec![[-h, 0.0, -h], [h, 0.0, -h], [h, 0.0, h], [-h, 0.0, h]],
         normals: vec![[0.0, 1.0, 0.0]; 4],
         indices: vec![0, 2, 1, 0, 3, 2],
+        ..Mesh::default()
     })
 }
 
@@ -43,13 +44,9 @@ fn main() {
         },
         background: [0.02, 0.03, 0.05],
         light: Light { direction: Vec3::new(0.0, -1.0, 0.0), color: [1.0; 3], ambient: [0.1; 3] },
-        objects: vec![Object {
-            name: "ground".into(),
-            mesh: quad(40.0),
-            transform: Mat4::translation(Vec3::new(0.0, -1.0, 0.0)),
-            color: [0.5, 0.5, 0.45],
-        }],
+        objects: vec![Object::new("ground", quad(40.0), Mat4::translation(Vec3::new(0.0, -1.0, 0.0)), [0.5, 0.5, 0.45])],
         waves: vec![Wave {
+            light: Default::default(),
             name: "beam".into(),
             color: [0.4, 0.7, 1.0, 1.0],
             falloff: Falloff::InverseSquare,

@@ -36,7 +36,7 @@ fn malformed_mesh_is_an_error_naming_the_object() {
     let Some(mut gpu) = gpu_or_skip("malformed mesh") else { return };
     let mut f = occlusion_frame(32, 24);
     let bad =
-        Mesh { positions: vec![[0.0; 3]; 3], normals: vec![[0.0, 1.0, 0.0]; 3], indices: vec![0, 1, 7] };
+        Mesh { positions: vec![[0.0; 3]; 3], normals: vec![[0.0, 1.0, 0.0]; 3], indices: vec![0, 1, 7], ..Mesh::default() };
     f.objects[0].mesh = Arc::new(bad);
     f.objects[0].name = "broken box".into();
     match gpu.render(&f) {
@@ -45,6 +45,6 @@ fn malformed_mesh_is_an_error_naming_the_object() {
     }
     let mut f = occlusion_frame(32, 24);
     f.objects[1].mesh =
-        Arc::new(Mesh { positions: vec![[0.0; 3]; 3], normals: vec![], indices: vec![0, 1, 2] });
+        Arc::new(Mesh { positions: vec![[0.0; 3]; 3], normals: vec![], indices: vec![0, 1, 2], ..Mesh::default() });
     assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("normals")));
 }

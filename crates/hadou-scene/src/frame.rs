@@ -1,8 +1,9 @@
 //! [`Frame`]: the plain values a backend draws — one instant of a scene, nothing animated, nothing
 //! to parse. Produced by `Scene::at`, consumed by every backend.
 
-use hadou_math::curve::CurveWave;
+use hadou_math::curve::{CurveWave, PreparedCurve};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
+pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use std::sync::Arc;
 
@@ -171,6 +172,130 @@ pub struct Mesh {
     pub normals: Vec<[f32; 3]>,
     /// Triangle list, counter-clockwise front faces.
     pub indices: Vec<u32>,
+    /// Texture coordinates, one per position, or empty (no textures can be sampled).
+    pub uvs: Vec<[f32; 2]>,
+    /// Linear RGBA vertex colours, one per position, or empty (white).
+    pub colors: Vec<[f32; 4]>,
+    /// Index into [`Mesh::materials`] per vertex (the three vertices of a triangle agree), or
+    /// empty (material 0 everywhere).
+    pub material_ids: Vec<u32>,
+    /// The materials the mesh came with (a glTF file's), or empty (one default material).
+    pub materials: Vec<Material>,
+    /// Outline directions, one per position: unit normals averaged over every vertex at the same
+    /// position, so an inverted hull pushed along them stays closed at hard edges (000 §2.3).
+    /// Empty until [`crate::mesh::with_outline_normals`] fills them; backends then fall back to
+    /// `normals`.
+    pub outline_normals: Vec<[f32; 3]>,
+}
+
+impl Mesh {
+    /// Material slot of vertex `v` (0 when the mesh has no per-vertex ids).
+    #[inline]
+    pub fn material_of(&self, v: usize) -> u32 {
+        self.material_ids.get(v).copied().unwrap_or(0)
+    }
+}
+
+/// An RGBA8 image for texturing: colour channels sRGB-encoded (as PNG and JPEG store them), alpha
+/// linear, rows from the top.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Texture {
+    /// Where it came from, for messages.
+    pub name: String,
+    /// Width in texels, `≥ 1`.
+    pub width: u32,
+    /// Height in texels, `≥ 1`.
+    pub height: u32,
+    /// `width × height` texels.
+    pub texels: Vec<[u8; 4]>,
+}
+
+/// A texture as a material uses it: the image and how it is sampled
+/// ([`hadou_math::toon::sample`]: level 0, bilinear or nearest, per-axis wrapping).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureRef {
+    /// The image (shared between materials and frames).
+    pub image: Arc<Texture>,
+    /// Wrapping along u and v.
+    pub wrap: [Wrap; 2],
+    /// Filtering.
+    pub filter: Filter,
+}
+
+impl TextureRef {
+    /// Samples the texture at `uv` (linear RGBA).
+    #[inline]
+    pub fn sample(&self, uv: [f32; 2]) -> [f32; 4] {
+        let t = &self.image;
+        hadou_math::toon::sample(&t.texels, t.width, t.height, self.wrap, self.filter, uv)
+    }
+}
+
+/// How a material responds to the scene's directional light (its look without the wave).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum ShadingModel {
+    /// `albedo · (ambient + light · max(0, N·(−L)))` (`hadou_math::shade::diffuse`).
+    #[default]
+    Diffuse,
+    /// `albedo · ramp(N·(−L))`: the ramp's colours multiply the albedo (toon shading).
+    Toon,
+    /// `albedo`, unaffected by lights (glTF `KHR_materials_unlit`).
+    Unlit,
+}
+
+/// The inverted-hull outline of a material (000 §2.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outline {
+    /// Width `d`: the hull's vertices move `d · |view depth|` along their outline normal, so the
+    /// outline is about `d / (2·tan(fov/2)) · image height` pixels wide at any distance.
+    pub width: f32,
+    /// Flat linear RGB colour.
+    pub color: [f32; 3],
+}
+
+/// How a surface is shaded: its own look and its response to the waves' light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name (from the scene file or the glTF file), for messages.
+    pub name: String,
+    /// Response to the scene light.
+    pub model: ShadingModel,
+    /// Linear RGB base colour; multiplied by the base texture and the vertex colour.
+    pub base_color: [f32; 3],
+    /// Base-colour texture (glTF `baseColorTexture`).
+    pub base_texture: Option<TextureRef>,
+    /// Feature texture `T` of 000 §2.2: multiplies the shaded colour, `H = S · T`.
+    pub feature_texture: Option<TextureRef>,
+    /// The toon ramp of [`ShadingModel::Toon`] (multipliers of the albedo).
+    pub ramp: Ramp,
+    /// `β ∈ [0, 1]`: 0 = the material's own look, 1 = the wave's look (000 §2.1: "the object's
+    /// own colour is ignored under the wave's light"); the shaded colour is
+    /// `(1 − β)·own + β·wave`.
+    pub wave_blend: f32,
+    /// Inverted-hull outline, if any.
+    pub outline: Option<Outline>,
+}
+
+impl Material {
+    /// The plain diffuse material of colour `color`: not lit by waves, no outline.
+    pub fn diffuse(color: [f32; 3]) -> Self {
+        Material {
+            name: "default".into(),
+            model: ShadingModel::Diffuse,
+            base_color: color,
+            base_texture: None,
+            feature_texture: None,
+            ramp: Ramp::two_band(0.0, [0.6; 3], 0.0),
+            wave_blend: 0.0,
+            outline: None,
+        }
+    }
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material::diffuse([0.8; 3])
+    }
 }
 
 /// A mesh placed in the world.
@@ -182,8 +307,66 @@ pub struct Object {
     pub mesh: Arc<Mesh>,
     /// Object → world.
     pub transform: Mat4,
-    /// Linear RGB albedo.
-    pub color: [f32; 3],
+    /// One material per slot of the mesh (`mesh.material_ids` index it), at least one.
+    pub materials: Vec<Material>,
+}
+
+impl Object {
+    /// An object with one diffuse material of `color`.
+    pub fn new(name: impl Into<String>, mesh: Arc<Mesh>, transform: Mat4, color: [f32; 3]) -> Self {
+        Object { name: name.into(), mesh, transform, materials: vec![Material::diffuse(color)] }
+    }
+
+    /// The material of slot `id` (the last one for an out-of-range id).
+    #[inline]
+    pub fn material(&self, id: u32) -> &Material {
+        let n = self.materials.len();
+        &self.materials[(id as usize).min(n.saturating_sub(1))]
+    }
+}
+
+/// How a wave lights surfaces (000 §2.1): the light point on its centre line, the ramp over
+/// `m = N·L`, and an optional glow in the wave's own colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WaveLight {
+    /// The look `ramp(m)` (absolute linear RGB) the wave gives a surface.
+    pub ramp: Ramp,
+    /// Glow: adds `glow · rgb · a · ρ(d)` to lit surfaces (`ρ` the wave's density at the
+    /// point; 0 = off, the thesis).
+    pub glow: f32,
+}
+
+impl Default for WaveLight {
+    /// White bands ([`Ramp::for_wave_color`] of white), no glow.
+    fn default() -> Self {
+        WaveLight { ramp: Ramp::for_wave_color([1.0; 3]), glow: 0.0 }
+    }
+}
+
+/// Where a wave's light comes from: its centre line.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightLine {
+    /// One point (sphere waves).
+    Point(Vec3f),
+    /// A segment (capsules and bulged beams: `M..M2`).
+    Segment(Vec3f, Vec3f),
+    /// An infinite line through a point along a unit direction (cylinder waves).
+    Line(Vec3f, Vec3f),
+    /// A polyline through points of the curve (curved waves).
+    Polyline(Vec<Vec3f>),
+}
+
+impl LightLine {
+    /// The nearest point of the line to `p` (000 §2.1, SPEC.md §2.1).
+    pub fn nearest(&self, p: Vec3f) -> Vec3f {
+        use hadou_math::toon::{nearest_on_line, nearest_on_polyline, nearest_on_segment};
+        match self {
+            LightLine::Point(c) => *c,
+            LightLine::Segment(a, b) => nearest_on_segment(p, *a, *b),
+            LightLine::Line(a, d) => nearest_on_line(p, *a, *d),
+            LightLine::Polyline(pts) => nearest_on_polyline(p, pts),
+        }
+    }
 }
 
 /// One energy wave of a frame.
@@ -199,6 +382,8 @@ pub struct Wave {
     pub core_radius: f32,
     /// The shape.
     pub shape: WaveShape,
+    /// Its light on surfaces.
+    pub light: WaveLight,
 }
 
 /// The shape of a wave.
@@ -233,4 +418,51 @@ pub enum ToneMode {
     /// A white-core filmic mapping: dense energy saturates towards white, smoothly.
     #[default]
     Filmic,
+}
+
+impl Wave {
+    /// A wave with the default light ([`Ramp::for_wave_color`], no glow).
+    pub fn new(name: impl Into<String>, color: [f32; 4], falloff: Falloff, core_radius: f32, shape: WaveShape) -> Self {
+        let light = WaveLight { ramp: Ramp::for_wave_color([color[0], color[1], color[2]]), glow: 0.0 };
+        Wave { name: name.into(), color, falloff, core_radius, shape, light }
+    }
+
+    /// The wave's centre line as a light (000 §2.1, SPEC.md §2.1): the centre of a sphere, the
+    /// segment `M..M₂` of a capsule or bulged beam, the axis of a cylinder, and for a curve the
+    /// polyline of [`PreparedCurve::light_polyline`] (`prepared` is used when given, else the
+    /// curve is prepared here).
+    pub fn light_line(&self, prepared: Option<&PreparedCurve>) -> LightLine {
+        match &self.shape {
+            WaveShape::Sphere(f) => LightLine::Point(f.center),
+            WaveShape::Cylinder(f) => LightLine::Line(f.point, f.dir),
+            WaveShape::Capsule(f) => LightLine::Segment(f.m, f.m2()),
+            WaveShape::Beam(f) => LightLine::Segment(f.capsule.m, f.capsule.m2()),
+            WaveShape::Curve(c) => {
+                let owned;
+                let prep = match prepared {
+                    Some(p) => p,
+                    None => {
+                        owned = hadou_math::curve::prepare(c);
+                        &owned
+                    }
+                };
+                LightLine::Polyline(prep.light_polyline())
+            }
+        }
+    }
+
+    /// The strength `α·a` that weighs this wave against others at a surface point
+    /// ([`hadou_math::toon::dominance`]): the colour's alpha times the field's largest strength.
+    pub fn light_strength(&self) -> f32 {
+        let alpha = match &self.shape {
+            WaveShape::Sphere(f) => f.alpha,
+            WaveShape::Cylinder(f) => f.alpha,
+            WaveShape::Capsule(f) => f.alpha_s.max(f.alpha_c),
+            WaveShape::Beam(f) => {
+                f.capsule.alpha_s.max(f.capsule.alpha_c).max(f.head_alpha).max(f.muzzle_alpha)
+            }
+            WaveShape::Curve(c) => c.alpha,
+        };
+        (self.color[3] * alpha).max(0.0)
+    }
 }

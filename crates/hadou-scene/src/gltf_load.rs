@@ -51,12 +51,17 @@ fn parent_dir(path: &Path) -> &Path {
 /// must lie inside the file's own directory tree.
 pub fn load_gltf(path: &Path) -> Result<Mesh, String> {
     let mut budget = Budget::FULL;
-    load_gltf_in(path, parent_dir(path), &mut budget)
+    load_gltf_in(path, parent_dir(path), &mut budget, &mut Vec::new())
 }
 
 /// [`load_gltf`] with external buffers confined to the directory tree of `root`, and the
 /// instanced triangles taken from `budget`.
-pub(crate) fn load_gltf_in(path: &Path, root: &Path, budget: &mut Budget) -> Result<Mesh, String> {
+pub(crate) fn load_gltf_in(
+    path: &Path,
+    root: &Path,
+    budget: &mut Budget,
+    _warnings: &mut Vec<String>,
+) -> Result<Mesh, String> {
     let bytes = read_regular_file(path, GLTF_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
     from_bytes_in(&bytes, parent_dir(path), root, budget)
 }
@@ -452,7 +457,7 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
         }
         None => smooth_normals(&positions, &indices),
     };
-    Ok(Mesh { positions, normals, indices })
+    Ok(Mesh { positions, normals, indices, ..Mesh::default() })
 }
 
 /// Checks that reading `acc` stays inside its buffer view and buffer and has the expected layout.

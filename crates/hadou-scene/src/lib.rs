@@ -24,6 +24,7 @@ pub mod mesh;
 mod params;
 mod scene;
 mod schema;
+mod texture;
 mod toml_read;
 
 pub use anim::Interpolation;
@@ -35,3 +36,4 @@ pub use gltf_load::{gltf_from_bytes, load_gltf};
 pub use image::Image;
 pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
 pub use scene::Scene;
+pub use texture::{decode_texture, encode_png, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS};

@@ -26,6 +26,7 @@ pub fn box_mesh(size: [f32; 3]) -> Mesh {
             let p: [f32; 3] = std::array::from_fn(|i| (n[i] + su * u[i] + sv * v[i]) * h[i]);
             m.positions.push(p);
             m.normals.push(n);
+            m.uvs.push([0.5 * (su + 1.0), 0.5 * (1.0 - sv)]);
         }
         m.indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
     }
@@ -49,6 +50,7 @@ pub fn sphere_mesh(radius: f32, segments: u32) -> Mesh {
             let n = [st * sp, ct, st * cp];
             m.positions.push(n.map(|c| c * radius));
             m.normals.push(n);
+            m.uvs.push([j as f32 / slices as f32, i as f32 / stacks as f32]);
         }
     }
     let row = slices + 1;
@@ -76,6 +78,8 @@ pub fn plane_mesh(size: [f32; 2]) -> Mesh {
         positions: vec![[-hx, 0.0, -hz], [-hx, 0.0, hz], [hx, 0.0, hz], [hx, 0.0, -hz]],
         normals: vec![[0.0, 1.0, 0.0]; 4],
         indices: vec![0, 1, 2, 0, 2, 3],
+        uvs: vec![[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]],
+        ..Mesh::default()
     }
 }
 
@@ -99,21 +103,19 @@ pub fn smooth_normals(positions: &[[f32; 3]], indices: &[u32]) -> Vec<[f32; 3]> 
     acc.into_iter().map(|n| n.normalize_or(Vec3f::Y).to_array()).collect()
 }
 
-/// `mesh` with `m` applied to positions and normals (normals by the inverse transpose, then
-/// renormalised). A mirroring transform (negative determinant) reverses the winding so front
+/// `mesh` with `m` applied to positions, normals and outline normals (normals by the inverse
+/// transpose, then renormalised); every other attribute is kept. A mirroring transform (negative determinant) reverses the winding so front
 /// faces stay counter-clockwise.
 pub fn transform_mesh(mesh: &Mesh, m: &Mat4) -> Mesh {
     let nm = m.normal_matrix();
     let positions =
         mesh.positions.iter().map(|&p| m.transform_point(Vec3f::from_array(p)).to_array()).collect();
-    let normals = mesh
-        .normals
-        .iter()
-        .map(|&n| {
-            let n0 = Vec3f::from_array(n);
-            nm.transform_vector(n0).normalize_or(n0.normalize_or(Vec3f::Y)).to_array()
-        })
-        .collect();
+    let normal = |&n: &[f32; 3]| {
+        let n0 = Vec3f::from_array(n);
+        nm.transform_vector(n0).normalize_or(n0.normalize_or(Vec3f::Y)).to_array()
+    };
+    let normals = mesh.normals.iter().map(normal).collect();
+    let outline_normals = mesh.outline_normals.iter().map(normal).collect();
     let x = m.transform_vector(Vec3f::X);
     let y = m.transform_vector(Vec3f::Y);
     let z = m.transform_vector(Vec3f::Z);
@@ -123,15 +125,62 @@ pub fn transform_mesh(mesh: &Mesh, m: &Mat4) -> Mesh {
             t.swap(1, 2);
         }
     }
-    Mesh { positions, normals, indices }
+    Mesh { positions, normals, indices, outline_normals, ..mesh.clone() }
 }
 
-/// Appends `other` to `mesh`.
+/// Appends `other`'s geometry and per-vertex attributes to `mesh` (an attribute only one side
+/// has is filled with its neutral value on the other: uv 0, white, material 0, the normal);
+/// material ids are taken as they are (callers keep one material list).
 pub fn append_mesh(mesh: &mut Mesh, other: &Mesh) {
-    let base = mesh.positions.len() as u32;
+    let base = mesh.positions.len();
+    let n = other.positions.len();
+    fn extend<T: Clone>(dst: &mut Vec<T>, base: usize, src: &[T], n: usize, fill: T) {
+        if dst.is_empty() && src.is_empty() {
+            return;
+        }
+        dst.resize(base, fill.clone());
+        if src.is_empty() {
+            dst.resize(base + n, fill);
+        } else {
+            dst.extend_from_slice(src);
+        }
+    }
+    extend(&mut mesh.uvs, base, &other.uvs, n, [0.0; 2]);
+    extend(&mut mesh.colors, base, &other.colors, n, [1.0; 4]);
+    extend(&mut mesh.material_ids, base, &other.material_ids, n, 0);
+    if !mesh.outline_normals.is_empty() || !other.outline_normals.is_empty() {
+        let mut on = std::mem::take(&mut mesh.outline_normals);
+        if on.is_empty() {
+            on = mesh.normals.clone();
+        }
+        on.extend_from_slice(if other.outline_normals.is_empty() { &other.normals } else { &other.outline_normals });
+        mesh.outline_normals = on;
+    }
     mesh.positions.extend_from_slice(&other.positions);
     mesh.normals.extend_from_slice(&other.normals);
-    mesh.indices.extend(other.indices.iter().map(|i| i + base));
+    mesh.indices.extend(other.indices.iter().map(|i| i + base as u32));
+}
+
+/// `mesh` with [`Mesh::outline_normals`] filled: for every group of vertices at exactly the same
+/// position, the normalised sum of their normals (so the hard edges of a box, whose corners carry
+/// three face normals, get one shared direction and the pushed-out hull stays closed). A group
+/// whose normals cancel keeps each vertex's own normal.
+pub fn with_outline_normals(mut mesh: Mesh) -> Mesh {
+    let mut groups: std::collections::HashMap<[u32; 3], Vec3f> = std::collections::HashMap::new();
+    let key = |p: &[f32; 3]| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        *groups.entry(key(p)).or_insert(Vec3f::ZERO) += Vec3f::from_array(*n);
+    }
+    mesh.outline_normals = mesh
+        .positions
+        .iter()
+        .zip(&mesh.normals)
+        .map(|(p, n)| {
+            let own = Vec3f::from_array(*n);
+            groups[&key(p)].try_normalize().unwrap_or(own).to_array()
+        })
+        .collect();
+    mesh
 }
 
 #[cfg(test)]
@@ -164,6 +213,26 @@ mod tests {
         let [a, b, c] = [t[0], t[1], t[2]].map(|i| Vec3f::from_array(m.positions[i as usize]));
         assert!((b - a).cross(c - a).y > 0.0);
         assert_eq!(m.positions[2], [1.0, 0.0, 2.0]);
+    }
+
+    #[test]
+    fn outline_normals_close_hard_edges() {
+        let m = with_outline_normals(box_mesh([2.0, 2.0, 2.0]));
+        let k = 1.0 / 3f32.sqrt();
+        for (p, n) in m.positions.iter().zip(&m.outline_normals) {
+            // Every box corner points diagonally out of the box.
+            let want = p.map(|c| c.signum() * k);
+            for i in 0..3 {
+                assert!((n[i] - want[i]).abs() < 1e-6, "{p:?} {n:?}");
+            }
+        }
+        let mut a = plane_mesh([1.0, 1.0]);
+        a.uvs.clear();
+        append_mesh(&mut a, &plane_mesh([1.0, 1.0]));
+        assert_eq!(a.uvs.len(), 8);
+        assert_eq!(a.uvs[0], [0.0, 0.0]);
+        assert_eq!(a.uvs[5], [0.0, 1.0]);
+        assert!(a.colors.is_empty() && a.material_ids.is_empty());
     }
 
     #[test]

@@ -3,7 +3,9 @@
 
 use crate::anim::Track;
 use crate::error::SceneError;
-use crate::frame::{Camera, ColorMapping, Frame, Light, Mesh, Object, ToneMode, Wave, WaveShape};
+use crate::frame::{
+    Camera, ColorMapping, Frame, Light, Material, Mesh, Object, Ramp, ToneMode, Wave, WaveLight, WaveShape,
+};
 use crate::params::ParamSet;
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
@@ -209,7 +211,7 @@ impl Scene {
                         v3(p, vals, "rotation"),
                         v3(p, vals, "scale"),
                     ),
-                    color: p.arr(vals, "color"),
+                    materials: self.object_materials(o, vals),
                 }
             })
             .collect();
@@ -267,7 +269,19 @@ impl Scene {
             falloff: w.falloff,
             core_radius: p.f(vals, "core_radius"),
             shape,
+            light: self.wave_light(w, vals),
         }
+    }
+
+    /// The materials of object `o` at these values.
+    fn object_materials(&self, o: &ObjectDef, vals: &[f32]) -> Vec<Material> {
+        vec![Material::diffuse(o.params.arr(vals, "color"))]
+    }
+
+    /// The light of wave `w` at these values.
+    fn wave_light(&self, w: &WaveDef, vals: &[f32]) -> WaveLight {
+        let c = w.params.arr::<4>(vals, "rgba");
+        WaveLight { ramp: Ramp::for_wave_color([c[0], c[1], c[2]]), glow: 0.0 }
     }
 
     pub(crate) fn build_curve(&self, w: &WaveDef, vals: &[f32]) -> CurveWave {

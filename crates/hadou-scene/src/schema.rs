@@ -343,7 +343,7 @@ fn parse_object(
                     m.clone()
                 }
                 None => {
-                    let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget)
+                    let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut Vec::new())
                         .map_err(|message| gltf_err(message, file.clone()))?;
                     let mesh = Arc::new(mesh);
                     assets.cache.insert(real, mesh.clone());

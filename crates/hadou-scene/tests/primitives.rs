@@ -63,5 +63,5 @@ fn scene_objects_use_their_size_and_segments() {
     let f = s.at(0.0);
     assert!(f.objects[0].mesh.positions.iter().all(|p| (Vec3f::from_array(*p).length() - 3.0).abs() < 1e-5));
     assert_eq!(f.objects[1].transform.transform_point(Vec3f::ZERO), Vec3f::new(0.0, -1.0, 0.0));
-    assert_eq!(f.objects[0].color, [0.8; 3]);
+    assert_eq!(f.objects[0].materials[0].base_color, [0.8; 3]);
 }

@@ -92,15 +92,16 @@ pub fn plane_mesh(size: f32) -> Arc<Mesh> {
         positions: vec![[-h, 0.0, -h], [h, 0.0, -h], [h, 0.0, h], [-h, 0.0, h]],
         normals: vec![[0.0, 1.0, 0.0]; 4],
         indices: vec![0, 2, 1, 0, 3, 2],
+        ..Mesh::default()
     })
 }
 
 pub fn object(name: &str, mesh: Arc<Mesh>, pos: Vec3f, rot: Vec3f, color: [f32; 3]) -> Object {
-    Object { name: name.into(), mesh, transform: Mat4::from_trs(pos, rot, Vec3::splat(1.0)), color }
+    Object::new(name, mesh, Mat4::from_trs(pos, rot, Vec3::splat(1.0)), color)
 }
 
 pub fn wave(name: &str, color: [f32; 4], falloff: Falloff, core_radius: f32, shape: WaveShape) -> Wave {
-    Wave { name: name.into(), color, falloff, core_radius, shape }
+    Wave::new(name, color, falloff, core_radius, shape)
 }
 
 /// A frame with a camera at `eye` looking at `target`, no objects or waves.

@@ -13,6 +13,20 @@ pub const MAX_PIECES: usize = 1 << 14;
 /// (`max(R, X/16)`, `R` the bounding radius, `X` the axial length).
 pub const LEAF_TOLERANCE: f64 = 2e-5;
 
+/// Distance a curve's light polyline may stray from the curve, relative to the curve's size
+/// ([`PreparedCurve::light_polyline`]).
+pub const LIGHT_TOLERANCE: f64 = 1e-3;
+/// Most points of a curve's light polyline.
+pub const MAX_LIGHT_POINTS: usize = 128;
+
+/// Distance from `p` to the segment `a..b`.
+fn segment_distance(p: Vec3<f64>, a: Vec3<f64>, b: Vec3<f64>) -> f64 {
+    let d = b - a;
+    let dd = d.dot(d);
+    let t = if dd > 0.0 { ((p - a).dot(d) / dd).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + d * t)).length()
+}
+
 /// Smallest core radius used, relative to the curve's size: the `1/r` and `1/r²` densities are
 /// singular on the curve, so with `r_c = 0` a ray exactly through it would be infinite. Every
 /// integrator and the reference use `max(r_c, MIN_CORE·size)` (see
@@ -147,6 +161,44 @@ impl PreparedCurve {
     /// The exact cross-section point `c_⊥(s)` (`s` clamped to `[0, k·s_end]`), in `f64`.
     pub fn cross_section(&self, s: f64) -> [f64; 2] {
         self.shape64.eval(s.clamp(0.0, self.s_head))
+    }
+    /// The curve as a polyline of world points for lighting (000 §2.1 generalised to curves: the
+    /// light point is the nearest point of the curve). The leaf nodes of the [`PieceTable`] (exact
+    /// curve points), thinned by Douglas–Peucker so that no dropped node lies farther than
+    /// `LIGHT_TOLERANCE · size` from the polyline, at most [`MAX_LIGHT_POINTS`] points (the
+    /// tolerance doubles until they fit). Always at least the two end points.
+    pub fn light_polyline(&self) -> Vec<Vec3<f32>> {
+        let pts: Vec<Vec3<f64>> =
+            self.table.nodes.iter().map(|n| self.point(f64::from(n[3]))).collect();
+        let mut tol = LIGHT_TOLERANCE * self.size;
+        loop {
+            let mut keep = vec![false; pts.len()];
+            keep[0] = true;
+            *keep.last_mut().expect("a table has at least two nodes") = true;
+            let mut stack = vec![(0usize, pts.len() - 1)];
+            while let Some((a, b)) = stack.pop() {
+                if b <= a + 1 {
+                    continue;
+                }
+                let (mut worst, mut at) = (-1.0f64, a);
+                for (i, p) in pts.iter().enumerate().take(b).skip(a + 1) {
+                    let d = segment_distance(*p, pts[a], pts[b]);
+                    if d > worst {
+                        worst = d;
+                        at = i;
+                    }
+                }
+                if worst > tol {
+                    keep[at] = true;
+                    stack.push((a, at));
+                    stack.push((at, b));
+                }
+            }
+            if keep.iter().filter(|&&k| k).count() <= MAX_LIGHT_POINTS || !(tol > 0.0) {
+                return pts.iter().zip(&keep).filter(|(_, &k)| k).map(|(p, _)| p.as_f32()).collect();
+            }
+            tol *= 2.0;
+        }
     }
     /// The curve point `c(s)` in world space (`s` clamped to `[0, k·s_end]`), in `f64`.
     pub fn point(&self, s: f64) -> Vec3<f64> {

@@ -1,0 +1,167 @@
+//! Texture images: decoding untrusted PNG (and JPEG) bytes into a [`Texture`] with bounded
+//! memory, and reading texture files named by a scene.
+//!
+//! The image's header is read first and its size checked against [`TEXTURE_MAX_EDGE`] and
+//! [`TEXTURE_MAX_TEXELS`] before any pixel buffer is allocated; decoders run under
+//! [`guarded`], so a panic inside one is an error, never a crash.
+
+use crate::files::read_regular_file;
+use crate::frame::Texture;
+use crate::guard::guarded;
+use std::path::Path;
+
+/// Largest texture file read, in bytes (256 MiB).
+pub const TEXTURE_MAX_BYTES: u64 = 256 << 20;
+/// Longest texture edge accepted, in texels.
+pub const TEXTURE_MAX_EDGE: u32 = 16384;
+/// Most texels of one texture (an 8192 × 8192 image).
+pub const TEXTURE_MAX_TEXELS: u64 = 8192 * 8192;
+/// Edge above which a texture is halved (box filter) at load, with a warning: textures are
+/// sampled at level 0 only, and the GPU keeps every texture of a frame in one storage buffer.
+pub const TEXTURE_DOWNSCALE_EDGE: u32 = 4096;
+
+/// Decodes PNG or JPEG `bytes` (recognised by their signature) into RGBA8. `warnings` receives a
+/// note when the image is downscaled.
+pub fn decode_texture(bytes: &[u8], name: &str, warnings: &mut Vec<String>) -> Result<Texture, String> {
+    let tex = if bytes.starts_with(b"\x89PNG\r\n\x1a\n") {
+        guarded("PNG", || decode_png(bytes, name))??
+    } else if bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
+        guarded("JPEG", || decode_jpeg(bytes, name))??
+    } else if bytes.is_empty() {
+        return Err("the file is empty; it is not a PNG or JPEG image".into());
+    } else {
+        return Err("not a PNG or JPEG image (unrecognised signature)".into());
+    };
+    Ok(downscale(tex, warnings))
+}
+
+/// Reads and decodes the texture file at `path`.
+pub(crate) fn load_texture_file(path: &Path, warnings: &mut Vec<String>) -> Result<Texture, String> {
+    let bytes = read_regular_file(path, TEXTURE_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
+    decode_texture(&bytes, &path.display().to_string(), warnings)
+}
+
+/// Checks a header's size before decoding.
+fn check_size(width: u32, height: u32) -> Result<(), String> {
+    if width == 0 || height == 0 {
+        return Err(format!("the image is {width}×{height} texels; it has no texels"));
+    }
+    if width > TEXTURE_MAX_EDGE || height > TEXTURE_MAX_EDGE || width as u64 * height as u64 > TEXTURE_MAX_TEXELS {
+        return Err(format!(
+            "the image is {width}×{height} texels, larger than the limit of {TEXTURE_MAX_EDGE} per edge and \
+             {TEXTURE_MAX_TEXELS} texels"
+        ));
+    }
+    Ok(())
+}
+
+fn decode_png(bytes: &[u8], name: &str) -> Result<Texture, String> {
+    let bad = |e: png::DecodingError| format!("not a valid PNG image: {e}");
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    decoder.set_limits(png::Limits { bytes: (TEXTURE_MAX_TEXELS * 8) as usize });
+    let mut reader = decoder.read_info().map_err(bad)?;
+    let (w, h) = (reader.info().width, reader.info().height);
+    check_size(w, h)?;
+    let size = reader.output_buffer_size().ok_or("the PNG image is too large")?;
+    let mut buf = vec![0u8; size];
+    let frame = reader.next_frame(&mut buf).map_err(bad)?;
+    let data = &buf[..frame.buffer_size()];
+    let n = w as usize * h as usize;
+    let texels: Vec<[u8; 4]> = match frame.color_type {
+        png::ColorType::Rgba => data.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+        png::ColorType::Rgb => data.chunks_exact(3).map(|c| [c[0], c[1], c[2], 255]).collect(),
+        png::ColorType::GrayscaleAlpha => data.chunks_exact(2).map(|c| [c[0], c[0], c[0], c[1]]).collect(),
+        png::ColorType::Grayscale => data.iter().map(|&g| [g, g, g, 255]).collect(),
+        png::ColorType::Indexed => return Err("indexed PNG was not expanded".into()),
+    };
+    if texels.len() != n {
+        return Err(format!("the PNG image decoded to {} texels instead of {n}", texels.len()));
+    }
+    Ok(Texture { name: name.into(), width: w, height: h, texels })
+}
+
+fn decode_jpeg(_bytes: &[u8], _name: &str) -> Result<Texture, String> {
+    Err("JPEG images are not supported yet".into())
+}
+
+/// Halves the image (2×2 box filter in linear light) until both edges are at most
+/// [`TEXTURE_DOWNSCALE_EDGE`], with a warning.
+fn downscale(mut t: Texture, warnings: &mut Vec<String>) -> Texture {
+    if t.width <= TEXTURE_DOWNSCALE_EDGE && t.height <= TEXTURE_DOWNSCALE_EDGE {
+        return t;
+    }
+    let (w0, h0) = (t.width, t.height);
+    let table = hadou_math::toon::srgb_table();
+    let encode = |v: f32| (hadou_math::shade::linear_to_srgb(v) * 255.0 + 0.5) as u8;
+    while t.width > TEXTURE_DOWNSCALE_EDGE || t.height > TEXTURE_DOWNSCALE_EDGE {
+        let (w, h) = (t.width.div_ceil(2), t.height.div_ceil(2));
+        let mut out = Vec::with_capacity(w as usize * h as usize);
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = [0.0f32; 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let sx = (2 * x + dx).min(t.width - 1);
+                    let sy = (2 * y + dy).min(t.height - 1);
+                    let p = t.texels[(sy * t.width + sx) as usize];
+                    for k in 0..3 {
+                        acc[k] += 0.25 * table[p[k] as usize];
+                    }
+                    acc[3] += 0.25 * p[3] as f32;
+                }
+                out.push([encode(acc[0]), encode(acc[1]), encode(acc[2]), (acc[3] + 0.5) as u8]);
+            }
+        }
+        t = Texture { width: w, height: h, texels: out, ..t };
+    }
+    warnings.push(format!(
+        "texture {}: {w0}×{h0} texels downscaled to {}×{} (textures above {TEXTURE_DOWNSCALE_EDGE} texels per \
+         edge are sampled at level 0 only)",
+        t.name, t.width, t.height
+    ));
+    t
+}
+
+/// Encodes RGBA8 texels as a PNG file's bytes (for tests and generated assets).
+pub fn encode_png(width: u32, height: u32, texels: &[[u8; 4]]) -> Vec<u8> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().expect("writing to a Vec cannot fail");
+        w.write_image_data(texels.as_flattened()).expect("the texel count matches the size");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_round_trip_and_bad_bytes() {
+        let texels = [[255, 0, 0, 255], [0, 255, 0, 128], [0, 0, 255, 0], [9, 9, 9, 9]];
+        let bytes = encode_png(2, 2, &texels);
+        let mut warn = Vec::new();
+        let t = decode_texture(&bytes, "t", &mut warn).unwrap();
+        assert_eq!((t.width, t.height), (2, 2));
+        assert_eq!(t.texels, texels);
+        assert!(warn.is_empty());
+        assert!(decode_texture(b"hello", "t", &mut warn).unwrap_err().contains("not a PNG or JPEG"));
+        assert!(decode_texture(&bytes[..40], "t", &mut warn).unwrap_err().contains("PNG"));
+        assert!(decode_texture(&[], "t", &mut warn).unwrap_err().contains("empty"));
+    }
+
+    #[test]
+    fn huge_textures_are_refused_before_allocation_and_large_ones_halved() {
+        assert!(check_size(20000, 1).unwrap_err().contains("larger than the limit"));
+        assert!(check_size(0, 5).unwrap_err().contains("no texels"));
+        let t = Texture { name: "big".into(), width: 4097, height: 2, texels: vec![[255; 4]; 8194] };
+        let mut warn = Vec::new();
+        let small = downscale(t, &mut warn);
+        assert_eq!((small.width, small.height), (2049, 1));
+        assert_eq!(small.texels[0], [255; 4]);
+        assert!(warn[0].contains("downscaled"), "{warn:?}");
+    }
+}
