@@ -5,10 +5,12 @@
 //! threads). It is the oracle the GPU backend is tested against, and the fall-back where no GPU
 //! adapter exists.
 //!
-//! Passes, in order: opaque geometry with the simple diffuse light (`raster`), then the energy
-//! integrals clipped at the visible surface and the colour mapping (`waves`).
+//! Passes, in order: opaque geometry and its outline hulls (`raster`), shaded with the materials
+//! and the waves as lights (`shading`), then the energy integrals clipped at the visible surface
+//! and the colour mapping (`waves`).
 
 mod raster;
+mod shading;
 mod waves;
 
 use hadou_scene::{Backend, Frame, Image, RenderError};
@@ -52,11 +54,12 @@ pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
     let basis = frame.camera.basis(frame.width, frame.height);
-    let opaque = raster::draw_opaque(frame, &basis, y0 as usize..y1 as usize);
+    let curves = waves::prepare_curves(frame);
+    let lights = shading::FrameLights::new(frame, &curves);
+    let opaque = raster::draw_opaque(frame, &basis, &lights, y0 as usize..y1 as usize);
     let mut img = Image::new(frame.width, y1 - y0);
     let w = frame.width as usize;
     let far = frame.camera.far;
-    let curves = waves::prepare_curves(frame);
     img.color
         .par_chunks_mut(w)
         .zip(img.energy.par_chunks_mut(w))
@@ -119,13 +122,14 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
         return None;
     }
     let basis = frame.camera.basis(frame.width, frame.height);
+    let curves = waves::prepare_curves(frame);
+    let lights = shading::FrameLights::new(frame, &curves);
     // The probed row alone: the opaque pass decides each pixel independently.
-    let opaque = raster::draw_opaque(frame, &basis, y as usize..y as usize + 1);
+    let opaque = raster::draw_opaque(frame, &basis, &lights, y as usize..y as usize + 1);
     let i = x as usize;
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();
-    let curves = waves::prepare_curves(frame);
     for (wave, prep) in frame.waves.iter().zip(&curves) {
         let (e, n) = waves::wave_energy(frame, &basis, wave, prep.as_ref(), x as f32, y as f32, surface);
         waves::accumulate(&mut light, wave, e);

@@ -1,13 +1,16 @@
-//! The opaque pass: a deterministic scanline-free triangle rasterizer with a depth buffer and the
-//! simple diffuse light (`hadou_math::shade::diffuse`).
+//! The opaque pass: a deterministic scanline-free triangle rasterizer with a depth buffer, the
+//! inverted-hull outlines (000 §2.3), and surface shading (`crate::shading`: the materials and the
+//! waves as lights).
 //!
 //! Conventions (the GPU backend's raster pass matches them): pixel `(px, py)` has its centre at
 //! `(px + ½, py + ½)`, `py = 0` is the top row; projection from [`CameraBasis`]; triangles are
 //! clipped at the near plane in view space, drawn double-sided, with the top-left fill rule;
 //! the depth test is `z < stored z` in submission order, so ties keep the earlier triangle and
-//! the result does not depend on the number of threads.
+//! the result does not depend on the number of threads. Every object's triangles come first, then
+//! the outline hulls, of which only the back faces are drawn.
 
-use hadou_math::{shade, Vec3, Vec3f};
+use crate::shading::{self, FrameLights};
+use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
 
@@ -21,6 +24,8 @@ struct Vert {
     view: Vec3f,
     world: Vec3f,
     normal: Vec3f,
+    uv: [f32; 2],
+    color: [f32; 4],
 }
 
 /// A projected triangle ready to rasterize.
@@ -33,7 +38,14 @@ struct ScreenTri {
     inv_z: [f32; 3],
     world: [Vec3f; 3],
     normal: [Vec3f; 3],
+    uv: [[f32; 2]; 3],
+    color: [[f32; 4]; 3],
     object: u32,
+    /// Material slot of the object.
+    material: u32,
+    /// An outline hull triangle: drawn only where it faces away from the eye, in the outline
+    /// colour.
+    hull: bool,
 }
 
 /// What the opaque pass leaves per pixel.
@@ -49,7 +61,12 @@ pub(crate) struct OpaqueBuffers {
 /// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
 /// Every pixel is decided by the triangles covering it alone, so a pixel's result does not depend
 /// on which rows are drawn with it.
-pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis, rows: std::ops::Range<usize>) -> OpaqueBuffers {
+pub(crate) fn draw_opaque(
+    frame: &Frame,
+    basis: &CameraBasis,
+    lights: &FrameLights,
+    rows: std::ops::Range<usize>,
+) -> OpaqueBuffers {
     let (w, h) = (frame.width as usize, rows.len());
     let tris = project_all(frame, basis);
     let far = frame.camera.far;
@@ -91,10 +108,14 @@ pub(crate) fn draw_opaque(frame: &Frame, basis: &CameraBasis, rows: std::ops::Ra
                         continue;
                     }
                     let t = &tris[tri_id[i] as usize];
-                    let (world, normal) = interpolate(t, x as f32 + 0.5, py + 0.5);
-                    let l = &frame.light;
-                    let albedo = frame.objects[t.object as usize].materials[0].base_color;
-                    col[i] = shade::diffuse(albedo, normal, l.direction, l.color, l.ambient);
+                    let s = interpolate(t, x as f32 + 0.5, py + 0.5);
+                    let object = &frame.objects[t.object as usize];
+                    let material = object.material(t.material);
+                    col[i] = match (t.hull, material.outline) {
+                        (true, Some(o)) => o.color,
+                        _ => shading::shade(frame, lights, material, &s),
+                    };
+                    let world = s.world;
                     let d = (world - basis.eye).length();
                     surf[i] = Some(if d.is_finite() { d } else { 0.0 });
                     obj[i] = Some(t.object);
@@ -112,42 +133,77 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
     let mut out = Vec::new();
     for (oi, obj) in frame.objects.iter().enumerate() {
         let nm = obj.transform.normal_matrix();
-        let verts: Vec<Vert> = obj
-            .mesh
-            .positions
-            .iter()
-            .zip(obj.mesh.normals.iter())
-            .map(|(p, n)| {
-                let world = obj.transform.transform_point(Vec3::from_array(*p));
-                let normal = nm.transform_vector(Vec3::from_array(*n));
-                Vert { view: basis.to_view(world), world, normal }
+        let mesh = &obj.mesh;
+        let verts: Vec<Vert> = (0..mesh.positions.len())
+            .map(|i| {
+                let world = obj.transform.transform_point(Vec3::from_array(mesh.positions[i]));
+                let normal =
+                    nm.transform_vector(Vec3::from_array(mesh.normals.get(i).copied().unwrap_or([0.0; 3])));
+                Vert {
+                    view: basis.to_view(world),
+                    world,
+                    normal,
+                    uv: mesh.uvs.get(i).copied().unwrap_or([0.0; 2]),
+                    color: mesh.colors.get(i).copied().unwrap_or([1.0; 4]),
+                }
             })
             .collect();
-        for tri in obj.mesh.indices.chunks_exact(3) {
-            let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
-            let [Some(a), Some(b), Some(c)] = v else { continue };
-            let mut poly = [a; 4];
-            let n = clip_near([a, b, c], near, &mut poly);
-            for k in 1..n.saturating_sub(1) {
-                let pv = [poly[0], poly[k], poly[k + 1]];
-                let mut t = ScreenTri {
-                    sx: [0.0; 3],
-                    sy: [0.0; 3],
-                    inv_z: [0.0; 3],
-                    world: pv.map(|v| v.world),
-                    normal: pv.map(|v| v.normal),
-                    object: oi as u32,
-                };
-                let mut ok = true;
-                for (j, v) in pv.iter().enumerate() {
-                    let iz = 1.0 / v.view.z;
-                    t.inv_z[j] = iz;
-                    t.sx[j] = (v.view.x * iz * sx_scale + 1.0) * 0.5 * w;
-                    t.sy[j] = (1.0 - v.view.y * iz * sy_scale) * 0.5 * h;
-                    ok &= t.sx[j].is_finite() && t.sy[j].is_finite() && iz.is_finite();
+        // The outline hull (000 §2.3): each vertex pushed along its world-space outline normal
+        // by `d·|z|` (`z` its view depth), which is `R' = R + d·|R_z|·U` in view space.
+        let outlined = obj.materials.iter().any(|m| m.outline.is_some_and(|o| o.width > 0.0));
+        let hull: Vec<Vert> = if outlined {
+            verts
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    let width = obj.material(mesh.material_of(i)).outline.map_or(0.0, |o| o.width);
+                    let dir =
+                        mesh.outline_normals.get(i).or(mesh.normals.get(i)).copied().unwrap_or([0.0; 3]);
+                    let u = nm.transform_vector(Vec3::from_array(dir)).normalize_or(Vec3f::ZERO);
+                    let world = v.world + u * (width * v.view.z.abs());
+                    Vert { view: basis.to_view(world), world, ..*v }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let passes: &[(&[Vert], bool)] =
+            if outlined { &[(&verts, false), (&hull, true)] } else { &[(&verts, false)] };
+        for &(verts, is_hull) in passes {
+            for tri in mesh.indices.chunks_exact(3) {
+                let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+                let [Some(a), Some(b), Some(c)] = v else { continue };
+                let material = mesh.material_of(tri[0] as usize);
+                if is_hull && obj.material(material).outline.is_none_or(|o| !(o.width > 0.0)) {
+                    continue;
                 }
-                if ok {
-                    out.push(t);
+                let mut poly = [a; 4];
+                let n = clip_near([a, b, c], near, &mut poly);
+                for k in 1..n.saturating_sub(1) {
+                    let pv = [poly[0], poly[k], poly[k + 1]];
+                    let mut t = ScreenTri {
+                        sx: [0.0; 3],
+                        sy: [0.0; 3],
+                        inv_z: [0.0; 3],
+                        world: pv.map(|v| v.world),
+                        normal: pv.map(|v| v.normal),
+                        uv: pv.map(|v| v.uv),
+                        color: pv.map(|v| v.color),
+                        object: oi as u32,
+                        material,
+                        hull: is_hull,
+                    };
+                    let mut ok = true;
+                    for (j, v) in pv.iter().enumerate() {
+                        let iz = 1.0 / v.view.z;
+                        t.inv_z[j] = iz;
+                        t.sx[j] = (v.view.x * iz * sx_scale + 1.0) * 0.5 * w;
+                        t.sy[j] = (1.0 - v.view.y * iz * sy_scale) * 0.5 * h;
+                        ok &= t.sx[j].is_finite() && t.sy[j].is_finite() && iz.is_finite();
+                    }
+                    if ok {
+                        out.push(t);
+                    }
                 }
             }
         }
@@ -171,10 +227,13 @@ fn clip_near(tri: [Vert; 3], near: f32, out: &mut [Vert; 4]) -> usize {
         if ina != inb {
             let s = (near - a.view.z) / (b.view.z - a.view.z);
             let lerp = |p: Vec3f, q: Vec3f| p + (q - p) * s;
+            let mix = |p: f32, q: f32| p + (q - p) * s;
             let mut v = Vert {
                 view: lerp(a.view, b.view),
                 world: lerp(a.world, b.world),
                 normal: lerp(a.normal, b.normal),
+                uv: std::array::from_fn(|k| mix(a.uv[k], b.uv[k])),
+                color: std::array::from_fn(|k| mix(a.color[k], b.color[k])),
             };
             v.view.z = near;
             if n < 4 {
@@ -229,6 +288,11 @@ fn raster_tri(
     if area == 0.0 || !area.is_finite() {
         return;
     }
+    // With y down, a triangle counter-clockwise seen from the eye (a front face) has area < 0;
+    // a hull shows only its back faces.
+    if t.hull && area < 0.0 {
+        return;
+    }
     let sign = area.signum();
     let inv_area = 1.0 / area;
     let xmin = t.sx[0].min(t.sx[1]).min(t.sx[2]);
@@ -275,8 +339,8 @@ fn raster_tri(
     }
 }
 
-/// Perspective-correct world position and normal at screen point `(px, py)`.
-fn interpolate(t: &ScreenTri, px: f32, py: f32) -> (Vec3f, Vec3f) {
+/// Perspective-correct surface attributes at screen point `(px, py)`.
+fn interpolate(t: &ScreenTri, px: f32, py: f32) -> shading::Surface {
     let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
     let b = [
         edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) / area,
@@ -288,5 +352,8 @@ fn interpolate(t: &ScreenTri, px: f32, py: f32) -> (Vec3f, Vec3f) {
     let wts = wts.map(|v| v / s);
     let world = t.world[0] * wts[0] + t.world[1] * wts[1] + t.world[2] * wts[2];
     let normal = t.normal[0] * wts[0] + t.normal[1] * wts[1] + t.normal[2] * wts[2];
-    (world, normal)
+    let uv = std::array::from_fn(|k| t.uv[0][k] * wts[0] + t.uv[1][k] * wts[1] + t.uv[2][k] * wts[2]);
+    let color =
+        std::array::from_fn(|k| t.color[0][k] * wts[0] + t.color[1][k] * wts[1] + t.color[2][k] * wts[2]);
+    shading::Surface { world, normal, uv, color }
 }

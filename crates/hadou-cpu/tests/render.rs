@@ -33,7 +33,12 @@ fn frame(objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
 }
 
 fn cube_at(name: &str, z: f32) -> Object {
-    Object::new(name, Arc::new(cube()), Mat4::from_trs(Vec3::new(0.0, 0.0, z), Vec3::ZERO, Vec3::splat(3.0)), [0.5, 0.5, 0.5])
+    Object::new(
+        name,
+        Arc::new(cube()),
+        Mat4::from_trs(Vec3::new(0.0, 0.0, z), Vec3::ZERO, Vec3::splat(3.0)),
+        [0.5, 0.5, 0.5],
+    )
 }
 
 fn beam(falloff: Falloff) -> Wave {

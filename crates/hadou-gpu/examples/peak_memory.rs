@@ -44,7 +44,12 @@ fn main() {
         },
         background: [0.02, 0.03, 0.05],
         light: Light { direction: Vec3::new(0.0, -1.0, 0.0), color: [1.0; 3], ambient: [0.1; 3] },
-        objects: vec![Object::new("ground", quad(40.0), Mat4::translation(Vec3::new(0.0, -1.0, 0.0)), [0.5, 0.5, 0.45])],
+        objects: vec![Object::new(
+            "ground",
+            quad(40.0),
+            Mat4::translation(Vec3::new(0.0, -1.0, 0.0)),
+            [0.5, 0.5, 0.45],
+        )],
         waves: vec![Wave {
             light: Default::default(),
             name: "beam".into(),

@@ -148,7 +148,12 @@ impl GpuObject {
     /// The GPU form of `object`.
     pub fn new(object: &Object) -> Self {
         let m: Mat4 = object.transform;
-        Self { model: m.cols, normal_matrix: m.normal_matrix().cols, color: object.materials[0].base_color, _pad: 0.0 }
+        Self {
+            model: m.cols,
+            normal_matrix: m.normal_matrix().cols,
+            color: object.materials[0].base_color,
+            _pad: 0.0,
+        }
     }
 }
 

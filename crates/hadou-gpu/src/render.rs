@@ -583,8 +583,9 @@ mod tests {
             indices: vec![0, 1, 2],
             ..Mesh::default()
         });
-        let object =
-            |name: &str, mesh: &Arc<Mesh>| hadou_scene::Object::new(name, mesh.clone(), hadou_math::Mat4::IDENTITY, [1.0; 3]);
+        let object = |name: &str, mesh: &Arc<Mesh>| {
+            hadou_scene::Object::new(name, mesh.clone(), hadou_math::Mat4::IDENTITY, [1.0; 3])
+        };
         let mut frame = small_frame();
         frame.objects = vec![object("a", &mesh), object("b", &mesh)];
         let first = r.render(&frame).unwrap();

@@ -35,8 +35,12 @@ fn bad_camera_is_an_error() {
 fn malformed_mesh_is_an_error_naming_the_object() {
     let Some(mut gpu) = gpu_or_skip("malformed mesh") else { return };
     let mut f = occlusion_frame(32, 24);
-    let bad =
-        Mesh { positions: vec![[0.0; 3]; 3], normals: vec![[0.0, 1.0, 0.0]; 3], indices: vec![0, 1, 7], ..Mesh::default() };
+    let bad = Mesh {
+        positions: vec![[0.0; 3]; 3],
+        normals: vec![[0.0, 1.0, 0.0]; 3],
+        indices: vec![0, 1, 7],
+        ..Mesh::default()
+    };
     f.objects[0].mesh = Arc::new(bad);
     f.objects[0].name = "broken box".into();
     match gpu.render(&f) {
@@ -44,7 +48,11 @@ fn malformed_mesh_is_an_error_naming_the_object() {
         other => panic!("expected a mesh error, got {other:?}"),
     }
     let mut f = occlusion_frame(32, 24);
-    f.objects[1].mesh =
-        Arc::new(Mesh { positions: vec![[0.0; 3]; 3], normals: vec![], indices: vec![0, 1, 2], ..Mesh::default() });
+    f.objects[1].mesh = Arc::new(Mesh {
+        positions: vec![[0.0; 3]; 3],
+        normals: vec![],
+        indices: vec![0, 1, 2],
+        ..Mesh::default()
+    });
     assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("normals")));
 }

@@ -422,7 +422,13 @@ pub enum ToneMode {
 
 impl Wave {
     /// A wave with the default light ([`Ramp::for_wave_color`], no glow).
-    pub fn new(name: impl Into<String>, color: [f32; 4], falloff: Falloff, core_radius: f32, shape: WaveShape) -> Self {
+    pub fn new(
+        name: impl Into<String>,
+        color: [f32; 4],
+        falloff: Falloff,
+        core_radius: f32,
+        shape: WaveShape,
+    ) -> Self {
         let light = WaveLight { ramp: Ramp::for_wave_color([color[0], color[1], color[2]]), glow: 0.0 };
         Wave { name: name.into(), color, falloff, core_radius, shape, light }
     }

@@ -20,6 +20,7 @@ mod gltf_load;
 mod guard;
 mod image;
 mod limits;
+mod materials;
 pub mod mesh;
 mod params;
 mod scene;

@@ -153,7 +153,11 @@ pub fn append_mesh(mesh: &mut Mesh, other: &Mesh) {
         if on.is_empty() {
             on = mesh.normals.clone();
         }
-        on.extend_from_slice(if other.outline_normals.is_empty() { &other.normals } else { &other.outline_normals });
+        on.extend_from_slice(if other.outline_normals.is_empty() {
+            &other.normals
+        } else {
+            &other.outline_normals
+        });
         mesh.outline_normals = on;
     }
     mesh.positions.extend_from_slice(&other.positions);

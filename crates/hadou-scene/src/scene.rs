@@ -6,6 +6,7 @@ use crate::error::SceneError;
 use crate::frame::{
     Camera, ColorMapping, Frame, Light, Material, Mesh, Object, Ramp, ToneMode, Wave, WaveLight, WaveShape,
 };
+use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
@@ -29,9 +30,13 @@ pub struct Scene {
     /// Holds `background`.
     pub(crate) globals: ParamSet,
     pub(crate) tone: ToneMode,
+    pub(crate) materials: Vec<MaterialDef>,
     pub(crate) objects: Vec<ObjectDef>,
     pub(crate) waves: Vec<WaveDef>,
     pub(crate) tracks: Vec<Track>,
+    /// Things that were accepted but deserve a note (a downscaled texture, textures on a mesh
+    /// without texture coordinates, …).
+    pub(crate) warnings: Vec<String>,
 }
 
 /// An `[[object]]`: its mesh (built once) and its animatable placement and colour.
@@ -40,6 +45,7 @@ pub(crate) struct ObjectDef {
     pub name: String,
     pub mesh: Arc<Mesh>,
     pub params: ParamSet,
+    pub materials: ObjectMaterials,
 }
 
 /// The wave kinds of the schema.
@@ -76,9 +82,17 @@ pub(crate) struct WaveDef {
     pub order: u32,
     /// B-spline has an explicit knot vector.
     pub has_knots: bool,
+    /// `light_ramp`, if given (else derived from the wave's colour).
+    pub light_ramp: Option<Ramp>,
 }
 
 impl Scene {
+    /// Notes about things the loader accepted but changed or ignored (downscaled textures,
+    /// textures on meshes without texture coordinates, …); the CLI prints them.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
     /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
@@ -155,6 +169,7 @@ impl Scene {
         let sets = [&self.camera, &self.light, &self.color, &self.globals]
             .into_iter()
             .chain(self.objects.iter().map(|o| &o.params))
+            .chain(self.materials.iter().map(|m| &m.params))
             .chain(self.waves.iter().map(|w| &w.params));
         for set in sets {
             for p in &set.params {
@@ -275,13 +290,18 @@ impl Scene {
 
     /// The materials of object `o` at these values.
     fn object_materials(&self, o: &ObjectDef, vals: &[f32]) -> Vec<Material> {
-        vec![Material::diffuse(o.params.arr(vals, "color"))]
+        o.materials
+            .slots
+            .iter()
+            .map(|s| build_material(s, &o.mesh, &self.materials, &o.materials, &o.params, vals))
+            .collect()
     }
 
     /// The light of wave `w` at these values.
     fn wave_light(&self, w: &WaveDef, vals: &[f32]) -> WaveLight {
         let c = w.params.arr::<4>(vals, "rgba");
-        WaveLight { ramp: Ramp::for_wave_color([c[0], c[1], c[2]]), glow: 0.0 }
+        let ramp = w.light_ramp.clone().unwrap_or_else(|| Ramp::for_wave_color([c[0], c[1], c[2]]));
+        WaveLight { ramp, glow: w.params.f(vals, "light_glow") }
     }
 
     pub(crate) fn build_curve(&self, w: &WaveDef, vals: &[f32]) -> CurveWave {

@@ -10,7 +10,10 @@ use crate::limits::{
     fmt_f32, fmt_f64, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_TRIANGLES, MAX_VERTICES,
     MAX_WAVES, NEAR_MIN, SCALE_MIN,
 };
-use crate::mesh::{box_mesh, plane_mesh, sphere_mesh};
+use crate::materials::{
+    parse_material, parse_object_materials, parse_ramp, MaterialDef, TextureCache, OBJECT_MATERIAL_KEYS,
+};
+use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::scene::{IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
 use crate::toml_read::{number, read_numbers, type_name, Fallback, ParamReader, Res, Span, Src, Table, Val};
@@ -21,14 +24,25 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use toml::de::{DeTable, DeValue};
 
-const ROOT_KEYS: &[&str] = &["image", "camera", "background", "light", "color", "object", "wave", "track"];
+const ROOT_KEYS: &[&str] =
+    &["image", "camera", "background", "light", "color", "material", "object", "wave", "track"];
 const CAMERA_KEYS: &[&str] = &["position", "target", "up", "fov", "near", "far"];
 const LIGHT_KEYS: &[&str] = &["direction", "color", "ambient"];
 const COLOR_KEYS: &[&str] = &["mode", "exposure"];
 const OBJECT_KINDS: &[&str] = &["box", "sphere", "plane", "gltf"];
 const OBJECT_COMMON: &[&str] = &["name", "kind", "position", "rotation", "scale", "color"];
 const WAVE_KINDS: &[&str] = &["sphere", "cylinder", "capsule", "beam", "helix", "trig", "bezier", "bspline"];
-const WAVE_COMMON: &[&str] = &["name", "kind", "rgba", "falloff", "core_radius"];
+const WAVE_COMMON: &[&str] = &[
+    "name",
+    "kind",
+    "rgba",
+    "falloff",
+    "core_radius",
+    "light_ramp",
+    "light_ramp_kind",
+    "light_ramp_smoothing",
+    "light_glow",
+];
 const CURVE_COMMON: &[&str] =
     &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
 const TRACK_KEYS: &[&str] = &["target", "interpolation", "keys"];
@@ -128,19 +142,40 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut globals = ParamSet::default();
     rd.add(&root, &mut globals, "background", V3, NONNEG, Fallback::Value(&[0.0; 3]), false)?;
 
-    // [[object]]
-    let mut objects: Vec<ObjectDef> = Vec::new();
-    let mut names: HashMap<String, Span> = HashMap::new();
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
     let mut assets = Assets { dir, root: None, cache: HashMap::new(), budget: Budget::FULL };
+    let mut warnings = Vec::new();
+
+    // [[material]]
+    let mut materials: Vec<MaterialDef> = Vec::new();
+    let mut names: HashMap<String, Span> = HashMap::new();
+    let material_tables = root.array_of_tables("material")?;
+    if !material_tables.is_empty() {
+        let mut cache = TextureCache {
+            dir: assets.dir.clone(),
+            root: None,
+            images: HashMap::new(),
+            warnings: &mut warnings,
+        };
+        for (i, (t, span)) in material_tables.into_iter().enumerate() {
+            let table = Table { src, t, span, what: format!("[[material]] #{}", i + 1) };
+            let name = entity_name(&table, &mut names, "material")?;
+            let table = Table { what: format!("[[material]] \"{name}\""), ..table };
+            materials.push(parse_material(&table, name, &mut rd, &mut cache)?);
+        }
+    }
+
+    // [[object]]
+    let mut objects: Vec<ObjectDef> = Vec::new();
+    let mut names: HashMap<String, Span> = HashMap::new();
     for (i, (t, span)) in root.array_of_tables("object")?.into_iter().enumerate() {
         let table = Table { src, t, span, what: format!("[[object]] #{}", i + 1) };
         let name = entity_name(&table, &mut names, "object")?;
         let table = Table { what: format!("[[object]] \"{name}\""), ..table };
-        objects.push(parse_object(&table, name, &mut rd, &mut assets)?);
+        objects.push(parse_object(&table, name, &mut rd, &mut assets, &materials, &mut warnings)?);
     }
 
     // [[wave]]
@@ -171,9 +206,11 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         color,
         globals,
         tone,
+        materials,
         objects,
         waves,
         tracks: Vec::new(),
+        warnings,
     };
 
     // The curve maths' own rules (limits on control points, order, terms, …), on the file's values.
@@ -260,6 +297,8 @@ fn parse_object(
     name: String,
     rd: &mut ParamReader<'_>,
     assets: &mut Assets,
+    materials: &[MaterialDef],
+    warnings: &mut Vec<String>,
 ) -> Res<ObjectDef> {
     let kind = t.choice("kind", OBJECT_KINDS, None)?;
     let extra: &[&str] = match kind {
@@ -268,8 +307,18 @@ fn parse_object(
         "plane" => &["size"],
         _ => &["path"],
     };
-    let allowed: Vec<&str> = OBJECT_COMMON.iter().chain(extra).copied().collect();
+    let allowed: Vec<&str> = OBJECT_COMMON.iter().chain(OBJECT_MATERIAL_KEYS).chain(extra).copied().collect();
     t.check_keys(&allowed)?;
+    if t.get("color").is_some() && (t.get("material").is_some() || t.get("materials").is_some()) {
+        let other = if t.get("material").is_some() { "material" } else { "materials" };
+        return Err(t.src.value_err(
+            &t.key_span("color"),
+            format!(
+                "{} gives `{other}`; set the colour as `base_color` of the [[material]] instead of `color`",
+                t.what
+            ),
+        ));
+    }
 
     // Structural values: read through a scratch store.
     let mut scratch_v = Vec::new();
@@ -279,7 +328,7 @@ fn parse_object(
     let mesh = match kind {
         "box" => {
             scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
-            Arc::new(box_mesh(shape_set.arr(&scratch_v, "size")))
+            Arc::new(with_outline_normals(box_mesh(shape_set.arr(&scratch_v, "size"))))
         }
         "plane" => {
             scratch.add(
@@ -291,12 +340,12 @@ fn parse_object(
                 Fallback::Value(&[10.0, 10.0]),
                 false,
             )?;
-            Arc::new(plane_mesh(shape_set.arr(&scratch_v, "size")))
+            Arc::new(with_outline_normals(plane_mesh(shape_set.arr(&scratch_v, "size"))))
         }
         "sphere" => {
             scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
             let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
-            Arc::new(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments))
+            Arc::new(with_outline_normals(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments)))
         }
         _ => {
             let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
@@ -343,9 +392,11 @@ fn parse_object(
                     m.clone()
                 }
                 None => {
-                    let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut Vec::new())
+                    let mut notes = Vec::new();
+                    let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut notes)
                         .map_err(|message| gltf_err(message, file.clone()))?;
-                    let mesh = Arc::new(mesh);
+                    warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", file.display())));
+                    let mesh = Arc::new(with_outline_normals(mesh));
                     assets.cache.insert(real, mesh.clone());
                     mesh
                 }
@@ -372,7 +423,8 @@ fn parse_object(
     let scale = Constraint::Range { lo: SCALE_MIN, hi: COORD_MAX, lo_open: false, hi_open: false };
     rd.add(t, &mut params, "scale", V3, scale, Fallback::Value(&[1.0; 3]), true)?;
     rd.add(t, &mut params, "color", V3, NONNEG, Fallback::Value(&[0.8; 3]), false)?;
-    Ok(ObjectDef { name, mesh, params })
+    let materials = parse_object_materials(t, &mesh, materials, &mut params, rd)?;
+    Ok(ObjectDef { name, mesh, params, materials })
 }
 
 fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<WaveDef> {
@@ -409,6 +461,8 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
     let mut p = ParamSet::default();
     rd.add(t, &mut p, "rgba", Shape::Vector(4), Constraint::Rgba, Fallback::Value(&DEFAULT_RGBA), false)?;
     rd.add(t, &mut p, "core_radius", S, NONNEG, Fallback::Value(&[DEFAULT_CORE_RADIUS]), false)?;
+    rd.add(t, &mut p, "light_glow", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+    let light_ramp = parse_ramp(t, "light_ramp")?;
     let dir = Constraint::NonZero;
     let mut def = WaveDef {
         name,
@@ -419,6 +473,7 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
         integrator: IntegratorDef::Default,
         order: 0,
         has_knots: false,
+        light_ramp,
     };
     match kind {
         WaveKind::Sphere => {
@@ -726,12 +781,17 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
             };
             (set, &segs[1..], format!("[{head}]"))
         }
-        "wave" | "object" if segs.len() >= 3 => {
+        "wave" | "object" | "material" if segs.len() >= 3 => {
             let name = segs[1];
-            let (set, names) = if head == "wave" {
-                (scene.waves.iter().find(|w| w.name == name).map(|w| &w.params), scene.wave_names())
-            } else {
-                (scene.objects.iter().find(|o| o.name == name).map(|o| &o.params), scene.object_names())
+            let (set, names) = match head {
+                "wave" => {
+                    (scene.waves.iter().find(|w| w.name == name).map(|w| &w.params), scene.wave_names())
+                }
+                "material" => (
+                    scene.materials.iter().find(|m| m.name == name).map(|m| &m.params),
+                    scene.materials.iter().map(|m| m.name.as_str()).collect(),
+                ),
+                _ => (scene.objects.iter().find(|o| o.name == name).map(|o| &o.params), scene.object_names()),
             };
             match set {
                 Some(s) => (s, &segs[2..], format!("[[{head}]] \"{name}\"")),
@@ -743,14 +803,14 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
         "camera" | "light" | "color" => {
             return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
         }
-        "wave" | "object" => {
+        "wave" | "object" | "material" => {
             return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
         }
         other => {
-            let heads = ["wave", "object", "camera", "light", "color", "background"];
+            let heads = ["wave", "object", "material", "camera", "light", "color", "background"];
             return Err(format!(
-                "target \"{target}\" must start with `wave.`, `object.`, `camera.`, `light.`, `color.` or be \
-                 `background`{}",
+                "target \"{target}\" must start with `wave.`, `object.`, `material.`, `camera.`, `light.`, \
+                 `color.` or be `background`{}",
                 hint(other, &heads, "targets")
             ));
         }

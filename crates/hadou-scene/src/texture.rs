@@ -37,7 +37,8 @@ pub fn decode_texture(bytes: &[u8], name: &str, warnings: &mut Vec<String>) -> R
 
 /// Reads and decodes the texture file at `path`.
 pub(crate) fn load_texture_file(path: &Path, warnings: &mut Vec<String>) -> Result<Texture, String> {
-    let bytes = read_regular_file(path, TEXTURE_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
+    let bytes =
+        read_regular_file(path, TEXTURE_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
     decode_texture(&bytes, &path.display().to_string(), warnings)
 }
 
@@ -46,7 +47,10 @@ fn check_size(width: u32, height: u32) -> Result<(), String> {
     if width == 0 || height == 0 {
         return Err(format!("the image is {width}×{height} texels; it has no texels"));
     }
-    if width > TEXTURE_MAX_EDGE || height > TEXTURE_MAX_EDGE || width as u64 * height as u64 > TEXTURE_MAX_TEXELS {
+    if width > TEXTURE_MAX_EDGE
+        || height > TEXTURE_MAX_EDGE
+        || width as u64 * height as u64 > TEXTURE_MAX_TEXELS
+    {
         return Err(format!(
             "the image is {width}×{height} texels, larger than the limit of {TEXTURE_MAX_EDGE} per edge and \
              {TEXTURE_MAX_TEXELS} texels"

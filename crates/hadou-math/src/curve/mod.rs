@@ -45,8 +45,8 @@ pub use integrate::{
     attenuation_split, curve_energy, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
 };
 pub use prepare::{
-    prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS, MAX_PIECES,
-    MIN_CORE,
+    prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS,
+    MAX_PIECES, MIN_CORE,
 };
 pub use reference::curve_energy_reference;
 pub use shape::clamped_uniform_knots;

@@ -168,8 +168,7 @@ impl PreparedCurve {
     /// `LIGHT_TOLERANCE · size` from the polyline, at most [`MAX_LIGHT_POINTS`] points (the
     /// tolerance doubles until they fit). Always at least the two end points.
     pub fn light_polyline(&self) -> Vec<Vec3<f32>> {
-        let pts: Vec<Vec3<f64>> =
-            self.table.nodes.iter().map(|n| self.point(f64::from(n[3]))).collect();
+        let pts: Vec<Vec3<f64>> = self.table.nodes.iter().map(|n| self.point(f64::from(n[3]))).collect();
         let mut tol = LIGHT_TOLERANCE * self.size;
         loop {
             let mut keep = vec![false; pts.len()];

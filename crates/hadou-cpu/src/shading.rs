@@ -1,0 +1,143 @@
+//! Surface shading: a material's own look under the scene light, the waves as lights on it
+//! (000 §2.1, SPEC.md §2.1), and the feature texture (000 §2.2). The GPU's wave pass mirrors
+//! [`shade`] line by line (`crates/hadou-gpu/src/shaders/shading.wgsl`).
+
+use hadou_math::curve::PreparedCurve;
+use hadou_math::energy::Falloff;
+use hadou_math::toon;
+use hadou_math::{shade as tone, Vec3f};
+use hadou_scene::{Frame, LightLine, Material, ShadingModel};
+
+/// The interpolated attributes of a visible surface point.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Surface {
+    /// World position.
+    pub world: Vec3f,
+    /// Interpolated world normal (not unit).
+    pub normal: Vec3f,
+    /// Texture coordinates.
+    pub uv: [f32; 2],
+    /// Linear RGBA vertex colour.
+    pub color: [f32; 4],
+}
+
+/// The frame's waves as lights: each wave's centre line and what weighs it against the others.
+pub(crate) struct FrameLights {
+    lines: Vec<LightLine>,
+    /// `α·a` per wave ([`hadou_scene::Wave::light_strength`]).
+    strength: Vec<f32>,
+    inverse_square: Vec<bool>,
+    core: Vec<f32>,
+    /// Whether any wave glows (then every surface takes the waves' light).
+    any_glow: bool,
+}
+
+impl FrameLights {
+    /// The lights of `frame`; `curves` are the wave pass's prepared curves (one per wave, `None`
+    /// for analytic waves).
+    pub(crate) fn new(frame: &Frame, curves: &[Option<PreparedCurve>]) -> Self {
+        let lines = frame.waves.iter().zip(curves).map(|(w, c)| w.light_line(c.as_ref())).collect();
+        FrameLights {
+            lines,
+            strength: frame.waves.iter().map(|w| w.light_strength()).collect(),
+            inverse_square: frame.waves.iter().map(|w| w.falloff == Falloff::InverseSquare).collect(),
+            core: frame.waves.iter().map(|w| w.core_radius).collect(),
+            any_glow: frame.waves.iter().any(|w| w.light.glow > 0.0),
+        }
+    }
+}
+
+/// Most waves whose densities one surface point weighs at once without allocating.
+const STACK_WAVES: usize = 16;
+
+/// The shaded linear RGB of a surface point with material `m`:
+///
+/// 1. albedo `A = base_color · base_texture(uv) · vertex colour`;
+/// 2. own look: diffuse `A·(ambient + light·max(0, N·(−L)))`, toon `A·ramp(N·(−L))` (unclamped
+///    `N·(−L)`), or unlit `A`;
+/// 3. wave look (when the material's `β = wave_blend > 0` and a wave has strength): for each wave
+///    `i`, the light point `Eᵢ` = nearest point of its centre line, `mᵢ = N·Lᵢ` unclamped
+///    (000 §2.1), look `rampᵢ(mᵢ)`; the looks are weighted by
+///    [`toon::dominance_weights`] of the waves' densities at the point; `S = own + β·(wave − own)`;
+/// 4. glow (waves with `light_glow > 0`): `S += glowᵢ · rgbᵢ · ρᵢ`, `ρᵢ` the density of
+///    [`toon::dominance`];
+/// 5. feature texture: `H = S · T(uv)` (000 §2.2).
+pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surface) -> [f32; 3] {
+    let n = s.normal.normalize_or(Vec3f::ZERO);
+    let tex = m.base_texture.as_ref().map_or([1.0; 4], |t| t.sample(s.uv));
+    let albedo: [f32; 3] = std::array::from_fn(|k| m.base_color[k] * tex[k] * s.color[k]);
+    let l = &frame.light;
+    let mut c = match m.model {
+        ShadingModel::Diffuse => tone::diffuse(albedo, n, l.direction, l.color, l.ambient),
+        ShadingModel::Toon => {
+            let r = m.ramp.eval(n.dot(-l.direction));
+            std::array::from_fn(|k| albedo[k] * r[k])
+        }
+        ShadingModel::Unlit => albedo,
+    };
+    let waves = &frame.waves;
+    if !waves.is_empty() && (m.wave_blend > 0.0 || lights.any_glow) {
+        let mut rho_buf = [0.0f32; STACK_WAVES];
+        let mut rho_vec = Vec::new();
+        let rho: &mut [f32] = if waves.len() <= STACK_WAVES {
+            &mut rho_buf[..waves.len()]
+        } else {
+            rho_vec.resize(waves.len(), 0.0);
+            &mut rho_vec
+        };
+        let mut nearest_buf = [Vec3f::ZERO; STACK_WAVES];
+        let mut nearest_vec = Vec::new();
+        let nearest: &mut [Vec3f] = if waves.len() <= STACK_WAVES {
+            &mut nearest_buf[..waves.len()]
+        } else {
+            nearest_vec.resize(waves.len(), Vec3f::ZERO);
+            &mut nearest_vec
+        };
+        for i in 0..waves.len() {
+            let e = lights.lines[i].nearest(s.world);
+            nearest[i] = e;
+            rho[i] = toon::dominance(
+                (e - s.world).length(),
+                lights.core[i],
+                lights.strength[i],
+                lights.inverse_square[i],
+            );
+        }
+        // Glow before the densities become weights.
+        let mut glow = [0.0f32; 3];
+        for (i, w) in waves.iter().enumerate() {
+            if w.light.glow > 0.0 {
+                for k in 0..3 {
+                    glow[k] += w.light.glow * w.color[k] * rho[i];
+                }
+            }
+        }
+        if m.wave_blend > 0.0 {
+            toon::dominance_weights(rho);
+            if rho.iter().any(|&w| w > 0.0) {
+                let mut look = [0.0f32; 3];
+                for (i, w) in waves.iter().enumerate() {
+                    if rho[i] > 0.0 {
+                        let r = w.light.ramp.eval(toon::wave_m(s.world, n, nearest[i]));
+                        for k in 0..3 {
+                            look[k] += rho[i] * r[k];
+                        }
+                    }
+                }
+                for k in 0..3 {
+                    c[k] += m.wave_blend * (look[k] - c[k]);
+                }
+            }
+        }
+        for k in 0..3 {
+            c[k] = hadou_math::energy::saturate(c[k] + glow[k]);
+        }
+    }
+    if let Some(t) = &m.feature_texture {
+        let f = t.sample(s.uv);
+        for k in 0..3 {
+            c[k] *= f[k];
+        }
+    }
+    c
+}
