@@ -65,7 +65,10 @@ const STACK_WAVES: usize = 16;
 pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surface) -> [f32; 3] {
     let n = s.normal.normalize_or(Vec3f::ZERO);
     let tex = m.base_texture.as_ref().map_or([1.0; 4], |t| t.sample(s.uv));
-    let albedo: [f32; 3] = std::array::from_fn(|k| m.base_color[k] * tex[k] * s.color[k]);
+    // Vertex colours are shaded at 8 bits per channel (the GPU's G-buffer keeps them as unorm8,
+    // WGSL `pack4x8unorm`): round(255·clamp(c, 0, 1)) / 255.
+    let vcolor = s.color.map(|c| (0.5 + 255.0 * c.clamp(0.0, 1.0)).floor() / 255.0);
+    let albedo: [f32; 3] = std::array::from_fn(|k| m.base_color[k] * tex[k] * vcolor[k]);
     let l = &frame.light;
     let mut c = match m.model {
         ShadingModel::Diffuse => tone::diffuse(albedo, n, l.direction, l.color, l.ambient),

@@ -97,8 +97,13 @@ const NEEDED_DOWNLEVEL: [(wgpu::DownlevelFlags, &str); 3] = [
     (wgpu::DownlevelFlags::FRAGMENT_STORAGE, "storage buffers in fragment shaders (per-object data)"),
 ];
 
-/// Storage buffers the wave pass binds in one compute stage (keep in sync with pipelines.rs).
-const NEEDED_COMPUTE_STORAGE_BUFFERS: u32 = 5;
+/// Storage buffers the wave pass binds in one compute stage (keep in sync with pipelines.rs):
+/// waves, output, three curve buffers, materials, lights, shading data.
+const NEEDED_COMPUTE_STORAGE_BUFFERS: u32 = 8;
+/// Colour targets of the raster pass (the two G-buffer targets of raster.wgsl).
+const NEEDED_COLOR_ATTACHMENTS: u32 = 2;
+/// Bytes per sample those targets take together (two `Rgba32Uint`).
+const NEEDED_COLOR_BYTES: u32 = 32;
 /// Invocations per workgroup the kernels use (8×8 wave pass, 64×1 twin-test kernels).
 const NEEDED_WORKGROUP_INVOCATIONS: u32 = 64;
 
@@ -119,6 +124,15 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
         missing.push(format!(
             "{NEEDED_COMPUTE_STORAGE_BUFFERS} storage buffers per shader stage (it allows {})",
             limits.max_storage_buffers_per_shader_stage
+        ));
+    }
+    if limits.max_color_attachments < NEEDED_COLOR_ATTACHMENTS
+        || limits.max_color_attachment_bytes_per_sample < NEEDED_COLOR_BYTES
+    {
+        missing.push(format!(
+            "{NEEDED_COLOR_ATTACHMENTS} colour targets of {NEEDED_COLOR_BYTES} bytes per pixel together (it allows \
+             {} targets, {} bytes)",
+            limits.max_color_attachments, limits.max_color_attachment_bytes_per_sample
         ));
     }
     if limits.max_compute_invocations_per_workgroup < NEEDED_WORKGROUP_INVOCATIONS

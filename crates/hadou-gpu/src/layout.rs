@@ -7,8 +7,11 @@
 use bytemuck::{Pod, Zeroable};
 use hadou_math::curve::{self, CurveShape, Integrator, PreparedCurve, DEFAULT_SETTINGS};
 use hadou_math::energy::Falloff;
+use hadou_math::toon::{Filter, Ramp, RampKind, Wrap, MAX_RAMP_BANDS};
 use hadou_math::{Mat4, Vec3f};
-use hadou_scene::{CameraBasis, Frame, Object, ToneMode, Wave, WaveShape};
+use hadou_scene::{
+    CameraBasis, Frame, LightLine, Object, ShadingModel, TextureRef, ToneMode, Wave, WaveShape,
+};
 
 /// `GpuWave::kind` of a sphere field. Keep in sync with `WAVE_SPHERE` in common.wgsl.
 pub const WAVE_SPHERE: u32 = 0;
@@ -76,8 +79,8 @@ pub struct FrameUniforms {
     pub wave_count: u32,
     /// Ambient term, linear RGB.
     pub ambient: [f32; 3],
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 when some wave glows (`light_glow > 0`): every surface then takes the waves' light.
+    pub any_glow: u32,
     /// Whole image size in pixels.
     pub image_size: [u32; 2],
     /// Top-left pixel of the tile in the image.
@@ -117,7 +120,7 @@ impl FrameUniforms {
             light_color: frame.light.color,
             wave_count: frame.waves.len() as u32,
             ambient: frame.light.ambient,
-            _pad0: 0,
+            any_glow: u32::from(frame.waves.iter().any(|w| w.light.glow > 0.0)),
             image_size: [frame.width, frame.height],
             tile_origin: origin,
             tile_size: size,
@@ -130,7 +133,8 @@ impl FrameUniforms {
     }
 }
 
-/// One object's transforms and albedo. Keep in sync with `GpuObject` in common.wgsl.
+/// One object's transforms and where its materials start. Keep in sync with `GpuObject` in
+/// common.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuObject {
@@ -138,22 +142,262 @@ pub struct GpuObject {
     pub model: [[f32; 4]; 4],
     /// [`Mat4::normal_matrix`] of `model`.
     pub normal_matrix: [[f32; 4]; 4],
-    /// Linear RGB albedo.
-    pub color: [f32; 3],
+    /// Index of the object's first material in the frame's material buffer.
+    pub material_base: u32,
+    /// Number of its materials (≥ 1); a vertex's slot is clamped to `count − 1`.
+    pub material_count: u32,
     /// Padding.
-    pub _pad: f32,
+    pub _pad: [u32; 2],
 }
 
 impl GpuObject {
-    /// The GPU form of `object`.
-    pub fn new(object: &Object) -> Self {
+    /// The GPU form of `object`, whose materials start at `material_base`.
+    pub fn new(object: &Object, material_base: u32) -> Self {
         let m: Mat4 = object.transform;
         Self {
             model: m.cols,
             normal_matrix: m.normal_matrix().cols,
-            color: object.materials[0].base_color,
-            _pad: 0.0,
+            material_base,
+            material_count: object.materials.len().max(1) as u32,
+            _pad: [0; 2],
         }
+    }
+}
+
+/// `GpuRamp::kind` of [`RampKind::Bands`]. Keep in sync with `RAMP_BANDS` in common.wgsl.
+pub const RAMP_BANDS: u32 = 0;
+/// `GpuRamp::kind` of [`RampKind::Gradient`]. Keep in sync with `RAMP_GRADIENT`.
+pub const RAMP_GRADIENT: u32 = 1;
+/// `GpuMaterial::model` of [`ShadingModel::Diffuse`]. Keep in sync with `MODEL_DIFFUSE`.
+pub const MODEL_DIFFUSE: u32 = 0;
+/// `GpuMaterial::model` of [`ShadingModel::Toon`]. Keep in sync with `MODEL_TOON`.
+pub const MODEL_TOON: u32 = 1;
+/// `GpuMaterial::model` of [`ShadingModel::Unlit`]. Keep in sync with `MODEL_UNLIT`.
+pub const MODEL_UNLIT: u32 = 2;
+/// `GpuLight::line_kind`s: a point, a segment, an infinite line, a polyline. Keep in sync with
+/// `LINE_*` in common.wgsl.
+pub const LINE_POINT: u32 = 0;
+/// See [`LINE_POINT`].
+pub const LINE_SEGMENT: u32 = 1;
+/// See [`LINE_POINT`].
+pub const LINE_LINE: u32 = 2;
+/// See [`LINE_POINT`].
+pub const LINE_POLYLINE: u32 = 3;
+/// Bit of the raster pass's material word marking an outline-hull fragment. Keep in sync with
+/// `HULL_BIT` in common.wgsl.
+pub const HULL_BIT: u32 = 1 << 31;
+/// Number of 32-bit words at the start of the shading data buffer holding the sRGB → linear
+/// table ([`hadou_math::toon::srgb_table`]).
+pub const SRGB_TABLE_WORDS: u32 = 256;
+
+/// A colour ramp ([`Ramp`]) in a fixed-size record. Keep in sync with `GpuRamp` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuRamp {
+    /// `(threshold, r, g, b)` per stop; `count` are used.
+    pub stops: [[f32; 4]; MAX_RAMP_BANDS],
+    /// Stops used, `1..=8`.
+    pub count: u32,
+    /// [`RAMP_BANDS`] or [`RAMP_GRADIENT`].
+    pub kind: u32,
+    /// Band smoothing width.
+    pub smoothing: f32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+impl GpuRamp {
+    /// The GPU form of `ramp` (extra stops beyond [`MAX_RAMP_BANDS`] are dropped; the scene
+    /// loader refuses them).
+    pub fn new(ramp: &Ramp) -> Self {
+        let mut g = GpuRamp::zeroed();
+        for (i, (t, c)) in ramp.stops.iter().take(MAX_RAMP_BANDS).enumerate() {
+            g.stops[i] = [*t, c[0], c[1], c[2]];
+        }
+        g.count = ramp.stops.len().min(MAX_RAMP_BANDS) as u32;
+        match ramp.kind {
+            RampKind::Bands { smoothing } => {
+                g.kind = RAMP_BANDS;
+                g.smoothing = smoothing;
+            }
+            RampKind::Gradient => g.kind = RAMP_GRADIENT,
+        }
+        g
+    }
+}
+
+/// Where a texture's texels are in the shading data buffer and how it is sampled. Keep in sync
+/// with `GpuTexture` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuTexture {
+    /// Word offset of texel (0, 0) in the shading data buffer; 0 = no texture.
+    pub offset: u32,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Wrap u (bits 0–1), wrap v (bits 2–3), nearest filter (bit 4); wraps: 0 repeat, 1 clamp,
+    /// 2 mirror.
+    pub flags: u32,
+}
+
+/// One material. Keep in sync with `GpuMaterial` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuMaterial {
+    /// Linear RGB base colour.
+    pub base_color: [f32; 3],
+    /// `MODEL_*`.
+    pub model: u32,
+    /// Outline colour.
+    pub outline_color: [f32; 3],
+    /// `β`.
+    pub wave_blend: f32,
+    /// Outline width `d`; 0 = no outline.
+    pub outline_width: f32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
+    /// Base-colour texture.
+    pub base_texture: GpuTexture,
+    /// Feature texture.
+    pub feature_texture: GpuTexture,
+    /// The toon ramp.
+    pub ramp: GpuRamp,
+}
+
+/// One wave as a light (000 §2.1): its centre line, strength, falloff and ramp. Keep in sync with
+/// `GpuLight` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct GpuLight {
+    /// `LINE_*`.
+    pub line_kind: u32,
+    /// Polyline: index of its first point in the shading data buffer (in words).
+    pub point_offset: u32,
+    /// Polyline: number of points.
+    pub point_count: u32,
+    /// 1 for the inverse-square falloff, 0 for the thesis's 1/r.
+    pub inverse_square: u32,
+    /// Point / segment start / a point on the line; `w` = strength `α·a`.
+    pub a: [f32; 4],
+    /// Segment end / unit line direction; `w` = glow.
+    pub b: [f32; 4],
+    /// Wave colour `rgb`; `w` = core radius.
+    pub color: [f32; 4],
+    /// The look ramp.
+    pub ramp: GpuRamp,
+}
+
+/// The frame's materials, lights and shading data (sRGB table, texels, polyline points).
+#[derive(Clone, Debug, Default)]
+pub struct ShadingBuffers {
+    /// One per material of every object, objects in order.
+    pub materials: Vec<GpuMaterial>,
+    /// One per wave.
+    pub lights: Vec<GpuLight>,
+    /// 32-bit words: the sRGB table, then texels (RGBA8 packed little-endian), then polyline
+    /// points (3 `f32` bit patterns each).
+    pub data: Vec<u32>,
+    /// `GpuObject::material_base` per object.
+    pub material_base: Vec<u32>,
+}
+
+fn wrap_bits(w: Wrap) -> u32 {
+    match w {
+        Wrap::Repeat => 0,
+        Wrap::Clamp => 1,
+        Wrap::Mirror => 2,
+    }
+}
+
+impl ShadingBuffers {
+    /// Builds the buffers of `frame`; `curves` are the frame's prepared curves (one per wave,
+    /// `None` for analytic ones). Textures shared between materials are stored once.
+    pub fn new(frame: &Frame, curves: &[Option<PreparedCurve>]) -> Self {
+        let mut b = ShadingBuffers::default();
+        b.data.extend(hadou_math::toon::srgb_table().iter().map(|v| v.to_bits()));
+        let mut stored: std::collections::HashMap<usize, u32> = std::collections::HashMap::new();
+        let mut texture = |data: &mut Vec<u32>, t: &Option<TextureRef>| -> GpuTexture {
+            let Some(t) = t else { return GpuTexture::zeroed() };
+            let key = std::sync::Arc::as_ptr(&t.image) as usize;
+            let offset = *stored.entry(key).or_insert_with(|| {
+                let o = data.len() as u32;
+                data.extend(t.image.texels.iter().map(|p| u32::from_le_bytes(*p)));
+                o
+            });
+            GpuTexture {
+                offset,
+                width: t.image.width,
+                height: t.image.height,
+                flags: wrap_bits(t.wrap[0])
+                    | wrap_bits(t.wrap[1]) << 2
+                    | u32::from(t.filter == Filter::Nearest) << 4,
+            }
+        };
+        for o in &frame.objects {
+            b.material_base.push(b.materials.len() as u32);
+            let fallback = [hadou_scene::Material::default()];
+            let mats: &[hadou_scene::Material] =
+                if o.materials.is_empty() { &fallback } else { &o.materials };
+            for m in mats {
+                b.materials.push(GpuMaterial {
+                    base_color: m.base_color,
+                    model: match m.model {
+                        ShadingModel::Diffuse => MODEL_DIFFUSE,
+                        ShadingModel::Toon => MODEL_TOON,
+                        ShadingModel::Unlit => MODEL_UNLIT,
+                    },
+                    outline_color: m.outline.map_or([0.0; 3], |o| o.color),
+                    wave_blend: m.wave_blend,
+                    outline_width: m.outline.map_or(0.0, |o| o.width),
+                    _pad0: 0,
+                    _pad1: 0,
+                    _pad2: 0,
+                    base_texture: texture(&mut b.data, &m.base_texture),
+                    feature_texture: texture(&mut b.data, &m.feature_texture),
+                    ramp: GpuRamp::new(&m.ramp),
+                });
+            }
+        }
+        for (w, c) in frame.waves.iter().zip(curves) {
+            let mut l = GpuLight::zeroed();
+            l.inverse_square = u32::from(w.falloff == Falloff::InverseSquare);
+            l.color = [w.color[0], w.color[1], w.color[2], w.core_radius];
+            l.ramp = GpuRamp::new(&w.light.ramp);
+            let (strength, glow) = (w.light_strength(), w.light.glow);
+            match w.light_line(c.as_ref()) {
+                LightLine::Point(p) => {
+                    l.line_kind = LINE_POINT;
+                    l.a = v4(p, strength);
+                    l.b = v4(p, glow);
+                }
+                LightLine::Segment(p, q) => {
+                    l.line_kind = LINE_SEGMENT;
+                    l.a = v4(p, strength);
+                    l.b = v4(q, glow);
+                }
+                LightLine::Line(p, d) => {
+                    l.line_kind = LINE_LINE;
+                    l.a = v4(p, strength);
+                    l.b = v4(d, glow);
+                }
+                LightLine::Polyline(pts) => {
+                    l.line_kind = LINE_POLYLINE;
+                    l.point_offset = b.data.len() as u32;
+                    l.point_count = pts.len() as u32;
+                    b.data.extend(pts.iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]));
+                    l.a = [0.0, 0.0, 0.0, strength];
+                    l.b = [0.0, 0.0, 0.0, glow];
+                }
+            }
+            b.lights.push(l);
+        }
+        b
     }
 }
 
@@ -477,23 +721,33 @@ impl CurveBuffers {
 
 /// The wave buffer and the curve buffers of a frame: every curved wave is prepared once
 /// ([`curve::prepare`], as the CPU backend does per frame) and appended to the curve buffers.
-pub fn frame_waves(frame: &Frame) -> Result<(Vec<GpuWave>, CurveBuffers), String> {
+/// Also returns the prepared curves, one entry per wave (`None` for analytic waves), for
+/// [`ShadingBuffers::new`].
+pub fn frame_waves(frame: &Frame) -> Result<FrameWaves, String> {
     let mut curves = CurveBuffers::default();
     let mut waves = Vec::with_capacity(frame.waves.len());
+    let mut prepared = Vec::with_capacity(frame.waves.len());
     for w in &frame.waves {
         match &w.shape {
             WaveShape::Curve(c) => {
                 let prep = curve::prepare(c);
                 let index = curves.push(&prep).map_err(|e| format!("wave `{}`: {e}", w.name))?;
                 waves.push(GpuWave::curve(w, index));
+                prepared.push(Some(prep));
             }
-            _ => waves.extend(GpuWave::new(w)),
+            _ => {
+                waves.extend(GpuWave::new(w));
+                prepared.push(None);
+            }
         }
     }
-    Ok((waves, curves))
+    Ok((waves, curves, prepared))
 }
 
-/// One mesh vertex as the raster pass reads it (locations 0 and 1 of `VertexIn` in raster.wgsl).
+/// What [`frame_waves`] returns: the wave buffer, the curve buffers, and the prepared curves.
+pub type FrameWaves = (Vec<GpuWave>, CurveBuffers, Vec<Option<PreparedCurve>>);
+
+/// One mesh vertex as the raster pass reads it (`VertexIn` in raster.wgsl, locations 0–5).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuVertex {
@@ -501,4 +755,12 @@ pub struct GpuVertex {
     pub position: [f32; 3],
     /// Object-space normal.
     pub normal: [f32; 3],
+    /// Object-space outline direction ([`hadou_scene::Mesh::outline_normals`]).
+    pub outline_normal: [f32; 3],
+    /// Texture coordinates.
+    pub uv: [f32; 2],
+    /// Linear RGBA vertex colour.
+    pub color: [f32; 4],
+    /// Material slot of the object.
+    pub material: u32,
 }

@@ -21,6 +21,8 @@ pub(crate) const WAVE_WORKGROUP: u32 = 8;
 /// The compiled pipelines of the backend.
 pub(crate) struct Pipelines {
     pub(crate) raster: wgpu::RenderPipeline,
+    /// The outline hulls: `vs_hull`, front faces culled (000 §2.3).
+    pub(crate) hull: wgpu::RenderPipeline,
     pub(crate) raster_layout: wgpu::BindGroupLayout,
     pub(crate) wave: wgpu::ComputePipeline,
     pub(crate) wave_layout: wgpu::BindGroupLayout,
@@ -79,6 +81,7 @@ fn storage_entry(
 }
 
 fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    // Both G-buffer targets (raster.wgsl) are read by the wave pass.
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -101,7 +104,11 @@ impl Pipelines {
             let vs_fs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
             let raster_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("raster"),
-                entries: &[uniform_entry(0, vs_fs), storage_entry(1, vs_fs, true)],
+                entries: &[
+                    uniform_entry(0, vs_fs),
+                    storage_entry(1, vs_fs, true),
+                    storage_entry(2, vs_fs, true),
+                ],
             });
             let cs = wgpu::ShaderStages::COMPUTE;
             let wave_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -110,11 +117,16 @@ impl Pipelines {
                     uniform_entry(0, cs),
                     storage_entry(1, cs, true),
                     texture_entry(2),
+                    texture_entry(3),
                     storage_entry(4, cs, false),
                     // Curve buffers; keep in sync with curve.wgsl and layout::CurveBuffers.
                     storage_entry(5, cs, true),
                     storage_entry(6, cs, true),
                     storage_entry(7, cs, true),
+                    // Materials, lights, shading data; keep in sync with shading.wgsl.
+                    storage_entry(8, cs, true),
+                    storage_entry(9, cs, true),
+                    storage_entry(10, cs, true),
                 ],
             });
             let raster_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -127,47 +139,63 @@ impl Pipelines {
                 bind_group_layouts: &[Some(&wave_layout)],
                 immediate_size: 0,
             });
-            let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
-            let raster = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("raster"),
-                layout: Some(&raster_pl),
-                vertex: wgpu::VertexState {
-                    module: &raster_module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[wgpu::VertexBufferLayout {
-                        array_stride: std::mem::size_of::<GpuVertex>() as u64,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &attributes,
-                    }],
-                },
-                // No culling: open meshes (planes) are visible from both sides, as on the CPU.
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
+            let attributes = wgpu::vertex_attr_array![
+                0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x2, 4 => Float32x4, 5 => Uint32
+            ];
+            let targets = [
+                Some(wgpu::ColorTargetState {
+                    format: SCENE_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
                 }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &raster_module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: SCENE_FORMAT,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
+                Some(wgpu::ColorTargetState {
+                    format: SCENE_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
                 }),
-                multiview_mask: None,
-                cache: None,
-            });
+            ];
+            let raster_pipeline = |label: &str, vs: &str, cull_mode: Option<wgpu::Face>| {
+                d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&raster_pl),
+                    vertex: wgpu::VertexState {
+                        module: &raster_module,
+                        entry_point: Some(vs),
+                        compilation_options: Default::default(),
+                        buffers: &[wgpu::VertexBufferLayout {
+                            array_stride: std::mem::size_of::<GpuVertex>() as u64,
+                            step_mode: wgpu::VertexStepMode::Vertex,
+                            attributes: &attributes,
+                        }],
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology: wgpu::PrimitiveTopology::TriangleList,
+                        front_face: wgpu::FrontFace::Ccw,
+                        cull_mode,
+                        ..Default::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH_FORMAT,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &raster_module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: Default::default(),
+                        targets: &targets,
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            };
+            // No culling: open meshes (planes) are visible from both sides, as on the CPU.
+            let raster = raster_pipeline("raster", "vs_main", None);
+            // Hulls show only their back faces (counter-clockwise front faces, as every mesh).
+            let hull = raster_pipeline("outline hull", "vs_hull", Some(wgpu::Face::Front));
             let wave = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("wave"),
                 layout: Some(&wave_pl),
@@ -176,7 +204,7 @@ impl Pipelines {
                 compilation_options: Default::default(),
                 cache: None,
             });
-            Self { raster, raster_layout, wave, wave_layout }
+            Self { raster, hull, raster_layout, wave, wave_layout }
         })
     }
 }

@@ -3,7 +3,9 @@
 //! is bounded by the tile size whatever the image size.
 
 use crate::device::GpuContext;
-use crate::layout::{self, FrameUniforms, GpuCurve, GpuObject, GpuVertex, GpuWave};
+use crate::layout::{
+    self, FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuVertex, GpuWave, ShadingBuffers,
+};
 use crate::pipelines::{self, Pipelines};
 use bytemuck::Zeroable;
 use hadou_scene::{Frame, Image, Mesh, RenderError};
@@ -28,8 +30,10 @@ struct CachedMesh {
 /// The per-tile GPU resources, sized for one tile edge pair.
 pub(crate) struct TileTargets {
     size: [u32; 2],
-    /// Scene colour and eye distance, packed (see `pipelines::SCENE_FORMAT`).
+    /// G-buffer target 0: normal and eye distance (see raster.wgsl and `pipelines::SCENE_FORMAT`).
     scene_view: wgpu::TextureView,
+    /// G-buffer target 1: texture coordinates, vertex colour, material.
+    attributes_view: wgpu::TextureView,
     depth_view: wgpu::TextureView,
     uniforms: wgpu::Buffer,
     output: wgpu::Buffer,
@@ -44,7 +48,13 @@ pub(crate) struct Prepared {
     waves: wgpu::Buffer,
     /// Curve buffers (bindings 5–7 of the wave pass; see `layout::CurveBuffers`).
     curves: [wgpu::Buffer; 3],
+    /// Materials, lights and shading data (bindings 8–10; see `layout::ShadingBuffers`).
+    materials: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    shading_data: wgpu::Buffer,
     draws: Vec<(usize, u32)>,
+    /// Whether any object has an outlined material (then the hull pipeline runs).
+    outlines: bool,
 }
 
 /// The renderer's state between frames.
@@ -161,11 +171,15 @@ impl Renderer {
                 continue;
             }
             let m = &o.mesh;
-            let vertices: Vec<GpuVertex> = m
-                .positions
-                .iter()
-                .zip(&m.normals)
-                .map(|(&position, &normal)| GpuVertex { position, normal })
+            let vertices: Vec<GpuVertex> = (0..m.positions.len())
+                .map(|i| GpuVertex {
+                    position: m.positions[i],
+                    normal: m.normals[i],
+                    outline_normal: m.outline_normals.get(i).copied().unwrap_or(m.normals[i]),
+                    uv: m.uvs.get(i).copied().unwrap_or([0.0; 2]),
+                    color: m.colors.get(i).copied().unwrap_or([1.0; 4]),
+                    material: m.material_of(i),
+                })
                 .collect();
             let d = &self.ctx.device;
             let vb = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -211,7 +225,8 @@ impl Renderer {
             .create_view(&Default::default())
         };
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let scene_view = texture("scene colour and distance", pipelines::SCENE_FORMAT, attach_and_read);
+        let scene_view = texture("normal and distance", pipelines::SCENE_FORMAT, attach_and_read);
+        let attributes_view = texture("uv, colour and material", pipelines::SCENE_FORMAT, attach_and_read);
         let depth_view = texture("depth", pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
         let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
@@ -232,7 +247,8 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        self.targets = Some(TileTargets { size, scene_view, depth_view, uniforms, output, staging });
+        self.targets =
+            Some(TileTargets { size, scene_view, attributes_view, depth_view, uniforms, output, staging });
     }
 
     /// Validates the frame, uploads what it needs and plans the tiles covering the rows `rows`.
@@ -244,8 +260,14 @@ impl Renderer {
         self.ctx.check()?;
         validate_frame(frame)?;
         let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
-        let objects: Vec<GpuObject> = frame.objects.iter().map(GpuObject::new).collect();
-        let (waves, curve_data) = layout::frame_waves(frame).map_err(other)?;
+        let (waves, curve_data, prepared_curves) = layout::frame_waves(frame).map_err(other)?;
+        let shading = ShadingBuffers::new(frame, &prepared_curves);
+        let objects: Vec<GpuObject> = frame
+            .objects
+            .iter()
+            .zip(&shading.material_base)
+            .map(|(o, &base)| GpuObject::new(o, base))
+            .collect();
         let max_binding =
             self.ctx.limits.max_storage_buffer_binding_size.min(self.ctx.limits.max_buffer_size);
         let curve_bytes = [
@@ -256,6 +278,13 @@ impl Renderer {
         if let Some(&big) = curve_bytes.iter().find(|&&b| b as u64 > max_binding) {
             return Err(RenderError::Device(format!(
                 "curve data of {big} bytes exceeds the device's storage buffer limit of {max_binding} bytes"
+            )));
+        }
+        let data_bytes = std::mem::size_of_val(shading.data.as_slice()) as u64;
+        if data_bytes > max_binding {
+            return Err(RenderError::Device(format!(
+                "the frame's textures take {data_bytes} bytes, more than the device's storage buffer limit of \
+                 {max_binding} bytes; use smaller textures"
             )));
         }
         let (zero_object, zero_wave) = (GpuObject::zeroed(), GpuWave::zeroed());
@@ -304,6 +333,25 @@ impl Renderer {
                 storage("curve vec4s", bytemuck::cast_slice(&curve_data.vec4s)),
                 storage("curve scalars", bytemuck::cast_slice(&curve_data.scalars)),
             ];
+            let (zero_material, zero_light) = ([GpuMaterial::zeroed()], [GpuLight::zeroed()]);
+            let materials = storage(
+                "materials",
+                bytemuck::cast_slice(if shading.materials.is_empty() {
+                    &zero_material[..]
+                } else {
+                    &shading.materials[..]
+                }),
+            );
+            let lights = storage(
+                "lights",
+                bytemuck::cast_slice(if shading.lights.is_empty() {
+                    &zero_light[..]
+                } else {
+                    &shading.lights[..]
+                }),
+            );
+            let shading_data = storage("shading data", bytemuck::cast_slice(&shading.data));
+            let outlines = shading.materials.iter().any(|m| m.outline_width > 0.0);
             let draws = frame
                 .objects
                 .iter()
@@ -319,7 +367,7 @@ impl Renderer {
                     tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(rows.end - y)]));
                 }
             }
-            Prepared { tile, tiles, objects, waves, curves, draws }
+            Prepared { tile, tiles, objects, waves, curves, materials, lights, shading_data, draws, outlines }
         };
         self.ctx.close_scopes(scopes, "uploading the frame")?;
         Ok(prepared)
@@ -347,6 +395,7 @@ impl Renderer {
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: t.uniforms.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: prepared.materials.as_entire_binding() },
             ],
         });
         let wave_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -363,6 +412,13 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 5, resource: prepared.curves[0].as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: prepared.curves[1].as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 7, resource: prepared.curves[2].as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&t.attributes_view),
+                },
+                wgpu::BindGroupEntry { binding: 8, resource: prepared.materials.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 9, resource: prepared.lights.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 10, resource: prepared.shading_data.as_entire_binding() },
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("tile") });
@@ -370,15 +426,26 @@ impl Renderer {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("raster"),
                 // Cleared to zero bits: distance 0 marks "nothing drawn".
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &t.scene_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
+                color_attachments: &[
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &t.scene_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &t.attributes_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                ],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &t.depth_view,
                     depth_ops: Some(wgpu::Operations {
@@ -396,14 +463,20 @@ impl Renderer {
                 multiview_mask: None,
             });
             pass.set_viewport(0.0, 0.0, size[0] as f32, size[1] as f32, 0.0, 1.0);
-            pass.set_pipeline(&self.pipelines.raster);
-            pass.set_bind_group(0, &raster_bg, &[]);
-            for &(object, index_count) in &prepared.draws {
-                let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
-                let Some(mesh) = self.meshes.get(&key) else { continue };
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
+            let hull = [(&self.pipelines.raster, true), (&self.pipelines.hull, prepared.outlines)];
+            for (pipeline, enabled) in hull {
+                if !enabled {
+                    continue;
+                }
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &raster_bg, &[]);
+                for &(object, index_count) in &prepared.draws {
+                    let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
+                    let Some(mesh) = self.meshes.get(&key) else { continue };
+                    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                    pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
+                }
             }
         }
         {

@@ -2,8 +2,8 @@
 //!
 //! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
 //! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
-//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave.wgsl` (energy integration,
-//!   colour mapping).
+//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `shading.wgsl` + `wave.wgsl`
+//!   (surface shading with the waves as lights, energy integration, colour mapping).
 //!
 //! A unit test parses and validates every composed module with naga (no adapter needed) and
 //! checks that the struct layouts naga computes equal the Rust ones in [`crate::layout`].
@@ -14,6 +14,8 @@ pub const COMMON: &str = include_str!("shaders/common.wgsl");
 pub const ENERGY: &str = include_str!("shaders/energy.wgsl");
 /// WGSL twins of `hadou_math::curve` (shape evaluation, default and Simpson integrators).
 pub const CURVE: &str = include_str!("shaders/curve.wgsl");
+/// WGSL twins of `hadou_math::toon` and `hadou-cpu`'s surface shading.
+pub const SHADING: &str = include_str!("shaders/shading.wgsl");
 /// The opaque geometry pass.
 pub const RASTER: &str = include_str!("shaders/raster.wgsl");
 /// The wave pass.
@@ -25,13 +27,14 @@ pub const FILES: &[(&str, &str)] = &[
     ("curve.wgsl", CURVE),
     ("energy.wgsl", ENERGY),
     ("raster.wgsl", RASTER),
+    ("shading.wgsl", SHADING),
     ("wave.wgsl", WAVE),
 ];
 
 /// The parts of the raster module, in order.
 pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
-pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE];
+pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, SHADING, WAVE];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -41,7 +44,9 @@ pub fn compose(parts: &[&str]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layout::{FrameUniforms, GpuCurve, GpuObject, GpuWave};
+    use crate::layout::{
+        FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuTexture, GpuWave,
+    };
     use std::mem::{offset_of, size_of};
 
     fn validate(name: &str, source: &str) -> naga::Module {
@@ -73,6 +78,7 @@ mod tests {
             ("energy.wgsl", ENERGY),
             ("curve.wgsl", CURVE),
             ("raster.wgsl", RASTER),
+            ("shading.wgsl", SHADING),
             ("wave.wgsl", WAVE),
         ] {
             for (i, line) in source.lines().enumerate() {
@@ -175,7 +181,7 @@ mod tests {
                 light_color,
                 wave_count,
                 ambient,
-                _pad0,
+                any_glow,
                 image_size,
                 tile_origin,
                 tile_size,
@@ -184,7 +190,31 @@ mod tests {
                 ndc_offset,
             ]
         );
-        check!(GpuObject, "GpuObject", [model, normal_matrix, color, _pad]);
+        check!(GpuObject, "GpuObject", [model, normal_matrix, material_base, material_count, _pad]);
+        check!(GpuRamp, "GpuRamp", [stops, count, kind, smoothing, _pad]);
+        check!(GpuTexture, "GpuTexture", [offset, width, height, flags]);
+        check!(
+            GpuMaterial,
+            "GpuMaterial",
+            [
+                base_color,
+                model,
+                outline_color,
+                wave_blend,
+                outline_width,
+                _pad0,
+                _pad1,
+                _pad2,
+                base_texture,
+                feature_texture,
+                ramp
+            ]
+        );
+        check!(
+            GpuLight,
+            "GpuLight",
+            [line_kind, point_offset, point_count, inverse_square, a, b, color, ramp]
+        );
         check!(GpuWave, "GpuWave", [color, kind, falloff, core_radius, _pad, p0, p1, p2]);
         check!(
             GpuCurve,

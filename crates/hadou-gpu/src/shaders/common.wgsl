@@ -40,7 +40,7 @@ struct FrameUniforms {
     light_color: vec3<f32>,
     wave_count: u32,
     ambient: vec3<f32>,
-    _pad0: u32,
+    any_glow: u32,
     image_size: vec2<u32>,
     tile_origin: vec2<u32>,
     tile_size: vec2<u32>,
@@ -53,8 +53,53 @@ struct FrameUniforms {
 struct GpuObject {
     model: mat4x4<f32>,
     normal_matrix: mat4x4<f32>,
-    color: vec3<f32>,
-    _pad: f32,
+    material_base: u32,
+    material_count: u32,
+    _pad: vec2<u32>,
+}
+
+// Keep in sync with layout.rs `GpuRamp` (hadou_math::toon::Ramp).
+struct GpuRamp {
+    stops: array<vec4<f32>, 8>,
+    count: u32,
+    kind: u32,
+    smoothing: f32,
+    _pad: u32,
+}
+
+// Keep in sync with layout.rs `GpuTexture`.
+struct GpuTexture {
+    offset: u32,
+    width: u32,
+    height: u32,
+    flags: u32,
+}
+
+// Keep in sync with layout.rs `GpuMaterial`.
+struct GpuMaterial {
+    base_color: vec3<f32>,
+    model: u32,
+    outline_color: vec3<f32>,
+    wave_blend: f32,
+    outline_width: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    base_texture: GpuTexture,
+    feature_texture: GpuTexture,
+    ramp: GpuRamp,
+}
+
+// Keep in sync with layout.rs `GpuLight`.
+struct GpuLight {
+    line_kind: u32,
+    point_offset: u32,
+    point_count: u32,
+    inverse_square: u32,
+    a: vec4<f32>,
+    b: vec4<f32>,
+    color: vec4<f32>,
+    ramp: GpuRamp,
 }
 
 // Keep in sync with layout.rs `GpuWave` (the meaning of p0/p1/p2 per kind is documented there).
@@ -126,6 +171,16 @@ const FALLOFF_FAITHFUL: u32 = 0u;
 const FALLOFF_INVERSE_SQUARE: u32 = 1u;
 const TONE_FAITHFUL: u32 = 0u;
 const TONE_FILMIC: u32 = 1u;
+const RAMP_BANDS: u32 = 0u;
+const RAMP_GRADIENT: u32 = 1u;
+const MODEL_DIFFUSE: u32 = 0u;
+const MODEL_TOON: u32 = 1u;
+const MODEL_UNLIT: u32 = 2u;
+const LINE_POINT: u32 = 0u;
+const LINE_SEGMENT: u32 = 1u;
+const LINE_LINE: u32 = 2u;
+const LINE_POLYLINE: u32 = 3u;
+const HULL_BIT: u32 = 0x80000000u;
 
 // Mirrors hadou_scene::CameraBasis::pixel_dir: direction through the centre of the global pixel
 // (px, py) (py = 0 is the top row), with unit component along `forward`.

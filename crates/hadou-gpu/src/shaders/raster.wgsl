@@ -1,54 +1,111 @@
 // Opaque geometry pass: every object's triangles, transformed by its object → world matrix and
 // projected with the camera basis exactly as the CPU rasterizer does (view-space x/z scaled by
-// 1/(tan_half·aspect), y/z by 1/tan_half), shaded with `diffuse` (hadou_math::shade::diffuse).
-// Writes the linear scene colour and the Euclidean eye distance of the visible surface, as the bits
-// of four f32s in one Rgba32Uint target (pipelines::SCENE_FORMAT: renderable on every adapter).
+// 1/(tan_half·aspect), y/z by 1/tan_half), then the outline hulls (000 §2.3, vs_hull). It writes a
+// G-buffer for the wave pass, which shades (shading.wgsl), as the bits of 32-bit values in two
+// Rgba32Uint targets (pipelines::SCENE_FORMAT: renderable on every adapter):
+// - target 0: world normal (x, y, z) as f32 bits, Euclidean eye distance as f32 bits (0 = nothing);
+// - target 1: u, v as f32 bits, the vertex colour as pack4x8unorm, the material index in the
+//   frame's material buffer (| HULL_BIT for an outline-hull fragment).
 // Prepended by common.wgsl.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> objects: array<GpuObject>;
+@group(0) @binding(2) var<storage, read> materials: array<GpuMaterial>;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    @location(2) outline_normal: vec3<f32>,
+    @location(3) uv: vec2<f32>,
+    @location(4) color: vec4<f32>,
+    @location(5) material: u32,
 }
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    @location(2) @interpolate(flat) object: u32,
+    @location(2) uv: vec2<f32>,
+    @location(3) color: vec4<f32>,
+    @location(4) @interpolate(flat) material: u32,
+}
+
+struct GBuffer {
+    @location(0) surface: vec4<u32>,
+    @location(1) attributes: vec4<u32>,
+}
+
+fn material_index(o: GpuObject, slot: u32) -> u32 {
+    return o.material_base + min(slot, max(o.material_count, 1u) - 1u);
+}
+
+// World → this tile's clip space (hadou_scene::CameraBasis::to_view, then the global NDC mapped to
+// the tile: ndc_tile = ndc·scale + offset, times w in clip space).
+fn project(world: vec3<f32>) -> vec4<f32> {
+    let d = world - frame.eye;
+    let view = vec3<f32>(dot3(d, frame.right), dot3(d, frame.up), dot3(d, frame.forward));
+    let gx = view.x / (frame.tan_half_fov * frame.aspect);
+    let gy = view.y / frame.tan_half_fov;
+    return vec4<f32>(
+        gx * frame.ndc_scale.x + view.z * frame.ndc_offset.x,
+        gy * frame.ndc_scale.y + view.z * frame.ndc_offset.y,
+        (view.z - frame.near) * (frame.far / (frame.far - frame.near)),
+        view.z,
+    );
 }
 
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     let o = objects[object];
     let world = (o.model * vec4<f32>(v.position, 1.0)).xyz;
-    let normal = (o.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
-    // World → view space (hadou_scene::CameraBasis::to_view).
-    let d = world - frame.eye;
-    let view = vec3<f32>(dot3(d, frame.right), dot3(d, frame.up), dot3(d, frame.forward));
-    // Global NDC, then this tile's part of it: ndc_tile = ndc·scale + offset (times w in clip space).
-    let gx = view.x / (frame.tan_half_fov * frame.aspect);
-    let gy = view.y / frame.tan_half_fov;
     var out: VertexOut;
-    out.clip = vec4<f32>(
-        gx * frame.ndc_scale.x + view.z * frame.ndc_offset.x,
-        gy * frame.ndc_scale.y + view.z * frame.ndc_offset.y,
-        (view.z - frame.near) * (frame.far / (frame.far - frame.near)),
-        view.z,
-    );
+    out.clip = project(world);
     out.world = world;
-    out.normal = normal;
-    out.object = object;
+    out.normal = (o.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
+    out.uv = v.uv;
+    out.color = v.color;
+    out.material = material_index(o, v.material);
     return out;
 }
 
-// (r, g, b, eye distance) as f32 bit patterns; read back by wave.wgsl's `scene_texel`.
+// The outline hull (000 §2.3): the vertex pushed along its world outline normal by d·|z|, which is
+// R' = R + d·|R_z|·U in view space (hadou-cpu raster::project_all). Vertices of materials without
+// an outline collapse to one point outside the clip volume, so their triangles are empty.
+@vertex
+fn vs_hull(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
+    let o = objects[object];
+    let index = material_index(o, v.material);
+    let width = materials[index].outline_width;
+    var out: VertexOut;
+    out.material = index | HULL_BIT;
+    out.uv = v.uv;
+    out.color = v.color;
+    if (!(width > 0.0)) {
+        out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0);
+        out.world = frame.eye;
+        out.normal = vec3<f32>(0.0);
+        return out;
+    }
+    let base = (o.model * vec4<f32>(v.position, 1.0)).xyz;
+    let n = (o.normal_matrix * vec4<f32>(v.outline_normal, 0.0)).xyz;
+    let len = length3(n);
+    var u = vec3<f32>(0.0);
+    if (len > 0.0 && len < 3.0e38) {
+        u = n / len;
+    }
+    let z = dot3(base - frame.eye, frame.forward);
+    let world = base + u * (width * abs(z));
+    out.clip = project(world);
+    out.world = world;
+    out.normal = (o.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
+    return out;
+}
+
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<u32> {
-    let o = objects[in.object];
-    let rgb = diffuse(o.color, in.normal, frame.light_dir, frame.light_color, frame.ambient);
+fn fs_main(in: VertexOut) -> GBuffer {
+    var g: GBuffer;
     let distance = length3(in.world - frame.eye);
-    return bitcast<vec4<u32>>(vec4<f32>(rgb, distance));
+    g.surface = bitcast<vec4<u32>>(vec4<f32>(in.normal, distance));
+    g.attributes = vec4<u32>(bitcast<u32>(in.uv.x), bitcast<u32>(in.uv.y), pack4x8unorm(in.color), in.material);
+    return g;
 }

@@ -1,13 +1,16 @@
-// Wave pass: per pixel, the integration ray of hadou_scene::CameraBasis::wave_ray (002 eq. 3.12–3.13,
-// clipped at the visible surface), the energy of every wave (energy.wgsl), the colour
-// scene + exposure·Σ rgb·a·I and the colour mapping (common.wgsl). Prepended by common.wgsl and
-// energy.wgsl and curve.wgsl (whose curve buffers are bindings 5–7).
+// Wave pass: per pixel, the visible surface's shading from the raster pass's G-buffer
+// (shading.wgsl: materials, the waves as lights), the integration ray of
+// hadou_scene::CameraBasis::wave_ray (002 eq. 3.12–3.13, clipped at the visible surface), the energy
+// of every wave (energy.wgsl), the colour scene + exposure·Σ rgb·a·I and the colour mapping
+// (common.wgsl). Prepended by common.wgsl, energy.wgsl, curve.wgsl (curve buffers: bindings 5–7)
+// and shading.wgsl (bindings 8–10).
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
-// The raster pass's output: (r, g, b, eye distance) as f32 bits; distance 0 = nothing drawn
-// (pipelines::SCENE_FORMAT).
+// The raster pass's G-buffer (raster.wgsl): (normal, eye distance) as f32 bits, distance 0 =
+// nothing drawn; (u, v, pack4x8unorm colour, material | HULL_BIT).
 @group(0) @binding(2) var scene_texels: texture_2d<u32>;
+@group(0) @binding(3) var attribute_texels: texture_2d<u32>;
 // Tile output, n = tile_size.x · tile_size.y pixels, row-major: colour (4 floats per pixel) in
 // [0, 4n), energy in [4n, 5n), eye distance in [5n, 6n). Keep in sync with readback in render.rs.
 @group(0) @binding(4) var<storage, read_write> out_buf: array<f32>;
@@ -80,11 +83,19 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let drawn = texel.w > 0.0;
     var surface = -1.0;
     var scene = frame.background;
+    let dir = pixel_dir(frame, px, py);
     if (drawn) {
         surface = texel.w;
-        scene = texel.xyz;
+        let attributes = textureLoad(attribute_texels, vec2<i32>(id.xy), 0);
+        let m = materials[attributes.w & ~HULL_BIT];
+        if ((attributes.w & HULL_BIT) != 0u) {
+            scene = m.outline_color;
+        } else {
+            let world = frame.eye + dir * (surface / length3(dir));
+            let uv = vec2<f32>(bitcast<f32>(attributes.x), bitcast<f32>(attributes.y));
+            scene = shade_surface(m, world, texel.xyz, uv, unpack4x8unorm(attributes.z));
+        }
     }
-    let dir = pixel_dir(frame, px, py);
 
     var total = 0.0;
     var light = vec3<f32>(0.0);

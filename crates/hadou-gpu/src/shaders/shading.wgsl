@@ -1,0 +1,246 @@
+// Surface shading of the wave pass: twins of hadou_math::toon (ramps, nearest points of centre
+// lines, dominance weights, texture sampling) and of hadou-cpu's shading::shade (000 §2.1–2.2,
+// SPEC.md §2.1–2.2). Prepended to wave.wgsl; the bindings are part of the wave pass's group.
+
+// One per material of every object (layout::ShadingBuffers::materials).
+@group(0) @binding(8) var<storage, read> materials: array<GpuMaterial>;
+// One per wave (layout::ShadingBuffers::lights).
+@group(0) @binding(9) var<storage, read> lights: array<GpuLight>;
+// Words: the sRGB → linear table (256 f32 bit patterns), texels (RGBA8, little-endian), polyline
+// points (3 f32 bit patterns each). layout::ShadingBuffers::data.
+@group(0) @binding(10) var<storage, read> shading_data: array<u32>;
+
+// Mirrors hadou_math::toon::band_step.
+fn band_step(m: f32, t: f32, w: f32) -> f32 {
+    if (w <= 0.0) {
+        return select(0.0, 1.0, m >= t);
+    }
+    let x = clamp((m - t) / w + 0.5, 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x);
+}
+
+// Mirrors hadou_math::toon::Ramp::eval (m is never NaN here: it comes from wave_m or a clamped dot).
+fn ramp_eval(r: GpuRamp, m: f32) -> vec3<f32> {
+    if (r.count == 0u) {
+        return vec3<f32>(0.0);
+    }
+    var c = r.stops[0].yzw;
+    for (var k = 1u; k < min(r.count, 8u); k++) {
+        let prev = r.stops[k - 1u];
+        let cur = r.stops[k];
+        var s = 0.0;
+        if (r.kind == RAMP_BANDS) {
+            s = band_step(m, cur.x, r.smoothing);
+        } else if (cur.x > prev.x) {
+            s = clamp((m - prev.x) / (cur.x - prev.x), 0.0, 1.0);
+        } else {
+            s = select(0.0, 1.0, m >= cur.x);
+        }
+        c = c + (cur.yzw - prev.yzw) * s;
+    }
+    return c;
+}
+
+// Mirrors hadou_math::toon::nearest_on_segment.
+fn nearest_on_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    let d = b - a;
+    let dd = dot3(d, d);
+    if (!(dd > 0.0) || !(dd <= 3.40282347e38)) {
+        return a;
+    }
+    let t = clamp(dot3(p - a, d) / dd, 0.0, 1.0);
+    return a + d * t;
+}
+
+fn polyline_point(offset: u32, i: u32) -> vec3<f32> {
+    let o = offset + 3u * i;
+    return vec3<f32>(bitcast<f32>(shading_data[o]), bitcast<f32>(shading_data[o + 1u]), bitcast<f32>(shading_data[o + 2u]));
+}
+
+// Mirrors hadou_scene::LightLine::nearest.
+fn light_nearest(l: GpuLight, p: vec3<f32>) -> vec3<f32> {
+    switch l.line_kind {
+        case LINE_POINT: {
+            return l.a.xyz;
+        }
+        case LINE_SEGMENT: {
+            return nearest_on_segment(p, l.a.xyz, l.b.xyz);
+        }
+        case LINE_LINE: {
+            return l.a.xyz + l.b.xyz * dot3(p - l.a.xyz, l.b.xyz);
+        }
+        default: {
+            // hadou_math::toon::nearest_on_polyline
+            if (l.point_count == 0u) {
+                return p;
+            }
+            var best = polyline_point(l.point_offset, 0u);
+            if (l.point_count == 1u) {
+                return best;
+            }
+            var best_d = 3.40282347e38;
+            for (var i = 0u; i + 1u < l.point_count; i++) {
+                let q = nearest_on_segment(p, polyline_point(l.point_offset, i), polyline_point(l.point_offset, i + 1u));
+                let e = q - p;
+                let d = dot3(e, e);
+                if (d < best_d) {
+                    best_d = d;
+                    best = q;
+                }
+            }
+            return best;
+        }
+    }
+}
+
+// Mirrors hadou_math::toon::wave_m.
+fn wave_m(p: vec3<f32>, n: vec3<f32>, e: vec3<f32>) -> f32 {
+    let v = e - p;
+    let len = length3(v);
+    if (len > 0.0 && len <= 3.40282347e38) {
+        return clamp(dot3(n, v / len), -1.0, 1.0);
+    }
+    return 1.0;
+}
+
+// Mirrors hadou_math::toon::dominance.
+fn dominance(distance: f32, core_radius: f32, strength: f32, inverse_square: bool) -> f32 {
+    let rc = max(core_radius, 1.0e-4);
+    let q = distance * distance + rc * rc;
+    var rho = 1.0 / sqrt(q);
+    if (inverse_square) {
+        rho = 1.0 / q;
+    }
+    let v = max(strength, 0.0) * rho;
+    if (v != v) {
+        return 0.0;
+    }
+    return min(v, 3.40282347e38);
+}
+
+// Mirrors hadou_math::toon::wrap_index (wrap: 0 repeat, 1 clamp, 2 mirror).
+fn wrap_index(i: i32, n: i32, wrap: u32) -> i32 {
+    if (wrap == 1u) {
+        return clamp(i, 0, n - 1);
+    }
+    if (wrap == 0u) {
+        return ((i % n) + n) % n;
+    }
+    let k = ((i % (2 * n)) + 2 * n) % (2 * n);
+    if (k < n) {
+        return k;
+    }
+    return 2 * n - 1 - k;
+}
+
+fn srgb(v: u32) -> f32 {
+    return bitcast<f32>(shading_data[v]);
+}
+
+fn texel(t: GpuTexture, i_in: i32, j_in: i32) -> vec4<f32> {
+    let i = wrap_index(i_in, i32(t.width), t.flags & 3u);
+    let j = wrap_index(j_in, i32(t.height), (t.flags >> 2u) & 3u);
+    let w = shading_data[t.offset + u32(j) * t.width + u32(i)];
+    return vec4<f32>(srgb(w & 255u), srgb((w >> 8u) & 255u), srgb((w >> 16u) & 255u), f32(w >> 24u) / 255.0);
+}
+
+fn fix_coord(v: f32) -> f32 {
+    if (v != v || abs(v) > 3.40282347e38) {
+        return 0.0;
+    }
+    return clamp(v, -1.0e6, 1.0e6);
+}
+
+// Mirrors hadou_math::toon::sample: level 0, texel centres at ((i + ½)/w, (j + ½)/h), bilinear
+// in linear light or nearest. `offset` 0 means no texture: opaque white.
+fn sample_texture(t: GpuTexture, uv: vec2<f32>) -> vec4<f32> {
+    if (t.offset == 0u || t.width == 0u || t.height == 0u) {
+        return vec4<f32>(1.0);
+    }
+    let x = fix_coord(uv.x) * f32(t.width);
+    let y = fix_coord(uv.y) * f32(t.height);
+    if ((t.flags & 16u) != 0u) {
+        return texel(t, i32(floor(x)), i32(floor(y)));
+    }
+    let xs = x - 0.5;
+    let ys = y - 0.5;
+    let x0 = floor(xs);
+    let y0 = floor(ys);
+    let fx = xs - x0;
+    let fy = ys - y0;
+    let i0 = i32(x0);
+    let j0 = i32(y0);
+    let a = texel(t, i0, j0);
+    let b = texel(t, i0 + 1, j0);
+    let c = texel(t, i0, j0 + 1);
+    let d = texel(t, i0 + 1, j0 + 1);
+    let top = a + (b - a) * fx;
+    let bottom = c + (d - c) * fx;
+    return top + (bottom - top) * fy;
+}
+
+// Most waves weighed per surface point (hadou_scene's limit is 256 waves per scene).
+const MAX_LIGHTS: u32 = 256u;
+
+// Mirrors hadou-cpu's shading::shade: own look, the waves' look weighted by their dominance,
+// glow, feature texture. `normal_in` need not be unit; `vcolor` is the 8-bit vertex colour.
+fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f32>, vcolor: vec4<f32>) -> vec3<f32> {
+    let len = length3(normal_in);
+    var n = vec3<f32>(0.0);
+    if (len > 0.0 && len < 3.0e38) {
+        n = normal_in / len;
+    }
+    let tex = sample_texture(m.base_texture, uv);
+    let albedo = m.base_color * tex.xyz * vcolor.xyz;
+    var c = albedo;
+    if (m.model == MODEL_DIFFUSE) {
+        c = diffuse(albedo, n, frame.light_dir, frame.light_color, frame.ambient);
+    } else if (m.model == MODEL_TOON) {
+        c = albedo * ramp_eval(m.ramp, dot3(n, -frame.light_dir));
+    }
+    let count = min(frame.wave_count, MAX_LIGHTS);
+    if (count > 0u && (m.wave_blend > 0.0 || frame.any_glow != 0u)) {
+        // Pass 1: the largest density and the glow.
+        var max_rho = 0.0;
+        var glow = vec3<f32>(0.0);
+        for (var i = 0u; i < count; i++) {
+            let l = lights[i];
+            let e = light_nearest(l, world);
+            let rho = dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+            max_rho = max(max_rho, rho);
+            if (l.b.w > 0.0) {
+                glow = glow + l.b.w * l.color.xyz * rho;
+            }
+        }
+        if (m.wave_blend > 0.0 && max_rho > 0.0) {
+            // Pass 2: weights (rho/max)², their sum, and the weighted looks
+            // (hadou_math::toon::dominance_weights).
+            var sum = 0.0;
+            var look = vec3<f32>(0.0);
+            for (var i = 0u; i < count; i++) {
+                let l = lights[i];
+                let e = light_nearest(l, world);
+                let rho = dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+                let x = rho / max_rho;
+                let w = x * x;
+                sum = sum + w;
+            }
+            for (var i = 0u; i < count; i++) {
+                let l = lights[i];
+                let e = light_nearest(l, world);
+                let rho = dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+                let x = rho / max_rho;
+                let w = (x * x) / sum;
+                if (w > 0.0) {
+                    look = look + w * ramp_eval(l.ramp, wave_m(world, n, e));
+                }
+            }
+            c = c + m.wave_blend * (look - c);
+        }
+        c = vec3<f32>(energy_saturate(c.x + glow.x), energy_saturate(c.y + glow.y), energy_saturate(c.z + glow.z));
+    }
+    if (m.feature_texture.offset != 0u) {
+        c = c * sample_texture(m.feature_texture, uv).xyz;
+    }
+    return c;
+}
