@@ -252,27 +252,30 @@ fn load_image(
     bytes_left: &mut u64,
     warnings: &mut Vec<String>,
 ) -> Result<Texture, String> {
-    let image = gltf.images().nth(index).ok_or_else(|| format!("image {index} is missing"))?;
+    // The JSON itself, not the gltf crate's `Image::source`, which requires a `mimeType` with a
+    // bufferView (the bytes are sniffed here instead).
+    let doc = gltf.document.as_json();
+    let image = doc.images.get(index).ok_or_else(|| format!("image {index} is missing"))?;
     let fail = |e: String| format!("image {index}: {e}");
-    let (bytes, name) = match image.source() {
-        gltf::image::Source::View { view, .. } => {
-            let data = src.buffers.get(view.buffer().index()).map_or(&[][..], |b| b.as_slice());
-            let end = view.offset().checked_add(view.length());
-            let bytes = end.and_then(|e| data.get(view.offset()..e)).ok_or_else(|| {
-                fail(format!(
-                    "bufferView {} reads past the end of buffer {}",
-                    view.index(),
-                    view.buffer().index()
-                ))
+    let (bytes, name) = match (&image.buffer_view, &image.uri) {
+        (Some(v), _) => {
+            let view = &doc.buffer_views[v.value()];
+            let buffer = view.buffer.value();
+            let data = src.buffers.get(buffer).map_or(&[][..], |b| b.as_slice());
+            let offset = view.byte_offset.map_or(0, |o| o.0) as usize;
+            let end = offset.checked_add(view.byte_length.0 as usize);
+            let bytes = end.and_then(|e| data.get(offset..e)).ok_or_else(|| {
+                fail(format!("bufferView {} reads past the end of buffer {buffer}", v.value()))
             })?;
-            (bytes.to_vec(), format!("image {index} (bufferView {})", view.index()))
+            (bytes.to_vec(), format!("image {index} (bufferView {})", v.value()))
         }
-        gltf::image::Source::Uri { uri, .. } => {
+        (None, Some(uri)) => {
             let bytes = crate::gltf_load::resolve_uri(uri, src.dir, src.root, *bytes_left).map_err(fail)?;
             *bytes_left = bytes_left.saturating_sub(bytes.len() as u64);
             let shown = if uri.starts_with("data:") { "data URI".to_string() } else { format!("`{uri}`") };
             (bytes, format!("image {index} ({shown})"))
         }
+        (None, None) => return Err(fail("it has neither a `bufferView` nor a `uri`".into())),
     };
     decode_texture(&bytes, &name, warnings).map_err(fail)
 }
