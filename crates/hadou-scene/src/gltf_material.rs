@@ -291,3 +291,21 @@ pub(crate) fn check_raw(raw: &Value, n_tex: usize) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mtoon_ramp_clamps_its_inputs() {
+        let ext = serde_json::json!({"shadeColorFactor": [1.0, 0.5, 0.3], "shadingShiftFactor": -3.0,
+                                     "shadingToonyFactor": -2.0});
+        let r = mtoon_ramp(&ext, [0.1, 0.0, 0.6], "m").unwrap();
+        assert_eq!(r.stops[0].1, [4.0, 1.0, 0.5]);
+        assert_eq!(r.stops[1].0, 1.0);
+        assert_eq!(r.kind, hadou_math::toon::RampKind::Bands { smoothing: 2.0 });
+        let e =
+            mtoon_ramp(&serde_json::json!({"shadingShiftFactor": "up"}), [1.0; 3], "material 2").unwrap_err();
+        assert!(e.contains("material 2 (VRMC_materials_mtoon).shadingShiftFactor"), "{e}");
+    }
+}
