@@ -1,17 +1,31 @@
 //! glTF 2.0 (`.gltf` with external or data-URI buffers, and `.glb`) → one [`Mesh`]: every
-//! TRIANGLES primitive of the default scene's nodes, with node transforms composed and baked in.
-//! Buffers are resolved here (no image decoding is pulled in).
+//! TRIANGLES primitive of the default scene's nodes, with node transforms composed and baked in,
+//! texture coordinates (`TEXCOORD_n`), vertex colours (`COLOR_0`), one material slot per vertex
+//! and the file's materials with their textures (`gltf_material`: base colour, base-colour and
+//! feature textures, `KHR_materials_unlit`, `VRMC_materials_mtoon`).
+//!
+//! A node with both a mesh and a skin is placed by its skin at the pose its joints' node
+//! transforms give (the rest pose of a file without animation; the node's own transform is
+//! ignored, as the glTF spec requires): each vertex goes through `Σ w_k · J_k · IBM_k` of its
+//! `JOINTS_0`/`WEIGHTS_0`, normals through the inverse transpose of the same matrix.
+//!
+//! `extensionsRequired` may only name the extensions hadou maps
+//! ([`crate::gltf_material::SUPPORTED_EXTENSIONS`]); unknown `extensionsUsed` are ignored.
 //!
 //! The file is untrusted: before the gltf crate's wrapper types are used, every index in the raw
-//! JSON is checked against the array it points into, the node graph is checked to be a forest
-//! (the glTF spec requires one; a node listed twice would otherwise multiply the instances
-//! exponentially), and the triangles the default scene instantiates are counted against the
-//! scene's budget before any data is copied. Every accessor is bounds-checked before it is read.
-//! Calls into the gltf crate run under [`guarded`], so even an unforeseen panic there is an
-//! error, never a crash.
+//! JSON is checked against the array it points into (the feature texture of the extras too), the
+//! node graph is checked to be a forest (the glTF spec requires one; a node listed twice would
+//! otherwise multiply the instances exponentially), and the triangles the default scene
+//! instantiates are counted against the scene's budget before any data is copied. Every accessor
+//! is bounds-checked before it is read, and every joint index against its skin. External buffer
+//! and image files must lie inside the asset root, every byte read counts against
+//! [`GLTF_MAX_BYTES`] and decoded texels against
+//! [`crate::gltf_material::TEXEL_BUDGET_BYTES`]. Calls into the gltf crate and the image decoders
+//! run under [`guarded`], so even an unforeseen panic there is an error, never a crash.
 
 use crate::files::{describe_bytes, read_regular_file, GLTF_MAX_BYTES};
 use crate::frame::Mesh;
+use crate::gltf_material::{load_materials, ImageSource, Materials, SUPPORTED_EXTENSIONS};
 use crate::guard::guarded;
 use crate::limits::{fmt_f32, COORD_MAX, MAX_TRIANGLES, MAX_VERTICES};
 use crate::mesh::{append_mesh, smooth_normals, transform_mesh};
@@ -60,17 +74,38 @@ pub(crate) fn load_gltf_in(
     path: &Path,
     root: &Path,
     budget: &mut Budget,
-    _warnings: &mut Vec<String>,
+    warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let bytes = read_regular_file(path, GLTF_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
-    from_bytes_in(&bytes, parent_dir(path), root, budget)
+    from_bytes_in(&bytes, parent_dir(path), root, budget, warnings)
 }
 
 /// Parses glTF or GLB `bytes`; external buffers are resolved relative to `dir` and must lie inside
 /// its directory tree.
 pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
+    gltf_from_bytes_with_warnings(bytes, dir).map(|(mesh, _)| mesh)
+}
+
+/// [`gltf_from_bytes`], also returning the warnings of the load (ignored material features,
+/// missing texture coordinates, downscaled textures, …).
+pub fn gltf_from_bytes_with_warnings(bytes: &[u8], dir: &Path) -> Result<(Mesh, Vec<String>), String> {
     let mut budget = Budget::FULL;
-    from_bytes_in(bytes, dir, dir, &mut budget)
+    let mut warnings = Vec::new();
+    let mesh = from_bytes_in(bytes, dir, dir, &mut budget, &mut warnings)?;
+    Ok((mesh, warnings))
+}
+
+/// The raw JSON of the file, for what the typed document does not keep (names, extensions,
+/// extras). serde_json limits its nesting depth, so hostile JSON cannot exhaust the stack.
+fn raw_json(body: &[u8]) -> Result<serde_json::Value, String> {
+    let json: Vec<u8> = if body.starts_with(b"glTF") {
+        let glb = guarded("GLB", || gltf::Glb::from_slice(body))?
+            .map_err(|e| format!("not a valid GLB file: {e}"))?;
+        glb.json.into_owned()
+    } else {
+        body.to_vec()
+    };
+    serde_json::from_slice(&json).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))
 }
 
 /// The JSON text of a `.gltf` (a UTF-8 byte-order mark dropped) or the whole `.glb`; anything
@@ -89,17 +124,39 @@ fn sniff(bytes: &[u8]) -> Result<&[u8], String> {
     }
 }
 
-fn from_bytes_in(bytes: &[u8], dir: &Path, root: &Path, budget: &mut Budget) -> Result<Mesh, String> {
+fn from_bytes_in(
+    bytes: &[u8],
+    dir: &Path,
+    root: &Path,
+    budget: &mut Budget,
+    warnings: &mut Vec<String>,
+) -> Result<Mesh, String> {
     let body = sniff(bytes)?;
     let gltf = guarded("glTF", || gltf::Gltf::from_slice_without_validation(body))?
         .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
     let doc = gltf.document.as_json();
+    for ext in &doc.extensions_required {
+        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
+            return Err(format!(
+                "it requires the glTF extension `{ext}`, which hadou does not support (supported: {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            ));
+        }
+    }
+    let raw = raw_json(body)?;
     check_indices(doc)?;
+    crate::gltf_material::check_raw(&raw, doc.textures.len())?;
     let parent = check_forest(doc)?;
     let mut problems = Vec::new();
     guarded("glTF", || {
         use gltf::json::validation::Validate;
-        doc.validate(doc, json::Path::new, &mut |path, e| problems.push(format!("{}: {e}", path())));
+        doc.validate(doc, json::Path::new, &mut |path, e| {
+            let at = path().to_string();
+            // Required extensions were checked above, against what hadou supports.
+            if !at.starts_with("extensionsRequired") {
+                problems.push(format!("{at}: {e}"));
+            }
+        });
     })?;
     if !problems.is_empty() {
         let more =
@@ -166,17 +223,22 @@ fn from_bytes_in(bytes: &[u8], dir: &Path, root: &Path, budget: &mut Budget) -> 
         buffers.push(data);
     }
 
+    let src = ImageSource { buffers: &buffers, dir, root };
+    let materials = guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, warnings))??;
     let out = guarded("glTF", || -> Result<Mesh, String> {
         let nodes: Vec<gltf::Node<'_>> = gltf.nodes().collect();
+        let ctx = Ctx { buffers: &buffers, materials: &materials, worlds: world_matrices(&nodes, &parent) };
         let mut out = Mesh::default();
         for &r in &roots {
-            add_node(&nodes[r], Mat4::IDENTITY, &buffers, &mut out, 0)?;
+            add_node(&nodes[r], Mat4::IDENTITY, &ctx, &mut out, 0, warnings)?;
         }
         Ok(out)
     })??;
     if out.indices.is_empty() {
         return Err("the default scene contains no triangles".into());
     }
+    let mut out = out;
+    out.materials = materials.list;
     budget.triangles -= need.triangles;
     budget.vertices -= need.vertices;
     Ok(out)
@@ -365,12 +427,36 @@ fn count_instances(r: &json::Root, roots: &[usize]) -> Result<Budget, String> {
     Ok(total)
 }
 
+/// What every node of a load needs.
+struct Ctx<'a> {
+    buffers: &'a [Vec<u8>],
+    materials: &'a Materials,
+    /// Every node's world matrix (`None`: non-finite), for skin joints.
+    worlds: Vec<Option<Mat4>>,
+}
+
+/// Every node's world matrix from the node hierarchy (the graph is a forest), without recursion.
+fn world_matrices(nodes: &[gltf::Node<'_>], parent: &[Option<usize>]) -> Vec<Option<Mat4>> {
+    let mut worlds: Vec<Option<Mat4>> = vec![None; nodes.len()];
+    let mut stack: Vec<(usize, Mat4)> =
+        (0..nodes.len()).filter(|&i| parent[i].is_none()).map(|i| (i, Mat4::IDENTITY)).collect();
+    while let Some((i, up)) = stack.pop() {
+        let world = up * Mat4 { cols: nodes[i].transform().matrix() };
+        if world.cols.iter().flatten().all(|v| v.is_finite()) {
+            worlds[i] = Some(world);
+            stack.extend(nodes[i].children().map(|c| (c.index(), world)));
+        }
+    }
+    worlds
+}
+
 fn add_node(
     node: &gltf::Node<'_>,
     parent: Mat4,
-    buffers: &[Vec<u8>],
+    ctx: &Ctx<'_>,
     out: &mut Mesh,
     depth: usize,
+    warnings: &mut Vec<String>,
 ) -> Result<(), String> {
     if depth > MAX_DEPTH {
         return Err(format!("node hierarchy deeper than {MAX_DEPTH} levels at node {}", node.index()));
@@ -381,10 +467,26 @@ fn add_node(
     }
     let world = parent * local;
     if let Some(mesh) = node.mesh() {
+        let skin = match node.skin() {
+            Some(skin) => Some(skin_matrices(&skin, ctx).map_err(|e| format!("skin {}: {e}", skin.index()))?),
+            None => None,
+        };
         for prim in mesh.primitives() {
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
-            let m = read_primitive(&prim, buffers).map_err(|e| format!("{what}: {e}"))?;
-            let placed = transform_mesh(&m, &world);
+            let p = read_primitive(&prim, ctx, &what, warnings).map_err(|e| format!("{what}: {e}"))?;
+            let placed = match (&skin, p.joints, p.weights) {
+                (Some(mats), Some(j), Some(w)) => skin_mesh(&p.mesh, &j, &w, mats, &world, &what, warnings)
+                    .map_err(|e| format!("{what}: {e}"))?,
+                (Some(_), ..) => {
+                    warnings.push(format!(
+                        "{what} under node {} has a skin but no JOINTS_0 and WEIGHTS_0; it is placed by the \
+                         node's own transform",
+                        node.index()
+                    ));
+                    transform_mesh(&p.mesh, &world)
+                }
+                (None, ..) => transform_mesh(&p.mesh, &world),
+            };
             if let Some(v) = placed.positions.iter().flatten().find(|v| !v.is_finite() || v.abs() > COORD_MAX)
             {
                 return Err(format!(
@@ -399,12 +501,158 @@ fn add_node(
         }
     }
     for child in node.children() {
-        add_node(&child, world, buffers, out, depth + 1)?;
+        add_node(&child, world, ctx, out, depth + 1, warnings)?;
     }
     Ok(())
 }
 
-fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mesh, String> {
+/// `J_k · IBM_k` for every joint `k` of `skin`.
+fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, String> {
+    let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+    if joints.is_empty() {
+        return Err("it has no joints".into());
+    }
+    let ibms: Vec<Mat4> = match skin.inverse_bind_matrices() {
+        Some(acc) => {
+            check_accessor(&acc, &[Dimensions::Mat4], &[DataType::F32], ctx.buffers)
+                .map_err(|e| format!("inverseBindMatrices: {e}"))?;
+            if acc.count() != joints.len() {
+                return Err(format!(
+                    "inverseBindMatrices has {} matrices but the skin has {} joints; they must match",
+                    acc.count(),
+                    joints.len()
+                ));
+            }
+            let get = |b: gltf::Buffer<'_>| ctx.buffers.get(b.index()).map(|d| d.as_slice());
+            let m: Vec<Mat4> = skin
+                .reader(get)
+                .read_inverse_bind_matrices()
+                .ok_or("inverseBindMatrices cannot be read")?
+                .map(|cols| Mat4 { cols })
+                .collect();
+            if m.iter().any(|m| m.cols.iter().flatten().any(|v| !v.is_finite())) {
+                return Err("inverseBindMatrices contains NaN or infinite values".into());
+            }
+            m
+        }
+        None => vec![Mat4::IDENTITY; joints.len()],
+    };
+    joints
+        .iter()
+        .zip(ibms)
+        .map(|(&j, ibm)| {
+            let w = ctx.worlds[j].ok_or_else(|| format!("joint node {j} has a non-finite transform"))?;
+            Ok(w * ibm)
+        })
+        .collect()
+}
+
+/// `mesh` skinned: each vertex through `Σ w_k · mats[j_k]` (weights normalised), normals through
+/// its inverse transpose; vertices whose weights are all zero keep the node transform `node`
+/// (with one warning).
+fn skin_mesh(
+    mesh: &Mesh,
+    joints: &[[u16; 4]],
+    weights: &[[f32; 4]],
+    mats: &[Mat4],
+    node: &Mat4,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Result<Mesh, String> {
+    let mut unweighted = 0usize;
+    let mut mirrored = Vec::with_capacity(mesh.positions.len());
+    let mut positions = Vec::with_capacity(mesh.positions.len());
+    let mut normals = Vec::with_capacity(mesh.positions.len());
+    for (v, (j, w)) in joints.iter().zip(weights).enumerate() {
+        if w.iter().any(|x| !x.is_finite() || *x < 0.0) {
+            return Err(format!("vertex {v} has a negative or non-finite weight in WEIGHTS_0"));
+        }
+        let sum: f32 = w.iter().sum();
+        let m = if sum > 0.0 {
+            let mut m = Mat4 { cols: [[0.0; 4]; 4] };
+            for k in 0..4 {
+                if w[k] == 0.0 {
+                    continue;
+                }
+                let s = mats.get(j[k] as usize).ok_or_else(|| {
+                    format!(
+                        "vertex {v} is bound to joint {} in JOINTS_0, but the skin has {} joints (0-based)",
+                        j[k],
+                        mats.len()
+                    )
+                })?;
+                let f = w[k] / sum;
+                for (c, sc) in m.cols.iter_mut().zip(&s.cols) {
+                    for (x, y) in c.iter_mut().zip(sc) {
+                        *x += f * y;
+                    }
+                }
+            }
+            m
+        } else {
+            unweighted += 1;
+            *node
+        };
+        let p = hadou_math::Vec3f::from_array(mesh.positions[v]);
+        positions.push(m.transform_point(p).to_array());
+        let n0 = hadou_math::Vec3f::from_array(mesh.normals[v]);
+        let n = m.normal_matrix().transform_vector(n0).normalize_or(n0.normalize_or(hadou_math::Vec3f::Y));
+        normals.push(n.to_array());
+        let (x, y, z) = (
+            m.transform_vector(hadou_math::Vec3f::X),
+            m.transform_vector(hadou_math::Vec3f::Y),
+            m.transform_vector(hadou_math::Vec3f::Z),
+        );
+        mirrored.push(x.cross(y).dot(z) < 0.0);
+    }
+    if unweighted > 0 {
+        warnings.push(format!(
+            "{what}: {unweighted} vertices have all-zero skin weights; they are placed by their node's own \
+             transform"
+        ));
+    }
+    let mut indices = mesh.indices.clone();
+    for t in indices.chunks_exact_mut(3) {
+        // A mirroring skin matrix reverses the winding (decided by the majority of the corners).
+        if t.iter().filter(|&&i| mirrored[i as usize]).count() >= 2 {
+            t.swap(1, 2);
+        }
+    }
+    Ok(Mesh { positions, normals, indices, ..mesh.clone() })
+}
+
+/// A primitive read in its mesh's space, with its skin attributes when it has them.
+struct Primitive {
+    mesh: Mesh,
+    joints: Option<Vec<[u16; 4]>>,
+    weights: Option<Vec<[f32; 4]>>,
+}
+
+/// The accessor of attribute `sem` checked for layout, bounds and a count of `n`, if present.
+fn attribute<'a>(
+    prim: &gltf::Primitive<'a>,
+    sem: Semantic,
+    dims: &[Dimensions],
+    types: &[DataType],
+    buffers: &[Vec<u8>],
+    n: usize,
+) -> Result<Option<gltf::Accessor<'a>>, String> {
+    let Some(acc) = prim.get(&sem) else { return Ok(None) };
+    let name = sem.to_string();
+    check_accessor(&acc, dims, types, buffers).map_err(|e| format!("{name}: {e}"))?;
+    if acc.count() != n {
+        return Err(format!("{name} has {} entries but POSITION has {n}", acc.count()));
+    }
+    Ok(Some(acc))
+}
+
+fn read_primitive(
+    prim: &gltf::Primitive<'_>,
+    ctx: &Ctx<'_>,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Result<Primitive, String> {
+    let buffers = ctx.buffers;
     let mode = prim.mode();
     if mode != Mode::Triangles {
         return Err(format!("mode {mode:?} is not supported; only TRIANGLES (4) primitives can be loaded"));
@@ -413,7 +661,7 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
     let reader = prim.reader(get);
 
     let pos_acc = prim.get(&Semantic::Positions).ok_or("has no POSITION attribute")?;
-    check_accessor(&pos_acc, Dimensions::Vec3, &[DataType::F32], buffers)
+    check_accessor(&pos_acc, &[Dimensions::Vec3], &[DataType::F32], buffers)
         .map_err(|e| format!("POSITION: {e}"))?;
     let positions: Vec<[f32; 3]> = reader.read_positions().ok_or("POSITION data cannot be read")?.collect();
     if positions.iter().flatten().any(|v| !v.is_finite()) {
@@ -423,8 +671,13 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
 
     let indices: Vec<u32> = match prim.indices() {
         Some(acc) => {
-            check_accessor(&acc, Dimensions::Scalar, &[DataType::U8, DataType::U16, DataType::U32], buffers)
-                .map_err(|e| format!("indices: {e}"))?;
+            check_accessor(
+                &acc,
+                &[Dimensions::Scalar],
+                &[DataType::U8, DataType::U16, DataType::U32],
+                buffers,
+            )
+            .map_err(|e| format!("indices: {e}"))?;
             let idx: Vec<u32> = reader.read_indices().ok_or("indices cannot be read")?.into_u32().collect();
             if let Some(bad) = idx.iter().find(|&&i| i as usize >= n) {
                 return Err(format!("index {bad} is out of range for {n} vertices"));
@@ -437,10 +690,9 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
         return Err(format!("{} indices is not a multiple of 3", indices.len()));
     }
 
-    let normals = match prim.get(&Semantic::Normals) {
-        Some(acc) => {
-            check_accessor(&acc, Dimensions::Vec3, &[DataType::F32], buffers)
-                .map_err(|e| format!("NORMAL: {e}"))?;
+    let normals = match attribute(prim, Semantic::Normals, &[Dimensions::Vec3], &[DataType::F32], buffers, n)?
+    {
+        Some(_) => {
             let normals: Vec<[f32; 3]> = reader.read_normals().ok_or("NORMAL data cannot be read")?.collect();
             if normals.len() != n {
                 return Err(format!("NORMAL has {} entries but POSITION has {n}", normals.len()));
@@ -457,18 +709,83 @@ fn read_primitive(prim: &gltf::Primitive<'_>, buffers: &[Vec<u8>]) -> Result<Mes
         }
         None => smooth_normals(&positions, &indices),
     };
-    Ok(Mesh { positions, normals, indices, ..Mesh::default() })
+
+    // Texture coordinates: the set the material's textures use, else TEXCOORD_0 when present.
+    let mat_index = prim.material().index();
+    let textured = mat_index.and_then(|m| ctx.materials.uv_set.get(m).copied().flatten());
+    let set = textured.unwrap_or(0);
+    let uv_types = [DataType::F32, DataType::U8, DataType::U16];
+    let uvs: Vec<[f32; 2]> =
+        match attribute(prim, Semantic::TexCoords(set), &[Dimensions::Vec2], &uv_types, buffers, n)? {
+            Some(_) => {
+                let uvs: Vec<[f32; 2]> =
+                    reader.read_tex_coords(set).ok_or("TEXCOORD data cannot be read")?.into_f32().collect();
+                if uvs.iter().flatten().any(|v| !v.is_finite()) {
+                    return Err(format!("TEXCOORD_{set} contains NaN or infinite values"));
+                }
+                uvs
+            }
+            None => {
+                if textured.is_some() {
+                    warnings.push(format!(
+                        "{what} has no TEXCOORD_{set}; its material's textures are sampled at uv (0, 0) there"
+                    ));
+                }
+                Vec::new()
+            }
+        };
+
+    let color_types = [DataType::F32, DataType::U8, DataType::U16];
+    let colors: Vec<[f32; 4]> = match attribute(
+        prim,
+        Semantic::Colors(0),
+        &[Dimensions::Vec3, Dimensions::Vec4],
+        &color_types,
+        buffers,
+        n,
+    )? {
+        Some(_) => {
+            let c: Vec<[f32; 4]> =
+                reader.read_colors(0).ok_or("COLOR_0 data cannot be read")?.into_rgba_f32().collect();
+            if c.iter().flatten().any(|v| !v.is_finite()) {
+                return Err("COLOR_0 contains NaN or infinite values".into());
+            }
+            c.into_iter().map(|c| c.map(|v| v.max(0.0))).collect()
+        }
+        None => Vec::new(),
+    };
+
+    let joint_types = [DataType::U8, DataType::U16];
+    let joints = match attribute(prim, Semantic::Joints(0), &[Dimensions::Vec4], &joint_types, buffers, n)? {
+        Some(_) => Some(reader.read_joints(0).ok_or("JOINTS_0 data cannot be read")?.into_u16().collect()),
+        None => None,
+    };
+    let weight_types = [DataType::F32, DataType::U8, DataType::U16];
+    let weights = match attribute(prim, Semantic::Weights(0), &[Dimensions::Vec4], &weight_types, buffers, n)?
+    {
+        Some(_) => Some(reader.read_weights(0).ok_or("WEIGHTS_0 data cannot be read")?.into_f32().collect()),
+        None => None,
+    };
+
+    let slot = ctx.materials.slot(mat_index);
+    let mesh =
+        Mesh { positions, normals, indices, uvs, colors, material_ids: vec![slot; n], ..Mesh::default() };
+    Ok(Primitive { mesh, joints, weights })
 }
 
 /// Checks that reading `acc` stays inside its buffer view and buffer and has the expected layout.
 fn check_accessor(
     acc: &gltf::Accessor<'_>,
-    dims: Dimensions,
+    dims: &[Dimensions],
     types: &[DataType],
     buffers: &[Vec<u8>],
 ) -> Result<(), String> {
-    if acc.dimensions() != dims {
-        return Err(format!("accessor {} has type {:?}, expected {dims:?}", acc.index(), acc.dimensions()));
+    if !dims.contains(&acc.dimensions()) {
+        return Err(format!(
+            "accessor {} has type {:?}, expected one of {dims:?}",
+            acc.index(),
+            acc.dimensions()
+        ));
     }
     if !types.contains(&acc.data_type()) {
         return Err(format!(
@@ -512,7 +829,7 @@ fn check_accessor(
 
 /// The bytes of a buffer URI: a `data:` URI with base64 payload, or a relative file path that
 /// resolves (symbolic links followed) inside the directory tree of `root`; at most `cap` bytes.
-fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Result<Vec<u8>, String> {
+pub(crate) fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) =
             rest.split_once(";base64,").ok_or("only base64 data URIs are supported (`data:…;base64,…`)")?;
@@ -524,7 +841,7 @@ fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Result<Vec<u8>, 
     let rel = PathBuf::from(percent_decode(uri));
     if rel.is_absolute() || rel.has_root() {
         return Err(format!(
-            "`{uri}` is an absolute path; buffer files must be named relative to the glTF file and lie \
+            "`{uri}` is an absolute path; buffer and image files must be named relative to the glTF file and lie \
              inside the scene file's directory"
         ));
     }
@@ -533,7 +850,7 @@ fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Result<Vec<u8>, 
     let top = std::fs::canonicalize(root).map_err(|e| format!("cannot resolve {}: {e}", root.display()))?;
     if !real.starts_with(&top) {
         return Err(format!(
-            "`{uri}` resolves to {}, outside {}; buffer files must lie inside the scene file's directory",
+            "`{uri}` resolves to {}, outside {}; buffer and image files must lie inside the scene file's directory",
             real.display(),
             top.display()
         ));

@@ -11,6 +11,7 @@ use crate::guard::guarded;
 use std::path::Path;
 
 /// Largest texture file read, in bytes (256 MiB).
+#[allow(dead_code)] // for texture files named by a scene; not read by any scene key yet
 pub const TEXTURE_MAX_BYTES: u64 = 256 << 20;
 /// Longest texture edge accepted, in texels.
 pub const TEXTURE_MAX_EDGE: u32 = 16384;
@@ -36,6 +37,7 @@ pub fn decode_texture(bytes: &[u8], name: &str, warnings: &mut Vec<String>) -> R
 }
 
 /// Reads and decodes the texture file at `path`.
+#[allow(dead_code)] // for texture files named by a scene; not read by any scene key yet
 pub(crate) fn load_texture_file(path: &Path, warnings: &mut Vec<String>) -> Result<Texture, String> {
     let bytes =
         read_regular_file(path, TEXTURE_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
@@ -85,8 +87,37 @@ fn decode_png(bytes: &[u8], name: &str) -> Result<Texture, String> {
     Ok(Texture { name: name.into(), width: w, height: h, texels })
 }
 
-fn decode_jpeg(_bytes: &[u8], _name: &str) -> Result<Texture, String> {
-    Err("JPEG images are not supported yet".into())
+fn decode_jpeg(bytes: &[u8], name: &str) -> Result<Texture, String> {
+    use zune_jpeg::zune_core::bytestream::ZCursor;
+    use zune_jpeg::zune_core::colorspace::ColorSpace;
+    use zune_jpeg::zune_core::options::DecoderOptions;
+    let bad = |e: zune_jpeg::errors::DecodeErrors| format!("not a valid JPEG image: {e:?}");
+    let edge = TEXTURE_MAX_EDGE as usize;
+    let options = DecoderOptions::default()
+        .jpeg_set_out_colorspace(ColorSpace::RGBA)
+        .set_max_width(edge)
+        .set_max_height(edge);
+    let mut decoder = zune_jpeg::JpegDecoder::new_with_options(ZCursor::new(bytes), options);
+    // The header alone first: the size is checked before any pixel buffer exists.
+    decoder.decode_headers().map_err(bad)?;
+    let (w, h) = decoder.dimensions().ok_or("the JPEG image has no frame header")?;
+    check_size(w as u32, h as u32)?;
+    let (w, h) = (w as u32, h as u32);
+    let data = decoder.decode().map_err(bad)?;
+    let n = w as usize * h as usize;
+    let texels: Vec<[u8; 4]> = if data.len() == 4 * n {
+        data.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
+    } else if data.len() == 3 * n {
+        data.chunks_exact(3).map(|c| [c[0], c[1], c[2], 255]).collect()
+    } else if data.len() == n {
+        data.iter().map(|&g| [g, g, g, 255]).collect()
+    } else {
+        return Err(format!(
+            "the JPEG image decoded to {} bytes, which does not fit {w}×{h} texels",
+            data.len()
+        ));
+    };
+    Ok(Texture { name: name.into(), width: w, height: h, texels })
 }
 
 /// Halves the image (2×2 box filter in linear light) until both edges are at most
