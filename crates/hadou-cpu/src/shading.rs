@@ -110,8 +110,8 @@ pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surfa
         let mut glow = [0.0f32; 3];
         for (i, w) in waves.iter().enumerate() {
             if w.light.glow > 0.0 {
-                for k in 0..3 {
-                    glow[k] += w.light.glow * w.color[k] * rho[i];
+                for (g, c) in glow.iter_mut().zip(&w.color) {
+                    *g += w.light.glow * c * rho[i];
                 }
             }
         }

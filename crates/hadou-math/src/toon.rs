@@ -125,7 +125,7 @@ pub fn band_step(m: f32, t: f32, w: f32) -> f32 {
 pub fn nearest_on_segment(p: Vec3f, a: Vec3f, b: Vec3f) -> Vec3f {
     let d = b - a;
     let dd = d.dot(d);
-    if !(dd > 0.0) || !dd.is_finite() {
+    if dd <= 0.0 || !dd.is_finite() {
         return a;
     }
     let t = ((p - a).dot(d) / dd).clamp(0.0, 1.0);
@@ -199,7 +199,7 @@ pub const DOMINANCE_POWER: f32 = 2.0;
 /// positive; all zero densities give all-zero weights.
 pub fn dominance_weights(rho: &mut [f32]) {
     let max = rho.iter().copied().fold(0.0f32, f32::max);
-    if !(max > 0.0) {
+    if max <= 0.0 {
         rho.iter_mut().for_each(|r| *r = 0.0);
         return;
     }

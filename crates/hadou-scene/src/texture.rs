@@ -11,7 +11,6 @@ use crate::guard::guarded;
 use std::path::Path;
 
 /// Largest texture file read, in bytes (256 MiB).
-#[allow(dead_code)] // for texture files named by a scene; not read by any scene key yet
 pub const TEXTURE_MAX_BYTES: u64 = 256 << 20;
 /// Longest texture edge accepted, in texels.
 pub const TEXTURE_MAX_EDGE: u32 = 16384;
@@ -37,7 +36,6 @@ pub fn decode_texture(bytes: &[u8], name: &str, warnings: &mut Vec<String>) -> R
 }
 
 /// Reads and decodes the texture file at `path`.
-#[allow(dead_code)] // for texture files named by a scene; not read by any scene key yet
 pub(crate) fn load_texture_file(path: &Path, warnings: &mut Vec<String>) -> Result<Texture, String> {
     let bytes =
         read_regular_file(path, TEXTURE_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;

@@ -164,7 +164,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(a) => render(a),
-        Command::Validate { scene } => Scene::load(&scene).map(|_| ()).map_err(Failure::from),
+        Command::Validate { scene } => load_scene(&scene).map(|_| ()),
         Command::Probe(a) => probe(a),
         Command::Bench(a) => bench(a),
     };
@@ -332,7 +332,7 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         let time = parse_time("--time", &a.time)?;
         let format = output::Format::from_path(&a.output)?;
         output::check_directory(&a.output)?;
-        let scene = Scene::load(&a.scene)?;
+        let scene = load_scene(&a.scene)?;
         let frame = frame_at(&scene, time, a.width, a.height);
         let mut backend = make_backend(a.backend)?;
         match format {
@@ -383,7 +383,7 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
             output::check_directory(&entry.path())?;
         }
     }
-    let scene = Scene::load(&a.scene)?;
+    let scene = load_scene(&a.scene)?;
     let mut backend = make_backend(a.backend)?;
     let bar = indicatif::ProgressBar::new(range.len() as u64);
     bar.set_style(
@@ -441,7 +441,7 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     size_override(a.width, a.height)?;
     let (x, y) = parse_pixel(&a.pixel)?;
     let time = parse_time("--time", &a.time)?;
-    let scene = Scene::load(&a.scene)?;
+    let scene = load_scene(&a.scene)?;
     let frame = frame_at(&scene, time, a.width, a.height);
     let outside = || {
         Failure::input(format!(
@@ -561,6 +561,16 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         println!("{}", serde_json::to_string_pretty(&json).unwrap_or_default());
     }
     Ok(())
+}
+
+/// Loads a scene and prints its warnings (downscaled textures, meshes without texture
+/// coordinates, …) to stderr as `path: warning: …`.
+fn load_scene(path: &std::path::Path) -> Result<Scene, Failure> {
+    let scene = Scene::load(path)?;
+    for w in scene.warnings() {
+        eprintln!("{}: warning: {w}", path.display());
+    }
+    Ok(scene)
 }
 
 #[cfg(test)]
