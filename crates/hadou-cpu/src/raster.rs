@@ -174,7 +174,9 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
                 let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
                 let [Some(a), Some(b), Some(c)] = v else { continue };
                 let material = mesh.material_of(tri[0] as usize);
-                if is_hull && obj.material(material).outline.is_none_or(|o| o.width.is_nan() || o.width <= 0.0) {
+                if is_hull
+                    && obj.material(material).outline.is_none_or(|o| o.width.is_nan() || o.width <= 0.0)
+                {
                     continue;
                 }
                 let mut poly = [a; 4];

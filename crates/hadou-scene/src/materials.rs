@@ -68,6 +68,8 @@ pub(crate) struct ObjectMaterials {
     pub outline: Option<bool>,
     /// Whether `color` was given explicitly (it then sets every slot's base colour).
     pub color_given: bool,
+    /// The mesh has no texture coordinates: textures of scene materials are dropped (warned).
+    pub no_uvs: bool,
 }
 
 /// Reads a ramp from `key` (rows `[threshold, r, g, b]`), `{key}_kind` and `{key}_smoothing`.
@@ -334,6 +336,7 @@ pub(crate) fn parse_object_materials(
     scene_materials: &[MaterialDef],
     params: &mut ParamSet,
     rd: &mut ParamReader<'_>,
+    warnings: &mut Vec<String>,
 ) -> Res<ObjectMaterials> {
     let n_slots = mesh.materials.len().max(1);
     let mut slots: Vec<SlotSource> = (0..n_slots).map(SlotSource::Mesh).collect();
@@ -403,7 +406,28 @@ pub(crate) fn parse_object_materials(
             rd.add(t, params, key, shape, rule, Fallback::Value(&[]), false)?;
         }
     }
-    Ok(ObjectMaterials { slots, outline: opt_bool(t, "outline")?, color_given: t.get("color").is_some() })
+    let textured = slots.iter().any(|s| match s {
+        SlotSource::Scene(i) => {
+            let m = &scene_materials[*i].base;
+            m.base_texture.is_some() || m.feature_texture.is_some()
+        }
+        SlotSource::Mesh(_) => false,
+    });
+    let no_uvs = mesh.uvs.is_empty() && textured;
+    if no_uvs {
+        let at = t.src.loc(&t.span);
+        warnings.push(format!(
+            "{}:{}: {} has no texture coordinates; the base and feature textures of its materials are \
+             ignored (features off)",
+            at.line, at.col, t.what
+        ));
+    }
+    Ok(ObjectMaterials {
+        slots,
+        outline: opt_bool(t, "outline")?,
+        color_given: t.get("color").is_some(),
+        no_uvs,
+    })
 }
 
 /// The material of one slot at the values `vals`.
@@ -426,6 +450,10 @@ pub(crate) fn build_material(
         SlotSource::Scene(i) => {
             let d = &scene_materials[*i];
             let mut m = d.base.clone();
+            if object.no_uvs {
+                m.base_texture = None;
+                m.feature_texture = None;
+            }
             m.base_color = d.params.arr(vals, "base_color");
             m.wave_blend = d.params.f(vals, "wave_blend");
             if let Some(o) = &mut m.outline {

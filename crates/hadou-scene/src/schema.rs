@@ -423,7 +423,7 @@ fn parse_object(
     let scale = Constraint::Range { lo: SCALE_MIN, hi: COORD_MAX, lo_open: false, hi_open: false };
     rd.add(t, &mut params, "scale", V3, scale, Fallback::Value(&[1.0; 3]), true)?;
     rd.add(t, &mut params, "color", V3, NONNEG, Fallback::Value(&[0.8; 3]), false)?;
-    let materials = parse_object_materials(t, &mesh, materials, &mut params, rd)?;
+    let materials = parse_object_materials(t, &mesh, materials, &mut params, rd, warnings)?;
     Ok(ObjectDef { name, mesh, params, materials })
 }
 

@@ -546,3 +546,120 @@ impl CurveTable {
         })
     }
 }
+
+/// The scene and time `hadou bench toon` renders: a toon character with textures, a feature
+/// texture and outlines, two outlined props and a toon ground, lit by a firing beam.
+pub const TOON_SCENE: (&str, f32) = ("light-from-front.toml", 1.2);
+
+/// One row of the toon table.
+#[derive(Clone, Debug)]
+pub struct ToonRow {
+    /// Image side in pixels.
+    pub size: u32,
+    /// `full` (the scene as written) or `plain` (every material diffuse, no wave light, no
+    /// outlines, no textures: the opaque pass hadou had before materials).
+    pub variant: &'static str,
+    /// Median milliseconds per frame.
+    pub ms: f64,
+}
+
+/// The toon table.
+#[derive(Clone, Debug)]
+pub struct ToonTable {
+    /// Backend name.
+    pub backend: String,
+    /// How time was measured.
+    pub method: String,
+    /// Repetitions per cell.
+    pub iterations: u32,
+    /// The scene file.
+    pub scene: String,
+    /// Rows, by size then variant.
+    pub rows: Vec<ToonRow>,
+}
+
+/// `frame` with every material reduced to plain diffuse shading of its base colour.
+pub fn plain_materials(frame: &Frame) -> Frame {
+    let mut f = frame.clone();
+    for o in &mut f.objects {
+        for m in &mut o.materials {
+            *m = hadou_scene::Material::diffuse(m.base_color);
+        }
+    }
+    for w in &mut f.waves {
+        w.light.glow = 0.0;
+    }
+    f
+}
+
+/// Measures the toon table: [`TOON_SCENE`] at each size, full and plain, in one run.
+pub fn toon_table(
+    time: &mut Timer<'_>,
+    scenes: &Path,
+    sizes: &[u32],
+    iterations: u32,
+    backend: &str,
+    method: &str,
+) -> Result<ToonTable, RenderError> {
+    let (file, t) = TOON_SCENE;
+    let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut rows = Vec::new();
+    for &size in sizes {
+        let mut frame = scene.at(t);
+        frame.width = size;
+        frame.height = size;
+        let plain = plain_materials(&frame);
+        for (variant, f) in [("full", &frame), ("plain", &plain)] {
+            rows.push(ToonRow { size, variant, ms: time(f, iterations)? });
+        }
+    }
+    Ok(ToonTable { backend: backend.into(), method: method.into(), iterations, scene: file.into(), rows })
+}
+
+impl ToonTable {
+    /// The table as plain text.
+    pub fn to_text(&self) -> String {
+        let mut out = format!(
+            "toon scene {} — backend {}, {} ({} runs, median)\n{:<8} {:>12} {:>10} {:>14} {:>10}\n",
+            self.scene,
+            self.backend,
+            self.method,
+            self.iterations,
+            "size",
+            "full ms",
+            "full fps",
+            "plain ms",
+            "ratio"
+        );
+        for pair in self.rows.chunks(2) {
+            if let [full, plain] = pair {
+                out += &format!(
+                    "{:<8} {:>12.2} {:>10.1} {:>14.2} {:>9.2}×\n",
+                    format!("{}²", full.size),
+                    full.ms,
+                    1e3 / full.ms,
+                    plain.ms,
+                    full.ms / plain.ms
+                );
+            }
+        }
+        out
+    }
+
+    /// The table as JSON: `rows` of `{size, variant, ms, fps}`.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "table": "toon",
+            "scene": self.scene,
+            "backend": self.backend,
+            "method": self.method,
+            "iterations": self.iterations,
+            "rows": self.rows.iter().map(|r| serde_json::json!({
+                "size": r.size,
+                "variant": r.variant,
+                "ms": r.ms,
+                "fps": 1e3 / r.ms,
+            })).collect::<Vec<_>>(),
+        })
+    }
+}

@@ -83,6 +83,8 @@ enum BenchTable {
     Analytic,
     /// Helix, trig sum, Bézier and B-spline: faithful Simpson against the default integrator.
     Curves,
+    /// The toon scene (character, props, ground, wave light, outlines, textures), full and plain.
+    Toon,
 }
 
 #[derive(Args, Debug)]
@@ -90,16 +92,18 @@ struct BenchArgs {
     /// Which table to measure.
     #[arg(value_enum, default_value_t = BenchTable::Analytic)]
     table: BenchTable,
-    /// Directory holding the example scenes (for the curve table).
+    /// Directory holding the example scenes (for the curve and toon tables).
     #[arg(long, default_value = "scenes")]
     scenes: PathBuf,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
-    /// Image sizes (square), comma-separated [default: 512,1024,2048 for analytic, 512 for curves].
+    /// Image sizes (square), comma-separated [default: 512,1024,2048 for analytic, 512 for curves,
+    /// 256,512,1024 for toon].
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     sizes: Vec<u32>,
-    /// Timed repetitions per cell (after one warm-up) [default: 5 for analytic, 1 for curves].
+    /// Timed repetitions per cell (after one warm-up) [default: 5 for analytic and toon, 1 for
+    /// curves].
     #[arg(long)]
     iterations: Option<u32>,
     /// Which backend to measure.
@@ -499,10 +503,12 @@ fn gpu_probe(backend: &mut dyn Backend, frame: &Frame, x: u32, y: u32) -> Result
 
 fn bench(a: BenchArgs) -> Result<(), Failure> {
     let curves = a.table == BenchTable::Curves;
-    let sizes = match (a.sizes.is_empty(), curves) {
+    let toon = a.table == BenchTable::Toon;
+    let sizes = match (a.sizes.is_empty(), a.table) {
         (false, _) => a.sizes.clone(),
-        (true, false) => vec![512, 1024, 2048],
-        (true, true) => vec![512],
+        (true, BenchTable::Analytic) => vec![512, 1024, 2048],
+        (true, BenchTable::Curves) => vec![512],
+        (true, BenchTable::Toon) => vec![256, 512, 1024],
     };
     for &s in &sizes {
         check_size("--sizes", s)?;
@@ -511,7 +517,7 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
     if iterations == 0 {
         return Err(Failure::input("--iterations 0: need at least one timed repetition"));
     }
-    if curves && !a.scenes.is_dir() {
+    if (curves || toon) && !a.scenes.is_dir() {
         return Err(Failure::input(format!(
             "--scenes {}: not a directory; run from the repository root or pass --scenes DIR",
             a.scenes.display()
@@ -532,8 +538,23 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
             })?;
         }
     }
+    if toon {
+        let file = hadou::bench::TOON_SCENE.0;
+        Scene::load(a.scenes.join(file)).map_err(|e| {
+            Failure::input(format!(
+                "--scenes {}: the toon bench needs the example scenes (scenes/ of the repository): {e}",
+                a.scenes.display()
+            ))
+        })?;
+    }
     let (mut timer, name, method) = make_timer(a.backend)?;
-    let json = if curves {
+    let json = if toon {
+        let t = hadou::bench::toon_table(&mut *timer, &a.scenes, &sizes, iterations, &name, &method)?;
+        if !a.json {
+            print!("{}", t.to_text());
+        }
+        t.to_json()
+    } else if curves {
         let bar = indicatif::ProgressBar::new_spinner();
         let mut progress = |m: &str| bar.set_message(m.to_string());
         let t = hadou::bench::curve_table(
