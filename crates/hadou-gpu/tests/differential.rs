@@ -131,3 +131,102 @@ fn row_bands_match_the_whole_frame() {
         assert_close(&format!("rows {rows:?} vs cpu"), &compare(&band, &c));
     }
 }
+
+/// Materials on hand-built frames: every shading model, a smoothed-band ramp, a base texture with
+/// each wrap mode and both filters, a feature texture, vertex colours, outlines on a box and a
+/// sphere, and three waves of every light-line kind (point, segment, curve polyline) sharing the
+/// surfaces, one of them glowing.
+#[test]
+fn materials_outlines_and_wave_lights_match_cpu() {
+    use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator};
+    use hadou_math::energy::{CapsuleField, Falloff, SphereField};
+    use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
+    use hadou_math::Vec3;
+    use hadou_scene::mesh::{box_mesh, sphere_mesh, with_outline_normals};
+    use hadou_scene::{Material, Outline, ShadingModel, Texture, TextureRef, WaveShape};
+    use std::sync::Arc;
+    let checker: Vec<[u8; 4]> = (0..64u32)
+        .map(|i| if (i % 8 + i / 8) % 2 == 0 { [230, 40, 40, 255] } else { [30, 200, 90, 255] })
+        .collect();
+    let image = Arc::new(Texture { name: "checker".into(), width: 8, height: 8, texels: checker });
+    let tex =
+        |wrap: Wrap, filter: Filter| TextureRef { image: image.clone(), wrap: [wrap, Wrap::Clamp], filter };
+    let face = Arc::new(Texture {
+        name: "face".into(),
+        width: 4,
+        height: 4,
+        texels: (0..16).map(|i| if i == 5 || i == 6 { [0, 0, 0, 255] } else { [255; 4] }).collect(),
+    });
+    let mut f = base_frame(160, 120, Vec3::new(0.0, 2.0, 9.0), Vec3::ZERO, hadou_scene::ToneMode::Filmic);
+    let models = [ShadingModel::Toon, ShadingModel::Diffuse, ShadingModel::Unlit, ShadingModel::Toon];
+    let wraps =
+        [(Wrap::Repeat, Filter::Linear), (Wrap::Mirror, Filter::Nearest), (Wrap::Clamp, Filter::Linear)];
+    for (i, model) in models.iter().enumerate() {
+        let mut mesh = if i % 2 == 0 { sphere_mesh(0.9, 40) } else { box_mesh([1.4, 1.4, 1.4]) };
+        mesh.uvs.iter_mut().for_each(|uv| *uv = [uv[0] * 3.0 - 1.0, uv[1] * 2.0]);
+        mesh.colors =
+            (0..mesh.positions.len()).map(|v| [1.0, 0.6 + 0.4 * ((v % 3) as f32 / 2.0), 1.0, 1.0]).collect();
+        let mesh = with_outline_normals(mesh);
+        let (wrap, filter) = wraps[i % 3];
+        let material = Material {
+            name: format!("m{i}"),
+            model: *model,
+            base_color: [0.9, 0.8, 0.7],
+            base_texture: Some(tex(wrap, filter)),
+            feature_texture: (i == 0).then(|| TextureRef {
+                image: face.clone(),
+                wrap: [Wrap::Clamp; 2],
+                filter: Filter::Nearest,
+            }),
+            ramp: Ramp {
+                kind: RampKind::Bands { smoothing: 0.08 * i as f32 },
+                ..Ramp::two_band(0.1, [0.4, 0.45, 0.6], 0.0)
+            },
+            wave_blend: [1.0, 0.6, 0.0, 0.3][i],
+            outline: (i != 2).then_some(Outline { width: 0.006, color: [0.05, 0.0, 0.1] }),
+        };
+        let x = -3.0 + 2.0 * i as f32;
+        let mut o = object(
+            &format!("o{i}"),
+            Arc::new(mesh),
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(10.0, 30.0 * i as f32, 0.0),
+            [1.0; 3],
+        );
+        o.materials = vec![material];
+        f.objects.push(o);
+    }
+    f.waves.push(wave(
+        "orb",
+        [0.3, 0.8, 1.0, 1.0],
+        Falloff::InverseSquare,
+        0.05,
+        WaveShape::Sphere(SphereField { center: Vec3::new(-2.0, 1.5, 1.5), alpha: 0.05 }),
+    ));
+    let mut beam = wave(
+        "beam",
+        [1.0, 0.7, 0.2, 1.0],
+        Falloff::Faithful,
+        0.05,
+        WaveShape::Capsule(CapsuleField {
+            m: Vec3::new(-4.0, -1.2, 1.0),
+            d: Vec3::X,
+            length: 8.0,
+            alpha_s: 0.5,
+            alpha_c: 0.5,
+        }),
+    );
+    beam.light.glow = 0.2;
+    f.waves.push(beam);
+    let helix = CurveWave {
+        frame: CurveFrame { origin: Vec3::new(-4.0, 1.2, -1.0), axis: Vec3::X, up: Vec3::Y },
+        shape: CurveShape::Helix { radius: 0.4, rate: 3.0, phase: 0.0, length: 8.0 },
+        gamma: 1.0,
+        extension: 1.0,
+        attenuation: 0.0,
+        alpha: 0.05,
+        integrator: Integrator::Default,
+    };
+    f.waves.push(wave("helix", [1.0, 0.3, 0.6, 1.0], Falloff::InverseSquare, 0.03, WaveShape::Curve(helix)));
+    check("materials", &f);
+}
