@@ -118,6 +118,12 @@ fn dominance(distance: f32, core_radius: f32, strength: f32, inverse_square: boo
     return min(v, 3.40282347e38);
 }
 
+// The density of light `l` at `world`, whose light point is `e` (hadou_math::toon::dominance with
+// the wave's core radius, strength and falloff).
+fn light_density(l: GpuLight, world: vec3<f32>, e: vec3<f32>) -> f32 {
+    return dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+}
+
 // Mirrors hadou_math::toon::wrap_index (wrap: 0 repeat, 1 clamp, 2 mirror).
 fn wrap_index(i: i32, n: i32, wrap: u32) -> i32 {
     if (wrap == 1u) {
@@ -206,7 +212,7 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
         for (var i = 0u; i < count; i++) {
             let l = lights[i];
             let e = light_nearest(l, world);
-            let rho = dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+            let rho = light_density(l, world, e);
             max_rho = max(max_rho, rho);
             if (l.b.w > 0.0) {
                 glow = glow + l.b.w * l.color.xyz * rho;
@@ -220,7 +226,7 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
             for (var i = 0u; i < count; i++) {
                 let l = lights[i];
                 let e = light_nearest(l, world);
-                let rho = dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+                let rho = light_density(l, world, e);
                 let x = rho / max_rho;
                 let w = x * x;
                 sum = sum + w;
@@ -228,7 +234,7 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
             for (var i = 0u; i < count; i++) {
                 let l = lights[i];
                 let e = light_nearest(l, world);
-                let rho = dominance(length3(e - world), l.color.w, l.a.w, l.inverse_square != 0u);
+                let rho = light_density(l, world, e);
                 let x = rho / max_rho;
                 let w = (x * x) / sum;
                 if (w > 0.0) {
