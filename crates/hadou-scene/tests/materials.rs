@@ -165,11 +165,8 @@ fn texture_files_are_checked() {
         assert!(e.to_string().contains(want), "{file}: {e}");
         assert_eq!(at(&e), (3, 16), "{file}: {e}");
     }
-    std::fs::write(
-        d.join("abs.toml"),
-        format!("[[material]]\nname = \"m\"\nbase_texture = \"/etc/passwd\"\n"),
-    )
-    .unwrap();
+    std::fs::write(d.join("abs.toml"), "[[material]]\nname = \"m\"\nbase_texture = \"/etc/passwd\"\n")
+        .unwrap();
     let e = Scene::load(d.join("abs.toml")).expect_err("absolute");
     assert!(e.to_string().contains("must be relative"), "{e}");
     // A directory is not a texture.
