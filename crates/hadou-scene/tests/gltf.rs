@@ -1,6 +1,10 @@
 //! glTF 2.0 loading from bytes built in the test: data URIs, GLB, node transforms, index types,
 //! missing files and unsupported modes.
 
+mod common;
+
+use common::base64;
+
 use hadou_scene::{gltf_from_bytes, Scene, SceneError};
 use std::path::{Path, PathBuf};
 
@@ -55,22 +59,6 @@ fn json(
          \"min\":[0,0,0],\"max\":[1,1,0]}},\
          {{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}}{normal_acc}]}}"
     )
-}
-
-fn base64(data: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in data.chunks(3) {
-        let v = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for i in 0..4 {
-            if i <= c.len() {
-                s.push(A[(v >> (18 - 6 * i) & 63) as usize] as char);
-            } else {
-                s.push('=');
-            }
-        }
-    }
-    s
 }
 
 fn glb(json: &str, blob: &[u8]) -> Vec<u8> {

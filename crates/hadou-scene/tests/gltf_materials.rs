@@ -2,6 +2,10 @@
 //! extensions, and hostile image data. Every file is built here in memory (JSON with a base64
 //! data-URI buffer).
 
+mod common;
+
+use common::base64;
+
 use hadou_scene::{encode_png, gltf_from_bytes, gltf_from_bytes_with_warnings, Mesh, RampKind, ShadingModel};
 use hadou_scene::{Filter, Wrap};
 use serde_json::{json, Value};
@@ -59,18 +63,6 @@ impl Builder {
         doc["accessors"] = Value::Array(self.accessors);
         serde_json::to_vec(&doc).unwrap()
     }
-}
-
-fn base64(data: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in data.chunks(3) {
-        let v = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for i in 0..4 {
-            s.push(if i <= c.len() { A[(v >> (18 - 6 * i) & 63) as usize] as char } else { '=' });
-        }
-    }
-    s
 }
 
 const TRI: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];

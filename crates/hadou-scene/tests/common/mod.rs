@@ -17,3 +17,16 @@ pub fn at(e: &SceneError) -> (usize, usize) {
     let l = e.location().unwrap_or_else(|| panic!("no location: {e}"));
     (l.line, l.col)
 }
+
+/// Standard base64 (with `=` padding), for `data:` URIs in hand-built glTF files.
+pub fn base64(data: &[u8]) -> String {
+    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in data.chunks(3) {
+        let v = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for i in 0..4 {
+            s.push(if i <= c.len() { A[(v >> (18 - 6 * i) & 63) as usize] as char } else { '=' });
+        }
+    }
+    s
+}
