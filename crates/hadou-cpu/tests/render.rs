@@ -29,6 +29,7 @@ fn frame(objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
         objects,
         waves,
         color_mapping: ColorMapping { mode: ToneMode::Filmic, exposure: 1.0 },
+        shadows: Vec::new(),
     }
 }
 

@@ -74,6 +74,7 @@ fn frame(shape: WaveShape, falloff: Falloff, mode: ToneMode) -> Frame {
         objects: vec![],
         waves: vec![wave.clone(), wave],
         color_mapping: ColorMapping { mode, exposure: 1.0 },
+        shadows: Vec::new(),
     }
 }
 

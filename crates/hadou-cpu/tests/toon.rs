@@ -35,6 +35,7 @@ fn frame(size: u32, eye: Vec3f, objects: Vec<Object>, waves: Vec<Wave>) -> Frame
         // Faithful mapping with a tiny exposure: the waves' own glow adds < 1e-6, so pixels show
         // the surface colour.
         color_mapping: ColorMapping { mode: ToneMode::Faithful, exposure: 1e-9 },
+        shadows: Vec::new(),
     }
 }
 

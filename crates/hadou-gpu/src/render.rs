@@ -644,6 +644,7 @@ mod tests {
             objects: Vec::new(),
             waves: Vec::new(),
             color_mapping: hadou_scene::ColorMapping { mode: hadou_scene::ToneMode::Filmic, exposure: 1.0 },
+            shadows: Vec::new(),
         }
     }
 

@@ -16,6 +16,7 @@ mod mat4;
 pub mod quadrature;
 mod real;
 pub mod shade;
+pub mod shadow;
 pub mod toon;
 mod vec3;
 

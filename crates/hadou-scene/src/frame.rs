@@ -7,6 +7,8 @@ pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use std::sync::Arc;
 
+pub use crate::shadow::{Shadow, ShadowCast, ShadowLight, ShadowMethod};
+
 /// One instant of a scene, ready to draw.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -28,6 +30,8 @@ pub struct Frame {
     pub waves: Vec<Wave>,
     /// How summed wave colour becomes the output colour.
     pub color_mapping: ColorMapping,
+    /// Hard shadows (`[[shadow]]`), applied to the receivers' shaded colour before the waves.
+    pub shadows: Vec<Shadow>,
 }
 
 /// A pinhole camera.

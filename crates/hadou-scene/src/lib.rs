@@ -26,6 +26,7 @@ pub mod mesh;
 mod params;
 mod scene;
 mod schema;
+mod shadow;
 mod texture;
 mod toml_read;
 
@@ -38,4 +39,7 @@ pub use gltf_load::{gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf};
 pub use image::Image;
 pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
 pub use scene::Scene;
+pub use shadow::{
+    object_bounds, object_center, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS, ON_PLANE,
+};
 pub use texture::{decode_texture, encode_png, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS};

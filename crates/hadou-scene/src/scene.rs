@@ -8,6 +8,7 @@ use crate::frame::{
 };
 use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
+use crate::shadow::{build_shadow, ShadowDef};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
 use hadou_math::{Mat4, Vec3, Vec3f};
@@ -33,6 +34,7 @@ pub struct Scene {
     pub(crate) materials: Vec<MaterialDef>,
     pub(crate) objects: Vec<ObjectDef>,
     pub(crate) waves: Vec<WaveDef>,
+    pub(crate) shadows: Vec<ShadowDef>,
     pub(crate) tracks: Vec<Track>,
     /// Things that were accepted but deserve a note (a downscaled texture, textures on a mesh
     /// without texture coordinates, …).
@@ -46,6 +48,8 @@ pub(crate) struct ObjectDef {
     pub mesh: Arc<Mesh>,
     pub params: ParamSet,
     pub materials: ObjectMaterials,
+    /// A `kind = "plane"` primitive (a shadow may take its plane).
+    pub is_plane: bool,
 }
 
 /// The wave kinds of the schema.
@@ -170,7 +174,8 @@ impl Scene {
             .into_iter()
             .chain(self.objects.iter().map(|o| &o.params))
             .chain(self.materials.iter().map(|m| &m.params))
-            .chain(self.waves.iter().map(|w| &w.params));
+            .chain(self.waves.iter().map(|w| &w.params))
+            .chain(self.shadows.iter().map(|s| &s.params));
         for set in sets {
             for p in &set.params {
                 let r = p.offset..p.offset + p.len;
@@ -229,8 +234,10 @@ impl Scene {
                     materials: self.object_materials(o, vals),
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
         let waves = self.waves.iter().map(|w| self.build_wave(w, vals)).collect();
+        let shadows =
+            self.shadows.iter().map(|s| build_shadow(s, vals, base, light.direction, &objects)).collect();
         Frame {
             width: self.width,
             height: self.height,
@@ -241,6 +248,7 @@ impl Scene {
             objects,
             waves,
             color_mapping,
+            shadows,
         }
     }
 

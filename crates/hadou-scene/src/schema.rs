@@ -16,6 +16,7 @@ use crate::materials::{
 use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::scene::{IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
+use crate::shadow::{check_map_budget, check_shadow, parse_shadow, ShadowDef, MAX_SHADOWS};
 use crate::toml_read::{number, read_numbers, type_name, Fallback, ParamReader, Res, Span, Src, Table, Val};
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
@@ -25,7 +26,7 @@ use std::sync::Arc;
 use toml::de::{DeTable, DeValue};
 
 const ROOT_KEYS: &[&str] =
-    &["image", "camera", "background", "light", "color", "material", "object", "wave", "track"];
+    &["image", "camera", "background", "light", "color", "material", "object", "wave", "shadow", "track"];
 const CAMERA_KEYS: &[&str] = &["position", "target", "up", "fov", "near", "far"];
 const LIGHT_KEYS: &[&str] = &["direction", "color", "ambient"];
 const COLOR_KEYS: &[&str] = &["mode", "exposure"];
@@ -196,6 +197,37 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         wave_tables.push(table);
     }
 
+    // [[shadow]]
+    let mut shadows: Vec<ShadowDef> = Vec::new();
+    let mut shadow_tables = Vec::new();
+    let mut names: HashMap<String, Span> = HashMap::new();
+    {
+        let object_names: Vec<(&str, bool)> = objects.iter().map(|o| (o.name.as_str(), o.is_plane)).collect();
+        let wave_names: Vec<&str> = waves.iter().map(|w| w.name.as_str()).collect();
+        for (i, (t, span)) in root.array_of_tables("shadow")?.into_iter().enumerate() {
+            if i == MAX_SHADOWS {
+                return Err(src.value_err(
+                    &span,
+                    format!("a scene may have at most {MAX_SHADOWS} shadows; this is shadow #{}", i + 1),
+                ));
+            }
+            let table = Table { src, t, span, what: format!("[[shadow]] #{}", i + 1) };
+            let name = entity_name(&table, &mut names, "shadow")?;
+            let table = Table { what: format!("[[shadow]] \"{name}\""), ..table };
+            let def = parse_shadow(&table, name, &object_names, &wave_names, &mut rd)?;
+            if let Err((key, msg)) = check_shadow(&def, rd.values) {
+                return Err(src.value_err(&table.key_span(key), format!("{msg} in {}", table.what)));
+            }
+            shadows.push(def);
+            shadow_tables.push(table);
+        }
+        if let Err((i, msg)) = check_map_budget(&shadows) {
+            let t = &shadow_tables[i];
+            let span = if t.get("map_size").is_some() { t.key_span("map_size") } else { t.span.clone() };
+            return Err(src.value_err(&span, format!("{msg} ({})", t.what)));
+        }
+    }
+
     let mut scene = Scene {
         path: path.to_path_buf(),
         width,
@@ -209,6 +241,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         materials,
         objects,
         waves,
+        shadows,
         tracks: Vec::new(),
         warnings,
     };
@@ -424,7 +457,7 @@ fn parse_object(
     rd.add(t, &mut params, "scale", V3, scale, Fallback::Value(&[1.0; 3]), true)?;
     rd.add(t, &mut params, "color", V3, NONNEG, Fallback::Value(&[0.8; 3]), false)?;
     let materials = parse_object_materials(t, &mesh, materials, &mut params, rd, warnings)?;
-    Ok(ObjectDef { name, mesh, params, materials })
+    Ok(ObjectDef { name, mesh, params, materials, is_plane: kind == "plane" })
 }
 
 fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<WaveDef> {
@@ -734,6 +767,9 @@ fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
     if Vec3f::from_array(scene.light.arr(vals, "direction")).try_normalize().is_none() {
         return Err("`direction` in [light] must not be the zero vector".into());
     }
+    for s in &scene.shadows {
+        check_shadow(s, vals).map_err(|e| format!("{} in [[shadow]] \"{}\"", e.1, s.name))?;
+    }
     for w in &scene.waves {
         let what = format!("[[wave]] \"{}\"", w.name);
         match w.kind {
@@ -781,9 +817,13 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
             };
             (set, &segs[1..], format!("[{head}]"))
         }
-        "wave" | "object" | "material" if segs.len() >= 3 => {
+        "wave" | "object" | "material" | "shadow" if segs.len() >= 3 => {
             let name = segs[1];
             let (set, names) = match head {
+                "shadow" => (
+                    scene.shadows.iter().find(|s| s.name == name).map(|s| &s.params),
+                    scene.shadows.iter().map(|s| s.name.as_str()).collect(),
+                ),
                 "wave" => {
                     (scene.waves.iter().find(|w| w.name == name).map(|w| &w.params), scene.wave_names())
                 }
@@ -803,14 +843,14 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
         "camera" | "light" | "color" => {
             return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
         }
-        "wave" | "object" | "material" => {
+        "wave" | "object" | "material" | "shadow" => {
             return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
         }
         other => {
-            let heads = ["wave", "object", "material", "camera", "light", "color", "background"];
+            let heads = ["wave", "object", "material", "shadow", "camera", "light", "color", "background"];
             return Err(format!(
-                "target \"{target}\" must start with `wave.`, `object.`, `material.`, `camera.`, `light.`, \
-                 `color.` or be `background`{}",
+                "target \"{target}\" must start with `wave.`, `object.`, `material.`, `shadow.`, `camera.`, \
+                 `light.`, `color.` or be `background`{}",
                 hint(other, &heads, "targets")
             ));
         }

@@ -120,6 +120,7 @@ pub fn base_frame(width: u32, height: u32, eye: Vec3f, target: Vec3f, mode: Tone
         objects: Vec::new(),
         waves: Vec::new(),
         color_mapping: ColorMapping { mode, exposure: 1.0 },
+        shadows: Vec::new(),
     }
 }
 
