@@ -77,8 +77,9 @@ impl FrameShadows {
         let c = &self.casts[cast as usize];
         let s = &frame.shadows[c.shadow as usize];
         let ShadowMethod::Plane(plane) = s.method else { return };
-        // `!(t >= 0)` also refuses a NaN.
-        if !(t >= 0.0) || c.opacity <= best.0 || !s.receives(object) {
+        // `t ≥ 0` is false for a NaN too.
+        let in_front = t >= 0.0;
+        if !in_front || c.opacity <= best.0 || !s.receives(object) {
             return;
         }
         if plane.distance(world).abs() <= ON_PLANE * (1.0 + dist) {

@@ -518,7 +518,7 @@ pub(crate) fn build_shadow(
         None if s.own_direction => ShadowLight::Sun(unit("direction", -Vec3f::Y)),
         None => ShadowLight::Sun(sun),
         Some(w) => {
-            ShadowLight::Wave { wave: w as u32, theta: p.f(vals, "theta").to_radians().clamp(0.0, 1.5707) }
+            ShadowLight::Wave { wave: w as u32, theta: p.f(vals, "theta").clamp(0.0, 89.99).to_radians() }
         }
     };
     let method = match s.plane {
