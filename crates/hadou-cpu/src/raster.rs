@@ -17,7 +17,7 @@ use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
 
 /// Rows per parallel band.
-const BAND: usize = 16;
+pub(crate) const BAND: usize = 16;
 
 /// One vertex after transform: view-space position (for clipping/projection) and world-space
 /// attributes (for shading).
@@ -173,7 +173,7 @@ pub(crate) fn draw_opaque(
 }
 
 /// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.
-fn bin_rows(tris: &[ScreenTri], height: usize, rows: &std::ops::Range<usize>) -> Vec<Vec<u32>> {
+pub(crate) fn bin_rows(tris: &[ScreenTri], height: usize, rows: &std::ops::Range<usize>) -> Vec<Vec<u32>> {
     let h = rows.len();
     let mut bins: Vec<Vec<u32>> = vec![Vec::new(); h.div_ceil(BAND)];
     for (i, t) in tris.iter().enumerate() {
