@@ -6,11 +6,12 @@
 //! adapter exists.
 //!
 //! Passes, in order: opaque geometry and its outline hulls (`raster`), shaded with the materials
-//! and the waves as lights (`shading`), then the energy integrals clipped at the visible surface
+//! and the waves as lights (`shading`) and darkened by the hard shadows (`shadows`), then the energy integrals clipped at the visible surface
 //! and the colour mapping (`waves`).
 
 mod raster;
 mod shading;
+mod shadows;
 mod waves;
 
 use hadou_scene::{Backend, Frame, Image, RenderError};
@@ -56,7 +57,8 @@ pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
     let basis = frame.camera.basis(frame.width, frame.height);
     let curves = waves::prepare_curves(frame);
     let lights = shading::FrameLights::new(frame, &curves);
-    let opaque = raster::draw_opaque(frame, &basis, &lights, y0 as usize..y1 as usize);
+    let shadows = shadows::FrameShadows::new(frame, &lights.lines);
+    let opaque = raster::draw_opaque(frame, &basis, &lights, &shadows, y0 as usize..y1 as usize);
     let mut img = Image::new(frame.width, y1 - y0);
     let w = frame.width as usize;
     let far = frame.camera.far;
@@ -124,8 +126,9 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let basis = frame.camera.basis(frame.width, frame.height);
     let curves = waves::prepare_curves(frame);
     let lights = shading::FrameLights::new(frame, &curves);
+    let shadows = shadows::FrameShadows::new(frame, &lights.lines);
     // The probed row alone: the opaque pass decides each pixel independently.
-    let opaque = raster::draw_opaque(frame, &basis, &lights, y as usize..y as usize + 1);
+    let opaque = raster::draw_opaque(frame, &basis, &lights, &shadows, y as usize..y as usize + 1);
     let i = x as usize;
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];

@@ -10,7 +10,9 @@
 //! the outline hulls, of which only the back faces are drawn.
 
 use crate::shading::{self, FrameLights};
+use crate::shadows::{FrameShadows, NO_SHADOW};
 use hadou_math::{Vec3, Vec3f};
+use hadou_scene::ShadowMethod;
 use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
 
@@ -30,7 +32,7 @@ struct Vert {
 
 /// A projected triangle ready to rasterize.
 #[derive(Clone, Copy, Debug)]
-struct ScreenTri {
+pub(crate) struct ScreenTri {
     /// Continuous screen coordinates (x right, y down).
     sx: [f32; 3],
     sy: [f32; 3],
@@ -48,6 +50,24 @@ struct ScreenTri {
     hull: bool,
 }
 
+impl ScreenTri {
+    /// A bare triangle in screen coordinates (for rasterizing shadow maps with [`cover`]).
+    pub(crate) fn flat(sx: [f32; 3], sy: [f32; 3]) -> Self {
+        ScreenTri {
+            sx,
+            sy,
+            inv_z: [1.0; 3],
+            world: [Vec3f::ZERO; 3],
+            normal: [Vec3f::ZERO; 3],
+            uv: [[0.0; 2]; 3],
+            color: [[0.0; 4]; 3],
+            object: 0,
+            material: 0,
+            hull: false,
+        }
+    }
+}
+
 /// What the opaque pass leaves per pixel.
 pub(crate) struct OpaqueBuffers {
     /// Shaded linear RGB, background where nothing is drawn.
@@ -61,28 +81,23 @@ pub(crate) struct OpaqueBuffers {
 /// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
 /// Every pixel is decided by the triangles covering it alone, so a pixel's result does not depend
 /// on which rows are drawn with it.
+///
+/// Shadows (`[[shadow]]`) darken the shaded colour of receiver pixels here, before the waves:
+/// [`FrameShadows::resolve`] picks, per pixel, the cast of largest opacity among the plane casts
+/// whose projected casters cover the pixel and the map casts whose map shadows it.
 pub(crate) fn draw_opaque(
     frame: &Frame,
     basis: &CameraBasis,
     lights: &FrameLights,
+    shadows: &FrameShadows,
     rows: std::ops::Range<usize>,
 ) -> OpaqueBuffers {
     let (w, h) = (frame.width as usize, rows.len());
     let tris = project_all(frame, basis);
+    let shadow_tris = if shadows.any_plane() { project_shadows(frame, basis, shadows) } else { Vec::new() };
     let far = frame.camera.far;
-    // Bin triangles into horizontal bands of the drawn rows, keeping submission order inside each.
-    let bands = h.div_ceil(BAND);
-    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
-    for (i, t) in tris.iter().enumerate() {
-        let (y0, y1) = y_range(t, frame.height as usize);
-        let (y0, y1) = (y0.max(rows.start), y1.min(rows.end.saturating_sub(1)));
-        if y0 > y1 || h == 0 {
-            continue;
-        }
-        for bin in &mut bins[((y0 - rows.start) / BAND)..=((y1 - rows.start) / BAND)] {
-            bin.push(i as u32);
-        }
-    }
+    let bins = bin_rows(&tris, frame.height as usize, &rows);
+    let shadow_bins = bin_rows(&shadow_tris, frame.height as usize, &rows);
     let mut color = vec![[0.0f32; 3]; w * h];
     let mut surface = vec![None; w * h];
     let mut object = vec![None; w * h];
@@ -99,37 +114,83 @@ pub(crate) fn draw_opaque(
             for &ti in &bins[b] {
                 raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, &mut zbuf, &mut tri_id);
             }
+            // The visible surface of every pixel.
+            let mut visible: Vec<Option<shading::Surface>> = vec![None; rows * w];
             for r in 0..rows {
                 for x in 0..w {
                     let i = r * w + x;
-                    let py = (y_start + r) as f32;
                     if tri_id[i] == u32::MAX {
-                        col[i] = frame.background;
                         continue;
                     }
-                    let t = &tris[tri_id[i] as usize];
-                    let s = interpolate(t, x as f32 + 0.5, py + 0.5);
-                    let object = &frame.objects[t.object as usize];
-                    let material = object.material(t.material);
-                    col[i] = match (t.hull, material.outline) {
-                        (true, Some(o)) => o.color,
-                        _ => shading::shade(frame, lights, material, &s),
-                    };
-                    let world = s.world;
-                    let d = (world - basis.eye).length();
+                    let py = (y_start + r) as f32;
+                    let s = interpolate(&tris[tri_id[i] as usize], x as f32 + 0.5, py + 0.5);
+                    let d = (s.world - basis.eye).length();
                     surf[i] = Some(if d.is_finite() { d } else { 0.0 });
-                    obj[i] = Some(t.object);
+                    obj[i] = Some(tris[tri_id[i] as usize].object);
+                    visible[i] = Some(s);
+                }
+            }
+            // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
+            let mut best = vec![NO_SHADOW; rows * w];
+            let receiver = |i: usize| {
+                let t = tris.get(tri_id[i] as usize)?;
+                (!t.hull).then_some(t.object)
+            };
+            for &si in &shadow_bins[b] {
+                let st = &shadow_tris[si as usize];
+                cover(st, y_start, rows, w, |i, bary| {
+                    let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
+                    let t = perspective(st, bary, |k| st.uv[k][0]);
+                    shadows.plane_candidate(
+                        frame,
+                        st.object,
+                        o,
+                        t,
+                        s.world,
+                        surf[i].unwrap_or(0.0),
+                        &mut best[i],
+                    );
+                });
+            }
+            for r in 0..rows {
+                for x in 0..w {
+                    let i = r * w + x;
+                    let Some(s) = visible[i].as_ref() else {
+                        col[i] = frame.background;
+                        continue;
+                    };
+                    let t = &tris[tri_id[i] as usize];
+                    let material = frame.objects[t.object as usize].material(t.material);
+                    let c = match (t.hull, material.outline) {
+                        (true, Some(o)) => o.color,
+                        _ => shading::shade(frame, lights, material, s),
+                    };
+                    col[i] = if t.hull { c } else { shadows.resolve(frame, t.object, s.world, best[i], c) };
                 }
             }
         });
     OpaqueBuffers { color, surface, object }
 }
 
+/// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.
+fn bin_rows(tris: &[ScreenTri], height: usize, rows: &std::ops::Range<usize>) -> Vec<Vec<u32>> {
+    let h = rows.len();
+    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); h.div_ceil(BAND)];
+    for (i, t) in tris.iter().enumerate() {
+        let (y0, y1) = y_range(t, height);
+        let (y0, y1) = (y0.max(rows.start), y1.min(rows.end.saturating_sub(1)));
+        if y0 > y1 || h == 0 {
+            continue;
+        }
+        for bin in &mut bins[((y0 - rows.start) / BAND)..=((y1 - rows.start) / BAND)] {
+            bin.push(i as u32);
+        }
+    }
+    bins
+}
+
 fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
-    let (w, h) = (frame.width as f32, frame.height as f32);
-    let near = frame.camera.near;
-    let sx_scale = 1.0 / (basis.tan_half_fov * basis.aspect);
-    let sy_scale = 1.0 / basis.tan_half_fov;
+    let screen = ScreenProjection::new(frame, basis);
     let mut out = Vec::new();
     for (oi, obj) in frame.objects.iter().enumerate() {
         let nm = obj.transform.normal_matrix();
@@ -179,34 +240,98 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
                 {
                     continue;
                 }
-                let mut poly = [a; 4];
-                let n = clip_near([a, b, c], near, &mut poly);
-                for k in 1..n.saturating_sub(1) {
-                    let pv = [poly[0], poly[k], poly[k + 1]];
-                    let mut t = ScreenTri {
-                        sx: [0.0; 3],
-                        sy: [0.0; 3],
-                        inv_z: [0.0; 3],
-                        world: pv.map(|v| v.world),
-                        normal: pv.map(|v| v.normal),
-                        uv: pv.map(|v| v.uv),
-                        color: pv.map(|v| v.color),
-                        object: oi as u32,
-                        material,
-                        hull: is_hull,
-                    };
-                    let mut ok = true;
-                    for (j, v) in pv.iter().enumerate() {
-                        let iz = 1.0 / v.view.z;
-                        t.inv_z[j] = iz;
-                        t.sx[j] = (v.view.x * iz * sx_scale + 1.0) * 0.5 * w;
-                        t.sy[j] = (1.0 - v.view.y * iz * sy_scale) * 0.5 * h;
-                        ok &= t.sx[j].is_finite() && t.sy[j].is_finite() && iz.is_finite();
+                screen.push([a, b, c], oi as u32, material, is_hull, &mut out);
+            }
+        }
+    }
+    out
+}
+
+/// The camera projection of view-space triangles to [`ScreenTri`]s, clipped at the near plane.
+struct ScreenProjection {
+    near: f32,
+    w: f32,
+    h: f32,
+    sx_scale: f32,
+    sy_scale: f32,
+}
+
+impl ScreenProjection {
+    fn new(frame: &Frame, basis: &CameraBasis) -> Self {
+        ScreenProjection {
+            near: frame.camera.near,
+            w: frame.width as f32,
+            h: frame.height as f32,
+            sx_scale: 1.0 / (basis.tan_half_fov * basis.aspect),
+            sy_scale: 1.0 / basis.tan_half_fov,
+        }
+    }
+
+    /// Clips `tri` at the near plane and appends the projected pieces to `out`.
+    fn push(&self, tri: [Vert; 3], object: u32, material: u32, hull: bool, out: &mut Vec<ScreenTri>) {
+        let mut poly = [tri[0]; 4];
+        let n = clip_near(tri, self.near, &mut poly);
+        for k in 1..n.saturating_sub(1) {
+            let pv = [poly[0], poly[k], poly[k + 1]];
+            let mut t = ScreenTri {
+                sx: [0.0; 3],
+                sy: [0.0; 3],
+                inv_z: [0.0; 3],
+                world: pv.map(|v| v.world),
+                normal: pv.map(|v| v.normal),
+                uv: pv.map(|v| v.uv),
+                color: pv.map(|v| v.color),
+                object,
+                material,
+                hull,
+            };
+            let mut ok = true;
+            for (j, v) in pv.iter().enumerate() {
+                let iz = 1.0 / v.view.z;
+                t.inv_z[j] = iz;
+                t.sx[j] = (v.view.x * iz * self.sx_scale + 1.0) * 0.5 * self.w;
+                t.sy[j] = (1.0 - v.view.y * iz * self.sy_scale) * 0.5 * self.h;
+                ok &= t.sx[j].is_finite() && t.sy[j].is_finite() && iz.is_finite();
+            }
+            if ok {
+                out.push(t);
+            }
+        }
+    }
+}
+
+/// The plane casts' projected casters (001's flattened copies, 000 §2.4's shadow models): every
+/// caster vertex `P` moved to `G = P + t·k` on the cast's plane
+/// ([`hadou_math::shadow::project`]), with `t` carried in `uv[0]` for the per-pixel `t ≥ 0` test
+/// (interpolated perspective-correctly, exact because `t` is affine on the projected triangle) and
+/// the cast's index in `object`. Drawn double-sided.
+fn project_shadows(frame: &Frame, basis: &CameraBasis, shadows: &FrameShadows) -> Vec<ScreenTri> {
+    let screen = ScreenProjection::new(frame, basis);
+    let mut out = Vec::new();
+    for (ci, cast) in shadows.casts.iter().enumerate() {
+        let ShadowMethod::Plane(plane) = frame.shadows[cast.shadow as usize].method else { continue };
+        for &o in &cast.casters {
+            let obj = &frame.objects[o as usize];
+            let mesh = &obj.mesh;
+            let verts: Vec<Vert> = mesh
+                .positions
+                .iter()
+                .map(|p| {
+                    let world = obj.transform.transform_point(Vec3::from_array(*p));
+                    let (g, t) = hadou_math::shadow::project(world, cast.k, &plane);
+                    Vert {
+                        view: basis.to_view(g),
+                        world: g,
+                        normal: Vec3f::ZERO,
+                        uv: [t, 0.0],
+                        color: [0.0; 4],
                     }
-                    if ok {
-                        out.push(t);
-                    }
-                }
+                })
+                .collect();
+            for tri in mesh.indices.chunks_exact(3) {
+                let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+                let [Some(a), Some(b), Some(c)] = v else { continue };
+                screen.push([a, b, c], ci as u32, 0, false, &mut out);
             }
         }
     }
@@ -286,13 +411,34 @@ fn raster_tri(
     zbuf: &mut [f32],
     tri_id: &mut [u32],
 ) {
-    let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
-    if area == 0.0 || !area.is_finite() {
-        return;
-    }
     // With y down, a triangle counter-clockwise seen from the eye (a front face) has area < 0;
     // a hull shows only its back faces.
-    if t.hull && area < 0.0 {
+    if t.hull && edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]) < 0.0 {
+        return;
+    }
+    cover(t, y_start, rows, w, |i, b| {
+        let iz = b[0] * t.inv_z[0] + b[1] * t.inv_z[1] + b[2] * t.inv_z[2];
+        let z = 1.0 / iz;
+        if z < zbuf[i] && z <= far {
+            zbuf[i] = z;
+            tri_id[i] = id;
+        }
+    });
+}
+
+/// Calls `f(i, b)` for every pixel centre of the rows `y_start..y_start + rows` (`i` indexing a
+/// `rows × w` buffer) that `t` covers under the top-left rule, with the screen-space barycentric
+/// weights `b` of the centre. Degenerate (zero-area or non-finite) triangles cover nothing.
+#[inline(always)]
+pub(crate) fn cover(
+    t: &ScreenTri,
+    y_start: usize,
+    rows: usize,
+    w: usize,
+    mut f: impl FnMut(usize, [f32; 3]),
+) {
+    let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
+    if area == 0.0 || !area.is_finite() {
         return;
     }
     let sign = area.signum();
@@ -329,16 +475,17 @@ fn raster_tri(
             if !(inside(e0, own[0]) && inside(e1, own[1]) && inside(e2, own[2])) {
                 continue;
             }
-            let (b0, b1, b2) = (e0 * inv_area * sign, e1 * inv_area * sign, e2 * inv_area * sign);
-            let iz = b0 * t.inv_z[0] + b1 * t.inv_z[1] + b2 * t.inv_z[2];
-            let z = 1.0 / iz;
-            let i = r * w + x;
-            if z < zbuf[i] && z <= far {
-                zbuf[i] = z;
-                tri_id[i] = id;
-            }
+            f(r * w + x, [e0 * inv_area * sign, e1 * inv_area * sign, e2 * inv_area * sign]);
         }
     }
+}
+
+/// A per-vertex attribute at screen barycentrics `b`, interpolated perspective-correctly.
+#[inline]
+fn perspective(t: &ScreenTri, b: [f32; 3], attr: impl Fn(usize) -> f32) -> f32 {
+    let wts = [b[0] * t.inv_z[0], b[1] * t.inv_z[1], b[2] * t.inv_z[2]];
+    let s = wts[0] + wts[1] + wts[2];
+    (wts[0] * attr(0) + wts[1] * attr(1) + wts[2] * attr(2)) / s
 }
 
 /// Perspective-correct surface attributes at screen point `(px, py)`.

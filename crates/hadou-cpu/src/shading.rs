@@ -23,7 +23,8 @@ pub(crate) struct Surface {
 
 /// The frame's waves as lights: each wave's centre line and what weighs it against the others.
 pub(crate) struct FrameLights {
-    lines: Vec<LightLine>,
+    /// Each wave's centre line as a light.
+    pub lines: Vec<LightLine>,
     /// `α·a` per wave ([`hadou_scene::Wave::light_strength`]).
     strength: Vec<f32>,
     inverse_square: Vec<bool>,
