@@ -244,7 +244,7 @@ fn shadows_match_cpu() {
     use hadou_scene::{Material, Outline, Shadow, ShadowLight, ShadowMethod, WaveShape};
     use std::sync::Arc;
     let mut f =
-        base_frame(160, 120, Vec3::new(7.0, 6.0, 13.0), Vec3::new(1.5, -0.5, 0.0), hadou_scene::ToneMode::Filmic);
+        base_frame(160, 120, Vec3::new(5.0, 4.5, 9.0), Vec3::new(1.2, -0.3, 0.0), hadou_scene::ToneMode::Filmic);
     let ground_y = -1.0;
     f.objects.push(object("ground", plane_mesh(40.0), Vec3::new(0.0, ground_y, 0.0), Vec3::ZERO, [0.6, 0.6, 0.55]));
     f.objects.push(object(
@@ -326,7 +326,8 @@ fn shadows_match_cpu() {
         },
         Shadow {
             name: "small map".into(),
-            light: ShadowLight::Sun(Vec3::new(-0.2, -1.0, 0.1).normalize_or(Vec3::Y)),
+            // Onto the box's side and the ground, over the plane shadows there.
+            light: ShadowLight::Sun(Vec3::new(-0.9, -0.7, 0.3).normalize_or(Vec3::Y)),
             method: ShadowMethod::Map { size: 96 },
             up: Vec3::Y,
             casters: vec![ball],
