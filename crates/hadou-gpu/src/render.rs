@@ -905,6 +905,100 @@ mod tests {
     }
 
     #[test]
+    fn shadow_maps_are_checked_against_the_device_limits() {
+        use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+        let mut frame = small_frame();
+        let mesh = Arc::new(Mesh {
+            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, 1.0]],
+            normals: vec![[0.0, 1.0, 0.0]; 3],
+            indices: vec![0, 1, 2],
+            ..Mesh::default()
+        });
+        for i in 0..3 {
+            let at = hadou_math::Mat4::from_trs(
+                hadou_math::Vec3::new(i as f32, 1.0, 0.0),
+                hadou_math::Vec3::ZERO,
+                hadou_math::Vec3::splat(1.0),
+            );
+            frame.objects.push(hadou_scene::Object::new(format!("o{i}"), mesh.clone(), at, [1.0; 3]));
+        }
+        let map = |name: &str, size: u32| Shadow {
+            name: name.into(),
+            light: ShadowLight::Sun(-hadou_math::Vec3::Y),
+            method: ShadowMethod::Map { size },
+            up: hadou_math::Vec3::Y,
+            casters: vec![0],
+            receivers: vec![1],
+            color: [0.0; 3],
+            opacity: 0.5,
+        };
+        frame.shadows = vec![map("a", 512), map("b", 4096), map("c", 16)];
+        let shadows = FrameShadows::new(&frame, &frame.shadow_casts(&[]));
+        assert_eq!(shadows.map_casts, [0, 1, 2]);
+        assert_eq!((shadows.map_size, shadows.map_layers), (4096, 3));
+        let mut limits = wgpu::Limits::downlevel_defaults();
+        limits.max_texture_dimension_2d = 8192;
+        assert!(check_maps(&limits, &frame, &shadows).is_ok());
+        limits.max_texture_dimension_2d = 2048;
+        match check_maps(&limits, &frame, &shadows) {
+            Err(RenderError::Device(m)) => {
+                assert_eq!(m, "shadow \"b\": map_size 4096 exceeds this adapter's largest texture (2048)")
+            }
+            other => panic!("expected a size error, got {other:?}"),
+        }
+        limits.max_texture_dimension_2d = 8192;
+        limits.max_texture_array_layers = 2;
+        match check_maps(&limits, &frame, &shadows) {
+            Err(RenderError::Device(m)) => assert!(m.starts_with("shadow \"c\": the frame needs 3 shadow maps"), "{m}"),
+            other => panic!("expected a layer error, got {other:?}"),
+        }
+    }
+
+    /// Plane casts get depth keys by decreasing opacity (equal opacities share one, so the first
+    /// drawn keeps the pixel); receivers' materials carry their shadows' bits.
+    #[test]
+    fn plane_casts_rank_by_opacity_and_receivers_carry_their_bits() {
+        use hadou_math::shadow::Plane;
+        use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+        let mut frame = small_frame();
+        let mesh = Arc::new(Mesh {
+            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.5, 1.0]],
+            normals: vec![[0.0, 1.0, 0.0]; 3],
+            indices: vec![0, 1, 2],
+            ..Mesh::default()
+        });
+        for i in 0..3 {
+            let at = hadou_math::Mat4::from_trs(
+                hadou_math::Vec3::new(i as f32, 1.0, 0.0),
+                hadou_math::Vec3::ZERO,
+                hadou_math::Vec3::splat(1.0),
+            );
+            frame.objects.push(hadou_scene::Object::new(format!("o{i}"), mesh.clone(), at, [1.0; 3]));
+        }
+        let plane = |opacity: f32, receivers: Vec<u32>| Shadow {
+            name: format!("{opacity}"),
+            light: ShadowLight::Sun(-hadou_math::Vec3::Y),
+            method: ShadowMethod::Plane(Plane { point: hadou_math::Vec3::ZERO, normal: hadou_math::Vec3::Y }),
+            up: hadou_math::Vec3::Y,
+            casters: vec![0],
+            receivers,
+            color: [0.1, 0.2, 0.3],
+            opacity,
+        };
+        frame.shadows = vec![plane(0.3, vec![1]), plane(0.9, vec![1, 2]), plane(0.3, vec![2]), plane(0.5, vec![])];
+        let casts = frame.shadow_casts(&[]);
+        let shadows = FrameShadows::new(&frame, &casts);
+        let keys: Vec<f32> = shadows.casts.iter().map(|c| c.depth_key).collect();
+        let step = 1.0 / (1u32 << 24) as f32;
+        assert_eq!(keys, [2.0 * step, 0.0, 2.0 * step, step]);
+        assert!(shadows.casts.iter().all(|c| c.map_size == layout::CAST_PLANE && c.color == [0.1, 0.2, 0.3]));
+        assert_eq!((shadows.map_casts.len(), shadows.map_layers), (0, 2));
+        let buffers = ShadingBuffers::new(&frame, &[]);
+        let masks: Vec<u32> = buffers.materials.iter().map(|m| m.shadow_mask).collect();
+        assert_eq!(masks, [0b0000, 0b0011, 0b0110]);
+    }
+
+    #[test]
     fn shader_compile_failure_is_an_error_naming_the_shader() {
         let Some((r, _gpu)) = renderer_or_skip("shader compile failure") else { return };
         match compile_module(&r.ctx, "deliberately broken", "fn f( -> { let }") {
