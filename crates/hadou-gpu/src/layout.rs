@@ -7,8 +7,8 @@
 use bytemuck::{Pod, Zeroable};
 use hadou_math::curve::{self, CurveShape, Integrator, PreparedCurve, DEFAULT_SETTINGS};
 use hadou_math::energy::Falloff;
-use hadou_math::toon::{Filter, Ramp, RampKind, Wrap, MAX_RAMP_BANDS};
 use hadou_math::shadow::MapFrame;
+use hadou_math::toon::{Filter, Ramp, RampKind, Wrap, MAX_RAMP_BANDS};
 use hadou_math::{Mat4, Vec3f};
 use hadou_scene::{
     CameraBasis, Frame, LightLine, Object, ShadingModel, ShadowCast, ShadowMethod, TextureRef, ToneMode,
@@ -502,8 +502,7 @@ pub struct FrameShadows {
 impl FrameShadows {
     /// The records of `casts` (from [`Frame::shadow_casts`] of `frame`).
     pub fn new(frame: &Frame, casts: &[ShadowCast]) -> Self {
-        let mut opacities: Vec<f32> =
-            casts.iter().filter(|c| c.map.is_none()).map(|c| c.opacity).collect();
+        let mut opacities: Vec<f32> = casts.iter().filter(|c| c.map.is_none()).map(|c| c.opacity).collect();
         opacities.sort_by(|a, b| b.total_cmp(a));
         opacities.dedup();
         let mut out = FrameShadows { map_layers: 2, ..Default::default() };

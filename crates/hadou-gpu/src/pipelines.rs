@@ -177,7 +177,11 @@ impl Pipelines {
             let vs = wgpu::ShaderStages::VERTEX;
             let shadow_map_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("shadow maps"),
-                entries: &[storage_entry(1, vs, true), storage_entry(3, vs, true), storage_entry(4, vs, true)],
+                entries: &[
+                    storage_entry(1, vs, true),
+                    storage_entry(3, vs, true),
+                    storage_entry(4, vs, true),
+                ],
             });
             let raster_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("raster"),

@@ -477,7 +477,11 @@ impl Renderer {
             let zero_cast = [GpuShadowCast::zeroed()];
             let casts = storage(
                 "shadow casts",
-                bytemuck::cast_slice(if shadows.casts.is_empty() { &zero_cast[..] } else { &shadows.casts[..] }),
+                bytemuck::cast_slice(if shadows.casts.is_empty() {
+                    &zero_cast[..]
+                } else {
+                    &shadows.casts[..]
+                }),
             );
             let shadow_draws = storage("shadow draws", bytemuck::cast_slice(&draw_pairs));
             let draws = frame
@@ -561,7 +565,8 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 4, resource: prepared.shadow_draws.as_entire_binding() },
             ],
         });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow maps") });
+        let mut enc =
+            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow maps") });
         for (layer, draws) in map_draws.iter().enumerate() {
             let j = shadows.map_casts[layer] as usize;
             let edge = shadows.casts[j].map_size as f32;
@@ -791,7 +796,10 @@ impl Renderer {
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &t.depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,
@@ -949,7 +957,9 @@ mod tests {
         limits.max_texture_dimension_2d = 8192;
         limits.max_texture_array_layers = 2;
         match check_maps(&limits, &frame, &shadows) {
-            Err(RenderError::Device(m)) => assert!(m.starts_with("shadow \"c\": the frame needs 3 shadow maps"), "{m}"),
+            Err(RenderError::Device(m)) => {
+                assert!(m.starts_with("shadow \"c\": the frame needs 3 shadow maps"), "{m}")
+            }
             other => panic!("expected a layer error, got {other:?}"),
         }
     }
@@ -985,7 +995,8 @@ mod tests {
             color: [0.1, 0.2, 0.3],
             opacity,
         };
-        frame.shadows = vec![plane(0.3, vec![1]), plane(0.9, vec![1, 2]), plane(0.3, vec![2]), plane(0.5, vec![])];
+        frame.shadows =
+            vec![plane(0.3, vec![1]), plane(0.9, vec![1, 2]), plane(0.3, vec![2]), plane(0.5, vec![])];
         let casts = frame.shadow_casts(&[]);
         let shadows = FrameShadows::new(&frame, &casts);
         let keys: Vec<f32> = shadows.casts.iter().map(|c| c.depth_key).collect();

@@ -243,10 +243,21 @@ fn shadows_match_cpu() {
     use hadou_scene::mesh::with_outline_normals;
     use hadou_scene::{Material, Outline, Shadow, ShadowLight, ShadowMethod, WaveShape};
     use std::sync::Arc;
-    let mut f =
-        base_frame(160, 120, Vec3::new(5.0, 4.5, 9.0), Vec3::new(1.2, -0.3, 0.0), hadou_scene::ToneMode::Filmic);
+    let mut f = base_frame(
+        160,
+        120,
+        Vec3::new(5.0, 4.5, 9.0),
+        Vec3::new(1.2, -0.3, 0.0),
+        hadou_scene::ToneMode::Filmic,
+    );
     let ground_y = -1.0;
-    f.objects.push(object("ground", plane_mesh(40.0), Vec3::new(0.0, ground_y, 0.0), Vec3::ZERO, [0.6, 0.6, 0.55]));
+    f.objects.push(object(
+        "ground",
+        plane_mesh(40.0),
+        Vec3::new(0.0, ground_y, 0.0),
+        Vec3::ZERO,
+        [0.6, 0.6, 0.55],
+    ));
     f.objects.push(object(
         "box",
         box_mesh([1.4, 1.4, 1.4]),
@@ -280,8 +291,20 @@ fn shadows_match_cpu() {
             f.objects.len() as u32 - 1
         })
         .collect();
-    f.objects.push(object("floater", sphere_mesh(0.6, 24), Vec3::new(3.6, 2.2, 0.2), Vec3::ZERO, [0.9, 0.8, 0.3]));
-    f.objects.push(object("post", box_mesh([0.3, 1.6, 0.3]), Vec3::new(5.3, 1.6, 0.8), Vec3::ZERO, [0.5, 0.8, 0.5]));
+    f.objects.push(object(
+        "floater",
+        sphere_mesh(0.6, 24),
+        Vec3::new(3.6, 2.2, 0.2),
+        Vec3::ZERO,
+        [0.9, 0.8, 0.3],
+    ));
+    f.objects.push(object(
+        "post",
+        box_mesh([0.3, 1.6, 0.3]),
+        Vec3::new(5.3, 1.6, 0.8),
+        Vec3::ZERO,
+        [0.5, 0.8, 0.5],
+    ));
     let (ground, boxed, ball, floater, post) = (0, 1, 2, stairs[2] + 1, stairs[2] + 2);
     f.waves.push(wave(
         "orb",
