@@ -17,7 +17,7 @@ use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
 
 /// Rows per parallel band.
-const BAND: usize = 16;
+pub(crate) const BAND: usize = 16;
 
 /// One vertex after transform: view-space position (for clipping/projection) and world-space
 /// attributes (for shading).
@@ -173,7 +173,7 @@ pub(crate) fn draw_opaque(
 }
 
 /// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.
-fn bin_rows(tris: &[ScreenTri], height: usize, rows: &std::ops::Range<usize>) -> Vec<Vec<u32>> {
+pub(crate) fn bin_rows(tris: &[ScreenTri], height: usize, rows: &std::ops::Range<usize>) -> Vec<Vec<u32>> {
     let h = rows.len();
     let mut bins: Vec<Vec<u32>> = vec![Vec::new(); h.div_ceil(BAND)];
     for (i, t) in tris.iter().enumerate() {
@@ -461,12 +461,40 @@ pub(crate) fn cover(
         owns_boundary(t.sx[2], t.sy[2], t.sx[0], t.sy[0], sign),
         owns_boundary(t.sx[0], t.sy[0], t.sx[1], t.sy[1], sign),
     ];
-    for r in 0..rows {
+    // Only the rows whose centres may lie within [ylo, yhi] (the test below still decides).
+    let r0 = ((ylo - 0.5).ceil() - y_start as f32 - 1.0).max(0.0) as usize;
+    let r1 = ((yhi - 0.5).floor() - y_start as f32 + 2.0).clamp(0.0, rows as f32) as usize;
+    for r in r0..r1 {
         let py = (y_start + r) as f32 + 0.5;
         if py < ylo || py > yhi {
             continue;
         }
-        for x in x0..=x1 {
+        // The row's span of the triangle, widened by a pixel against rounding: only its pixels
+        // are tested (the exact edge tests below decide), so long thin triangles cost their
+        // area, not their bounding box.
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            let (ay, by) = (t.sy[a], t.sy[b]);
+            if (ay <= py && py <= by) || (by <= py && py <= ay) {
+                let x = if ay == by {
+                    lo = lo.min(t.sx[a].min(t.sx[b]));
+                    t.sx[a].max(t.sx[b])
+                } else {
+                    t.sx[a] + (py - ay) * ((t.sx[b] - t.sx[a]) / (by - ay))
+                };
+                lo = lo.min(x);
+                hi = hi.max(x);
+            }
+        }
+        if lo.partial_cmp(&hi) == Some(std::cmp::Ordering::Greater) || lo.is_nan() || hi.is_nan() {
+            continue;
+        }
+        let xs = ((lo - 1.5).ceil().max(x0 as f32)) as usize;
+        let xe = ((hi + 0.5).floor().min(x1 as f32)).max(-1.0);
+        if xe < xs as f32 {
+            continue;
+        }
+        for x in xs..=xe as usize {
             let px = x as f32 + 0.5;
             let e0 = edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) * sign;
             let e1 = edge(t.sx[2], t.sy[2], t.sx[0], t.sy[0], px, py) * sign;

@@ -13,7 +13,7 @@
 //! casters of one shadow therefore darken an overlap once, and a shadow shows only on its
 //! receivers.
 
-use crate::raster::{cover, ScreenTri};
+use crate::raster::{bin_rows, cover, ScreenTri, BAND};
 use hadou_math::shadow::MapFrame;
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{Frame, LightLine, ShadowCast, ShadowMethod, ON_PLANE};
@@ -77,8 +77,9 @@ impl FrameShadows {
         let c = &self.casts[cast as usize];
         let s = &frame.shadows[c.shadow as usize];
         let ShadowMethod::Plane(plane) = s.method else { return };
-        // `!(t >= 0)` also refuses a NaN.
-        if !(t >= 0.0) || c.opacity <= best.0 || !s.receives(object) {
+        // `t ≥ 0` is false for a NaN too.
+        let in_front = t >= 0.0;
+        if !in_front || c.opacity <= best.0 || !s.receives(object) {
             return;
         }
         if plane.distance(world).abs() <= ON_PLANE * (1.0 + dist) {
@@ -136,7 +137,8 @@ impl DepthMap {
 fn render_map(frame: &Frame, c: &ShadowCast, m: MapFrame, size: u32) -> DepthMap {
     let n = size as usize;
     let nf = size as f32;
-    let mut depth = vec![1.0f32; n * n];
+    let mut tris: Vec<ScreenTri> = Vec::new();
+    let mut depths: Vec<[f32; 3]> = Vec::new();
     for &o in &c.casters {
         let obj = &frame.objects[o as usize];
         let pts: Vec<[f32; 3]> = obj
@@ -151,15 +153,25 @@ fn render_map(frame: &Frame, c: &ShadowCast, m: MapFrame, size: u32) -> DepthMap
         for tri in obj.mesh.indices.chunks_exact(3) {
             let v = [tri[0], tri[1], tri[2]].map(|i| pts.get(i as usize).copied());
             let [Some(a), Some(b), Some(cc)] = v else { continue };
-            let st = ScreenTri::flat([a[0], b[0], cc[0]], [a[1], b[1], cc[1]]);
-            let dz = [a[2], b[2], cc[2]];
-            cover(&st, 0, n, n, |i, w| {
+            tris.push(ScreenTri::flat([a[0], b[0], cc[0]], [a[1], b[1], cc[1]]));
+            depths.push([a[2], b[2], cc[2]]);
+        }
+    }
+    // Bands of rows in parallel, each drawing the triangles that reach it (the nearest depth
+    // wins, so the result does not depend on the banding).
+    let bins = bin_rows(&tris, n, &(0..n));
+    let mut depth = vec![1.0f32; n * n];
+    depth.par_chunks_mut(BAND * n).zip(&bins).enumerate().for_each(|(b, (band, bin))| {
+        let rows = band.len() / n;
+        for &ti in bin {
+            let dz = depths[ti as usize];
+            cover(&tris[ti as usize], b * BAND, rows, n, |i, w| {
                 let z = w[0] * dz[0] + w[1] * dz[1] + w[2] * dz[2];
-                if z < depth[i] {
-                    depth[i] = z;
+                if z < band[i] {
+                    band[i] = z;
                 }
             });
         }
-    }
+    });
     DepthMap { frame: m, size, depth }
 }

@@ -17,6 +17,7 @@ pub mod quadrature;
 mod real;
 pub mod shade;
 pub mod shadow;
+pub mod soft;
 pub mod toon;
 mod vec3;
 

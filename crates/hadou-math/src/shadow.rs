@@ -38,7 +38,9 @@ impl<R: Real> Plane<R> {
         let (big_x, small_x) = (j - i, k - i);
         let y = small_x.cross(big_x);
         let scale = big_x.length() * small_x.length();
-        if !(scale > R::ZERO) || !(y.length() > R::from_f64(1e-6) * scale) {
+        // Written so that a NaN anywhere refuses the points too.
+        let spans = scale > R::ZERO && y.length() > R::from_f64(1e-6) * scale;
+        if !spans {
             return None;
         }
         Some(Plane { point: i, normal: y.try_normalize()? })

@@ -101,9 +101,7 @@ impl Shadow {
 /// World-space axis-aligned bounds of an object's mesh: the 8 transformed corners of its local
 /// bounds. `None` for an empty mesh.
 pub fn object_bounds(o: &Object) -> Option<(Vec3f, Vec3f)> {
-    let mut it = o.mesh.positions.iter().map(|p| Vec3f::from_array(*p));
-    let first = it.next()?;
-    let (lo, hi) = it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let (lo, hi) = local_bounds(o)?;
     let mut w_lo = Vec3::splat(f32::INFINITY);
     let mut w_hi = Vec3::splat(f32::NEG_INFINITY);
     for i in 0..8 {
@@ -122,10 +120,15 @@ pub fn object_bounds(o: &Object) -> Option<(Vec3f, Vec3f)> {
 /// The centre `B` of a caster (000 §2.4's "model's centre"): the centre of its mesh's local
 /// bounding box, placed in the world. `None` for an empty mesh.
 pub fn object_center(o: &Object) -> Option<Vec3f> {
+    let (lo, hi) = local_bounds(o)?;
+    Some(o.transform.transform_point((lo + hi) * 0.5))
+}
+
+/// The object-space bounding box of an object's mesh (`None` when it has no vertices).
+fn local_bounds(o: &Object) -> Option<(Vec3f, Vec3f)> {
     let mut it = o.mesh.positions.iter().map(|p| Vec3f::from_array(*p));
     let first = it.next()?;
-    let (lo, hi) = it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    Some(o.transform.transform_point((lo + hi) * 0.5))
+    Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }
 
 impl Frame {
@@ -518,7 +521,7 @@ pub(crate) fn build_shadow(
         None if s.own_direction => ShadowLight::Sun(unit("direction", -Vec3f::Y)),
         None => ShadowLight::Sun(sun),
         Some(w) => {
-            ShadowLight::Wave { wave: w as u32, theta: p.f(vals, "theta").to_radians().clamp(0.0, 1.5707) }
+            ShadowLight::Wave { wave: w as u32, theta: p.f(vals, "theta").clamp(0.0, 89.99).to_radians() }
         }
     };
     let method = match s.plane {

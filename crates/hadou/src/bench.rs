@@ -551,14 +551,21 @@ impl CurveTable {
 /// texture and outlines, two outlined props and a toon ground, lit by a firing beam.
 pub const TOON_SCENE: (&str, f32) = ("light-from-front.toml", 1.2);
 
+/// The scene and time whose shadows `hadou bench toon` times on and off: sun shadows by shadow map
+/// (2048²) and by plane projection, and a wave shadow by shadow map, over toon materials.
+pub const SHADOW_SCENE: (&str, f32) = ("shadow-uneven.toml", 1.0);
+
 /// One row of the toon table.
 #[derive(Clone, Debug)]
 pub struct ToonRow {
     /// Image side in pixels.
     pub size: u32,
-    /// `full` (the scene as written) or `plain` (every material diffuse, no wave light, no
-    /// outlines, no textures: the opaque pass hadou had before materials).
+    /// For [`TOON_SCENE`]: `full` (the scene as written) or `plain` (every material diffuse, no
+    /// wave light, no outlines, no textures: the opaque pass hadou had before materials). For
+    /// [`SHADOW_SCENE`]: `shadows` (as written) or `no-shadows` (its `[[shadow]]`s removed).
     pub variant: &'static str,
+    /// The scene file.
+    pub scene: &'static str,
     /// Median milliseconds per frame.
     pub ms: f64,
 }
@@ -610,7 +617,19 @@ pub fn toon_table(
         frame.height = size;
         let plain = plain_materials(&frame);
         for (variant, f) in [("full", &frame), ("plain", &plain)] {
-            rows.push(ToonRow { size, variant, ms: time(f, iterations)? });
+            rows.push(ToonRow { size, variant, scene: file, ms: time(f, iterations)? });
+        }
+    }
+    let (shadow_file, st) = SHADOW_SCENE;
+    let shadow_scene =
+        Scene::load(scenes.join(shadow_file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    for &size in sizes {
+        let mut frame = shadow_scene.at(st);
+        frame.width = size;
+        frame.height = size;
+        let bare = Frame { shadows: Vec::new(), ..frame.clone() };
+        for (variant, f) in [("shadows", &frame), ("no-shadows", &bare)] {
+            rows.push(ToonRow { size, variant, scene: shadow_file, ms: time(f, iterations)? });
         }
     }
     Ok(ToonTable { backend: backend.into(), method: method.into(), iterations, scene: file.into(), rows })
@@ -631,7 +650,9 @@ impl ToonTable {
             "plain ms",
             "ratio"
         );
-        for pair in self.rows.chunks(2) {
+        let (toon, shadows): (Vec<&ToonRow>, Vec<&ToonRow>) =
+            self.rows.iter().partition(|r| r.variant == "full" || r.variant == "plain");
+        for pair in toon.chunks(2) {
             if let [full, plain] = pair {
                 out += &format!(
                     "{:<8} {:>12.2} {:>10.1} {:>14.2} {:>9.2}×\n",
@@ -643,10 +664,28 @@ impl ToonTable {
                 );
             }
         }
+        if !shadows.is_empty() {
+            out += &format!(
+                "\nshadow scene {}\n{:<8} {:>12} {:>10} {:>14} {:>10}\n",
+                SHADOW_SCENE.0, "size", "shadows ms", "fps", "no-shadows ms", "ratio"
+            );
+            for pair in shadows.chunks(2) {
+                if let [on, off] = pair {
+                    out += &format!(
+                        "{:<8} {:>12.2} {:>10.1} {:>14.2} {:>9.2}×\n",
+                        format!("{}²", on.size),
+                        on.ms,
+                        1e3 / on.ms,
+                        off.ms,
+                        on.ms / off.ms
+                    );
+                }
+            }
+        }
         out
     }
 
-    /// The table as JSON: `rows` of `{size, variant, ms, fps}`.
+    /// The table as JSON: `rows` of `{scene, size, variant, ms, fps}`.
     pub fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "table": "toon",
@@ -655,6 +694,7 @@ impl ToonTable {
             "method": self.method,
             "iterations": self.iterations,
             "rows": self.rows.iter().map(|r| serde_json::json!({
+                "scene": r.scene,
                 "size": r.size,
                 "variant": r.variant,
                 "ms": r.ms,

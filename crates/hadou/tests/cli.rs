@@ -167,6 +167,23 @@ fn zero_length_vectors_are_rejected() {
 }
 
 #[test]
+fn bad_shadows_are_exit_2_with_their_line() {
+    // GOOD has 28 lines; the `[[shadow]]` header is line 30.
+    let shadow = |body: &str| format!("{GOOD}\n[[shadow]]\nname = \"s\"\n{body}");
+    let cases = [
+        ("collinear", "kind = \"sun\"\ncasters = \"cube\"\nreceivers = \"cube\"\nplane_points = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]\n", 35, "one line"),
+        ("zero-normal", "kind = \"sun\"\ncasters = \"cube\"\nreceivers = \"cube\"\nplane_point = [0, 0, 0]\nplane_normal = [0, 0, 0]\n", 36, "zero vector"),
+        ("theta", "kind = \"wave\"\ncasters = \"cube\"\nreceivers = \"cube\"\nmethod = \"map\"\ntheta = 95\n", 36, "[0, 90)"),
+        ("zero-direction", "kind = \"sun\"\ndirection = [0, 0, 0]\ncasters = \"cube\"\nreceivers = \"cube\"\nmethod = \"map\"\n", 33, "zero vector"),
+        ("unknown-caster", "kind = \"sun\"\ncasters = \"cub\"\nreceivers = \"cube\"\n", 33, "did you mean `cube`"),
+        ("map-size", "kind = \"sun\"\nmethod = \"map\"\nmap_size = 0\ncasters = \"cube\"\nreceivers = \"cube\"\n", 34, "1..=8192"),
+    ];
+    for (name, body, line, needle) in cases {
+        assert_rejected(name, &shadow(body), line, needle);
+    }
+}
+
+#[test]
 fn camera_ranges_are_checked() {
     assert_rejected("fov0", &GOOD.replace("fov = 45.0", "fov = 0.0"), 9, "fov");
     assert_rejected("fov180", &GOOD.replace("fov = 45.0", "fov = 180.0"), 9, "fov");
