@@ -104,6 +104,12 @@ const NEEDED_COMPUTE_STORAGE_BUFFERS: u32 = 8;
 const NEEDED_COLOR_ATTACHMENTS: u32 = 2;
 /// Bytes per sample those targets take together (two `Rgba32Uint`).
 const NEEDED_COLOR_BYTES: u32 = 32;
+/// Array layers of the shadow-map texture at least (two even for one map: OpenGL backends take a
+/// one-layer array texture for a plain 2D one).
+const NEEDED_ARRAY_LAYERS: u32 = 2;
+/// Textures the wave pass reads in one compute stage: the two G-buffer targets, the plane-shadow
+/// target and the shadow maps.
+const NEEDED_COMPUTE_TEXTURES: u32 = 4;
 /// Invocations per workgroup the kernels use (8×8 wave pass, 64×1 twin-test kernels).
 const NEEDED_WORKGROUP_INVOCATIONS: u32 = 64;
 
@@ -143,12 +149,24 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
             limits.max_compute_invocations_per_workgroup
         ));
     }
+    if limits.max_texture_array_layers < NEEDED_ARRAY_LAYERS {
+        missing.push(format!(
+            "{NEEDED_ARRAY_LAYERS} texture array layers (it allows {})",
+            limits.max_texture_array_layers
+        ));
+    }
+    if limits.max_sampled_textures_per_shader_stage < NEEDED_COMPUTE_TEXTURES {
+        missing.push(format!(
+            "{NEEDED_COMPUTE_TEXTURES} sampled textures per shader stage (it allows {})",
+            limits.max_sampled_textures_per_shader_stage
+        ));
+    }
+    let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
     let formats = [
-        (
-            crate::pipelines::SCENE_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        ),
+        (crate::pipelines::SCENE_FORMAT, attach_and_read),
         (crate::pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
+        (crate::pipelines::PLANE_SHADOW_FORMAT, attach_and_read),
+        (crate::pipelines::MAP_FORMAT, attach_and_read),
     ];
     for (format, usages) in formats {
         if !adapter.get_texture_format_features(format).allowed_usages.contains(usages) {

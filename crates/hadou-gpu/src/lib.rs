@@ -13,6 +13,11 @@
 //!    chord-walk integrator over the uploaded `PieceTable` and the faithful Simpson integrator),
 //!    `scene + exposure·Σ rgb·a·I` and the colour mapping.
 //!
+//! Hard shadows (`Frame::shadows`) add a plane-shadow pass per tile between the two
+//! (`shaders/shadow_raster.wgsl`: each plane cast's casters projected onto its plane, keeping per
+//! pixel the most opaque cast), shadow maps drawn once per frame into a depth array texture, and
+//! the lookup in the wave pass (`shaders/shadow_lookup.wgsl`), mirroring `hadou-cpu`'s shadows.
+//!
 //! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next,
 //! so GPU memory stays bounded whatever the image size.
 //!

@@ -1,4 +1,5 @@
-//! Shader modules, bind group layouts and the two pipelines (raster, wave).
+//! Shader modules, bind group layouts and the pipelines: raster (and outline hulls), plane
+//! shadows, shadow maps, wave.
 
 use crate::device::GpuContext;
 use crate::layout::GpuVertex;
@@ -15,6 +16,12 @@ use hadou_scene::RenderError;
 pub(crate) const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 /// Depth buffer of the raster pass (renderable on every adapter).
 pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Target of the plane-shadow pass (shadow_raster.wgsl): `j + 1` of the kept plane cast, 0 = none.
+/// Colour-renderable and readable on every adapter, GLES 3.0 included.
+pub(crate) const PLANE_SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// The shadow maps: a depth array texture rendered by the map pass and read (as unfilterable
+/// float) by the wave pass.
+pub(crate) const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Workgroup edge of the wave pass (keep in sync with `@workgroup_size` in wave.wgsl).
 pub(crate) const WAVE_WORKGROUP: u32 = 8;
 
@@ -26,6 +33,12 @@ pub(crate) struct Pipelines {
     pub(crate) raster_layout: wgpu::BindGroupLayout,
     pub(crate) wave: wgpu::ComputePipeline,
     pub(crate) wave_layout: wgpu::BindGroupLayout,
+    /// Plane shadows (`vs_plane`, `fs_plane`), per tile after the raster pass.
+    pub(crate) plane_shadow: wgpu::RenderPipeline,
+    pub(crate) plane_shadow_layout: wgpu::BindGroupLayout,
+    /// Shadow maps (`vs_map`, depth only), once per frame.
+    pub(crate) shadow_map: wgpu::RenderPipeline,
+    pub(crate) shadow_map_layout: wgpu::BindGroupLayout,
 }
 
 /// Compiles WGSL into a module; a compile error becomes [`RenderError::Other`] naming the module.
@@ -81,10 +94,14 @@ fn storage_entry(
 }
 
 fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    // Both G-buffer targets (raster.wgsl) are read by the wave pass.
+    // Both G-buffer targets (raster.wgsl) and the plane-shadow target are read by the wave pass.
+    uint_texture_entry(binding, wgpu::ShaderStages::COMPUTE)
+}
+
+fn uint_texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
+        visibility,
         ty: wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Uint,
             view_dimension: wgpu::TextureViewDimension::D2,
@@ -99,6 +116,7 @@ impl Pipelines {
     pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
         let raster_module = compile_module(ctx, "raster", &shaders::compose(shaders::RASTER_PARTS))?;
         let wave_module = compile_module(ctx, "wave", &shaders::compose(shaders::WAVE_PARTS))?;
+        let shadow_module = compile_module(ctx, "shadow", &shaders::compose(shaders::SHADOW_PARTS))?;
         ctx.scoped("building pipelines", || {
             let d = &ctx.device;
             let vs_fs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
@@ -127,6 +145,42 @@ impl Pipelines {
                     storage_entry(8, cs, true),
                     storage_entry(9, cs, true),
                     storage_entry(10, cs, true),
+                    // Hard shadows; keep in sync with shadow_lookup.wgsl.
+                    texture_entry(11),
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 12,
+                        visibility: cs,
+                        ty: wgpu::BindingType::Texture {
+                            // A depth texture read with textureLoad as unfilterable float.
+                            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                            view_dimension: wgpu::TextureViewDimension::D2Array,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                ],
+            });
+            // Keep in sync with the bindings of shadow_raster.wgsl.
+            let fs = wgpu::ShaderStages::FRAGMENT;
+            let plane_shadow_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("plane shadows"),
+                entries: &[
+                    uniform_entry(0, vs_fs),
+                    storage_entry(1, vs_fs, true),
+                    storage_entry(2, vs_fs, true),
+                    storage_entry(3, vs_fs, true),
+                    storage_entry(4, vs_fs, true),
+                    uint_texture_entry(5, fs),
+                    uint_texture_entry(6, fs),
+                ],
+            });
+            let vs = wgpu::ShaderStages::VERTEX;
+            let shadow_map_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("shadow maps"),
+                entries: &[
+                    storage_entry(1, vs, true),
+                    storage_entry(3, vs, true),
+                    storage_entry(4, vs, true),
                 ],
             });
             let raster_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -137,6 +191,16 @@ impl Pipelines {
             let wave_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("wave"),
                 bind_group_layouts: &[Some(&wave_layout)],
+                immediate_size: 0,
+            });
+            let plane_shadow_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("plane shadows"),
+                bind_group_layouts: &[Some(&plane_shadow_layout)],
+                immediate_size: 0,
+            });
+            let shadow_map_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("shadow maps"),
+                bind_group_layouts: &[Some(&shadow_map_layout)],
                 immediate_size: 0,
             });
             let attributes = wgpu::vertex_attr_array![
@@ -204,7 +268,79 @@ impl Pipelines {
                 compilation_options: Default::default(),
                 cache: None,
             });
-            Self { raster, hull, raster_layout, wave, wave_layout }
+            // The shadow passes read only the positions of the mesh vertices.
+            let position = wgpu::vertex_attr_array![0 => Float32x3];
+            let positions = [wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<GpuVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &position,
+            }];
+            let depth_less = |format| wgpu::DepthStencilState {
+                format,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            };
+            // Double-sided, as the CPU draws casters.
+            let primitive = wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: None,
+                ..Default::default()
+            };
+            let plane_shadow = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("plane shadows"),
+                layout: Some(&plane_shadow_pl),
+                vertex: wgpu::VertexState {
+                    module: &shadow_module,
+                    entry_point: Some("vs_plane"),
+                    compilation_options: Default::default(),
+                    buffers: &positions,
+                },
+                primitive,
+                depth_stencil: Some(depth_less(DEPTH_FORMAT)),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &shadow_module,
+                    entry_point: Some("fs_plane"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: PLANE_SHADOW_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+            let shadow_map = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("shadow maps"),
+                layout: Some(&shadow_map_pl),
+                vertex: wgpu::VertexState {
+                    module: &shadow_module,
+                    entry_point: Some("vs_map"),
+                    compilation_options: Default::default(),
+                    buffers: &positions,
+                },
+                primitive,
+                depth_stencil: Some(depth_less(MAP_FORMAT)),
+                multisample: Default::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            });
+            Self {
+                raster,
+                hull,
+                raster_layout,
+                wave,
+                wave_layout,
+                plane_shadow,
+                plane_shadow_layout,
+                shadow_map,
+                shadow_map_layout,
+            }
         })
     }
 }

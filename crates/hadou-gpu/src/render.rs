@@ -4,11 +4,12 @@
 
 use crate::device::GpuContext;
 use crate::layout::{
-    self, FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuVertex, GpuWave, ShadingBuffers,
+    self, FrameShadows, FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuShadowCast, GpuVertex,
+    GpuWave, ShadingBuffers,
 };
 use crate::pipelines::{self, Pipelines};
 use bytemuck::Zeroable;
-use hadou_scene::{Frame, Image, Mesh, RenderError};
+use hadou_scene::{Frame, Image, LightLine, Mesh, RenderError, MAX_SHADOWS};
 use std::collections::HashMap;
 use std::sync::{Arc, Weak};
 use wgpu::util::DeviceExt;
@@ -34,7 +35,10 @@ pub(crate) struct TileTargets {
     scene_view: wgpu::TextureView,
     /// G-buffer target 1: texture coordinates, vertex colour, material.
     attributes_view: wgpu::TextureView,
+    /// Depth of the raster pass, then of the plane-shadow pass.
     depth_view: wgpu::TextureView,
+    /// The plane-shadow pass's target (`pipelines::PLANE_SHADOW_FORMAT`).
+    plane_shadow_view: wgpu::TextureView,
     uniforms: wgpu::Buffer,
     output: wgpu::Buffer,
     staging: wgpu::Buffer,
@@ -55,6 +59,37 @@ pub(crate) struct Prepared {
     draws: Vec<(usize, u32)>,
     /// Whether any object has an outlined material (then the hull pipeline runs).
     outlines: bool,
+    /// The frame's shadow casts (bindings 3 of shadow_raster.wgsl).
+    casts: wgpu::Buffer,
+    /// (cast, object) per shadow draw (binding 4 of shadow_raster.wgsl): the plane draws, then the
+    /// map draws.
+    shadow_draws: wgpu::Buffer,
+    /// The plane casts' draws in cast order: (instance = index into `shadow_draws`, object, index
+    /// count).
+    plane_draws: Vec<(u32, usize, u32)>,
+    /// Where the cast records and map-cast indices are in the shading data, and their counts
+    /// (the shadow fields of `FrameUniforms`).
+    shadow_fields: ShadowFields,
+}
+
+/// The shadow fields of [`FrameUniforms`] for one frame.
+#[derive(Clone, Copy, Debug, Default)]
+struct ShadowFields {
+    shadow_casts: u32,
+    map_casts: u32,
+    cast_count: u32,
+    map_count: u32,
+    plane_count: u32,
+}
+
+/// The frame's shadow maps: a `size² × layers` depth array texture, kept between frames while
+/// its size stays the same.
+struct ShadowMaps {
+    size: u32,
+    layers: u32,
+    texture: wgpu::Texture,
+    /// All layers, as the wave pass reads them.
+    view: wgpu::TextureView,
 }
 
 /// The renderer's state between frames.
@@ -63,6 +98,7 @@ pub(crate) struct Renderer {
     pipelines: Pipelines,
     meshes: HashMap<usize, CachedMesh>,
     targets: Option<TileTargets>,
+    maps: Option<ShadowMaps>,
 }
 
 fn other(msg: String) -> RenderError {
@@ -112,6 +148,44 @@ fn validate_frame(frame: &Frame) -> Result<(), RenderError> {
             )));
         }
     }
+    if frame.shadows.len() > MAX_SHADOWS {
+        return Err(other(format!(
+            "{} shadows; at most {MAX_SHADOWS} fit (receivers carry one bit per shadow)",
+            frame.shadows.len()
+        )));
+    }
+    let objects = frame.objects.len();
+    for s in &frame.shadows {
+        if let Some(bad) = s.casters.iter().chain(&s.receivers).find(|&&o| o as usize >= objects) {
+            return Err(other(format!(
+                "shadow \"{}\": object index {bad} out of range ({objects} objects)",
+                s.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Checks the frame's shadow maps against the device: each map's edge within the largest 2D
+/// texture, their number within the array layers of one texture.
+fn check_maps(limits: &wgpu::Limits, frame: &Frame, shadows: &FrameShadows) -> Result<(), RenderError> {
+    for (i, g) in shadows.map_casts.iter().map(|&j| &shadows.casts[j as usize]).enumerate() {
+        let name = &frame.shadows[g.shadow as usize].name;
+        if g.map_size > limits.max_texture_dimension_2d {
+            return Err(RenderError::Device(format!(
+                "shadow \"{name}\": map_size {} exceeds this adapter's largest texture ({})",
+                g.map_size, limits.max_texture_dimension_2d
+            )));
+        }
+        if i as u32 >= limits.max_texture_array_layers {
+            return Err(RenderError::Device(format!(
+                "shadow \"{name}\": the frame needs {} shadow maps, more than this adapter's {} texture array \
+                 layers",
+                shadows.map_casts.len(),
+                limits.max_texture_array_layers
+            )));
+        }
+    }
     Ok(())
 }
 
@@ -153,7 +227,7 @@ impl Renderer {
     pub(crate) fn new() -> Result<Self, RenderError> {
         let ctx = GpuContext::new()?;
         let pipelines = Pipelines::new(&ctx)?;
-        Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None })
+        Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None, maps: None })
     }
 
     fn upload_meshes(&mut self, frame: &Frame) {
@@ -228,6 +302,7 @@ impl Renderer {
         let scene_view = texture("normal and distance", pipelines::SCENE_FORMAT, attach_and_read);
         let attributes_view = texture("uv, colour and material", pipelines::SCENE_FORMAT, attach_and_read);
         let depth_view = texture("depth", pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let plane_shadow_view = texture("plane shadows", pipelines::PLANE_SHADOW_FORMAT, attach_and_read);
         let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
         let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
@@ -247,8 +322,16 @@ impl Renderer {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        self.targets =
-            Some(TileTargets { size, scene_view, attributes_view, depth_view, uniforms, output, staging });
+        self.targets = Some(TileTargets {
+            size,
+            scene_view,
+            attributes_view,
+            depth_view,
+            plane_shadow_view,
+            uniforms,
+            output,
+            staging,
+        });
     }
 
     /// Validates the frame, uploads what it needs and plans the tiles covering the rows `rows`.
@@ -261,7 +344,46 @@ impl Renderer {
         validate_frame(frame)?;
         let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
         let (waves, curve_data, prepared_curves) = layout::frame_waves(frame).map_err(other)?;
-        let shading = ShadingBuffers::new(frame, &prepared_curves);
+        let mut shading = ShadingBuffers::new(frame, &prepared_curves);
+        // The waves' light lines, as the shading buffers hold them: the wave shadows' lights.
+        let lines: Vec<LightLine> =
+            frame.waves.iter().zip(&prepared_curves).map(|(w, c)| w.light_line(c.as_ref())).collect();
+        let shadow_casts = frame.shadow_casts(&lines);
+        let shadows = FrameShadows::new(frame, &shadow_casts);
+        check_maps(&self.ctx.limits, frame, &shadows)?;
+        let (cast_offset, map_offset) = shading.push_shadows(&shadows);
+        // Draws of the shadow passes: (cast, object) pairs, the plane casts' first, then each map
+        // cast's; casters without triangles draw nothing.
+        let mut draw_pairs: Vec<[u32; 2]> = Vec::new();
+        let mut plane_draws = Vec::new();
+        let mut map_draws: Vec<Vec<(u32, usize, u32)>> = vec![Vec::new(); shadows.map_casts.len()];
+        let caster_draws = |j: usize| {
+            shadow_casts[j].casters.iter().filter_map(|&o| {
+                let count = frame.objects[o as usize].mesh.indices.len() as u32;
+                (count > 0).then_some((o as usize, count))
+            })
+        };
+        for (j, g) in shadows.casts.iter().enumerate() {
+            if g.map_size == layout::CAST_PLANE {
+                for (o, count) in caster_draws(j) {
+                    plane_draws.push((draw_pairs.len() as u32, o, count));
+                    draw_pairs.push([j as u32, o as u32]);
+                }
+            }
+        }
+        for (layer, &j) in shadows.map_casts.iter().enumerate() {
+            for (o, count) in caster_draws(j as usize) {
+                map_draws[layer].push((draw_pairs.len() as u32, o, count));
+                draw_pairs.push([j, o as u32]);
+            }
+        }
+        let shadow_fields = ShadowFields {
+            shadow_casts: cast_offset,
+            map_casts: map_offset,
+            cast_count: shadows.casts.len() as u32,
+            map_count: shadows.map_casts.len() as u32,
+            plane_count: shadows.casts.len() as u32 - shadows.map_casts.len() as u32,
+        };
         let objects: Vec<GpuObject> = frame
             .objects
             .iter()
@@ -352,6 +474,16 @@ impl Renderer {
             );
             let shading_data = storage("shading data", bytemuck::cast_slice(&shading.data));
             let outlines = shading.materials.iter().any(|m| m.outline_width > 0.0);
+            let zero_cast = [GpuShadowCast::zeroed()];
+            let casts = storage(
+                "shadow casts",
+                bytemuck::cast_slice(if shadows.casts.is_empty() {
+                    &zero_cast[..]
+                } else {
+                    &shadows.casts[..]
+                }),
+            );
+            let shadow_draws = storage("shadow draws", bytemuck::cast_slice(&draw_pairs));
             let draws = frame
                 .objects
                 .iter()
@@ -367,10 +499,112 @@ impl Renderer {
                     tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(rows.end - y)]));
                 }
             }
-            Prepared { tile, tiles, objects, waves, curves, materials, lights, shading_data, draws, outlines }
+            let prepared = Prepared {
+                tile,
+                tiles,
+                objects,
+                waves,
+                curves,
+                materials,
+                lights,
+                shading_data,
+                draws,
+                outlines,
+                casts,
+                shadow_draws,
+                plane_draws,
+                shadow_fields,
+            };
+            self.draw_shadow_maps(frame, &prepared, &shadows, &map_draws);
+            prepared
         };
         self.ctx.close_scopes(scopes, "uploading the frame")?;
         Ok(prepared)
+    }
+
+    /// Makes the shadow-map texture fit `shadows` (at least 1² × 2 texels: the wave pass binds one
+    /// even without map casts) and draws every map cast's casters into its layer.
+    fn draw_shadow_maps(
+        &mut self,
+        frame: &Frame,
+        prepared: &Prepared,
+        shadows: &FrameShadows,
+        map_draws: &[Vec<(u32, usize, u32)>],
+    ) {
+        let (size, layers) = (shadows.map_size.max(1), shadows.map_layers.max(2));
+        if !self.maps.as_ref().is_some_and(|m| m.size == size && m.layers == layers) {
+            self.maps = None; // free the old one first
+            let texture = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("shadow maps"),
+                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: pipelines::MAP_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("shadow maps"),
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+            self.maps = Some(ShadowMaps { size, layers, texture, view });
+        }
+        if map_draws.is_empty() {
+            return;
+        }
+        let maps = self.maps.as_ref().expect("created above");
+        let d = &self.ctx.device;
+        let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow maps"),
+            layout: &self.pipelines.shadow_map_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: prepared.casts.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: prepared.shadow_draws.as_entire_binding() },
+            ],
+        });
+        let mut enc =
+            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow maps") });
+        for (layer, draws) in map_draws.iter().enumerate() {
+            let j = shadows.map_casts[layer] as usize;
+            let edge = shadows.casts[j].map_size as f32;
+            let view = maps.texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("shadow map layer"),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow map"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            // Texel (x, y) covers the map's pixel x = ⌊s·size⌋, y = ⌊(1 − t)·size⌋.
+            pass.set_viewport(0.0, 0.0, edge, edge, 0.0, 1.0);
+            pass.set_pipeline(&self.pipelines.shadow_map);
+            pass.set_bind_group(0, &bind_group, &[]);
+            for &(instance, object, index_count) in draws {
+                let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
+                let Some(mesh) = self.meshes.get(&key) else { continue };
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..index_count, 0, instance..instance + 1);
+            }
+        }
+        self.ctx.queue.submit([enc.finish()]);
     }
 
     /// Records one tile's raster and wave passes (and, when `readback`, the copy to the staging
@@ -386,7 +620,13 @@ impl Renderer {
         let t = self.targets.as_ref().expect("targets are created in prepare");
         let basis = frame.camera.basis(frame.width, frame.height);
         let (origin, size) = tile;
-        let uniforms = FrameUniforms::new(frame, &basis, origin, size);
+        let mut uniforms = FrameUniforms::new(frame, &basis, origin, size);
+        let sf = prepared.shadow_fields;
+        uniforms.shadow_casts = sf.shadow_casts;
+        uniforms.map_casts = sf.map_casts;
+        uniforms.cast_count = sf.cast_count;
+        uniforms.map_count = sf.map_count;
+        uniforms.plane_count = sf.plane_count;
         self.ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let d = &self.ctx.device;
         let raster_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -419,6 +659,16 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 8, resource: prepared.materials.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 9, resource: prepared.lights.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 10, resource: prepared.shading_data.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 11,
+                    resource: wgpu::BindingResource::TextureView(&t.plane_shadow_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 12,
+                    resource: wgpu::BindingResource::TextureView(
+                        &self.maps.as_ref().expect("shadow maps are created in prepare").view,
+                    ),
+                },
             ],
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("tile") });
@@ -479,6 +729,9 @@ impl Renderer {
                 }
             }
         }
+        if !prepared.plane_draws.is_empty() {
+            self.encode_plane_shadows(&mut enc, frame, prepared, t, size);
+        }
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("wave"),
@@ -498,6 +751,71 @@ impl Renderer {
             enc.copy_buffer_to_buffer(&t.output, 0, &t.staging, 0, bytes);
         }
         enc
+    }
+
+    /// Records the plane-shadow pass of a tile (shadow_raster.wgsl): each plane cast's casters
+    /// projected onto its plane, keeping per pixel the most opaque cast that shows there.
+    fn encode_plane_shadows(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &Frame,
+        prepared: &Prepared,
+        t: &TileTargets,
+        size: [u32; 2],
+    ) {
+        let bind_group = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("plane shadows"),
+            layout: &self.pipelines.plane_shadow_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: t.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: prepared.materials.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: prepared.casts.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: prepared.shadow_draws.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&t.scene_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&t.attributes_view),
+                },
+            ],
+        });
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("plane shadows"),
+            // 0: no plane cast.
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &t.plane_shadow_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_viewport(0.0, 0.0, size[0] as f32, size[1] as f32, 0.0, 1.0);
+        pass.set_pipeline(&self.pipelines.plane_shadow);
+        pass.set_bind_group(0, &bind_group, &[]);
+        for &(instance, object, index_count) in &prepared.plane_draws {
+            let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
+            let Some(mesh) = self.meshes.get(&key) else { continue };
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..index_count, 0, instance..instance + 1);
+        }
     }
 
     /// Renders `frame` into a new [`Image`].
@@ -592,6 +910,103 @@ mod tests {
         assert_eq!(tile_size(&limits, 5000, 5000).unwrap(), [128, 128]);
         limits.max_buffer_size = 1000;
         assert!(matches!(tile_size(&limits, 5000, 5000), Err(RenderError::Device(_))));
+    }
+
+    #[test]
+    fn shadow_maps_are_checked_against_the_device_limits() {
+        use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+        let mut frame = small_frame();
+        let mesh = Arc::new(Mesh {
+            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, 1.0]],
+            normals: vec![[0.0, 1.0, 0.0]; 3],
+            indices: vec![0, 1, 2],
+            ..Mesh::default()
+        });
+        for i in 0..3 {
+            let at = hadou_math::Mat4::from_trs(
+                hadou_math::Vec3::new(i as f32, 1.0, 0.0),
+                hadou_math::Vec3::ZERO,
+                hadou_math::Vec3::splat(1.0),
+            );
+            frame.objects.push(hadou_scene::Object::new(format!("o{i}"), mesh.clone(), at, [1.0; 3]));
+        }
+        let map = |name: &str, size: u32| Shadow {
+            name: name.into(),
+            light: ShadowLight::Sun(-hadou_math::Vec3::Y),
+            method: ShadowMethod::Map { size },
+            up: hadou_math::Vec3::Y,
+            casters: vec![0],
+            receivers: vec![1],
+            color: [0.0; 3],
+            opacity: 0.5,
+        };
+        frame.shadows = vec![map("a", 512), map("b", 4096), map("c", 16)];
+        let shadows = FrameShadows::new(&frame, &frame.shadow_casts(&[]));
+        assert_eq!(shadows.map_casts, [0, 1, 2]);
+        assert_eq!((shadows.map_size, shadows.map_layers), (4096, 3));
+        let mut limits = wgpu::Limits::downlevel_defaults();
+        limits.max_texture_dimension_2d = 8192;
+        assert!(check_maps(&limits, &frame, &shadows).is_ok());
+        limits.max_texture_dimension_2d = 2048;
+        match check_maps(&limits, &frame, &shadows) {
+            Err(RenderError::Device(m)) => {
+                assert_eq!(m, "shadow \"b\": map_size 4096 exceeds this adapter's largest texture (2048)")
+            }
+            other => panic!("expected a size error, got {other:?}"),
+        }
+        limits.max_texture_dimension_2d = 8192;
+        limits.max_texture_array_layers = 2;
+        match check_maps(&limits, &frame, &shadows) {
+            Err(RenderError::Device(m)) => {
+                assert!(m.starts_with("shadow \"c\": the frame needs 3 shadow maps"), "{m}")
+            }
+            other => panic!("expected a layer error, got {other:?}"),
+        }
+    }
+
+    /// Plane casts get depth keys by decreasing opacity (equal opacities share one, so the first
+    /// drawn keeps the pixel); receivers' materials carry their shadows' bits.
+    #[test]
+    fn plane_casts_rank_by_opacity_and_receivers_carry_their_bits() {
+        use hadou_math::shadow::Plane;
+        use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+        let mut frame = small_frame();
+        let mesh = Arc::new(Mesh {
+            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.5, 1.0]],
+            normals: vec![[0.0, 1.0, 0.0]; 3],
+            indices: vec![0, 1, 2],
+            ..Mesh::default()
+        });
+        for i in 0..3 {
+            let at = hadou_math::Mat4::from_trs(
+                hadou_math::Vec3::new(i as f32, 1.0, 0.0),
+                hadou_math::Vec3::ZERO,
+                hadou_math::Vec3::splat(1.0),
+            );
+            frame.objects.push(hadou_scene::Object::new(format!("o{i}"), mesh.clone(), at, [1.0; 3]));
+        }
+        let plane = |opacity: f32, receivers: Vec<u32>| Shadow {
+            name: format!("{opacity}"),
+            light: ShadowLight::Sun(-hadou_math::Vec3::Y),
+            method: ShadowMethod::Plane(Plane { point: hadou_math::Vec3::ZERO, normal: hadou_math::Vec3::Y }),
+            up: hadou_math::Vec3::Y,
+            casters: vec![0],
+            receivers,
+            color: [0.1, 0.2, 0.3],
+            opacity,
+        };
+        frame.shadows =
+            vec![plane(0.3, vec![1]), plane(0.9, vec![1, 2]), plane(0.3, vec![2]), plane(0.5, vec![])];
+        let casts = frame.shadow_casts(&[]);
+        let shadows = FrameShadows::new(&frame, &casts);
+        let keys: Vec<f32> = shadows.casts.iter().map(|c| c.depth_key).collect();
+        let step = 1.0 / (1u32 << 24) as f32;
+        assert_eq!(keys, [2.0 * step, 0.0, 2.0 * step, step]);
+        assert!(shadows.casts.iter().all(|c| c.map_size == layout::CAST_PLANE && c.color == [0.1, 0.2, 0.3]));
+        assert_eq!((shadows.map_casts.len(), shadows.map_layers), (0, 2));
+        let buffers = ShadingBuffers::new(&frame, &[]);
+        let masks: Vec<u32> = buffers.materials.iter().map(|m| m.shadow_mask).collect();
+        assert_eq!(masks, [0b0000, 0b0011, 0b0110]);
     }
 
     #[test]

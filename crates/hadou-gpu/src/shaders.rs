@@ -2,8 +2,11 @@
 //!
 //! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
 //! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
-//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `shading.wgsl` + `wave.wgsl`
-//!   (surface shading with the waves as lights, energy integration, colour mapping).
+//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `shading.wgsl` +
+//!   `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as lights, hard shadows,
+//!   energy integration, colour mapping);
+//! - shadow module: `common.wgsl` + `shadow_raster.wgsl` (the plane-shadow pass and the shadow
+//!   maps).
 //!
 //! A unit test parses and validates every composed module with naga (no adapter needed) and
 //! checks that the struct layouts naga computes equal the Rust ones in [`crate::layout`].
@@ -20,6 +23,10 @@ pub const SHADING: &str = include_str!("shaders/shading.wgsl");
 pub const RASTER: &str = include_str!("shaders/raster.wgsl");
 /// The wave pass.
 pub const WAVE: &str = include_str!("shaders/wave.wgsl");
+/// The wave pass's hard-shadow lookups.
+pub const SHADOW_LOOKUP: &str = include_str!("shaders/shadow_lookup.wgsl");
+/// The plane-shadow pass and the shadow-map pass.
+pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
 
 /// Every `.wgsl` file in `src/shaders/`, by file name.
 pub const FILES: &[(&str, &str)] = &[
@@ -28,13 +35,17 @@ pub const FILES: &[(&str, &str)] = &[
     ("energy.wgsl", ENERGY),
     ("raster.wgsl", RASTER),
     ("shading.wgsl", SHADING),
+    ("shadow_lookup.wgsl", SHADOW_LOOKUP),
+    ("shadow_raster.wgsl", SHADOW_RASTER),
     ("wave.wgsl", WAVE),
 ];
 
 /// The parts of the raster module, in order.
 pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
-pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, SHADING, WAVE];
+pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, SHADING, SHADOW_LOOKUP, WAVE];
+/// The parts of the shadow module, in order.
+pub const SHADOW_PARTS: &[&str] = &[COMMON, SHADOW_RASTER];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -45,7 +56,8 @@ pub fn compose(parts: &[&str]) -> String {
 mod tests {
     use super::*;
     use crate::layout::{
-        FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuTexture, GpuWave,
+        FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuShadowCast, GpuTexture,
+        GpuWave,
     };
     use std::mem::{offset_of, size_of};
 
@@ -66,6 +78,7 @@ mod tests {
         vec![
             ("raster module", validate("raster module", &compose(RASTER_PARTS))),
             ("wave module", validate("wave module", &compose(WAVE_PARTS))),
+            ("shadow module", validate("shadow module", &compose(SHADOW_PARTS))),
         ]
     }
 
@@ -79,6 +92,8 @@ mod tests {
             ("curve.wgsl", CURVE),
             ("raster.wgsl", RASTER),
             ("shading.wgsl", SHADING),
+            ("shadow_lookup.wgsl", SHADOW_LOOKUP),
+            ("shadow_raster.wgsl", SHADOW_RASTER),
             ("wave.wgsl", WAVE),
         ] {
             for (i, line) in source.lines().enumerate() {
@@ -104,7 +119,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 2);
+        assert_eq!(modules.len(), 3);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -117,7 +132,8 @@ mod tests {
         listed.sort();
         assert_eq!(on_disk, listed, "src/shaders/*.wgsl and shaders::FILES differ");
         for (name, text) in FILES {
-            let used = RASTER_PARTS.iter().chain(WAVE_PARTS).any(|p| std::ptr::eq(*p, *text));
+            let used =
+                RASTER_PARTS.iter().chain(WAVE_PARTS).chain(SHADOW_PARTS).any(|p| std::ptr::eq(*p, *text));
             assert!(used, "{name} is not part of any module");
         }
     }
@@ -185,9 +201,14 @@ mod tests {
                 image_size,
                 tile_origin,
                 tile_size,
-                _pad1,
+                shadow_casts,
+                map_casts,
                 ndc_scale,
                 ndc_offset,
+                cast_count,
+                map_count,
+                plane_count,
+                _pad2,
             ]
         );
         check!(GpuObject, "GpuObject", [model, normal_matrix, material_base, material_count, _pad]);
@@ -202,7 +223,7 @@ mod tests {
                 outline_color,
                 wave_blend,
                 outline_width,
-                _pad0,
+                shadow_mask,
                 _pad1,
                 _pad2,
                 base_texture,
@@ -216,6 +237,26 @@ mod tests {
             [line_kind, point_offset, point_count, inverse_square, a, b, color, ramp]
         );
         check!(GpuWave, "GpuWave", [color, kind, falloff, core_radius, _pad, p0, p1, p2]);
+        check!(
+            GpuShadowCast,
+            "GpuShadowCast",
+            [
+                k,
+                opacity,
+                plane_point,
+                shadow,
+                plane_normal,
+                depth_key,
+                color,
+                map_size,
+                map_center,
+                map_scale,
+                map_u,
+                map_layer,
+                map_v,
+                map_bias,
+            ]
+        );
         check!(
             GpuCurve,
             "GpuCurve",
@@ -291,5 +332,58 @@ mod tests {
         assert_eq!(value("TONE_FAITHFUL"), TONE_FAITHFUL);
         assert_eq!(value("TONE_FILMIC"), TONE_FILMIC);
         assert_eq!(value("CURVE_MAX_PARTS") as usize, hadou_math::curve::MAX_ATTENUATION_PARTS);
+        assert_eq!(value("HULL_BIT"), HULL_BIT);
+        assert_eq!(value("CAST_PLANE"), CAST_PLANE);
+        assert_eq!(value("SHADOW_CAST_WORDS"), SHADOW_CAST_WORDS);
+        let (_, on_plane) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some("ON_PLANE"))
+            .expect("const ON_PLANE");
+        match module.global_expressions[on_plane.init] {
+            naga::Expression::Literal(naga::Literal::F32(v)) => assert_eq!(v, hadou_scene::ON_PLANE),
+            ref e => panic!("ON_PLANE: unexpected {e:?}"),
+        }
+    }
+
+    /// `load_shadow_cast` (shadow_lookup.wgsl) reads every field of `GpuShadowCast` from the word
+    /// at its Rust offset.
+    #[test]
+    fn shadow_cast_loader_reads_the_rust_offsets() {
+        use crate::layout::GpuShadowCast;
+        let body = SHADOW_LOOKUP
+            .split("fn load_shadow_cast")
+            .nth(1)
+            .and_then(|b| b.split("\n}").next())
+            .expect("load_shadow_cast in shadow_lookup.wgsl");
+        let mut fields = Vec::new();
+        for line in body.lines().map(str::trim).filter(|l| l.starts_with("c.")) {
+            let (field, rhs) = line[2..].split_once(" = ").expect("c.field = …");
+            let word = match rhs.split_once("o + ") {
+                Some((_, rest)) => rest.split('u').next().expect("offset").parse::<usize>().expect("number"),
+                None => 0, // `data_vec3(o)`: word 0
+            };
+            fields.push((field.to_string(), 4 * word));
+        }
+        macro_rules! offsets {
+            ($($field:ident),*) => { vec![$((stringify!($field).to_string(), offset_of!(GpuShadowCast, $field))),*] };
+        }
+        let rust = offsets!(
+            k,
+            opacity,
+            plane_point,
+            shadow,
+            plane_normal,
+            depth_key,
+            color,
+            map_size,
+            map_center,
+            map_scale,
+            map_u,
+            map_layer,
+            map_v,
+            map_bias
+        );
+        assert_eq!(fields, rust);
     }
 }

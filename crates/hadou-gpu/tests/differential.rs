@@ -230,3 +230,146 @@ fn materials_outlines_and_wave_lights_match_cpu() {
     f.waves.push(wave("helix", [1.0, 0.3, 0.6, 1.0], Falloff::InverseSquare, 0.03, WaveShape::Curve(helix)));
     check("materials", &f);
 }
+
+/// Hard shadows on a hand-built frame: a box and a sphere casting onto a ground plane by
+/// projection from the sun and from a wave (overlapping, so the more opaque one must win), a
+/// shadow map from the sun onto stairs of boxes and the ground (a receiver that is no plane), an
+/// outlined caster (hull pixels take no shadow), and a receiver that is not listed for one shadow.
+#[test]
+fn shadows_match_cpu() {
+    use hadou_math::energy::{Falloff, SphereField};
+    use hadou_math::shadow::Plane;
+    use hadou_math::Vec3;
+    use hadou_scene::mesh::with_outline_normals;
+    use hadou_scene::{Material, Outline, Shadow, ShadowLight, ShadowMethod, WaveShape};
+    use std::sync::Arc;
+    let mut f = base_frame(
+        160,
+        120,
+        Vec3::new(5.0, 4.5, 9.0),
+        Vec3::new(1.2, -0.3, 0.0),
+        hadou_scene::ToneMode::Filmic,
+    );
+    let ground_y = -1.0;
+    f.objects.push(object(
+        "ground",
+        plane_mesh(40.0),
+        Vec3::new(0.0, ground_y, 0.0),
+        Vec3::ZERO,
+        [0.6, 0.6, 0.55],
+    ));
+    f.objects.push(object(
+        "box",
+        box_mesh([1.4, 1.4, 1.4]),
+        Vec3::new(-1.8, 0.2, 0.3),
+        Vec3::new(0.0, 35.0, 10.0),
+        [0.8, 0.3, 0.2],
+    ));
+    let mut ball = object(
+        "ball",
+        Arc::new(with_outline_normals((*sphere_mesh(0.9, 32)).clone())),
+        Vec3::new(-0.4, 0.6, 1.2),
+        Vec3::ZERO,
+        [0.3, 0.5, 0.9],
+    );
+    ball.materials = vec![Material {
+        outline: Some(Outline { width: 0.008, color: [0.02, 0.0, 0.05] }),
+        ..Material::diffuse([0.3, 0.5, 0.9])
+    }];
+    f.objects.push(ball);
+    // Stairs: three boxes rising towards −z, x from 3 to 5.
+    let stairs: Vec<u32> = (0..3)
+        .map(|i| {
+            let h = 0.5 * (i + 1) as f32;
+            f.objects.push(object(
+                &format!("step{i}"),
+                box_mesh([2.0, h, 1.2]),
+                Vec3::new(4.0, ground_y + 0.5 * h, 1.2 - 1.2 * i as f32),
+                Vec3::ZERO,
+                [0.7, 0.7, 0.6],
+            ));
+            f.objects.len() as u32 - 1
+        })
+        .collect();
+    f.objects.push(object(
+        "floater",
+        sphere_mesh(0.6, 24),
+        Vec3::new(3.6, 2.2, 0.2),
+        Vec3::ZERO,
+        [0.9, 0.8, 0.3],
+    ));
+    f.objects.push(object(
+        "post",
+        box_mesh([0.3, 1.6, 0.3]),
+        Vec3::new(5.3, 1.6, 0.8),
+        Vec3::ZERO,
+        [0.5, 0.8, 0.5],
+    ));
+    let (ground, boxed, ball, floater, post) = (0, 1, 2, stairs[2] + 1, stairs[2] + 2);
+    f.waves.push(wave(
+        "orb",
+        [0.3, 0.8, 1.0, 1.0],
+        Falloff::InverseSquare,
+        0.05,
+        WaveShape::Sphere(SphereField { center: Vec3::new(0.8, 3.5, -1.0), alpha: 0.05 }),
+    ));
+    let ground_plane = Plane { point: Vec3::new(0.0, ground_y, 0.0), normal: Vec3::Y };
+    let sun = f.light.direction;
+    f.shadows = vec![
+        Shadow {
+            name: "sun".into(),
+            light: ShadowLight::Sun(sun),
+            method: ShadowMethod::Plane(ground_plane),
+            up: Vec3::Y,
+            casters: vec![boxed, ball],
+            receivers: vec![ground],
+            color: [0.05, 0.05, 0.12],
+            opacity: 0.55,
+        },
+        Shadow {
+            name: "orb".into(),
+            light: ShadowLight::Wave { wave: 0, theta: 60f32.to_radians() },
+            method: ShadowMethod::Plane(ground_plane),
+            up: Vec3::Y,
+            casters: vec![boxed, ball],
+            receivers: vec![ground],
+            color: [0.25, 0.0, 0.3],
+            opacity: 0.8,
+        },
+        Shadow {
+            name: "map".into(),
+            light: ShadowLight::Sun(Vec3::new(0.35, -1.0, -0.25).normalize_or(Vec3::Y)),
+            method: ShadowMethod::Map { size: 512 },
+            up: Vec3::Y,
+            casters: vec![floater, post],
+            // The post casts on the stairs and the ground but not on itself.
+            receivers: stairs.iter().copied().chain([ground]).collect(),
+            color: [0.0, 0.02, 0.0],
+            opacity: 0.7,
+        },
+        Shadow {
+            name: "small map".into(),
+            // Onto the box's side and the ground, over the plane shadows there.
+            light: ShadowLight::Sun(Vec3::new(-0.9, -0.7, 0.3).normalize_or(Vec3::Y)),
+            method: ShadowMethod::Map { size: 96 },
+            up: Vec3::Y,
+            casters: vec![ball],
+            receivers: vec![boxed, ground],
+            color: [0.3, 0.0, 0.0],
+            opacity: 0.7,
+        },
+    ];
+    let casts = f.shadow_casts(&[f.waves[0].light_line(None)]);
+    assert_eq!(casts.len(), 5, "one sun cast, one wave cast per caster, two maps: {casts:?}");
+    check("shadows", &f);
+    // Without its shadows the same frame renders as before shadows existed (the casts' effect is
+    // visible: the images differ).
+    let Some(mut gpu) = gpu_or_skip("shadows") else { return };
+    let shadowed = gpu.render(&f).expect("shadowed frame");
+    f.shadows.clear();
+    let plain = gpu.render(&f).expect("plain frame");
+    let changed = (0..plain.color.len()).filter(|&i| plain.color[i] != shadowed.color[i]).count();
+    assert!(changed > 200, "the shadows changed only {changed} pixels");
+    assert_eq!(plain.energy, shadowed.energy, "shadows leave the energy alone");
+    assert_eq!(plain.depth, shadowed.depth, "shadows leave the depth alone");
+}

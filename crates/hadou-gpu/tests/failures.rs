@@ -56,3 +56,33 @@ fn malformed_mesh_is_an_error_naming_the_object() {
     });
     assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("normals")));
 }
+
+#[test]
+fn shadow_map_larger_than_the_adapter_allows_is_an_error_naming_the_shadow() {
+    use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+    let Some(mut gpu) = gpu_or_skip("shadow map size") else { return };
+    let mut f = occlusion_frame(32, 24);
+    f.shadows.push(Shadow {
+        name: "huge".into(),
+        light: ShadowLight::Sun(-Vec3::Y),
+        method: ShadowMethod::Map { size: 1 << 20 },
+        up: Vec3::Y,
+        casters: vec![0],
+        receivers: vec![1],
+        color: [0.0; 3],
+        opacity: 0.5,
+    });
+    match gpu.render(&f) {
+        Err(RenderError::Device(m)) => assert!(
+            m.starts_with("shadow \"huge\": map_size 1048576 exceeds this adapter's largest texture ("),
+            "{m}"
+        ),
+        other => panic!("expected a device error, got {other:?}"),
+    }
+    // A shadow naming an object that does not exist is refused too, and the backend still works.
+    f.shadows[0].method = ShadowMethod::Map { size: 64 };
+    f.shadows[0].casters = vec![9];
+    assert!(matches!(gpu.render(&f), Err(RenderError::Other(m)) if m.contains("huge") && m.contains('9')));
+    f.shadows[0].casters = vec![0];
+    assert!(gpu.render(&f).is_ok());
+}

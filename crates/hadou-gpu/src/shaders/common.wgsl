@@ -44,9 +44,14 @@ struct FrameUniforms {
     image_size: vec2<u32>,
     tile_origin: vec2<u32>,
     tile_size: vec2<u32>,
-    _pad1: vec2<u32>,
+    shadow_casts: u32,
+    map_casts: u32,
     ndc_scale: vec2<f32>,
     ndc_offset: vec2<f32>,
+    cast_count: u32,
+    map_count: u32,
+    plane_count: u32,
+    _pad2: u32,
 }
 
 // Keep in sync with layout.rs `GpuObject`.
@@ -82,7 +87,7 @@ struct GpuMaterial {
     outline_color: vec3<f32>,
     wave_blend: f32,
     outline_width: f32,
-    _pad0: u32,
+    shadow_mask: u32,
     _pad1: u32,
     _pad2: u32,
     base_texture: GpuTexture,
@@ -155,6 +160,26 @@ struct GpuCurve {
     att_floor: f32,
 }
 
+// One shadow cast (hadou_scene::ShadowCast): a plane projection or a shadow map. Keep in sync with
+// layout.rs `GpuShadowCast` (its fields are documented there) and with load_shadow_cast in
+// shadow_lookup.wgsl, which reads it word by word.
+struct GpuShadowCast {
+    k: vec3<f32>,
+    opacity: f32,
+    plane_point: vec3<f32>,
+    shadow: u32,
+    plane_normal: vec3<f32>,
+    depth_key: f32,
+    color: vec3<f32>,
+    map_size: u32,
+    map_center: vec3<f32>,
+    map_scale: f32,
+    map_u: vec3<f32>,
+    map_layer: u32,
+    map_v: vec3<f32>,
+    map_bias: f32,
+}
+
 // Keep in sync with layout.rs: wave kinds and falloff/tone codes.
 const WAVE_SPHERE: u32 = 0u;
 const WAVE_CYLINDER: u32 = 1u;
@@ -181,6 +206,12 @@ const LINE_SEGMENT: u32 = 1u;
 const LINE_LINE: u32 = 2u;
 const LINE_POLYLINE: u32 = 3u;
 const HULL_BIT: u32 = 0x80000000u;
+// Keep in sync with layout.rs `CAST_PLANE` and `SHADOW_CAST_WORDS`.
+const CAST_PLANE: u32 = 0u;
+const SHADOW_CAST_WORDS: u32 = 28u;
+// Mirrors hadou_scene::ON_PLANE: a visible point is on a receiver plane within
+// ON_PLANE · (1 + eye distance) of it.
+const ON_PLANE: f32 = 1.0e-3;
 
 // Mirrors hadou_scene::CameraBasis::pixel_dir: direction through the centre of the global pixel
 // (px, py) (py = 0 is the top row), with unit component along `forward`.
@@ -188,6 +219,35 @@ fn pixel_dir(u: FrameUniforms, px: u32, py: u32) -> vec3<f32> {
     let ndc_x = 2.0 * (f32(px) + 0.5) / f32(u.image_size.x) - 1.0;
     let ndc_y = 1.0 - 2.0 * (f32(py) + 0.5) / f32(u.image_size.y);
     return u.forward + u.right * (ndc_x * u.tan_half_fov * u.aspect) + u.up * (ndc_y * u.tan_half_fov);
+}
+
+// The visible point of a pixel whose direction is `dir` (pixel_dir) at eye distance `distance`:
+// eye + unit(dir) · distance (the G-buffer stores the distance; hadou-cpu keeps the point).
+fn surface_point(u: FrameUniforms, dir: vec3<f32>, distance: f32) -> vec3<f32> {
+    return u.eye + dir * (distance / length3(dir));
+}
+
+// World → the tile's clip space: hadou_scene::CameraBasis::to_view, view-space x/z scaled by
+// 1/(tan_half·aspect) and y/z by 1/tan_half as the CPU rasterizer does, then the image NDC mapped
+// to the tile (ndc_tile = ndc·scale + offset, times w in clip space); depth 0 at near, 1 at far.
+fn clip_position(u: FrameUniforms, world: vec3<f32>) -> vec4<f32> {
+    let d = world - u.eye;
+    let view = vec3<f32>(dot3(d, u.right), dot3(d, u.up), dot3(d, u.forward));
+    let gx = view.x / (u.tan_half_fov * u.aspect);
+    let gy = view.y / u.tan_half_fov;
+    return vec4<f32>(
+        gx * u.ndc_scale.x + view.z * u.ndc_offset.x,
+        gy * u.ndc_scale.y + view.z * u.ndc_offset.y,
+        (view.z - u.near) * (u.far / (u.far - u.near)),
+        view.z,
+    );
+}
+
+// Mirrors hadou_math::shadow::MapFrame::to_map for a map cast: (s, t, depth) of world point `p`.
+fn map_coords(c: GpuShadowCast, p: vec3<f32>) -> vec3<f32> {
+    let d = p - c.map_center;
+    let inv = c.map_scale;
+    return vec3<f32>(dot3(d, c.map_u) * inv + 0.5, dot3(d, c.map_v) * inv + 0.5, dot3(d, c.k) * inv + 0.5);
 }
 
 // Mirrors hadou_math::shade::diffuse: albedo · (ambient + light · max(0, N·(−L))); a zero or

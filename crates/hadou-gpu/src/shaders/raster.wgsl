@@ -39,19 +39,8 @@ fn material_index(o: GpuObject, slot: u32) -> u32 {
     return o.material_base + min(slot, max(o.material_count, 1u) - 1u);
 }
 
-// World → this tile's clip space (hadou_scene::CameraBasis::to_view, then the global NDC mapped to
-// the tile: ndc_tile = ndc·scale + offset, times w in clip space).
 fn project(world: vec3<f32>) -> vec4<f32> {
-    let d = world - frame.eye;
-    let view = vec3<f32>(dot3(d, frame.right), dot3(d, frame.up), dot3(d, frame.forward));
-    let gx = view.x / (frame.tan_half_fov * frame.aspect);
-    let gy = view.y / frame.tan_half_fov;
-    return vec4<f32>(
-        gx * frame.ndc_scale.x + view.z * frame.ndc_offset.x,
-        gy * frame.ndc_scale.y + view.z * frame.ndc_offset.y,
-        (view.z - frame.near) * (frame.far / (frame.far - frame.near)),
-        view.z,
-    );
+    return clip_position(frame, world);
 }
 
 @vertex

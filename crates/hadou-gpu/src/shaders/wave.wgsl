@@ -2,8 +2,8 @@
 // (shading.wgsl: materials, the waves as lights), the integration ray of
 // hadou_scene::CameraBasis::wave_ray (002 eq. 3.12–3.13, clipped at the visible surface), the energy
 // of every wave (energy.wgsl), the colour scene + exposure·Σ rgb·a·I and the colour mapping
-// (common.wgsl). Prepended by common.wgsl, energy.wgsl, curve.wgsl (curve buffers: bindings 5–7)
-// and shading.wgsl (bindings 8–10).
+// (common.wgsl). Prepended by common.wgsl, energy.wgsl, curve.wgsl (curve buffers: bindings 5–7),
+// shading.wgsl (bindings 8–10) and shadow_lookup.wgsl (hard shadows: bindings 11–12).
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
 @group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
@@ -91,9 +91,10 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
         if ((attributes.w & HULL_BIT) != 0u) {
             scene = m.outline_color;
         } else {
-            let world = frame.eye + dir * (surface / length3(dir));
+            let world = surface_point(frame, dir, surface);
             let uv = vec2<f32>(bitcast<f32>(attributes.x), bitcast<f32>(attributes.y));
             scene = shade_surface(m, world, texel.xyz, uv, unpack4x8unorm(attributes.z));
+            scene = apply_shadows(scene, m.shadow_mask, world, id.xy);
         }
     }
 
