@@ -104,6 +104,8 @@ pub struct Probe {
     pub depth: f32,
     /// Name of the visible object, if any.
     pub object: Option<String>,
+    /// Name of the `[[shadow]]` darkening the pixel, if any.
+    pub shadow: Option<String>,
 }
 
 /// One wave's contribution at a probed pixel.
@@ -147,5 +149,6 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
         depth: surface
             .unwrap_or_else(|| far * basis.pixel_dir(x as f32, y as f32, frame.width, frame.height).length()),
         object: opaque.object[i].map(|o| frame.objects[o as usize].name.clone()),
+        shadow: opaque.shadow[i].map(|s| frame.shadows[s as usize].name.clone()),
     })
 }

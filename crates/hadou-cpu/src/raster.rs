@@ -76,6 +76,8 @@ pub(crate) struct OpaqueBuffers {
     pub surface: Vec<Option<f32>>,
     /// Index into `frame.objects` of the visible object, if any.
     pub object: Vec<Option<u32>>,
+    /// Index into `frame.shadows` of the shadow the pixel takes, if any.
+    pub shadow: Vec<Option<u32>>,
 }
 
 /// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
@@ -101,12 +103,14 @@ pub(crate) fn draw_opaque(
     let mut color = vec![[0.0f32; 3]; w * h];
     let mut surface = vec![None; w * h];
     let mut object = vec![None; w * h];
+    let mut shadow = vec![None; w * h];
     color
         .par_chunks_mut(BAND * w)
         .zip(surface.par_chunks_mut(BAND * w))
         .zip(object.par_chunks_mut(BAND * w))
+        .zip(shadow.par_chunks_mut(BAND * w))
         .enumerate()
-        .for_each(|(b, ((col, surf), obj))| {
+        .for_each(|(b, (((col, surf), obj), shad))| {
             let y_start = rows.start + b * BAND;
             let rows = col.len() / w;
             let mut zbuf = vec![f32::INFINITY; rows * w];
@@ -165,11 +169,15 @@ pub(crate) fn draw_opaque(
                         (true, Some(o)) => o.color,
                         _ => shading::shade(frame, lights, material, s),
                     };
-                    col[i] = if t.hull { c } else { shadows.resolve(frame, t.object, s.world, best[i], c) };
+                    if t.hull {
+                        col[i] = c;
+                    } else {
+                        (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
+                    }
                 }
             }
         });
-    OpaqueBuffers { color, surface, object }
+    OpaqueBuffers { color, surface, object, shadow }
 }
 
 /// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.

@@ -87,8 +87,9 @@ impl FrameShadows {
         }
     }
 
-    /// The colour of a receiver pixel: the map casts are tested against `best` (the plane
-    /// casts' choice), and the winner's colour is blended over `c`.
+    /// The colour of a receiver pixel and the shadow it takes (an index into `frame.shadows`):
+    /// the map casts are tested against `best` (the plane casts' choice), and the winner's colour
+    /// is blended over `c`.
     pub(crate) fn resolve(
         &self,
         frame: &Frame,
@@ -96,7 +97,7 @@ impl FrameShadows {
         world: Vec3f,
         mut best: Choice,
         c: [f32; 3],
-    ) -> [f32; 3] {
+    ) -> ([f32; 3], Option<u32>) {
         for (j, (cast, map)) in self.casts.iter().zip(&self.maps).enumerate() {
             let Some(map) = map else { continue };
             let j = j as u32;
@@ -108,10 +109,11 @@ impl FrameShadows {
             }
         }
         if best.1 == u32::MAX {
-            return c;
+            return (c, None);
         }
-        let s = &frame.shadows[self.casts[best.1 as usize].shadow as usize];
-        std::array::from_fn(|k| c[k] + (s.color[k] - c[k]) * best.0)
+        let si = self.casts[best.1 as usize].shadow;
+        let s = &frame.shadows[si as usize];
+        (std::array::from_fn(|k| c[k] + (s.color[k] - c[k]) * best.0), Some(si))
     }
 }
 

@@ -217,6 +217,12 @@ opacity = 1
     let light_side = rgb(&img, pixel(&f, Vec3::new(-0.9, 0.0, 0.0)).unwrap());
     assert_eq!(dark, [0.0; 3]);
     assert_eq!(light_side, [1.0; 3]);
+    // `hadou probe` names the shadow a pixel takes.
+    let (x, y) = pixel(&f, Vec3::new(0.9, 0.0, 0.0)).unwrap();
+    let p = hadou_cpu::probe(&f, x, y).unwrap();
+    assert_eq!((p.object.as_deref(), p.shadow.as_deref()), (Some("ground"), Some("sun")));
+    let (x, y) = pixel(&f, Vec3::new(-0.9, 0.0, 0.0)).unwrap();
+    assert_eq!(hadou_cpu::probe(&f, x, y).unwrap().shadow, None);
 }
 
 #[test]

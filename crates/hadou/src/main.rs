@@ -479,6 +479,7 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
         "color": p.color.map(json_number),
         "depth": json_number(p.depth),
         "object": p.object,
+        "shadow": p.shadow,
         "backend": backend.name(),
     });
     println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
@@ -497,8 +498,8 @@ fn gpu_probe(backend: &mut dyn Backend, frame: &Frame, x: u32, y: u32) -> Result
         let e = backend.render(&single)?.energy[i];
         waves.push(hadou::WaveProbe { name: w.name.clone(), energy: e, evaluations: 0 });
     }
-    let object = hadou::probe(frame, x, y).and_then(|p| p.object);
-    Ok(hadou::Probe { x, y, waves, color: img.color[i], depth: img.depth[i], object })
+    let (object, shadow) = hadou::probe(frame, x, y).map_or((None, None), |p| (p.object, p.shadow));
+    Ok(hadou::Probe { x, y, waves, color: img.color[i], depth: img.depth[i], object, shadow })
 }
 
 fn bench(a: BenchArgs) -> Result<(), Failure> {
