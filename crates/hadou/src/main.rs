@@ -479,9 +479,13 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
         "color": p.color.map(json_number),
         "depth": json_number(p.depth),
         "object": p.object,
-        "shadow": p.shadow,
         "backend": backend.name(),
     });
+    // The shadow the pixel takes, present only where there is one.
+    let mut j = j;
+    if let (Some(shadow), Some(map)) = (p.shadow, j.as_object_mut()) {
+        map.insert("shadow".into(), serde_json::Value::String(shadow));
+    }
     println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
     Ok(())
 }

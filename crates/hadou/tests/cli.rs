@@ -444,6 +444,28 @@ fn probe_never_prints_null() {
     assert!(j["energy"].as_f64().unwrap() > 1e10, "{j}");
 }
 
+#[test]
+fn probe_names_the_shadow_a_pixel_takes() {
+    // Seen from straight above, a box stands on the ground in a low sun from −x: the ground just
+    // to its +x side is in the shadow "sun", the ground on its −x side is lit.
+    let dir = tmpdir("probe-shadow");
+    let text = "[image]\nwidth = 200\nheight = 200\n[camera]\nposition = [0, 12, 0]\ntarget = [0, 0, 0]\n\
+                up = [0, 0, -1]\nfov = 45\n[[object]]\nname = \"ground\"\nkind = \"plane\"\nsize = [12, 12]\n\
+                [[object]]\nname = \"box\"\nkind = \"box\"\nsize = [0.6, 2, 0.6]\n\
+                [[shadow]]\nname = \"sun\"\nkind = \"sun\"\ndirection = [1, -1, 0]\ncasters = \"box\"\n\
+                receivers = \"ground\"\n";
+    let s = write_scene(&dir, text);
+    let probe = |px: &str| {
+        let o = hadou(&["probe", s.to_str().unwrap(), "--pixel", px, "--backend", "cpu"]);
+        assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let shadowed = probe("118,100"); // the ground at x ≈ 0.9
+    assert_eq!((shadowed["object"].as_str(), shadowed["shadow"].as_str()), (Some("ground"), Some("sun")));
+    let lit = probe("82,100"); // x ≈ −0.9
+    assert_eq!((lit["object"].as_str(), lit.get("shadow")), (Some("ground"), None));
+}
+
 /// Decodes an 8-bit RGB PNG into its pixel bytes.
 fn decode_png(path: &Path) -> (u32, u32, Vec<u8>) {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
