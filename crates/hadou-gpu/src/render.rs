@@ -912,12 +912,12 @@ mod tests {
         assert!(matches!(tile_size(&limits, 5000, 5000), Err(RenderError::Device(_))));
     }
 
-    #[test]
-    fn shadow_maps_are_checked_against_the_device_limits() {
-        use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+    /// [`small_frame`] with three triangle objects `o0..o2` side by side at height 1, the
+    /// triangle's third vertex raised by `tip`.
+    fn three_triangles(tip: f32) -> Frame {
         let mut frame = small_frame();
         let mesh = Arc::new(Mesh {
-            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.0, 1.0]],
+            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, tip, 1.0]],
             normals: vec![[0.0, 1.0, 0.0]; 3],
             indices: vec![0, 1, 2],
             ..Mesh::default()
@@ -930,6 +930,13 @@ mod tests {
             );
             frame.objects.push(hadou_scene::Object::new(format!("o{i}"), mesh.clone(), at, [1.0; 3]));
         }
+        frame
+    }
+
+    #[test]
+    fn shadow_maps_are_checked_against_the_device_limits() {
+        use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
+        let mut frame = three_triangles(0.0);
         let map = |name: &str, size: u32| Shadow {
             name: name.into(),
             light: ShadowLight::Sun(-hadou_math::Vec3::Y),
@@ -970,21 +977,7 @@ mod tests {
     fn plane_casts_rank_by_opacity_and_receivers_carry_their_bits() {
         use hadou_math::shadow::Plane;
         use hadou_scene::{Shadow, ShadowLight, ShadowMethod};
-        let mut frame = small_frame();
-        let mesh = Arc::new(Mesh {
-            positions: vec![[-1.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 0.5, 1.0]],
-            normals: vec![[0.0, 1.0, 0.0]; 3],
-            indices: vec![0, 1, 2],
-            ..Mesh::default()
-        });
-        for i in 0..3 {
-            let at = hadou_math::Mat4::from_trs(
-                hadou_math::Vec3::new(i as f32, 1.0, 0.0),
-                hadou_math::Vec3::ZERO,
-                hadou_math::Vec3::splat(1.0),
-            );
-            frame.objects.push(hadou_scene::Object::new(format!("o{i}"), mesh.clone(), at, [1.0; 3]));
-        }
+        let mut frame = three_triangles(0.5);
         let plane = |opacity: f32, receivers: Vec<u32>| Shadow {
             name: format!("{opacity}"),
             light: ShadowLight::Sun(-hadou_math::Vec3::Y),
