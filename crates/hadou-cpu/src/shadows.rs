@@ -1,6 +1,7 @@
 //! Hard shadows (`[[shadow]]`): the frame's projections ([`hadou_scene::Frame::shadow_casts`]),
 //! their shadow maps, and the per-pixel choice of the shadow a receiver pixel takes. The GPU
-//! backend mirrors this module (its shadow coverage pass, map pass and `shadows.wgsl`).
+//! backend mirrors this module: `shadow_raster.wgsl` (the plane-shadow pass and the map pass) and
+//! `shadow_lookup.wgsl` (the choice per pixel, in the wave pass).
 //!
 //! A receiver pixel (visible, not an outline hull, its object among the shadow's receivers) takes
 //! the cast of largest effective opacity among

@@ -580,14 +580,7 @@ impl Renderer {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow map"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: cleared_depth(&view, wgpu::StoreOp::Store),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -676,34 +669,8 @@ impl Renderer {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("raster"),
                 // Cleared to zero bits: distance 0 marks "nothing drawn".
-                color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &t.scene_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &t.attributes_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    }),
-                ],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &t.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
+                color_attachments: &[cleared_color(&t.scene_view), cleared_color(&t.attributes_view)],
+                depth_stencil_attachment: cleared_depth(&t.depth_view, wgpu::StoreOp::Discard),
                 timestamp_writes: timestamps.map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
                     query_set,
                     beginning_of_pass_write_index: Some(2 * i),
@@ -785,23 +752,8 @@ impl Renderer {
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("plane shadows"),
             // 0: no plane cast.
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &t.plane_shadow_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &t.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
+            color_attachments: &[cleared_color(&t.plane_shadow_view)],
+            depth_stencil_attachment: cleared_depth(&t.depth_view, wgpu::StoreOp::Discard),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -854,6 +806,31 @@ impl Renderer {
 }
 
 /// Copies one tile's read-back bytes (layout: see the output binding in wave.wgsl) into `image`.
+/// A colour attachment cleared to zero bits and stored.
+fn cleared_color(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
+/// A depth attachment cleared to 1 (the far plane; in a shadow map, "no caster").
+fn cleared_depth(
+    view: &wgpu::TextureView,
+    store: wgpu::StoreOp,
+) -> Option<wgpu::RenderPassDepthStencilAttachment<'_>> {
+    Some(wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store }),
+        stencil_ops: None,
+    })
+}
+
 fn copy_tile(image: &mut Image, raw: &[u8], origin: [u32; 2], size: [u32; 2]) {
     let n = size[0] as usize * size[1] as usize;
     let floats: Vec<f32>;

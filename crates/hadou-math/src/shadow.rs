@@ -17,7 +17,8 @@ pub const HORIZON_NONE: f32 = 1e-3;
 /// Above this `−k·n` (an elevation of 1.15°) a shadow has its full opacity.
 pub const HORIZON_FULL: f32 = 2e-2;
 
-/// The thesis's longest-shadow angle `θ` (000 §2.4 uses 60° in its figures), in degrees.
+/// hadou's default longest-shadow angle `θ`, in degrees. 000 §2.4 leaves `θ` to the user and prints
+/// no value; at 60° a shadow is at most `tan 60° ≈ 1.73` times as long as its caster is high.
 pub const DEFAULT_THETA_DEG: f32 = 60.0;
 
 /// A receiver plane: a point on it and the unit normal of its lit side.
@@ -62,6 +63,7 @@ impl<R: Real> Plane<R> {
 /// `t = ((O − P)·n) / (k·n)` (000 §2.4's `t = ((I − P)·Y) / (k·Y)`; for the sun `k = L` it is
 /// 001's `p' = p − ((p − o)·n / (L·n)) L`). `t < 0`: `p` is beyond the plane as seen from the light
 /// and casts nothing. Callers only project when `k·n < −`[`HORIZON_NONE`], so `t` is finite.
+/// WGSL twin: `vs_plane` in hadou-gpu's `shadow_raster.wgsl`.
 #[inline]
 pub fn project<R: Real>(p: Vec3<R>, k: Vec3<R>, plane: &Plane<R>) -> (Vec3<R>, R) {
     let t = (plane.point - p).dot(plane.normal) / k.dot(plane.normal);
@@ -137,6 +139,7 @@ impl MapFrame {
 
     /// `(s, t, depth)` of world point `p`: `s = ((p − c)·u / r + 1) / 2`, likewise `t` with `v`,
     /// `depth = ((p − c)·k / r + 1) / 2`. Not clamped: a receiver beyond the sphere has depth > 1.
+    /// WGSL twin: `map_coords` in hadou-gpu's `common.wgsl`.
     #[inline]
     pub fn to_map(&self, p: Vec3f) -> [f32; 3] {
         let d = p - self.center;

@@ -395,6 +395,20 @@ pub(crate) fn parse_shadow(
             ));
         }
         Some(if has_pts {
+            let three = |v: &DeValue<'_>| matches!(v, DeValue::Array(a) if a.len() == 3);
+            if let Some(v) = t.get("plane_points").filter(|v| !three(v.get_ref())) {
+                return Err(t.src.type_err(
+                    &v.span(),
+                    format!(
+                        "`plane_points` in {} must be three points [[x, y, z], [x, y, z], [x, y, z]] (I, J, K), got {}",
+                        t.what,
+                        match v.get_ref() {
+                            DeValue::Array(a) => format!("{} entries", a.len()),
+                            other => type_name(other).to_string(),
+                        }
+                    ),
+                ));
+            }
             rd.add(
                 t,
                 &mut params,
@@ -404,13 +418,6 @@ pub(crate) fn parse_shadow(
                 Fallback::Required(""),
                 false,
             )?;
-            let n = params.find("plane_points").map_or(0, |p| p.len);
-            if n != 9 {
-                return Err(t.src.type_err(
-                    &t.get("plane_points").map_or(t.span.clone(), |v| v.span()),
-                    format!("`plane_points` in {} must be three points [[x, y, z], [x, y, z], [x, y, z]] (I, J, K)", t.what),
-                ));
-            }
             PlaneSource::ThreePoints
         } else if has_pn {
             rd.add(

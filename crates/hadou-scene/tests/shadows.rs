@@ -217,6 +217,9 @@ fn bad_shadows_name_their_line_and_column() {
             "coincide",
         ),
         ("kind = \"sun\"\ncasters = \"a\"\nreceivers = \"b\"\nplane_point = [0, 0, 0]\nplane_normal = [0, 0, 0]\n", 6, 16, "zero vector"),
+        ("kind = \"sun\"\ncasters = \"a\"\nreceivers = \"b\"\nplane_points = [[0, 0, 0], [1, 0, 0]]\n", 5, 16, "three points"),
+        ("kind = \"sun\"\ncasters = \"a\"\nreceivers = \"b\"\nplane_points = \"up\"\n", 5, 16, "got a string"),
+
         ("kind = \"wave\"\ncasters = \"a\"\nreceivers = \"ground\"\ntheta = 90\n", 5, 9, "must be in [0, 90), got 90"),
         ("kind = \"wave\"\ncasters = \"a\"\nreceivers = \"ground\"\ntheta = -1\n", 5, 9, "must be in [0, 90), got -1"),
         ("kind = \"sun\"\ndirection = [0, 0, 0]\ncasters = \"a\"\nreceivers = \"ground\"\n", 3, 13, "zero vector"),
