@@ -6,12 +6,14 @@
 //! adapter exists.
 //!
 //! Passes, in order: opaque geometry and its outline hulls (`raster`), shaded with the materials
-//! and the waves as lights (`shading`) and darkened by the hard shadows (`shadows`), then the energy integrals clipped at the visible surface
-//! and the colour mapping (`waves`).
+//! and the waves as lights (`shading`) and darkened by the hard shadows (`shadows`), lit by the
+//! area light through its soft shadows (`soft`), then the energy integrals clipped at the visible
+//! surface and the colour mapping (`waves`).
 
 mod raster;
 mod shading;
 mod shadows;
+pub mod soft;
 mod waves;
 
 use hadou_scene::{Backend, Frame, Image, RenderError};
@@ -58,7 +60,7 @@ pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
     let curves = waves::prepare_curves(frame);
     let lights = shading::FrameLights::new(frame, &curves);
     let shadows = shadows::FrameShadows::new(frame, &lights.lines);
-    let opaque = raster::draw_opaque(frame, &basis, &lights, &shadows, y0 as usize..y1 as usize);
+    let (opaque, oy0) = opaque_pass(frame, &basis, &lights, &shadows, y0 as usize..y1 as usize);
     let mut img = Image::new(frame.width, y1 - y0);
     let w = frame.width as usize;
     let far = frame.camera.far;
@@ -70,7 +72,7 @@ pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
         .for_each(|(r, ((col, en), dep))| {
             let py = (y0 as usize + r) as f32;
             for x in 0..w {
-                let i = r * w + x;
+                let i = (y0 as usize - oy0 + r) * w + x;
                 let px = x as f32;
                 let surface = opaque.surface[i];
                 let mut light = [0.0f32; 3];
@@ -87,6 +89,37 @@ pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
             }
         });
     img
+}
+
+/// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which
+/// needs the whole image: then every row is drawn). Returns the buffers and their first row.
+fn opaque_pass(
+    frame: &Frame,
+    basis: &hadou_scene::CameraBasis,
+    lights: &shading::FrameLights,
+    shadows: &shadows::FrameShadows,
+    rows: std::ops::Range<usize>,
+) -> (raster::OpaqueBuffers, usize) {
+    let Some(light) = &frame.area_light else {
+        let y0 = rows.start;
+        return (raster::draw_opaque(frame, basis, lights, shadows, rows), y0);
+    };
+    let mut opaque = raster::draw_opaque(frame, basis, lights, shadows, 0..frame.height as usize);
+    let input = soft::SoftInput {
+        width: frame.width as usize,
+        height: frame.height as usize,
+        points: std::mem::take(&mut opaque.soft),
+    };
+    let vis = soft::visibility(frame, light, &input, light.resolve);
+    opaque.color.par_iter_mut().zip(&input.points).zip(&vis).for_each(|((c, p), &v)| {
+        if let Some(p) = p {
+            for k in 0..3 {
+                c[k] = hadou_math::energy::saturate(c[k] + v * p.term[k]);
+            }
+        }
+    });
+    opaque.visibility = vis;
+    (opaque, 0)
 }
 
 /// What `hadou probe` reports about one pixel.
@@ -106,6 +139,9 @@ pub struct Probe {
     pub object: Option<String>,
     /// Name of the `[[shadow]]` darkening the pixel, if any.
     pub shadow: Option<String>,
+    /// With an `[area_light]`, the pixel's soft-shadow visibility (0 umbra … 1 lit) where a
+    /// surface is visible.
+    pub soft: Option<f32>,
 }
 
 /// One wave's contribution at a probed pixel.
@@ -129,9 +165,10 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let curves = waves::prepare_curves(frame);
     let lights = shading::FrameLights::new(frame, &curves);
     let shadows = shadows::FrameShadows::new(frame, &lights.lines);
-    // The probed row alone: the opaque pass decides each pixel independently.
-    let opaque = raster::draw_opaque(frame, &basis, &lights, &shadows, y as usize..y as usize + 1);
-    let i = x as usize;
+    // The probed row alone (the opaque pass decides each pixel independently), or every row when
+    // the area light's penumbra search needs them.
+    let (opaque, oy0) = opaque_pass(frame, &basis, &lights, &shadows, y as usize..y as usize + 1);
+    let i = (y as usize - oy0) * frame.width as usize + x as usize;
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();
@@ -150,5 +187,6 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
             .unwrap_or_else(|| far * basis.pixel_dir(x as f32, y as f32, frame.width, frame.height).length()),
         object: opaque.object[i].map(|o| frame.objects[o as usize].name.clone()),
         shadow: opaque.shadow[i].map(|s| frame.shadows[s as usize].name.clone()),
+        soft: opaque.visibility.get(i).copied().filter(|_| surface.is_some() && opaque.object[i].is_some()),
     })
 }

@@ -11,6 +11,7 @@
 
 use crate::shading::{self, FrameLights};
 use crate::shadows::{FrameShadows, NO_SHADOW};
+use crate::soft::SoftPoint;
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::ShadowMethod;
 use hadou_scene::{CameraBasis, Frame};
@@ -51,6 +52,12 @@ pub(crate) struct ScreenTri {
 }
 
 impl ScreenTri {
+    /// The view depth at screen barycentrics `w`: `1 / Σ wᵢ/zᵢ` (perspective-correct).
+    #[inline]
+    pub(crate) fn depth_at(&self, w: [f32; 3]) -> f32 {
+        1.0 / (w[0] * self.inv_z[0] + w[1] * self.inv_z[1] + w[2] * self.inv_z[2])
+    }
+
     /// A bare triangle in screen coordinates (for rasterizing shadow maps with [`cover`]).
     pub(crate) fn flat(sx: [f32; 3], sy: [f32; 3]) -> Self {
         ScreenTri {
@@ -78,6 +85,12 @@ pub(crate) struct OpaqueBuffers {
     pub object: Vec<Option<u32>>,
     /// Index into `frame.shadows` of the shadow the pixel takes, if any.
     pub shadow: Vec<Option<u32>>,
+    /// With an `[area_light]`: each pixel's visible point for the soft shadows (`None` for the
+    /// background and outline hulls); empty without one.
+    pub soft: Vec<Option<SoftPoint>>,
+    /// The soft-shadow visibility per pixel once resolved (empty before, and without an area
+    /// light).
+    pub visibility: Vec<f32>,
 }
 
 /// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
@@ -104,13 +117,22 @@ pub(crate) fn draw_opaque(
     let mut surface = vec![None; w * h];
     let mut object = vec![None; w * h];
     let mut shadow = vec![None; w * h];
+    let area = frame.area_light.as_ref();
+    let mut soft = if area.is_some() { vec![None; w * h] } else { Vec::new() };
+    // Without an area light every band gets an empty slice.
+    let soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
+        soft.chunks_mut(BAND * w).collect()
+    } else {
+        (0..h.div_ceil(BAND)).map(|_| Default::default()).collect()
+    };
     color
         .par_chunks_mut(BAND * w)
         .zip(surface.par_chunks_mut(BAND * w))
         .zip(object.par_chunks_mut(BAND * w))
         .zip(shadow.par_chunks_mut(BAND * w))
+        .zip(soft_chunks.into_par_iter())
         .enumerate()
-        .for_each(|(b, (((col, surf), obj), shad))| {
+        .for_each(|(b, ((((col, surf), obj), shad), soft))| {
             let y_start = rows.start + b * BAND;
             let rows = col.len() / w;
             let mut zbuf = vec![f32::INFINITY; rows * w];
@@ -173,11 +195,18 @@ pub(crate) fn draw_opaque(
                         col[i] = c;
                     } else {
                         (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
+                        if let Some(al) = area {
+                            soft[i] = Some(SoftPoint {
+                                world: s.world,
+                                normal: s.normal.normalize_or(Vec3f::ZERO),
+                                term: shading::area_term(al, material, s),
+                            });
+                        }
                     }
                 }
             }
         });
-    OpaqueBuffers { color, surface, object, shadow }
+    OpaqueBuffers { color, surface, object, shadow, soft, visibility: Vec::new() }
 }
 
 /// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.
@@ -249,6 +278,49 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
                     continue;
                 }
                 screen.push([a, b, c], oi as u32, material, is_hull, &mut out);
+            }
+        }
+    }
+    out
+}
+
+/// Every object's triangles (not the outline hulls) as seen from one of 003's soft-shadow maps:
+/// clipped at the map's near plane and projected to texel coordinates of a `size²` map (texel
+/// `(x, y)` covers `[x, x+1) × [y, y+1)`, row 0 at the frustum's top), `1/z` per vertex for the
+/// perspective-correct depth ([`ScreenTri::inv_z_at`]).
+pub(crate) fn spot_tris(frame: &Frame, map: &hadou_math::soft::SpotMap, size: u32) -> Vec<ScreenTri> {
+    let n = size as f32;
+    let scale = 1.0 / map.tan_half;
+    let mut out = Vec::new();
+    for obj in &frame.objects {
+        let verts: Vec<Vert> = obj
+            .mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let world = obj.transform.transform_point(Vec3::from_array(*p));
+                Vert { view: map.to_view(world), world, normal: Vec3f::ZERO, uv: [0.0; 2], color: [0.0; 4] }
+            })
+            .collect();
+        for tri in obj.mesh.indices.chunks_exact(3) {
+            let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+            let [Some(a), Some(b), Some(c)] = v else { continue };
+            let mut poly = [a; 4];
+            let k = clip_near([a, b, c], map.near, &mut poly);
+            for j in 1..k.saturating_sub(1) {
+                let pv = [poly[0], poly[j], poly[j + 1]];
+                let mut t = ScreenTri::flat([0.0; 3], [0.0; 3]);
+                let mut ok = true;
+                for (m, v) in pv.iter().enumerate() {
+                    let iz = 1.0 / v.view.z;
+                    t.inv_z[m] = iz;
+                    t.sx[m] = (v.view.x * iz * scale + 1.0) * 0.5 * n;
+                    t.sy[m] = (1.0 - v.view.y * iz * scale) * 0.5 * n;
+                    ok &= t.sx[m].is_finite() && t.sy[m].is_finite() && iz.is_finite();
+                }
+                if ok {
+                    out.push(t);
+                }
             }
         }
     }

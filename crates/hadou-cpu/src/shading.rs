@@ -6,7 +6,7 @@ use hadou_math::curve::PreparedCurve;
 use hadou_math::energy::Falloff;
 use hadou_math::toon;
 use hadou_math::{shade as tone, Vec3f};
-use hadou_scene::{Frame, LightLine, Material, ShadingModel};
+use hadou_scene::{AreaLight, Frame, LightLine, Material, ShadingModel};
 
 /// The interpolated attributes of a visible surface point.
 #[derive(Clone, Copy, Debug)]
@@ -51,6 +51,34 @@ impl FrameLights {
 /// Most waves whose densities one surface point weighs at once without allocating.
 const STACK_WAVES: usize = 16;
 
+/// Albedo `A = base_color · base_texture(uv) · vertex colour` of a surface point with material `m`.
+fn albedo(m: &Material, s: &Surface) -> [f32; 3] {
+    let tex = m.base_texture.as_ref().map_or([1.0; 4], |t| t.sample(s.uv));
+    // Vertex colours are shaded at 8 bits per channel (the GPU's G-buffer keeps them as unorm8,
+    // WGSL `pack4x8unorm`): round(255·clamp(c, 0, 1)) / 255.
+    let vcolor = s.color.map(|c| (0.5 + 255.0 * c.clamp(0.0, 1.0)).floor() / 255.0);
+    std::array::from_fn(|k| m.base_color[k] * tex[k] * vcolor[k])
+}
+
+/// What the `[area_light]` adds to a surface point with material `m` where it is fully visible
+/// (the soft shadow's visibility scales it): with `l̂` the unit vector from the point to the light
+/// centre `L` and `m = N·l̂`, diffuse `A·E·max(0, m)`, toon `A·E·ramp(m)` (unclamped `m`, as the
+/// waves light toon materials, 000 §2.1), unlit nothing; `E` the light's colour times intensity;
+/// then the feature texture, as for [`shade`]. Mirrored by `area_term` in `shading.wgsl`.
+pub(crate) fn area_term(light: &AreaLight, m: &Material, s: &Surface) -> [f32; 3] {
+    let n = s.normal.normalize_or(Vec3f::ZERO);
+    let dir = (light.position - s.world).normalize_or(Vec3f::ZERO);
+    let mdot = n.dot(dir);
+    let k: [f32; 3] = match m.model {
+        ShadingModel::Diffuse => [mdot.max(0.0); 3],
+        ShadingModel::Toon => m.ramp.eval(mdot),
+        ShadingModel::Unlit => return [0.0; 3],
+    };
+    let a = albedo(m, s);
+    let f = m.feature_texture.as_ref().map_or([1.0; 4], |t| t.sample(s.uv));
+    std::array::from_fn(|i| hadou_math::energy::saturate(a[i] * light.color[i] * k[i] * f[i]))
+}
+
 /// The shaded linear RGB of a surface point with material `m`:
 ///
 /// 1. albedo `A = base_color · base_texture(uv) · vertex colour`;
@@ -65,11 +93,7 @@ const STACK_WAVES: usize = 16;
 /// 5. feature texture: `H = S · T(uv)` (000 §2.2).
 pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surface) -> [f32; 3] {
     let n = s.normal.normalize_or(Vec3f::ZERO);
-    let tex = m.base_texture.as_ref().map_or([1.0; 4], |t| t.sample(s.uv));
-    // Vertex colours are shaded at 8 bits per channel (the GPU's G-buffer keeps them as unorm8,
-    // WGSL `pack4x8unorm`): round(255·clamp(c, 0, 1)) / 255.
-    let vcolor = s.color.map(|c| (0.5 + 255.0 * c.clamp(0.0, 1.0)).floor() / 255.0);
-    let albedo: [f32; 3] = std::array::from_fn(|k| m.base_color[k] * tex[k] * vcolor[k]);
+    let albedo = albedo(m, s);
     let l = &frame.light;
     let mut c = match m.model {
         ShadingModel::Diffuse => tone::diffuse(albedo, n, l.direction, l.color, l.ambient),

@@ -30,6 +30,7 @@ fn frame(objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
         waves,
         color_mapping: ColorMapping { mode: ToneMode::Filmic, exposure: 1.0 },
         shadows: Vec::new(),
+        area_light: None,
     }
 }
 

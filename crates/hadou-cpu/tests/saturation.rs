@@ -75,6 +75,7 @@ fn frame(shape: WaveShape, falloff: Falloff, mode: ToneMode) -> Frame {
         waves: vec![wave.clone(), wave],
         color_mapping: ColorMapping { mode, exposure: 1.0 },
         shadows: Vec::new(),
+        area_light: None,
     }
 }
 

@@ -36,6 +36,7 @@ fn frame(size: u32, eye: Vec3f, objects: Vec<Object>, waves: Vec<Wave>) -> Frame
         // the surface colour.
         color_mapping: ColorMapping { mode: ToneMode::Faithful, exposure: 1e-9 },
         shadows: Vec::new(),
+        area_light: None,
     }
 }
 

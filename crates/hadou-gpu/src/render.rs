@@ -1030,6 +1030,7 @@ mod tests {
             waves: Vec::new(),
             color_mapping: hadou_scene::ColorMapping { mode: hadou_scene::ToneMode::Filmic, exposure: 1.0 },
             shadows: Vec::new(),
+            area_light: None,
         }
     }
 

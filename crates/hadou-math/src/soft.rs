@@ -57,12 +57,13 @@ pub fn distance_transform(feature: &[bool], width: usize, height: usize) -> Vec<
     let mut scratch = Envelope::new(n);
     let mut line = vec![0.0f32; n];
     let mut out = vec![0.0f32; n];
+    let mut arg = vec![0u32; n];
     // Columns.
     for x in 0..width {
         for y in 0..height {
             line[y] = d[y * width + x];
         }
-        scratch.transform(&line[..height], &mut out[..height]);
+        scratch.transform(&line[..height], &mut out[..height], &mut arg[..height]);
         for y in 0..height {
             d[y * width + x] = out[y];
         }
@@ -71,26 +72,35 @@ pub fn distance_transform(feature: &[bool], width: usize, height: usize) -> Vec<
     for y in 0..height {
         let row = &mut d[y * width..(y + 1) * width];
         line[..width].copy_from_slice(row);
-        scratch.transform(&line[..width], &mut out[..width]);
+        scratch.transform(&line[..width], &mut out[..width], &mut arg[..width]);
         row.copy_from_slice(&out[..width]);
     }
     d
 }
 
-/// Work space of the 1-D transform: the parabolas of the lower envelope and their boundaries.
-struct Envelope {
+/// Work space of the 1-D squared distance transform (Felzenszwalb–Huttenlocher): the parabolas of
+/// the lower envelope and their boundaries. One per thread; [`Envelope::transform`] is the step
+/// both passes of [`distance_transform`] make, public so a renderer can run the lines in parallel.
+#[derive(Clone, Debug)]
+pub struct Envelope {
     v: Vec<usize>,
     z: Vec<f64>,
 }
 
 impl Envelope {
-    fn new(n: usize) -> Self {
+    /// Work space for lines of up to `n` samples.
+    pub fn new(n: usize) -> Self {
         Envelope { v: vec![0; n.max(1)], z: vec![0.0; n.max(1) + 1] }
     }
 
-    /// `out[q] = min_p (q − p)² + f[p]` over `p` with finite `f[p]` ([`FAR`] if none).
-    fn transform(&mut self, f: &[f32], out: &mut [f32]) {
+    /// `out[q] = min_p (q − p)² + f[p]` over `p` with finite `f[p]` ([`FAR`] if none), and
+    /// `arg[q]` = that `p` (the lowest-index parabola of the envelope at `q`; `u32::MAX` if none).
+    /// Lines longer than [`Envelope::new`]'s `n` grow the work space.
+    pub fn transform(&mut self, f: &[f32], out: &mut [f32], arg: &mut [u32]) {
         let n = f.len();
+        if self.v.len() < n {
+            *self = Envelope::new(n);
+        }
         let mut k: usize = 0;
         let mut any = false;
         for q in 0..n {
@@ -124,17 +134,179 @@ impl Envelope {
         }
         if !any {
             out.iter_mut().for_each(|o| *o = FAR);
+            arg.iter_mut().for_each(|a| *a = u32::MAX);
             return;
         }
         let mut j = 0;
-        for (q, o) in out.iter_mut().enumerate() {
+        for (q, (o, a)) in out.iter_mut().zip(arg.iter_mut()).enumerate() {
             while self.z[j + 1] < q as f64 {
                 j += 1;
             }
             let p = self.v[j];
             let dq = q as f32 - p as f32;
             *o = dq * dq + f[p];
+            *a = p as u32;
         }
+    }
+}
+
+/// Farthest a penumbra pixel looks for its nearest umbra and lit pixels, in pixels: beyond it a
+/// kind counts as absent (its distance infinite), in every resolve alike, so the faithful search
+/// (which costs the square of the distance) stays bounded and the exact resolve gives the same
+/// answer. Wider than any penumbra 003 shows at 512².
+pub const SEARCH_RADIUS: u32 = 256;
+
+/// Depth-aware search (003 §4.5's proposal, SPEC.md §4.5): an umbra or lit pixel whose visible
+/// point `q` lies off the tangent plane of the penumbra pixel's point `p` (unit normal `n`) by more
+/// than this fraction of their distance, `|n·(q − p)| > DEPTH_SLOPE·|q − p|` (a slope of 17°), is
+/// across a depth discontinuity and does not count.
+pub const DEPTH_SLOPE: f32 = 0.3;
+
+/// Whether `q` counts for a penumbra pixel at `p` with unit normal `n` under the depth-aware search
+/// ([`DEPTH_SLOPE`]).
+#[inline]
+pub fn same_surface(p: Vec3f, n: Vec3f, q: Vec3f) -> bool {
+    let d = q - p;
+    d.dot(n).abs() <= DEPTH_SLOPE * d.length()
+}
+
+/// Shadow-map bias in texels at the point's depth (see [`SpotMap::texel`]): a stored depth counts
+/// as an occluder when it is nearer than the point by more than this many texel widths.
+pub const BIAS_TEXELS: f32 = 1.5;
+
+/// The perspective frame of one of 003's shadow maps: from a light position `eye` towards the
+/// point of interest, a square frustum of half-angle `atan(tan_half)` wide enough for every
+/// object. Map coordinates `s, t ∈ [0, 1]` (right, up) and the view depth `z` (distance along
+/// `forward`); texel `(x, y)` of a `size²` map covers `s ∈ [x/size, (x+1)/size)`,
+/// `1 − t ∈ [y/size, (y+1)/size)` (row 0 at `t = 1`, as the hard shadows' maps).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotMap {
+    /// The map's light position (`L₁` or `L₂`).
+    pub eye: Vec3f,
+    /// Unit axis towards the point of interest.
+    pub forward: Vec3f,
+    /// Unit right.
+    pub right: Vec3f,
+    /// Unit up.
+    pub up: Vec3f,
+    /// `tan` of the frustum's half-angle.
+    pub tan_half: f32,
+    /// Near plane distance (triangles are clipped there).
+    pub near: f32,
+}
+
+/// Widest half-angle of a [`SpotMap`]'s frustum (`tan 80°`).
+pub const SPOT_MAX_TAN: f32 = 5.671_282;
+
+impl SpotMap {
+    /// A map at `eye` looking at `target`, its frustum enclosing `corners` (world points, e.g. the
+    /// objects' bounding boxes) up to [`SPOT_MAX_TAN`]; the near plane at `10⁻³·|target − eye|`.
+    pub fn look(eye: Vec3f, target: Vec3f, corners: &[Vec3f]) -> Self {
+        let dist = (target - eye).length();
+        let forward = (target - eye).normalize_or(-Vec3f::Y);
+        let helper = if forward.y.abs() < 0.99 { Vec3f::Y } else { Vec3f::X };
+        let right = forward.cross(helper).normalize_or(forward.orthonormal_basis().0);
+        let up = right.cross(forward);
+        let near = (1e-3 * dist).max(1e-5);
+        let mut tan_half: f32 = 1e-3;
+        for &c in corners {
+            let d = c - eye;
+            let z = d.dot(forward);
+            let lateral = d.dot(right).abs().max(d.dot(up).abs());
+            let t = if z > near { lateral / z } else { SPOT_MAX_TAN };
+            if t.is_finite() {
+                tan_half = tan_half.max(t);
+            } else {
+                tan_half = SPOT_MAX_TAN;
+            }
+        }
+        SpotMap { eye, forward, right, up, tan_half: (tan_half * 1.02).min(SPOT_MAX_TAN), near }
+    }
+
+    /// View coordinates `(x, y, z)` of `p`: right, up, along the axis.
+    #[inline]
+    pub fn to_view(&self, p: Vec3f) -> Vec3f {
+        let d = p - self.eye;
+        Vec3f::new(d.dot(self.right), d.dot(self.up), d.dot(self.forward))
+    }
+
+    /// World width of one texel of a `size²` map at view depth `z`.
+    #[inline]
+    pub fn texel(&self, z: f32, size: u32) -> f32 {
+        2.0 * self.tan_half * z / size as f32
+    }
+
+    /// Where a receiver point `p` with unit normal `n` looks the map up: `None` when `p` faces away
+    /// from the map's light (`n·(eye − p) ≤ 0`: it shades itself, as an opaque closed surface
+    /// would), else `Some((x, y, z))`, the texel and the depth to compare after moving `p` one
+    /// texel along `n` (normal-offset bias); `x` or `y` outside `0..size` when the point is outside
+    /// the frustum (no occluder there), and `z ≤ near` likewise.
+    #[inline]
+    pub fn lookup(&self, p: Vec3f, n: Vec3f, size: u32) -> Option<(i64, i64, f32)> {
+        if n.dot(self.eye - p) <= 0.0 {
+            return None;
+        }
+        let z0 = self.to_view(p).z;
+        let q = p + n * self.texel(z0.abs(), size);
+        let v = self.to_view(q);
+        if !(v.z > self.near) {
+            return Some((-1, -1, v.z));
+        }
+        let sz = size as f32;
+        let s = (v.x / (v.z * self.tan_half) + 1.0) * 0.5;
+        let t = (v.y / (v.z * self.tan_half) + 1.0) * 0.5;
+        let (x, y) = ((s * sz).floor(), ((1.0 - t) * sz).floor());
+        if !(x.is_finite() && y.is_finite()) {
+            return Some((-1, -1, v.z));
+        }
+        Some((x.clamp(-1.0, sz) as i64, y.clamp(-1.0, sz) as i64, v.z))
+    }
+
+    /// Whether a map value `stored` (view depth of the nearest caster in the texel) hides a point
+    /// at view depth `z`: nearer by more than [`BIAS_TEXELS`] texels.
+    #[inline]
+    pub fn occludes(&self, stored: f32, z: f32, size: u32) -> bool {
+        stored < z - BIAS_TEXELS * self.texel(z, size)
+    }
+}
+
+/// A pixel's class under 003 §4.1: shadowed in both maps, in one, or in neither.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Class {
+    /// No visible surface (background, outline hull): neither classified nor searched for.
+    None = 0,
+    /// Shadowed in both maps.
+    Umbra = 1,
+    /// Shadowed in exactly one.
+    Penumbra = 2,
+    /// Shadowed in neither.
+    Lit = 3,
+}
+
+impl Class {
+    /// The class from the two maps' verdicts.
+    #[inline]
+    pub fn of(shadowed1: bool, shadowed2: bool) -> Class {
+        match (shadowed1, shadowed2) {
+            (true, true) => Class::Umbra,
+            (false, false) => Class::Lit,
+            _ => Class::Penumbra,
+        }
+    }
+}
+
+/// Radius of the disc light whose penumbra has the width of 003's two-map band at an occluder
+/// edge: with the maps at `D ∓ l` on the axis and the edge at lateral offset `r` and axial
+/// distance `D`, a receiver at `D_r` sees the edge's two shadows `2·l·r·(D_r − D)/(D² − l²)` apart,
+/// the width a disc of radius `R` gives is `2·R·(D_r − D)/D`, so `R = l·r·D/(D² − l²)`. The
+/// ground truth of `hadou bench shadows` uses it with `r` the point of interest's bounding radius.
+pub fn implied_disc_radius(l: f32, r: f32, d: f32) -> f32 {
+    let den = d * d - l * l;
+    if den > 0.0 {
+        l * r * d / den
+    } else {
+        l
     }
 }
 

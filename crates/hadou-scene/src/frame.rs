@@ -1,6 +1,7 @@
 //! [`Frame`]: the plain values a backend draws — one instant of a scene, nothing animated, nothing
 //! to parse. Produced by `Scene::at`, consumed by every backend.
 
+use crate::area_light::AreaLight;
 use hadou_math::curve::{CurveWave, PreparedCurve};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
 pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
@@ -32,6 +33,8 @@ pub struct Frame {
     pub color_mapping: ColorMapping,
     /// Hard shadows (`[[shadow]]`), applied to the receivers' shaded colour before the waves.
     pub shadows: Vec<Shadow>,
+    /// The `[area_light]` (003's soft shadows), if any.
+    pub area_light: Option<AreaLight>,
 }
 
 /// A pinhole camera.

@@ -2,6 +2,7 @@
 //! it into a [`Frame`].
 
 use crate::anim::Track;
+use crate::area_light::{build_area_light, AreaLightDef};
 use crate::error::SceneError;
 use crate::frame::{
     Camera, ColorMapping, Frame, Light, Material, Mesh, Object, Ramp, ToneMode, Wave, WaveLight, WaveShape,
@@ -35,6 +36,7 @@ pub struct Scene {
     pub(crate) objects: Vec<ObjectDef>,
     pub(crate) waves: Vec<WaveDef>,
     pub(crate) shadows: Vec<ShadowDef>,
+    pub(crate) area_light: Option<AreaLightDef>,
     pub(crate) tracks: Vec<Track>,
     /// Things that were accepted but deserve a note (a downscaled texture, textures on a mesh
     /// without texture coordinates, …).
@@ -175,7 +177,8 @@ impl Scene {
             .chain(self.objects.iter().map(|o| &o.params))
             .chain(self.materials.iter().map(|m| &m.params))
             .chain(self.waves.iter().map(|w| &w.params))
-            .chain(self.shadows.iter().map(|s| &s.params));
+            .chain(self.shadows.iter().map(|s| &s.params))
+            .chain(self.area_light.iter().map(|a| &a.params));
         for set in sets {
             for p in &set.params {
                 let r = p.offset..p.offset + p.len;
@@ -218,23 +221,7 @@ impl Scene {
             ambient: l.arr(vals, "ambient"),
         };
         let color_mapping = ColorMapping { mode: self.tone, exposure: self.color.f(vals, "exposure") };
-        let objects = self
-            .objects
-            .iter()
-            .map(|o| {
-                let p = &o.params;
-                Object {
-                    name: o.name.clone(),
-                    mesh: o.mesh.clone(),
-                    transform: Mat4::from_trs(
-                        v3(p, vals, "position"),
-                        v3(p, vals, "rotation"),
-                        v3(p, vals, "scale"),
-                    ),
-                    materials: self.object_materials(o, vals),
-                }
-            })
-            .collect::<Vec<_>>();
+        let objects = self.build_objects(vals);
         let waves = self.waves.iter().map(|w| self.build_wave(w, vals)).collect();
         let shadows =
             self.shadows.iter().map(|s| build_shadow(s, vals, base, light.direction, &objects)).collect();
@@ -245,11 +232,29 @@ impl Scene {
             camera,
             background: self.globals.arr(vals, "background"),
             light,
-            objects,
             waves,
             color_mapping,
             shadows,
+            area_light: self.area_light.as_ref().map(|a| build_area_light(a, vals, base, &objects)),
+            objects,
         }
+    }
+
+    /// The frame's objects at these values.
+    pub(crate) fn build_objects(&self, vals: &[f32]) -> Vec<Object> {
+        let v3 = |set: &ParamSet, key: &str| Vec3f::from_array(set.arr::<3>(vals, key));
+        self.objects
+            .iter()
+            .map(|o| {
+                let p = &o.params;
+                Object {
+                    name: o.name.clone(),
+                    mesh: o.mesh.clone(),
+                    transform: Mat4::from_trs(v3(p, "position"), v3(p, "rotation"), v3(p, "scale")),
+                    materials: self.object_materials(o, vals),
+                }
+            })
+            .collect()
     }
 
     fn build_wave(&self, w: &WaveDef, vals: &[f32]) -> Wave {

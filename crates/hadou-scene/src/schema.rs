@@ -3,6 +3,7 @@
 //! `docs/scene-format.md`.
 
 use crate::anim::{Interpolation, Track};
+use crate::area_light::{check_area_light, parse_area_light, SOFT_MAX_PIXELS};
 use crate::error::{hint, Location, SceneError};
 use crate::frame::{Mesh, ToneMode};
 use crate::gltf_load::Budget;
@@ -25,8 +26,19 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use toml::de::{DeTable, DeValue};
 
-const ROOT_KEYS: &[&str] =
-    &["image", "camera", "background", "light", "color", "material", "object", "wave", "shadow", "track"];
+const ROOT_KEYS: &[&str] = &[
+    "image",
+    "camera",
+    "background",
+    "light",
+    "color",
+    "material",
+    "object",
+    "wave",
+    "shadow",
+    "area_light",
+    "track",
+];
 const CAMERA_KEYS: &[&str] = &["position", "target", "up", "fov", "near", "far"];
 const LIGHT_KEYS: &[&str] = &["direction", "color", "ambient"];
 const COLOR_KEYS: &[&str] = &["mode", "exposure"];
@@ -228,6 +240,24 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         }
     }
 
+    // [area_light]
+    let mut area_light = None;
+    let mut area_table = None;
+    if let Some(t) = root.sub("area_light", "[area_light]")? {
+        let names: Vec<&str> = objects.iter().map(|o| o.name.as_str()).collect();
+        area_light = Some(parse_area_light(&t, &names, &mut rd)?);
+        if u64::from(width) * u64::from(height) > SOFT_MAX_PIXELS {
+            return Err(src.value_err(
+                &t.span,
+                format!(
+                    "[area_light] needs an image of at most {SOFT_MAX_PIXELS} pixels (4096²; the penumbra search works on the \
+                     whole image at once); this one is {width}×{height}"
+                ),
+            ));
+        }
+        area_table = Some(t);
+    }
+
     let mut scene = Scene {
         path: path.to_path_buf(),
         width,
@@ -242,6 +272,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         objects,
         waves,
         shadows,
+        area_light,
         tracks: Vec::new(),
         warnings,
     };
@@ -250,6 +281,12 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     for (w, table) in scene.waves.iter().zip(&wave_tables) {
         if let Err((key, msg)) = validate_curve(&scene, w, &scene.values) {
             return Err(src.value_err(&table.key_span(key), format!("`{key}` in {} {msg}", table.what)));
+        }
+    }
+
+    if let (Some(a), Some(t)) = (&scene.area_light, &area_table) {
+        if let Err((key, msg)) = check_area_light(a, &scene.values, &scene.build_objects(&scene.values)) {
+            return Err(src.value_err(&t.key_span(key), format!("{msg} in [area_light]")));
         }
     }
 
@@ -767,6 +804,10 @@ fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
     if Vec3f::from_array(scene.light.arr(vals, "direction")).try_normalize().is_none() {
         return Err("`direction` in [light] must not be the zero vector".into());
     }
+    if let Some(a) = &scene.area_light {
+        check_area_light(a, vals, &scene.build_objects(vals))
+            .map_err(|e| format!("{} in [area_light]", e.1))?;
+    }
     for s in &scene.shadows {
         check_shadow(s, vals).map_err(|e| format!("{} in [[shadow]] \"{}\"", e.1, s.name))?;
     }
@@ -803,12 +844,16 @@ struct Selection {
 }
 
 /// Resolves `target` (`wave.<name>.<key>[i].c`, `object.<name>.<key>`, `camera.<key>`,
-/// `light.<key>`, `color.exposure`, `background`) against the scene.
+/// `light.<key>`, `area_light.<key>`, `color.exposure`, `background`) against the scene.
 fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
     let segs: Vec<&str> = target.split('.').collect();
     let head = segs[0];
     let (set, rest, ent): (&ParamSet, &[&str], String) = match head.split('[').next().unwrap_or("") {
         "background" => (&scene.globals, &segs[..], "the scene".into()),
+        "area_light" if segs.len() >= 2 => match &scene.area_light {
+            Some(a) => (&a.params, &segs[1..], "[area_light]".into()),
+            None => return Err(format!("target \"{target}\": the scene has no [area_light]")),
+        },
         "camera" | "light" | "color" if segs.len() >= 2 => {
             let set = match head {
                 "camera" => &scene.camera,
@@ -840,17 +885,27 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
                 }
             }
         }
-        "camera" | "light" | "color" => {
+        "camera" | "light" | "color" | "area_light" => {
             return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
         }
         "wave" | "object" | "material" | "shadow" => {
             return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
         }
         other => {
-            let heads = ["wave", "object", "material", "shadow", "camera", "light", "color", "background"];
+            let heads = [
+                "wave",
+                "object",
+                "material",
+                "shadow",
+                "camera",
+                "light",
+                "area_light",
+                "color",
+                "background",
+            ];
             return Err(format!(
                 "target \"{target}\" must start with `wave.`, `object.`, `material.`, `shadow.`, `camera.`, \
-                 `light.`, `color.` or be `background`{}",
+                 `light.`, `area_light.`, `color.` or be `background`{}",
                 hint(other, &heads, "targets")
             ));
         }

@@ -486,6 +486,10 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     if let (Some(shadow), Some(map)) = (p.shadow, j.as_object_mut()) {
         map.insert("shadow".into(), serde_json::Value::String(shadow));
     }
+    // The area light's soft-shadow visibility, present only with an [area_light].
+    if let (Some(v), Some(map)) = (p.soft, j.as_object_mut()) {
+        map.insert("soft_visibility".into(), serde_json::json!(json_number(v)));
+    }
     println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
     Ok(())
 }
@@ -502,8 +506,9 @@ fn gpu_probe(backend: &mut dyn Backend, frame: &Frame, x: u32, y: u32) -> Result
         let e = backend.render(&single)?.energy[i];
         waves.push(hadou::WaveProbe { name: w.name.clone(), energy: e, evaluations: 0 });
     }
-    let (object, shadow) = hadou::probe(frame, x, y).map_or((None, None), |p| (p.object, p.shadow));
-    Ok(hadou::Probe { x, y, waves, color: img.color[i], depth: img.depth[i], object, shadow })
+    let (object, shadow, soft) =
+        hadou::probe(frame, x, y).map_or((None, None, None), |p| (p.object, p.shadow, p.soft));
+    Ok(hadou::Probe { x, y, waves, color: img.color[i], depth: img.depth[i], object, shadow, soft })
 }
 
 fn bench(a: BenchArgs) -> Result<(), Failure> {

@@ -1,0 +1,447 @@
+//! Soft shadows from the `[area_light]` (003, SPEC.md §4): two perspective shadow maps from
+//! `L₁ = L + l·P` and `L₂ = L − l·P`, every visible pixel classed umbra / penumbra / lit, and each
+//! penumbra pixel's brightness `D₁/(D₁ + D₂)` from its distances to the nearest umbra and lit
+//! pixels, found either by 003's search on every `N`-th pixel with bilinear interpolation
+//! ([`SoftResolve::Faithful`]) or by exact Euclidean distance transforms ([`SoftResolve::Exact`],
+//! the default). Both count only umbra and lit pixels within [`SEARCH_RADIUS`], and with the
+//! depth-aware search only those on the penumbra pixel's own surface ([`same_surface`]), so the
+//! exact resolve gives exactly what the faithful one gives at `N = 1`.
+//!
+//! Also the references `hadou bench shadows` measures against: [`truth`] (a true disc light, many
+//! shadow maps) and [`pcss`] (percentage-closer soft shadows as commonly shipped).
+//!
+//! The GPU backend mirrors [`visibility`] (`soft.wgsl`).
+
+use crate::raster::{bin_rows, cover, spot_tris, BAND};
+use hadou_math::soft::{
+    bilinear, penumbra_brightness, same_surface, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
+};
+use hadou_math::Vec3f;
+use hadou_scene::{AreaLight, Frame, SoftResolve};
+use rayon::prelude::*;
+
+/// A visible pixel's point for the soft shadows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftPoint {
+    /// World position.
+    pub world: Vec3f,
+    /// Unit normal (zero if the surface has none).
+    pub normal: Vec3f,
+    /// What the area light adds there when fully visible (`shading::area_term`).
+    pub term: [f32; 3],
+}
+
+/// The visible points of a whole frame, as the soft-shadow stage takes them.
+#[derive(Clone, Debug)]
+pub struct SoftInput {
+    /// Image width.
+    pub width: usize,
+    /// Image height.
+    pub height: usize,
+    /// Row-major, `None` for the background and outline hulls.
+    pub points: Vec<Option<SoftPoint>>,
+}
+
+/// Runs the opaque pass of `frame` (which must have an `[area_light]`) and returns its visible
+/// points: what [`visibility`] and the references work on. `None` without an area light.
+pub fn soft_input(frame: &Frame) -> Option<SoftInput> {
+    frame.area_light.as_ref()?;
+    let basis = frame.camera.basis(frame.width, frame.height);
+    let curves = crate::waves::prepare_curves(frame);
+    let lights = crate::shading::FrameLights::new(frame, &curves);
+    let shadows = crate::shadows::FrameShadows::new(frame, &lights.lines);
+    let opaque = crate::raster::draw_opaque(frame, &basis, &lights, &shadows, 0..frame.height as usize);
+    Some(SoftInput { width: frame.width as usize, height: frame.height as usize, points: opaque.soft })
+}
+
+/// A perspective depth map: the view depth of the nearest surface per texel, `+∞` where none.
+#[derive(Clone, Debug)]
+pub struct SpotDepth {
+    /// The map's frame.
+    pub map: SpotMap,
+    /// Edge in texels.
+    pub size: u32,
+    /// `size²` view depths, row 0 at the frustum's top.
+    pub depth: Vec<f32>,
+}
+
+impl SpotDepth {
+    /// Renders every object of `frame` (double-sided, top-left rule, perspective-correct depth,
+    /// the nearest kept) into a `size²` map of frame `map`, bands of rows in parallel.
+    pub fn render(frame: &Frame, map: &SpotMap, size: u32) -> SpotDepth {
+        let n = size as usize;
+        let tris = spot_tris(frame, map, size);
+        let bins = bin_rows(&tris, n, &(0..n));
+        let mut depth = vec![f32::INFINITY; n * n];
+        depth.par_chunks_mut(BAND * n).zip(&bins).enumerate().for_each(|(b, (band, bin))| {
+            let rows = band.len() / n;
+            for &ti in bin {
+                let t = &tris[ti as usize];
+                cover(t, b * BAND, rows, n, |i, w| {
+                    let z = t.depth_at(w);
+                    if z < band[i] {
+                        band[i] = z;
+                    }
+                });
+            }
+        });
+        SpotDepth { map: *map, size, depth }
+    }
+
+    /// The stored depth of texel `(x, y)`, `+∞` outside the map.
+    #[inline]
+    fn at(&self, x: i64, y: i64) -> f32 {
+        let n = i64::from(self.size);
+        if x < 0 || y < 0 || x >= n || y >= n {
+            return f32::INFINITY;
+        }
+        self.depth[(y * n + x) as usize]
+    }
+
+    /// Whether the point `p` (unit normal `n`) is in this map's shadow: it faces away from the
+    /// map's light, or the texel it looks up ([`SpotMap::lookup`]) holds a nearer surface
+    /// ([`SpotMap::occludes`]).
+    #[inline]
+    pub fn shadowed(&self, p: Vec3f, n: Vec3f) -> bool {
+        match self.map.lookup(p, n, self.size) {
+            None => true,
+            Some((x, y, z)) => self.map.occludes(self.at(x, y), z, self.size),
+        }
+    }
+}
+
+/// Every pixel's class (003 §4.1) from the two maps.
+pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
+    input
+        .points
+        .par_iter()
+        .with_min_len(4096)
+        .map(|p| match p {
+            None => Class::None,
+            Some(p) => Class::of(maps[0].shadowed(p.world, p.normal), maps[1].shadowed(p.world, p.normal)),
+        })
+        .collect()
+}
+
+/// The soft-shadow visibility of every pixel of `input` under `light` (0 in the umbra, 1 where
+/// lit, `D₁/(D₁ + D₂)` in the penumbra; 0 where no point is): the two maps, the classes and the
+/// resolve `resolve`. What [`crate::render`] multiplies the area light's term by.
+pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
+    let maps = light.maps.map(|m| (m, light.map_size));
+    let [a, b] = maps;
+    let (m1, m2) =
+        rayon::join(|| SpotDepth::render(frame, &a.0, a.1), || SpotDepth::render(frame, &b.0, b.1));
+    let class = classify(&[m1, m2], input);
+    let search = Search { input, class: &class, depth_aware: light.depth_aware };
+    match resolve {
+        SoftResolve::Exact => search.exact(),
+        SoftResolve::Faithful { n } => search.faithful(n.max(1) as usize),
+    }
+}
+
+/// The classes of a frame and how its penumbra pixels look for umbra and lit pixels.
+struct Search<'a> {
+    input: &'a SoftInput,
+    class: &'a [Class],
+    depth_aware: bool,
+}
+
+/// The value of a pixel that is not in the penumbra.
+#[inline]
+fn plain(c: Class) -> f32 {
+    match c {
+        Class::Umbra | Class::None => 0.0,
+        _ => 1.0,
+    }
+}
+
+const R2: f32 = (SEARCH_RADIUS * SEARCH_RADIUS) as f32;
+
+impl Search<'_> {
+    /// Whether pixel `j` counts as a `want` pixel for the penumbra pixel `i`.
+    #[inline]
+    fn counts(&self, i: usize, j: usize, want: Class) -> bool {
+        if self.class[j] != want {
+            return false;
+        }
+        if !self.depth_aware {
+            return true;
+        }
+        match (self.input.points[i], self.input.points[j]) {
+            (Some(p), Some(q)) => same_surface(p.world, p.normal, q.world),
+            _ => false,
+        }
+    }
+
+    /// The squared distance from pixel `i` to the nearest pixel that [`Search::counts`] as `want`
+    /// within [`SEARCH_RADIUS`] (Euclidean), `FAR` if none: square rings of Chebyshev radius
+    /// `r ≥ start`, stopping once `r²` exceeds the best found. Exact when no counting pixel lies
+    /// nearer than `start` in Chebyshev distance.
+    fn ring_search(&self, i: usize, want: Class, start: u32) -> f32 {
+        let (w, h) = (self.input.width as i64, self.input.height as i64);
+        let (x, y) = ((i as i64) % w, (i as i64) / w);
+        let mut best = FAR;
+        let mut r = i64::from(start.max(1));
+        while r <= i64::from(SEARCH_RADIUS) && ((r * r) as f32) <= best {
+            if x - r < 0 && y - r < 0 && x + r >= w && y + r >= h {
+                break;
+            }
+            let mut visit = |u: i64, v: i64| {
+                if u < 0 || v < 0 || u >= w || v >= h {
+                    return;
+                }
+                let d2 = ((u - x) * (u - x) + (v - y) * (v - y)) as f32;
+                if d2 < best && d2 <= R2 && self.counts(i, (v * w + u) as usize, want) {
+                    best = d2;
+                }
+            };
+            for u in x - r..=x + r {
+                visit(u, y - r);
+                visit(u, y + r);
+            }
+            for v in y - r + 1..y + r {
+                visit(x - r, v);
+                visit(x + r, v);
+            }
+            r += 1;
+        }
+        best
+    }
+
+    /// The brightness of penumbra pixel `i` by searching (003 §3.2).
+    fn searched(&self, i: usize) -> f32 {
+        let d1 = self.ring_search(i, Class::Umbra, 1);
+        let d2 = self.ring_search(i, Class::Lit, 1);
+        penumbra_brightness(d1.sqrt(), d2.sqrt())
+    }
+
+    /// 003's resolve (SPEC.md §4.2–4.3): the search on every `n`-th pixel in x and y (pixels
+    /// `(x, y)` with `x, y ≡ 0 mod n`; umbra grid pixels 0, lit and empty ones 1), every other
+    /// penumbra pixel bilinearly interpolated from the four grid pixels around it (the last grid
+    /// column or row repeated at the image's edge), standard weights.
+    fn faithful(&self, n: usize) -> Vec<f32> {
+        let (w, h) = (self.input.width, self.input.height);
+        let (gw, gh) = ((w - 1) / n + 1, (h - 1) / n + 1);
+        let grid: Vec<f32> = (0..gw * gh)
+            .into_par_iter()
+            .with_min_len(64)
+            .map(|g| {
+                let i = (g / gw) * n * w + (g % gw) * n;
+                match self.class[i] {
+                    Class::Penumbra => self.searched(i),
+                    Class::Umbra => 0.0,
+                    _ => 1.0,
+                }
+            })
+            .collect();
+        let mut out = vec![0.0f32; w * h];
+        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let (gy0, fy) = (y / n, (y % n) as f32 / n as f32);
+            let gy1 = (gy0 + 1).min(gh - 1);
+            let fy = if gy1 == gy0 { 0.0 } else { fy };
+            for (x, o) in row.iter_mut().enumerate() {
+                let c = self.class[y * w + x];
+                if c != Class::Penumbra {
+                    *o = plain(c);
+                    continue;
+                }
+                let (gx0, fx) = (x / n, (x % n) as f32 / n as f32);
+                let gx1 = (gx0 + 1).min(gw - 1);
+                let fx = if gx1 == gx0 { 0.0 } else { fx };
+                let g = |gx: usize, gy: usize| grid[gy * gw + gx];
+                *o = bilinear(g(gx0, gy0), g(gx1, gy0), g(gx0, gy1), g(gx1, gy1), fx, fy);
+            }
+        });
+        out
+    }
+
+    /// hadou's resolve: exact squared distance transforms (with nearest-pixel indices) of the umbra
+    /// and the lit pixels give every penumbra pixel its nearest of each; with the depth-aware
+    /// search a nearest pixel on another surface sends that pixel to [`Search::ring_search`] from
+    /// `⌊d/√2⌋` (no counting pixel is nearer), so the answer is the faithful `N = 1` one.
+    fn exact(&self) -> Vec<f32> {
+        let (w, h) = (self.input.width, self.input.height);
+        let (du, fu) = edt(self.class, Class::Umbra, w, h);
+        let (dl, fl) = edt(self.class, Class::Lit, w, h);
+        let mut out = vec![0.0f32; w * h];
+        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                let i = y * w + x;
+                let c = self.class[i];
+                if c != Class::Penumbra {
+                    *o = plain(c);
+                    continue;
+                }
+                let fix = |d2: f32, f: u32, want: Class| -> f32 {
+                    if d2 == FAR || d2 > R2 && !self.depth_aware {
+                        return FAR;
+                    }
+                    if !self.depth_aware || self.counts(i, f as usize, want) {
+                        return if d2 <= R2 { d2 } else { FAR };
+                    }
+                    let start = (d2.sqrt() * std::f32::consts::FRAC_1_SQRT_2).floor() as u32;
+                    if start > SEARCH_RADIUS {
+                        return FAR;
+                    }
+                    self.ring_search(i, want, start)
+                };
+                let d1 = fix(du[i], fu[i], Class::Umbra);
+                let d2 = fix(dl[i], fl[i], Class::Lit);
+                *o = penumbra_brightness(d1.sqrt(), d2.sqrt());
+            }
+        });
+        out
+    }
+}
+
+/// The exact squared Euclidean distance transform of the pixels of class `want`, with the index of
+/// a nearest such pixel (`u32::MAX` where none): Felzenszwalb–Huttenlocher's two passes, columns
+/// in parallel into a transposed buffer, then rows in parallel.
+fn edt(class: &[Class], want: Class, w: usize, h: usize) -> (Vec<f32>, Vec<u32>) {
+    // Columns: `col[x·h + y]`, `row_of[x·h + y]` the feature's row.
+    let mut col = vec![0.0f32; w * h];
+    let mut row_of = vec![0u32; w * h];
+    col.par_chunks_mut(h).zip(row_of.par_chunks_mut(h)).enumerate().for_each_init(
+        || (Envelope::new(h), vec![0.0f32; h]),
+        |(env, line), (x, (out, arg))| {
+            for (y, l) in line.iter_mut().enumerate() {
+                *l = if class[y * w + x] == want { 0.0 } else { FAR };
+            }
+            env.transform(line, out, arg);
+        },
+    );
+    let mut d2 = vec![0.0f32; w * h];
+    let mut feat = vec![u32::MAX; w * h];
+    d2.par_chunks_mut(w).zip(feat.par_chunks_mut(w)).enumerate().for_each_init(
+        || (Envelope::new(w), vec![0.0f32; w], vec![0u32; w]),
+        |(env, line, arg), (y, (out, f))| {
+            for (x, l) in line.iter_mut().enumerate() {
+                *l = col[x * h + y];
+            }
+            env.transform(line, out, arg);
+            for (x, fo) in f.iter_mut().enumerate() {
+                let p = arg[x];
+                if p != u32::MAX && out[x] != FAR {
+                    let r = row_of[p as usize * h + y];
+                    *fo = r * w as u32 + p;
+                }
+            }
+        },
+    );
+    (d2, feat)
+}
+
+/// The ground truth of a frame's soft shadow: the fraction of `samples` points of a disc of radius
+/// `radius` centred at the light's `L` and facing the point of interest (golden-angle spiral,
+/// equal areas) from which each pixel's point is visible, each by its own `map_size²` shadow map
+/// (the same bias as the two-map method). Slow: for measuring against, not for rendering.
+pub fn truth(
+    frame: &Frame,
+    light: &AreaLight,
+    input: &SoftInput,
+    radius: f32,
+    samples: u32,
+    map_size: u32,
+) -> Vec<f32> {
+    let axis = (light.interest - light.position).normalize_or(-Vec3f::Y);
+    let (u, v) = axis.orthonormal_basis();
+    let mut lit = vec![0u32; input.points.len()];
+    let corners = corners(frame);
+    for k in 0..samples {
+        let (px, py) = spiral(k, samples);
+        let eye = light.position + u * (px * radius) + v * (py * radius);
+        let map = SpotDepth::render(frame, &SpotMap::look(eye, light.interest, &corners), map_size);
+        lit.par_iter_mut().zip(&input.points).with_min_len(4096).for_each(|(l, p)| {
+            if let Some(p) = p {
+                if !map.shadowed(p.world, p.normal) {
+                    *l += 1;
+                }
+            }
+        });
+    }
+    lit.into_iter().map(|l| l as f32 / samples.max(1) as f32).collect()
+}
+
+/// Point `k` of `n` of a golden-angle spiral on the unit disc (equal areas).
+fn spiral(k: u32, n: u32) -> (f32, f32) {
+    let r = ((k as f32 + 0.5) / n.max(1) as f32).sqrt();
+    let a = k as f32 * 2.399_963_2;
+    (r * a.cos(), r * a.sin())
+}
+
+/// The corners of every object's bounding box (what a [`SpotMap`]'s frustum must enclose).
+fn corners(frame: &Frame) -> Vec<Vec3f> {
+    let mut out = Vec::new();
+    for o in &frame.objects {
+        if let Some((lo, hi)) = hadou_scene::object_bounds(o) {
+            for i in 0..8 {
+                out.push(Vec3f::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Percentage-closer soft shadows as commonly shipped, for comparison: one shadow map from the
+/// light centre `L` (`light.map_size²`); for a point at map depth `z_r`, a blocker search with 16
+/// samples over the map region through which a disc light of radius `radius` could be hidden
+/// (radius `R·(1/z_min − 1/z_r)` in tangent units, `z_min` the map's nearest depth), the average
+/// blocker depth `z_b`, then 16 filter samples over the penumbra `R·(1/z_b − 1/z_r)`; the same
+/// bias as the two-map method. Samples on a golden-angle spiral.
+pub fn pcss(frame: &Frame, light: &AreaLight, input: &SoftInput, radius: f32) -> Vec<f32> {
+    let map = SpotDepth::render(
+        frame,
+        &SpotMap::look(light.position, light.interest, &corners(frame)),
+        light.map_size,
+    );
+    let z_min = map.depth.iter().copied().fold(f32::INFINITY, f32::min);
+    let m = map.map;
+    let size = map.size as f32;
+    let taps: Vec<(f32, f32)> = (0..16).map(|k| spiral(k, 16)).collect();
+    input
+        .points
+        .par_iter()
+        .with_min_len(1024)
+        .map(|p| {
+            let Some(p) = p else { return 0.0 };
+            let Some((x, y, z)) = m.lookup(p.world, p.normal, map.size) else { return 0.0 };
+            let _ = (x, y);
+            // The looked-up point in tangent units.
+            let q = p.world + p.normal * m.texel(m.to_view(p.world).z.abs(), map.size);
+            let v = m.to_view(q);
+            let (su, sv) = (v.x / v.z, v.y / v.z);
+            let to_texel = |tu: f32, tv: f32| {
+                let s = (tu / m.tan_half + 1.0) * 0.5;
+                let t = (tv / m.tan_half + 1.0) * 0.5;
+                ((s * size).floor() as i64, ((1.0 - t) * size).floor() as i64)
+            };
+            let search = (radius * (1.0 / z_min - 1.0 / z)).max(0.0);
+            let (mut sum, mut count) = (0.0f32, 0u32);
+            for &(a, b) in &taps {
+                let (tx, ty) = to_texel(su + a * search, sv + b * search);
+                let d = map.at(tx, ty);
+                if m.occludes(d, z, map.size) {
+                    sum += d;
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                return 1.0;
+            }
+            let zb = sum / count as f32;
+            let pen = (radius * (1.0 / zb - 1.0 / z)).max(0.0);
+            let lit = taps
+                .iter()
+                .filter(|&&(a, b)| {
+                    let (tx, ty) = to_texel(su + a * pen, sv + b * pen);
+                    !m.occludes(map.at(tx, ty), z, map.size)
+                })
+                .count();
+            lit as f32 / taps.len() as f32
+        })
+        .collect()
+}
