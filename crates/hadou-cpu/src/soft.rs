@@ -259,34 +259,56 @@ impl Search<'_> {
     /// and the lit pixels give every penumbra pixel its nearest of each; with the depth-aware
     /// search a nearest pixel on another surface sends that pixel to [`Search::ring_search`] from
     /// `⌊d/√2⌋` (no counting pixel is nearer), so the answer is the faithful `N = 1` one.
+    ///
+    /// The transforms cover only the penumbra's bounding box widened by [`MARGIN`] pixels: a
+    /// nearest pixel found there at distance `d` is the nearest of the whole image when `d` is at
+    /// most the distance `b` to the box's edge (image edges aside); otherwise every pixel nearer
+    /// than `b` lies in the box and was not one, so the ring search starts at `⌊b/√2⌋`.
     fn exact(&self) -> Vec<f32> {
         let (w, h) = (self.input.width, self.input.height);
-        let (du, fu) = edt(self.class, Class::Umbra, w, h);
-        let (dl, fl) = edt(self.class, Class::Lit, w, h);
-        let mut out = vec![0.0f32; w * h];
-        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (x, o) in row.iter_mut().enumerate() {
+        let mut out: Vec<f32> = self.class.par_iter().with_min_len(4096).map(|&c| plain(c)).collect();
+        let Some(rect) = penumbra_box(self.class, w, h) else { return out };
+        let (du, fu) = edt(self.class, Class::Umbra, w, &rect);
+        let (dl, fl) = edt(self.class, Class::Lit, w, &rect);
+        let bw = rect.x1 - rect.x0;
+        out.par_chunks_mut(w).enumerate().skip(rect.y0).take(rect.y1 - rect.y0).for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate().skip(rect.x0).take(bw) {
                 let i = y * w + x;
-                let c = self.class[i];
-                if c != Class::Penumbra {
-                    *o = plain(c);
+                if self.class[i] != Class::Penumbra {
                     continue;
                 }
+                let b = (y - rect.y0) * bw + (x - rect.x0);
+                // Distance to the nearest pixel outside the box (infinite where the box is the image).
+                let edge = [
+                    (rect.x0 > 0).then(|| x - rect.x0 + 1),
+                    (rect.x1 < w).then(|| rect.x1 - x),
+                    (rect.y0 > 0).then(|| y - rect.y0 + 1),
+                    (rect.y1 < h).then(|| rect.y1 - y),
+                ]
+                .into_iter()
+                .flatten()
+                .min();
+                let b2 = edge.map_or(FAR, |e| (e * e) as f32);
                 let fix = |d2: f32, f: u32, want: Class| -> f32 {
-                    if d2 == FAR || d2 > R2 && !self.depth_aware {
-                        return FAR;
-                    }
-                    if !self.depth_aware || self.counts(i, f as usize, want) {
-                        return if d2 <= R2 { d2 } else { FAR };
-                    }
-                    let start = (d2.sqrt() * std::f32::consts::FRAC_1_SQRT_2).floor() as u32;
+                    let start = if d2 <= b2 {
+                        if d2 == FAR {
+                            return FAR;
+                        }
+                        if !self.depth_aware || self.counts(i, f as usize, want) {
+                            return if d2 <= R2 { d2 } else { FAR };
+                        }
+                        d2
+                    } else {
+                        b2
+                    };
+                    let start = (start.sqrt() * std::f32::consts::FRAC_1_SQRT_2).floor() as u32;
                     if start > SEARCH_RADIUS {
                         return FAR;
                     }
                     self.ring_search(i, want, start)
                 };
-                let d1 = fix(du[i], fu[i], Class::Umbra);
-                let d2 = fix(dl[i], fl[i], Class::Lit);
+                let d1 = fix(du[b], fu[b], Class::Umbra);
+                let d2 = fix(dl[b], fl[b], Class::Lit);
                 *o = penumbra_brightness(d1.sqrt(), d2.sqrt());
             }
         });
@@ -294,36 +316,96 @@ impl Search<'_> {
     }
 }
 
-/// The exact squared Euclidean distance transform of the pixels of class `want`, with the index of
-/// a nearest such pixel (`u32::MAX` where none): Felzenszwalb–Huttenlocher's two passes, columns
-/// in parallel into a transposed buffer, then rows in parallel.
-fn edt(class: &[Class], want: Class, w: usize, h: usize) -> (Vec<f32>, Vec<u32>) {
-    // Columns: `col[x·h + y]`, `row_of[x·h + y]` the feature's row.
-    let mut col = vec![0.0f32; w * h];
-    let mut row_of = vec![0u32; w * h];
-    col.par_chunks_mut(h).zip(row_of.par_chunks_mut(h)).enumerate().for_each_init(
-        || (Envelope::new(h), vec![0.0f32; h]),
-        |(env, line), (x, (out, arg))| {
-            for (y, l) in line.iter_mut().enumerate() {
-                *l = if class[y * w + x] == want { 0.0 } else { FAR };
+/// A rectangle of pixels `[x0, x1) × [y0, y1)`.
+struct Rect {
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    y1: usize,
+}
+
+/// How far the exact resolve's distance transforms reach beyond the penumbra's bounding box, in
+/// pixels (a speed setting: any value gives the same result).
+pub const MARGIN: usize = 64;
+
+/// The bounding box of the penumbra pixels widened by [`MARGIN`] and clipped to the image;
+/// `None` without penumbra pixels.
+fn penumbra_box(class: &[Class], w: usize, h: usize) -> Option<Rect> {
+    let rows = class
+        .par_chunks(w)
+        .enumerate()
+        .filter_map(|(y, row)| {
+            let first = row.iter().position(|&c| c == Class::Penumbra)?;
+            let last = row.iter().rposition(|&c| c == Class::Penumbra)?;
+            Some((y, first, last))
+        })
+        .collect::<Vec<_>>();
+    let r = MARGIN;
+    let (y0, y1) = (rows.first()?.0, rows.last()?.0);
+    let x0 = rows.iter().map(|t| t.1).min()?;
+    let x1 = rows.iter().map(|t| t.2).max()?;
+    Some(Rect {
+        x0: x0.saturating_sub(r),
+        x1: (x1 + r + 1).min(w),
+        y0: y0.saturating_sub(r),
+        y1: (y1 + r + 1).min(h),
+    })
+}
+
+/// The exact squared Euclidean distance transform, within `rect`, of its pixels of class `want`,
+/// with the image index of a nearest such pixel (`u32::MAX` where none); both row-major over the
+/// rectangle. Felzenszwalb–Huttenlocher's two passes, columns in parallel into a transposed
+/// buffer (for a binary image the column pass is the distance to the nearest feature pixel of the
+/// column: two sweeps, the upper one on ties), then rows in parallel (the lower envelope).
+fn edt(class: &[Class], want: Class, w: usize, rect: &Rect) -> (Vec<f32>, Vec<u32>) {
+    let (bw, bh) = (rect.x1 - rect.x0, rect.y1 - rect.y0);
+    // Columns: `col[x·bh + y]`, `row_of[x·bh + y]` the feature's row (both within the rectangle).
+    let mut col = vec![0.0f32; bw * bh];
+    let mut row_of = vec![0u32; bw * bh];
+    col.par_chunks_mut(bh).zip(row_of.par_chunks_mut(bh)).enumerate().for_each(|(x, (out, arg))| {
+        let is = |y: usize| class[(rect.y0 + y) * w + rect.x0 + x] == want;
+        // Downwards: the nearest feature at or above.
+        let mut last: Option<usize> = None;
+        for y in 0..bh {
+            if is(y) {
+                last = Some(y);
             }
-            env.transform(line, out, arg);
-        },
-    );
-    let mut d2 = vec![0.0f32; w * h];
-    let mut feat = vec![u32::MAX; w * h];
-    d2.par_chunks_mut(w).zip(feat.par_chunks_mut(w)).enumerate().for_each_init(
-        || (Envelope::new(w), vec![0.0f32; w], vec![0u32; w]),
+            arg[y] = last.map_or(u32::MAX, |l| l as u32);
+        }
+        // Upwards: a nearer feature below replaces it (strictly nearer: ties keep the upper one).
+        let mut next: Option<usize> = None;
+        for y in (0..bh).rev() {
+            if is(y) {
+                next = Some(y);
+            }
+            let up = (arg[y] != u32::MAX).then(|| y - arg[y] as usize);
+            match (up, next) {
+                (Some(u), Some(n)) if n - y < u => arg[y] = n as u32,
+                (None, Some(n)) => arg[y] = n as u32,
+                _ => {}
+            }
+            out[y] = if arg[y] == u32::MAX {
+                FAR
+            } else {
+                let d = y as f32 - arg[y] as f32;
+                d * d
+            };
+        }
+    });
+    let mut d2 = vec![0.0f32; bw * bh];
+    let mut feat = vec![u32::MAX; bw * bh];
+    d2.par_chunks_mut(bw).zip(feat.par_chunks_mut(bw)).enumerate().for_each_init(
+        || (Envelope::new(bw), vec![0.0f32; bw], vec![0u32; bw]),
         |(env, line, arg), (y, (out, f))| {
             for (x, l) in line.iter_mut().enumerate() {
-                *l = col[x * h + y];
+                *l = col[x * bh + y];
             }
             env.transform(line, out, arg);
             for (x, fo) in f.iter_mut().enumerate() {
                 let p = arg[x];
                 if p != u32::MAX && out[x] != FAR {
-                    let r = row_of[p as usize * h + y];
-                    *fo = r * w as u32 + p;
+                    let r = row_of[p as usize * bh + y] as usize;
+                    *fo = ((rect.y0 + r) * w + rect.x0 + p as usize) as u32;
                 }
             }
         },

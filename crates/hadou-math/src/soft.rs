@@ -246,9 +246,9 @@ impl SpotMap {
         if n.dot(self.eye - p) <= 0.0 {
             return None;
         }
-        let z0 = self.to_view(p).z;
-        let q = p + n * self.texel(z0.abs(), size);
-        let v = self.to_view(q);
+        let v0 = self.to_view(p);
+        let off = self.texel(v0.z.abs(), size);
+        let v = v0 + Vec3f::new(n.dot(self.right), n.dot(self.up), n.dot(self.forward)) * off;
         if !(v.z > self.near) {
             return Some((-1, -1, v.z));
         }

@@ -703,3 +703,210 @@ impl ToonTable {
         })
     }
 }
+
+/// The scene of the soft-shadow table and the time it is taken at: 003's penumbra close-up (a
+/// pillar on a floor under a lamp-sized light).
+pub const SOFT_SCENE: (&str, f32) = ("soft-gradient.toml", 0.0);
+/// Points of the true disc light in the ground truth (each its own shadow map).
+pub const TRUTH_SAMPLES: u32 = 128;
+/// Shadow-map edge of the ground truth's maps.
+pub const TRUTH_MAP: u32 = 2048;
+
+/// The methods of the soft-shadow table, in order: 003's faithful resolve at N = 1, 3, 5, 10,
+/// hadou's exact resolve, and PCSS.
+pub const SOFT_METHODS: [&str; 6] =
+    ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact", "pcss"];
+
+/// One row of the soft-shadow table.
+#[derive(Clone, Debug)]
+pub struct SoftRow {
+    /// One of [`SOFT_METHODS`], or `frame` (the whole render with the scene's own resolve, by the
+    /// bench's backend) and `frame-unlit` (the same without the area light).
+    pub method: String,
+    /// Image side in pixels.
+    pub size: u32,
+    /// Median milliseconds: the soft-shadow stage (its maps, the classes and the resolve, on the
+    /// CPU) for the methods; the whole frame for the `frame` rows.
+    pub ms: f64,
+    /// Mean per-pixel visibility difference from the ground truth over the shadow-edge pixels
+    /// (`None` for the `frame` rows).
+    pub mean_error: Option<f64>,
+    /// 99th percentile of the same.
+    pub p99_error: Option<f64>,
+}
+
+/// The soft-shadow table.
+#[derive(Clone, Debug)]
+pub struct SoftTable {
+    /// The scene file.
+    pub scene: String,
+    /// Repetitions per timed cell.
+    pub iterations: u32,
+    /// The true disc light's radius (world units).
+    pub disc_radius: f32,
+    /// Backend of the `frame` rows.
+    pub backend: String,
+    /// Rows, by size then method.
+    pub rows: Vec<SoftRow>,
+}
+
+/// The disc radius the ground truth and PCSS use for `frame`'s area light: 003's two maps at
+/// `L ± l·P` give the penumbra of a disc of radius `l·r·D/(D² − l²)` at a silhouette `r` off the
+/// axis ([`hadou_math::soft::implied_disc_radius`]), `D = |L − G|` and `r` the bounding radius of
+/// the object whose centre is nearest `G` (the point of interest's object).
+pub fn soft_disc_radius(frame: &Frame) -> Option<f32> {
+    let light = frame.area_light.as_ref()?;
+    let d = (light.position - light.interest).length();
+    let r = frame
+        .objects
+        .iter()
+        .filter_map(hadou_scene::object_bounds)
+        .map(|(lo, hi)| (((lo + hi) * 0.5 - light.interest).length(), (hi - lo).length() * 0.5))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(light.size, |(_, r)| r);
+    Some(hadou_math::soft::implied_disc_radius(light.size, r, d))
+}
+
+/// Mean and 99th percentile of `|v − truth|` over the shadow-edge pixels: those with a visible
+/// point where either value lies strictly between 0 and 1 or the two differ.
+pub fn soft_errors(v: &[f32], truth: &[f32], visible: &[bool]) -> (f64, f64) {
+    let mut e: Vec<f64> = v
+        .iter()
+        .zip(truth)
+        .zip(visible)
+        .filter(|((&a, &b), &vis)| vis && ((a > 0.0 && a < 1.0) || (b > 0.0 && b < 1.0) || a != b))
+        .map(|((&a, &b), _)| f64::from((a - b).abs()))
+        .collect();
+    if e.is_empty() {
+        return (0.0, 0.0);
+    }
+    e.sort_by(f64::total_cmp);
+    let mean = e.iter().sum::<f64>() / e.len() as f64;
+    let p99 = e[((e.len() - 1) as f64 * 0.99).round() as usize];
+    (mean, p99)
+}
+
+/// Measures the soft-shadow table: [`SOFT_SCENE`] at each size, every method's soft-shadow stage
+/// on the CPU against the ground truth ([`hadou_cpu::soft::truth`]), then the whole frame by
+/// `time` with and without the area light, all in one run. `progress` hears what is being done.
+pub fn soft_table(
+    time: &mut Timer<'_>,
+    scenes: &Path,
+    sizes: &[u32],
+    iterations: u32,
+    backend: &str,
+    progress: &mut dyn FnMut(&str),
+) -> Result<SoftTable, RenderError> {
+    use hadou_cpu::soft;
+    use hadou_scene::SoftResolve;
+    let (file, t) = SOFT_SCENE;
+    let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut rows = Vec::new();
+    let mut disc_radius = 0.0;
+    for &size in sizes {
+        let mut frame = scene.at(t);
+        frame.width = size;
+        frame.height = size;
+        let light = frame
+            .area_light
+            .clone()
+            .ok_or_else(|| RenderError::Other(format!("{file} has no [area_light]")))?;
+        let radius = soft_disc_radius(&frame).unwrap_or(light.size);
+        disc_radius = radius;
+        progress(&format!("{size}²: visible points"));
+        let input = soft::soft_input(&frame).ok_or_else(|| RenderError::Other("no area light".into()))?;
+        progress(&format!("{size}²: ground truth ({TRUTH_SAMPLES} shadow maps of {TRUTH_MAP}²)"));
+        let truth = soft::truth(&frame, &light, &input, radius, TRUTH_SAMPLES, TRUTH_MAP);
+        let visible: Vec<bool> = input.points.iter().map(Option::is_some).collect();
+        for method in SOFT_METHODS {
+            progress(&format!("{size}²: {method}"));
+            let resolve = match method {
+                "exact" => Some(SoftResolve::Exact),
+                "pcss" => None,
+                m => {
+                    Some(SoftResolve::Faithful { n: m.trim_start_matches("faithful-n").parse().unwrap_or(1) })
+                }
+            };
+            let mut out = Vec::new();
+            let mut run = |_: &Frame| -> Result<(), RenderError> {
+                out = match resolve {
+                    Some(r) => soft::visibility(&frame, &light, &input, r),
+                    None => soft::pcss(&frame, &light, &input, radius),
+                };
+                Ok(())
+            };
+            let ms = median_ms(&mut run, &frame, iterations)?;
+            let (mean, p99) = soft_errors(&out, &truth, &visible);
+            rows.push(SoftRow {
+                method: method.into(),
+                size,
+                ms,
+                mean_error: Some(mean),
+                p99_error: Some(p99),
+            });
+        }
+        progress(&format!("{size}²: whole frames"));
+        let unlit = Frame { area_light: None, ..frame.clone() };
+        for (method, f) in [("frame", &frame), ("frame-unlit", &unlit)] {
+            rows.push(SoftRow {
+                method: method.into(),
+                size,
+                ms: time(f, iterations)?,
+                mean_error: None,
+                p99_error: None,
+            });
+        }
+    }
+    Ok(SoftTable { scene: file.into(), iterations, disc_radius, backend: backend.into(), rows })
+}
+
+impl SoftTable {
+    /// The table as plain text.
+    pub fn to_text(&self) -> String {
+        let mut out = format!(
+            "soft shadows, scene {} ({} runs, median; stage = maps + classes + resolve on the CPU; error = |visibility − \
+             truth| on shadow-edge pixels, truth = disc of radius {:.4} by {TRUTH_SAMPLES} maps of {TRUTH_MAP}²)\n\
+             {:<14} {:>6} {:>10} {:>9} {:>11} {:>10}\n",
+            self.scene, self.iterations, self.disc_radius, "method", "size", "ms", "fps", "mean error", "p99 error"
+        );
+        for r in &self.rows {
+            let err = |e: Option<f64>| e.map_or("—".to_string(), |e| format!("{e:.4}"));
+            let label = match r.method.as_str() {
+                "frame" => format!("frame ({})", self.backend),
+                "frame-unlit" => "  no area light".into(),
+                m => m.into(),
+            };
+            out += &format!(
+                "{:<14} {:>6} {:>10.2} {:>9.1} {:>11} {:>10}\n",
+                label,
+                format!("{}²", r.size),
+                r.ms,
+                1e3 / r.ms,
+                err(r.mean_error),
+                err(r.p99_error)
+            );
+        }
+        out
+    }
+
+    /// The table as JSON: `rows` of `{method, size, ms, fps, mean_error, p99_error}`.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "table": "shadows",
+            "scene": self.scene,
+            "iterations": self.iterations,
+            "disc_radius": self.disc_radius,
+            "truth_samples": TRUTH_SAMPLES,
+            "truth_map": TRUTH_MAP,
+            "backend": self.backend,
+            "rows": self.rows.iter().map(|r| serde_json::json!({
+                "method": r.method,
+                "size": r.size,
+                "ms": r.ms,
+                "fps": 1e3 / r.ms,
+                "mean_error": r.mean_error,
+                "p99_error": r.p99_error,
+            })).collect::<Vec<_>>(),
+        })
+    }
+}

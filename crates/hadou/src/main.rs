@@ -85,6 +85,8 @@ enum BenchTable {
     Curves,
     /// The toon scene (character, props, ground, wave light, outlines, textures), full and plain.
     Toon,
+    /// Soft shadows (003): faithful N = 1, 3, 5, 10, exact and PCSS against a true disc light.
+    Shadows,
 }
 
 #[derive(Args, Debug)]
@@ -514,11 +516,13 @@ fn gpu_probe(backend: &mut dyn Backend, frame: &Frame, x: u32, y: u32) -> Result
 fn bench(a: BenchArgs) -> Result<(), Failure> {
     let curves = a.table == BenchTable::Curves;
     let toon = a.table == BenchTable::Toon;
+    let shadows = a.table == BenchTable::Shadows;
     let sizes = match (a.sizes.is_empty(), a.table) {
         (false, _) => a.sizes.clone(),
         (true, BenchTable::Analytic) => vec![512, 1024, 2048],
         (true, BenchTable::Curves) => vec![512],
         (true, BenchTable::Toon) => vec![256, 512, 1024],
+        (true, BenchTable::Shadows) => vec![512, 1024],
     };
     for &s in &sizes {
         check_size("--sizes", s)?;
@@ -527,7 +531,7 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
     if iterations == 0 {
         return Err(Failure::input("--iterations 0: need at least one timed repetition"));
     }
-    if (curves || toon) && !a.scenes.is_dir() {
+    if (curves || toon || shadows) && !a.scenes.is_dir() {
         return Err(Failure::input(format!(
             "--scenes {}: not a directory; run from the repository root or pass --scenes DIR",
             a.scenes.display()
@@ -548,17 +552,26 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
             })?;
         }
     }
-    if toon {
-        let file = hadou::bench::TOON_SCENE.0;
+    if toon || shadows {
+        let file = if toon { hadou::bench::TOON_SCENE.0 } else { hadou::bench::SOFT_SCENE.0 };
         Scene::load(a.scenes.join(file)).map_err(|e| {
             Failure::input(format!(
-                "--scenes {}: the toon bench needs the example scenes (scenes/ of the repository): {e}",
+                "--scenes {}: this bench needs the example scenes (scenes/ of the repository): {e}",
                 a.scenes.display()
             ))
         })?;
     }
     let (mut timer, name, method) = make_timer(a.backend)?;
-    let json = if toon {
+    let json = if shadows {
+        let bar = indicatif::ProgressBar::new_spinner();
+        let mut progress = |m: &str| bar.set_message(m.to_string());
+        let t = hadou::bench::soft_table(&mut *timer, &a.scenes, &sizes, iterations, &name, &mut progress)?;
+        bar.finish_and_clear();
+        if !a.json {
+            print!("{}", t.to_text());
+        }
+        t.to_json()
+    } else if toon {
         let t = hadou::bench::toon_table(&mut *timer, &a.scenes, &sizes, iterations, &name, &method)?;
         if !a.json {
             print!("{}", t.to_text());
