@@ -1,0 +1,255 @@
+//! Soft shadows from the `[area_light]` on the CPU reference (003, SPEC.md §4): the classes agree
+//! with exact shadow rays to `L₁` and `L₂`, the exact resolve equals a brute-force nearest search
+//! under the same rules and the faithful resolve at `N = 1`, the faithful grid pixels carry the
+//! searched values, the depth-aware search changes the failure case it is for, the light adds its
+//! term only where visible, and nothing is ever NaN.
+
+use hadou_cpu::soft::{classify, pcss, soft_input, truth, visibility, SoftInput, SpotDepth};
+use hadou_math::soft::{penumbra_brightness, same_surface, Class, SEARCH_RADIUS};
+use hadou_math::{Vec3, Vec3f};
+use hadou_scene::{Frame, Scene, SoftResolve};
+use std::path::Path;
+
+fn scene_dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+/// Example scene `name` at time `t`, `size²` pixels.
+fn example(name: &str, t: f32, size: u32) -> Frame {
+    let s = Scene::load(scene_dir().join(name)).unwrap_or_else(|e| panic!("{e}"));
+    let mut f = s.at(t);
+    f.width = size;
+    f.height = size;
+    f
+}
+
+fn soft_scenes() -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(scene_dir())
+        .expect("scenes/")
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.starts_with("soft-") && n.ends_with(".toml"))
+        .collect();
+    v.sort();
+    assert!(v.len() >= 6, "the soft-* example scenes: {v:?}");
+    v
+}
+
+fn classes(f: &Frame, input: &SoftInput) -> Vec<Class> {
+    let light = f.area_light.as_ref().expect("area light");
+    let maps = light.maps.map(|m| SpotDepth::render(f, &m, light.map_size));
+    classify(&maps, input)
+}
+
+/// Brute force of the resolve's definition: the nearest pixel of class `want` within
+/// `SEARCH_RADIUS` (on the same surface when depth-aware), by trying every pixel.
+fn brute_nearest(input: &SoftInput, class: &[Class], i: usize, want: Class, aware: bool) -> f32 {
+    let w = input.width as i64;
+    let (x, y) = (i as i64 % w, i as i64 / w);
+    let p = input.points[i].expect("penumbra pixels have points");
+    let mut best = f32::INFINITY;
+    for (j, c) in class.iter().enumerate() {
+        if *c != want {
+            continue;
+        }
+        let (u, v) = (j as i64 % w, j as i64 / w);
+        let d2 = ((u - x).pow(2) + (v - y).pow(2)) as f32;
+        if d2 > (SEARCH_RADIUS * SEARCH_RADIUS) as f32 || d2 >= best {
+            continue;
+        }
+        if aware && !input.points[j].is_some_and(|q| same_surface(p.world, p.normal, q.world)) {
+            continue;
+        }
+        best = d2;
+    }
+    best
+}
+
+#[test]
+fn exact_resolve_is_the_brute_force_nearest_search_and_faithful_n1() {
+    for name in soft_scenes() {
+        for aware in [true, false] {
+            let mut f = example(&name, 0.0, 72);
+            let light = f.area_light.as_mut().unwrap();
+            light.depth_aware = aware;
+            let light = light.clone();
+            let input = soft_input(&f).unwrap();
+            let class = classes(&f, &input);
+            let exact = visibility(&f, &light, &input, SoftResolve::Exact);
+            let n1 = visibility(&f, &light, &input, SoftResolve::Faithful { n: 1 });
+            assert_eq!(exact, n1, "{name}: exact ≠ faithful N = 1");
+            let mut penumbra = 0;
+            for (i, c) in class.iter().enumerate() {
+                let want = match c {
+                    Class::Penumbra => {
+                        penumbra += 1;
+                        let d1 = brute_nearest(&input, &class, i, Class::Umbra, aware);
+                        let d2 = brute_nearest(&input, &class, i, Class::Lit, aware);
+                        penumbra_brightness(d1.sqrt(), d2.sqrt())
+                    }
+                    Class::Lit => 1.0,
+                    _ => 0.0,
+                };
+                assert_eq!(exact[i], want, "{name} (depth-aware {aware}): pixel {i}");
+            }
+            assert!(penumbra > 0 || name.contains("small"), "{name}: no penumbra at 72²");
+        }
+    }
+}
+
+#[test]
+fn faithful_grid_pixels_carry_the_searched_values() {
+    let f = example("soft-gradient.toml", 0.0, 96);
+    let light = f.area_light.clone().unwrap();
+    let input = soft_input(&f).unwrap();
+    let exact = visibility(&f, &light, &input, SoftResolve::Exact);
+    for n in [3usize, 5, 10] {
+        let v = visibility(&f, &light, &input, SoftResolve::Faithful { n: n as u32 });
+        let mut differs = 0;
+        for (i, (&a, &b)) in v.iter().zip(&exact).enumerate() {
+            let (x, y) = (i % 96, i / 96);
+            if x % n == 0 && y % n == 0 {
+                assert_eq!(a, b, "N = {n}: grid pixel ({x}, {y})");
+            }
+            assert!((0.0..=1.0).contains(&a), "N = {n}: {a}");
+            differs += usize::from(a != b);
+        }
+        assert!(differs > 0, "N = {n} interpolates: some off-grid pixel must differ from the exact value");
+    }
+}
+
+/// Whether the segment from `p` to `l` passes through the axis-aligned box `lo..hi`.
+fn blocked(p: Vec3f, l: Vec3f, lo: Vec3f, hi: Vec3f) -> bool {
+    let d = l - p;
+    let (mut t0, mut t1) = (1e-4f32, 1.0f32);
+    for k in 0..3 {
+        let (o, dk, a, b) = match k {
+            0 => (p.x, d.x, lo.x, hi.x),
+            1 => (p.y, d.y, lo.y, hi.y),
+            _ => (p.z, d.z, lo.z, hi.z),
+        };
+        if dk.abs() < 1e-12 {
+            if o < a || o > b {
+                return false;
+            }
+        } else {
+            let (u, v) = ((a - o) / dk, (b - o) / dk);
+            t0 = t0.max(u.min(v));
+            t1 = t1.min(u.max(v));
+        }
+    }
+    t0 <= t1
+}
+
+#[test]
+fn classes_agree_with_exact_shadow_rays_to_the_two_map_positions() {
+    // The pillar (a box 0.5 × 1.6 × 0.5 standing at the origin) shadows the floor: a floor pixel
+    // is umbra when both segments to L₁ and L₂ hit the box, penumbra when one does.
+    let f = example("soft-gradient.toml", 0.0, 128);
+    let light = f.area_light.clone().unwrap();
+    let (l1, l2) = (light.maps[0].eye, light.maps[1].eye);
+    let (lo, hi) = (Vec3::new(-0.25, 0.0, -0.25), Vec3::new(0.25, 1.6, 0.25));
+    let input = soft_input(&f).unwrap();
+    let class = classes(&f, &input);
+    let (mut floor, mut agree, mut counts) = (0, 0, [0usize; 4]);
+    for (p, c) in input.points.iter().zip(&class) {
+        let Some(p) = p else { continue };
+        if p.world.y.abs() > 1e-3 || p.world.x.abs().max(p.world.z.abs()) < 0.3 {
+            continue;
+        }
+        floor += 1;
+        let want = Class::of(blocked(p.world, l1, lo, hi), blocked(p.world, l2, lo, hi));
+        agree += usize::from(want == *c);
+        counts[want as usize] += 1;
+    }
+    assert!(counts[1] > 100 && counts[2] > 100 && counts[3] > 100, "umbra, penumbra, lit: {counts:?}");
+    // Disagreements are pixels within a map texel of a shadow edge (the maps' resolution and bias).
+    assert!(agree as f64 >= 0.985 * floor as f64, "{agree} of {floor} floor pixels agree");
+}
+
+#[test]
+fn the_nearer_map_casts_the_larger_shadow_and_the_penumbra_widens_away_from_the_pillar() {
+    let f = example("soft-gradient.toml", 0.0, 160);
+    let input = soft_input(&f).unwrap();
+    let class = classes(&f, &input);
+    // Floor pixels by distance from the pillar's footprint: the penumbra's share grows.
+    let (mut near, mut far) = ([0usize; 2], [0usize; 2]);
+    for (p, c) in input.points.iter().zip(&class) {
+        let Some(p) = p else { continue };
+        if p.world.y.abs() > 1e-3 || *c == Class::Lit {
+            continue;
+        }
+        let r = p.world.x.abs().max(p.world.z.abs());
+        let bucket = if r < 0.8 {
+            &mut near
+        } else if r > 1.6 {
+            &mut far
+        } else {
+            continue;
+        };
+        bucket[usize::from(*c == Class::Penumbra)] += 1;
+    }
+    let share = |b: [usize; 2]| b[1] as f64 / (b[0] + b[1]).max(1) as f64;
+    assert!(share(far) > 2.0 * share(near), "penumbra share near {near:?} far {far:?}");
+}
+
+#[test]
+fn depth_aware_search_removes_the_halo_of_an_object_in_front() {
+    let aware = example("soft-in-front.toml", 0.0, 256);
+    let naive = example("soft-in-front-naive.toml", 0.0, 256);
+    assert!(aware.area_light.as_ref().unwrap().depth_aware);
+    assert!(!naive.area_light.as_ref().unwrap().depth_aware);
+    let input = soft_input(&aware).unwrap();
+    let va = visibility(&aware, aware.area_light.as_ref().unwrap(), &input, SoftResolve::Exact);
+    let vn = visibility(&naive, naive.area_light.as_ref().unwrap(), &input, SoftResolve::Exact);
+    // The naive search lets the crate's pixels stand in for the floor's: floor penumbra pixels
+    // next to the crate's outline come out lighter or darker (003 Fig. 4.6).
+    let changed = va
+        .iter()
+        .zip(&vn)
+        .zip(&input.points)
+        .filter(|((a, n), p)| p.is_some_and(|p| p.world.y.abs() < 1e-3) && (**n - **a).abs() > 0.05)
+        .count();
+    assert!(changed > 20, "{changed} floor pixels change with the depth-aware search");
+}
+
+#[test]
+fn the_light_adds_its_term_where_visible_and_images_stay_finite() {
+    for name in soft_scenes() {
+        for t in [0.0, 1.0, 2.0] {
+            let f = example(&name, t, 64);
+            let img = hadou_cpu::render(&f);
+            assert!(img.color.iter().flatten().all(|c| c.is_finite()), "{name} at {t}");
+            let dark = hadou_cpu::render(&Frame { area_light: None, ..f.clone() });
+            let input = soft_input(&f).unwrap();
+            let light = f.area_light.as_ref().unwrap();
+            let v = visibility(&f, light, &input, light.resolve);
+            for (i, p) in input.points.iter().enumerate() {
+                let Some(p) = p else { continue };
+                for k in 0..3 {
+                    let want = dark.color[i][k] + v[i] * p.term[k];
+                    // Colour mapping is monotone: the umbra gets nothing, the rest no less.
+                    if v[i] == 0.0 || p.term[k] == 0.0 {
+                        assert_eq!(img.color[i][k], dark.color[i][k], "{name} pixel {i}");
+                    } else {
+                        assert!(img.color[i][k] >= dark.color[i][k], "{name} pixel {i}: {want}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn references_are_bounded_and_truth_tends_to_the_hard_shadow() {
+    let f = example("soft-gradient.toml", 0.0, 64);
+    let light = f.area_light.clone().unwrap();
+    let input = soft_input(&f).unwrap();
+    let p = pcss(&f, &light, &input, 0.1);
+    assert!(p.iter().all(|v| (0.0..=1.0).contains(v)));
+    let t = truth(&f, &light, &input, 0.1, 16, 512);
+    assert!(t.iter().all(|v| (0.0..=1.0).contains(v)));
+    assert!(t.iter().any(|&v| v > 0.0 && v < 1.0), "a disc light has a penumbra");
+    // A disc of radius 0 is the point light at L: every point fully lit or fully dark.
+    let hard = truth(&f, &light, &input, 0.0, 4, 512);
+    assert!(hard.iter().all(|&v| v == 0.0 || v == 1.0));
+}
