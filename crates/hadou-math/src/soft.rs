@@ -382,4 +382,64 @@ mod tests {
         assert_eq!(l2, Vec3f::new(0.0, 3.5, 0.0));
         assert!(light_pair(Vec3f::ZERO, Vec3f::ZERO, 1.0).is_none());
     }
+
+    #[test]
+    fn envelope_argmin_is_a_nearest_feature() {
+        let f = [FAR, 0.0, FAR, FAR, 4.0, FAR, 0.0, FAR];
+        let (mut out, mut arg) = ([0.0f32; 8], [0u32; 8]);
+        Envelope::new(8).transform(&f, &mut out, &mut arg);
+        for q in 0..8 {
+            let best = (0..8)
+                .filter(|&p| f[p] != FAR)
+                .map(|p| (q as f32 - p as f32).powi(2) + f[p])
+                .fold(FAR, f32::min);
+            assert_eq!(out[q], best, "q = {q}");
+            let p = arg[q] as usize;
+            assert_eq!((q as f32 - p as f32).powi(2) + f[p], best, "q = {q}: argmin {p}");
+        }
+        let mut none = [0u32; 3];
+        Envelope::new(1).transform(&[FAR; 3], &mut [0.0; 3], &mut none);
+        assert_eq!(none, [u32::MAX; 3]);
+    }
+
+    #[test]
+    fn spot_map_encloses_the_corners_and_biases_by_texels() {
+        let corners = [Vec3f::new(-4.0, 0.0, -4.0), Vec3f::new(4.0, 0.0, 4.0), Vec3f::new(4.0, 2.0, -4.0)];
+        let m = SpotMap::look(Vec3f::new(0.0, 6.0, 0.0), Vec3f::ZERO, &corners);
+        for c in corners {
+            let v = m.to_view(c);
+            assert!(v.x.abs() <= v.z * m.tan_half && v.y.abs() <= v.z * m.tan_half, "{v:?}");
+        }
+        // A floor point facing the light looks up a texel inside the map; the underside does not.
+        let (x, y, z) = m.lookup(Vec3f::new(1.0, 0.0, 1.0), Vec3f::Y, 512).unwrap();
+        assert!((0..512).contains(&x) && (0..512).contains(&y) && z > 5.9, "{x} {y} {z}");
+        assert!(m.lookup(Vec3f::new(1.0, 0.0, 1.0), -Vec3f::Y, 512).is_none());
+        // Within the bias a surface does not shadow itself; a caster a metre nearer does.
+        assert!(!m.occludes(z - 0.5 * m.texel(z, 512), z, 512));
+        assert!(m.occludes(z - 1.0, z, 512));
+        // A light inside the objects' bounds takes the widest frustum.
+        let wide = SpotMap::look(Vec3f::new(0.0, 1.0, 0.0), Vec3f::ZERO, &corners);
+        assert_eq!(wide.tan_half, SPOT_MAX_TAN);
+    }
+
+    #[test]
+    fn implied_disc_matches_the_band_width_of_the_two_maps() {
+        // Edge at r = 0.5 off the axis at D = 4, receiver at D_r = 6, l = 0.5: the two shadows of
+        // the edge are 2·l·r·(D_r − D)/(D² − l²) apart, a disc of radius R gives 2·R·(D_r − D)/D.
+        let (l, r, d, dr) = (0.5f32, 0.5f32, 4.0f32, 6.0f32);
+        let two_maps = r * ((dr - l) / (d - l) - (dr + l) / (d + l));
+        let disc = 2.0 * implied_disc_radius(l, r, d) * (dr - d) / d;
+        assert!((two_maps - disc).abs() < 1e-6, "{two_maps} vs {disc}");
+        assert_eq!(implied_disc_radius(2.0, 1.0, 1.0), 2.0);
+    }
+
+    #[test]
+    fn classes_follow_the_two_verdicts() {
+        assert_eq!(Class::of(true, true), Class::Umbra);
+        assert_eq!(Class::of(true, false), Class::Penumbra);
+        assert_eq!(Class::of(false, true), Class::Penumbra);
+        assert_eq!(Class::of(false, false), Class::Lit);
+        assert!(same_surface(Vec3f::ZERO, Vec3f::Y, Vec3f::new(3.0, 0.5, 0.0)));
+        assert!(!same_surface(Vec3f::ZERO, Vec3f::Y, Vec3f::new(1.0, 1.0, 0.0)));
+    }
 }

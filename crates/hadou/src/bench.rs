@@ -709,8 +709,14 @@ impl ToonTable {
 pub const SOFT_SCENE: (&str, f32) = ("soft-gradient.toml", 0.0);
 /// Points of the true disc light in the ground truth (each its own shadow map).
 pub const TRUTH_SAMPLES: u32 = 128;
-/// Shadow-map edge of the ground truth's maps.
+/// Largest shadow-map edge of the ground truth's maps (four map texels per image pixel, at least
+/// 256, at most this).
 pub const TRUTH_MAP: u32 = 2048;
+
+/// The ground truth's map edge for an image of `size²`.
+pub fn truth_map(size: u32) -> u32 {
+    (4 * size).clamp(256, TRUTH_MAP)
+}
 
 /// The methods of the soft-shadow table, in order: 003's faithful resolve at N = 1, 3, 5, 10,
 /// hadou's exact resolve, and PCSS.
@@ -815,8 +821,9 @@ pub fn soft_table(
         disc_radius = radius;
         progress(&format!("{size}²: visible points"));
         let input = soft::soft_input(&frame).ok_or_else(|| RenderError::Other("no area light".into()))?;
-        progress(&format!("{size}²: ground truth ({TRUTH_SAMPLES} shadow maps of {TRUTH_MAP}²)"));
-        let truth = soft::truth(&frame, &light, &input, radius, TRUTH_SAMPLES, TRUTH_MAP);
+        let tm = truth_map(size);
+        progress(&format!("{size}²: ground truth ({TRUTH_SAMPLES} shadow maps of {tm}²)"));
+        let truth = soft::truth(&frame, &light, &input, radius, TRUTH_SAMPLES, tm);
         let visible: Vec<bool> = input.points.iter().map(Option::is_some).collect();
         for method in SOFT_METHODS {
             progress(&format!("{size}²: {method}"));
@@ -865,7 +872,7 @@ impl SoftTable {
     pub fn to_text(&self) -> String {
         let mut out = format!(
             "soft shadows, scene {} ({} runs, median; stage = maps + classes + resolve on the CPU; error = |visibility − \
-             truth| on shadow-edge pixels, truth = disc of radius {:.4} by {TRUTH_SAMPLES} maps of {TRUTH_MAP}²)\n\
+             truth| on shadow-edge pixels, truth = disc of radius {:.4} by {TRUTH_SAMPLES} maps of 4 texels a pixel)\n\
              {:<14} {:>6} {:>10} {:>9} {:>11} {:>10}\n",
             self.scene, self.iterations, self.disc_radius, "method", "size", "ms", "fps", "mean error", "p99 error"
         );
@@ -897,7 +904,7 @@ impl SoftTable {
             "iterations": self.iterations,
             "disc_radius": self.disc_radius,
             "truth_samples": TRUTH_SAMPLES,
-            "truth_map": TRUTH_MAP,
+            "truth_map_texels_per_pixel": 4,
             "backend": self.backend,
             "rows": self.rows.iter().map(|r| serde_json::json!({
                 "method": r.method,

@@ -580,3 +580,54 @@ fn an_interrupted_render_leaves_no_temporary_file() {
         assert!(!out.exists(), "{signal}: a partial output appeared");
     }
 }
+
+#[test]
+fn bench_shadows_prints_every_method_with_its_error() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let o = hadou(&[
+        "bench",
+        "shadows",
+        "--sizes",
+        "48",
+        "--iterations",
+        "1",
+        "--json",
+        "--backend",
+        "cpu",
+        "--scenes",
+        scenes.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    let rows = j["rows"].as_array().expect("rows");
+    for m in ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact", "pcss"] {
+        let r = rows.iter().find(|r| r["method"] == m).unwrap_or_else(|| panic!("no {m} row: {j}"));
+        assert_eq!(r["size"], 48);
+        assert!(r["ms"].as_f64().is_some_and(|v| v > 0.0), "{r}");
+        for k in ["mean_error", "p99_error"] {
+            assert!(r[k].as_f64().is_some_and(|v| (0.0..=1.0).contains(&v)), "{m} {k}: {r}");
+        }
+    }
+    // The exact resolve and the search at N = 1 are the same answer.
+    let err = |m: &str| rows.iter().find(|r| r["method"] == m).unwrap()["mean_error"].as_f64().unwrap();
+    assert_eq!(err("exact"), err("faithful-n1"));
+}
+
+#[test]
+fn area_light_probes_its_visibility_and_bad_ones_exit_2() {
+    let dir = tmpdir("area");
+    let light = "\n[[object]]\nname = \"floor\"\nkind = \"plane\"\nsize = [80.0, 80.0]\nposition = [0.0, -3.0, -20.0]\n\n[area_light]\nposition = [0.0, 20.0, -20.0]\nsize = 1.0\ntarget = \"cube\"\n";
+    let s = write_scene(&dir, &format!("{GOOD}{light}"));
+    let o = hadou(&["probe", s.to_str().unwrap(), "--pixel", "32,24"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    assert!(j["soft_visibility"].as_f64().is_some_and(|v| (0.0..=1.0).contains(&v)), "{j}");
+    let bad = write_scene(&dir, &format!("{GOOD}{light}").replace("size = 1.0", "size = 0.0"));
+    let out = dir.join("o.png");
+    let lines = format!("{GOOD}{light}").lines().position(|l| l == "size = 1.0").unwrap() + 1;
+    assert_exit_2(
+        &["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        &[&format!(":{lines}:8:"), "`size` in [area_light]"],
+    );
+    assert!(!out.exists());
+}
