@@ -114,13 +114,13 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let s1 = spot_shadowed(0u, world, n);
     let s2 = spot_shadowed(1u, world, n);
-    var class = CLASS_PENUMBRA;
+    var kind = CLASS_PENUMBRA;
     if (s1 && s2) {
-        class = CLASS_UMBRA;
+        kind = CLASS_UMBRA;
     } else if (!s1 && !s2) {
-        class = CLASS_LIT;
+        kind = CLASS_LIT;
     }
-    soft_world[gi] = vec4<u32>(bitcast<vec3<u32>>(world), class);
+    soft_world[gi] = vec4<u32>(bitcast<vec3<u32>>(world), kind);
     soft_normal[gi] = vec4<u32>(bitcast<vec3<u32>>(n), 0u);
 }
 
