@@ -91,7 +91,10 @@ impl GpuBackend {
     /// tests compare with hadou-cpu's `soft::classify` and `soft::visibility`. `None` without an
     /// area light.
     #[doc(hidden)]
-    pub fn render_soft(&mut self, frame: &Frame) -> Result<(Image, Option<(Vec<u8>, Vec<f32>)>), RenderError> {
+    pub fn render_soft(
+        &mut self,
+        frame: &Frame,
+    ) -> Result<(Image, Option<(Vec<u8>, Vec<f32>)>), RenderError> {
         let image = self.renderer.render(frame)?;
         let soft = self.renderer.read_soft(frame)?;
         Ok((image, soft))

@@ -642,7 +642,12 @@ impl Renderer {
                 .create_view(&Default::default())
             };
             let buffer = |label, size: u64, usage| {
-                d.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+                d.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
             };
             let pixels = frame.width as u64 * frame.height as u64;
             let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
@@ -650,7 +655,10 @@ impl Renderer {
             let spot = std::mem::size_of::<GpuSpotMap>() as u64;
             self.soft = Some(SoftTargets {
                 key,
-                spot_views: [texture("soft map 1", pipelines::SPOT_FORMAT), texture("soft map 2", pipelines::SPOT_FORMAT)],
+                spot_views: [
+                    texture("soft map 1", pipelines::SPOT_FORMAT),
+                    texture("soft map 2", pipelines::SPOT_FORMAT),
+                ],
                 spot_depth: texture("soft map depth", pipelines::MAP_FORMAT),
                 spot_uniforms: [buffer("soft map 1", spot, uniform), buffer("soft map 2", spot, uniform)],
                 uniforms: buffer("soft uniforms", std::mem::size_of::<SoftUniforms>() as u64, uniform),
@@ -693,13 +701,21 @@ impl Renderer {
                     resolve_target: None,
                     ops: wgpu::Operations {
                         // +∞ as f32 bits: no surface.
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r: f32::INFINITY.to_bits() as f64, g: 0.0, b: 0.0, a: 0.0 }),
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: f32::INFINITY.to_bits() as f64,
+                            g: 0.0,
+                            b: 0.0,
+                            a: 0.0,
+                        }),
                         store: wgpu::StoreOp::Store,
                     },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &soft.spot_depth,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Discard }),
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
@@ -730,9 +746,17 @@ impl Renderer {
         }
         let t = self.targets.as_ref().expect("targets are created in prepare");
         let soft = self.soft.as_ref().expect("created in ensure_soft");
-        let bg = soft.bind_group(d, &self.pipelines.soft_layout, &t.uniforms, &t.scene_view, &t.attributes_view, &t.output);
+        let bg = soft.bind_group(
+            d,
+            &self.pipelines.soft_layout,
+            &t.uniforms,
+            &t.scene_view,
+            &t.attributes_view,
+            &t.output,
+        );
         let (w, h) = (frame.width, frame.height);
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft resolve") });
+        let mut enc =
+            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft resolve") });
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_bind_group(0, &bg, &[]);
@@ -972,7 +996,14 @@ impl Renderer {
             }
         }
         let soft_bg = self.soft.as_ref().filter(|_| frame.area_light.is_some()).map(|soft| {
-            soft.bind_group(d, &self.pipelines.soft_layout, &t.uniforms, &t.scene_view, &t.attributes_view, &t.output)
+            soft.bind_group(
+                d,
+                &self.pipelines.soft_layout,
+                &t.uniforms,
+                &t.scene_view,
+                &t.attributes_view,
+                &t.output,
+            )
         });
         if classify {
             if let Some(bg) = &soft_bg {

@@ -66,8 +66,8 @@ pub fn compose(parts: &[&str]) -> String {
 mod tests {
     use super::*;
     use crate::layout::{
-        FrameUniforms, GpuCurve, GpuSpotMap, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuShadowCast, GpuTexture,
-        GpuWave,
+        FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuShadowCast, GpuSpotMap,
+        GpuTexture, GpuWave,
     };
     use std::mem::{offset_of, size_of};
 
@@ -146,8 +146,7 @@ mod tests {
         listed.sort();
         assert_eq!(on_disk, listed, "src/shaders/*.wgsl and shaders::FILES differ");
         for (name, text) in FILES {
-            let used =
-                RASTER_PARTS
+            let used = RASTER_PARTS
                 .iter()
                 .chain(WAVE_PARTS)
                 .chain(SHADOW_PARTS)
