@@ -104,8 +104,17 @@ pub struct FrameUniforms {
     pub map_count: u32,
     /// Number of plane casts (when 0 the wave pass does not read the plane-shadow target).
     pub plane_count: u32,
+    /// 1 when the frame has an `[area_light]`: the wave pass then reads each pixel's soft-shadow
+    /// visibility where it later writes the eye distance, and adds the area term (soft.wgsl).
+    pub area: u32,
+    /// The area light's centre `L`.
+    pub area_position: [f32; 3],
     /// Padding.
-    pub _pad2: u32,
+    pub _pad3: u32,
+    /// The area light's colour times intensity.
+    pub area_color: [f32; 3],
+    /// Padding.
+    pub _pad4: u32,
 }
 
 impl FrameUniforms {
@@ -146,7 +155,11 @@ impl FrameUniforms {
             cast_count: 0,
             map_count: 0,
             plane_count: 0,
-            _pad2: 0,
+            area: u32::from(frame.area_light.is_some()),
+            area_position: frame.area_light.as_ref().map_or([0.0; 3], |a| a.position.to_array()),
+            _pad3: 0,
+            area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
+            _pad4: 0,
         }
     }
 }
@@ -908,4 +921,58 @@ pub struct GpuVertex {
     pub color: [f32; 4],
     /// Material slot of the object.
     pub material: u32,
+}
+
+/// One of the `[area_light]`'s two perspective shadow maps (hadou_math::soft::SpotMap) and its
+/// edge in texels. Keep in sync with `GpuSpotMap` in common.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuSpotMap {
+    /// The map's light position.
+    pub eye: [f32; 3],
+    /// `tan` of the frustum's half-angle.
+    pub tan_half: f32,
+    /// Unit axis.
+    pub forward: [f32; 3],
+    /// Near plane distance.
+    pub near: f32,
+    /// Unit right.
+    pub right: [f32; 3],
+    /// Edge in texels.
+    pub size: u32,
+    /// Unit up.
+    pub up: [f32; 3],
+    /// Padding.
+    pub _pad: u32,
+}
+
+impl GpuSpotMap {
+    /// The map `m` of edge `size`.
+    pub fn new(m: &hadou_math::soft::SpotMap, size: u32) -> Self {
+        GpuSpotMap {
+            eye: m.eye.to_array(),
+            tan_half: m.tan_half,
+            forward: m.forward.to_array(),
+            near: m.near,
+            right: m.right.to_array(),
+            size,
+            up: m.up.to_array(),
+            _pad: 0,
+        }
+    }
+}
+
+/// What the soft-shadow passes (soft.wgsl) know of the frame's `[area_light]`. Keep in sync with
+/// `SoftUniforms` in soft.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SoftUniforms {
+    /// The two maps, `[L₁, L₂]`.
+    pub maps: [GpuSpotMap; 2],
+    /// 1 with the depth-aware search.
+    pub depth_aware: u32,
+    /// 0 for the exact resolve, else the faithful resolve's grid spacing `n`.
+    pub grid: u32,
+    /// The faithful grid's size in grid pixels.
+    pub grid_size: [u32; 2],
 }

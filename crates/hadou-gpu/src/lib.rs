@@ -39,7 +39,7 @@ mod timing;
 #[cfg(test)]
 mod twins;
 
-pub use render::MAX_TILE;
+pub use render::{MAX_TILE, SOFT_BYTES_PER_PIXEL};
 pub use timing::{FrameTiming, TimingMethod};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
@@ -84,6 +84,20 @@ impl GpuBackend {
     /// Whether the device supports GPU timestamps (then [`GpuBackend::time_frame`] uses them).
     pub fn has_timestamps(&self) -> bool {
         self.renderer.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Renders `frame` and, when it has an `[area_light]`, reads back every pixel's soft-shadow
+    /// class (`hadou_math::soft::Class as u8`) and visibility, row-major: what the differential
+    /// tests compare with hadou-cpu's `soft::classify` and `soft::visibility`. `None` without an
+    /// area light.
+    #[doc(hidden)]
+    pub fn render_soft(
+        &mut self,
+        frame: &Frame,
+    ) -> Result<(Image, Option<(Vec<u8>, Vec<f32>)>), RenderError> {
+        let image = self.renderer.render(frame)?;
+        let soft = self.renderer.read_soft(frame)?;
+        Ok((image, soft))
     }
 
     /// Measures the GPU time of drawing `frame` (both passes over every tile, no read-back),

@@ -22,6 +22,8 @@ pub(crate) const PLANE_SHADOW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat:
 /// The shadow maps: a depth array texture rendered by the map pass and read (as unfilterable
 /// float) by the wave pass.
 pub(crate) const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Target of the `[area_light]`'s map pass (soft_map.wgsl): the f32 bits of the view depth.
+pub(crate) const SPOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Workgroup edge of the wave pass (keep in sync with `@workgroup_size` in wave.wgsl).
 pub(crate) const WAVE_WORKGROUP: u32 = 8;
 
@@ -39,6 +41,22 @@ pub(crate) struct Pipelines {
     /// Shadow maps (`vs_map`, depth only), once per frame.
     pub(crate) shadow_map: wgpu::RenderPipeline,
     pub(crate) shadow_map_layout: wgpu::BindGroupLayout,
+    /// The `[area_light]`'s maps (soft_map.wgsl), once per frame.
+    pub(crate) spot_map: wgpu::RenderPipeline,
+    pub(crate) spot_map_layout: wgpu::BindGroupLayout,
+    /// The soft-shadow compute passes (soft.wgsl), one layout for all.
+    pub(crate) soft: SoftPipelines,
+    pub(crate) soft_layout: wgpu::BindGroupLayout,
+}
+
+/// The compute pipelines of soft.wgsl.
+pub(crate) struct SoftPipelines {
+    pub(crate) classify: wgpu::ComputePipeline,
+    pub(crate) columns: wgpu::ComputePipeline,
+    pub(crate) exact: wgpu::ComputePipeline,
+    pub(crate) grid: wgpu::ComputePipeline,
+    pub(crate) interp: wgpu::ComputePipeline,
+    pub(crate) gather: wgpu::ComputePipeline,
 }
 
 /// Compiles WGSL into a module; a compile error becomes [`RenderError::Other`] naming the module.
@@ -117,6 +135,8 @@ impl Pipelines {
         let raster_module = compile_module(ctx, "raster", &shaders::compose(shaders::RASTER_PARTS))?;
         let wave_module = compile_module(ctx, "wave", &shaders::compose(shaders::WAVE_PARTS))?;
         let shadow_module = compile_module(ctx, "shadow", &shaders::compose(shaders::SHADOW_PARTS))?;
+        let spot_module = compile_module(ctx, "soft map", &shaders::compose(shaders::SOFT_MAP_PARTS))?;
+        let soft_module = compile_module(ctx, "soft", &shaders::compose(shaders::SOFT_PARTS))?;
         ctx.scoped("building pipelines", || {
             let d = &ctx.device;
             let vs_fs = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
@@ -330,7 +350,92 @@ impl Pipelines {
                 multiview_mask: None,
                 cache: None,
             });
+            // Keep in sync with the bindings of soft_map.wgsl and soft.wgsl.
+            let spot_map_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("soft maps"),
+                entries: &[uniform_entry(0, vs), storage_entry(1, vs, true)],
+            });
+            let soft_layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("soft"),
+                entries: &[
+                    uniform_entry(0, cs),
+                    uniform_entry(1, cs),
+                    texture_entry(2),
+                    texture_entry(3),
+                    texture_entry(4),
+                    texture_entry(5),
+                    storage_entry(6, cs, false),
+                    storage_entry(7, cs, false),
+                    storage_entry(8, cs, false),
+                    storage_entry(9, cs, false),
+                    storage_entry(10, cs, false),
+                ],
+            });
+            let spot_map_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("soft maps"),
+                bind_group_layouts: &[Some(&spot_map_layout)],
+                immediate_size: 0,
+            });
+            let soft_pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("soft"),
+                bind_group_layouts: &[Some(&soft_layout)],
+                immediate_size: 0,
+            });
+            let spot_map = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("soft maps"),
+                layout: Some(&spot_map_pl),
+                vertex: wgpu::VertexState {
+                    module: &spot_module,
+                    entry_point: Some("vs_spot"),
+                    compilation_options: Default::default(),
+                    buffers: &positions,
+                },
+                primitive,
+                // Depth near/z: the nearest surface has the greatest.
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: MAP_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Greater),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &spot_module,
+                    entry_point: Some("fs_spot"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: SPOT_FORMAT,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+            let soft_pipeline = |entry: &str| {
+                d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&soft_pl),
+                    module: &soft_module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+            };
+            let soft = SoftPipelines {
+                classify: soft_pipeline("cs_classify"),
+                columns: soft_pipeline("cs_columns"),
+                exact: soft_pipeline("cs_exact"),
+                grid: soft_pipeline("cs_grid"),
+                interp: soft_pipeline("cs_interp"),
+                gather: soft_pipeline("cs_gather"),
+            };
             Self {
+                spot_map,
+                spot_map_layout,
+                soft,
+                soft_layout,
                 raster,
                 hull,
                 raster_layout,

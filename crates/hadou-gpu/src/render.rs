@@ -4,12 +4,12 @@
 
 use crate::device::GpuContext;
 use crate::layout::{
-    self, FrameShadows, FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuShadowCast, GpuVertex,
-    GpuWave, ShadingBuffers,
+    self, FrameShadows, FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuShadowCast, GpuSpotMap,
+    GpuVertex, GpuWave, ShadingBuffers, SoftUniforms,
 };
 use crate::pipelines::{self, Pipelines};
 use bytemuck::Zeroable;
-use hadou_scene::{Frame, Image, LightLine, Mesh, RenderError, MAX_SHADOWS};
+use hadou_scene::{Frame, Image, LightLine, Mesh, RenderError, SoftResolve, MAX_SHADOWS};
 use std::collections::HashMap;
 use std::sync::{Arc, Weak};
 use wgpu::util::DeviceExt;
@@ -99,6 +99,93 @@ pub(crate) struct Renderer {
     meshes: HashMap<usize, CachedMesh>,
     targets: Option<TileTargets>,
     maps: Option<ShadowMaps>,
+    /// The `[area_light]`'s resources, kept while the image and map sizes hold.
+    soft: Option<SoftTargets>,
+}
+
+/// Bytes per pixel of the whole-image soft-shadow buffers: the visible point and class (16), the
+/// unit normal and the column pass's nearest rows (16), the visibility (4); the faithful grid adds
+/// at most 4 more (`n = 1`).
+pub const SOFT_BYTES_PER_PIXEL: u64 = 36;
+
+/// The `[area_light]`'s GPU resources. Its soft shadows need the whole image at once: a first
+/// sweep over the tiles rasterizes each and classifies its pixels into whole-image buffers
+/// (`cs_classify`), the resolve then runs over the whole image (`cs_columns` + `cs_exact`, or
+/// `cs_grid` + `cs_interp`), and each tile's wave pass takes its visibility (`cs_gather`).
+/// GPU memory: [`SOFT_BYTES_PER_PIXEL`] (36, up to 40 with the faithful grid) bytes per image pixel
+/// (604 MiB at the loader's limit of 4096² pixels, `SOFT_MAX_PIXELS`), plus 12 bytes per map texel
+/// for the two maps and their shared depth buffer (12 MiB at `map_size` 1024).
+struct SoftTargets {
+    key: (u32, u32, u32, u32),
+    spot_views: [wgpu::TextureView; 2],
+    spot_depth: wgpu::TextureView,
+    /// One uniform buffer per map (soft_map.wgsl binding 0), then the soft uniforms (soft.wgsl 1).
+    spot_uniforms: [wgpu::Buffer; 2],
+    uniforms: wgpu::Buffer,
+    world: wgpu::Buffer,
+    normal: wgpu::Buffer,
+    visibility: wgpu::Buffer,
+    grid: wgpu::Buffer,
+}
+
+impl SoftTargets {
+    fn bind_group(
+        &self,
+        d: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        frame_uniforms: &wgpu::Buffer,
+        scene: &wgpu::TextureView,
+        attributes: &wgpu::TextureView,
+        output: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let view = wgpu::BindingResource::TextureView;
+        d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("soft"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: frame_uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: self.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: view(scene) },
+                wgpu::BindGroupEntry { binding: 3, resource: view(attributes) },
+                wgpu::BindGroupEntry { binding: 4, resource: view(&self.spot_views[0]) },
+                wgpu::BindGroupEntry { binding: 5, resource: view(&self.spot_views[1]) },
+                wgpu::BindGroupEntry { binding: 6, resource: self.world.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: self.normal.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 8, resource: self.visibility.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 9, resource: self.grid.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 10, resource: output.as_entire_binding() },
+            ],
+        })
+    }
+}
+
+/// Checks the frame's `[area_light]` against the device: the map edge within the largest 2D
+/// texture, the whole-image buffers within the storage-buffer limits.
+fn check_area_light(limits: &wgpu::Limits, frame: &Frame) -> Result<(), RenderError> {
+    let Some(light) = &frame.area_light else { return Ok(()) };
+    if light.map_size > limits.max_texture_dimension_2d {
+        return Err(RenderError::Device(format!(
+            "[area_light]: map_size {} exceeds this adapter's largest texture ({})",
+            light.map_size, limits.max_texture_dimension_2d
+        )));
+    }
+    let pixels = frame.width as u64 * frame.height as u64;
+    let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    if pixels * 16 > max {
+        return Err(RenderError::Device(format!(
+            "[area_light]: a {}×{} image needs soft-shadow buffers of {} bytes, more than this adapter's storage \
+             buffer limit of {max} bytes",
+            frame.width,
+            frame.height,
+            pixels * 16
+        )));
+    }
+    Ok(())
+}
+
+/// The faithful grid's size for an image and spacing `n` (hadou-cpu's `Search::faithful`).
+fn grid_size(width: u32, height: u32, n: u32) -> [u32; 2] {
+    [(width - 1) / n + 1, (height - 1) / n + 1]
 }
 
 fn other(msg: String) -> RenderError {
@@ -227,7 +314,7 @@ impl Renderer {
     pub(crate) fn new() -> Result<Self, RenderError> {
         let ctx = GpuContext::new()?;
         let pipelines = Pipelines::new(&ctx)?;
-        Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None, maps: None })
+        Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None, maps: None, soft: None })
     }
 
     fn upload_meshes(&mut self, frame: &Frame) {
@@ -351,6 +438,7 @@ impl Renderer {
         let shadow_casts = frame.shadow_casts(&lines);
         let shadows = FrameShadows::new(frame, &shadow_casts);
         check_maps(&self.ctx.limits, frame, &shadows)?;
+        check_area_light(&self.ctx.limits, frame)?;
         let (cast_offset, map_offset) = shading.push_shadows(&shadows);
         // Draws of the shadow passes: (cast, object) pairs, the plane casts' first, then each map
         // cast's; casters without triangles draw nothing.
@@ -516,10 +604,207 @@ impl Renderer {
                 shadow_fields,
             };
             self.draw_shadow_maps(frame, &prepared, &shadows, &map_draws);
+            if frame.area_light.is_some() {
+                self.draw_soft(frame, &prepared);
+            }
             prepared
         };
         self.ctx.close_scopes(scopes, "uploading the frame")?;
         Ok(prepared)
+    }
+
+    /// Makes the soft-shadow resources fit `frame` (which has an `[area_light]`) and writes their
+    /// uniforms.
+    fn ensure_soft(&mut self, frame: &Frame) {
+        let light = frame.area_light.as_ref().expect("an area light");
+        let n = match light.resolve {
+            SoftResolve::Exact => 0,
+            SoftResolve::Faithful { n } => n.max(1),
+        };
+        let gs = grid_size(frame.width, frame.height, n.max(1));
+        let grid_len = if n == 0 { 1 } else { gs[0] * gs[1] };
+        let key = (frame.width, frame.height, light.map_size.max(1), grid_len);
+        if self.soft.as_ref().is_none_or(|s| s.key != key) {
+            self.soft = None; // free the old ones first
+            let d = &self.ctx.device;
+            let size = key.2;
+            let texture = |label, format| {
+                d.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+            };
+            let buffer = |label, size: u64, usage| {
+                d.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            let pixels = frame.width as u64 * frame.height as u64;
+            let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+            let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+            let spot = std::mem::size_of::<GpuSpotMap>() as u64;
+            self.soft = Some(SoftTargets {
+                key,
+                spot_views: [
+                    texture("soft map 1", pipelines::SPOT_FORMAT),
+                    texture("soft map 2", pipelines::SPOT_FORMAT),
+                ],
+                spot_depth: texture("soft map depth", pipelines::MAP_FORMAT),
+                spot_uniforms: [buffer("soft map 1", spot, uniform), buffer("soft map 2", spot, uniform)],
+                uniforms: buffer("soft uniforms", std::mem::size_of::<SoftUniforms>() as u64, uniform),
+                world: buffer("soft points", pixels * 16, storage),
+                normal: buffer("soft normals", pixels * 16, storage),
+                visibility: buffer("soft visibility", pixels * 4, storage),
+                grid: buffer("soft grid", grid_len as u64 * 4, storage),
+            });
+        }
+        let soft = self.soft.as_ref().expect("created above");
+        let maps = light.maps.map(|m| GpuSpotMap::new(&m, key.2));
+        let q = &self.ctx.queue;
+        q.write_buffer(&soft.spot_uniforms[0], 0, bytemuck::bytes_of(&maps[0]));
+        q.write_buffer(&soft.spot_uniforms[1], 0, bytemuck::bytes_of(&maps[1]));
+        let u = SoftUniforms { maps, depth_aware: u32::from(light.depth_aware), grid: n, grid_size: gs };
+        q.write_buffer(&soft.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// The `[area_light]`'s soft shadows over the whole image: its two maps (soft_map.wgsl), every
+    /// tile rasterized and classified, then the resolve; the wave passes read the visibility.
+    fn draw_soft(&mut self, frame: &Frame, prepared: &Prepared) {
+        self.ensure_soft(frame);
+        let soft = self.soft.as_ref().expect("created in ensure_soft");
+        let d = &self.ctx.device;
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
+        for k in 0..2 {
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("soft map"),
+                layout: &self.pipelines.spot_map_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: soft.spot_uniforms[k].as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
+                ],
+            });
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("soft map"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &soft.spot_views[k],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        // +∞ as f32 bits: no surface.
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: f32::INFINITY.to_bits() as f64,
+                            g: 0.0,
+                            b: 0.0,
+                            a: 0.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &soft.spot_depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            let edge = soft.key.2 as f32;
+            pass.set_viewport(0.0, 0.0, edge, edge, 0.0, 1.0);
+            pass.set_pipeline(&self.pipelines.spot_map);
+            pass.set_bind_group(0, &bg, &[]);
+            for &(object, index_count) in &prepared.draws {
+                let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
+                let Some(mesh) = self.meshes.get(&key) else { continue };
+                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
+            }
+        }
+        self.ctx.queue.submit([enc.finish()]);
+        // Every tile of the image, whatever rows are asked for: the search needs them all.
+        let tile = prepared.tile;
+        for y in (0..frame.height).step_by(tile[1] as usize) {
+            for x in (0..frame.width).step_by(tile[0] as usize) {
+                let t = ([x, y], [tile[0].min(frame.width - x), tile[1].min(frame.height - y)]);
+                let enc = self.encode_tile_passes(frame, prepared, t, false, None, true);
+                self.ctx.queue.submit([enc.finish()]);
+            }
+        }
+        let t = self.targets.as_ref().expect("targets are created in prepare");
+        let soft = self.soft.as_ref().expect("created in ensure_soft");
+        let bg = soft.bind_group(
+            d,
+            &self.pipelines.soft_layout,
+            &t.uniforms,
+            &t.scene_view,
+            &t.attributes_view,
+            &t.output,
+        );
+        let (w, h) = (frame.width, frame.height);
+        let mut enc =
+            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft resolve") });
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &bg, &[]);
+            let p = &self.pipelines.soft;
+            match frame.area_light.as_ref().map(|l| l.resolve) {
+                Some(SoftResolve::Faithful { n }) => {
+                    let gs = grid_size(w, h, n.max(1));
+                    pass.set_pipeline(&p.grid);
+                    pass.dispatch_workgroups(gs[0].div_ceil(8), gs[1].div_ceil(8), 1);
+                    pass.set_pipeline(&p.interp);
+                    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+                }
+                _ => {
+                    pass.set_pipeline(&p.columns);
+                    pass.dispatch_workgroups(w.div_ceil(64), 1, 1);
+                    pass.set_pipeline(&p.exact);
+                    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+                }
+            }
+        }
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
+    /// class (`hadou_math::soft::Class` as `u8`) and visibility, read back (for tests).
+    pub(crate) fn read_soft(&self, frame: &Frame) -> Result<Option<(Vec<u8>, Vec<f32>)>, RenderError> {
+        let Some(soft) = self.soft.as_ref().filter(|_| frame.area_light.is_some()) else { return Ok(None) };
+        let pixels = frame.width as u64 * frame.height as u64;
+        let read = |src: &wgpu::Buffer, bytes: u64| -> Result<Vec<u32>, RenderError> {
+            let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("soft read-back"),
+                size: bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut enc = self.ctx.device.create_command_encoder(&Default::default());
+            enc.copy_buffer_to_buffer(src, 0, &staging, 0, bytes);
+            let submission = self.ctx.queue.submit([enc.finish()]);
+            let mut out = Vec::new();
+            self.ctx.read_buffer(&staging, bytes, submission, |raw| {
+                out = raw.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+            })?;
+            Ok(out)
+        };
+        let world = read(&soft.world, pixels * 16)?;
+        let vis = read(&soft.visibility, pixels * 4)?;
+        let class = world.chunks_exact(4).map(|p| p[3] as u8).collect();
+        Ok(Some((class, vis.into_iter().map(f32::from_bits).collect())))
     }
 
     /// Makes the shadow-map texture fit `shadows` (at least 1² × 2 texels: the wave pass binds one
@@ -610,6 +895,20 @@ impl Renderer {
         readback: bool,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> wgpu::CommandEncoder {
+        self.encode_tile_passes(frame, prepared, tile, readback, timestamps, false)
+    }
+
+    /// [`Renderer::encode_tile`], or with `classify` the raster pass then the soft shadows'
+    /// classification of the tile's pixels (soft.wgsl `cs_classify`) instead of the other passes.
+    fn encode_tile_passes(
+        &self,
+        frame: &Frame,
+        prepared: &Prepared,
+        tile: ([u32; 2], [u32; 2]),
+        readback: bool,
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
+        classify: bool,
+    ) -> wgpu::CommandEncoder {
         let t = self.targets.as_ref().expect("targets are created in prepare");
         let basis = frame.camera.basis(frame.width, frame.height);
         let (origin, size) = tile;
@@ -696,8 +995,33 @@ impl Renderer {
                 }
             }
         }
+        let soft_bg = self.soft.as_ref().filter(|_| frame.area_light.is_some()).map(|soft| {
+            soft.bind_group(
+                d,
+                &self.pipelines.soft_layout,
+                &t.uniforms,
+                &t.scene_view,
+                &t.attributes_view,
+                &t.output,
+            )
+        });
+        if classify {
+            if let Some(bg) = &soft_bg {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.pipelines.soft.classify);
+                pass.set_bind_group(0, bg, &[]);
+                pass.dispatch_workgroups(size[0].div_ceil(8), size[1].div_ceil(8), 1);
+            }
+            return enc;
+        }
         if !prepared.plane_draws.is_empty() {
             self.encode_plane_shadows(&mut enc, frame, prepared, t, size);
+        }
+        if let Some(bg) = &soft_bg {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipelines.soft.gather);
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(size[0].div_ceil(8), size[1].div_ceil(8), 1);
         }
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -27,6 +27,10 @@ pub const WAVE: &str = include_str!("shaders/wave.wgsl");
 pub const SHADOW_LOOKUP: &str = include_str!("shaders/shadow_lookup.wgsl");
 /// The plane-shadow pass and the shadow-map pass.
 pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
+/// The `[area_light]`'s perspective shadow maps (render pass).
+pub const SOFT_MAP: &str = include_str!("shaders/soft_map.wgsl");
+/// The soft shadows' classification and penumbra resolve (compute passes).
+pub const SOFT: &str = include_str!("shaders/soft.wgsl");
 
 /// Every `.wgsl` file in `src/shaders/`, by file name.
 pub const FILES: &[(&str, &str)] = &[
@@ -37,6 +41,8 @@ pub const FILES: &[(&str, &str)] = &[
     ("shading.wgsl", SHADING),
     ("shadow_lookup.wgsl", SHADOW_LOOKUP),
     ("shadow_raster.wgsl", SHADOW_RASTER),
+    ("soft.wgsl", SOFT),
+    ("soft_map.wgsl", SOFT_MAP),
     ("wave.wgsl", WAVE),
 ];
 
@@ -46,6 +52,10 @@ pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, SHADING, SHADOW_LOOKUP, WAVE];
 /// The parts of the shadow module, in order.
 pub const SHADOW_PARTS: &[&str] = &[COMMON, SHADOW_RASTER];
+/// The parts of the soft-shadow map module, in order.
+pub const SOFT_MAP_PARTS: &[&str] = &[COMMON, SOFT_MAP];
+/// The parts of the soft-shadow compute module, in order.
+pub const SOFT_PARTS: &[&str] = &[COMMON, SOFT];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -56,8 +66,8 @@ pub fn compose(parts: &[&str]) -> String {
 mod tests {
     use super::*;
     use crate::layout::{
-        FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuShadowCast, GpuTexture,
-        GpuWave,
+        FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuRamp, GpuShadowCast, GpuSpotMap,
+        GpuTexture, GpuWave,
     };
     use std::mem::{offset_of, size_of};
 
@@ -79,6 +89,8 @@ mod tests {
             ("raster module", validate("raster module", &compose(RASTER_PARTS))),
             ("wave module", validate("wave module", &compose(WAVE_PARTS))),
             ("shadow module", validate("shadow module", &compose(SHADOW_PARTS))),
+            ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
+            ("soft module", validate("soft module", &compose(SOFT_PARTS))),
         ]
     }
 
@@ -94,6 +106,8 @@ mod tests {
             ("shading.wgsl", SHADING),
             ("shadow_lookup.wgsl", SHADOW_LOOKUP),
             ("shadow_raster.wgsl", SHADOW_RASTER),
+            ("soft.wgsl", SOFT),
+            ("soft_map.wgsl", SOFT_MAP),
             ("wave.wgsl", WAVE),
         ] {
             for (i, line) in source.lines().enumerate() {
@@ -119,7 +133,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 3);
+        assert_eq!(modules.len(), 5);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -132,8 +146,13 @@ mod tests {
         listed.sort();
         assert_eq!(on_disk, listed, "src/shaders/*.wgsl and shaders::FILES differ");
         for (name, text) in FILES {
-            let used =
-                RASTER_PARTS.iter().chain(WAVE_PARTS).chain(SHADOW_PARTS).any(|p| std::ptr::eq(*p, *text));
+            let used = RASTER_PARTS
+                .iter()
+                .chain(WAVE_PARTS)
+                .chain(SHADOW_PARTS)
+                .chain(SOFT_MAP_PARTS)
+                .chain(SOFT_PARTS)
+                .any(|p| std::ptr::eq(*p, *text));
             assert!(used, "{name} is not part of any module");
         }
     }
@@ -208,9 +227,14 @@ mod tests {
                 cast_count,
                 map_count,
                 plane_count,
-                _pad2,
+                area,
+                area_position,
+                _pad3,
+                area_color,
+                _pad4,
             ]
         );
+        check!(GpuSpotMap, "GpuSpotMap", [eye, tan_half, forward, near, right, size, up, _pad]);
         check!(GpuObject, "GpuObject", [model, normal_matrix, material_base, material_count, _pad]);
         check!(GpuRamp, "GpuRamp", [stops, count, kind, smoothing, _pad]);
         check!(GpuTexture, "GpuTexture", [offset, width, height, flags]);

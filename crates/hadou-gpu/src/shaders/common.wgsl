@@ -51,7 +51,29 @@ struct FrameUniforms {
     cast_count: u32,
     map_count: u32,
     plane_count: u32,
-    _pad2: u32,
+    area: u32,
+    area_position: vec3<f32>,
+    _pad3: u32,
+    area_color: vec3<f32>,
+    _pad4: u32,
+}
+
+// Keep in sync with layout.rs `GpuSpotMap` (hadou_math::soft::SpotMap and its edge in texels).
+struct GpuSpotMap {
+    eye: vec3<f32>,
+    tan_half: f32,
+    forward: vec3<f32>,
+    near: f32,
+    right: vec3<f32>,
+    size: u32,
+    up: vec3<f32>,
+    _pad: u32,
+}
+
+// Twin of hadou_math::soft::SpotMap::to_view: right, up, along the axis.
+fn spot_to_view(s: GpuSpotMap, p: vec3<f32>) -> vec3<f32> {
+    let d = p - s.eye;
+    return vec3<f32>(dot3(d, s.right), dot3(d, s.up), dot3(d, s.forward));
 }
 
 // Keep in sync with layout.rs `GpuObject`.

@@ -250,3 +250,37 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
     }
     return c;
 }
+
+// Twin of hadou_cpu::shading::area_term: what the `[area_light]` adds to a visible point where it
+// is fully visible (the soft shadow's visibility scales it): with l̂ the unit vector from the point
+// to the light centre and m = N·l̂, diffuse A·E·max(0, m), toon A·E·ramp(m), unlit nothing; then
+// the feature texture. E = frame.area_color (colour times intensity).
+fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f32>, vcolor: vec4<f32>) -> vec3<f32> {
+    if (m.model != MODEL_DIFFUSE && m.model != MODEL_TOON) {
+        return vec3<f32>(0.0);
+    }
+    let len = length3(normal_in);
+    var n = vec3<f32>(0.0);
+    if (len > 0.0 && len < 3.0e38) {
+        n = normal_in / len;
+    }
+    let to_light = frame.area_position - world;
+    let dl = length3(to_light);
+    var dir = vec3<f32>(0.0);
+    if (dl > 0.0 && dl < 3.0e38) {
+        dir = to_light / dl;
+    }
+    let mdot = dot3(n, dir);
+    var k = vec3<f32>(max(mdot, 0.0));
+    if (m.model == MODEL_TOON) {
+        k = ramp_eval(m.ramp, mdot);
+    }
+    let tex = sample_texture(m.base_texture, uv);
+    let a = m.base_color * tex.xyz * vcolor.xyz;
+    var f = vec3<f32>(1.0);
+    if (m.feature_texture.offset != 0u) {
+        f = sample_texture(m.feature_texture, uv).xyz;
+    }
+    let t = a * frame.area_color * k * f;
+    return vec3<f32>(energy_saturate(t.x), energy_saturate(t.y), energy_saturate(t.z));
+}

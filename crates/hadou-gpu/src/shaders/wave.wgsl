@@ -95,6 +95,13 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
             let uv = vec2<f32>(bitcast<f32>(attributes.x), bitcast<f32>(attributes.y));
             scene = shade_surface(m, world, texel.xyz, uv, unpack4x8unorm(attributes.z));
             scene = apply_shadows(scene, m.shadow_mask, world, id.xy);
+            if (frame.area != 0u) {
+                // As hadou-cpu's opaque_pass: c + visibility · area term, saturated, after the hard
+                // shadows. soft.wgsl's cs_gather left the visibility in the eye-distance slot.
+                let v = out_buf[5u * n + i];
+                let t = v * area_term(m, world, texel.xyz, uv, unpack4x8unorm(attributes.z));
+                scene = vec3<f32>(energy_saturate(scene.x + t.x), energy_saturate(scene.y + t.y), energy_saturate(scene.z + t.z));
+            }
         }
     }
 

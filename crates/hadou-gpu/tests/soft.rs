@@ -1,0 +1,95 @@
+//! GPU ↔ CPU on the `[area_light]`'s soft shadows: every `scenes/soft-*.toml` at the start, middle
+//! and end of its animation, at 128×96, with its own resolve, the faithful resolve at `n = 3`, and
+//! the exact resolve without the depth-aware search.
+//!
+//! Tolerances: the two backends' maps and visible points agree to rounding (the rasterizers round
+//! differently), so a pixel whose stored and looked-up depths lie within an ulp of the bias may
+//! change class. At most [`CLASS_FLIP_SHARE`] of the pixels may differ in class; the colour is
+//! within the differential tests' `COLOR_ABS` on all but [`COLOR_SHARE`] of the pixels. Where
+//! every class agrees and the search is not depth-aware, the GPU's visibility equals the CPU's
+//! exactly, pixel for pixel; otherwise it equals it at all but [`VIS_SHARE`] of the pixels whose
+//! class agrees (a flipped class moves its neighbours' nearest umbra or lit pixel).
+
+mod common;
+
+use common::*;
+use hadou_cpu::soft::{classify, soft_input, visibility, SpotDepth};
+use hadou_cpu::CpuBackend;
+use hadou_scene::{Backend, Frame, SoftResolve};
+
+/// Largest share of pixels whose class may differ.
+const CLASS_FLIP_SHARE: f64 = 0.005;
+/// Largest share of pixels whose colour may differ beyond `COLOR_ABS`.
+const COLOR_SHARE: f64 = 0.01;
+/// Largest share of same-class pixels whose visibility may differ.
+const VIS_SHARE: f64 = 0.01;
+
+fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
+    let (g, soft) = gpu.render_soft(frame).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
+    let (g_class, g_vis) = soft.expect("an area light");
+    let c = CpuBackend::new().render(frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
+    let light = frame.area_light.as_ref().expect("an area light");
+    let input = soft_input(frame).expect("an area light");
+    let maps = light.maps.map(|m| SpotDepth::render(frame, &m, light.map_size));
+    let c_class = classify(&maps, &input);
+    let c_vis = visibility(frame, light, &input, light.resolve);
+    let n = g_class.len();
+    assert_eq!(n, c_class.len());
+    let flips = (0..n).filter(|&i| g_class[i] != c_class[i] as u8).count();
+    let same: Vec<usize> = (0..n).filter(|&i| g_class[i] == c_class[i] as u8).collect();
+    let vis_diff = same.iter().filter(|&&i| g_vis[i] != c_vis[i]).count();
+    let max_vis = same.iter().map(|&i| (g_vis[i] - c_vis[i]).abs()).fold(0.0f32, f32::max);
+    let color_bad =
+        (0..n).filter(|&i| (0..4).any(|k| !((g.color[i][k] - c.color[i][k]).abs() <= COLOR_ABS))).count();
+    assert!(g.color.iter().flatten().all(|v| v.is_finite()), "{label}: non-finite colour");
+    let penumbra = c_class.iter().filter(|&&k| k as u8 == 2).count();
+    eprintln!(
+        "{label}: {flips} class flips, {vis_diff} visibility differences (max {max_vis}) among {} same-class \
+         pixels, {color_bad} colours beyond {COLOR_ABS}, of {n} ({penumbra} penumbra)",
+        same.len()
+    );
+    assert!(flips as f64 <= CLASS_FLIP_SHARE * n as f64, "{label}: {flips} of {n} pixels change class");
+    if flips == 0 && !light.depth_aware {
+        assert_eq!(vis_diff, 0, "{label}: visibility differs with every class equal");
+    }
+    assert!(vis_diff as f64 <= VIS_SHARE * n as f64, "{label}: {vis_diff} visibilities differ");
+    assert!(color_bad as f64 <= COLOR_SHARE * n as f64, "{label}: {color_bad} of {n} colours differ");
+}
+
+#[test]
+fn soft_shadows_match_cpu() {
+    let Some(mut gpu) = gpu_or_skip("soft shadows") else { return };
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| {
+            p.extension().is_some_and(|x| x == "toml")
+                && p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("soft-"))
+        })
+        .collect();
+    paths.sort();
+    assert!(!paths.is_empty(), "no soft-*.toml scenes in {dir}");
+    for path in paths {
+        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+        let d = scene.duration();
+        for t in [0.0, 0.5 * d, d] {
+            let mut frame = scene.at(t);
+            frame.width = 128;
+            frame.height = 96;
+            check(&mut gpu, &format!("{name} t={t}"), &frame);
+            let mut faithful = frame.clone();
+            faithful.area_light.as_mut().expect("an area light").resolve = SoftResolve::Faithful { n: 3 };
+            check(&mut gpu, &format!("{name} t={t} faithful n=3"), &faithful);
+            let mut plain = frame.clone();
+            let light = plain.area_light.as_mut().expect("an area light");
+            light.resolve = SoftResolve::Exact;
+            light.depth_aware = false;
+            check(&mut gpu, &format!("{name} t={t} exact, not depth-aware"), &plain);
+            if d == 0.0 {
+                break;
+            }
+        }
+    }
+}
