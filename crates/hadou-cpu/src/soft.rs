@@ -263,13 +263,41 @@ impl Search<'_> {
     /// The transforms cover only the penumbra's bounding box widened by [`MARGIN`] pixels: a
     /// nearest pixel found there at distance `d` is the nearest of the whole image when `d` is at
     /// most the distance `b` to the box's edge (image edges aside); otherwise every pixel nearer
-    /// than `b` lies in the box and was not one, so the ring search starts at `⌊b/√2⌋`.
+    /// than `b` lies in the box and was not one, so the nearest is farther than `b`: infinite when
+    /// `b` exceeds [`SEARCH_RADIUS`], else found by the ring search from `⌊b/√2⌋`. When more than
+    /// 1 % of the penumbra pixels would need that search (a penumbra far wider than the margin),
+    /// the transforms are redone over the box widened by [`SEARCH_RADIUS`], where none does.
     fn exact(&self) -> Vec<f32> {
         let (w, h) = (self.input.width, self.input.height);
         let mut out: Vec<f32> = self.class.par_iter().with_min_len(4096).map(|&c| plain(c)).collect();
-        let Some(rect) = penumbra_box(self.class, w, h) else { return out };
-        let (du, fu) = edt(self.class, Class::Umbra, w, &rect);
-        let (dl, fl) = edt(self.class, Class::Lit, w, &rect);
+        let Some(mut rect) = penumbra_box(self.class, w, h, MARGIN) else { return out };
+        let mut du_fu = edt(self.class, Class::Umbra, w, &rect);
+        let mut dl_fl = edt(self.class, Class::Lit, w, &rect);
+        let uncertain = |rect: &Rect, du: &[f32], dl: &[f32]| -> (usize, usize) {
+            let bw = rect.x1 - rect.x0;
+            (rect.y0..rect.y1)
+                .into_par_iter()
+                .map(|y| {
+                    let (mut pen, mut unc) = (0, 0);
+                    for x in rect.x0..rect.x1 {
+                        if self.class[y * w + x] == Class::Penumbra {
+                            pen += 1;
+                            let b2 = edge2(rect, w, h, x, y);
+                            let k = (y - rect.y0) * bw + (x - rect.x0);
+                            unc += usize::from(b2 <= R2 && (du[k] > b2 || dl[k] > b2));
+                        }
+                    }
+                    (pen, unc)
+                })
+                .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
+        };
+        let (pen, unc) = uncertain(&rect, &du_fu.0, &dl_fl.0);
+        if unc * 100 > pen {
+            rect = penumbra_box(self.class, w, h, SEARCH_RADIUS as usize).expect("there is a penumbra");
+            du_fu = edt(self.class, Class::Umbra, w, &rect);
+            dl_fl = edt(self.class, Class::Lit, w, &rect);
+        }
+        let ((du, fu), (dl, fl)) = (du_fu, dl_fl);
         let bw = rect.x1 - rect.x0;
         out.par_chunks_mut(w).enumerate().skip(rect.y0).take(rect.y1 - rect.y0).for_each(|(y, row)| {
             for (x, o) in row.iter_mut().enumerate().skip(rect.x0).take(bw) {
@@ -278,17 +306,7 @@ impl Search<'_> {
                     continue;
                 }
                 let b = (y - rect.y0) * bw + (x - rect.x0);
-                // Distance to the nearest pixel outside the box (infinite where the box is the image).
-                let edge = [
-                    (rect.x0 > 0).then(|| x - rect.x0 + 1),
-                    (rect.x1 < w).then(|| rect.x1 - x),
-                    (rect.y0 > 0).then(|| y - rect.y0 + 1),
-                    (rect.y1 < h).then(|| rect.y1 - y),
-                ]
-                .into_iter()
-                .flatten()
-                .min();
-                let b2 = edge.map_or(FAR, |e| (e * e) as f32);
+                let b2 = edge2(&rect, w, h, x, y);
                 let fix = |d2: f32, f: u32, want: Class| -> f32 {
                     let start = if d2 <= b2 {
                         if d2 == FAR {
@@ -298,6 +316,8 @@ impl Search<'_> {
                             return if d2 <= R2 { d2 } else { FAR };
                         }
                         d2
+                    } else if b2 > R2 {
+                        return FAR;
                     } else {
                         b2
                     };
@@ -324,13 +344,28 @@ struct Rect {
     y1: usize,
 }
 
-/// How far the exact resolve's distance transforms reach beyond the penumbra's bounding box, in
-/// pixels (a speed setting: any value gives the same result).
+/// How far the exact resolve's distance transforms reach beyond the penumbra's bounding box at
+/// first, in pixels (a speed setting: any value gives the same result).
 pub const MARGIN: usize = 64;
 
-/// The bounding box of the penumbra pixels widened by [`MARGIN`] and clipped to the image;
-/// `None` without penumbra pixels.
-fn penumbra_box(class: &[Class], w: usize, h: usize) -> Option<Rect> {
+/// The squared distance from pixel `(x, y)` of `rect` to the nearest pixel outside it in the
+/// `w × h` image (`FAR` where the rectangle is the whole image).
+fn edge2(rect: &Rect, w: usize, h: usize, x: usize, y: usize) -> f32 {
+    [
+        (rect.x0 > 0).then(|| x - rect.x0 + 1),
+        (rect.x1 < w).then(|| rect.x1 - x),
+        (rect.y0 > 0).then(|| y - rect.y0 + 1),
+        (rect.y1 < h).then(|| rect.y1 - y),
+    ]
+    .into_iter()
+    .flatten()
+    .min()
+    .map_or(FAR, |e| (e * e) as f32)
+}
+
+/// The bounding box of the penumbra pixels widened by `r` and clipped to the image; `None`
+/// without penumbra pixels.
+fn penumbra_box(class: &[Class], w: usize, h: usize, r: usize) -> Option<Rect> {
     let rows = class
         .par_chunks(w)
         .enumerate()
@@ -340,7 +375,6 @@ fn penumbra_box(class: &[Class], w: usize, h: usize) -> Option<Rect> {
             Some((y, first, last))
         })
         .collect::<Vec<_>>();
-    let r = MARGIN;
     let (y0, y1) = (rows.first()?.0, rows.last()?.0);
     let x0 = rows.iter().map(|t| t.1).min()?;
     let x1 = rows.iter().map(|t| t.2).max()?;

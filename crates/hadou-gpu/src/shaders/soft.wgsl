@@ -64,9 +64,9 @@ fn spot_shadowed(k: u32, p: vec3<f32>, n: vec3<f32>) -> bool {
     if (dot3(n, s.eye - p) <= 0.0) {
         return true;
     }
-    let z0 = spot_to_view(s, p).z;
-    let q = p + n * spot_texel(s, abs(z0));
-    let v = spot_to_view(s, q);
+    let v0 = spot_to_view(s, p);
+    let off = spot_texel(s, abs(v0.z));
+    let v = v0 + vec3<f32>(dot3(n, s.right), dot3(n, s.up), dot3(n, s.forward)) * off;
     if (!(v.z > s.near)) {
         return false; // outside the map: +∞ stored, never nearer
     }
