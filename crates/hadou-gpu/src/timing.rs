@@ -12,7 +12,9 @@ pub enum TimingMethod {
     /// end of its wave pass, summed over tiles: pure GPU execution time.
     GpuTimestamps,
     /// Wall-clock time from the first submit of a frame until the GPU reports it finished; includes
-    /// submission and driver overhead.
+    /// submission and driver overhead. Frames with an `[area_light]` are always timed this way,
+    /// with their preparation inside the timing (uploads, the two soft-shadow maps and the
+    /// whole-image penumbra resolve run there, before the tiles).
     WallClock,
 }
 
@@ -89,8 +91,10 @@ pub(crate) fn time_frame(
     }
 
     let queries = 2 * tiles;
-    let use_timestamps =
-        r.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY) && queries <= wgpu::QUERY_SET_MAX_QUERIES;
+    let soft = frame.area_light.is_some();
+    let use_timestamps = !soft
+        && r.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+        && queries <= wgpu::QUERY_SET_MAX_QUERIES;
     let mut samples = Vec::with_capacity(iterations as usize);
     if use_timestamps {
         let bytes = queries as u64 * 8;
@@ -142,6 +146,22 @@ pub(crate) fn time_frame(
             samples.push(ticks as f64 * period_ns * 1e-6);
         }
         return Ok(FrameTiming::from_samples(TimingMethod::GpuTimestamps, tiles, samples));
+    }
+    if soft {
+        for _ in 0..iterations {
+            let start = Instant::now();
+            let prepared = r.prepare(frame, 0..frame.height)?;
+            let mut last = None;
+            for &t in &prepared.tiles {
+                let c = r.encode_tile(frame, &prepared, t, false, None).finish();
+                last = Some(r.ctx.queue.submit([c]));
+            }
+            if let Some(s) = last {
+                r.ctx.wait(s)?;
+            }
+            samples.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        return Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples));
     }
     for _ in 0..iterations {
         let cmds = r.ctx.scoped("encoding a frame", || {

@@ -255,11 +255,13 @@ impl SpotMap {
         let sz = size as f32;
         let s = (v.x / (v.z * self.tan_half) + 1.0) * 0.5;
         let t = (v.y / (v.z * self.tan_half) + 1.0) * 0.5;
-        let (x, y) = ((s * sz).floor(), ((1.0 - t) * sz).floor());
-        if !(x.is_finite() && y.is_finite()) {
+        let (fx, fy) = (s * sz, (1.0 - t) * sz);
+        // `⌊fx⌋ ∈ 0..size` exactly when `0 ≤ fx < size` (false for NaN), and then `⌊fx⌋` is the
+        // truncation: no call to `floor`.
+        if !(fx >= 0.0 && fx < sz && fy >= 0.0 && fy < sz) {
             return Some((-1, -1, v.z));
         }
-        Some((x.clamp(-1.0, sz) as i64, y.clamp(-1.0, sz) as i64, v.z))
+        Some((fx as i64, fy as i64, v.z))
     }
 
     /// Whether a map value `stored` (view depth of the nearest caster in the texel) hides a point
