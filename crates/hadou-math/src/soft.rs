@@ -81,21 +81,37 @@ pub fn distance_transform(feature: &[bool], width: usize, height: usize) -> Vec<
 /// Work space of the 1-D squared distance transform (Felzenszwalb–Huttenlocher): the parabolas of
 /// the lower envelope and their boundaries. One per thread; [`Envelope::transform`] is the step
 /// both passes of [`distance_transform`] make, public so a renderer can run the lines in parallel.
+///
+/// The boundaries are kept as exact fractions `num/den` (`den > 0`; `den = 0` stands for `±∞` by
+/// the sign of `num`) and compared by cross-multiplying in `i64`: no division, no rounding, so the
+/// envelope is exact for integer inputs.
 #[derive(Clone, Debug)]
 pub struct Envelope {
     v: Vec<usize>,
-    z: Vec<f64>,
+    z: Vec<(i64, i64)>,
+}
+
+/// `a/b ≤ c/d` for fractions with `b, d ≥ 0` (`0` denominators are `±∞` by the numerator's sign).
+#[inline]
+fn frac_le(a: i64, b: i64, c: i64, d: i64) -> bool {
+    match (b, d) {
+        (0, 0) => a <= c,
+        (0, _) => a < 0,
+        (_, 0) => c > 0,
+        _ => a * d <= c * b,
+    }
 }
 
 impl Envelope {
     /// Work space for lines of up to `n` samples.
     pub fn new(n: usize) -> Self {
-        Envelope { v: vec![0; n.max(1)], z: vec![0.0; n.max(1) + 1] }
+        Envelope { v: vec![0; n.max(1)], z: vec![(0, 1); n.max(1) + 1] }
     }
 
-    /// `out[q] = min_p (q − p)² + f[p]` over `p` with finite `f[p]` ([`FAR`] if none), and
+    /// `out[q] = min_p (q − p)² + f[p]` over `p` with `f[p] ≠` [`FAR`] ([`FAR`] if none), and
     /// `arg[q]` = that `p` (the lowest-index parabola of the envelope at `q`; `u32::MAX` if none).
-    /// Lines longer than [`Envelope::new`]'s `n` grow the work space.
+    /// The finite `f[p]` must be integers (squared distances in pixels), below 2⁴⁰. Lines longer
+    /// than [`Envelope::new`]'s `n` grow the work space.
     pub fn transform(&mut self, f: &[f32], out: &mut [f32], arg: &mut [u32]) {
         let n = f.len();
         if self.v.len() < n {
@@ -110,18 +126,21 @@ impl Envelope {
             if !any {
                 any = true;
                 self.v[0] = q;
-                self.z[0] = f64::NEG_INFINITY;
-                self.z[1] = f64::INFINITY;
+                self.z[0] = (-1, 0);
+                self.z[1] = (1, 0);
                 k = 0;
                 continue;
             }
-            // Drop the envelope's parabolas the one at q hides (z[0] = −∞ stops the loop at the first).
-            let fq = f64::from(f[q]) + (q * q) as f64;
-            let mut s;
+            // Drop the envelope's parabolas the one at q hides (z[0] = −∞ stops the loop at the
+            // first). The parabolas from p and q meet at s = (F_q − F_p) / (2(q − p)), F = f + x².
+            let fq = f[q] as i64 + (q * q) as i64;
+            let (mut sn, mut sd);
             loop {
                 let p = self.v[k];
-                s = (fq - (f64::from(f[p]) + (p * p) as f64)) / (2.0 * (q - p) as f64);
-                if s <= self.z[k] {
+                sn = fq - (f[p] as i64 + (p * p) as i64);
+                sd = 2 * (q - p) as i64;
+                let (zn, zd) = self.z[k];
+                if frac_le(sn, sd, zn, zd) {
                     k -= 1;
                 } else {
                     break;
@@ -129,8 +148,8 @@ impl Envelope {
             }
             k += 1;
             self.v[k] = q;
-            self.z[k] = s;
-            self.z[k + 1] = f64::INFINITY;
+            self.z[k] = (sn, sd);
+            self.z[k + 1] = (1, 0);
         }
         if !any {
             out.iter_mut().for_each(|o| *o = FAR);
@@ -139,7 +158,11 @@ impl Envelope {
         }
         let mut j = 0;
         for (q, (o, a)) in out.iter_mut().zip(arg.iter_mut()).enumerate() {
-            while self.z[j + 1] < q as f64 {
+            // z[j + 1] < q.
+            while {
+                let (zn, zd) = self.z[j + 1];
+                !frac_le(q as i64, 1, zn, zd)
+            } {
                 j += 1;
             }
             let p = self.v[j];
