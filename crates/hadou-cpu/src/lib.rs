@@ -113,8 +113,8 @@ fn opaque_pass(
     let vis = soft::visibility(frame, light, &input, light.resolve);
     opaque.color.par_iter_mut().zip(&input.points).zip(&vis).for_each(|((c, p), &v)| {
         if let Some(p) = p {
-            for k in 0..3 {
-                c[k] = hadou_math::energy::saturate(c[k] + v * p.term[k]);
+            for (ck, tk) in c.iter_mut().zip(p.term) {
+                *ck = hadou_math::energy::saturate(*ck + v * tk);
             }
         }
     });

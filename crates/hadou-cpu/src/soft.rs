@@ -400,11 +400,11 @@ fn edt(class: &[Class], want: Class, w: usize, rect: &Rect) -> (Vec<f32>, Vec<u3
         let is = |y: usize| class[(rect.y0 + y) * w + rect.x0 + x] == want;
         // Downwards: the nearest feature at or above.
         let mut last: Option<usize> = None;
-        for y in 0..bh {
+        for (y, a) in arg.iter_mut().enumerate() {
             if is(y) {
                 last = Some(y);
             }
-            arg[y] = last.map_or(u32::MAX, |l| l as u32);
+            *a = last.map_or(u32::MAX, |l| l as u32);
         }
         // Upwards: a nearer feature below replaces it (strictly nearer: ties keep the upper one).
         let mut next: Option<usize> = None;

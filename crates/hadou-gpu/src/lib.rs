@@ -94,7 +94,7 @@ impl GpuBackend {
     pub fn render_soft(
         &mut self,
         frame: &Frame,
-    ) -> Result<(Image, Option<(Vec<u8>, Vec<f32>)>), RenderError> {
+    ) -> Result<(Image, Option<render::SoftReadback>), RenderError> {
         let image = self.renderer.render(frame)?;
         let soft = self.renderer.read_soft(frame)?;
         Ok((image, soft))

@@ -103,6 +103,9 @@ pub(crate) struct Renderer {
     soft: Option<SoftTargets>,
 }
 
+/// Every pixel's soft-shadow class (`hadou_math::soft::Class as u8`) and visibility, row-major.
+pub type SoftReadback = (Vec<u8>, Vec<f32>);
+
 /// Bytes per pixel of the whole-image soft-shadow buffers: the visible point and class (16), the
 /// unit normal and the column pass's nearest rows (16), the visibility (4); the faithful grid adds
 /// at most 4 more (`n = 1`).
@@ -782,7 +785,7 @@ impl Renderer {
 
     /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
     /// class (`hadou_math::soft::Class` as `u8`) and visibility, read back (for tests).
-    pub(crate) fn read_soft(&self, frame: &Frame) -> Result<Option<(Vec<u8>, Vec<f32>)>, RenderError> {
+    pub(crate) fn read_soft(&self, frame: &Frame) -> Result<Option<SoftReadback>, RenderError> {
         let Some(soft) = self.soft.as_ref().filter(|_| frame.area_light.is_some()) else { return Ok(None) };
         let pixels = frame.width as u64 * frame.height as u64;
         let read = |src: &wgpu::Buffer, bytes: u64| -> Result<Vec<u32>, RenderError> {

@@ -39,8 +39,14 @@ fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
     let same: Vec<usize> = (0..n).filter(|&i| g_class[i] == c_class[i] as u8).collect();
     let vis_diff = same.iter().filter(|&&i| g_vis[i] != c_vis[i]).count();
     let max_vis = same.iter().map(|&i| (g_vis[i] - c_vis[i]).abs()).fold(0.0f32, f32::max);
-    let color_bad =
-        (0..n).filter(|&i| (0..4).any(|k| !((g.color[i][k] - c.color[i][k]).abs() <= COLOR_ABS))).count();
+    let color_bad = (0..n)
+        .filter(|&i| {
+            (0..4).any(|k| {
+                let d = (g.color[i][k] - c.color[i][k]).abs();
+                d.is_nan() || d > COLOR_ABS
+            })
+        })
+        .count();
     assert!(g.color.iter().flatten().all(|v| v.is_finite()), "{label}: non-finite colour");
     let penumbra = c_class.iter().filter(|&&k| k as u8 == 2).count();
     eprintln!(

@@ -272,7 +272,7 @@ impl SpotMap {
         let v0 = self.to_view(p);
         let off = self.texel(v0.z.abs(), size);
         let v = v0 + Vec3f::new(n.dot(self.right), n.dot(self.up), n.dot(self.forward)) * off;
-        if !(v.z > self.near) {
+        if v.z.is_nan() || v.z <= self.near {
             return Some((-1, -1, v.z));
         }
         let sz = size as f32;

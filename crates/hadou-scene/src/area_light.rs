@@ -192,7 +192,7 @@ pub(crate) fn check_area_light(
     let g = interest(def, vals, objects);
     let d = (l - g).length();
     let key = if def.target == Target::Point { "target" } else { "position" };
-    if !(d > 1e-6) {
+    if d.is_nan() || d <= 1e-6 {
         return Err((
             key,
             "the point of interest `target` coincides with the light's `position`: G must differ from L"
@@ -223,10 +223,10 @@ pub(crate) fn build_area_light(
     let p = &def.params;
     let at = |vals: &[f32]| (Vec3f::from_array(p.arr(vals, "position")), interest(def, vals, objects));
     let (mut l, mut g) = at(vals);
-    if !((l - g).length() > 1e-6) {
+    if (l - g).length().is_nan() || (l - g).length() <= 1e-6 {
         (l, g) = at(base);
     }
-    if !((l - g).length() > 1e-6) {
+    if (l - g).length().is_nan() || (l - g).length() <= 1e-6 {
         g = l - Vec3f::Y;
     }
     let d = (l - g).length();

@@ -793,14 +793,16 @@ pub fn soft_errors(v: &[f32], truth: &[f32], visible: &[bool]) -> (f64, f64) {
 }
 
 /// Measures the soft-shadow table: [`SOFT_SCENE`] at each size, every method's soft-shadow stage
-/// on the CPU against the ground truth ([`hadou_cpu::soft::truth`]), then the whole frame by
-/// `time` with and without the area light, all in one run. `progress` hears what is being done.
+/// on the CPU against the ground truth ([`hadou_cpu::soft::truth`], a disc of radius
+/// `disc_radius`, by default [`soft_disc_radius`]), then the whole frame by `time` with and
+/// without the area light, all in one run. `progress` hears what is being done.
 pub fn soft_table(
     time: &mut Timer<'_>,
     scenes: &Path,
     sizes: &[u32],
     iterations: u32,
     backend: &str,
+    disc_radius: Option<f32>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<SoftTable, RenderError> {
     use hadou_cpu::soft;
@@ -808,7 +810,7 @@ pub fn soft_table(
     let (file, t) = SOFT_SCENE;
     let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
     let mut rows = Vec::new();
-    let mut disc_radius = 0.0;
+    let mut used_radius = 0.0;
     for &size in sizes {
         let mut frame = scene.at(t);
         frame.width = size;
@@ -817,8 +819,8 @@ pub fn soft_table(
             .area_light
             .clone()
             .ok_or_else(|| RenderError::Other(format!("{file} has no [area_light]")))?;
-        let radius = soft_disc_radius(&frame).unwrap_or(light.size);
-        disc_radius = radius;
+        let radius = disc_radius.or_else(|| soft_disc_radius(&frame)).unwrap_or(light.size);
+        used_radius = radius;
         progress(&format!("{size}²: visible points"));
         let input = soft::soft_input(&frame).ok_or_else(|| RenderError::Other("no area light".into()))?;
         let tm = truth_map(size);
@@ -864,7 +866,7 @@ pub fn soft_table(
             });
         }
     }
-    Ok(SoftTable { scene: file.into(), iterations, disc_radius, backend: backend.into(), rows })
+    Ok(SoftTable { scene: file.into(), iterations, disc_radius: used_radius, backend: backend.into(), rows })
 }
 
 impl SoftTable {

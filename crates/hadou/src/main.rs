@@ -111,6 +111,10 @@ struct BenchArgs {
     /// Which backend to measure.
     #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
     backend: BackendChoice,
+    /// shadows only: the ground truth's (and PCSS's) disc radius in scene units [default: the
+    /// radius whose penumbra matches the two maps' band, docs/soft-shadows.md].
+    #[arg(long, allow_hyphen_values = true)]
+    disc_radius: Option<f32>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -528,6 +532,15 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         check_size("--sizes", s)?;
     }
     let iterations = a.iterations.unwrap_or(if curves { 1 } else { 5 });
+    match a.disc_radius {
+        Some(r) if a.table != BenchTable::Shadows => {
+            return Err(Failure::input(format!("--disc-radius {r}: applies to `hadou bench shadows` only")));
+        }
+        Some(r) if !(r.is_finite() && (0.0..=1e6).contains(&r)) => {
+            return Err(Failure::input(format!("--disc-radius {r}: must be a number in [0, 1e6]")));
+        }
+        _ => {}
+    }
     if iterations == 0 {
         return Err(Failure::input("--iterations 0: need at least one timed repetition"));
     }
@@ -565,7 +578,15 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
     let json = if shadows {
         let bar = indicatif::ProgressBar::new_spinner();
         let mut progress = |m: &str| bar.set_message(m.to_string());
-        let t = hadou::bench::soft_table(&mut *timer, &a.scenes, &sizes, iterations, &name, &mut progress)?;
+        let t = hadou::bench::soft_table(
+            &mut *timer,
+            &a.scenes,
+            &sizes,
+            iterations,
+            &name,
+            a.disc_radius,
+            &mut progress,
+        )?;
         bar.finish_and_clear();
         if !a.json {
             print!("{}", t.to_text());
