@@ -729,13 +729,7 @@ impl Renderer {
             pass.set_viewport(0.0, 0.0, edge, edge, 0.0, 1.0);
             pass.set_pipeline(&self.pipelines.spot_map);
             pass.set_bind_group(0, &bg, &[]);
-            for &(object, index_count) in &prepared.draws {
-                let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
-                let Some(mesh) = self.meshes.get(&key) else { continue };
-                pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
-            }
+            self.draw_objects(&mut pass, frame, &prepared.draws);
         }
         self.ctx.queue.submit([enc.finish()]);
         // Every tile of the image, whatever rows are asked for: the search needs them all.
@@ -781,6 +775,18 @@ impl Renderer {
             }
         }
         self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Draws every `(object, index count)` of `draws` with its cached mesh, the object's index as
+    /// the instance (objects without a cached mesh draw nothing).
+    fn draw_objects(&self, pass: &mut wgpu::RenderPass<'_>, frame: &Frame, draws: &[(usize, u32)]) {
+        for &(object, index_count) in draws {
+            let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
+            let Some(mesh) = self.meshes.get(&key) else { continue };
+            pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
+        }
     }
 
     /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
@@ -989,13 +995,7 @@ impl Renderer {
                 }
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &raster_bg, &[]);
-                for &(object, index_count) in &prepared.draws {
-                    let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
-                    let Some(mesh) = self.meshes.get(&key) else { continue };
-                    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-                    pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..index_count, 0, object as u32..object as u32 + 1);
-                }
+                self.draw_objects(&mut pass, frame, &prepared.draws);
             }
         }
         let soft_bg = self.soft.as_ref().filter(|_| frame.area_light.is_some()).map(|soft| {

@@ -575,9 +575,9 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         })?;
     }
     let (mut timer, name, method) = make_timer(a.backend)?;
-    let json = if shadows {
-        let bar = indicatif::ProgressBar::new_spinner();
-        let mut progress = |m: &str| bar.set_message(m.to_string());
+    let bar = indicatif::ProgressBar::new_spinner();
+    let mut progress = |m: &str| bar.set_message(m.to_string());
+    let (text, json) = if shadows {
         let t = hadou::bench::soft_table(
             &mut *timer,
             &a.scenes,
@@ -587,20 +587,11 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
             a.disc_radius,
             &mut progress,
         )?;
-        bar.finish_and_clear();
-        if !a.json {
-            print!("{}", t.to_text());
-        }
-        t.to_json()
+        (t.to_text(), t.to_json())
     } else if toon {
         let t = hadou::bench::toon_table(&mut *timer, &a.scenes, &sizes, iterations, &name, &method)?;
-        if !a.json {
-            print!("{}", t.to_text());
-        }
-        t.to_json()
+        (t.to_text(), t.to_json())
     } else if curves {
-        let bar = indicatif::ProgressBar::new_spinner();
-        let mut progress = |m: &str| bar.set_message(m.to_string());
         let t = hadou::bench::curve_table(
             &mut *timer,
             &a.scenes,
@@ -610,18 +601,15 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
             &method,
             &mut progress,
         )?;
-        bar.finish_and_clear();
-        if !a.json {
-            print!("{}", t.to_text());
-        }
-        t.to_json()
+        (t.to_text(), t.to_json())
     } else {
         let t = hadou::bench::analytic_table(&mut *timer, &sizes, iterations, &name, &method)?;
-        if !a.json {
-            print!("{}", t.to_text());
-        }
-        t.to_json()
+        (t.to_text(), t.to_json())
     };
+    bar.finish_and_clear();
+    if !a.json {
+        print!("{text}");
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&json).unwrap_or_default());
     }
