@@ -284,15 +284,20 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
     out
 }
 
-/// Every object's triangles (not the outline hulls) as seen from one of 003's soft-shadow maps:
+/// The triangles of the objects `casters` (not the outline hulls) as seen from one of 003's soft-shadow maps:
 /// clipped at the map's near plane and projected to texel coordinates of a `size²` map (texel
 /// `(x, y)` covers `[x, x+1) × [y, y+1)`, row 0 at the frustum's top), `1/z` per vertex for the
 /// perspective-correct depth ([`ScreenTri::inv_z_at`]).
-pub(crate) fn spot_tris(frame: &Frame, map: &hadou_math::soft::SpotMap, size: u32) -> Vec<ScreenTri> {
+pub(crate) fn spot_tris(
+    frame: &Frame,
+    casters: &[u32],
+    map: &hadou_math::soft::SpotMap,
+    size: u32,
+) -> Vec<ScreenTri> {
     let n = size as f32;
     let scale = 1.0 / map.tan_half;
     let mut out = Vec::new();
-    for obj in &frame.objects {
+    for obj in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
         let verts: Vec<Vert> = obj
             .mesh
             .positions

@@ -66,11 +66,11 @@ pub struct SpotDepth {
 }
 
 impl SpotDepth {
-    /// Renders every object of `frame` (double-sided, top-left rule, perspective-correct depth,
-    /// the nearest kept) into a `size²` map of frame `map`, bands of rows in parallel.
-    pub fn render(frame: &Frame, map: &SpotMap, size: u32) -> SpotDepth {
+    /// Renders the objects `casters` of `frame` (double-sided, top-left rule, perspective-correct
+    /// depth, the nearest kept) into a `size²` map of frame `map`, bands of rows in parallel.
+    pub fn render(frame: &Frame, casters: &[u32], map: &SpotMap, size: u32) -> SpotDepth {
         let n = size as usize;
-        let tris = spot_tris(frame, map, size);
+        let tris = spot_tris(frame, casters, map, size);
         let bins = bin_rows(&tris, n, &(0..n));
         let mut depth = vec![f32::INFINITY; n * n];
         depth.par_chunks_mut(BAND * n).zip(&bins).enumerate().for_each(|(b, (band, bin))| {
@@ -129,8 +129,10 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
     let maps = light.maps.map(|m| (m, light.map_size));
     let [a, b] = maps;
-    let (m1, m2) =
-        rayon::join(|| SpotDepth::render(frame, &a.0, a.1), || SpotDepth::render(frame, &b.0, b.1));
+    let (m1, m2) = rayon::join(
+        || SpotDepth::render(frame, &light.casters, &a.0, a.1),
+        || SpotDepth::render(frame, &light.casters, &b.0, b.1),
+    );
     let class = classify(&[m1, m2], input);
     let search = Search { input, class: &class, depth_aware: light.depth_aware };
     match resolve {
@@ -462,11 +464,12 @@ pub fn truth(
     let axis = (light.interest - light.position).normalize_or(-Vec3f::Y);
     let (u, v) = axis.orthonormal_basis();
     let mut lit = vec![0u32; input.points.len()];
-    let corners = corners(frame);
+    let corners = corners(frame, &light.casters);
     for k in 0..samples {
         let (px, py) = spiral(k, samples);
         let eye = light.position + u * (px * radius) + v * (py * radius);
-        let map = SpotDepth::render(frame, &SpotMap::look(eye, light.interest, &corners), map_size);
+        let map =
+            SpotDepth::render(frame, &light.casters, &SpotMap::look(eye, light.interest, &corners), map_size);
         lit.par_iter_mut().zip(&input.points).with_min_len(4096).for_each(|(l, p)| {
             if let Some(p) = p {
                 if !map.shadowed(p.world, p.normal) {
@@ -485,10 +488,11 @@ fn spiral(k: u32, n: u32) -> (f32, f32) {
     (r * a.cos(), r * a.sin())
 }
 
-/// The corners of every object's bounding box (what a [`SpotMap`]'s frustum must enclose).
-fn corners(frame: &Frame) -> Vec<Vec3f> {
+/// The corners of the bounding boxes of the objects `casters` (what a [`SpotMap`]'s frustum must
+/// enclose).
+fn corners(frame: &Frame, casters: &[u32]) -> Vec<Vec3f> {
     let mut out = Vec::new();
-    for o in &frame.objects {
+    for o in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
         if let Some((lo, hi)) = hadou_scene::object_bounds(o) {
             for i in 0..8 {
                 out.push(Vec3f::new(
@@ -511,7 +515,8 @@ fn corners(frame: &Frame) -> Vec<Vec3f> {
 pub fn pcss(frame: &Frame, light: &AreaLight, input: &SoftInput, radius: f32) -> Vec<f32> {
     let map = SpotDepth::render(
         frame,
-        &SpotMap::look(light.position, light.interest, &corners(frame)),
+        &light.casters,
+        &SpotMap::look(light.position, light.interest, &corners(frame, &light.casters)),
         light.map_size,
     );
     let z_min = map.depth.iter().copied().fold(f32::INFINITY, f32::min);

@@ -36,7 +36,7 @@ fn soft_scenes() -> Vec<String> {
 
 fn classes(f: &Frame, input: &SoftInput) -> Vec<Class> {
     let light = f.area_light.as_ref().expect("area light");
-    let maps = light.maps.map(|m| SpotDepth::render(f, &m, light.map_size));
+    let maps = light.maps.map(|m| SpotDepth::render(f, &light.casters, &m, light.map_size));
     classify(&maps, input)
 }
 

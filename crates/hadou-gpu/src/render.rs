@@ -686,6 +686,10 @@ impl Renderer {
         self.ensure_soft(frame);
         let soft = self.soft.as_ref().expect("created in ensure_soft");
         let d = &self.ctx.device;
+        // Only the area light's casters are drawn into its maps (hadou-cpu's `spot_tris`).
+        let casters = frame.area_light.as_ref().map_or(&[][..], |l| &l.casters[..]);
+        let caster_draws: Vec<(usize, u32)> =
+            prepared.draws.iter().copied().filter(|&(o, _)| casters.contains(&(o as u32))).collect();
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
         for k in 0..2 {
             let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -729,7 +733,7 @@ impl Renderer {
             pass.set_viewport(0.0, 0.0, edge, edge, 0.0, 1.0);
             pass.set_pipeline(&self.pipelines.spot_map);
             pass.set_bind_group(0, &bg, &[]);
-            self.draw_objects(&mut pass, frame, &prepared.draws);
+            self.draw_objects(&mut pass, frame, &caster_draws);
         }
         self.ctx.queue.submit([enc.finish()]);
         // Every tile of the image, whatever rows are asked for: the search needs them all.

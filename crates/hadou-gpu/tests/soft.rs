@@ -30,7 +30,7 @@ fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
     let c = CpuBackend::new().render(frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
     let light = frame.area_light.as_ref().expect("an area light");
     let input = soft_input(frame).expect("an area light");
-    let maps = light.maps.map(|m| SpotDepth::render(frame, &m, light.map_size));
+    let maps = light.maps.map(|m| SpotDepth::render(frame, &light.casters, &m, light.map_size));
     let c_class = classify(&maps, &input);
     let c_vis = visibility(frame, light, &input, light.resolve);
     let n = g_class.len();

@@ -12,8 +12,18 @@ use hadou_math::soft::{light_pair, SpotMap};
 use hadou_math::Vec3f;
 use toml::de::DeValue;
 
-pub(crate) const AREA_LIGHT_KEYS: &[&str] =
-    &["position", "size", "target", "color", "intensity", "map_size", "resolve", "n", "depth_aware"];
+pub(crate) const AREA_LIGHT_KEYS: &[&str] = &[
+    "position",
+    "size",
+    "target",
+    "color",
+    "intensity",
+    "map_size",
+    "resolve",
+    "n",
+    "depth_aware",
+    "casters",
+];
 
 /// Most pixels of an image with an `[area_light]` (4096²): the penumbra search works on the whole
 /// image at once (about 60 bytes a pixel on the CPU).
@@ -52,7 +62,9 @@ pub struct AreaLight {
     pub resolve: SoftResolve,
     /// Depth-aware search ([`hadou_math::soft::same_surface`]).
     pub depth_aware: bool,
-    /// The two maps: `[L₁ = L + l·P, L₂ = L − l·P]`, each looking at `G`, every object inside.
+    /// The objects drawn into the maps (indices into `Frame::objects`); every object receives.
+    pub casters: Vec<u32>,
+    /// The two maps: `[L₁ = L + l·P, L₂ = L − l·P]`, each looking at `G`, every caster inside.
     pub maps: [SpotMap; 2],
 }
 
@@ -69,19 +81,29 @@ pub(crate) enum Target {
 #[derive(Clone, Debug)]
 pub(crate) struct AreaLightDef {
     pub target: Target,
+    pub casters: Vec<u32>,
     pub map_size: u32,
     pub resolve: SoftResolve,
     pub depth_aware: bool,
     pub params: ParamSet,
 }
 
-/// Parses `[area_light]`; `objects` are the scene's object names.
+/// Parses `[area_light]`; `objects_with_kind` are the scene's objects (name, is a `plane`
+/// primitive).
 pub(crate) fn parse_area_light(
     t: &Table<'_, '_>,
-    objects: &[&str],
+    objects_with_kind: &[(&str, bool)],
     rd: &mut ParamReader<'_>,
 ) -> Res<AreaLightDef> {
     t.check_keys(AREA_LIGHT_KEYS)?;
+    let names: Vec<&str> = objects_with_kind.iter().map(|o| o.0).collect();
+    let objects = names.as_slice();
+    // Casters: as listed, or every object that is not a `kind = "plane"` primitive.
+    let casters = if t.get("casters").is_some() {
+        crate::shadow::object_list(t, "casters", objects_with_kind)?
+    } else {
+        (0..objects_with_kind.len() as u32).filter(|&i| !objects_with_kind[i as usize].1).collect()
+    };
     let mut params = ParamSet::default();
     rd.add(
         t,
@@ -168,7 +190,7 @@ pub(crate) fn parse_area_light(
         }
     };
     let depth_aware = opt_bool(t, "depth_aware")?.unwrap_or(true);
-    Ok(AreaLightDef { target, map_size, resolve, depth_aware, params })
+    Ok(AreaLightDef { target, casters, map_size, resolve, depth_aware, params })
 }
 
 /// `G` of the light at these values.
@@ -232,8 +254,8 @@ pub(crate) fn build_area_light(
     let d = (l - g).length();
     let size = p.f(vals, "size").clamp(1e-6 * d, 0.99 * d);
     let (l1, l2) = light_pair(l, g, size).unwrap_or((l + Vec3f::Y * size, l - Vec3f::Y * size));
-    let mut corners = Vec::with_capacity(objects.len() * 8);
-    for o in objects {
+    let mut corners = Vec::with_capacity(def.casters.len() * 8);
+    for o in def.casters.iter().map(|&c| &objects[c as usize]) {
         if let Some((lo, hi)) = object_bounds(o) {
             for i in 0..8 {
                 corners.push(Vec3f::new(
@@ -254,6 +276,7 @@ pub(crate) fn build_area_light(
         map_size: def.map_size,
         resolve: def.resolve,
         depth_aware: def.depth_aware,
+        casters: def.casters.clone(),
         maps: [SpotMap::look(l1, g, &corners), SpotMap::look(l2, g, &corners)],
     }
 }

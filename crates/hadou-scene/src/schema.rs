@@ -244,7 +244,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut area_light = None;
     let mut area_table = None;
     if let Some(t) = root.sub("area_light", "[area_light]")? {
-        let names: Vec<&str> = objects.iter().map(|o| o.name.as_str()).collect();
+        let names: Vec<(&str, bool)> = objects.iter().map(|o| (o.name.as_str(), o.is_plane)).collect();
         area_light = Some(parse_area_light(&t, &names, &mut rd)?);
         if u64::from(width) * u64::from(height) > SOFT_MAX_PIXELS {
             return Err(src.value_err(

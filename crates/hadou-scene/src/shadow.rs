@@ -248,7 +248,7 @@ const THETA: Constraint = Constraint::Range { lo: 0.0, hi: 90.0, lo_open: false,
 const V3: Shape = Shape::Vector(3);
 
 /// Reads a list of object names (`"a"` or `["a", "b"]`) into object indices.
-fn object_list(t: &Table<'_, '_>, key: &str, objects: &[(&str, bool)]) -> Res<Vec<u32>> {
+pub(crate) fn object_list(t: &Table<'_, '_>, key: &str, objects: &[(&str, bool)]) -> Res<Vec<u32>> {
     let v = t.get(key).ok_or_else(|| {
         t.src.missing(&t.span, format!("{} needs `{key}` (an object name or a list of them)", t.what))
     })?;

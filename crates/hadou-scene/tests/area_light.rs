@@ -42,14 +42,21 @@ fn maps_sit_at_l_plus_and_minus_l_p_and_every_object_is_inside_them() {
     );
     assert_eq!(a.color, [2.0, 1.0, 0.5]);
     assert_eq!((a.map_size, a.resolve, a.depth_aware), (1024, SoftResolve::Exact, true));
+    // The floor (a plane) receives but does not cast: the frustum fits the pillar alone.
+    assert_eq!(a.casters, vec![0]);
     for m in &a.maps {
         assert!(close(m.forward, -Vec3f::Y));
-        // The floor's corners are inside the frustum.
-        for c in [[10.0, 0.0, 10.0], [-10.0, 0.0, -10.0]] {
+        for c in [[0.5, 0.0, 0.5], [-0.5, 2.0, -0.5]] {
             let v = m.to_view(Vec3f::from_array(c));
             assert!(v.z > m.near && v.x.abs() <= v.z * m.tan_half && v.y.abs() <= v.z * m.tan_half, "{v:?}");
         }
+        let far = m.to_view(Vec3f::new(10.0, 0.0, 10.0));
+        assert!(far.x.abs() > far.z * m.tan_half, "the floor's far corner is outside: {far:?}");
     }
+    let listed = parse(&format!(
+        "{OBJECTS}\n[area_light]\nposition = [0, 5, 0]\nsize = 0.5\ntarget = \"pillar\"\ncasters = [\"floor\", \"pillar\"]\n"
+    ));
+    assert_eq!(listed.at(0.0).area_light.unwrap().casters, vec![1, 0]);
 }
 
 #[test]
@@ -107,6 +114,8 @@ fn bad_area_lights_name_their_line_and_column() {
         (format!("{ok}resolve = \"blur\"\n"), 4, 11, "cannot be \"blur\""),
         (format!("{ok}depth_aware = 1\n"), 4, 15, "depth_aware"),
         (format!("{ok}radius = 1\n"), 4, 1, "unknown key `radius`"),
+        (format!("{ok}casters = [\"pilar\"]\n"), 4, 12, "did you mean `pillar`"),
+        (format!("{ok}casters = []\n"), 4, 11, "at least one object"),
     ];
     for (body, line, col, needle) in cases {
         let e = light_err(&body);

@@ -28,11 +28,11 @@ fn main() {
     let input = soft_input(&frame).expect("area light");
     let maps_ms = median(|| {
         let _ = rayon::join(
-            || SpotDepth::render(&frame, &light.maps[0], light.map_size),
-            || SpotDepth::render(&frame, &light.maps[1], light.map_size),
+            || SpotDepth::render(&frame, &light.casters, &light.maps[0], light.map_size),
+            || SpotDepth::render(&frame, &light.casters, &light.maps[1], light.map_size),
         );
     });
-    let maps = light.maps.map(|m| SpotDepth::render(&frame, &m, light.map_size));
+    let maps = light.maps.map(|m| SpotDepth::render(&frame, &light.casters, &m, light.map_size));
     let class_ms = median(|| {
         let _ = classify(&maps, &input);
     });
