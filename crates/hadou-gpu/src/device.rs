@@ -57,6 +57,16 @@ pub(crate) struct GpuContext {
     reports: Arc<Mutex<Reports>>,
 }
 
+impl Drop for GpuContext {
+    /// Waits (up to [`WAIT_TIMEOUT`]) for every submission before the queue goes: wgpu's own
+    /// wait when a queue is dropped gives up after about 6 s and panics, and a software adapter
+    /// compiling a large shader on a busy machine can take longer than that.
+    fn drop(&mut self) {
+        let _ =
+            self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(WAIT_TIMEOUT) });
+    }
+}
+
 fn lock(reports: &Mutex<Reports>) -> std::sync::MutexGuard<'_, Reports> {
     // A poisoned lock only means a callback panicked mid-push; the data is still usable.
     reports.lock().unwrap_or_else(|p| p.into_inner())
