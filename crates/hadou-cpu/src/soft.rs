@@ -348,7 +348,7 @@ struct Rect {
 
 /// How far the exact resolve's distance transforms reach beyond the penumbra's bounding box at
 /// first, in pixels (a speed setting: any value gives the same result).
-pub const MARGIN: usize = 64;
+pub const MARGIN: usize = 128;
 
 /// The squared distance from pixel `(x, y)` of `rect` to the nearest pixel outside it in the
 /// `w × h` image (`FAR` where the rectangle is the whole image).
@@ -390,57 +390,58 @@ fn penumbra_box(class: &[Class], w: usize, h: usize, r: usize) -> Option<Rect> {
 
 /// The exact squared Euclidean distance transform, within `rect`, of its pixels of class `want`,
 /// with the image index of a nearest such pixel (`u32::MAX` where none); both row-major over the
-/// rectangle. Felzenszwalb–Huttenlocher's two passes, columns in parallel into a transposed
-/// buffer (for a binary image the column pass is the distance to the nearest feature pixel of the
-/// column: two sweeps, the upper one on ties), then rows in parallel (the lower envelope).
+/// rectangle. Felzenszwalb–Huttenlocher's two passes: the columns (for a binary image, the
+/// nearest feature pixel of each column: a sweep down and one up over whole rows, in memory order,
+/// the upper one on ties), then the rows in parallel (the lower envelope).
 fn edt(class: &[Class], want: Class, w: usize, rect: &Rect) -> (Vec<f32>, Vec<u32>) {
     let (bw, bh) = (rect.x1 - rect.x0, rect.y1 - rect.y0);
-    // Columns: `col[x·bh + y]`, `row_of[x·bh + y]` the feature's row (both within the rectangle).
-    let mut col = vec![0.0f32; bw * bh];
-    let mut row_of = vec![0u32; bw * bh];
-    col.par_chunks_mut(bh).zip(row_of.par_chunks_mut(bh)).enumerate().for_each(|(x, (out, arg))| {
-        let is = |y: usize| class[(rect.y0 + y) * w + rect.x0 + x] == want;
-        // Downwards: the nearest feature at or above.
-        let mut last: Option<usize> = None;
-        for (y, a) in arg.iter_mut().enumerate() {
-            if is(y) {
-                last = Some(y);
+    // Columns, row-major (`row_of[y·bw + x]`: the nearest feature's row in column x, within the
+    // rectangle), sweeping whole rows so the classes are read in memory order.
+    let mut row_of = vec![u32::MAX; bw * bh];
+    let mut last = vec![u32::MAX; bw];
+    for (y, out) in row_of.chunks_exact_mut(bw).enumerate() {
+        let row = &class[(rect.y0 + y) * w + rect.x0..][..bw];
+        for ((o, l), &c) in out.iter_mut().zip(last.iter_mut()).zip(row) {
+            // Downwards: the nearest feature at or above.
+            if c == want {
+                *l = y as u32;
             }
-            *a = last.map_or(u32::MAX, |l| l as u32);
+            *o = *l;
         }
-        // Upwards: a nearer feature below replaces it (strictly nearer: ties keep the upper one).
-        let mut next: Option<usize> = None;
-        for y in (0..bh).rev() {
-            if is(y) {
-                next = Some(y);
+    }
+    // Upwards: a nearer feature below replaces it (strictly nearer: ties keep the upper one).
+    let mut next = vec![u32::MAX; bw];
+    for (y, out) in row_of.chunks_exact_mut(bw).enumerate().rev() {
+        let row = &class[(rect.y0 + y) * w + rect.x0..][..bw];
+        let y = y as u32;
+        for ((o, n), &c) in out.iter_mut().zip(next.iter_mut()).zip(row) {
+            if c == want {
+                *n = y;
             }
-            let up = (arg[y] != u32::MAX).then(|| y - arg[y] as usize);
-            match (up, next) {
-                (Some(u), Some(n)) if n - y < u => arg[y] = n as u32,
-                (None, Some(n)) => arg[y] = n as u32,
-                _ => {}
+            if *n != u32::MAX && (*o == u32::MAX || *n - y < y - *o) {
+                *o = *n;
             }
-            out[y] = if arg[y] == u32::MAX {
-                FAR
-            } else {
-                let d = y as f32 - arg[y] as f32;
-                d * d
-            };
         }
-    });
+    }
     let mut d2 = vec![0.0f32; bw * bh];
     let mut feat = vec![u32::MAX; bw * bh];
     d2.par_chunks_mut(bw).zip(feat.par_chunks_mut(bw)).enumerate().for_each_init(
         || (Envelope::new(bw), vec![0.0f32; bw], vec![0u32; bw]),
         |(env, line, arg), (y, (out, f))| {
-            for (x, l) in line.iter_mut().enumerate() {
-                *l = col[x * bh + y];
+            let rows = &row_of[y * bw..][..bw];
+            for (l, &r) in line.iter_mut().zip(rows) {
+                *l = if r == u32::MAX {
+                    FAR
+                } else {
+                    let d = y as f32 - r as f32;
+                    d * d
+                };
             }
             env.transform(line, out, arg);
             for (x, fo) in f.iter_mut().enumerate() {
                 let p = arg[x];
                 if p != u32::MAX && out[x] != FAR {
-                    let r = row_of[p as usize * bh + y] as usize;
+                    let r = rows[p as usize] as usize;
                     *fo = ((rect.y0 + r) * w + rect.x0 + p as usize) as u32;
                 }
             }
