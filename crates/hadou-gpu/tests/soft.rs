@@ -65,37 +65,15 @@ fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
 #[test]
 fn soft_shadows_match_cpu() {
     let Some(mut gpu) = gpu_or_skip("soft shadows") else { return };
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
-    let mut paths: Vec<_> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{dir}: {e}"))
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| {
-            p.extension().is_some_and(|x| x == "toml")
-                && p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("soft-"))
-        })
-        .collect();
-    paths.sort();
-    assert!(!paths.is_empty(), "no soft-*.toml scenes in {dir}");
-    for path in paths {
-        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
-        let d = scene.duration();
-        for t in [0.0, 0.5 * d, d] {
-            let mut frame = scene.at(t);
-            frame.width = 128;
-            frame.height = 96;
-            check(&mut gpu, &format!("{name} t={t}"), &frame);
-            let mut faithful = frame.clone();
-            faithful.area_light.as_mut().expect("an area light").resolve = SoftResolve::Faithful { n: 3 };
-            check(&mut gpu, &format!("{name} t={t} faithful n=3"), &faithful);
-            let mut plain = frame.clone();
-            let light = plain.area_light.as_mut().expect("an area light");
-            light.resolve = SoftResolve::Exact;
-            light.depth_aware = false;
-            check(&mut gpu, &format!("{name} t={t} exact, not depth-aware"), &plain);
-            if d == 0.0 {
-                break;
-            }
-        }
+    for (label, frame) in example_frames(|name| name.starts_with("soft-")) {
+        check(&mut gpu, &label, &frame);
+        let mut faithful = frame.clone();
+        faithful.area_light.as_mut().expect("an area light").resolve = SoftResolve::Faithful { n: 3 };
+        check(&mut gpu, &format!("{label} faithful n=3"), &faithful);
+        let mut plain = frame.clone();
+        let light = plain.area_light.as_mut().expect("an area light");
+        light.resolve = SoftResolve::Exact;
+        light.depth_aware = false;
+        check(&mut gpu, &format!("{label} exact, not depth-aware"), &plain);
     }
 }

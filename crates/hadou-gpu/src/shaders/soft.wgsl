@@ -267,6 +267,26 @@ fn plain(c: u32) -> f32 {
     return 1.0;
 }
 
+const NOT_PENUMBRA: u32 = 0xffffffffu;
+
+// The resolves' first step per pixel: the image index of invocation `id` when that pixel is in the
+// penumbra; otherwise NOT_PENUMBRA, after writing the pixel's plain value (the value of a pixel
+// outside the penumbra in hadou-cpu's soft::Search::exact and ::faithful) when it is inside the
+// image.
+fn penumbra_pixel(id: vec3<u32>) -> u32 {
+    let w = frame.image_size.x;
+    if (id.x >= w || id.y >= frame.image_size.y) {
+        return NOT_PENUMBRA;
+    }
+    let i = id.y * w + id.x;
+    let c = class_at(i);
+    if (c != CLASS_PENUMBRA) {
+        visibility[i] = plain(c);
+        return NOT_PENUMBRA;
+    }
+    return i;
+}
+
 // Second pass of the exact transform for one kind (`shift` 0: umbra, 16: lit) at pixel (x, y):
 // the nearest pixel of that kind over the columns x ± dx, |dx| ≤ SEARCH_RADIUS (a nearer one
 // beyond cannot exist: any kind farther than SEARCH_RADIUS counts as absent), nearest first so the
@@ -320,14 +340,8 @@ fn exact_distance(i: u32, nearest: vec2<u32>, want: u32) -> u32 {
 // hadou-cpu's soft::Search::exact, per pixel of the image.
 @compute @workgroup_size(8, 8, 1)
 fn cs_exact(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = frame.image_size.x;
-    if (id.x >= w || id.y >= frame.image_size.y) {
-        return;
-    }
-    let i = id.y * w + id.x;
-    let c = class_at(i);
-    if (c != CLASS_PENUMBRA) {
-        visibility[i] = plain(c);
+    let i = penumbra_pixel(id);
+    if (i == NOT_PENUMBRA) {
         return;
     }
     let x = i32(id.x);
@@ -367,14 +381,8 @@ fn bilinear(v00: f32, v10: f32, v01: f32, v11: f32, fx: f32, fy: f32) -> f32 {
 // pixels around them (the last grid column or row repeated at the image's edge).
 @compute @workgroup_size(8, 8, 1)
 fn cs_interp(@builtin(global_invocation_id) id: vec3<u32>) {
-    let w = frame.image_size.x;
-    if (id.x >= w || id.y >= frame.image_size.y) {
-        return;
-    }
-    let i = id.y * w + id.x;
-    let c = class_at(i);
-    if (c != CLASS_PENUMBRA) {
-        visibility[i] = plain(c);
+    let i = penumbra_pixel(id);
+    if (i == NOT_PENUMBRA) {
         return;
     }
     let n = soft.grid;

@@ -8,6 +8,39 @@ use hadou_math::{Mat4, Vec3, Vec3f};
 use hadou_scene::{Camera, ColorMapping, Frame, Image, Light, Mesh, Object, ToneMode, Wave, WaveShape};
 use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
+/// Every example scene in `scenes/` whose file name `keep` accepts, as `(label, frame)` at the
+/// start, middle and end of its animation (once for a still scene), at 128×96, in file-name
+/// order. Panics if none is kept or one fails to load.
+pub fn example_frames(keep: impl Fn(&str) -> bool) -> Vec<(String, Frame)> {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{dir}: {e}"))
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| {
+            p.extension().is_some_and(|x| x == "toml")
+                && p.file_name().is_some_and(|n| keep(&n.to_string_lossy()))
+        })
+        .collect();
+    paths.sort();
+    assert!(!paths.is_empty(), "no matching scenes in {dir}");
+    let mut out = Vec::new();
+    for path in paths {
+        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+        let d = scene.duration();
+        for t in [0.0, 0.5 * d, d] {
+            let mut frame = scene.at(t);
+            frame.width = 128;
+            frame.height = 96;
+            out.push((format!("{name} t={t}"), frame));
+            if d == 0.0 {
+                break;
+            }
+        }
+    }
+    out
+}
+
 /// The one GPU backend of this test binary, shared by its tests in turn, or `None` (with a clear
 /// message on stderr) when this machine has no usable adapter. With `HADOU_REQUIRE_GPU=1` a
 /// missing adapter fails the test instead.
