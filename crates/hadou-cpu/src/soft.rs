@@ -1,7 +1,7 @@
 //! Soft shadows from the `[area_light]` (003, SPEC.md §4): two perspective shadow maps from
 //! `L₁ = L + l·P` and `L₂ = L − l·P`, every visible pixel classed umbra / penumbra / lit, and each
-//! penumbra pixel's brightness `D₁/(D₁ + D₂)` from its distances to the nearest umbra and lit
-//! pixels, found either by 003's search on every `N`-th pixel with bilinear interpolation
+//! penumbra pixel's brightness `k·D₁/(k·D₁ + D₂)` ([`segment_brightness`]; `k = 1` is 003's
+//! `D₁/(D₁ + D₂)`) from its distances to the nearest umbra and lit pixels, found either by 003's search on every `N`-th pixel with bilinear interpolation
 //! ([`SoftResolve::Faithful`]) or by exact Euclidean distance transforms ([`SoftResolve::Exact`],
 //! the default). Both count only umbra and lit pixels within [`SEARCH_RADIUS`], and with the
 //! depth-aware search only those on the penumbra pixel's own surface ([`same_surface`]), so the
@@ -14,7 +14,7 @@
 
 use crate::raster::{bin_rows, cover, spot_tris, BAND};
 use hadou_math::soft::{
-    bilinear, penumbra_brightness, same_surface, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
+    bilinear, same_surface, segment_brightness, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
 };
 use hadou_math::Vec3f;
 use hadou_scene::{AreaLight, Frame, SoftResolve};
@@ -124,7 +124,8 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 }
 
 /// The soft-shadow visibility of every pixel of `input` under `light` (0 in the umbra, 1 where
-/// lit, `D₁/(D₁ + D₂)` in the penumbra; 0 where no point is): the two maps, the classes and the
+/// lit, `k·D₁/(k·D₁ + D₂)` in the penumbra with `k` = [`AreaLight::penumbra_ratio`]; 0 where no
+/// point is): the two maps, the classes and the
 /// resolve `resolve`. What [`crate::render`] multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
     let maps = light.maps.map(|m| (m, light.map_size));
@@ -134,7 +135,8 @@ pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: 
         || SpotDepth::render(frame, &light.casters, &b.0, b.1),
     );
     let class = classify(&[m1, m2], input);
-    let search = Search { input, class: &class, depth_aware: light.depth_aware };
+    let search =
+        Search { input, class: &class, depth_aware: light.depth_aware, ratio: light.penumbra_ratio() };
     match resolve {
         SoftResolve::Exact => search.exact(),
         SoftResolve::Faithful { n } => search.faithful(n.max(1) as usize),
@@ -146,6 +148,8 @@ struct Search<'a> {
     input: &'a SoftInput,
     class: &'a [Class],
     depth_aware: bool,
+    /// `k` of [`segment_brightness`] (1: 003's linear ratio).
+    ratio: f32,
 }
 
 /// The value of a pixel that is not in the penumbra.
@@ -214,7 +218,7 @@ impl Search<'_> {
     fn searched(&self, i: usize) -> f32 {
         let d1 = self.ring_search(i, Class::Umbra, 1);
         let d2 = self.ring_search(i, Class::Lit, 1);
-        penumbra_brightness(d1.sqrt(), d2.sqrt())
+        segment_brightness(d1.sqrt(), d2.sqrt(), self.ratio)
     }
 
     /// 003's resolve (SPEC.md §4.2–4.3): the search on every `n`-th pixel in x and y (pixels
@@ -331,7 +335,7 @@ impl Search<'_> {
                 };
                 let d1 = fix(du[b], fu[b], Class::Umbra);
                 let d2 = fix(dl[b], fl[b], Class::Lit);
-                *o = penumbra_brightness(d1.sqrt(), d2.sqrt());
+                *o = segment_brightness(d1.sqrt(), d2.sqrt(), self.ratio);
             }
         });
         out

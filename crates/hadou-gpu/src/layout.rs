@@ -975,4 +975,8 @@ pub struct SoftUniforms {
     pub grid: u32,
     /// The faithful grid's size in grid pixels.
     pub grid_size: [u32; 2],
+    /// `k` of `hadou_math::soft::segment_brightness` (1: 003's linear ratio).
+    pub ratio: f32,
+    /// Padding to the uniform's 16-byte alignment.
+    pub _pad: [u32; 3],
 }

@@ -676,7 +676,14 @@ impl Renderer {
         let q = &self.ctx.queue;
         q.write_buffer(&soft.spot_uniforms[0], 0, bytemuck::bytes_of(&maps[0]));
         q.write_buffer(&soft.spot_uniforms[1], 0, bytemuck::bytes_of(&maps[1]));
-        let u = SoftUniforms { maps, depth_aware: u32::from(light.depth_aware), grid: n, grid_size: gs };
+        let u = SoftUniforms {
+            maps,
+            depth_aware: u32::from(light.depth_aware),
+            grid: n,
+            grid_size: gs,
+            ratio: light.penumbra_ratio(),
+            _pad: [0; 3],
+        };
         q.write_buffer(&soft.uniforms, 0, bytemuck::bytes_of(&u));
     }
 

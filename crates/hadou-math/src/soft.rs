@@ -31,6 +31,39 @@ pub fn penumbra_brightness(d1: f32, d2: f32) -> f32 {
     }
 }
 
+/// hadou's penumbra brightness (SPEC.md §4.2 as corrected, made perspective-correct): the fraction
+/// of the segment light `L₁L₂` that a penumbra pixel sees, `k·D₁/(k·D₁ + D₂)` with
+/// `k = A₁/A₂` ([`segment_ratio`]).
+///
+/// The two maps sample a light spread along the axis from `L₁` (axial distance `A₁ = A + l` from
+/// an occluder edge) to `L₂` (`A₂ = A − l`). A point light at axial distance `a` throws that edge's
+/// shadow `∝ 1/a` beyond the edge on a receiver, so the shadows of the lights between `L₁` and
+/// `L₂` are spaced evenly in `1/a`, not in image distance: at the fraction `s = D₁/(D₁ + D₂)` of
+/// the band from the umbra's edge (`L₁`'s shadow edge) lies the edge of the light at
+/// `1/a = 1/A₁ + s·(1/A₂ − 1/A₁)`, and the pixel sees the lights farther than that, the fraction
+/// `(A₁ − a)/(A₁ − A₂) = k·s/(1 + (k − 1)·s) = k·D₁/(k·D₁ + D₂)` of the segment. `k = 1` (a light
+/// far from its occluders) is 003's linear ratio [`penumbra_brightness`] bit for bit. 0 at the
+/// umbra's edge, 1 at the lit edge, never NaN.
+#[inline]
+pub fn segment_brightness(d1: f32, d2: f32, k: f32) -> f32 {
+    penumbra_brightness(k * d1, d2)
+}
+
+/// The ratio `k = A₁/A₂ = (D + l)/(D − l)` of [`segment_brightness`]: the distances of the two map
+/// positions `L ± l·P` from an occluder at the point of interest, `D = |L − G|` and `l` the light's
+/// size parameter. 1 where `l ≤ 0` or `D` is infinite, at most `10⁶` (`l` near or past `D`),
+/// never NaN.
+#[inline]
+pub fn segment_ratio(l: f32, d: f32) -> f32 {
+    if l.is_nan() || l <= 0.0 || !d.is_finite() {
+        return 1.0;
+    }
+    if d <= l {
+        return 1e6;
+    }
+    ((d + l) / (d - l)).clamp(1.0, 1e6)
+}
+
 /// Standard bilinear interpolation of the four grid values around a pixel (SPEC.md §4.3), `fx`,
 /// `fy ∈ [0, 1]` its offsets from the top-left grid pixel in grid cells:
 /// `(1−fx)(1−fy)·v00 + fx(1−fy)·v10 + (1−fx)fy·v01 + fx·fy·v11`. *Correction:* 003's eq. 3.6 gives
@@ -445,6 +478,45 @@ mod tests {
         // A light inside the objects' bounds takes the widest frustum.
         let wide = SpotMap::look(Vec3f::new(0.0, 1.0, 0.0), Vec3f::ZERO, &corners);
         assert_eq!(wide.tan_half, SPOT_MAX_TAN);
+    }
+
+    #[test]
+    fn segment_brightness_is_the_visible_fraction_of_the_segment_light() {
+        // Lights spread evenly along the axis from A₁ = 5 to A₂ = 3 (D = 4, l = 1): each throws an
+        // edge's shadow at 1/a; a receiver point at image fraction s of the band between the
+        // shadows of L₁ and L₂ sees exactly the lights whose shadow edge lies short of it.
+        let (d, l) = (4.0f64, 1.0f64);
+        let k = segment_ratio(l as f32, d as f32);
+        assert!((f64::from(k) - 5.0 / 3.0).abs() < 1e-6);
+        for j in 0..=20 {
+            let s = j as f64 / 20.0;
+            let x = 1.0 / (d + l) + s * (1.0 / (d - l) - 1.0 / (d + l));
+            let m = 200_000;
+            let seen = (0..m)
+                .filter(|&i| {
+                    let a = (d + l) - (i as f64 + 0.5) / m as f64 * 2.0 * l;
+                    1.0 / a < x
+                })
+                .count() as f64
+                / m as f64;
+            let got = f64::from(segment_brightness(s as f32, (1.0 - s) as f32, k));
+            assert!((got - seen).abs() < 2e-5, "s = {s}: {got} against {seen}");
+        }
+        // k = 1 is 003's ratio bit for bit; the ends and the degenerate cases stay finite.
+        for (d1, d2) in [(0.0, 0.0), (1.0, 3.0), (2.5, 0.5), (FAR, 2.0), (2.0, FAR), (FAR, FAR)] {
+            assert_eq!(segment_brightness(d1, d2, 1.0).to_bits(), penumbra_brightness(d1, d2).to_bits());
+            for k in [1.0, 1.7, 1e6] {
+                let v = segment_brightness(d1, d2, k);
+                assert!((0.0..=1.0).contains(&v), "{d1} {d2} {k}: {v}");
+            }
+        }
+        assert_eq!(segment_brightness(0.0, 4.0, 3.0), 0.0);
+        assert_eq!(segment_brightness(4.0, 0.0, 3.0), 1.0);
+        for (l, d) in [(0.0, 1.0), (-1.0, 1.0), (1.0, 1.0), (2.0, 1.0), (f32::NAN, 1.0), (1.0, f32::INFINITY)]
+        {
+            let k = segment_ratio(l, d);
+            assert!((1.0..=1e6).contains(&k), "l = {l}, d = {d}: {k}");
+        }
     }
 
     #[test]

@@ -23,6 +23,7 @@ pub(crate) const AREA_LIGHT_KEYS: &[&str] = &[
     "n",
     "depth_aware",
     "casters",
+    "penumbra",
 ];
 
 /// Most pixels of an image with an `[area_light]` (4096²): the penumbra search works on the whole
@@ -45,6 +46,18 @@ pub enum SoftResolve {
     },
 }
 
+/// How a penumbra pixel's brightness follows from its distances `D₁` to the nearest umbra pixel
+/// and `D₂` to the nearest lit pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Penumbra {
+    /// hadou's: the fraction of the segment light between the two map positions that the pixel
+    /// sees, `k·D₁/(k·D₁ + D₂)` ([`hadou_math::soft::segment_brightness`]); the default of the
+    /// exact resolve.
+    Segment,
+    /// 003's `D₁/(D₁ + D₂)` as SPEC.md §4.2 corrects it; the default of the faithful resolve.
+    Linear,
+}
+
 /// The frame's `[area_light]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AreaLight {
@@ -62,10 +75,25 @@ pub struct AreaLight {
     pub resolve: SoftResolve,
     /// Depth-aware search ([`hadou_math::soft::same_surface`]).
     pub depth_aware: bool,
+    /// The penumbra's brightness from its distances.
+    pub penumbra: Penumbra,
     /// The objects drawn into the maps (indices into `Frame::objects`); every object receives.
     pub casters: Vec<u32>,
     /// The two maps: `[L₁ = L + l·P, L₂ = L − l·P]`, each looking at `G`, every caster inside.
     pub maps: [SpotMap; 2],
+}
+
+impl AreaLight {
+    /// The `k` of [`hadou_math::soft::segment_brightness`] for this frame: `(D + l)/(D − l)` with
+    /// `D = |L − G|` for [`Penumbra::Segment`], 1 (003's linear ratio) for [`Penumbra::Linear`].
+    pub fn penumbra_ratio(&self) -> f32 {
+        match self.penumbra {
+            Penumbra::Linear => 1.0,
+            Penumbra::Segment => {
+                hadou_math::soft::segment_ratio(self.size, (self.position - self.interest).length())
+            }
+        }
+    }
 }
 
 /// Where `G` comes from.
@@ -85,6 +113,7 @@ pub(crate) struct AreaLightDef {
     pub map_size: u32,
     pub resolve: SoftResolve,
     pub depth_aware: bool,
+    pub penumbra: Penumbra,
     pub params: ParamSet,
 }
 
@@ -190,7 +219,12 @@ pub(crate) fn parse_area_light(
         }
     };
     let depth_aware = opt_bool(t, "depth_aware")?.unwrap_or(true);
-    Ok(AreaLightDef { target, casters, map_size, resolve, depth_aware, params })
+    let default_penumbra = if resolve == SoftResolve::Exact { "segment" } else { "linear" };
+    let penumbra = match t.choice("penumbra", &["segment", "linear"], Some(default_penumbra))? {
+        "linear" => Penumbra::Linear,
+        _ => Penumbra::Segment,
+    };
+    Ok(AreaLightDef { target, casters, map_size, resolve, depth_aware, penumbra, params })
 }
 
 /// `G` of the light at these values.
@@ -276,6 +310,7 @@ pub(crate) fn build_area_light(
         map_size: def.map_size,
         resolve: def.resolve,
         depth_aware: def.depth_aware,
+        penumbra: def.penumbra,
         casters: def.casters.clone(),
         maps: [SpotMap::look(l1, g, &corners), SpotMap::look(l2, g, &corners)],
     }

@@ -32,7 +32,7 @@ mod texture;
 mod toml_read;
 
 pub use anim::Interpolation;
-pub use area_light::{AreaLight, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
+pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
 pub use backend::{Backend, RenderError};
 pub use error::{Location, SceneError};
 pub use files::{read_regular_file, GLTF_MAX_BYTES, SCENE_MAX_BYTES};

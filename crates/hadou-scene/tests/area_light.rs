@@ -5,7 +5,7 @@ mod common;
 
 use common::{at, err};
 use hadou_math::Vec3f;
-use hadou_scene::{Scene, SoftResolve};
+use hadou_scene::{Penumbra, Scene, SoftResolve};
 use std::path::Path;
 
 const OBJECTS: &str = r#"
@@ -42,6 +42,9 @@ fn maps_sit_at_l_plus_and_minus_l_p_and_every_object_is_inside_them() {
     );
     assert_eq!(a.color, [2.0, 1.0, 0.5]);
     assert_eq!((a.map_size, a.resolve, a.depth_aware), (1024, SoftResolve::Exact, true));
+    // The exact resolve's default brightness is the segment light's: k = (D + l)/(D − l), D = 4.
+    assert_eq!(a.penumbra, Penumbra::Segment);
+    assert!((a.penumbra_ratio() - 4.5 / 3.5).abs() < 1e-6, "{}", a.penumbra_ratio());
     // The floor (a plane) receives but does not cast: the frustum fits the pillar alone.
     assert_eq!(a.casters, vec![0]);
     for m in &a.maps {
@@ -68,6 +71,25 @@ fn a_point_target_faithful_resolve_and_tracks() {
     ));
     let a0 = s.at(0.0).area_light.unwrap();
     assert_eq!((a0.resolve, a0.depth_aware, a0.map_size), (SoftResolve::Faithful { n: 5 }, false, 256));
+    // The faithful resolve keeps 003's linear ratio unless told otherwise.
+    assert_eq!((a0.penumbra, a0.penumbra_ratio()), (Penumbra::Linear, 1.0));
+    for (resolve, key, want) in [
+        ("exact", "linear", Penumbra::Linear),
+        ("faithful", "segment", Penumbra::Segment),
+        ("exact", "segment", Penumbra::Segment),
+    ] {
+        let s = parse(&format!(
+            "{OBJECTS}
+[area_light]
+position = [3, 4, 0]
+size = 1
+target = [0, 0, 0]
+resolve = \"{resolve}\"
+penumbra = \"{key}\"
+"
+        ));
+        assert_eq!(s.at(0.0).area_light.unwrap().penumbra, want, "{resolve} {key}");
+    }
     // P = (3, 4, 0)/5: L₁ = L + P, L₂ = L − P.
     assert!(
         close(a0.maps[0].eye, Vec3f::new(3.6, 4.8, 0.0)) && close(a0.maps[1].eye, Vec3f::new(2.4, 3.2, 0.0))
@@ -113,6 +135,8 @@ fn bad_area_lights_name_their_line_and_column() {
         (format!("{ok}n = 3\n"), 4, 1, "applies to `resolve = \"faithful\"`"),
         (format!("{ok}resolve = \"blur\"\n"), 4, 11, "cannot be \"blur\""),
         (format!("{ok}depth_aware = 1\n"), 4, 15, "depth_aware"),
+        (format!("{ok}penumbra = \"smooth\"\n"), 4, 12, "cannot be \"smooth\""),
+        (format!("{ok}penumbra = 1\n"), 4, 12, "penumbra"),
         (format!("{ok}radius = 1\n"), 4, 1, "unknown key `radius`"),
         (format!("{ok}casters = [\"pilar\"]\n"), 4, 12, "did you mean `pillar`"),
         (format!("{ok}casters = []\n"), 4, 11, "at least one object"),

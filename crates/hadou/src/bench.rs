@@ -3,7 +3,7 @@
 //! The scenes are built from scene-file text, so the bench measures exactly what users render.
 
 use hadou_math::curve::{self, Integrator, Reduction};
-use hadou_scene::{Frame, RenderError, Scene, WaveShape};
+use hadou_scene::{AreaLight, Frame, RenderError, Scene, WaveShape};
 use std::path::Path;
 
 /// One measured cell.
@@ -718,10 +718,11 @@ pub fn truth_map(size: u32) -> u32 {
     (4 * size).clamp(256, TRUTH_MAP)
 }
 
-/// The methods of the soft-shadow table, in order: 003's faithful resolve at N = 1, 3, 5, 10,
-/// hadou's exact resolve, and PCSS.
-pub const SOFT_METHODS: [&str; 6] =
-    ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact", "pcss"];
+/// The methods of the soft-shadow table, in order: 003's faithful resolve at N = 1, 3, 5, 10 (with
+/// 003's linear brightness), hadou's exact resolve with 003's linear brightness (`exact-linear`:
+/// faithful N = 1's picture) and with its default segment brightness (`exact`), and PCSS.
+pub const SOFT_METHODS: [&str; 7] =
+    ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact-linear", "exact", "pcss"];
 
 /// One row of the soft-shadow table.
 #[derive(Clone, Debug)]
@@ -806,7 +807,7 @@ pub fn soft_table(
     progress: &mut dyn FnMut(&str),
 ) -> Result<SoftTable, RenderError> {
     use hadou_cpu::soft;
-    use hadou_scene::SoftResolve;
+    use hadou_scene::{Penumbra, SoftResolve};
     let (file, t) = SOFT_SCENE;
     let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
     let mut rows = Vec::new();
@@ -830,16 +831,19 @@ pub fn soft_table(
         for method in SOFT_METHODS {
             progress(&format!("{size}²: {method}"));
             let resolve = match method {
-                "exact" => Some(SoftResolve::Exact),
+                "exact" => Some((SoftResolve::Exact, Penumbra::Segment)),
+                "exact-linear" => Some((SoftResolve::Exact, Penumbra::Linear)),
                 "pcss" => None,
-                m => {
-                    Some(SoftResolve::Faithful { n: m.trim_start_matches("faithful-n").parse().unwrap_or(1) })
-                }
-            };
+                m => Some((
+                    SoftResolve::Faithful { n: m.trim_start_matches("faithful-n").parse().unwrap_or(1) },
+                    Penumbra::Linear,
+                )),
+            }
+            .map(|(r, penumbra)| (r, AreaLight { penumbra, ..light.clone() }));
             let mut out = Vec::new();
             let mut run = |_: &Frame| -> Result<(), RenderError> {
-                out = match resolve {
-                    Some(r) => soft::visibility(&frame, &light, &input, r),
+                out = match &resolve {
+                    Some((r, light)) => soft::visibility(&frame, light, &input, *r),
                     None => soft::pcss(&frame, &light, &input, radius),
                 };
                 Ok(())

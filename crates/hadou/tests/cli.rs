@@ -600,7 +600,7 @@ fn bench_shadows_prints_every_method_with_its_error() {
     assert!(o.status.success(), "{}", stderr(&o));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
     let rows = j["rows"].as_array().expect("rows");
-    for m in ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact", "pcss"] {
+    for m in ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact-linear", "exact", "pcss"] {
         let r = rows.iter().find(|r| r["method"] == m).unwrap_or_else(|| panic!("no {m} row: {j}"));
         assert_eq!(r["size"], 48);
         assert!(r["ms"].as_f64().is_some_and(|v| v > 0.0), "{r}");
@@ -608,9 +608,11 @@ fn bench_shadows_prints_every_method_with_its_error() {
             assert!(r[k].as_f64().is_some_and(|v| (0.0..=1.0).contains(&v)), "{m} {k}: {r}");
         }
     }
-    // The exact resolve and the search at N = 1 are the same answer.
+    // The exact resolve with 003's linear brightness and the search at N = 1 are the same answer;
+    // the segment brightness (the exact resolve's default) is another.
     let err = |m: &str| rows.iter().find(|r| r["method"] == m).unwrap()["mean_error"].as_f64().unwrap();
-    assert_eq!(err("exact"), err("faithful-n1"));
+    assert_eq!(err("exact-linear"), err("faithful-n1"));
+    assert_ne!(err("exact"), err("exact-linear"));
 }
 
 #[test]

@@ -15,6 +15,11 @@ struct SoftUniforms {
     depth_aware: u32,
     grid: u32,
     grid_size: vec2<u32>,
+    // k of hadou_math::soft::segment_brightness (1: 003's linear ratio).
+    ratio: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
@@ -240,10 +245,11 @@ fn visit(i: u32, x: i32, y: i32, u: i32, v: i32, w: i32, h: i32, want: u32, best
     return best;
 }
 
-// Twin of hadou_math::soft::penumbra_brightness on squared distances (FAR = infinite).
+// Twin of hadou_math::soft::segment_brightness (penumbra_brightness of k·D₁ and D₂, k =
+// soft.ratio) on squared distances (FAR = infinite).
 fn brightness(d1: u32, d2: u32) -> f32 {
     if (d1 != FAR && d2 != FAR) {
-        let a = sqrt(f32(d1));
+        let a = soft.ratio * sqrt(f32(d1));
         let s = a + sqrt(f32(d2));
         if (s > 0.0) {
             return clamp(a / s, 0.0, 1.0);
