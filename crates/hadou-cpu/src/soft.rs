@@ -1,14 +1,15 @@
 //! Soft shadows from the `[area_light]` (003, SPEC.md §4): two perspective shadow maps from
 //! `L₁ = L + l·P` and `L₂ = L − l·P`, every visible pixel classed umbra / penumbra / lit, and each
 //! penumbra pixel's brightness `k·D₁/(k·D₁ + D₂)` ([`segment_brightness`]; `k = 1` is 003's
-//! `D₁/(D₁ + D₂)`) from its distances to the nearest umbra and lit pixels, found either by 003's search on every `N`-th pixel with bilinear interpolation
-//! ([`SoftResolve::Faithful`]) or by exact Euclidean distance transforms ([`SoftResolve::Exact`],
-//! the default). Both count only umbra and lit pixels within [`SEARCH_RADIUS`], and with the
+//! `D₁/(D₁ + D₂)`) from its distances to the nearest umbra and lit pixels, found either by 003's
+//! search on every `N`-th pixel with bilinear interpolation ([`SoftResolve::Faithful`]) or by exact
+//! Euclidean distance transforms ([`SoftResolve::Exact`], the default). Both count only umbra and lit pixels within [`SEARCH_RADIUS`], and with the
 //! depth-aware search only those on the penumbra pixel's own surface ([`same_surface`]), so the
 //! exact resolve gives exactly what the faithful one gives at `N = 1`.
 //!
 //! Also the references `hadou bench shadows` measures against: [`truth`] (a true disc light, many
-//! shadow maps) and [`pcss`] (percentage-closer soft shadows as commonly shipped).
+//! shadow maps, of the radius [`disc_radius`]) and [`pcss`] (percentage-closer soft shadows as
+//! commonly shipped), and the error it reports ([`edge_errors`]).
 //!
 //! The GPU backend mirrors [`visibility`] (`soft.wgsl`).
 
@@ -125,8 +126,8 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 
 /// The soft-shadow visibility of every pixel of `input` under `light` (0 in the umbra, 1 where
 /// lit, `k·D₁/(k·D₁ + D₂)` in the penumbra with `k` = [`AreaLight::penumbra_ratio`]; 0 where no
-/// point is): the two maps, the classes and the
-/// resolve `resolve`. What [`crate::render`] multiplies the area light's term by.
+/// point is): the two maps, the classes and the resolve `resolve`. What [`crate::render`]
+/// multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
     let maps = light.maps.map(|m| (m, light.map_size));
     let [a, b] = maps;
@@ -484,6 +485,44 @@ pub fn truth(
         });
     }
     lit.into_iter().map(|l| l as f32 / samples.max(1) as f32).collect()
+}
+
+/// The disc radius the ground truth and PCSS are measured with for `frame`'s area light: 003's two
+/// maps at `L ± l·P` give the penumbra of a disc of radius `l·r·D/(D² − l²)` at a silhouette `r` off
+/// the axis ([`hadou_math::soft::implied_disc_radius`]), `D = |L − G|` and `r` the bounding radius
+/// of the object whose centre is nearest `G` (the point of interest's object). `None` without an
+/// area light.
+pub fn disc_radius(frame: &Frame) -> Option<f32> {
+    let light = frame.area_light.as_ref()?;
+    let d = (light.position - light.interest).length();
+    let r = frame
+        .objects
+        .iter()
+        .filter_map(hadou_scene::object_bounds)
+        .map(|(lo, hi)| (((lo + hi) * 0.5 - light.interest).length(), (hi - lo).length() * 0.5))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(light.size, |(_, r)| r);
+    Some(hadou_math::soft::implied_disc_radius(light.size, r, d))
+}
+
+/// Mean and 99th percentile of `|v − truth|` over the shadow-edge pixels: those with a visible
+/// point where either value lies strictly between 0 and 1 or the two differ. `(0, 0)` when there
+/// are none.
+pub fn edge_errors(v: &[f32], truth: &[f32], visible: &[bool]) -> (f64, f64) {
+    let mut e: Vec<f64> = v
+        .iter()
+        .zip(truth)
+        .zip(visible)
+        .filter(|((&a, &b), &vis)| vis && ((a > 0.0 && a < 1.0) || (b > 0.0 && b < 1.0) || a != b))
+        .map(|((&a, &b), _)| f64::from((a - b).abs()))
+        .collect();
+    if e.is_empty() {
+        return (0.0, 0.0);
+    }
+    e.sort_by(f64::total_cmp);
+    let mean = e.iter().sum::<f64>() / e.len() as f64;
+    let p99 = e[((e.len() - 1) as f64 * 0.99).round() as usize];
+    (mean, p99)
 }
 
 /// Point `k` of `n` of a golden-angle spiral on the unit disc (equal areas).

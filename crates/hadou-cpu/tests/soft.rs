@@ -4,7 +4,9 @@
 //! searched values, the depth-aware search changes the failure case it is for, the light adds its
 //! term only where visible, and nothing is ever NaN.
 
-use hadou_cpu::soft::{classify, pcss, soft_input, truth, visibility, SoftInput, SpotDepth};
+use hadou_cpu::soft::{
+    classify, disc_radius, edge_errors, pcss, soft_input, truth, visibility, SoftInput, SpotDepth,
+};
 use hadou_math::soft::{same_surface, segment_brightness, Class, SEARCH_RADIUS};
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame, Penumbra, Scene, SoftResolve};
@@ -268,20 +270,12 @@ fn segment_brightness_is_closer_to_a_disc_light_than_the_linear_ratio() {
     let f = example("soft-gradient.toml", 0.0, 160);
     let light = f.area_light.clone().unwrap();
     let input = soft_input(&f).unwrap();
-    // The disc of the bench (hadou::bench::soft_disc_radius): the pillar's bounding radius r.
-    let (d, r) = ((light.position - light.interest).length(), (0.25f32 * 0.25 * 2.0 + 0.8 * 0.8).sqrt());
-    let radius = hadou_math::soft::implied_disc_radius(light.size, r, d);
-    let t = truth(&f, &light, &input, radius, 64, 640);
+    // The disc `hadou bench shadows` measures against, and its error.
+    let t = truth(&f, &light, &input, disc_radius(&f).unwrap(), 64, 640);
+    let visible: Vec<bool> = input.points.iter().map(Option::is_some).collect();
     let error = |penumbra: Penumbra| {
         let v = visibility(&f, &AreaLight { penumbra, ..light.clone() }, &input, SoftResolve::Exact);
-        let (mut sum, mut n) = (0.0f64, 0usize);
-        for (&a, &b) in v.iter().zip(&t) {
-            if (a > 0.0 && a < 1.0) || (b > 0.0 && b < 1.0) || a != b {
-                sum += f64::from((a - b).abs());
-                n += 1;
-            }
-        }
-        (sum / n as f64, v)
+        (edge_errors(&v, &t, &visible).0, v)
     };
     let (segment, vs) = error(Penumbra::Segment);
     let (linear, vl) = error(Penumbra::Linear);

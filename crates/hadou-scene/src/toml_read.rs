@@ -230,7 +230,12 @@ impl<'t, 'i> Table<'t, 'i> {
             Some(o) => Ok(o),
             None => Err(self.src.value_err(
                 &got.1,
-                format!("`{key}` in {} cannot be \"{}\"{}", self.what, got.0, hint(got.0, options, "values")),
+                format!(
+                    "`{key}` in {} cannot be \"{}\"{}",
+                    self.what,
+                    echo(got.0),
+                    hint(got.0, options, "values")
+                ),
             )),
         }
     }
@@ -376,5 +381,15 @@ impl ParamReader<'_> {
         }
         set.params.push(Param { key, offset, len: vals.len(), shape, rule, broadcast });
         Ok(())
+    }
+}
+
+/// A value from the file as an error message quotes it: at most 48 characters, the rest replaced
+/// by `…`, so a hostile file cannot make a message as long as itself.
+pub(crate) fn echo(value: &str) -> String {
+    const MAX: usize = 48;
+    match value.char_indices().nth(MAX) {
+        Some((cut, _)) => format!("{}…", &value[..cut]),
+        None => value.to_string(),
     }
 }

@@ -79,14 +79,7 @@ fn a_point_target_faithful_resolve_and_tracks() {
         ("exact", "segment", Penumbra::Segment),
     ] {
         let s = parse(&format!(
-            "{OBJECTS}
-[area_light]
-position = [3, 4, 0]
-size = 1
-target = [0, 0, 0]
-resolve = \"{resolve}\"
-penumbra = \"{key}\"
-"
+            "{OBJECTS}\n[area_light]\nposition = [3, 4, 0]\nsize = 1\ntarget = [0, 0, 0]\nresolve = \"{resolve}\"\npenumbra = \"{key}\"\n"
         ));
         assert_eq!(s.at(0.0).area_light.unwrap().penumbra, want, "{resolve} {key}");
     }
@@ -141,6 +134,11 @@ fn bad_area_lights_name_their_line_and_column() {
         (format!("{ok}casters = [\"pilar\"]\n"), 4, 12, "did you mean `pillar`"),
         (format!("{ok}casters = []\n"), 4, 11, "at least one object"),
     ];
+    // A hostile value is quoted shortened, still located.
+    let e = light_err(&format!("{ok}penumbra = \"{}\"\n", "x".repeat(5000)));
+    let msg = e.to_string();
+    assert!(msg.len() < 300 && msg.contains("xxxx…"), "{} bytes: {}", msg.len(), &msg[..200]);
+    assert_eq!(at(&e), (l + 4, 12), "{msg}");
     for (body, line, col, needle) in cases {
         let e = light_err(&body);
         let msg = e.to_string();

@@ -757,41 +757,7 @@ pub struct SoftTable {
     pub rows: Vec<SoftRow>,
 }
 
-/// The disc radius the ground truth and PCSS use for `frame`'s area light: 003's two maps at
-/// `L ± l·P` give the penumbra of a disc of radius `l·r·D/(D² − l²)` at a silhouette `r` off the
-/// axis ([`hadou_math::soft::implied_disc_radius`]), `D = |L − G|` and `r` the bounding radius of
-/// the object whose centre is nearest `G` (the point of interest's object).
-pub fn soft_disc_radius(frame: &Frame) -> Option<f32> {
-    let light = frame.area_light.as_ref()?;
-    let d = (light.position - light.interest).length();
-    let r = frame
-        .objects
-        .iter()
-        .filter_map(hadou_scene::object_bounds)
-        .map(|(lo, hi)| (((lo + hi) * 0.5 - light.interest).length(), (hi - lo).length() * 0.5))
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map_or(light.size, |(_, r)| r);
-    Some(hadou_math::soft::implied_disc_radius(light.size, r, d))
-}
-
-/// Mean and 99th percentile of `|v − truth|` over the shadow-edge pixels: those with a visible
-/// point where either value lies strictly between 0 and 1 or the two differ.
-pub fn soft_errors(v: &[f32], truth: &[f32], visible: &[bool]) -> (f64, f64) {
-    let mut e: Vec<f64> = v
-        .iter()
-        .zip(truth)
-        .zip(visible)
-        .filter(|((&a, &b), &vis)| vis && ((a > 0.0 && a < 1.0) || (b > 0.0 && b < 1.0) || a != b))
-        .map(|((&a, &b), _)| f64::from((a - b).abs()))
-        .collect();
-    if e.is_empty() {
-        return (0.0, 0.0);
-    }
-    e.sort_by(f64::total_cmp);
-    let mean = e.iter().sum::<f64>() / e.len() as f64;
-    let p99 = e[((e.len() - 1) as f64 * 0.99).round() as usize];
-    (mean, p99)
-}
+pub use hadou_cpu::soft::{disc_radius as soft_disc_radius, edge_errors as soft_errors};
 
 /// Measures the soft-shadow table: [`SOFT_SCENE`] at each size, every method's soft-shadow stage
 /// on the CPU against the ground truth ([`hadou_cpu::soft::truth`], a disc of radius
