@@ -54,6 +54,27 @@ pub fn render(frame: &Frame) -> Image {
 /// Renders the rows `rows` of `frame` (clamped to the image): the same pixels as those rows of
 /// [`render`], bit for bit, in an image `frame.width` wide and `rows.len()` high.
 pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
+    render_timed(frame, rows).0
+}
+
+/// Wall-clock milliseconds of each pass of one CPU render (see [`render_timed`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimes {
+    /// Per-frame set-up (camera, curve tables, lights, shadow maps) and the opaque pass: meshes,
+    /// outlines, shading, hard and soft shadows.
+    pub opaque_ms: f64,
+    /// The energy integrals of every wave per pixel, clipped at the visible surface.
+    pub wave_ms: f64,
+    /// `scene + exposure·Σ rgb·a·I` and the colour mapping.
+    pub color_ms: f64,
+}
+
+/// [`render_rows`], also returning how long each pass took. The opaque pass runs first; then each
+/// row runs its wave pass and its colour mapping, and the wall time of that stage is split
+/// between the two in the proportion of the threads' time in each. The times add up to the
+/// render's.
+pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTimes) {
+    let start = std::time::Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
     let basis = frame.camera.basis(frame.width, frame.height);
@@ -61,34 +82,45 @@ pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
     let lights = shading::FrameLights::new(frame, &curves);
     let shadows = shadows::FrameShadows::new(frame, &lights.lines);
     let (opaque, oy0) = opaque_pass(frame, &basis, &lights, &shadows, y0 as usize..y1 as usize);
+    let opaque_done = std::time::Instant::now();
+
     let mut img = Image::new(frame.width, y1 - y0);
     let w = frame.width as usize;
-    let far = frame.camera.far;
+    let pass = waves::WavePass::new(frame, &basis, &curves);
+    let first = (y0 as usize - oy0) * w;
+    let surface = &opaque.surface[first..first + img.color.len()];
+    let scene = &opaque.color[first..first + img.color.len()];
+    // Each row: the wave pass into a row buffer, then the colour mapping from it; the threads'
+    // time in each, to split the wall time between them.
+    let wave_ns = std::sync::atomic::AtomicU64::new(0);
+    let color_ns = std::sync::atomic::AtomicU64::new(0);
     img.color
         .par_chunks_mut(w)
         .zip(img.energy.par_chunks_mut(w))
         .zip(img.depth.par_chunks_mut(w))
+        .zip(surface.par_chunks(w).zip(scene.par_chunks(w)))
         .enumerate()
-        .for_each(|(r, ((col, en), dep))| {
-            let py = (y0 as usize + r) as f32;
-            for x in 0..w {
-                let i = (y0 as usize - oy0 + r) * w + x;
-                let px = x as f32;
-                let surface = opaque.surface[i];
-                let mut light = [0.0f32; 3];
-                let mut total = 0.0f32;
-                for (wave, prep) in frame.waves.iter().zip(&curves) {
-                    let (e, _) = waves::wave_energy(frame, &basis, wave, prep.as_ref(), px, py, surface);
-                    waves::accumulate(&mut light, wave, e);
-                    total = hadou_math::energy::saturate(total + e);
-                }
-                col[x] = waves::compose(frame, opaque.color[i], light);
-                en[x] = total;
-                dep[x] = surface
-                    .unwrap_or_else(|| far * basis.pixel_dir(px, py, frame.width, frame.height).length());
-            }
+        .for_each_init(Vec::new, |buf, (r, (((col, en), dep), (surf, scene)))| {
+            let t0 = std::time::Instant::now();
+            pass.row_light((y0 as usize + r) as f32, surf, buf);
+            let t1 = std::time::Instant::now();
+            pass.row_color(buf, scene, col, en, dep);
+            let t2 = std::time::Instant::now();
+            let ns = |d: std::time::Duration| d.as_nanos() as u64;
+            wave_ns.fetch_add(ns(t1 - t0), std::sync::atomic::Ordering::Relaxed);
+            color_ns.fetch_add(ns(t2 - t1), std::sync::atomic::Ordering::Relaxed);
         });
-    img
+    let end = std::time::Instant::now();
+    let (wn, cn) = (wave_ns.into_inner() as f64, color_ns.into_inner() as f64);
+    let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };
+    let waves_done = opaque_done + (end - opaque_done).mul_f64(wave_share);
+    let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
+    let times = PassTimes {
+        opaque_ms: ms(start, opaque_done),
+        wave_ms: ms(opaque_done, waves_done),
+        color_ms: ms(waves_done, end),
+    };
+    (img, times)
 }
 
 /// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which
@@ -172,19 +204,20 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();
-    for (wave, prep) in frame.waves.iter().zip(&curves) {
-        let (e, n) = waves::wave_energy(frame, &basis, wave, prep.as_ref(), x as f32, y as f32, surface);
+    let pass = waves::WavePass::new(frame, &basis, &curves);
+    let s = hadou_math::energy::lanes::Lanes::splat(surface.unwrap_or(f32::INFINITY));
+    let depth = pass.energies(x as usize, y as f32, s, 1, |wi, e, n| {
+        let wave = &frame.waves[wi];
+        let e = e.to_array()[0];
         waves::accumulate(&mut light, wave, e);
-        out.push(WaveProbe { name: wave.name.clone(), energy: e, evaluations: n });
-    }
-    let far = frame.camera.far;
+        out.push(WaveProbe { name: wave.name.clone(), energy: e, evaluations: n[0] });
+    });
     Some(Probe {
         x,
         y,
         waves: out,
         color: waves::compose(frame, opaque.color[i], light),
-        depth: surface
-            .unwrap_or_else(|| far * basis.pixel_dir(x as f32, y as f32, frame.width, frame.height).length()),
+        depth: depth.to_array()[0],
         object: opaque.object[i].map(|o| frame.objects[o as usize].name.clone()),
         shadow: opaque.shadow[i].map(|s| frame.shadows[s as usize].name.clone()),
         soft: opaque.visibility.get(i).copied().filter(|_| surface.is_some() && opaque.object[i].is_some()),

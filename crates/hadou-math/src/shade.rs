@@ -1,6 +1,7 @@
 //! Shading of opaque objects and the mapping from summed wave light to output colour. Mirrored in
 //! WGSL by `hadou-gpu` (keep in sync with `crates/hadou-gpu/src/shaders/common.wgsl`).
 
+use crate::energy::lanes::Lanes;
 use crate::Vec3f;
 
 /// Simple diffuse shading of the opaque scene: `albedo · (ambient + light · max(0, N·(−L)))`.
@@ -83,6 +84,55 @@ fn one_minus_exp_neg(x: f32) -> f32 {
     }
 }
 
+/// [`map_faithful`] on eight pixels at once (`c[channel]` holds one channel of each), lane for
+/// lane the same values.
+#[inline]
+pub fn map_faithful_lanes(c: [Lanes; 3]) -> [Lanes; 3] {
+    c.map(|v| {
+        let v = v.is_nan().select(Lanes::ZERO, v);
+        v.max(Lanes::ZERO).min(Lanes::ONE)
+    })
+}
+
+/// [`map_filmic`] on eight pixels at once (`c[channel]` holds one channel of each), with the same
+/// arithmetic in the same order, so lane for lane the same values (a zero may lose its sign).
+#[inline]
+pub fn map_filmic_lanes(c: [Lanes; 3]) -> [Lanes; 3] {
+    let c = c.map(|v| v.is_nan().select(Lanes::ZERO, v.max(Lanes::ZERO)));
+    let m = c[0].max(c[1]).max(c[2]);
+    let w = Lanes::splat(0.5) * (m - Lanes::ONE).max(Lanes::ZERO);
+    c.map(|v| one_minus_exp_neg_lanes((v + w).min(Lanes::splat(80.0))))
+}
+
+/// [`one_minus_exp_neg`] per lane, the same operations in the same order.
+#[inline(always)]
+fn one_minus_exp_neg_lanes(x: Lanes) -> Lanes {
+    let k = Lanes::splat;
+    let one = Lanes::ONE;
+    let small = x
+        * (one
+            - x * (k(1.0 / 2.0)
+                - x * (k(1.0 / 6.0)
+                    - x * (k(1.0 / 24.0)
+                        - x * (k(1.0 / 120.0)
+                            - x * (k(1.0 / 720.0) - x * (k(1.0 / 5040.0) - x * k(1.0 / 40320.0))))))));
+    let y = -x * k(std::f32::consts::LOG2_E);
+    let shift = k(12_582_912.0);
+    let n = (y + shift) - shift;
+    let f = y - n;
+    let g = f * k(std::f32::consts::LN_2);
+    let p = one
+        + g * (one
+            + g * (k(0.5)
+                + g * (k(1.0 / 6.0)
+                    + g * (k(1.0 / 24.0)
+                        + g * (k(1.0 / 120.0) + g * (k(1.0 / 720.0) + g * k(1.0 / 5040.0)))))));
+    let e = (n.round_int() + wide::i32x8::splat(127)).max(wide::i32x8::splat(1)) << 23;
+    let scale = Lanes::from_bits(wide::bytemuck::cast::<wide::i32x8, wide::u32x8>(e));
+    let large = one - p * scale;
+    x.simd_lt(k(0.25)).select(small, large)
+}
+
 /// Linear → sRGB transfer (IEC 61966-2-1), for 8-bit output.
 #[inline]
 pub fn linear_to_srgb(v: f32) -> f32 {
@@ -94,9 +144,115 @@ pub fn linear_to_srgb(v: f32) -> f32 {
     }
 }
 
+/// `linear_to_srgb(v)` as an 8-bit code, `⌊255·srgb(v) + ½⌋`, exactly as that expression
+/// computes it but without the power function: the code is the number of the 255 thresholds
+/// (the smallest `f32` reaching each code, found once by bisection on the exact expression) that
+/// `v` reaches, by an 8-step binary search. NaN and values ≤ 0 give 0, values ≥ 1 give 255.
+#[inline]
+pub fn linear_to_srgb8(v: f32) -> u8 {
+    let t = srgb8_thresholds();
+    let mut k = 0usize;
+    for step in [128, 64, 32, 16, 8, 4, 2, 1] {
+        if v >= t[k + step] {
+            k += step;
+        }
+    }
+    k as u8
+}
+
+/// The code of [`linear_to_srgb8`] by its definition.
+#[inline]
+fn srgb8_exact(v: f32) -> u8 {
+    (linear_to_srgb(v) * 255.0 + 0.5) as u8
+}
+
+/// `t[k]` (k ≥ 1): the smallest non-negative `f32` whose exact code is at least `k` (`t[0]` is
+/// unused). The code is non-decreasing in `v`, and non-negative floats order as their bits.
+fn srgb8_thresholds() -> &'static [f32; 256] {
+    static T: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    T.get_or_init(|| {
+        let mut t = [0.0f32; 256];
+        for (k, tk) in t.iter_mut().enumerate().skip(1) {
+            // Invariant: code(lo) < k ≤ code(hi).
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                if (srgb8_exact(f32::from_bits(mid)) as usize) < k {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            *tk = f32::from_bits(hi);
+        }
+        t
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lane_mappings_equal_the_scalar_ones() {
+        let mut vals: Vec<f32> =
+            (0..4000).map(|i| (i as f32 * 0.37).sin().abs() * 6.0 * (i % 7) as f32 / 3.0).collect();
+        vals.extend([
+            0.0,
+            -0.0,
+            -1.0,
+            0.2499999,
+            0.25,
+            1.0,
+            79.0,
+            80.0,
+            1e30,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NAN,
+            1e-30,
+        ]);
+        for chunk in vals.chunks_exact(24) {
+            let px: Vec<[f32; 3]> = chunk.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            let lanes = [0, 1, 2].map(|ch| Lanes::from(std::array::from_fn::<f32, 8, _>(|i| px[i][ch])));
+            for (scalar, vector) in [
+                (map_filmic as fn([f32; 3]) -> [f32; 3], map_filmic_lanes as fn([Lanes; 3]) -> [Lanes; 3]),
+                (map_faithful, map_faithful_lanes),
+            ] {
+                let got = vector(lanes).map(|l| l.to_array());
+                for (i, p) in px.iter().enumerate() {
+                    let want = scalar(*p);
+                    for ch in 0..3 {
+                        // Equal values (a zero's sign may differ: `max(−0, 0)` is either).
+                        assert!(got[ch][i] == want[ch], "{p:?} channel {ch}: {} vs {}", got[ch][i], want[ch]);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn srgb8_codes_equal_the_power_function_everywhere_they_change() {
+        // Every code's threshold and 64 floats either side, a dense sweep of [0, 1] and the
+        // special values.
+        let t = srgb8_thresholds();
+        for &tk in &t[1..] {
+            let b = tk.to_bits();
+            for v in (b.saturating_sub(64)..=b + 64).map(f32::from_bits) {
+                assert_eq!(linear_to_srgb8(v), srgb8_exact(v), "{v:e}");
+            }
+        }
+        for i in 0..=2_000_000u32 {
+            let v = i as f32 / 2_000_000.0;
+            assert_eq!(linear_to_srgb8(v), srgb8_exact(v), "{v:e}");
+        }
+        for v in
+            [-1.0, -0.0, 0.0, 1.0, 1.5, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MIN_POSITIVE, 1e-45]
+        {
+            assert_eq!(linear_to_srgb8(v), srgb8_exact(v), "{v:e}");
+        }
+        assert_eq!((linear_to_srgb8(0.0), linear_to_srgb8(1.0)), (0, 255));
+    }
 
     #[test]
     fn filmic_is_monotone_bounded_and_whitens_the_core() {

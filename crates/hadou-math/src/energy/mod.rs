@@ -57,6 +57,7 @@
 //! For finite inputs the results are finite, in `[0, f32::MAX]`.
 
 mod kernel;
+pub mod lanes;
 
 pub use kernel::{saturate, scaled, RayAxis, RayQuadratic, ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
 

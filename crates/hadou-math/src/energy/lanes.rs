@@ -1,0 +1,328 @@
+//! The analytic kernels eight rays at a time: the same closed forms as [`RayQuadratic`], on
+//! `wide::f32x8` lanes, with every branch of the scalar kernel turned into a per-lane select.
+//!
+//! Rays of one batch share their origin (the eye) and carry their own direction and span, as the
+//! CPU backend's pixels do. Each function here agrees with its scalar twin in `f32` within a few
+//! units in the last place (the logarithm and `atan2` are `wide`'s polynomial ones rather than
+//! the maths library's), is finite and non-negative on every ray the scalar tests cover (through
+//! a centre, along an axis, far away, `r_c = 0`, empty or NaN spans), and saturates the same way
+//! (`tests/analytic_lanes.rs` holds them to the scalar kernels and to the `f64` reference).
+//!
+//! [`RayQuadratic`]: super::RayQuadratic
+
+use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
+use super::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
+use crate::Vec3;
+use wide::f32x8;
+
+/// Rays evaluated together.
+pub const LANES: usize = 8;
+
+/// One `f32` per ray of a batch.
+pub type Lanes = f32x8;
+
+/// A 3-vector per lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3 {
+    /// x of every lane.
+    pub x: Lanes,
+    /// y of every lane.
+    pub y: Lanes,
+    /// z of every lane.
+    pub z: Lanes,
+}
+
+impl V3 {
+    /// The same vector in every lane.
+    #[inline(always)]
+    pub fn splat(v: Vec3<f32>) -> Self {
+        Self { x: Lanes::splat(v.x), y: Lanes::splat(v.y), z: Lanes::splat(v.z) }
+    }
+
+    /// Lane `i` of each component taken from `v[i]`.
+    #[inline(always)]
+    pub fn from_vecs(v: &[Vec3<f32>; LANES]) -> Self {
+        Self {
+            x: Lanes::from(v.map(|p| p.x)),
+            y: Lanes::from(v.map(|p| p.y)),
+            z: Lanes::from(v.map(|p| p.z)),
+        }
+    }
+
+    #[inline(always)]
+    fn dot(self, o: Self) -> Lanes {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    #[inline(always)]
+    fn cross(self, o: Self) -> Self {
+        Self {
+            x: self.y * o.z - self.z * o.y,
+            y: self.z * o.x - self.x * o.z,
+            z: self.x * o.y - self.y * o.x,
+        }
+    }
+
+    #[inline(always)]
+    fn scale(self, k: Lanes) -> Self {
+        Self { x: self.x * k, y: self.y * k, z: self.z * k }
+    }
+
+    /// `self × d` for a vector `d` shared by every lane (as [`Vec3::cross`]).
+    #[inline(always)]
+    fn cross_splat(self, d: Vec3<f32>) -> Self {
+        self.cross(Self::splat(d))
+    }
+}
+
+/// Eight rays `origin + t·dir[i]`, `t ∈ [t0[i], t1[i]]`, sharing one origin (see
+/// [`super::Ray`] for what `dir` means per falloff).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayLanes {
+    /// The shared origin `S`.
+    pub origin: Vec3<f32>,
+    /// Each ray's direction.
+    pub dir: V3,
+    /// Each span's start.
+    pub t0: Lanes,
+    /// Each span's end.
+    pub t1: Lanes,
+}
+
+/// [`super::RayAxis`] per lane: `s = |u|`, `û = u/s`, or `s = 0`, `û = 0` where `|u|²` is not a
+/// positive normal number.
+#[derive(Clone, Copy)]
+struct Axis {
+    s: Lanes,
+    unit: V3,
+}
+
+impl Axis {
+    #[inline(always)]
+    fn new(u: V3) -> Self {
+        let a = u.dot(u);
+        let ok = a.simd_ge(Lanes::splat(f32::MIN_POSITIVE));
+        let s = ok.select(a.sqrt(), Lanes::ZERO);
+        let inv = ok.select(Lanes::ONE / s, Lanes::ZERO);
+        Self { s, unit: u.scale(inv) }
+    }
+}
+
+/// [`super::RayQuadratic`] per lane: `|v + t·u|² + r_c² = (s·t + β)² + H`.
+#[derive(Clone, Copy)]
+struct Quad {
+    s: Lanes,
+    beta: Lanes,
+    h: Lanes,
+}
+
+impl Quad {
+    /// As [`super::RayQuadratic::new`].
+    #[inline(always)]
+    fn new(axis: &Axis, v: V3, rc2: f32) -> Self {
+        let beta = axis.unit.dot(v);
+        let c = axis.unit.cross(v);
+        let d2 = axis.s.simd_gt(Lanes::ZERO).select(c.dot(c), v.dot(v));
+        Self { s: axis.s, beta, h: (d2 + Lanes::splat(rc2)).max(Lanes::splat(H_FLOOR as f32)) }
+    }
+
+    /// Lane-wise `if m { a } else { b }`.
+    #[inline(always)]
+    fn select(m: Lanes, a: &Self, b: &Self) -> Self {
+        Self { s: a.s, beta: m.select(a.beta, b.beta), h: m.select(a.h, b.h) }
+    }
+
+    /// `∫ dt / sqrt(Y² + H)` over `[t0, t1]` per lane: the scalar
+    /// [`super::RayQuadratic::faithful`] (002 eq. 3.8–3.9 with SPEC.md §1.2's corrected `asinh`,
+    /// as `ln(P₁/P₀)` from positive terms), its sign branches as selects.
+    ///
+    /// The last step differs in form, not in value: with `z = s·k`, the scalar `ln(1 + z)/s` (or
+    /// `ln_1p(z)/s`, or `k` as `s → 0`) is here `k · ln(u)/(u − 1)`, `u = 1 + z` (the ratio is 1
+    /// where `u` rounds to 1). `ln(u)/(u − 1)` equals `ln(1 + z)/z` to a few ulp because the
+    /// rounding of `u` cancels between numerator and denominator, so one formula covers every
+    /// `z ≥ 0` and needs no division by `s`.
+    #[inline(always)]
+    fn faithful(&self, t0: Lanes, t1: Lanes) -> Lanes {
+        let lim = Lanes::splat(T_LIMIT as f32);
+        let t0c = t0.max(-lim);
+        let t1c = t1.min(lim);
+        // False for NaN ends and empty spans, before and after the clamps (as the scalar kernel).
+        let live = t1.simd_gt(t0) & t1c.simd_gt(t0c);
+        let (s, h) = (self.s, self.h);
+        let dt = t1c - t0c;
+        let y0 = s * t0c + self.beta;
+        let y1 = s * t1c + self.beta;
+        let r0 = (y0 * y0 + h).sqrt();
+        let r1 = (y1 * y1 + h).sqrt();
+        let sum = y0 + y1;
+        let rs = r0 + r1;
+        let one = Lanes::ONE;
+        let ahead = sum.simd_ge(Lanes::ZERO);
+        // sum ≥ 0: P₀ = y₀ + r₀, or H/(r₀ − y₀) for y₀ < 0; else N₁ = r₁ − y₁, or H/(r₁ + y₁).
+        let y0_pos = y0.simd_ge(Lanes::ZERO);
+        let y1_neg = y1.simd_le(Lanes::ZERO);
+        let a_fwd = y0_pos.select(one, r0 - y0);
+        let b_fwd = y0_pos.select(y0 + r0, h);
+        let a_bwd = y1_neg.select(one, r1 + y1);
+        let b_bwd = y1_neg.select(r1 - y1, h);
+        let num = ahead.select(rs + sum, rs - sum);
+        let a = ahead.select(a_fwd, a_bwd);
+        let b = ahead.select(b_fwd, b_bwd);
+        let k = dt * num * a / (rs * b);
+        let u = one + s * k;
+        let ratio = u.simd_gt(one).select(u.ln() / (u - one), one);
+        let v = k * ratio;
+        // u = +∞ (k overflowed): ln(u)/(u − 1) is NaN; the integral is then beyond ENERGY_MAX.
+        let v = u.is_inf().select(Lanes::INFINITY, v);
+        clamp_energy(live, v)
+    }
+
+    /// `∫ dt / (Y² + H)` over `[t0, t1]` per lane: the scalar
+    /// [`super::RayQuadratic::inverse_square`] (one `atan2(√H·s·Δt, H + Y₀Y₁)`, `t ≥ T_LIMIT` as
+    /// `±∞`), its branches as selects.
+    #[inline(always)]
+    fn inverse_square(&self, t0: Lanes, t1: Lanes) -> Lanes {
+        let lim = Lanes::splat(T_LIMIT as f32);
+        let live = t1.simd_gt(t0);
+        let (s, h) = (self.s, self.h);
+        let sh = h.sqrt();
+        let y0 = s * t0 + self.beta;
+        let y1 = s * t1 + self.beta;
+        let to_inf = t1.simd_ge(lim);
+        let from_inf = t0.simd_le(-lim);
+        let finite = !(to_inf | from_inf);
+        let dt = t1 - t0;
+        let num_f = sh * s * dt;
+        let den_f = h + y0 * y1;
+        // Infinite ends: (√H, Y₀) to +∞, (√H, −Y₁) from −∞, (0, −1) for the whole line.
+        let num_i = (to_inf & from_inf).select(Lanes::ZERO, sh);
+        let den_i = from_inf.select(to_inf.select(-Lanes::ONE, -y1), y0);
+        let num = finite.select(num_f, num_i);
+        let den = finite.select(den_f, den_i);
+        let angle = num.atan2(den) / (s * sh);
+        let tiny = finite & num_f.simd_le(Lanes::splat(f32::EPSILON) * den_f);
+        let v = tiny.select(dt / den_f, angle);
+        clamp_energy(live, v)
+    }
+
+    #[inline(always)]
+    fn integral(&self, falloff: Falloff, t0: Lanes, t1: Lanes) -> Lanes {
+        match falloff {
+            Falloff::Faithful => self.faithful(t0, t1),
+            Falloff::InverseSquare => self.inverse_square(t0, t1),
+        }
+    }
+}
+
+/// `v` clamped to `[0, ENERGY_MAX]` where `live`, 0 elsewhere; NaN gives 0 (as the scalar
+/// `v.max(0).min(ENERGY_MAX)`).
+#[inline(always)]
+fn clamp_energy(live: Lanes, v: Lanes) -> Lanes {
+    let ok = live & v.simd_ge(Lanes::ZERO);
+    ok.select(v.min(Lanes::splat(ENERGY_MAX as f32)), Lanes::ZERO)
+}
+
+/// [`super::saturate`] per lane: `[0, f32::MAX]`, `+∞` and NaN to `f32::MAX`, negatives to 0.
+#[inline(always)]
+pub fn saturate(x: Lanes) -> Lanes {
+    let max = Lanes::splat(ENERGY_SATURATION as f32);
+    let pos = x.simd_ge(Lanes::ZERO);
+    let neg = x.simd_lt(Lanes::ZERO);
+    pos.select(x.min(max), neg.select(Lanes::ZERO, max))
+}
+
+/// [`super::scaled`] per lane: `α·I` saturated, `α = 0` giving 0.
+#[inline(always)]
+pub fn scaled(integral: Lanes, alpha: f32) -> Lanes {
+    saturate(saturate(integral) * Lanes::splat(alpha))
+}
+
+/// [`super::sphere_energy`] for eight rays (002 eq. 3.4, 3.6, 3.8–3.9, SPEC.md §1.2).
+#[inline]
+pub fn sphere_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &SphereField<f32>) -> Lanes {
+    let axis = Axis::new(ray.dir);
+    let q = Quad::new(&axis, V3::splat(ray.origin - f.center), p.core_radius * p.core_radius);
+    scaled(q.integral(p.falloff, ray.t0, ray.t1), f.alpha)
+}
+
+/// [`super::cylinder_energy`] for eight rays (002 eq. 3.5, 3.7–3.9, SPEC.md §1.2).
+#[inline]
+pub fn cylinder_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &CylinderField<f32>) -> Lanes {
+    let axis = Axis::new(ray.dir.cross_splat(f.dir));
+    let v = V3::splat((ray.origin - f.point).cross(f.dir));
+    let q = Quad::new(&axis, v, p.core_radius * p.core_radius);
+    scaled(q.integral(p.falloff, ray.t0, ray.t1), f.alpha)
+}
+
+/// The capsule's energy and its end spheres' quadratics (reused by the beam).
+struct CapsuleParts {
+    at_m: Quad,
+    at_m2: Quad,
+    energy: Lanes,
+}
+
+/// As the scalar `capsule_parts` (002 eq. 3.10–3.11, SPEC.md §1.2): the ray split at the planes
+/// through `M` and `M₂`, each region its closed form, the region order per lane by the sign of
+/// `D·Q`.
+#[inline(always)]
+fn capsule_parts(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) -> CapsuleParts {
+    let live = ray.t1.simd_gt(ray.t0);
+    let t0 = live.select(ray.t0, Lanes::ZERO);
+    let t1 = live.select(ray.t1, Lanes::ZERO);
+    let rc2 = p.core_radius * p.core_radius;
+    let q = ray.dir;
+    let w = ray.origin - f.m;
+    let sphere_axis = Axis::new(q);
+    let at_m = Quad::new(&sphere_axis, V3::splat(w), rc2);
+    let at_m2 = Quad::new(&sphere_axis, V3::splat(w - f.d * f.length), rc2);
+    let cyl_axis = Axis::new(q.cross_splat(f.d));
+    let cyl = Quad::new(&cyl_axis, V3::splat(w.cross(f.d)), rc2);
+    // Axial coordinate along the ray: z(t) = ds + t·dq; planes at z = 0 (M) and z = length (M₂).
+    let dq = q.dot(V3::splat(f.d));
+    let ds = w.dot(f.d);
+    let len = Lanes::splat(f.length);
+    let inf = f32::INFINITY;
+    let fwd = dq.simd_gt(Lanes::ZERO);
+    let bwd = dq.simd_lt(Lanes::ZERO);
+    let at_plane_m = Lanes::splat(-ds) / dq;
+    let at_plane_m2 = (len - Lanes::splat(ds)) / dq;
+    // dq = 0: the whole ray in one region, by the offset ds.
+    let (flat_lo, flat_hi) = if ds < 0.0 {
+        (inf, inf)
+    } else if ds > f.length {
+        (-inf, -inf)
+    } else {
+        (-inf, inf)
+    };
+    let lo = fwd.select(at_plane_m, bwd.select(at_plane_m2, Lanes::splat(flat_lo)));
+    let hi = fwd.select(at_plane_m2, bwd.select(at_plane_m, Lanes::splat(flat_hi)));
+    let lo = lo.max(t0).min(t1);
+    let hi = hi.max(lo).min(t1);
+    let first = Quad::select(bwd, &at_m2, &at_m);
+    let last = Quad::select(bwd, &at_m, &at_m2);
+    let fo = p.falloff;
+    let spheres = first.integral(fo, t0, lo) + last.integral(fo, hi, t1);
+    let energy = saturate(scaled(spheres, f.alpha_s) + scaled(cyl.integral(fo, lo, hi), f.alpha_c));
+    CapsuleParts { at_m, at_m2, energy }
+}
+
+/// [`super::capsule_energy`] for eight rays (002 eq. 3.10–3.11, SPEC.md §1.2).
+#[inline]
+pub fn capsule_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) -> Lanes {
+    capsule_parts(p, ray, f).energy
+}
+
+/// [`super::beam_energy`] for eight rays: the capsule plus the head and muzzle spheres over the
+/// whole span (002 §3.3.3, eq. 3.4 and 3.11; SPEC.md §1.2).
+#[inline]
+pub fn beam_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &BeamField<f32>) -> Lanes {
+    let parts = capsule_parts(p, ray, &f.capsule);
+    let mut e = parts.energy;
+    if f.head_alpha != 0.0 {
+        e = saturate(e + scaled(parts.at_m2.integral(p.falloff, ray.t0, ray.t1), f.head_alpha));
+    }
+    if f.muzzle_alpha != 0.0 {
+        e = saturate(e + scaled(parts.at_m.integral(p.falloff, ray.t0, ray.t1), f.muzzle_alpha));
+    }
+    e
+}
