@@ -19,16 +19,31 @@ mod waves;
 use hadou_scene::{Backend, Frame, Image, RenderError};
 use rayon::prelude::*;
 
-/// The CPU reference backend.
-#[derive(Debug, Default)]
+/// The CPU reference backend. It keeps the opaque pass's buffers between frames, so a frame
+/// drawn with [`CpuBackend::render_into`] into an image from an earlier frame allocates nothing
+/// that grows with the image.
+#[derive(Default)]
 pub struct CpuBackend {
-    _private: (),
+    scratch: raster::OpaqueBuffers,
+}
+
+impl std::fmt::Debug for CpuBackend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CpuBackend").finish_non_exhaustive()
+    }
 }
 
 impl CpuBackend {
     /// A backend using rayon's global thread pool.
     pub fn new() -> Self {
-        Self { _private: () }
+        Self::default()
+    }
+
+    /// Renders `frame` into `image` (resized to the frame, its allocations reused: what a viewer
+    /// or a benchmark drawing frame after frame wants) and returns the passes' times; the same
+    /// pixels as [`render`].
+    pub fn render_into(&mut self, frame: &Frame, image: &mut Image) -> PassTimes {
+        render_with(frame, 0..frame.height, &mut self.scratch, image)
     }
 }
 
@@ -74,6 +89,20 @@ pub struct PassTimes {
 /// between the two in the proportion of the threads' time in each. The times add up to the
 /// render's.
 pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTimes) {
+    let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+    let mut img = Image::new(frame.width, y1.max(y0) - y0);
+    let times = render_with(frame, rows, &mut raster::OpaqueBuffers::default(), &mut img);
+    (img, times)
+}
+
+/// [`render_timed`] with the opaque pass's buffers from `scratch` and into `img`, both resized
+/// and their allocations reused.
+fn render_with(
+    frame: &Frame,
+    rows: std::ops::Range<u32>,
+    scratch: &mut raster::OpaqueBuffers,
+    img: &mut Image,
+) -> PassTimes {
     let start = std::time::Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
@@ -81,11 +110,17 @@ pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTi
     let curves = waves::prepare_curves(frame);
     let lights = shading::FrameLights::new(frame, &curves);
     let shadows = shadows::FrameShadows::new(frame, &lights.lines);
-    let (opaque, oy0) = opaque_pass(frame, &basis, &lights, &shadows, y0 as usize..y1 as usize);
+    let oy0 = opaque_pass(frame, &basis, &lights, &shadows, y0 as usize..y1 as usize, scratch);
+    let opaque = &*scratch;
     let opaque_done = std::time::Instant::now();
 
-    let mut img = Image::new(frame.width, y1 - y0);
     let w = frame.width as usize;
+    let n = w * (y1 - y0) as usize;
+    (img.width, img.height) = (frame.width, y1 - y0);
+    // Every pixel is written below: the resizes only size the buffers.
+    img.color.resize(n, [0.0; 4]);
+    img.energy.resize(n, 0.0);
+    img.depth.resize(n, 0.0);
     let pass = waves::WavePass::new(frame, &basis, &curves);
     let first = (y0 as usize - oy0) * w;
     let surface = &opaque.surface[first..first + img.color.len()];
@@ -115,12 +150,11 @@ pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTi
     let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };
     let waves_done = opaque_done + (end - opaque_done).mul_f64(wave_share);
     let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
-    let times = PassTimes {
+    PassTimes {
         opaque_ms: ms(start, opaque_done),
         wave_ms: ms(opaque_done, waves_done),
         color_ms: ms(waves_done, end),
-    };
-    (img, times)
+    }
 }
 
 /// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which
@@ -131,12 +165,14 @@ fn opaque_pass(
     lights: &shading::FrameLights,
     shadows: &shadows::FrameShadows,
     rows: std::ops::Range<usize>,
-) -> (raster::OpaqueBuffers, usize) {
+    opaque: &mut raster::OpaqueBuffers,
+) -> usize {
     let Some(light) = &frame.area_light else {
         let y0 = rows.start;
-        return (raster::draw_opaque(frame, basis, lights, shadows, rows), y0);
+        raster::draw_opaque_into(frame, basis, lights, shadows, rows, opaque);
+        return y0;
     };
-    let mut opaque = raster::draw_opaque(frame, basis, lights, shadows, 0..frame.height as usize);
+    raster::draw_opaque_into(frame, basis, lights, shadows, 0..frame.height as usize, opaque);
     let input = soft::SoftInput {
         width: frame.width as usize,
         height: frame.height as usize,
@@ -150,8 +186,9 @@ fn opaque_pass(
             }
         }
     });
+    opaque.soft = input.points;
     opaque.visibility = vis;
-    (opaque, 0)
+    0
 }
 
 /// What `hadou probe` reports about one pixel.
@@ -199,7 +236,8 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let shadows = shadows::FrameShadows::new(frame, &lights.lines);
     // The probed row alone (the opaque pass decides each pixel independently), or every row when
     // the area light's penumbra search needs them.
-    let (opaque, oy0) = opaque_pass(frame, &basis, &lights, &shadows, y as usize..y as usize + 1);
+    let mut opaque = raster::OpaqueBuffers::default();
+    let oy0 = opaque_pass(frame, &basis, &lights, &shadows, y as usize..y as usize + 1, &mut opaque);
     let i = (y as usize - oy0) * frame.width as usize + x as usize;
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];

@@ -76,6 +76,7 @@ impl ScreenTri {
 }
 
 /// What the opaque pass leaves per pixel.
+#[derive(Default)]
 pub(crate) struct OpaqueBuffers {
     /// Shaded linear RGB, background where nothing is drawn.
     pub color: Vec<[f32; 3]>,
@@ -107,18 +108,46 @@ pub(crate) fn draw_opaque(
     shadows: &FrameShadows,
     rows: std::ops::Range<usize>,
 ) -> OpaqueBuffers {
+    let mut out = OpaqueBuffers::default();
+    draw_opaque_into(frame, basis, lights, shadows, rows, &mut out);
+    out
+}
+
+/// Resizes `v` to `n` copies of `x`, reusing its allocation (every element is rewritten, so a
+/// reused buffer costs a fill, not fresh pages).
+fn refill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    v.clear();
+    v.resize(n, x);
+}
+
+/// [`draw_opaque`] into `out`, reusing its buffers' allocations from an earlier frame. Bands of
+/// rows that no triangle or shadow touches are filled with the background without further work.
+pub(crate) fn draw_opaque_into(
+    frame: &Frame,
+    basis: &CameraBasis,
+    lights: &FrameLights,
+    shadows: &FrameShadows,
+    rows: std::ops::Range<usize>,
+    out: &mut OpaqueBuffers,
+) {
     let (w, h) = (frame.width as usize, rows.len());
     let tris = project_all(frame, basis);
     let shadow_tris = if shadows.any_plane() { project_shadows(frame, basis, shadows) } else { Vec::new() };
     let far = frame.camera.far;
     let bins = bin_rows(&tris, frame.height as usize, &rows);
     let shadow_bins = bin_rows(&shadow_tris, frame.height as usize, &rows);
-    let mut color = vec![[0.0f32; 3]; w * h];
-    let mut surface = vec![None; w * h];
-    let mut object = vec![None; w * h];
-    let mut shadow = vec![None; w * h];
+    let OpaqueBuffers { color, surface, object, shadow, soft, visibility } = out;
+    // Every element is written below: the fills only size the buffers.
+    refill(color, w * h, [0.0f32; 3]);
+    refill(surface, w * h, None);
+    refill(object, w * h, None);
+    refill(shadow, w * h, None);
+    visibility.clear();
     let area = frame.area_light.as_ref();
-    let mut soft = if area.is_some() { vec![None; w * h] } else { Vec::new() };
+    refill(soft, if area.is_some() { w * h } else { 0 }, None);
+    if w * h == 0 {
+        return;
+    }
     // Without an area light every band gets an empty slice.
     let soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
         soft.chunks_mut(BAND * w).collect()
@@ -135,6 +164,11 @@ pub(crate) fn draw_opaque(
         .for_each(|(b, ((((col, surf), obj), shad), soft))| {
             let y_start = rows.start + b * BAND;
             let rows = col.len() / w;
+            if bins[b].is_empty() && shadow_bins[b].is_empty() {
+                // Nothing drawn here (the refills left surface, object, shadow and soft empty).
+                col.fill(frame.background);
+                return;
+            }
             let mut zbuf = vec![f32::INFINITY; rows * w];
             let mut tri_id = vec![u32::MAX; rows * w];
             for &ti in &bins[b] {
@@ -206,7 +240,6 @@ pub(crate) fn draw_opaque(
                 }
             }
         });
-    OpaqueBuffers { color, surface, object, shadow, soft, visibility: Vec::new() }
 }
 
 /// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.

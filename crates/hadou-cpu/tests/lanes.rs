@@ -90,3 +90,22 @@ fn probe_reports_the_rendered_pixel_whatever_its_lane() {
         }
     }
 }
+
+#[test]
+fn frames_drawn_into_reused_buffers_equal_fresh_renders() {
+    // One backend and one image through scenes of other sizes, objects, shadows and an area
+    // light: each frame equals its fresh render bit for bit (nothing left over from the last).
+    let mut cpu = hadou_cpu::CpuBackend::new();
+    let mut image = hadou_scene::Image::new(0, 0);
+    let sizes = [(64, 48), (33, 17), (64, 48), (40, 40)];
+    for (k, file) in ["fig4-14-occlusion.toml", "shadow-sunset.toml", "soft-gradient.toml", "kamehameha.toml"]
+        .iter()
+        .enumerate()
+    {
+        let scene = Scene::load(scenes_dir().join(file)).unwrap_or_else(|e| panic!("{e}"));
+        let mut frame = scene.at(0.0);
+        (frame.width, frame.height) = sizes[k];
+        cpu.render_into(&frame, &mut image);
+        assert_eq!(image, render(&frame), "{file}");
+    }
+}

@@ -1,0 +1,37 @@
+//! Times the CPU backend's passes on one scene: `cargo run --release -p hadou-cpu --example parts
+//! -- SCENE [SIZE] [TIME]` prints the median whole render and its opaque, wave and colour parts
+//! (`CpuBackend::render_into`, reusing its buffers) over nine runs.
+use hadou_scene::Scene;
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let Some(path) = args.next() else {
+        eprintln!("usage: parts SCENE [SIZE] [TIME]");
+        std::process::exit(2);
+    };
+    let scene = Scene::load(&path).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
+    let size: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(1024);
+    let t: f32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(0.0);
+    let mut frame = scene.at(t);
+    (frame.width, frame.height) = (size, size);
+    let mut cpu = hadou_cpu::CpuBackend::new();
+    let mut image = hadou_scene::Image::new(0, 0);
+    cpu.render_into(&frame, &mut image);
+    let mut runs: Vec<(f64, hadou_cpu::PassTimes)> = (0..9)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            let p = cpu.render_into(&frame, &mut image);
+            (start.elapsed().as_secs_f64() * 1e3, p)
+        })
+        .collect();
+    runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (ms, p) = runs[runs.len() / 2];
+    let mpx = (size as f64).powi(2) / (ms * 1e3);
+    println!(
+        "{path} {size}²: {ms:.2} ms ({mpx:.1} Mpx/s) = opaque {:.2} + wave {:.2} + colour {:.2}",
+        p.opaque_ms, p.wave_ms, p.color_ms
+    );
+}
