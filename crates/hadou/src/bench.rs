@@ -15,6 +15,8 @@ pub struct Cell {
     pub occlusion: bool,
     /// Median time per frame in milliseconds.
     pub ms: f64,
+    /// The frame's parts (pass name, median milliseconds), see [`Timing::parts`].
+    pub parts: Vec<(String, f64)>,
 }
 
 impl Cell {
@@ -124,9 +126,73 @@ pub fn analytic_frame(shape: &str, falloff: &str, size: u32, occlusion: bool) ->
     Ok(scene.at(0.0))
 }
 
-/// A timer: renders `frame` once untimed, then `iterations` timed times, and returns the median
-/// milliseconds per frame.
-pub type Timer<'a> = dyn FnMut(&Frame, u32) -> Result<f64, RenderError> + 'a;
+/// What a [`Timer`] measured for one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Median milliseconds per frame: the whole render, without writing the output.
+    pub ms: f64,
+    /// The parts, in order, as (name, median milliseconds): on the CPU the opaque pass, the wave
+    /// pass and the colour mapping (which add up to the whole) and the output (8-bit sRGB and
+    /// PNG encoding into memory, after the render); on the GPU each pass's GPU timestamps where
+    /// the adapter has them, and the output. Empty where nothing finer was measured.
+    pub parts: Vec<(String, f64)>,
+}
+
+impl Timing {
+    /// A timing with no parts.
+    pub fn whole(ms: f64) -> Self {
+        Self { ms, parts: Vec::new() }
+    }
+}
+
+/// A timer: renders `frame` once untimed, then `iterations` timed times, and returns the medians.
+pub type Timer<'a> = dyn FnMut(&Frame, u32) -> Result<Timing, RenderError> + 'a;
+
+/// The median of `v` (0 when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// Times the CPU backend: `iterations` frames after a warm-up, drawn as a real-time loop draws
+/// them (one [`hadou_cpu::CpuBackend`] and one image reused from frame to frame), each split into
+/// its passes ([`hadou_cpu::CpuBackend::render_into`]), then the output of the image (sRGB and
+/// PNG encoding into memory) as many times. Medians of each.
+pub fn time_cpu(frame: &Frame, iterations: u32) -> Result<Timing, RenderError> {
+    let mut cpu = hadou_cpu::CpuBackend::new();
+    let mut image = hadou_scene::Image::new(0, 0);
+    cpu.render_into(frame, &mut image);
+    let (mut whole, mut opaque, mut wave, mut color, mut output) = (vec![], vec![], vec![], vec![], vec![]);
+    for _ in 0..iterations.max(1) {
+        let t = std::time::Instant::now();
+        let p = cpu.render_into(frame, &mut image);
+        whole.push(t.elapsed().as_secs_f64() * 1e3);
+        opaque.push(p.opaque_ms);
+        wave.push(p.wave_ms);
+        color.push(p.color_ms);
+    }
+    for _ in 0..iterations.max(1) {
+        output.push(output_ms(&image)?);
+    }
+    Ok(Timing {
+        ms: median(whole),
+        parts: vec![
+            ("opaque".into(), median(opaque)),
+            ("wave".into(), median(wave)),
+            ("colour".into(), median(color)),
+            ("output".into(), median(output)),
+        ],
+    })
+}
+
+/// Milliseconds to turn `image` into PNG bytes in memory, as `hadou render` does before writing.
+pub fn output_ms(image: &hadou_scene::Image) -> Result<f64, RenderError> {
+    let t = std::time::Instant::now();
+    let bytes = crate::output::encode_png(image).map_err(RenderError::Other)?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    std::hint::black_box(bytes);
+    Ok(ms)
+}
 
 /// Measures the analytic table: for each shape and falloff, each size, plus occlusion at the
 /// largest size.
@@ -146,8 +212,8 @@ pub fn analytic_table(
             cases.push((largest, true));
             for (size, occlusion) in cases {
                 let frame = analytic_frame(shape, falloff, size, occlusion)?;
-                let ms = time(&frame, iterations)?;
-                cells.push(Cell { size, occlusion, ms });
+                let t = time(&frame, iterations)?;
+                cells.push(Cell { size, occlusion, ms: t.ms, parts: t.parts });
             }
             rows.push(Row { shape: shape.into(), falloff: falloff.into(), cells });
         }
@@ -194,6 +260,33 @@ impl Table {
             }
             out += "\n";
         }
+        out += &self.parts_text();
+        out
+    }
+
+    /// Where the time goes: per row, the largest size without occlusion split into its parts.
+    fn parts_text(&self) -> String {
+        let cell = |r: &Row| r.cells.iter().filter(|c| !c.occlusion).max_by_key(|c| c.size).cloned();
+        let Some(first) = self.rows.first().and_then(cell) else { return String::new() };
+        if first.parts.is_empty() {
+            return String::new();
+        }
+        let mut out =
+            format!("\nwhere the time goes at {}² (median ms, share of the whole render)\n", first.size);
+        out += &format!("{:<16} {:<15} {:>9}", "shape", "falloff", "whole");
+        for (name, _) in &first.parts {
+            out += &format!(" {:>16}", name);
+        }
+        out += "\n";
+        for r in &self.rows {
+            let Some(c) = cell(r) else { continue };
+            out += &format!("{:<16} {:<15} {:>9.2}", r.shape, r.falloff, c.ms);
+            for (_, ms) in &c.parts {
+                let share = if c.ms > 0.0 { 100.0 * ms / c.ms } else { 0.0 };
+                out += &format!(" {:>16}", format!("{ms:.2} ({share:.0}%)"));
+            }
+            out += "\n";
+        }
         out
     }
 
@@ -213,6 +306,8 @@ impl Table {
                     "ms": c.ms,
                     "fps": c.fps(),
                     "mpix_per_s": c.mpix_per_s(),
+                    "parts": c.parts.iter().map(|(name, ms)| serde_json::json!({"name": name, "ms": ms}))
+                        .collect::<Vec<_>>(),
                 })).collect::<Vec<_>>(),
             })).collect::<Vec<_>>(),
         })
@@ -374,7 +469,7 @@ pub fn curve_table(
                 let mut f = frame.clone();
                 f.width = size;
                 f.height = size;
-                ms.push((size, time(&f, iterations)?));
+                ms.push((size, time(&f, iterations)?.ms));
             }
             rows.push(CurveRow { shape: shape.into(), integrator: label, ms, evals_per_pixel, p99_error });
         }
@@ -390,8 +485,8 @@ pub fn curve_table(
         let default = with_integrator(&base, Integrator::Default);
         let (simpson_evals, simpson_p99) = curve_accuracy(&simpson, &reference, ACCURACY_GRID);
         let (default_evals, default_p99) = curve_accuracy(&default, &reference, ACCURACY_GRID);
-        let simpson_ms = time(&simpson, iterations)?;
-        let default_ms = time(&default, iterations)?;
+        let simpson_ms = time(&simpson, iterations)?.ms;
+        let default_ms = time(&default, iterations)?.ms;
         acceptance.push(AcceptanceRow {
             scene: label.into(),
             size: (base.width, base.height),
@@ -617,7 +712,7 @@ pub fn toon_table(
         frame.height = size;
         let plain = plain_materials(&frame);
         for (variant, f) in [("full", &frame), ("plain", &plain)] {
-            rows.push(ToonRow { size, variant, scene: file, ms: time(f, iterations)? });
+            rows.push(ToonRow { size, variant, scene: file, ms: time(f, iterations)?.ms });
         }
     }
     let (shadow_file, st) = SHADOW_SCENE;
@@ -629,7 +724,7 @@ pub fn toon_table(
         frame.height = size;
         let bare = Frame { shadows: Vec::new(), ..frame.clone() };
         for (variant, f) in [("shadows", &frame), ("no-shadows", &bare)] {
-            rows.push(ToonRow { size, variant, scene: shadow_file, ms: time(f, iterations)? });
+            rows.push(ToonRow { size, variant, scene: shadow_file, ms: time(f, iterations)?.ms });
         }
     }
     Ok(ToonTable { backend: backend.into(), method: method.into(), iterations, scene: file.into(), rows })
@@ -830,7 +925,7 @@ pub fn soft_table(
             rows.push(SoftRow {
                 method: method.into(),
                 size,
-                ms: time(f, iterations)?,
+                ms: time(f, iterations)?.ms,
                 mean_error: None,
                 p99_error: None,
             });
@@ -885,6 +980,184 @@ impl SoftTable {
                 "fps": 1e3 / r.ms,
                 "mean_error": r.mean_error,
                 "p99_error": r.p99_error,
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// One line of the kernel-limit table.
+#[derive(Clone, Debug)]
+pub struct LimitRow {
+    /// What was timed.
+    pub what: String,
+    /// Median milliseconds per frame.
+    pub ms: f64,
+}
+
+/// The faithful bulged beam of the analytic table at one size, timed five ways in one run: the
+/// whole render and its wave pass, the eight-lane kernel alone and the scalar kernel alone over
+/// every pixel's ray, and a plain scalar loop of the same maths ([`plain_beam_loop`]), so the
+/// distance from hadou to the machine's limit is a ratio measured on the same machine at the same
+/// moment.
+#[derive(Clone, Debug)]
+pub struct LimitTable {
+    /// Image side.
+    pub size: u32,
+    /// Repetitions per line.
+    pub iterations: u32,
+    /// The lines, in the order above.
+    pub rows: Vec<LimitRow>,
+}
+
+/// Measures [`LimitTable`] at `size`.
+pub fn limit_table(size: u32, iterations: u32) -> Result<LimitTable, RenderError> {
+    use hadou_math::energy::{lanes, FieldParams};
+    use rayon::prelude::*;
+    let frame = analytic_frame("bulged beam", "faithful", size, false)?;
+    let Some(WaveShape::Beam(beam)) = frame.waves.first().map(|w| w.shape.clone()) else {
+        return Err(RenderError::Other("the bench beam scene has no beam".into()));
+    };
+    let wave = &frame.waves[0];
+    let p = FieldParams { falloff: wave.falloff, core_radius: wave.core_radius };
+    let basis = frame.camera.basis(frame.width, frame.height);
+    let (w, h, far) = (frame.width, frame.height, frame.camera.far);
+    let whole = time_cpu(&frame, iterations)?;
+    let wave_ms = whole.parts.iter().find(|(n, _)| n == "wave").map_or(0.0, |p| p.1);
+    let ray = |x: u32, y: u32| basis.wave_ray(wave.falloff, far, x as f32, y as f32, w, h, None);
+    let mut kernel = |f: &Frame| -> Result<(), RenderError> {
+        let sum: f32 = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let mut acc = lanes::Lanes::ZERO;
+                for x0 in (0..w).step_by(lanes::LANES) {
+                    let rays: [_; lanes::LANES] = std::array::from_fn(|i| ray(x0 + i as u32, y));
+                    let batch = lanes::RayLanes {
+                        origin: f.camera.position,
+                        dir: lanes::V3::from_vecs(&rays.map(|r| r.ray.dir)),
+                        t0: lanes::Lanes::from(rays.map(|r| r.t0)),
+                        t1: lanes::Lanes::from(rays.map(|r| r.t1)),
+                    };
+                    acc += lanes::beam_energy(&p, &batch, &beam);
+                }
+                acc.reduce_add()
+            })
+            .sum();
+        std::hint::black_box(sum);
+        Ok(())
+    };
+    let lanes_ms = median_ms(&mut kernel, &frame, iterations)?;
+    let mut scalar = |_: &Frame| -> Result<(), RenderError> {
+        let sum: f32 = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                (0..w)
+                    .map(|x| {
+                        let r = ray(x, y);
+                        hadou_math::energy::beam_energy(&p, &r.ray, r.t0, r.t1, &beam)
+                    })
+                    .sum::<f32>()
+            })
+            .sum();
+        std::hint::black_box(sum);
+        Ok(())
+    };
+    let scalar_ms = median_ms(&mut scalar, &frame, iterations)?;
+    let mut plain = |f: &Frame| -> Result<(), RenderError> {
+        std::hint::black_box(plain_beam_loop(f, &beam));
+        Ok(())
+    };
+    let plain_ms = median_ms(&mut plain, &frame, iterations)?;
+    let row = |what: &str, ms: f64| LimitRow { what: what.into(), ms };
+    Ok(LimitTable {
+        size,
+        iterations,
+        rows: vec![
+            row("whole render (hadou)", whole.ms),
+            row("wave pass (hadou)", wave_ms),
+            row("kernel only, 8 lanes", lanes_ms),
+            row("kernel only, scalar", scalar_ms),
+            row("plain scalar loop", plain_ms),
+        ],
+    })
+}
+
+/// A plain, unoptimised scalar `f32` render of a faithful bulged beam, for comparison only: per
+/// pixel the ray `Q = E − S` over `[0, 1]`, the capsule split at its two planes plus the head and
+/// muzzle spheres over the whole ray, each piece `∫ dt/√(Y² + H) = ln(P₁/P₀)/s` with one
+/// logarithm (002 eq. 3.8–3.11 with SPEC.md §1.2's `asinh`; `P = Y + √(Y² + H)`, mirrored where
+/// `Y < 0`), rayon over rows, `1 − e^(−x)` colour. Returns the colours.
+pub fn plain_beam_loop(frame: &Frame, beam: &hadou_math::energy::BeamField<f32>) -> Vec<[f32; 3]> {
+    use hadou_math::Vec3f;
+    use rayon::prelude::*;
+    let basis = frame.camera.basis(frame.width, frame.height);
+    let (w, h, far) = (frame.width, frame.height, frame.camera.far);
+    let rc2 = frame.waves.first().map_or(0.0, |w| w.core_radius * w.core_radius);
+    let c = &beam.capsule;
+    // ∫_{t0}^{t1} dt/√((s·t + β)² + H) for |v + t·u|² + r_c², with one logarithm.
+    let piece = |u: Vec3f, v: Vec3f, t0: f32, t1: f32| -> f32 {
+        let s = u.length();
+        if t1 <= t0 || s < 1e-20 {
+            return if t1 > t0 { (t1 - t0) / (v.length_squared() + rc2).max(1e-24).sqrt() } else { 0.0 };
+        }
+        let un = u / s;
+        let beta = un.dot(v);
+        let hh = (un.cross(v).length_squared() + rc2).max(1e-24);
+        let (y0, y1) = (s * t0 + beta, s * t1 + beta);
+        let p = |y: f32| if y >= 0.0 { y + (y * y + hh).sqrt() } else { hh / ((y * y + hh).sqrt() - y) };
+        (p(y1) / p(y0)).ln() / s
+    };
+    let mut out = vec![[0.0f32; 3]; (w * h) as usize];
+    out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let q = basis.pixel_dir(x as f32, y as f32, w, h) * far;
+            let s0 = basis.eye - c.m;
+            let s2 = s0 - c.d * c.length;
+            let (dq, ds) = (q.dot(c.d), s0.dot(c.d));
+            let (mut lo, mut hi) =
+                if dq.abs() > 1e-20 { (-ds / dq, (c.length - ds) / dq) } else { (0.0, 1.0) };
+            let (first, last) = if dq >= 0.0 { (s0, s2) } else { (s2, s0) };
+            if dq < 0.0 {
+                std::mem::swap(&mut lo, &mut hi);
+            }
+            let (lo, hi) = (lo.clamp(0.0, 1.0), hi.clamp(0.0, 1.0).max(lo.clamp(0.0, 1.0)));
+            let spheres = piece(q, first, 0.0, lo) + piece(q, last, hi, 1.0);
+            let cyl = piece(q.cross(c.d), s0.cross(c.d), lo, hi);
+            let e = c.alpha_s * spheres
+                + c.alpha_c * cyl
+                + beam.head_alpha * piece(q, s2, 0.0, 1.0)
+                + beam.muzzle_alpha * piece(q, s0, 0.0, 1.0);
+            let [r, g, b, a] = frame.waves[0].color;
+            *px = [r, g, b].map(|k| 1.0 - (-(k * a * e)).exp());
+        }
+    });
+    out
+}
+
+impl LimitTable {
+    /// The table as plain text, with each line's ratio to the plain loop.
+    pub fn to_text(&self) -> String {
+        let plain = self.rows.last().map_or(0.0, |r| r.ms);
+        let mut out = format!(
+            "\nbulged beam (faithful) at {}², kernel at its limit ({} runs, median, one run)\n{:<26} {:>10} {:>10} {:>14}\n",
+            self.size, self.iterations, "what", "ms", "Mpx/s", "plain loop ×"
+        );
+        for r in &self.rows {
+            let mpx = (self.size as f64).powi(2) / (r.ms * 1e3);
+            let ratio = if r.ms > 0.0 { plain / r.ms } else { 0.0 };
+            out += &format!("{:<26} {:>10.2} {:>10.1} {:>13.2}×\n", r.what, r.ms, mpx, ratio);
+        }
+        out
+    }
+
+    /// The table as JSON.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "size": self.size,
+            "iterations": self.iterations,
+            "rows": self.rows.iter().map(|r| serde_json::json!({
+                "what": r.what,
+                "ms": r.ms,
+                "mpix_per_s": (self.size as f64).powi(2) / (r.ms * 1e3),
             })).collect::<Vec<_>>(),
         })
     }

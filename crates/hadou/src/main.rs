@@ -299,12 +299,18 @@ fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>
         } else {
             "submit-and-wait wall clock (no timestamp queries on this adapter), excluding read-back"
         };
-        let timer = move |f: &Frame, n: u32| gpu.time_frame(f, n).map(|t| t.median_ms);
+        let timer = move |f: &Frame, n: u32| {
+            let t = gpu.time_frame(f, n)?;
+            let mut parts: Vec<(String, f64)> = Vec::new(); // PASSES-PENDING
+            let image = gpu.render(f)?;
+            let output =
+                (0..n.max(1)).map(|_| hadou::bench::output_ms(&image)).collect::<Result<Vec<_>, _>>()?;
+            parts.push(("output".into(), hadou::bench::median(output)));
+            Ok(hadou::bench::Timing { ms: t.median_ms, parts })
+        };
         return Ok((Box::new(timer), name, method.into()));
     }
-    let mut cpu = CpuBackend::new();
-    let timer =
-        move |f: &Frame, n: u32| hadou::bench::median_ms(&mut |f: &Frame| cpu.render(f).map(|_| ()), f, n);
+    let timer = hadou::bench::time_cpu;
     let threads = rayon::current_num_threads();
     Ok((Box::new(timer), format!("cpu ({threads} threads)"), "wall clock, whole render".into()))
 }
@@ -604,7 +610,15 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         (t.to_text(), t.to_json())
     } else {
         let t = hadou::bench::analytic_table(&mut *timer, &sizes, iterations, &name, &method)?;
-        (t.to_text(), t.to_json())
+        let (mut text, mut json) = (t.to_text(), t.to_json());
+        if name.starts_with("cpu") {
+            // The distance to the machine's limit, at the largest size, in the same run.
+            let largest = sizes.iter().copied().max().unwrap_or(1024);
+            let l = hadou::bench::limit_table(largest, iterations)?;
+            text += &l.to_text();
+            json["limit"] = l.to_json();
+        }
+        (text, json)
     };
     bar.finish_and_clear();
     if !a.json {
