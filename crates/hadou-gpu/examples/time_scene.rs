@@ -1,8 +1,11 @@
 //! Times a scene file on the GPU backend with `GpuBackend::time_frame` at several square sizes
-//! (the layout of thesis 002's tables) and prints one line per size.
+//! (the layout of thesis 002's tables) and prints one line per size, with the GPU time of each
+//! pass when the adapter has timestamp queries.
 //!
 //! `cargo run --release -p hadou-gpu --example time_scene -- SCENE.toml [TIME] [SIZE...]`
-//! (defaults: time 0, sizes 512 1024 2048; 5 timed iterations after one warm-up).
+//! (defaults: time 0, sizes 512 1024 2048; 5 timed iterations after one warm-up), then the wall
+//! time of a whole `render` (preparation and read-back included). `HADOU_UBER=1` times the
+//! uber-shader instead of the frame's wave-pass variant.
 
 use hadou_gpu::GpuBackend;
 
@@ -31,21 +34,46 @@ fn main() {
             std::process::exit(1);
         }
     };
+    // HADOU_UBER=1: every frame on the uber-shader (all wave kinds and shading compiled in), the
+    // wave pass before it was specialised, for before/after comparisons.
+    if std::env::var("HADOU_UBER").is_ok_and(|v| v == "1") {
+        gpu.set_specialise(false);
+    }
     println!("adapter: {} (software: {})", gpu.adapter_name(), gpu.is_software());
     for size in sizes {
         let mut frame = scene.at(time);
         frame.width = size;
         frame.height = size;
         match gpu.time_frame(&frame, 5) {
-            Ok(t) => println!(
-                "{path} {size}²: median {:.3} ms, min {:.3} ms ({:.1} fps, {:?}, {} tile(s))",
-                t.median_ms,
-                t.min_ms,
-                t.fps(),
-                t.method,
-                t.tiles
-            ),
+            Ok(t) => {
+                let passes: Vec<String> =
+                    t.passes.iter().map(|p| format!("{} {:.3} ms", p.name, p.median_ms)).collect();
+                println!(
+                    "{path} {size}²: median {:.3} ms, min {:.3} ms ({:.1} fps, {:?}, {} tile(s)){}{}",
+                    t.median_ms,
+                    t.min_ms,
+                    t.fps(),
+                    t.method,
+                    t.tiles,
+                    if passes.is_empty() { "" } else { "; passes: " },
+                    passes.join(", ")
+                )
+            }
             Err(e) => println!("{path} {size}²: {e}"),
         }
+        // The whole render as a caller sees it: preparation, every pass and the read-back.
+        let mut wall: Vec<f64> = (0..5)
+            .map(|_| {
+                let start = std::time::Instant::now();
+                let ok = hadou_scene::Backend::render(&mut gpu, &frame).is_ok();
+                if ok {
+                    start.elapsed().as_secs_f64() * 1e3
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect();
+        wall.sort_by(f64::total_cmp);
+        println!("{path} {size}²: render() with read-back, wall clock: median {:.3} ms", wall[2]);
     }
 }

@@ -19,7 +19,18 @@
 //! the lookup in the wave pass (`shaders/shadow_lookup.wgsl`), mirroring `hadou-cpu`'s shadows.
 //!
 //! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next,
-//! so GPU memory stays bounded whatever the image size.
+//! so GPU memory stays bounded whatever the image size. A frame with nothing to draw (waves only)
+//! skips the raster pass.
+//!
+//! The wave pass is specialised per frame: the wave module declares pipeline-overridable `bool`
+//! constants (`USE_SPHERE`, `USE_CURVE`, `USE_SURFACES`, `USE_TEXTURES`, …, all `true` by
+//! default: the uber-shader) guarding each wave kind, falloff, curve integrator and shape, and each
+//! shading path; each frame gets a compute pipeline with only what its data can reach compiled in,
+//! built on first use and cached by that set. Software adapters need this: llvmpipe (lavapipe,
+//! and Mesa's GL) runs every branch of a shader under an execution mask whichever way the pixels
+//! go, so with the uber-shader a one-sphere frame paid for every kind, the curve walker and the
+//! surface shading (about 0.8 s instead of 6 ms at 512²). A variant renders bit for bit what the
+//! uber-shader renders (`tests/variants.rs`).
 //!
 //! Curved waves are prepared once per frame with `hadou_math::curve::prepare` (as the CPU backend
 //! does) and uploaded as storage buffers ([`layout::CurveBuffers`]).
@@ -40,7 +51,7 @@ mod timing;
 mod twins;
 
 pub use render::{MAX_TILE, SOFT_BYTES_PER_PIXEL};
-pub use timing::{FrameTiming, TimingMethod};
+pub use timing::{FrameTiming, PassTime, TimingMethod};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
 
@@ -100,8 +111,23 @@ impl GpuBackend {
         Ok((image, soft))
     }
 
-    /// Measures the GPU time of drawing `frame` (both passes over every tile, no read-back),
-    /// `iterations` times after one untimed warm-up; see [`FrameTiming`].
+    /// With `false`, every frame's wave pass runs the uber-shader (every wave kind, integrator and
+    /// shading path compiled in) instead of the variant built for the frame's contents; for
+    /// comparisons and tests. Both draw the same image. On by default.
+    #[doc(hidden)]
+    pub fn set_specialise(&mut self, on: bool) {
+        self.renderer.set_specialise(on);
+    }
+
+    /// How many wave-pass pipelines (variants) this backend has built so far; for tests.
+    #[doc(hidden)]
+    pub fn wave_variants_built(&self) -> usize {
+        self.renderer.wave_variants_built()
+    }
+
+    /// Measures the GPU time of drawing `frame` (its shadow maps, then every pass of every tile,
+    /// no read-back), `iterations` times after one untimed warm-up; see [`FrameTiming`], whose
+    /// `passes` split the time by pass when the adapter has timestamp queries.
     pub fn time_frame(&mut self, frame: &Frame, iterations: u32) -> Result<FrameTiming, RenderError> {
         timing::time_frame(&mut self.renderer, frame, iterations)
     }

@@ -2,9 +2,10 @@
 //! shadows, shadow maps, wave.
 
 use crate::device::GpuContext;
-use crate::layout::GpuVertex;
+use crate::layout::{self, GpuVertex};
 use crate::shaders;
 use hadou_scene::RenderError;
+use std::collections::HashMap;
 
 /// The raster pass's one colour target: the linear scene colour and the Euclidean eye distance of
 /// the visible surface, as the bit patterns of four `f32`s (`bitcast` in raster.wgsl and
@@ -33,7 +34,13 @@ pub(crate) struct Pipelines {
     /// The outline hulls: `vs_hull`, front faces culled (000 §2.3).
     pub(crate) hull: wgpu::RenderPipeline,
     pub(crate) raster_layout: wgpu::BindGroupLayout,
-    pub(crate) wave: wgpu::ComputePipeline,
+    /// The wave module (the uber-shader source; variants set its `USE_*` overrides).
+    wave_module: wgpu::ShaderModule,
+    wave_pl: wgpu::PipelineLayout,
+    /// The wave pipelines built so far, one per variant (see [`Pipelines::wave`]).
+    wave_variants: HashMap<WaveVariant, wgpu::ComputePipeline>,
+    /// Whether [`Pipelines::wave`] specialises; `false` gives every frame the uber-shader.
+    pub(crate) specialise: bool,
     pub(crate) wave_layout: wgpu::BindGroupLayout,
     /// Plane shadows (`vs_plane`, `fs_plane`), per tile after the raster pass.
     pub(crate) plane_shadow: wgpu::RenderPipeline,
@@ -280,14 +287,6 @@ impl Pipelines {
             let raster = raster_pipeline("raster", "vs_main", None);
             // Hulls show only their back faces (counter-clockwise front faces, as every mesh).
             let hull = raster_pipeline("outline hull", "vs_hull", Some(wgpu::Face::Front));
-            let wave = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("wave"),
-                layout: Some(&wave_pl),
-                module: &wave_module,
-                entry_point: Some("cs_main"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
             // The shadow passes read only the positions of the mesh vertices.
             let position = wgpu::vertex_attr_array![0 => Float32x3];
             let positions = [wgpu::VertexBufferLayout {
@@ -439,7 +438,10 @@ impl Pipelines {
                 raster,
                 hull,
                 raster_layout,
-                wave,
+                wave_module,
+                wave_pl,
+                wave_variants: HashMap::new(),
+                specialise: true,
                 wave_layout,
                 plane_shadow,
                 plane_shadow_layout,
@@ -447,5 +449,269 @@ impl Pipelines {
                 shadow_map_layout,
             }
         })
+    }
+}
+
+/// Which parts of the wave pass a frame needs: one bit per pipeline-overridable `USE_*` constant of
+/// the wave module (wave.wgsl, energy.wgsl, curve.wgsl, shading.wgsl, shadow_lookup.wgsl). A clear
+/// bit compiles its part out (the constant is `false`, so the branch is dead and the driver drops
+/// it); a set bit leaves the code exactly as the uber-shader's ([`WaveVariant::UBER`], every bit
+/// set). [`WaveVariant::of`] sets a bit for everything the frame's data can reach, so a frame
+/// renders identically with its variant and with the uber-shader.
+///
+/// Why: a software adapter such as llvmpipe runs a shader's branches under an execution mask,
+/// both sides of every `if` and every `switch` case, whichever the pixels take; the uber-shader
+/// made a one-sphere frame pay for every wave kind, the curve walker and the surface shading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct WaveVariant(u32);
+
+impl WaveVariant {
+    /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
+    pub(crate) const NAMES: [&'static str; 26] = [
+        // wave.wgsl
+        "USE_SPHERE",
+        "USE_CYLINDER",
+        "USE_CAPSULE",
+        "USE_BEAM",
+        "USE_CURVE",
+        "USE_SURFACES",
+        "USE_AREA",
+        "USE_TONE_FAITHFUL",
+        "USE_TONE_FILMIC",
+        // energy.wgsl
+        "USE_FAITHFUL",
+        "USE_INVERSE_SQUARE",
+        // curve.wgsl
+        "USE_CHORD",
+        "USE_SIMPSON",
+        "USE_HELIX",
+        "USE_TRIG",
+        "USE_BEZIER",
+        "USE_BSPLINE",
+        // shading.wgsl
+        "USE_TOON",
+        "USE_TEXTURES",
+        "USE_WAVE_LIGHTS",
+        "USE_LINE_POINT",
+        "USE_LINE_SEGMENT",
+        "USE_LINE_LINE",
+        "USE_LINE_POLYLINE",
+        // shadow_lookup.wgsl
+        "USE_PLANE_SHADOWS",
+        "USE_MAP_SHADOWS",
+    ];
+    /// Every part: the uber-shader, right for any frame.
+    pub(crate) const UBER: WaveVariant = WaveVariant((1 << Self::NAMES.len()) - 1);
+
+    /// The bit of override `name`.
+    fn bit(name: &str) -> u32 {
+        let i = Self::NAMES.iter().position(|n| *n == name).expect("a USE_* name");
+        1 << i
+    }
+
+    /// Whether the override `name` is set.
+    pub(crate) fn has(self, name: &str) -> bool {
+        self.0 & Self::bit(name) != 0
+    }
+
+    /// The variant with nothing but the overrides in `names` set.
+    pub(crate) fn from_names<'a>(names: impl IntoIterator<Item = &'a str>) -> Self {
+        WaveVariant(names.into_iter().fold(0, |v, n| v | Self::bit(n)))
+    }
+
+    /// The variant a frame needs, from what the wave pass will read: the waves, the curves, the
+    /// materials and lights (the lights shading.wgsl reads), whether anything is drawn, whether
+    /// some wave glows, the shadow casts (plane, map), the `[area_light]` and the colour mapping.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn of(
+        waves: &[layout::GpuWave],
+        curves: &[layout::GpuCurve],
+        materials: &[layout::GpuMaterial],
+        lights: &[layout::GpuLight],
+        any_glow: bool,
+        surfaces: bool,
+        shadows: (bool, bool),
+        area: bool,
+        tone_faithful: bool,
+    ) -> Self {
+        let mut on: Vec<&str> = Vec::new();
+        for w in waves {
+            on.push(match w.kind {
+                layout::WAVE_SPHERE => "USE_SPHERE",
+                layout::WAVE_CYLINDER => "USE_CYLINDER",
+                layout::WAVE_CAPSULE => "USE_CAPSULE",
+                layout::WAVE_BEAM => "USE_BEAM",
+                _ => "USE_CURVE",
+            });
+            on.push(if w.falloff == layout::FALLOFF_FAITHFUL {
+                "USE_FAITHFUL"
+            } else {
+                "USE_INVERSE_SQUARE"
+            });
+        }
+        for c in curves {
+            on.push(if c.integrator == layout::INTEGRATOR_SIMPSON { "USE_SIMPSON" } else { "USE_CHORD" });
+            on.push(match c.shape {
+                layout::SHAPE_HELIX => "USE_HELIX",
+                layout::SHAPE_TRIG => "USE_TRIG",
+                layout::SHAPE_BEZIER => "USE_BEZIER",
+                _ => "USE_BSPLINE",
+            });
+        }
+        if surfaces {
+            on.push("USE_SURFACES");
+            if materials.iter().any(|m| m.model == layout::MODEL_TOON) {
+                on.push("USE_TOON");
+            }
+            if materials.iter().any(|m| m.base_texture.offset != 0 || m.feature_texture.offset != 0) {
+                on.push("USE_TEXTURES");
+            }
+            let lit = !lights.is_empty() && (any_glow || materials.iter().any(|m| m.wave_blend > 0.0));
+            if lit {
+                on.push("USE_WAVE_LIGHTS");
+                for l in lights {
+                    on.push(match l.line_kind {
+                        layout::LINE_POINT => "USE_LINE_POINT",
+                        layout::LINE_SEGMENT => "USE_LINE_SEGMENT",
+                        layout::LINE_LINE => "USE_LINE_LINE",
+                        _ => "USE_LINE_POLYLINE",
+                    });
+                }
+            }
+            if shadows.0 {
+                on.push("USE_PLANE_SHADOWS");
+            }
+            if shadows.1 {
+                on.push("USE_MAP_SHADOWS");
+            }
+            if area {
+                on.push("USE_AREA");
+            }
+        }
+        on.push(if tone_faithful { "USE_TONE_FAITHFUL" } else { "USE_TONE_FILMIC" });
+        Self::from_names(on)
+    }
+
+    /// The override values of this variant (`1.0` true, `0.0` false), for the pipeline.
+    fn constants(self) -> Vec<(&'static str, f64)> {
+        Self::NAMES.iter().map(|&n| (n, if self.has(n) { 1.0 } else { 0.0 })).collect()
+    }
+}
+
+impl Pipelines {
+    /// The wave pipeline of `variant` ([`WaveVariant::UBER`] when not specialising), built on first
+    /// use and kept: the same variant always gets the same pipeline. Also the variant it is.
+    pub(crate) fn wave(
+        &mut self,
+        ctx: &GpuContext,
+        variant: WaveVariant,
+    ) -> Result<(wgpu::ComputePipeline, WaveVariant), RenderError> {
+        let variant = if self.specialise { variant } else { WaveVariant::UBER };
+        if let Some(p) = self.wave_variants.get(&variant) {
+            return Ok((p.clone(), variant));
+        }
+        let constants = variant.constants();
+        let pipeline = ctx.scoped("building the wave pipeline", || {
+            ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("wave"),
+                layout: Some(&self.wave_pl),
+                module: &self.wave_module,
+                entry_point: Some("cs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            })
+        })?;
+        self.wave_variants.insert(variant, pipeline.clone());
+        Ok((pipeline, variant))
+    }
+
+    /// How many wave pipelines have been built.
+    pub(crate) fn wave_variant_count(&self) -> usize {
+        self.wave_variants.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bytemuck::Zeroable;
+
+    /// `WaveVariant::NAMES` are exactly the wave module's overrides, each a `bool` defaulting to
+    /// true (so the module alone is the uber-shader).
+    #[test]
+    fn variant_names_are_the_wave_modules_overrides() {
+        let source = shaders::compose(shaders::WAVE_PARTS);
+        let module = naga::front::wgsl::parse_str(&source).expect("the wave module parses");
+        let mut overrides: Vec<&str> = Vec::new();
+        for (_, o) in module.overrides.iter() {
+            let name = o.name.as_deref().expect("named override");
+            assert_eq!(module.types[o.ty].inner, naga::TypeInner::Scalar(naga::Scalar::BOOL), "{name}");
+            let init = o.init.expect("a default");
+            assert!(
+                matches!(
+                    module.global_expressions[init],
+                    naga::Expression::Literal(naga::Literal::Bool(true))
+                ),
+                "{name} defaults to true"
+            );
+            overrides.push(name);
+        }
+        overrides.sort_unstable();
+        let mut names = WaveVariant::NAMES.to_vec();
+        names.sort_unstable();
+        assert_eq!(overrides, names);
+        assert!(WaveVariant::NAMES.iter().all(|n| WaveVariant::UBER.has(n)));
+        assert!(WaveVariant::UBER.constants().iter().all(|&(_, v)| v == 1.0));
+    }
+
+    /// `WaveVariant::of` sets a part exactly when the frame's data can reach it.
+    #[test]
+    fn a_variant_has_exactly_what_the_frame_uses() {
+        let wave = |kind, falloff| layout::GpuWave { kind, falloff, ..layout::GpuWave::zeroed() };
+        let waves = [wave(layout::WAVE_SPHERE, layout::FALLOFF_FAITHFUL), wave(layout::WAVE_CURVE, 1)];
+        let curve = layout::GpuCurve {
+            integrator: layout::INTEGRATOR_SIMPSON,
+            shape: layout::SHAPE_BEZIER,
+            ..Zeroable::zeroed()
+        };
+        let mut toon = layout::GpuMaterial::zeroed();
+        toon.model = layout::MODEL_TOON;
+        toon.wave_blend = 0.5;
+        let light = layout::GpuLight { line_kind: layout::LINE_POLYLINE, ..Zeroable::zeroed() };
+        let names = |v: WaveVariant| -> Vec<&str> {
+            WaveVariant::NAMES.iter().copied().filter(|n| v.has(n)).collect()
+        };
+        let v =
+            WaveVariant::of(&waves, &[curve], &[toon], &[light], false, true, (false, true), false, false);
+        assert_eq!(
+            names(v),
+            [
+                "USE_SPHERE",
+                "USE_CURVE",
+                "USE_SURFACES",
+                "USE_TONE_FILMIC",
+                "USE_FAITHFUL",
+                "USE_INVERSE_SQUARE",
+                "USE_SIMPSON",
+                "USE_BEZIER",
+                "USE_TOON",
+                "USE_WAVE_LIGHTS",
+                "USE_LINE_POLYLINE",
+                "USE_MAP_SHADOWS"
+            ]
+        );
+        // Without surfaces nothing of the shading is compiled in; without blending or glow, no
+        // wave lights.
+        let v = WaveVariant::of(&waves[..1], &[], &[toon], &[light], true, false, (true, true), true, true);
+        assert_eq!(names(v), ["USE_SPHERE", "USE_TONE_FAITHFUL", "USE_FAITHFUL"]);
+        toon.wave_blend = 0.0;
+        let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true);
+        assert_eq!(
+            names(v),
+            ["USE_SURFACES", "USE_AREA", "USE_TONE_FAITHFUL", "USE_TOON", "USE_PLANE_SHADOWS"]
+        );
     }
 }

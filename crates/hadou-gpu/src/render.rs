@@ -7,7 +7,8 @@ use crate::layout::{
     self, FrameShadows, FrameUniforms, GpuCurve, GpuLight, GpuMaterial, GpuObject, GpuShadowCast, GpuSpotMap,
     GpuVertex, GpuWave, ShadingBuffers, SoftUniforms,
 };
-use crate::pipelines::{self, Pipelines};
+use crate::pipelines::{self, Pipelines, WaveVariant};
+use crate::timing::PassQueries;
 use bytemuck::Zeroable;
 use hadou_scene::{Frame, Image, LightLine, Mesh, RenderError, SoftResolve, MAX_SHADOWS};
 use std::collections::HashMap;
@@ -70,6 +71,35 @@ pub(crate) struct Prepared {
     /// Where the cast records and map-cast indices are in the shading data, and their counts
     /// (the shadow fields of `FrameUniforms`).
     shadow_fields: ShadowFields,
+    /// The shadow-map passes, one per map cast, and their bind group (`None` without map casts).
+    map_passes: Vec<MapPass>,
+    map_bind_group: Option<wgpu::BindGroup>,
+    /// The wave pass's pipeline: the variant this frame needs (`pipelines::WaveVariant`).
+    wave_pipeline: wgpu::ComputePipeline,
+    /// Whether the tiles need the raster pass: false when nothing is drawn and the wave pass's
+    /// variant does not read the G-buffer (no surfaces, no `[area_light]`), so an empty frame
+    /// skips clearing 36 bytes per pixel.
+    raster: bool,
+    /// The tiles' bind groups, made once per frame (set at the end of `prepare`).
+    groups: Option<TileBindGroups>,
+}
+
+/// The bind groups every tile of a frame uses (the tile's uniforms are rewritten before each
+/// tile's submission, so one set serves them all).
+struct TileBindGroups {
+    raster: wgpu::BindGroup,
+    wave: wgpu::BindGroup,
+    /// Only when the frame has plane casts.
+    plane: Option<wgpu::BindGroup>,
+    /// Only with an `[area_light]`.
+    soft: Option<wgpu::BindGroup>,
+}
+
+impl Prepared {
+    /// The number of shadow-map passes (map casts) of the frame.
+    pub(crate) fn map_pass_count(&self) -> u32 {
+        self.map_passes.len() as u32
+    }
 }
 
 /// The shadow fields of [`FrameUniforms`] for one frame.
@@ -87,9 +117,18 @@ struct ShadowFields {
 struct ShadowMaps {
     size: u32,
     layers: u32,
-    texture: wgpu::Texture,
     /// All layers, as the wave pass reads them.
     view: wgpu::TextureView,
+    /// One view per layer, as the map passes draw them.
+    layer_views: Vec<wgpu::TextureView>,
+}
+
+/// One shadow-map layer's pass: its layer, its edge in texels and its draws (instance = index into
+/// the shadow draws, object, index count).
+pub(crate) struct MapPass {
+    layer: u32,
+    edge: f32,
+    draws: Vec<(u32, usize, u32)>,
 }
 
 /// The renderer's state between frames.
@@ -320,6 +359,16 @@ impl Renderer {
         Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None, maps: None, soft: None })
     }
 
+    /// See [`crate::GpuBackend::set_specialise`].
+    pub(crate) fn set_specialise(&mut self, on: bool) {
+        self.pipelines.specialise = on;
+    }
+
+    /// See [`crate::GpuBackend::wave_variants_built`].
+    pub(crate) fn wave_variants_built(&self) -> usize {
+        self.pipelines.wave_variant_count()
+    }
+
     fn upload_meshes(&mut self, frame: &Frame) {
         self.meshes.retain(|_, m| m.source.strong_count() > 0);
         for o in &frame.objects {
@@ -500,11 +549,27 @@ impl Renderer {
                  {max_binding} bytes; use smaller textures"
             )));
         }
+        let variant = WaveVariant::of(
+            &waves,
+            &curve_data.curves,
+            &shading.materials,
+            // The lights shading.wgsl reads (MAX_LIGHTS there).
+            &shading.lights[..shading.lights.len().min(256)],
+            frame.waves.iter().any(|w| w.light.glow > 0.0),
+            // Every object with triangles is drawn (upload_meshes).
+            frame.objects.iter().any(|o| !o.mesh.indices.is_empty()),
+            (shadow_fields.plane_count > 0, shadow_fields.map_count > 0),
+            frame.area_light.is_some(),
+            frame.color_mapping.mode == hadou_scene::ToneMode::Faithful,
+        );
+        let (wave_pipeline, variant) = self.pipelines.wave(&self.ctx, variant)?;
+        let raster = variant.has("USE_SURFACES") || frame.area_light.is_some() || !plane_draws.is_empty();
         let (zero_object, zero_wave) = (GpuObject::zeroed(), GpuWave::zeroed());
         let scopes = self.ctx.open_scopes();
         let prepared = {
             self.upload_meshes(frame);
             self.ensure_targets(tile);
+            self.ensure_maps(&shadows);
             let d = &self.ctx.device;
             // Storage bindings may not be empty: pad with one zeroed element.
             let objects = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -590,6 +655,26 @@ impl Renderer {
                     tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(rows.end - y)]));
                 }
             }
+            let map_passes: Vec<MapPass> = map_draws
+                .into_iter()
+                .enumerate()
+                .map(|(layer, draws)| MapPass {
+                    layer: layer as u32,
+                    edge: shadows.casts[shadows.map_casts[layer] as usize].map_size as f32,
+                    draws,
+                })
+                .collect();
+            let map_bind_group = (!map_passes.is_empty()).then(|| {
+                d.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadow maps"),
+                    layout: &self.pipelines.shadow_map_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 1, resource: objects.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 3, resource: casts.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 4, resource: shadow_draws.as_entire_binding() },
+                    ],
+                })
+            });
             let prepared = Prepared {
                 tile,
                 tiles,
@@ -605,8 +690,18 @@ impl Renderer {
                 shadow_draws,
                 plane_draws,
                 shadow_fields,
+                map_passes,
+                map_bind_group,
+                wave_pipeline,
+                raster,
+                groups: None,
             };
-            self.draw_shadow_maps(frame, &prepared, &shadows, &map_draws);
+            self.submit_shadow_maps(frame, &prepared, None);
+            if frame.area_light.is_some() {
+                self.ensure_soft(frame);
+            }
+            let mut prepared = prepared;
+            prepared.groups = Some(self.tile_bind_groups(frame, &prepared));
             if frame.area_light.is_some() {
                 self.draw_soft(frame, &prepared);
             }
@@ -689,8 +784,7 @@ impl Renderer {
 
     /// The `[area_light]`'s soft shadows over the whole image: its two maps (soft_map.wgsl), every
     /// tile rasterized and classified, then the resolve; the wave passes read the visibility.
-    fn draw_soft(&mut self, frame: &Frame, prepared: &Prepared) {
-        self.ensure_soft(frame);
+    fn draw_soft(&self, frame: &Frame, prepared: &Prepared) {
         let soft = self.soft.as_ref().expect("created in ensure_soft");
         let d = &self.ctx.device;
         // Only the area light's casters are drawn into its maps (hadou-cpu's `spot_tris`).
@@ -828,73 +922,73 @@ impl Renderer {
     }
 
     /// Makes the shadow-map texture fit `shadows` (at least 1² × 2 texels: the wave pass binds one
-    /// even without map casts) and draws every map cast's casters into its layer.
-    fn draw_shadow_maps(
-        &mut self,
-        frame: &Frame,
-        prepared: &Prepared,
-        shadows: &FrameShadows,
-        map_draws: &[Vec<(u32, usize, u32)>],
-    ) {
+    /// even without map casts); kept while its size holds.
+    fn ensure_maps(&mut self, shadows: &FrameShadows) {
         let (size, layers) = (shadows.map_size.max(1), shadows.map_layers.max(2));
-        if !self.maps.as_ref().is_some_and(|m| m.size == size && m.layers == layers) {
-            self.maps = None; // free the old one first
-            let texture = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("shadow maps"),
-                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: pipelines::MAP_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("shadow maps"),
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
-            self.maps = Some(ShadowMaps { size, layers, texture, view });
-        }
-        if map_draws.is_empty() {
+        if self.maps.as_ref().is_some_and(|m| m.size == size && m.layers == layers) {
             return;
         }
-        let maps = self.maps.as_ref().expect("created above");
-        let d = &self.ctx.device;
-        let bind_group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        self.maps = None; // free the old one first
+        let texture = self.ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
-            layout: &self.pipelines.shadow_map_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: prepared.casts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: prepared.shadow_draws.as_entire_binding() },
-            ],
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: pipelines::MAP_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
         });
-        let mut enc =
-            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow maps") });
-        for (layer, draws) in map_draws.iter().enumerate() {
-            let j = shadows.map_casts[layer] as usize;
-            let edge = shadows.casts[j].map_size as f32;
-            let view = maps.texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("shadow map layer"),
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer as u32,
-                array_layer_count: Some(1),
-                ..Default::default()
-            });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("shadow maps"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let layer_views = (0..layers)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("shadow map layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        self.maps = Some(ShadowMaps { size, layers, view, layer_views });
+    }
+
+    /// Records every map cast's casters into its layer of the shadow maps (nothing when the frame
+    /// has no map casts), one render pass per layer.
+    pub(crate) fn encode_shadow_maps(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        frame: &Frame,
+        prepared: &Prepared,
+        mut timestamps: Option<&mut PassQueries<'_>>,
+    ) {
+        let Some(bind_group) = &prepared.map_bind_group else { return };
+        let maps = self.maps.as_ref().expect("shadow maps are created in prepare");
+        if let Some(q) = timestamps.as_deref_mut() {
+            q.next_group();
+        }
+        for m in &prepared.map_passes {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow map"),
                 color_attachments: &[],
-                depth_stencil_attachment: cleared_depth(&view, wgpu::StoreOp::Store),
-                timestamp_writes: None,
+                depth_stencil_attachment: cleared_depth(
+                    &maps.layer_views[m.layer as usize],
+                    wgpu::StoreOp::Store,
+                ),
+                timestamp_writes: timestamps.as_deref_mut().and_then(|q| q.render("shadow maps")),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
             // Texel (x, y) covers the map's pixel x = ⌊s·size⌋, y = ⌊(1 − t)·size⌋.
-            pass.set_viewport(0.0, 0.0, edge, edge, 0.0, 1.0);
+            pass.set_viewport(0.0, 0.0, m.edge, m.edge, 0.0, 1.0);
             pass.set_pipeline(&self.pipelines.shadow_map);
-            pass.set_bind_group(0, &bind_group, &[]);
-            for &(instance, object, index_count) in draws {
+            pass.set_bind_group(0, bind_group, &[]);
+            for &(instance, object, index_count) in &m.draws {
                 let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
                 let Some(mesh) = self.meshes.get(&key) else { continue };
                 pass.set_vertex_buffer(0, mesh.vertices.slice(..));
@@ -902,46 +996,47 @@ impl Renderer {
                 pass.draw_indexed(0..index_count, 0, instance..instance + 1);
             }
         }
-        self.ctx.queue.submit([enc.finish()]);
     }
 
-    /// Records one tile's raster and wave passes (and, when `readback`, the copy to the staging
-    /// buffer) after writing its uniforms. `timestamps`: query set and the index of the pair.
-    pub(crate) fn encode_tile(
+    /// Submits the frame's shadow maps (see [`Renderer::encode_shadow_maps`]); `None` when it has
+    /// none.
+    pub(crate) fn submit_shadow_maps(
         &self,
         frame: &Frame,
         prepared: &Prepared,
-        tile: ([u32; 2], [u32; 2]),
-        readback: bool,
-        timestamps: Option<(&wgpu::QuerySet, u32)>,
-    ) -> wgpu::CommandEncoder {
-        self.encode_tile_passes(frame, prepared, tile, readback, timestamps, false)
+        timestamps: Option<&mut PassQueries<'_>>,
+    ) -> Option<wgpu::SubmissionIndex> {
+        prepared.map_bind_group.as_ref()?;
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow maps") });
+        self.encode_shadow_maps(&mut enc, frame, prepared, timestamps);
+        Some(self.ctx.queue.submit([enc.finish()]))
     }
 
-    /// [`Renderer::encode_tile`], or with `classify` the raster pass then the soft shadows'
-    /// classification of the tile's pixels (soft.wgsl `cs_classify`) instead of the other passes.
-    fn encode_tile_passes(
+    /// Encodes and submits every tile of `prepared` (no read-back), one submission per tile;
+    /// the last submission.
+    pub(crate) fn submit_tiles(
         &self,
         frame: &Frame,
         prepared: &Prepared,
-        tile: ([u32; 2], [u32; 2]),
-        readback: bool,
-        timestamps: Option<(&wgpu::QuerySet, u32)>,
-        classify: bool,
-    ) -> wgpu::CommandEncoder {
+        mut timestamps: Option<&mut PassQueries<'_>>,
+    ) -> Option<wgpu::SubmissionIndex> {
+        let mut last = None;
+        for &t in &prepared.tiles {
+            let enc = self.encode_tile(frame, prepared, t, false, timestamps.as_deref_mut());
+            last = Some(self.ctx.queue.submit([enc.finish()]));
+        }
+        last
+    }
+
+    /// The bind groups of `prepared`'s tiles (after its shadow maps and soft-shadow resources
+    /// exist).
+    fn tile_bind_groups(&self, frame: &Frame, prepared: &Prepared) -> TileBindGroups {
         let t = self.targets.as_ref().expect("targets are created in prepare");
-        let basis = frame.camera.basis(frame.width, frame.height);
-        let (origin, size) = tile;
-        let mut uniforms = FrameUniforms::new(frame, &basis, origin, size);
-        let sf = prepared.shadow_fields;
-        uniforms.shadow_casts = sf.shadow_casts;
-        uniforms.map_casts = sf.map_casts;
-        uniforms.cast_count = sf.cast_count;
-        uniforms.map_count = sf.map_count;
-        uniforms.plane_count = sf.plane_count;
-        self.ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let d = &self.ctx.device;
-        let raster_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        let raster = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("raster"),
             layout: &self.pipelines.raster_layout,
             entries: &[
@@ -950,7 +1045,7 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 2, resource: prepared.materials.as_entire_binding() },
             ],
         });
-        let wave_bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        let wave = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("wave"),
             layout: &self.pipelines.wave_layout,
             entries: &[
@@ -983,18 +1078,90 @@ impl Renderer {
                 },
             ],
         });
+        let plane = (!prepared.plane_draws.is_empty()).then(|| {
+            self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("plane shadows"),
+                layout: &self.pipelines.plane_shadow_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: t.uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: prepared.materials.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: prepared.casts.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: prepared.shadow_draws.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::TextureView(&t.scene_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: wgpu::BindingResource::TextureView(&t.attributes_view),
+                    },
+                ],
+            })
+        });
+        let soft = self.soft.as_ref().filter(|_| frame.area_light.is_some()).map(|soft| {
+            soft.bind_group(
+                d,
+                &self.pipelines.soft_layout,
+                &t.uniforms,
+                &t.scene_view,
+                &t.attributes_view,
+                &t.output,
+            )
+        });
+        TileBindGroups { raster, wave, plane, soft }
+    }
+
+    /// Records one tile's passes — raster (unless the frame skips it), plane shadows, the soft
+    /// shadows' gather, wave — and, when `readback`, the copy to the staging buffer, after writing
+    /// its uniforms. The tiles share one uniform buffer, so submit each tile before encoding the
+    /// next. `timestamps`: every pass gets a query pair, the tile a group of its own.
+    pub(crate) fn encode_tile(
+        &self,
+        frame: &Frame,
+        prepared: &Prepared,
+        tile: ([u32; 2], [u32; 2]),
+        readback: bool,
+        timestamps: Option<&mut PassQueries<'_>>,
+    ) -> wgpu::CommandEncoder {
+        self.encode_tile_passes(frame, prepared, tile, readback, timestamps, false)
+    }
+
+    /// [`Renderer::encode_tile`], or with `classify` the raster pass then the soft shadows'
+    /// classification of the tile's pixels (soft.wgsl `cs_classify`) instead of the other passes.
+    fn encode_tile_passes(
+        &self,
+        frame: &Frame,
+        prepared: &Prepared,
+        tile: ([u32; 2], [u32; 2]),
+        readback: bool,
+        mut timestamps: Option<&mut PassQueries<'_>>,
+        classify: bool,
+    ) -> wgpu::CommandEncoder {
+        if let Some(q) = timestamps.as_deref_mut() {
+            q.next_group();
+        }
+        let t = self.targets.as_ref().expect("targets are created in prepare");
+        let basis = frame.camera.basis(frame.width, frame.height);
+        let (origin, size) = tile;
+        let mut uniforms = FrameUniforms::new(frame, &basis, origin, size);
+        let sf = prepared.shadow_fields;
+        uniforms.shadow_casts = sf.shadow_casts;
+        uniforms.map_casts = sf.map_casts;
+        uniforms.cast_count = sf.cast_count;
+        uniforms.map_count = sf.map_count;
+        uniforms.plane_count = sf.plane_count;
+        self.ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&uniforms));
+        let groups = prepared.groups.as_ref().expect("bind groups are made in prepare");
+        let d = &self.ctx.device;
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("tile") });
-        {
+        if prepared.raster || classify {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("raster"),
                 // Cleared to zero bits: distance 0 marks "nothing drawn".
                 color_attachments: &[cleared_color(&t.scene_view), cleared_color(&t.attributes_view)],
                 depth_stencil_attachment: cleared_depth(&t.depth_view, wgpu::StoreOp::Discard),
-                timestamp_writes: timestamps.map(|(query_set, i)| wgpu::RenderPassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: Some(2 * i),
-                    end_of_pass_write_index: None,
-                }),
+                timestamp_writes: timestamps.as_deref_mut().and_then(|q| q.render("raster")),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -1005,22 +1172,13 @@ impl Renderer {
                     continue;
                 }
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &raster_bg, &[]);
+                pass.set_bind_group(0, &groups.raster, &[]);
                 self.draw_objects(&mut pass, frame, &prepared.draws);
             }
         }
-        let soft_bg = self.soft.as_ref().filter(|_| frame.area_light.is_some()).map(|soft| {
-            soft.bind_group(
-                d,
-                &self.pipelines.soft_layout,
-                &t.uniforms,
-                &t.scene_view,
-                &t.attributes_view,
-                &t.output,
-            )
-        });
+        let soft_bg = groups.soft.as_ref().filter(|_| frame.area_light.is_some());
         if classify {
-            if let Some(bg) = &soft_bg {
+            if let Some(bg) = soft_bg {
                 let mut pass = enc.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&self.pipelines.soft.classify);
                 pass.set_bind_group(0, bg, &[]);
@@ -1028,11 +1186,14 @@ impl Renderer {
             }
             return enc;
         }
-        if !prepared.plane_draws.is_empty() {
-            self.encode_plane_shadows(&mut enc, frame, prepared, t, size);
+        if groups.plane.is_some() {
+            self.encode_plane_shadows(&mut enc, frame, prepared, t, size, timestamps.as_deref_mut());
         }
-        if let Some(bg) = &soft_bg {
-            let mut pass = enc.begin_compute_pass(&Default::default());
+        if let Some(bg) = soft_bg {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("soft gather"),
+                timestamp_writes: timestamps.as_deref_mut().and_then(|q| q.compute("soft gather")),
+            });
             pass.set_pipeline(&self.pipelines.soft.gather);
             pass.set_bind_group(0, bg, &[]);
             pass.dispatch_workgroups(size[0].div_ceil(8), size[1].div_ceil(8), 1);
@@ -1040,14 +1201,10 @@ impl Renderer {
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("wave"),
-                timestamp_writes: timestamps.map(|(query_set, i)| wgpu::ComputePassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: None,
-                    end_of_pass_write_index: Some(2 * i + 1),
-                }),
+                timestamp_writes: timestamps.and_then(|q| q.compute("wave")),
             });
-            pass.set_pipeline(&self.pipelines.wave);
-            pass.set_bind_group(0, &wave_bg, &[]);
+            pass.set_pipeline(&prepared.wave_pipeline);
+            pass.set_bind_group(0, &groups.wave, &[]);
             let g = pipelines::WAVE_WORKGROUP;
             pass.dispatch_workgroups(size[0].div_ceil(g), size[1].div_ceil(g), 1);
         }
@@ -1067,38 +1224,21 @@ impl Renderer {
         prepared: &Prepared,
         t: &TileTargets,
         size: [u32; 2],
+        timestamps: Option<&mut PassQueries<'_>>,
     ) {
-        let bind_group = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("plane shadows"),
-            layout: &self.pipelines.plane_shadow_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: t.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: prepared.objects.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: prepared.materials.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: prepared.casts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: prepared.shadow_draws.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&t.scene_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::TextureView(&t.attributes_view),
-                },
-            ],
-        });
+        let Some(bind_group) = prepared.groups.as_ref().and_then(|g| g.plane.as_ref()) else { return };
         let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("plane shadows"),
             // 0: no plane cast.
             color_attachments: &[cleared_color(&t.plane_shadow_view)],
             depth_stencil_attachment: cleared_depth(&t.depth_view, wgpu::StoreOp::Discard),
-            timestamp_writes: None,
+            timestamp_writes: timestamps.and_then(|q| q.render("plane shadows")),
             occlusion_query_set: None,
             multiview_mask: None,
         });
         pass.set_viewport(0.0, 0.0, size[0] as f32, size[1] as f32, 0.0, 1.0);
         pass.set_pipeline(&self.pipelines.plane_shadow);
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(0, bind_group, &[]);
         for &(instance, object, index_count) in &prepared.plane_draws {
             let key = Arc::as_ptr(&frame.objects[object].mesh) as usize;
             let Some(mesh) = self.meshes.get(&key) else { continue };
@@ -1370,6 +1510,53 @@ mod tests {
             shadows: Vec::new(),
             area_light: None,
         }
+    }
+
+    /// The wave pipeline comes from the variant cache: the same kinds give the same pipeline
+    /// whatever their parameters, other kinds another one; without specialisation every frame gets
+    /// the uber-shader. A frame without surfaces skips the raster pass unless the uber-shader
+    /// (which reads the G-buffer) runs it.
+    #[test]
+    fn wave_pipelines_are_cached_per_variant() {
+        let Some((mut r, _gpu)) = renderer_or_skip("wave pipeline cache") else { return };
+        let sphere = |x: f32| {
+            let mut f = small_frame();
+            f.waves.push(hadou_scene::Wave::new(
+                "orb",
+                [1.0; 4],
+                hadou_math::energy::Falloff::Faithful,
+                0.02,
+                hadou_scene::WaveShape::Sphere(hadou_math::energy::SphereField {
+                    center: hadou_math::Vec3::new(x, 0.0, 0.0),
+                    alpha: 1.0,
+                }),
+            ));
+            f
+        };
+        let a = r.prepare(&sphere(0.0), 0..8).unwrap();
+        let b = r.prepare(&sphere(2.0), 0..8).unwrap();
+        assert_eq!(a.wave_pipeline, b.wave_pipeline, "same kinds, same pipeline");
+        assert_eq!(r.wave_variants_built(), 1);
+        assert!(!a.raster, "nothing to draw: no raster pass");
+        let mut cylinder = sphere(0.0);
+        cylinder.waves[0].shape = hadou_scene::WaveShape::Cylinder(hadou_math::energy::CylinderField {
+            point: hadou_math::Vec3::ZERO,
+            dir: hadou_math::Vec3::Y,
+            alpha: 1.0,
+        });
+        let c = r.prepare(&cylinder, 0..8).unwrap();
+        assert_ne!(a.wave_pipeline, c.wave_pipeline, "another kind, another pipeline");
+        let with_objects = three_triangles(0.0);
+        let d = r.prepare(&with_objects, 0..8).unwrap();
+        assert!(d.raster, "objects are rasterized");
+        assert_eq!(r.wave_variants_built(), 3);
+        r.set_specialise(false);
+        let u1 = r.prepare(&sphere(0.0), 0..8).unwrap();
+        let u2 = r.prepare(&cylinder, 0..8).unwrap();
+        assert_eq!(u1.wave_pipeline, u2.wave_pipeline, "one uber-shader for every frame");
+        assert!(u1.raster, "the uber-shader reads the G-buffer");
+        assert_ne!(u1.wave_pipeline, a.wave_pipeline);
+        assert_eq!(r.wave_variants_built(), 4);
     }
 
     #[test]

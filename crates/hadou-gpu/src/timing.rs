@@ -8,14 +8,29 @@ use std::time::Instant;
 /// How [`FrameTiming`] was measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TimingMethod {
-    /// GPU timestamps (`Features::TIMESTAMP_QUERY`) at the start of each tile's raster pass and the
-    /// end of its wave pass, summed over tiles: pure GPU execution time.
+    /// GPU timestamps (`Features::TIMESTAMP_QUERY`) written at the beginning and end of every pass
+    /// (`timestamp_writes` of the pass descriptors): the frame is the shadow-map passes' span plus,
+    /// per tile, the span from its first pass's beginning to its last pass's end, summed over
+    /// tiles: pure GPU execution time. [`FrameTiming::passes`] splits it by pass.
     GpuTimestamps,
-    /// Wall-clock time from the first submit of a frame until the GPU reports it finished; includes
-    /// submission and driver overhead. Frames with an `[area_light]` are always timed this way,
+    /// Wall-clock time from the first submit of a frame (its shadow maps, then its tiles) until the
+    /// GPU reports it finished; includes submission and driver overhead. Frames with an `[area_light]` are always timed this way,
     /// with their preparation inside the timing (uploads, the two soft-shadow maps and the
     /// whole-image penumbra resolve run there, before the tiles).
     WallClock,
+}
+
+/// The GPU time of one kind of pass in a frame, from [`crate::GpuBackend::time_frame`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTime {
+    /// The pass: `"shadow maps"` (once per frame, every map layer), then per tile `"raster"`
+    /// (opaque geometry and outline hulls into the G-buffer), `"plane shadows"` (only when the
+    /// frame has plane shadows) and `"wave"` (shading, shadow lookups, the energy integrals and
+    /// the colour mapping).
+    pub name: String,
+    /// Median over the timed iterations of this pass's time summed over the frame's tiles (or
+    /// map layers), in milliseconds.
+    pub median_ms: f64,
 }
 
 /// The result of [`crate::GpuBackend::time_frame`].
@@ -33,23 +48,114 @@ pub struct FrameTiming {
     pub median_ms: f64,
     /// Minimum of `per_iteration_ms`.
     pub min_ms: f64,
+    /// The frame split by pass, in the order the passes first run ([`PassTime`]). Only with
+    /// [`TimingMethod::GpuTimestamps`]; empty when the adapter has no timestamp queries (e.g.
+    /// OpenGL) or the frame is timed by wall clock. Each pass's median is at most `median_ms`,
+    /// and in any one iteration the passes sum to at most the frame (the frame also holds the
+    /// gaps between passes).
+    pub passes: Vec<PassTime>,
+}
+
+/// The median of `samples` (0 when empty).
+fn median(samples: &[f64]) -> f64 {
+    let mut sorted = samples.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    match sorted.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => sorted[n / 2],
+        n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+    }
+}
+
+/// Timestamp queries handed out to passes as they are encoded: pass `k` writes queries `2k`
+/// (beginning) and `2k + 1` (end). Passes are grouped (one group per tile, one for the shadow
+/// maps); a group's span, from its first beginning to its last end, is its share of the frame.
+pub(crate) struct PassQueries<'a> {
+    set: &'a wgpu::QuerySet,
+    capacity: u32,
+    /// `(name, group)` of every pass given queries, in encoding order.
+    passes: Vec<(&'static str, u32)>,
+    group: u32,
+}
+
+impl<'a> PassQueries<'a> {
+    fn new(set: &'a wgpu::QuerySet, capacity: u32) -> Self {
+        Self { set, capacity, passes: Vec::new(), group: 0 }
+    }
+
+    /// Starts a new group: the passes encoded from now on belong to it.
+    pub(crate) fn next_group(&mut self) {
+        self.group += 1;
+    }
+
+    /// The query pair of the next pass, named `name`; `None` once the set is full.
+    fn slot(&mut self, name: &'static str) -> Option<(u32, u32)> {
+        let k = self.passes.len() as u32;
+        if 2 * k + 2 > self.capacity {
+            return None;
+        }
+        self.passes.push((name, self.group));
+        Some((2 * k, 2 * k + 1))
+    }
+
+    /// Timestamp writes for a render pass named `name`.
+    pub(crate) fn render(&mut self, name: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'a>> {
+        let set = self.set;
+        self.slot(name).map(|(b, e)| wgpu::RenderPassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: Some(b),
+            end_of_pass_write_index: Some(e),
+        })
+    }
+
+    /// Timestamp writes for a compute pass named `name`.
+    pub(crate) fn compute(&mut self, name: &'static str) -> Option<wgpu::ComputePassTimestampWrites<'a>> {
+        let set = self.set;
+        self.slot(name).map(|(b, e)| wgpu::ComputePassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: Some(b),
+            end_of_pass_write_index: Some(e),
+        })
+    }
+
+    /// Queries written so far.
+    fn used(&self) -> u32 {
+        2 * self.passes.len() as u32
+    }
+}
+
+/// One iteration's timestamps (`ticks`: beginning and end of every pass of `passes`, in
+/// nanoseconds) reduced to the frame time and the time per pass name, both in milliseconds, the
+/// names in order of first appearance.
+fn split_frame(passes: &[(&'static str, u32)], ns: &[f64]) -> (f64, Vec<(&'static str, f64)>) {
+    let mut per_pass: Vec<(&'static str, f64)> = Vec::new();
+    let mut spans: Vec<(u32, f64, f64)> = Vec::new();
+    for (k, &(name, group)) in passes.iter().enumerate() {
+        let (Some(&b), Some(&e)) = (ns.get(2 * k), ns.get(2 * k + 1)) else { break };
+        let ms = (e - b).max(0.0) * 1e-6;
+        match per_pass.iter_mut().find(|(n, _)| *n == name) {
+            Some(p) => p.1 += ms,
+            None => per_pass.push((name, ms)),
+        }
+        match spans.iter_mut().find(|s| s.0 == group) {
+            Some(s) => {
+                s.1 = s.1.min(b);
+                s.2 = s.2.max(e);
+            }
+            None => spans.push((group, b, e)),
+        }
+    }
+    let frame = spans.iter().map(|&(_, b, e)| (e - b).max(0.0) * 1e-6).sum();
+    (frame, per_pass)
 }
 
 impl FrameTiming {
     fn from_samples(method: TimingMethod, tiles: u32, per_iteration_ms: Vec<f64>) -> Self {
         let n = per_iteration_ms.len().max(1) as f64;
         let mean_ms = per_iteration_ms.iter().sum::<f64>() / n;
-        let mut sorted = per_iteration_ms.clone();
-        sorted.sort_by(f64::total_cmp);
-        let median_ms = if sorted.is_empty() {
-            0.0
-        } else if sorted.len() % 2 == 1 {
-            sorted[sorted.len() / 2]
-        } else {
-            0.5 * (sorted[sorted.len() / 2 - 1] + sorted[sorted.len() / 2])
-        };
-        let min_ms = sorted.first().copied().unwrap_or(0.0);
-        Self { method, tiles, per_iteration_ms, mean_ms, median_ms, min_ms }
+        let median_ms = median(&per_iteration_ms);
+        let min_ms = per_iteration_ms.iter().copied().min_by(f64::total_cmp).unwrap_or(0.0);
+        Self { method, tiles, per_iteration_ms, mean_ms, median_ms, min_ms, passes: Vec::new() }
     }
 
     /// Frames per second at the median time (0 when the time is 0).
@@ -61,6 +167,9 @@ impl FrameTiming {
         }
     }
 }
+
+/// Passes per tile that may take timestamps: raster, plane shadows, soft gather, wave.
+const PASSES_PER_TILE: u32 = 4;
 
 /// See [`crate::GpuBackend::time_frame`].
 pub(crate) fn time_frame(
@@ -75,22 +184,14 @@ pub(crate) fn time_frame(
     let tiles = prepared.tiles.len() as u32;
     // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
     let last = r.ctx.scoped("warming up", || {
-        let cmds: Vec<_> = prepared
-            .tiles
-            .iter()
-            .map(|&t| r.encode_tile(frame, &prepared, t, false, None).finish())
-            .collect();
-        let mut last = None;
-        for c in cmds {
-            last = Some(r.ctx.queue.submit([c]));
-        }
-        last
+        let maps = r.submit_shadow_maps(frame, &prepared, None);
+        r.submit_tiles(frame, &prepared, None).or(maps)
     })?;
     if let Some(s) = last {
         r.ctx.wait(s)?;
     }
 
-    let queries = 2 * tiles;
+    let queries = 2 * (PASSES_PER_TILE * tiles + prepared.map_pass_count());
     let soft = frame.area_light.is_some();
     let use_timestamps = !soft
         && r.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
@@ -101,7 +202,7 @@ pub(crate) fn time_frame(
         let (set, resolve, read) = r.ctx.scoped("creating timestamp queries", || {
             let d = &r.ctx.device;
             let set = d.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("frame timestamps"),
+                label: Some("pass timestamps"),
                 ty: wgpu::QueryType::Timestamp,
                 count: queries,
             });
@@ -120,42 +221,61 @@ pub(crate) fn time_frame(
             (set, resolve, read)
         })?;
         let period_ns = r.ctx.queue.get_timestamp_period() as f64;
-        for _ in 0..iterations {
-            let last = r.ctx.scoped("timing a frame", || {
-                let mut last = None;
-                for (k, &t) in prepared.tiles.iter().enumerate() {
-                    let mut enc = r.encode_tile(frame, &prepared, t, false, Some((&set, k as u32)));
-                    if k + 1 == prepared.tiles.len() {
-                        enc.resolve_query_set(&set, 0..queries, &resolve, 0);
-                        enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, bytes);
-                    }
-                    last = Some(r.ctx.queue.submit([enc.finish()]));
+        // Per pass name, its time in each iteration.
+        let mut passes: Vec<(&'static str, Vec<f64>)> = Vec::new();
+        for i in 0..iterations as usize {
+            let mut q = PassQueries::new(&set, queries);
+            let (last, used) = r.ctx.scoped("timing a frame", || {
+                r.submit_shadow_maps(frame, &prepared, Some(&mut q));
+                r.submit_tiles(frame, &prepared, Some(&mut q));
+                let used = q.used();
+                let mut enc = r.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("timestamp resolve"),
+                });
+                if used > 0 {
+                    enc.resolve_query_set(&set, 0..used, &resolve, 0);
+                    enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, used as u64 * 8);
                 }
-                last
+                (r.ctx.queue.submit([enc.finish()]), used)
             })?;
-            let Some(last) = last else { break };
-            let ticks = r.ctx.read_buffer(&read, bytes, last, |raw| {
-                raw.chunks_exact(16)
-                    .map(|q| {
-                        let begin = u64::from_ne_bytes(q[0..8].try_into().unwrap_or_default());
-                        let end = u64::from_ne_bytes(q[8..16].try_into().unwrap_or_default());
-                        end.saturating_sub(begin)
-                    })
-                    .sum::<u64>()
+            if used == 0 {
+                break;
+            }
+            let ns = r.ctx.read_buffer(&read, used as u64 * 8, last, |raw| {
+                raw.chunks_exact(8)
+                    .map(|t| u64::from_ne_bytes(t.try_into().unwrap_or_default()) as f64 * period_ns)
+                    .collect::<Vec<f64>>()
             })?;
-            samples.push(ticks as f64 * period_ns * 1e-6);
+            let (frame_ms, per_pass) = split_frame(&q.passes, &ns);
+            samples.push(frame_ms);
+            for (name, ms) in per_pass {
+                match passes.iter_mut().find(|(n, _)| *n == name) {
+                    Some(p) => p.1.push(ms),
+                    None => {
+                        // A pass missing from earlier iterations took no time there.
+                        let mut v = vec![0.0; i];
+                        v.push(ms);
+                        passes.push((name, v));
+                    }
+                }
+            }
+            for (_, v) in passes.iter_mut() {
+                v.resize(i + 1, 0.0);
+            }
         }
-        return Ok(FrameTiming::from_samples(TimingMethod::GpuTimestamps, tiles, samples));
+        let mut timing = FrameTiming::from_samples(TimingMethod::GpuTimestamps, tiles, samples);
+        timing.passes = passes
+            .into_iter()
+            .map(|(name, v)| PassTime { name: name.to_string(), median_ms: median(&v) })
+            .collect();
+        return Ok(timing);
     }
     if soft {
         for _ in 0..iterations {
             let start = Instant::now();
+            // `prepare` draws the shadow maps and the soft shadows.
             let prepared = r.prepare(frame, 0..frame.height)?;
-            let mut last = None;
-            for &t in &prepared.tiles {
-                let c = r.encode_tile(frame, &prepared, t, false, None).finish();
-                last = Some(r.ctx.queue.submit([c]));
-            }
+            let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))?;
             if let Some(s) = last {
                 r.ctx.wait(s)?;
             }
@@ -164,22 +284,38 @@ pub(crate) fn time_frame(
         return Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples));
     }
     for _ in 0..iterations {
-        let cmds = r.ctx.scoped("encoding a frame", || {
-            prepared
-                .tiles
-                .iter()
-                .map(|&t| r.encode_tile(frame, &prepared, t, false, None).finish())
-                .collect::<Vec<_>>()
-        })?;
         let start = Instant::now();
-        let mut last = None;
-        for c in cmds {
-            last = Some(r.ctx.queue.submit([c]));
-        }
+        let last = r.ctx.scoped("timing a frame", || {
+            let maps = r.submit_shadow_maps(frame, &prepared, None);
+            r.submit_tiles(frame, &prepared, None).or(maps)
+        })?;
         if let Some(s) = last {
             r.ctx.wait(s)?;
         }
         samples.push(start.elapsed().as_secs_f64() * 1e3);
     }
     Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn passes_split_by_name_and_the_frame_is_the_sum_of_group_spans() {
+        // Group 1: shadow maps (two layers); groups 2 and 3: tiles with raster and wave passes.
+        let passes =
+            [("shadow maps", 1), ("shadow maps", 1), ("raster", 2), ("wave", 2), ("raster", 3), ("wave", 3)];
+        let ms = 1e6;
+        let ns: Vec<f64> =
+            [0.0, 1.0, 1.5, 2.0, 3.0, 4.0, 4.5, 9.0, 10.0, 11.0, 11.0, 20.0].iter().map(|t| t * ms).collect();
+        let (frame, per_pass) = split_frame(&passes, &ns);
+        // Spans: maps 0..2, tile 3..9, tile 10..20.
+        assert_eq!(frame, 2.0 + 6.0 + 10.0);
+        assert_eq!(per_pass, [("shadow maps", 1.5), ("raster", 2.0), ("wave", 4.5 + 9.0)]);
+        assert!(per_pass.iter().map(|p| p.1).sum::<f64>() <= frame);
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert_eq!(median(&[]), 0.0);
+    }
 }

@@ -1,4 +1,5 @@
-//! `GpuBackend::time_frame`: the method matches the device's features and the samples are sane.
+//! `GpuBackend::time_frame`: the method matches the device's features, the samples are sane, and
+//! with timestamps the frame splits into its passes.
 
 mod common;
 
@@ -18,4 +19,59 @@ fn time_frame_reports_its_method_and_positive_times() {
     assert!(t.min_ms <= t.median_ms && t.median_ms <= t.per_iteration_ms.iter().cloned().fold(0.0, f64::max));
     eprintln!("{}: {:?}, median {:.3} ms ({:.0} fps)", gpu.adapter_name(), t.method, t.median_ms, t.fps());
     assert!(gpu.time_frame(&frame, 0).is_err());
+}
+
+/// The names of `t`'s passes, in order.
+fn names(t: &hadou_gpu::FrameTiming) -> Vec<&str> {
+    t.passes.iter().map(|p| p.name.as_str()).collect()
+}
+
+/// With timestamps every pass of the frame is timed (shadow maps, raster, plane shadows, wave)
+/// and, in one iteration, the passes sum to no more than the frame; without them (GL) there is no
+/// split. A frame with nothing to draw skips the raster pass.
+#[test]
+fn time_frame_splits_the_frame_into_its_passes() {
+    let Some(mut gpu) = gpu_or_skip("time_frame passes") else { return };
+    let (_, shadows) = example_frames(|name| name == "shadow-uneven.toml").remove(0);
+    let mut waves_only = kamehameha_frame(64, 48);
+    waves_only.objects.clear();
+    let cases = [
+        (kamehameha_frame(200, 150), vec!["raster", "wave"]),
+        (shadows, vec!["shadow maps", "raster", "plane shadows", "wave"]),
+        (waves_only, vec!["wave"]),
+    ];
+    for (frame, expected) in cases {
+        let t = gpu.time_frame(&frame, 1).expect("timing");
+        if !gpu.has_timestamps() {
+            assert_eq!(t.method, TimingMethod::WallClock);
+            assert!(t.passes.is_empty(), "no timestamps, no passes: {t:?}");
+            continue;
+        }
+        assert_eq!(t.method, TimingMethod::GpuTimestamps);
+        assert_eq!(names(&t), expected, "{t:?}");
+        assert!(t.passes.iter().all(|p| p.median_ms >= 0.0 && p.median_ms.is_finite()), "{t:?}");
+        let sum: f64 = t.passes.iter().map(|p| p.median_ms).sum();
+        assert!(sum <= t.median_ms * (1.0 + 1e-9), "passes {sum} ms > frame {} ms: {t:?}", t.median_ms);
+        assert!(t.passes.iter().any(|p| p.name == "wave" && p.median_ms > 0.0), "{t:?}");
+        // Several iterations: each pass's median is within the frame's.
+        let t = gpu.time_frame(&frame, 3).expect("timing");
+        let max = t.per_iteration_ms.iter().cloned().fold(0.0, f64::max);
+        assert!(t.passes.iter().all(|p| p.median_ms <= max), "{t:?}");
+    }
+}
+
+/// A frame with an `[area_light]` is timed by the wall clock (its soft shadows are prepared
+/// with it), without a split, on any adapter.
+#[test]
+fn time_frame_times_an_area_light_frame_by_the_wall_clock() {
+    let Some(mut gpu) = gpu_or_skip("time_frame area light") else { return };
+    let (_, mut frame) = example_frames(|name| name == "soft-gradient.toml").remove(0);
+    assert!(frame.area_light.is_some());
+    frame.width = 96;
+    frame.height = 72;
+    let t = gpu.time_frame(&frame, 2).expect("timing");
+    assert_eq!(t.method, TimingMethod::WallClock);
+    assert!(t.passes.is_empty());
+    assert_eq!(t.per_iteration_ms.len(), 2);
+    assert!(t.per_iteration_ms.iter().all(|&ms| ms > 0.0 && ms.is_finite()), "{t:?}");
 }

@@ -301,7 +301,8 @@ fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>
         };
         let timer = move |f: &Frame, n: u32| {
             let t = gpu.time_frame(f, n)?;
-            let mut parts: Vec<(String, f64)> = Vec::new(); // PASSES-PENDING
+            let mut parts: Vec<(String, f64)> =
+                t.passes.iter().map(|p| (p.name.clone(), p.median_ms)).collect();
             let image = gpu.render(f)?;
             let output =
                 (0..n.max(1)).map(|_| hadou::bench::output_ms(&image)).collect::<Result<Vec<_>, _>>()?;

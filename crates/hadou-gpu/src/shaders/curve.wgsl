@@ -13,6 +13,15 @@
 // (u32 bits) of every curve.
 @group(0) @binding(7) var<storage, read> curve_f32: array<f32>;
 
+// The integrators and shapes the frame's curves use (pipeline-overridable; see USE_SPHERE in
+// wave.wgsl): the others are compiled out of curve_energy and curve_eval.
+override USE_CHORD: bool = true;
+override USE_SIMPSON: bool = true;
+override USE_HELIX: bool = true;
+override USE_TRIG: bool = true;
+override USE_BEZIER: bool = true;
+override USE_BSPLINE: bool = true;
+
 // `dt` above this is an open (infinite) span: the GPU's stand-in for f32::INFINITY is T_OPEN.
 const CURVE_INF: f32 = 1.0e38;
 const F32_MAX: f32 = 3.4028235e38;
@@ -134,23 +143,33 @@ fn curve_bspline(c: GpuCurve, tau: f32) -> vec2<f32> {
 
 // Mirrors shape.rs `ShapeEval::eval`: the cross-section point (y(s), z(s)).
 fn curve_eval(c: GpuCurve, s: f32) -> vec2<f32> {
+    // Each shape is compiled in only when the frame has it (USE_HELIX … USE_BSPLINE).
     switch c.shape {
         case SHAPE_HELIX: {
-            let a = c.rate * s + c.phase;
-            return vec2<f32>(c.radius * sin(a), c.radius * cos(a));
+            if (USE_HELIX) {
+                let a = c.rate * s + c.phase;
+                return vec2<f32>(c.radius * sin(a), c.radius * cos(a));
+            }
         }
         case SHAPE_TRIG: {
-            let zs = c.points + 2u * c.y_terms;
-            return vec2<f32>(curve_trig_sum(c.rate, s, c.points, c.y_terms), curve_trig_sum(c.rate, s, zs, c.z_terms));
+            if (USE_TRIG) {
+                let zs = c.points + 2u * c.y_terms;
+                return vec2<f32>(curve_trig_sum(c.rate, s, c.points, c.y_terms), curve_trig_sum(c.rate, s, zs, c.z_terms));
+            }
         }
         case SHAPE_BEZIER: {
-            return curve_bezier(c, s);
+            if (USE_BEZIER) {
+                return curve_bezier(c, s);
+            }
         }
         default: {
-            let tau = c.lo + clamp(s, 0.0, 1.0) * (c.hi - c.lo);
-            return curve_bspline(c, tau);
+            if (USE_BSPLINE) {
+                let tau = c.lo + clamp(s, 0.0, 1.0) * (c.hi - c.lo);
+                return curve_bspline(c, tau);
+            }
         }
     }
+    return vec2<f32>(0.0);
 }
 
 // ---- integrate.rs: LocalRay ----
@@ -866,8 +885,15 @@ fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
 
 // Mirrors hadou_math::curve::curve_energy: dispatch on the wave's integrator.
 fn curve_energy(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
+    // Each integrator is compiled in only when the frame's curves use it.
     if (c.integrator == INTEGRATOR_SIMPSON) {
-        return curve_simpson(c, falloff, core_radius, ray, t0, t1, t_far);
+        if (USE_SIMPSON) {
+            return curve_simpson(c, falloff, core_radius, ray, t0, t1, t_far);
+        }
+        return 0.0;
     }
-    return curve_default(c, falloff, core_radius, ray, t0, t1, t_far);
+    if (USE_CHORD) {
+        return curve_default(c, falloff, core_radius, ray, t0, t1, t_far);
+    }
+    return 0.0;
 }

@@ -9,6 +9,11 @@
 // capsule regions). Every use compares it against T_LIMIT (1e12), exactly as the Rust code treats
 // infinity.
 
+// The falloffs the frame's waves use (pipeline-overridable; see USE_SPHERE in wave.wgsl): the
+// other one's integral is compiled out of rq_integral.
+override USE_FAITHFUL: bool = true;
+override USE_INVERSE_SQUARE: bool = true;
+
 const T_OPEN: f32 = 3.0e38;
 // Mirrors hadou_math::energy::T_LIMIT.
 const T_LIMIT: f32 = 1.0e12;
@@ -203,9 +208,15 @@ fn rq_inverse_square(q: RayQuadratic, t0: f32, t1: f32) -> f32 {
 // Mirrors RayQuadratic::integral.
 fn rq_integral(q: RayQuadratic, falloff: u32, t0: f32, t1: f32) -> f32 {
     if (falloff == FALLOFF_FAITHFUL) {
-        return rq_faithful(q, t0, t1);
+        if (USE_FAITHFUL) {
+            return rq_faithful(q, t0, t1);
+        }
+        return 0.0;
     }
-    return rq_inverse_square(q, t0, t1);
+    if (USE_INVERSE_SQUARE) {
+        return rq_inverse_square(q, t0, t1);
+    }
+    return 0.0;
 }
 
 // Mirrors hadou_math::energy::sphere_energy (002 eq. 3.4, 3.6, 3.8).

@@ -10,6 +10,17 @@
 // points (3 f32 bit patterns each). layout::ShadingBuffers::data.
 @group(0) @binding(10) var<storage, read> shading_data: array<u32>;
 
+// The shading the frame's materials and lights need (pipeline-overridable; see USE_SPHERE in
+// wave.wgsl): toon-model materials, textures (base or feature), the waves as lights (some material
+// blends towards them or some wave glows) and each kind of light line. The rest is compiled out.
+override USE_TOON: bool = true;
+override USE_TEXTURES: bool = true;
+override USE_WAVE_LIGHTS: bool = true;
+override USE_LINE_POINT: bool = true;
+override USE_LINE_SEGMENT: bool = true;
+override USE_LINE_LINE: bool = true;
+override USE_LINE_POLYLINE: bool = true;
+
 // Mirrors hadou_math::toon::band_step.
 fn band_step(m: f32, t: f32, w: f32) -> f32 {
     if (w <= 0.0) {
@@ -59,38 +70,48 @@ fn polyline_point(offset: u32, i: u32) -> vec3<f32> {
 
 // Mirrors hadou_scene::LightLine::nearest.
 fn light_nearest(l: GpuLight, p: vec3<f32>) -> vec3<f32> {
+    // Each line kind is compiled in only when the frame has it (USE_LINE_*).
     switch l.line_kind {
         case LINE_POINT: {
-            return l.a.xyz;
+            if (USE_LINE_POINT) {
+                return l.a.xyz;
+            }
         }
         case LINE_SEGMENT: {
-            return nearest_on_segment(p, l.a.xyz, l.b.xyz);
+            if (USE_LINE_SEGMENT) {
+                return nearest_on_segment(p, l.a.xyz, l.b.xyz);
+            }
         }
         case LINE_LINE: {
-            return l.a.xyz + l.b.xyz * dot3(p - l.a.xyz, l.b.xyz);
+            if (USE_LINE_LINE) {
+                return l.a.xyz + l.b.xyz * dot3(p - l.a.xyz, l.b.xyz);
+            }
         }
         default: {
             // hadou_math::toon::nearest_on_polyline
-            if (l.point_count == 0u) {
-                return p;
-            }
-            var best = polyline_point(l.point_offset, 0u);
-            if (l.point_count == 1u) {
+            if (USE_LINE_POLYLINE) {
+                if (l.point_count == 0u) {
+                    return p;
+                }
+                var best = polyline_point(l.point_offset, 0u);
+                if (l.point_count == 1u) {
+                    return best;
+                }
+                var best_d = 3.40282347e38;
+                for (var i = 0u; i + 1u < l.point_count; i++) {
+                    let q = nearest_on_segment(p, polyline_point(l.point_offset, i), polyline_point(l.point_offset, i + 1u));
+                    let e = q - p;
+                    let d = dot3(e, e);
+                    if (d < best_d) {
+                        best_d = d;
+                        best = q;
+                    }
+                }
                 return best;
             }
-            var best_d = 3.40282347e38;
-            for (var i = 0u; i + 1u < l.point_count; i++) {
-                let q = nearest_on_segment(p, polyline_point(l.point_offset, i), polyline_point(l.point_offset, i + 1u));
-                let e = q - p;
-                let d = dot3(e, e);
-                if (d < best_d) {
-                    best_d = d;
-                    best = q;
-                }
-            }
-            return best;
         }
     }
+    return p;
 }
 
 // Mirrors hadou_math::toon::wave_m.
@@ -160,7 +181,7 @@ fn fix_coord(v: f32) -> f32 {
 // Mirrors hadou_math::toon::sample: level 0, texel centres at ((i + ½)/w, (j + ½)/h), bilinear
 // in linear light or nearest. `offset` 0 means no texture: opaque white.
 fn sample_texture(t: GpuTexture, uv: vec2<f32>) -> vec4<f32> {
-    if (t.offset == 0u || t.width == 0u || t.height == 0u) {
+    if (!USE_TEXTURES || t.offset == 0u || t.width == 0u || t.height == 0u) {
         return vec4<f32>(1.0);
     }
     let x = fix_coord(uv.x) * f32(t.width);
@@ -201,11 +222,11 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
     var c = albedo;
     if (m.model == MODEL_DIFFUSE) {
         c = diffuse(albedo, n, frame.light_dir, frame.light_color, frame.ambient);
-    } else if (m.model == MODEL_TOON) {
+    } else if (USE_TOON && m.model == MODEL_TOON) {
         c = albedo * ramp_eval(m.ramp, dot3(n, -frame.light_dir));
     }
     let count = min(frame.wave_count, MAX_LIGHTS);
-    if (count > 0u && (m.wave_blend > 0.0 || frame.any_glow != 0u)) {
+    if (USE_WAVE_LIGHTS && count > 0u && (m.wave_blend > 0.0 || frame.any_glow != 0u)) {
         // Pass 1: the largest density and the glow.
         var max_rho = 0.0;
         var glow = vec3<f32>(0.0);
@@ -245,7 +266,7 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
         }
         c = vec3<f32>(energy_saturate(c.x + glow.x), energy_saturate(c.y + glow.y), energy_saturate(c.z + glow.z));
     }
-    if (m.feature_texture.offset != 0u) {
+    if (USE_TEXTURES && m.feature_texture.offset != 0u) {
         c = c * sample_texture(m.feature_texture, uv).xyz;
     }
     return c;
@@ -272,7 +293,7 @@ fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f3
     }
     let mdot = dot3(n, dir);
     var k = vec3<f32>(max(mdot, 0.0));
-    if (m.model == MODEL_TOON) {
+    if (USE_TOON && m.model == MODEL_TOON) {
         k = ramp_eval(m.ramp, mdot);
     }
     let tex = sample_texture(m.base_texture, uv);

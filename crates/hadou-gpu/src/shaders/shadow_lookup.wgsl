@@ -9,6 +9,11 @@
 // The frame's shadow maps, one layer per map cast (cleared to 1 = no caster).
 @group(0) @binding(12) var shadow_maps: texture_2d_array<f32>;
 
+// Whether the frame has plane casts, map casts (pipeline-overridable; see USE_SPHERE in
+// wave.wgsl): a kind it lacks is compiled out of apply_shadows.
+override USE_PLANE_SHADOWS: bool = true;
+override USE_MAP_SHADOWS: bool = true;
+
 fn data_f32(o: u32) -> f32 {
     return bitcast<f32>(shading_data[o]);
 }
@@ -42,13 +47,13 @@ fn load_shadow_cast(j: u32) -> GpuShadowCast {
 // material receives the shadows in `mask`, with the winning shadow applied:
 // c + (shadow colour − c)·opacity.
 fn apply_shadows(c: vec3<f32>, mask: u32, p: vec3<f32>, pixel: vec2<u32>) -> vec3<f32> {
-    if (frame.cast_count == 0u || mask == 0u) {
+    if (!(USE_PLANE_SHADOWS || USE_MAP_SHADOWS) || frame.cast_count == 0u || mask == 0u) {
         return c;
     }
     var best_j = 0xffffffffu;
     var best_opacity = 0.0;
     var color = vec3<f32>(0.0);
-    if (frame.plane_count != 0u) {
+    if (USE_PLANE_SHADOWS && frame.plane_count != 0u) {
         let v = textureLoad(plane_shadow_texels, vec2<i32>(pixel), 0).x;
         if (v != 0u) {
             let s = load_shadow_cast(v - 1u);
@@ -57,7 +62,7 @@ fn apply_shadows(c: vec3<f32>, mask: u32, p: vec3<f32>, pixel: vec2<u32>) -> vec
             color = s.color;
         }
     }
-    for (var i = 0u; i < frame.map_count; i++) {
+    for (var i = 0u; USE_MAP_SHADOWS && i < frame.map_count; i++) {
         let j = shading_data[frame.map_casts + i];
         let s = load_shadow_cast(j);
         if ((mask & (1u << s.shadow)) == 0u) {

@@ -15,6 +15,23 @@
 // [0, 4n), energy in [4n, 5n), eye distance in [5n, 6n). Keep in sync with readback in render.rs.
 @group(0) @binding(4) var<storage, read_write> out_buf: array<f32>;
 
+// The wave pass's variant (pipeline-overridable constants; see pipelines::WaveVariant, which sets
+// each from the frame's contents). The defaults, all true, give the uber-shader that handles any
+// frame. A part set false is compiled out: on a software adapter (llvmpipe runs both sides of
+// every branch under a mask) that is what keeps a frame from paying for what it does not contain.
+// With a part set true the code is exactly the uber-shader's. Here: the wave kinds, whether any
+// surface is drawn, the `[area_light]` and the colour mappings; energy.wgsl, curve.wgsl,
+// shading.wgsl and shadow_lookup.wgsl have the others.
+override USE_SPHERE: bool = true;
+override USE_CYLINDER: bool = true;
+override USE_CAPSULE: bool = true;
+override USE_BEAM: bool = true;
+override USE_CURVE: bool = true;
+override USE_SURFACES: bool = true;
+override USE_AREA: bool = true;
+override USE_TONE_FAITHFUL: bool = true;
+override USE_TONE_FILMIC: bool = true;
+
 // Mirrors hadou_scene::CameraBasis::wave_ray: the ray and span of one pixel for one falloff.
 // `surface < 0` means nothing was drawn (None).
 fn wave_ray(falloff: u32, dir: vec3<f32>, surface: f32, span: ptr<function, vec2<f32>>) -> Ray {
@@ -41,32 +58,42 @@ fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
     var span = vec2<f32>(0.0, 0.0);
     let ray = wave_ray(w.falloff, dir, surface, &span);
     let p = FieldParams(w.falloff, w.core_radius);
+    // Each kind's case is compiled in only when its USE_* is set (the variant has the frame's kinds).
     switch w.kind {
         case WAVE_SPHERE: {
-            return sphere_energy(p, ray, span.x, span.y, w.p0.xyz, w.p0.w);
+            if (USE_SPHERE) {
+                return sphere_energy(p, ray, span.x, span.y, w.p0.xyz, w.p0.w);
+            }
         }
         case WAVE_CYLINDER: {
-            return cylinder_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p0.w);
+            if (USE_CYLINDER) {
+                return cylinder_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p0.w);
+            }
         }
         case WAVE_CAPSULE: {
-            return capsule_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
+            if (USE_CAPSULE) {
+                return capsule_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
+            }
         }
         case WAVE_BEAM: {
-            return beam_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
+            if (USE_BEAM) {
+                return beam_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
+            }
         }
         case WAVE_CURVE: {
-            // t_far of hadou_scene::WaveRay: 1 (faithful, t ∈ [0, 1] to the far point) or the
-            // far point's distance (inverse square, unit direction).
-            var t_far = 1.0;
-            if (w.falloff != FALLOFF_FAITHFUL) {
-                t_far = frame.far * length3(dir);
+            if (USE_CURVE) {
+                // t_far of hadou_scene::WaveRay: 1 (faithful, t ∈ [0, 1] to the far point) or the
+                // far point's distance (inverse square, unit direction).
+                var t_far = 1.0;
+                if (w.falloff != FALLOFF_FAITHFUL) {
+                    t_far = frame.far * length3(dir);
+                }
+                return curve_energy(curves[u32(w.p0.x)], w.falloff, w.core_radius, ray, span.x, span.y, t_far);
             }
-            return curve_energy(curves[u32(w.p0.x)], w.falloff, w.core_radius, ray, span.x, span.y, t_far);
         }
-        default: {
-            return 0.0;
-        }
+        default: {}
     }
+    return 0.0;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -84,7 +111,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     var surface = -1.0;
     var scene = frame.background;
     let dir = pixel_dir(frame, px, py);
-    if (drawn) {
+    if (USE_SURFACES && drawn) {
         surface = texel.w;
         let attributes = textureLoad(attribute_texels, vec2<i32>(id.xy), 0);
         let m = materials[attributes.w & ~HULL_BIT];
@@ -95,7 +122,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
             let uv = vec2<f32>(bitcast<f32>(attributes.x), bitcast<f32>(attributes.y));
             scene = shade_surface(m, world, texel.xyz, uv, unpack4x8unorm(attributes.z));
             scene = apply_shadows(scene, m.shadow_mask, world, id.xy);
-            if (frame.area != 0u) {
+            if (USE_AREA && frame.area != 0u) {
                 // As hadou-cpu's opaque_pass: c + visibility · area term, saturated, after the hard
                 // shadows. soft.wgsl's cs_gather left the visibility in the eye-distance slot.
                 let v = out_buf[5u * n + i];
@@ -121,12 +148,14 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let rgb_in = scene + lit;
     var rgb = vec3<f32>(0.0);
     if (frame.tone_mode == TONE_FAITHFUL) {
-        rgb = map_faithful(rgb_in);
-    } else {
+        if (USE_TONE_FAITHFUL) {
+            rgb = map_faithful(rgb_in);
+        }
+    } else if (USE_TONE_FILMIC) {
         rgb = map_filmic(rgb_in);
     }
     var depth = frame.far * length3(dir);
-    if (drawn) {
+    if (USE_SURFACES && drawn) {
         depth = surface;
     }
     out_buf[4u * i] = rgb.x;
