@@ -3,18 +3,33 @@
 //! (`CpuBackend::render_into`, reusing its buffers) over nine runs.
 use hadou_scene::Scene;
 
+/// Prints `msg` and exits with status 2 (bad arguments).
+fn usage(msg: &str) -> ! {
+    eprintln!("parts: {msg}\nusage: parts SCENE [SIZE in 1..=16384] [TIME ≥ 0]");
+    std::process::exit(2);
+}
+
 fn main() {
     let mut args = std::env::args().skip(1);
-    let Some(path) = args.next() else {
-        eprintln!("usage: parts SCENE [SIZE] [TIME]");
-        std::process::exit(2);
-    };
+    let Some(path) = args.next() else { usage("missing SCENE") };
     let scene = Scene::load(&path).unwrap_or_else(|e| {
         eprintln!("{e}");
         std::process::exit(2)
     });
-    let size: u32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(1024);
-    let t: f32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(0.0);
+    let size = match args.next() {
+        None => 1024,
+        Some(a) => match a.parse::<u32>() {
+            Ok(s) if (1..=16384).contains(&s) => s,
+            _ => usage(&format!("SIZE {a}: expected a whole number of pixels in 1..=16384")),
+        },
+    };
+    let t = match args.next() {
+        None => 0.0,
+        Some(a) => match a.parse::<f32>() {
+            Ok(t) if t.is_finite() && t >= 0.0 => t,
+            _ => usage(&format!("TIME {a}: expected a finite number of seconds ≥ 0")),
+        },
+    };
     let mut frame = scene.at(t);
     (frame.width, frame.height) = (size, size);
     let mut cpu = hadou_cpu::CpuBackend::new();

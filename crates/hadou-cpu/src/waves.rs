@@ -39,7 +39,6 @@ pub(crate) struct WavePass<'a> {
     curves: &'a [Option<PreparedCurve>],
     faithful: bool,
     inverse_square: bool,
-    any_curve: bool,
     colors: Vec<[Lanes; 3]>,
 }
 
@@ -82,7 +81,6 @@ impl<'a> WavePass<'a> {
             curves,
             faithful: uses(Falloff::Faithful),
             inverse_square: uses(Falloff::InverseSquare),
-            any_curve: frame.waves.iter().any(|w| matches!(w.shape, WaveShape::Curve(_))),
             colors,
         }
     }
@@ -176,7 +174,6 @@ impl<'a> WavePass<'a> {
         rays: &PixelRays,
         valid: usize,
     ) -> (Lanes, [u32; LANES]) {
-        debug_assert!(self.any_curve);
         let owned;
         let prep = match &self.curves[wi] {
             Some(p) => p,

@@ -50,7 +50,8 @@ pub fn map_filmic(c: [f32; 3]) -> [f32; 3] {
 /// cancellation for small `x`); above, `e^{−x} = 2^{n}·2^{f}` with `n = round(−x·log₂e)`, `|f| ≤ ½`
 /// and a degree-7 polynomial for `2^f` (relative error under `10⁻⁸`). The GPU's
 /// `one_minus_exp_neg` uses its own `exp`; the two agree far inside the backends' colour
-/// tolerance.
+/// tolerance. Mirrored per lane by [`one_minus_exp_neg_lanes`] (keep in sync: the test
+/// `lane_mappings_equal_the_scalar_ones` holds them equal).
 #[inline(always)]
 fn one_minus_exp_neg(x: f32) -> f32 {
     // Taylor: x − x²/2 + x³/6 − … − x⁸/40320, as Horner in x.

@@ -91,6 +91,8 @@ impl Camera {
 impl CameraBasis {
     /// Direction through the centre of pixel `(px, py)` (`py = 0` is the top row), scaled so its
     /// component along `forward` is exactly 1: the point at view depth `z` is `eye + z·dir`.
+    /// `hadou-cpu`'s wave pass builds the same directions eight at a time with the same
+    /// operations (`waves::WavePass::rays`; keep in sync).
     #[inline]
     pub fn pixel_dir(&self, px: f32, py: f32, width: u32, height: u32) -> Vec3f {
         let ndc_x = 2.0 * (px + 0.5) / width as f32 - 1.0;
@@ -110,7 +112,8 @@ impl CameraBasis {
     /// - [`Falloff::InverseSquare`]: `dir` unit, `t ∈ [0, d]` (or `[0, ∞)` with nothing drawn),
     ///   `t_far = |E − S|` (used only by attenuation).
     ///
-    /// Both backends build their rays with exactly this construction.
+    /// Both backends build their rays with exactly this construction (`hadou-cpu`'s
+    /// `waves::WavePass::rays` lane for lane; keep in sync).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     pub fn wave_ray(

@@ -234,8 +234,7 @@ pub fn median_ms(
         render(frame)?;
         v.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    v.sort_by(|a, b| a.total_cmp(b));
-    Ok(v[v.len() / 2])
+    Ok(median(v))
 }
 
 impl Table {

@@ -112,6 +112,8 @@ impl<R: Real> RayQuadratic<R> {
     /// `N₁ = R₁ − Y₁` (or `H/(R₁ + Y₁)` for `Y₁ > 0`). As `s → 0` the value tends to
     /// `Δt/sqrt(Y² + H)` without dividing by `s`. Ends are clamped to `±T_LIMIT`; empty or NaN
     /// intervals give 0.
+    ///
+    /// Mirrored eight rays at a time by `lanes::Quad::faithful` (keep in sync).
     #[inline(always)]
     pub fn faithful(&self, t0: R, t1: R) -> R {
         let nonempty = t1 > t0; // false for NaN ends too
@@ -164,6 +166,8 @@ impl<R: Real> RayQuadratic<R> {
     /// insensitive to it). When the angle is below `ε` the value is `Δt/(H + Y₀Y₁)`, the `s → 0`
     /// limit, with no division by `s`. `t1 ≥ T_LIMIT` means `+∞` (angle `atan2(√H, Y₀)`),
     /// `t0 ≤ −T_LIMIT` means `−∞`.
+    ///
+    /// Mirrored eight rays at a time by `lanes::Quad::inverse_square` (keep in sync).
     #[inline(always)]
     pub fn inverse_square(&self, t0: R, t1: R) -> R {
         let nonempty = t1 > t0; // false for NaN ends too

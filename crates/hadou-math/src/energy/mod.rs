@@ -186,6 +186,8 @@ struct CapsuleParts<R> {
     energy: R,
 }
 
+/// The capsule's split and pieces (002 eq. 3.10–3.11); mirrored eight rays at a time by
+/// `lanes::capsule_parts` (keep in sync).
 #[inline(always)]
 fn capsule_parts<R: Real>(
     p: &FieldParams<R>,
