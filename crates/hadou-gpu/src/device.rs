@@ -1,9 +1,16 @@
 //! Adapter and device set-up, and the failure story: every wgpu error is captured (error scopes
 //! plus an uncaptured-error handler that records instead of panicking), device loss is recorded
 //! by a callback, and every wait on the GPU has a timeout. All of it ends in a [`RenderError`].
+//!
+//! On the web (`wasm32`) nothing here blocks: there is no adapter search or device request of our
+//! own (the page opens the device and hands it to [`GpuContext::from_device`]), no waits, and no
+//! error scopes — their results arrive only after the browser's GPU process answers, so errors
+//! go to the uncaptured-error handler instead and [`GpuContext::check`] reports them on the next
+//! frame.
 
 use hadou_scene::RenderError;
 use std::sync::{Arc, Mutex};
+#[cfg(not(target_arch = "wasm32"))]
 use std::time::Duration;
 
 /// Serialises the GPU work of this crate's unit tests: Mesa 22's lavapipe crashed (SIGSEGV) with
@@ -31,6 +38,7 @@ pub(crate) fn context_or_skip(test: &str) -> Option<(GpuContext, std::sync::Mute
 }
 
 /// How long one wait for submitted work may take before the device is declared hung.
+#[cfg(not(target_arch = "wasm32"))]
 pub(crate) const WAIT_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// Errors the device reported outside any error scope, and the reason it was lost, if it was.
@@ -40,10 +48,13 @@ struct Reports {
     lost: Option<String>,
 }
 
-/// Error scopes pushed by [`GpuContext::open_scopes`].
+/// Error scopes pushed by [`GpuContext::open_scopes`] (none on the web, see the module docs).
 pub(crate) struct ErrorScopes {
+    #[cfg(not(target_arch = "wasm32"))]
     oom: wgpu::ErrorScopeGuard,
+    #[cfg(not(target_arch = "wasm32"))]
     internal: wgpu::ErrorScopeGuard,
+    #[cfg(not(target_arch = "wasm32"))]
     validation: wgpu::ErrorScopeGuard,
 }
 
@@ -57,10 +68,12 @@ pub(crate) struct GpuContext {
     reports: Arc<Mutex<Reports>>,
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 impl Drop for GpuContext {
     /// Waits (up to [`WAIT_TIMEOUT`]) for every submission before the queue goes: wgpu's own
     /// wait when a queue is dropped gives up after about 6 s and panics, and a software adapter
-    /// compiling a large shader on a busy machine can take longer than that.
+    /// compiling a large shader on a busy machine can take longer than that. (Not on the web,
+    /// where nothing may block and the browser keeps the work alive.)
     fn drop(&mut self) {
         let _ =
             self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(WAIT_TIMEOUT) });
@@ -74,7 +87,8 @@ fn lock(reports: &Mutex<Reports>) -> std::sync::MutexGuard<'_, Reports> {
 
 /// The best adapter: the primary backends (Vulkan, Metal, DX12) first, OpenGL only if none of
 /// those has one. `WGPU_BACKEND` (e.g. `gl`, `vulkan`) overrides the choice.
-fn request_adapter() -> Result<wgpu::Adapter, String> {
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) fn request_adapter() -> Result<wgpu::Adapter, String> {
     let options = wgpu::RequestAdapterOptions {
         power_preference: wgpu::PowerPreference::HighPerformance,
         force_fallback_adapter: false,
@@ -123,11 +137,46 @@ const NEEDED_COMPUTE_TEXTURES: u32 = 4;
 /// Invocations per workgroup the kernels use (8×8 wave pass, 64×1 twin-test kernels).
 const NEEDED_WORKGROUP_INVOCATIONS: u32 = 64;
 
+/// The optional features hadou uses when `adapter` has them (timestamp queries, for
+/// [`crate::GpuBackend::time_frame`]); it requires none.
+pub(crate) fn required_features(adapter: &wgpu::Adapter) -> wgpu::Features {
+    adapter.features() & wgpu::Features::TIMESTAMP_QUERY
+}
+
+/// The limits hadou asks for: everything `adapter` offers (tiles, shadow maps and the soft
+/// shadows' whole-image buffers grow with the limits).
+pub(crate) fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+    adapter.limits()
+}
+
+/// The descriptor [`GpuContext::new`] opens its device with.
+pub(crate) fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    wgpu::DeviceDescriptor {
+        label: Some("hadou-gpu"),
+        required_features: required_features(adapter),
+        required_limits: required_limits(adapter),
+        experimental_features: wgpu::ExperimentalFeatures::disabled(),
+        memory_hints: wgpu::MemoryHints::MemoryUsage,
+        trace: wgpu::Trace::Off,
+    }
+}
+
 /// Checks, before a device is opened, that `adapter` can run hadou: the downlevel capabilities,
 /// the limits and the texture formats the passes use. Every shortfall is listed in one
 /// [`RenderError::NoDevice`] starting "unsupported adapter", so callers and tests treat it like a
 /// missing adapter (a skip, or a failure under `HADOU_REQUIRE_GPU=1`).
-fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<(), RenderError> {
+pub(crate) fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<(), RenderError> {
+    check_capabilities(adapter, info, &adapter.limits(), "adapter")
+}
+
+/// [`check_adapter`] with the limits of a device already opened on `adapter` (`what`:
+/// "adapter" or "device", for the message).
+fn check_capabilities(
+    adapter: &wgpu::Adapter,
+    info: &wgpu::AdapterInfo,
+    limits: &wgpu::Limits,
+    what: &str,
+) -> Result<(), RenderError> {
     let mut missing: Vec<String> = Vec::new();
     let downlevel = adapter.get_downlevel_capabilities();
     for (flag, what) in NEEDED_DOWNLEVEL {
@@ -135,7 +184,6 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
             missing.push(what.into());
         }
     }
-    let limits = adapter.limits();
     if limits.max_storage_buffers_per_shader_stage < NEEDED_COMPUTE_STORAGE_BUFFERS {
         missing.push(format!(
             "{NEEDED_COMPUTE_STORAGE_BUFFERS} storage buffers per shader stage (it allows {})",
@@ -177,6 +225,7 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
         (crate::pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
         (crate::pipelines::PLANE_SHADOW_FORMAT, attach_and_read),
         (crate::pipelines::MAP_FORMAT, attach_and_read),
+        (crate::present::PRESENT_FORMAT, crate::present::PRESENT_USAGE),
     ];
     for (format, usages) in formats {
         if !adapter.get_texture_format_features(format).allowed_usages.contains(usages) {
@@ -187,7 +236,7 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
         return Ok(());
     }
     Err(RenderError::NoDevice(format!(
-        "unsupported adapter `{}` ({:?}, driver {} {}): it lacks {}",
+        "unsupported {what} `{}` ({:?}, driver {} {}): it lacks {}",
         info.name,
         info.backend,
         info.driver,
@@ -198,6 +247,7 @@ fn check_adapter(adapter: &wgpu::Adapter, info: &wgpu::AdapterInfo) -> Result<()
 
 /// The adapter [`GpuContext::new`] would open, without opening a device or compiling anything:
 /// what `--backend auto` asks before deciding.
+#[cfg(not(target_arch = "wasm32"))]
 pub(crate) fn adapter_info() -> Result<wgpu::AdapterInfo, RenderError> {
     let adapter =
         request_adapter().map_err(|e| RenderError::NoDevice(format!("no GPU adapter found ({e})")))?;
@@ -206,8 +256,23 @@ pub(crate) fn adapter_info() -> Result<wgpu::AdapterInfo, RenderError> {
     Ok(info)
 }
 
+/// The first error of a popped error scope. wgpu-core (every native backend) pops synchronously,
+/// so the future is ready at once and this never waits; the blocking fallback is only for a
+/// future that is not.
+#[cfg(not(target_arch = "wasm32"))]
+fn pop_now(scope: wgpu::ErrorScopeGuard) -> Option<wgpu::Error> {
+    use std::future::Future;
+    let mut future = std::pin::pin!(scope.pop());
+    let mut cx = std::task::Context::from_waker(std::task::Waker::noop());
+    match future.as_mut().poll(&mut cx) {
+        std::task::Poll::Ready(error) => error,
+        std::task::Poll::Pending => pollster::block_on(future),
+    }
+}
+
 impl GpuContext {
     /// Opens the best adapter wgpu finds (no surface; `WGPU_BACKEND` and friends are honoured).
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn new() -> Result<Self, RenderError> {
         let adapter = request_adapter().map_err(|e| {
             RenderError::NoDevice(format!(
@@ -217,20 +282,27 @@ impl GpuContext {
         })?;
         let info = adapter.get_info();
         check_adapter(&adapter, &info)?;
-        let adapter_features = adapter.features();
-        // Timestamps are optional: used by `time_frame` when present.
-        let features = adapter_features & wgpu::Features::TIMESTAMP_QUERY;
-        let limits = adapter.limits();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("hadou-gpu"),
-            required_features: features,
-            required_limits: limits.clone(),
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::MemoryUsage,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| RenderError::NoDevice(format!("adapter `{}` refused a device: {e}", info.name)))?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&device_descriptor(&adapter)))
+            .map_err(|e| RenderError::NoDevice(format!("adapter `{}` refused a device: {e}", info.name)))?;
+        Ok(Self::with_device(device, queue, info))
+    }
 
+    /// A context on a device someone else opened on `adapter` (a window's, compatible with its
+    /// surface): checks the adapter and the device's limits as [`GpuContext::new`] does, and
+    /// installs the error and device-loss handlers (replacing any the device had). Never blocks.
+    pub(crate) fn from_device(
+        adapter: &wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Result<Self, RenderError> {
+        let info = adapter.get_info();
+        check_capabilities(adapter, &info, &device.limits(), "device")?;
+        Ok(Self::with_device(device, queue, info))
+    }
+
+    fn with_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        // What the device was granted, which for one opened elsewhere may be less than the adapter's.
+        let (limits, features) = (device.limits(), device.features());
         let reports = Arc::new(Mutex::new(Reports::default()));
         let r = reports.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| lock(&r).uncaptured.push(e.to_string())));
@@ -238,7 +310,7 @@ impl GpuContext {
         device.set_device_lost_callback(move |reason, message| {
             lock(&r).lost = Some(format!("{reason:?}: {message}"));
         });
-        Ok(Self { device, queue, info, limits, features, reports })
+        Self { device, queue, info, limits, features, reports }
     }
 
     /// `Err` if the device was lost or reported an error nobody caught.
@@ -256,6 +328,7 @@ impl GpuContext {
 
     /// Opens out-of-memory, internal and validation error scopes; close them with
     /// [`GpuContext::close_scopes`] on the same thread.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn open_scopes(&self) -> ErrorScopes {
         ErrorScopes {
             oom: self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory),
@@ -264,13 +337,38 @@ impl GpuContext {
         }
     }
 
+    /// On the web: no scopes (see the module docs).
+    #[cfg(target_arch = "wasm32")]
+    pub(crate) fn open_scopes(&self) -> ErrorScopes {
+        ErrorScopes {}
+    }
+
     /// Closes scopes from [`GpuContext::open_scopes`]; any error they caught becomes a
     /// [`RenderError`] (`what` says what was being done).
+    /// Never blocks (see [`pop_now`]); on the web there are no scopes and this is
+    /// [`GpuContext::check`].
     pub(crate) fn close_scopes(&self, scopes: ErrorScopes, what: &str) -> Result<(), RenderError> {
-        // Pop in reverse order of pushing.
-        let validation = pollster::block_on(scopes.validation.pop());
-        let internal = pollster::block_on(scopes.internal.pop());
-        let oom = pollster::block_on(scopes.oom.pop());
+        #[cfg(target_arch = "wasm32")]
+        let _ = (scopes, what);
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            // Pop in reverse order of pushing.
+            let validation = pop_now(scopes.validation);
+            let internal = pop_now(scopes.internal);
+            let oom = pop_now(scopes.oom);
+            Self::scope_errors(oom, internal, validation, what)?;
+        }
+        self.check()
+    }
+
+    /// The first of the errors the scopes caught, as a [`RenderError`].
+    #[cfg(not(target_arch = "wasm32"))]
+    fn scope_errors(
+        oom: Option<wgpu::Error>,
+        internal: Option<wgpu::Error>,
+        validation: Option<wgpu::Error>,
+        what: &str,
+    ) -> Result<(), RenderError> {
         if let Some(e) = oom {
             return Err(RenderError::Device(format!("out of GPU memory while {what}: {e}")));
         }
@@ -280,7 +378,7 @@ impl GpuContext {
         if let Some(e) = validation {
             return Err(RenderError::Other(format!("GPU rejected the work while {what}: {e}")));
         }
-        self.check()
+        Ok(())
     }
 
     /// Runs `f` inside [`GpuContext::open_scopes`] / [`GpuContext::close_scopes`].
@@ -292,6 +390,7 @@ impl GpuContext {
     }
 
     /// Waits (with [`WAIT_TIMEOUT`]) until `submission` has finished on the GPU.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn wait(&self, submission: wgpu::SubmissionIndex) -> Result<(), RenderError> {
         self.device
             .poll(wgpu::PollType::Wait { submission_index: Some(submission), timeout: Some(WAIT_TIMEOUT) })
@@ -303,6 +402,7 @@ impl GpuContext {
 
     /// Maps `buffer` for reading after `submission`, waiting with a timeout, and hands its bytes
     /// to `read`; unmaps afterwards.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn read_buffer<T>(
         &self,
         buffer: &wgpu::Buffer,

@@ -38,24 +38,49 @@
 //! Failures never panic: no adapter is [`RenderError::NoDevice`]; a lost device, out-of-memory or
 //! a GPU that does not answer within a timeout is [`RenderError::Device`]; a shader that fails to
 //! compile is [`RenderError::Other`] naming the shader.
+//!
+//! ## In a window
+//!
+//! A window (e.g. egui with egui-wgpu) opens its device on a surface-compatible adapter, asking for
+//! what [`device_descriptor`] gives (the same as [`GpuBackend::new`] asks), and hands it to
+//! [`GpuBackend::from_device`]. [`GpuBackend::render_to_texture`] then draws each frame straight
+//! into one full-frame [`PRESENT_FORMAT`] texture on the GPU (a present pass per tile,
+//! `shaders/present.wgsl`), with no read-back and no wait: the window samples the texture in its
+//! own pass on the same queue. The bytes equal `hadou_math::shade::linear_to_srgb8` of
+//! [`Backend::render`]'s colour within one code (`tests/present.rs`).
+//!
+//! ## On the web (`wasm32`)
+//!
+//! The crate builds for `wasm32-unknown-unknown` on wgpu's WebGPU backend (WebGL2 lacks compute
+//! shaders). A browser may not block, so only the non-blocking path is compiled there:
+//! [`GpuBackend::from_device`] (the page requests the adapter and device asynchronously itself,
+//! with [`device_descriptor`]), [`GpuBackend::render_to_texture`] and the accessors. Everything
+//! that waits for the GPU — [`GpuBackend::new`], [`find_adapter`], the [`Backend`] impl (it reads
+//! the image back), `render_soft` and [`GpuBackend::time_frame`] — exists only off the web. There,
+//! wgpu error scopes are not used (their results arrive asynchronously): errors reach the
+//! device's uncaptured-error handler and are returned by the next frame's call.
 
 #[cfg(test)]
 mod curve_twins;
 mod device;
 pub mod layout;
 mod pipelines;
+mod present;
 mod render;
 pub mod shaders;
 mod timing;
 #[cfg(test)]
 mod twins;
 
+pub use present::{PresentedFrame, PRESENT_FORMAT, PRESENT_USAGE};
 pub use render::{MAX_TILE, SOFT_BYTES_PER_PIXEL};
 pub use timing::{FrameTiming, PassTime, TimingMethod};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
 
-use hadou_scene::{Backend, Frame, Image, RenderError};
+#[cfg(not(target_arch = "wasm32"))]
+use hadou_scene::{Backend, Image};
+use hadou_scene::{Frame, RenderError};
 
 /// The wgpu backend. Create once and reuse: meshes stay uploaded between frames (cached by the
 /// address of their `Arc`), and tile resources are reused while the tile size stays the same.
@@ -65,16 +90,86 @@ pub struct GpuBackend {
 
 /// The adapter [`GpuBackend::new`] would use, found without opening a device or compiling shaders
 /// (cheap: what `--backend auto` asks before deciding). [`RenderError::NoDevice`] when there is
-/// none or it cannot run hadou ("unsupported adapter …").
+/// none or it cannot run hadou ("unsupported adapter …"). Not on the web.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn find_adapter() -> Result<wgpu::AdapterInfo, RenderError> {
     device::adapter_info()
 }
 
+/// Whether `adapter` can run hadou (the downlevel capabilities, limits and texture formats the
+/// passes use); check it before opening a device for [`GpuBackend::from_device`]. Every
+/// shortfall is listed in one [`RenderError::NoDevice`] starting "unsupported adapter".
+pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), RenderError> {
+    device::check_adapter(adapter, &adapter.get_info())
+}
+
+/// The optional features hadou uses when `adapter` has them: only
+/// [`wgpu::Features::TIMESTAMP_QUERY`] (for [`GpuBackend::time_frame`]'s per-pass times); none is
+/// required. Part of [`device_descriptor`].
+pub fn required_features(adapter: &wgpu::Adapter) -> wgpu::Features {
+    device::required_features(adapter)
+}
+
+/// The limits hadou asks for: all that `adapter` offers (`adapter.limits()`); the tile size, the
+/// shadow maps and the soft shadows' whole-image buffers follow the device's limits. Part of
+/// [`device_descriptor`].
+pub fn required_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+    device::required_limits(adapter)
+}
+
+/// What a device for [`GpuBackend::from_device`] should be requested with: the descriptor
+/// [`GpuBackend::new`] uses ([`required_features`], [`required_limits`], label `"hadou-gpu"`).
+/// A window may add the features it needs itself before requesting.
+pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+    device::device_descriptor(adapter)
+}
+
 impl GpuBackend {
     /// Opens the best GPU adapter wgpu finds (honouring `WGPU_BACKEND`, `WGPU_ADAPTER_NAME`) and
-    /// compiles the shaders. [`RenderError::NoDevice`] when there is no adapter.
+    /// compiles the shaders. [`RenderError::NoDevice`] when there is no adapter. Not on the web
+    /// (it blocks on the adapter and device requests): use [`GpuBackend::from_device`] there.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new() -> Result<GpuBackend, RenderError> {
         Ok(Self { renderer: render::Renderer::new()? })
+    }
+
+    /// Builds the backend on a device someone else opened on `adapter` — a window's, on an
+    /// adapter compatible with its surface, requested with [`device_descriptor`] — and compiles
+    /// the shaders. Checks the adapter and the device's granted limits ([`RenderError::NoDevice`]
+    /// "unsupported …" naming what is missing). Never blocks, so it is the constructor on the web.
+    ///
+    /// The backend installs its own uncaptured-error handler and device-lost callback on
+    /// `device` (replacing any set before), so that errors become this backend's
+    /// [`RenderError`]s; `device` and `queue` are shared handles, and the caller keeps using its
+    /// clones for its own drawing.
+    pub fn from_device(
+        adapter: &wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Result<GpuBackend, RenderError> {
+        let ctx = device::GpuContext::from_device(adapter, device, queue)?;
+        Ok(Self { renderer: render::Renderer::from_context(ctx)? })
+    }
+
+    /// Renders the whole of `frame` (every tile) into one `frame.width × frame.height` texture of
+    /// [`PRESENT_FORMAT`] (`Rgba8UnormSrgb`, usages [`PRESENT_USAGE`]) on the GPU, for a window to
+    /// draw: no read-back, no wait — the work is submitted and the texture returned. Its bytes
+    /// are `hadou_math::shade::linear_to_srgb8` of the colour [`Backend::render`] gives (within one
+    /// code), alpha as stored (1). The texture is kept and drawn over while the frame size holds,
+    /// and made anew when it changes ([`PresentedFrame::recreated`]). Errors as for `render`; on
+    /// the web an error from the GPU surfaces on the next call.
+    pub fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
+        self.renderer.render_to_texture(frame)
+    }
+
+    /// The device this backend draws with.
+    pub fn device(&self) -> &wgpu::Device {
+        &self.renderer.ctx.device
+    }
+
+    /// The queue this backend submits to.
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.renderer.ctx.queue
     }
 
     /// The adapter's name (e.g. `"llvmpipe (LLVM 15.0.6, 256 bits)"`).
@@ -102,6 +197,7 @@ impl GpuBackend {
     /// tests compare with hadou-cpu's `soft::classify` and `soft::visibility`. `None` without an
     /// area light.
     #[doc(hidden)]
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn render_soft(
         &mut self,
         frame: &Frame,
@@ -127,12 +223,15 @@ impl GpuBackend {
 
     /// Measures the GPU time of drawing `frame` (its shadow maps, then every pass of every tile,
     /// no read-back), `iterations` times after one untimed warm-up; see [`FrameTiming`], whose
-    /// `passes` split the time by pass when the adapter has timestamp queries.
+    /// `passes` split the time by pass when the adapter has timestamp queries. Not on the web.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn time_frame(&mut self, frame: &Frame, iterations: u32) -> Result<FrameTiming, RenderError> {
         timing::time_frame(&mut self.renderer, frame, iterations)
     }
 }
 
+/// Reads every tile back to the CPU: not on the web.
+#[cfg(not(target_arch = "wasm32"))]
 impl Backend for GpuBackend {
     fn name(&self) -> &str {
         "gpu"

@@ -1,6 +1,7 @@
 //! Rendering a [`Frame`]: mesh upload (cached per mesh `Arc`), per-frame object and wave buffers,
-//! and the tile loop — each tile is rasterized, integrated and read back on its own, so GPU memory
-//! is bounded by the tile size whatever the image size.
+//! and the tile loop — each tile is rasterized, integrated and read back on its own (or, in
+//! `present.rs`, drawn into a window texture), so GPU memory is bounded by the tile size whatever
+//! the image size.
 
 use crate::device::GpuContext;
 use crate::layout::{
@@ -10,7 +11,9 @@ use crate::layout::{
 use crate::pipelines::{self, Pipelines, WaveVariant};
 use crate::timing::PassQueries;
 use bytemuck::Zeroable;
-use hadou_scene::{Frame, Image, LightLine, Mesh, RenderError, SoftResolve, MAX_SHADOWS};
+#[cfg(not(target_arch = "wasm32"))]
+use hadou_scene::Image;
+use hadou_scene::{Frame, LightLine, Mesh, RenderError, SoftResolve, MAX_SHADOWS};
 use std::collections::HashMap;
 use std::sync::{Arc, Weak};
 use wgpu::util::DeviceExt;
@@ -40,8 +43,10 @@ pub(crate) struct TileTargets {
     depth_view: wgpu::TextureView,
     /// The plane-shadow pass's target (`pipelines::PLANE_SHADOW_FORMAT`).
     plane_shadow_view: wgpu::TextureView,
-    uniforms: wgpu::Buffer,
-    output: wgpu::Buffer,
+    /// The tile's `FrameUniforms` (rewritten before each tile's submission).
+    pub(crate) uniforms: wgpu::Buffer,
+    /// The wave pass's output (see wave.wgsl binding 4), read by the present pass.
+    pub(crate) output: wgpu::Buffer,
     staging: wgpu::Buffer,
 }
 
@@ -97,6 +102,7 @@ struct TileBindGroups {
 
 impl Prepared {
     /// The number of shadow-map passes (map casts) of the frame.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn map_pass_count(&self) -> u32 {
         self.map_passes.len() as u32
     }
@@ -136,13 +142,16 @@ pub(crate) struct Renderer {
     pub(crate) ctx: GpuContext,
     pipelines: Pipelines,
     meshes: HashMap<usize, CachedMesh>,
-    targets: Option<TileTargets>,
+    pub(crate) targets: Option<TileTargets>,
     maps: Option<ShadowMaps>,
     /// The `[area_light]`'s resources, kept while the image and map sizes hold.
     soft: Option<SoftTargets>,
+    /// The present pass and its window texture, made on the first `render_to_texture`.
+    pub(crate) present: Option<crate::present::Present>,
 }
 
 /// Every pixel's soft-shadow class (`hadou_math::soft::Class as u8`) and visibility, row-major.
+#[cfg(not(target_arch = "wasm32"))]
 pub type SoftReadback = (Vec<u8>, Vec<f32>);
 
 /// Bytes per pixel of the whole-image soft-shadow buffers: the visible point and class (16), the
@@ -319,6 +328,7 @@ fn check_maps(limits: &wgpu::Limits, frame: &Frame, shadows: &FrameShadows) -> R
 }
 
 /// Allocates the host image, reporting (not aborting on) a failed allocation.
+#[cfg(not(target_arch = "wasm32"))]
 fn alloc_image(width: u32, height: u32) -> Result<Image, RenderError> {
     let n = width as usize * height as usize;
     let oom = |_| RenderError::Device(format!("out of host memory for a {width}×{height} image"));
@@ -353,10 +363,23 @@ fn tile_size(limits: &wgpu::Limits, width: u32, height: u32) -> Result<[u32; 2],
 
 impl Renderer {
     /// Opens the device and compiles the pipelines.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn new() -> Result<Self, RenderError> {
-        let ctx = GpuContext::new()?;
+        Self::from_context(GpuContext::new()?)
+    }
+
+    /// Compiles the pipelines on an open device.
+    pub(crate) fn from_context(ctx: GpuContext) -> Result<Self, RenderError> {
         let pipelines = Pipelines::new(&ctx)?;
-        Ok(Self { ctx, pipelines, meshes: HashMap::new(), targets: None, maps: None, soft: None })
+        Ok(Self {
+            ctx,
+            pipelines,
+            meshes: HashMap::new(),
+            targets: None,
+            maps: None,
+            soft: None,
+            present: None,
+        })
     }
 
     /// See [`crate::GpuBackend::set_specialise`].
@@ -896,6 +919,7 @@ impl Renderer {
 
     /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
     /// class (`hadou_math::soft::Class` as `u8`) and visibility, read back (for tests).
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn read_soft(&self, frame: &Frame) -> Result<Option<SoftReadback>, RenderError> {
         let Some(soft) = self.soft.as_ref().filter(|_| frame.area_light.is_some()) else { return Ok(None) };
         let pixels = frame.width as u64 * frame.height as u64;
@@ -1017,6 +1041,7 @@ impl Renderer {
 
     /// Encodes and submits every tile of `prepared` (no read-back), one submission per tile;
     /// the last submission.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn submit_tiles(
         &self,
         frame: &Frame,
@@ -1249,12 +1274,14 @@ impl Renderer {
     }
 
     /// Renders `frame` into a new [`Image`].
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
         self.render_rows(frame, 0..frame.height)
     }
 
     /// Renders the rows `rows` of `frame` (clamped to the image) into a `frame.width ×
     /// rows.len()` [`Image`]: only the tiles of those rows are drawn.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn render_rows(
         &mut self,
         frame: &Frame,
@@ -1283,7 +1310,6 @@ impl Renderer {
     }
 }
 
-/// Copies one tile's read-back bytes (layout: see the output binding in wave.wgsl) into `image`.
 /// A colour attachment cleared to zero bits and stored.
 fn cleared_color(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
     Some(wgpu::RenderPassColorAttachment {
@@ -1309,6 +1335,8 @@ fn cleared_depth(
     })
 }
 
+/// Copies one tile's read-back bytes (layout: see the output binding in wave.wgsl) into `image`.
+#[cfg(not(target_arch = "wasm32"))]
 fn copy_tile(image: &mut Image, raw: &[u8], origin: [u32; 2], size: [u32; 2]) {
     let n = size[0] as usize * size[1] as usize;
     let floats: Vec<f32>;

@@ -6,7 +6,9 @@
 //!   `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as lights, hard shadows,
 //!   energy integration, colour mapping);
 //! - shadow module: `common.wgsl` + `shadow_raster.wgsl` (the plane-shadow pass and the shadow
-//!   maps).
+//!   maps);
+//! - present module: `common.wgsl` + `present.wgsl` (a tile's colour into the window texture of
+//!   [`crate::GpuBackend::render_to_texture`]).
 //!
 //! A unit test parses and validates every composed module with naga (no adapter needed) and
 //! checks that the struct layouts naga computes equal the Rust ones in [`crate::layout`].
@@ -31,12 +33,15 @@ pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
 pub const SOFT_MAP: &str = include_str!("shaders/soft_map.wgsl");
 /// The soft shadows' classification and penumbra resolve (compute passes).
 pub const SOFT: &str = include_str!("shaders/soft.wgsl");
+/// The present pass: a tile's final colour into the full-frame sRGB texture (render pass).
+pub const PRESENT: &str = include_str!("shaders/present.wgsl");
 
 /// Every `.wgsl` file in `src/shaders/`, by file name.
 pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", COMMON),
     ("curve.wgsl", CURVE),
     ("energy.wgsl", ENERGY),
+    ("present.wgsl", PRESENT),
     ("raster.wgsl", RASTER),
     ("shading.wgsl", SHADING),
     ("shadow_lookup.wgsl", SHADOW_LOOKUP),
@@ -56,6 +61,8 @@ pub const SHADOW_PARTS: &[&str] = &[COMMON, SHADOW_RASTER];
 pub const SOFT_MAP_PARTS: &[&str] = &[COMMON, SOFT_MAP];
 /// The parts of the soft-shadow compute module, in order.
 pub const SOFT_PARTS: &[&str] = &[COMMON, SOFT];
+/// The parts of the present module, in order.
+pub const PRESENT_PARTS: &[&str] = &[COMMON, PRESENT];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -91,6 +98,7 @@ mod tests {
             ("shadow module", validate("shadow module", &compose(SHADOW_PARTS))),
             ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
+            ("present module", validate("present module", &compose(PRESENT_PARTS))),
         ]
     }
 
@@ -109,6 +117,7 @@ mod tests {
             ("soft.wgsl", SOFT),
             ("soft_map.wgsl", SOFT_MAP),
             ("wave.wgsl", WAVE),
+            ("present.wgsl", PRESENT),
         ] {
             for (i, line) in source.lines().enumerate() {
                 let code = line.split("//").next().unwrap_or("");
@@ -133,7 +142,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 5);
+        assert_eq!(modules.len(), 6);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -152,6 +161,7 @@ mod tests {
                 .chain(SHADOW_PARTS)
                 .chain(SOFT_MAP_PARTS)
                 .chain(SOFT_PARTS)
+                .chain(PRESENT_PARTS)
                 .any(|p| std::ptr::eq(*p, *text));
             assert!(used, "{name} is not part of any module");
         }

@@ -1,8 +1,14 @@
 //! GPU frame timing for benchmarks: timestamp queries when the device has them, otherwise the
 //! wall time from submitting a frame's work to its completion. Read-back is never included.
 
+// On the web only the pass queries are used (nothing there waits for the GPU to time it).
+#![cfg_attr(target_arch = "wasm32", allow(dead_code))]
+
+#[cfg(not(target_arch = "wasm32"))]
 use crate::render::Renderer;
+#[cfg(not(target_arch = "wasm32"))]
 use hadou_scene::{Frame, RenderError};
+#[cfg(not(target_arch = "wasm32"))]
 use std::time::Instant;
 
 /// How [`FrameTiming`] was measured.
@@ -172,6 +178,7 @@ impl FrameTiming {
 const PASSES_PER_TILE: u32 = 4;
 
 /// See [`crate::GpuBackend::time_frame`].
+#[cfg(not(target_arch = "wasm32"))]
 pub(crate) fn time_frame(
     r: &mut Renderer,
     frame: &Frame,

@@ -1,0 +1,224 @@
+//! `GpuBackend::render_to_texture` on a device opened the way a window opens it (an adapter of its
+//! own, `hadou_gpu::device_descriptor`, `GpuBackend::from_device`): the texture, copied back here
+//! (test code may wait), holds `linear_to_srgb8` of the colour `Backend::render` gives for the same
+//! frame, every byte within one code (alpha: the stored alpha as an 8-bit unorm), on example
+//! scenes, at two sizes in a row, across more than one tile.
+//!
+//! Skips with a message when there is no usable adapter; fails instead under
+//! `HADOU_REQUIRE_GPU=1`.
+
+use hadou_gpu::{GpuBackend, PRESENT_FORMAT, PRESENT_USAGE};
+use hadou_math::shade::linear_to_srgb8;
+use hadou_scene::{Backend, Frame, Image, RenderError};
+use std::sync::{Mutex, MutexGuard, OnceLock};
+
+/// A backend on a device this test opened, with the test's own handles to that device.
+struct Gpu {
+    backend: GpuBackend,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+}
+
+/// The adapter `GpuBackend::new` would choose: `WGPU_BACKEND`'s backends when set, otherwise the
+/// primary backends (Vulkan, Metal, DX12) and OpenGL only if none of those has one.
+fn adapter() -> Result<wgpu::Adapter, String> {
+    let options = wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: None,
+    };
+    let from_env = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    let tries = if std::env::var_os("WGPU_BACKEND").is_some() {
+        vec![from_env.backends]
+    } else {
+        vec![wgpu::Backends::PRIMARY, wgpu::Backends::SECONDARY]
+    };
+    let mut errors = Vec::new();
+    for backends in tries {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = backends;
+        match pollster::block_on(wgpu::Instance::new(desc).request_adapter(&options)) {
+            Ok(a) => return Ok(a),
+            Err(e) => errors.push(e.to_string()),
+        }
+    }
+    Err(errors.join("; "))
+}
+
+/// Opens a device as a window would and builds the backend on it. `Err(None)` when there is no
+/// usable adapter (a skip), `Err(Some(_))` on any other failure.
+fn open() -> Result<Gpu, Option<String>> {
+    let adapter = adapter().map_err(|e| {
+        eprintln!("no adapter: {e}");
+        None
+    })?;
+    match hadou_gpu::check_adapter(&adapter) {
+        Ok(()) => {}
+        Err(RenderError::NoDevice(m)) => {
+            eprintln!("{m}");
+            return Err(None);
+        }
+        Err(e) => return Err(Some(e.to_string())),
+    }
+    let (device, queue) = pollster::block_on(adapter.request_device(&hadou_gpu::device_descriptor(&adapter)))
+        .map_err(|e| Some(format!("request_device: {e}")))?;
+    let backend =
+        GpuBackend::from_device(&adapter, device.clone(), queue.clone()).map_err(|e| Some(e.to_string()))?;
+    eprintln!("adapter: {:?}", adapter.get_info());
+    Ok(Gpu { backend, device, queue })
+}
+
+/// The one backend of this test binary, shared by its tests in turn (see tests/common), or
+/// `None` when there is no usable adapter.
+fn gpu_or_skip(test: &str) -> Option<MutexGuard<'static, Gpu>> {
+    static SHARED: OnceLock<Result<Mutex<Gpu>, Option<String>>> = OnceLock::new();
+    match SHARED.get_or_init(|| open().map(Mutex::new)) {
+        Ok(gpu) => Some(gpu.lock().unwrap_or_else(|p| p.into_inner())),
+        Err(None) => {
+            if std::env::var("HADOU_REQUIRE_GPU").is_ok_and(|v| v == "1") {
+                panic!("{test}: HADOU_REQUIRE_GPU=1 but no usable GPU adapter");
+            }
+            eprintln!(
+                "SKIPPED {test}: no usable GPU adapter; set HADOU_REQUIRE_GPU=1 to make this a failure"
+            );
+            None
+        }
+        Err(Some(e)) => panic!("{test}: GPU backend failed to start: {e}"),
+    }
+}
+
+/// An example scene at time `t` (a fraction of its duration), `width × height`.
+fn scene_frame(file: &str, t: f32, width: u32, height: u32) -> Frame {
+    let path = format!("{}/../../scenes/{file}", env!("CARGO_MANIFEST_DIR"));
+    let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut frame = scene.at(t * scene.duration());
+    frame.width = width;
+    frame.height = height;
+    frame
+}
+
+/// Renders `frame` into the texture, copies the texture into a buffer and waits for it: the
+/// texture's rows of RGBA bytes, and whether the texture was recreated.
+fn texture_bytes(gpu: &mut Gpu, frame: &Frame) -> (Vec<u8>, bool) {
+    let Gpu { backend, device, queue } = gpu;
+    let presented = backend.render_to_texture(frame).unwrap_or_else(|e| panic!("render_to_texture: {e}"));
+    let [w, h] = presented.size;
+    assert_eq!([w, h], [frame.width, frame.height]);
+    let texture = presented.texture;
+    assert_eq!(texture.format(), PRESENT_FORMAT);
+    assert_eq!(texture.usage(), PRESENT_USAGE);
+    assert_eq!((texture.width(), texture.height()), (w, h));
+    let row = (4 * w).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture read-back"),
+        size: row as u64 * h as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
+    let recreated = presented.recreated;
+    queue.submit([enc.finish()]);
+    buffer.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the read-back buffer"));
+    device
+        .poll(wgpu::PollType::Wait {
+            submission_index: None,
+            timeout: Some(std::time::Duration::from_secs(300)),
+        })
+        .expect("waiting for the GPU");
+    let mapped = buffer.slice(..).get_mapped_range();
+    let mut bytes = Vec::with_capacity(4 * w as usize * h as usize);
+    for y in 0..h as usize {
+        bytes.extend_from_slice(&mapped[y * row as usize..][..4 * w as usize]);
+    }
+    drop(mapped);
+    buffer.unmap();
+    (bytes, recreated)
+}
+
+/// The bytes a read-back image should become: sRGB codes of the colour, alpha as unorm.
+fn expected_bytes(image: &Image) -> Vec<u8> {
+    image
+        .color
+        .iter()
+        .flat_map(|c| [linear_to_srgb8(c[0]), linear_to_srgb8(c[1]), linear_to_srgb8(c[2]), unorm8(c[3])])
+        .collect()
+}
+
+fn unorm8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
+/// Bytes further than one code from the expected ones, with the first as a message.
+fn differences(got: &[u8], want: &[u8], width: u32) -> (usize, usize, Option<String>) {
+    assert_eq!(got.len(), want.len());
+    let (mut bad, mut off_by_one, mut first) = (0, 0, None);
+    for (i, (&g, &w)) in got.iter().zip(want).enumerate() {
+        match g.abs_diff(w) {
+            0 => {}
+            1 => off_by_one += 1,
+            _ => {
+                bad += 1;
+                if first.is_none() {
+                    let px = i / 4;
+                    first = Some(format!(
+                        "pixel ({}, {}) channel {}: texture {g}, expected {w}",
+                        px % width as usize,
+                        px / width as usize,
+                        i % 4
+                    ));
+                }
+            }
+        }
+    }
+    (bad, off_by_one, first)
+}
+
+/// Asserts that the texture of `frame` matches `render(frame)`; returns whether it was recreated.
+fn check(gpu: &mut Gpu, label: &str, frame: &Frame) -> bool {
+    let (got, recreated) = texture_bytes(gpu, frame);
+    let image = gpu.backend.render(frame).unwrap_or_else(|e| panic!("{label}: render: {e}"));
+    let (bad, off_by_one, first) = differences(&got, &expected_bytes(&image), frame.width);
+    eprintln!("{label}: {} bytes, {off_by_one} one code off, {bad} further", got.len());
+    assert_eq!(bad, 0, "{label}: {bad} bytes differ by more than one code; first: {first:?}");
+    recreated
+}
+
+#[test]
+fn texture_holds_the_rendered_image_in_srgb() {
+    let Some(mut gpu) = gpu_or_skip("present: texture = sRGB of render") else { return };
+    for file in ["kamehameha.toml", "shadow-wave-top.toml", "soft-gradient.toml"] {
+        check(&mut gpu, file, &scene_frame(file, 0.5, 128, 96));
+    }
+    // The comparison can fail: another frame's texture against this frame's image.
+    let a = scene_frame("kamehameha.toml", 0.0, 128, 96);
+    let b = scene_frame("kamehameha.toml", 1.0, 128, 96);
+    let (got, _) = texture_bytes(&mut gpu, &b);
+    let image = gpu.backend.render(&a).expect("render");
+    let (bad, _, first) = differences(&got, &expected_bytes(&image), a.width);
+    eprintln!("a different frame: {bad} bytes differ by more than one code; first: {first:?}");
+    assert!(bad > 100, "the texture of another frame should not match: {bad} bytes differ");
+}
+
+#[test]
+fn two_sizes_in_a_row_and_several_tiles() {
+    let Some(mut gpu) = gpu_or_skip("present: sizes") else { return };
+    let small = scene_frame("kamehameha.toml", 0.25, 96, 64);
+    check(&mut gpu, "96×64", &small);
+    assert!(!check(&mut gpu, "96×64 again", &small), "the same size keeps the texture");
+    // Wider than one tile (MAX_TILE = 1024): two tiles side by side, the second 20 pixels wide.
+    let wide = scene_frame("kamehameha.toml", 0.25, hadou_gpu::MAX_TILE + 20, 24);
+    assert!(check(&mut gpu, "1044×24", &wide), "a new size makes a new texture");
+    assert!(check(&mut gpu, "96×64 after 1044×24", &small), "and back");
+}
