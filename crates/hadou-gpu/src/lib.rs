@@ -2,7 +2,8 @@
 //!
 //! hadou's wgpu backend: the real-time path, drawing the same picture as the CPU reference.
 //!
-//! [`GpuBackend`] renders a [`Frame`] headlessly (no window or surface) in two passes per tile:
+//! [`GpuBackend`] renders a [`Frame`] in two passes per tile, headlessly (no window or surface of
+//! its own; see "In a window" below for drawing into one):
 //! 1. **raster** (`shaders/raster.wgsl`): the opaque meshes, depth-tested, shaded with the WGSL
 //!    twin of `hadou_math::shade::diffuse`, writing the scene colour and the Euclidean eye distance
 //!    of the visible surface;
@@ -18,8 +19,9 @@
 //! pixel the most opaque cast), shadow maps drawn once per frame into a depth array texture, and
 //! the lookup in the wave pass (`shaders/shadow_lookup.wgsl`), mirroring `hadou-cpu`'s shadows.
 //!
-//! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next,
-//! so GPU memory stays bounded whatever the image size. A frame with nothing to draw (waves only)
+//! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next
+//! (or, for a window, copied into the frame's texture by the present pass), so GPU memory stays
+//! bounded whatever the image size. A frame with nothing to draw (waves only)
 //! skips the raster pass.
 //!
 //! The wave pass is specialised per frame: the wave module declares pipeline-overridable `bool`
