@@ -21,6 +21,7 @@ mod gltf_load;
 mod gltf_material;
 mod guard;
 mod image;
+mod introspect;
 mod limits;
 mod materials;
 pub mod mesh;
@@ -39,6 +40,7 @@ pub use files::{read_regular_file, GLTF_MAX_BYTES, SCENE_MAX_BYTES};
 pub use frame::*;
 pub use gltf_load::{gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf};
 pub use image::Image;
+pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
 pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
 pub use scene::Scene;
 pub use shadow::{
