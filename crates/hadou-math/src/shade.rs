@@ -146,19 +146,77 @@ pub fn linear_to_srgb(v: f32) -> f32 {
 }
 
 /// `linear_to_srgb(v)` as an 8-bit code, `⌊255·srgb(v) + ½⌋`, exactly as that expression
-/// computes it but without the power function: the code is the number of the 255 thresholds
-/// (the smallest `f32` reaching each code, found once by bisection on the exact expression) that
-/// `v` reaches, by an 8-step binary search. NaN and values ≤ 0 give 0, values ≥ 1 give 255.
+/// computes it but without the power function. Non-negative floats order as their bits, and the
+/// code is non-decreasing in `v`: the top 19 bits of `v` pick a bucket whose first code is
+/// tabulated, and one comparison with the next code's threshold (the smallest `f32` reaching
+/// it, found once by bisection on the exact expression) finishes: no bucket holds two
+/// thresholds (asserted when the table is built). NaN and values ≤ 0 give 0, values ≥ 1 give 255.
 #[inline]
 pub fn linear_to_srgb8(v: f32) -> u8 {
-    let t = srgb8_thresholds();
-    let mut k = 0usize;
-    for step in [128, 64, 32, 16, 8, 4, 2, 1] {
-        if v >= t[k + step] {
-            k += step;
-        }
+    srgb8_code(srgb8_tables(), v)
+}
+
+/// [`linear_to_srgb8`] with its tables at hand.
+#[inline]
+fn srgb8_code(tables: &Srgb8Tables, v: f32) -> u8 {
+    if v.is_nan() || v <= 0.0 {
+        0
+    } else if v >= 1.0 {
+        255
+    } else {
+        let k = tables.start[(v.to_bits() >> SRGB8_SHIFT) as usize];
+        k + u8::from(v >= tables.next[k as usize])
     }
-    k as u8
+}
+
+/// [`linear_to_srgb8`] of the red, green and blue of each colour into `out` as RGBA bytes with
+/// alpha 255 (`out` holds `4 · colors.len()` bytes; extra bytes are left alone): the viewer's
+/// upload format. The tables are looked up once for the whole slice.
+pub fn rgba_to_srgba8(colors: &[[f32; 4]], out: &mut [u8]) {
+    let tables = srgb8_tables();
+    let code = |v: f32| srgb8_code(tables, v);
+    for (o, c) in out.chunks_exact_mut(4).zip(colors) {
+        o[0] = code(c[0]);
+        o[1] = code(c[1]);
+        o[2] = code(c[2]);
+        o[3] = 255;
+    }
+}
+
+/// Bits dropped from a float to find its bucket.
+const SRGB8_SHIFT: u32 = 13;
+
+/// The number of buckets below 1.0.
+const SRGB8_BUCKETS: usize = (0x3F80_0000u32 >> SRGB8_SHIFT) as usize;
+
+/// The tables of [`linear_to_srgb8`].
+struct Srgb8Tables {
+    /// Per bucket of floats sharing their top 19 bits, the code of the bucket's first float.
+    start: Vec<u8>,
+    /// `next[k]`: the smallest `f32` whose code exceeds `k` (`+∞` for 255).
+    next: [f32; 256],
+}
+
+fn srgb8_tables() -> &'static Srgb8Tables {
+    static T: std::sync::OnceLock<Srgb8Tables> = std::sync::OnceLock::new();
+    T.get_or_init(|| {
+        let t = srgb8_thresholds();
+        let mut next = [f32::INFINITY; 256];
+        next[..255].copy_from_slice(&t[1..]);
+        let mut start = vec![0u8; SRGB8_BUCKETS];
+        let mut k = 0usize;
+        for (b, s) in start.iter_mut().enumerate() {
+            let first = f32::from_bits((b as u32) << SRGB8_SHIFT);
+            while k < 255 && first >= t[k + 1] {
+                k += 1;
+            }
+            *s = k as u8;
+            // One comparison must suffice: the bucket's last float reaches at most code k + 1.
+            let last = f32::from_bits((((b as u32) + 1) << SRGB8_SHIFT) - 1);
+            debug_assert!(k >= 254 || last < t[k + 2], "bucket {b} spans two thresholds");
+        }
+        Srgb8Tables { start, next }
+    })
 }
 
 /// The code of [`linear_to_srgb8`] by its definition.
@@ -169,25 +227,22 @@ fn srgb8_exact(v: f32) -> u8 {
 
 /// `t[k]` (k ≥ 1): the smallest non-negative `f32` whose exact code is at least `k` (`t[0]` is
 /// unused). The code is non-decreasing in `v`, and non-negative floats order as their bits.
-fn srgb8_thresholds() -> &'static [f32; 256] {
-    static T: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
-    T.get_or_init(|| {
-        let mut t = [0.0f32; 256];
-        for (k, tk) in t.iter_mut().enumerate().skip(1) {
-            // Invariant: code(lo) < k ≤ code(hi).
-            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
-            while hi - lo > 1 {
-                let mid = lo + (hi - lo) / 2;
-                if (srgb8_exact(f32::from_bits(mid)) as usize) < k {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
+fn srgb8_thresholds() -> [f32; 256] {
+    let mut t = [0.0f32; 256];
+    for (k, tk) in t.iter_mut().enumerate().skip(1) {
+        // Invariant: code(lo) < k ≤ code(hi).
+        let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if (srgb8_exact(f32::from_bits(mid)) as usize) < k {
+                lo = mid;
+            } else {
+                hi = mid;
             }
-            *tk = f32::from_bits(hi);
         }
-        t
-    })
+        *tk = f32::from_bits(hi);
+    }
+    t
 }
 
 #[cfg(test)]
@@ -236,6 +291,14 @@ mod tests {
     fn srgb8_codes_equal_the_power_function_everywhere_they_change() {
         // Every code's threshold and 64 floats either side, a dense sweep of [0, 1] and the
         // special values.
+        // Every bucket's first float and its neighbours (the bucket table's seams).
+        for b in 0..SRGB8_BUCKETS as u32 {
+            for v in [(b << SRGB8_SHIFT).saturating_sub(1), b << SRGB8_SHIFT, (b << SRGB8_SHIFT) + 1]
+                .map(f32::from_bits)
+            {
+                assert_eq!(linear_to_srgb8(v), srgb8_exact(v), "{v:e}");
+            }
+        }
         let t = srgb8_thresholds();
         for &tk in &t[1..] {
             let b = tk.to_bits();
@@ -253,6 +316,12 @@ mod tests {
             assert_eq!(linear_to_srgb8(v), srgb8_exact(v), "{v:e}");
         }
         assert_eq!((linear_to_srgb8(0.0), linear_to_srgb8(1.0)), (0, 255));
+        let colors: Vec<[f32; 4]> = (0..1000).map(|i| [i as f32 / 900.0, -1.0, f32::NAN, 0.5]).collect();
+        let mut out = vec![7u8; 4 * colors.len()];
+        rgba_to_srgba8(&colors, &mut out);
+        for (c, o) in colors.iter().zip(out.chunks_exact(4)) {
+            assert_eq!(o, [linear_to_srgb8(c[0]), 0, 0, 255]);
+        }
     }
 
     #[test]

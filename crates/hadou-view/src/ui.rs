@@ -331,10 +331,8 @@ fn entity_actions(ui: &mut egui::Ui, v: &mut Viewer, e: &Entity) {
                 v.apply(Edit::RemoveWave(name.clone()));
             }
         }
-        Entity::Object(name) => {
-            if ui.button("Remove").clicked() {
-                v.apply(Edit::RemoveObject(name.clone()));
-            }
+        Entity::Object(name) if ui.button("Remove").clicked() => {
+            v.apply(Edit::RemoveObject(name.clone()));
         }
         _ => {}
     });

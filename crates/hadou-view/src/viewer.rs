@@ -30,7 +30,7 @@ impl Timeline {
     /// Advances by `dt` seconds of wall time in a scene lasting `duration` seconds (a static
     /// scene, `duration = 0`, keeps time 0). Non-finite or negative `dt` does nothing.
     pub fn advance(&mut self, dt: f32, duration: f32) {
-        if !self.playing || !(dt.is_finite() && dt > 0.0) {
+        if !(self.playing && dt.is_finite() && dt > 0.0) {
             return;
         }
         let end = if duration.is_finite() { duration.max(0.0) } else { 0.0 };
@@ -467,7 +467,7 @@ pub fn project(frame: &Frame, p: Vec3f) -> Option<[f32; 2]> {
     let b = frame.camera.basis(frame.width, frame.height);
     let d = p - b.eye;
     let z = d.dot(b.forward);
-    if !(z > 1e-6) {
+    if z.is_nan() || z <= 1e-6 {
         return None;
     }
     let ndc_x = d.dot(b.right) / (z * b.tan_half_fov * b.aspect);

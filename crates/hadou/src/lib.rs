@@ -13,7 +13,9 @@
 //! ```
 
 pub mod bench;
+pub mod export;
 pub mod output;
+pub mod view;
 
 pub use hadou_cpu::{probe, CpuBackend, Probe, WaveProbe};
 pub use hadou_gpu as gpu;

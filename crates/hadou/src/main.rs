@@ -27,6 +27,39 @@ enum Command {
     Probe(ProbeArgs),
     /// Measure rendering speed in the layout of the thesis's tables.
     Bench(BenchArgs),
+    /// Open a window: tune every parameter live, play the animation, save, export.
+    View(ViewArgs),
+}
+
+#[derive(Args, Debug)]
+struct ViewArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Drive the viewer from a script file (one command per line; see docs/viewer.md), then exit.
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// Write the viewport (the scene's image, as `hadou render` writes it) to this PNG/EXR file
+    /// once drawn (after the script, if any), and exit.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+    /// Start at this scene time in seconds (≥ 0).
+    #[arg(long, allow_hyphen_values = true)]
+    time: Option<String>,
+    /// Which backend draws the viewport [default: auto: the GPU backend on a hardware GPU, the CPU
+    /// backend when the only adapter is a software rasterizer].
+    #[arg(long, value_enum)]
+    backend: Option<ViewBackend>,
+    /// Print the median frame, render and viewer-overhead times as JSON on exit.
+    #[arg(long)]
+    stats: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ViewBackend {
+    /// The CPU reference backend (its image uploaded as a texture).
+    Cpu,
+    /// The GPU backend, drawing straight into the window.
+    Gpu,
 }
 
 #[derive(Args, Debug)]
@@ -177,6 +210,7 @@ fn main() -> ExitCode {
         Command::Validate { scene } => load_scene(&scene).map(|_| ()),
         Command::Probe(a) => probe(a),
         Command::Bench(a) => bench(a),
+        Command::View(a) => view(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -185,6 +219,22 @@ fn main() -> ExitCode {
             ExitCode::from(f.code)
         }
     }
+}
+
+fn view(a: ViewArgs) -> Result<(), Failure> {
+    let time = a.time.as_deref().map(|t| parse_time("--time", t)).transpose()?;
+    let opts = hadou::view::ViewOptions {
+        scene: a.scene,
+        script: a.script,
+        screenshot: a.screenshot,
+        time,
+        backend: a.backend.map(|b| match b {
+            ViewBackend::Cpu => hadou_view::viewer::BackendKind::Cpu,
+            ViewBackend::Gpu => hadou_view::viewer::BackendKind::Gpu,
+        }),
+        stats: a.stats,
+    };
+    hadou::view::run(opts).map_err(|e| Failure { code: e.code, message: e.message })
 }
 
 fn size_override(w: Option<u32>, h: Option<u32>) -> Result<(), Failure> {

@@ -1,0 +1,457 @@
+//! Animation export with progress and cancel: a numbered PNG sequence (the files `hadou render
+//! --frames` writes, byte for byte) or an animated GIF.
+//!
+//! ```no_run
+//! use hadou::export::{export_animation, AnimationSpec, Control};
+//! use hadou::{CpuBackend, Scene};
+//! let scene = Scene::load("scenes/kamehameha.toml").expect("valid scene");
+//! let spec = AnimationSpec { frames: 0..48, fps: 24.0, width: Some(320), height: Some(180) };
+//! let outcome = export_animation(&scene, &mut CpuBackend::new(), &spec, "fire.gif".as_ref(), &mut |p| {
+//!     eprintln!("{}/{}", p.done, p.total);
+//!     Control::Continue
+//! })
+//! .expect("exported");
+//! println!("{outcome:?}");
+//! ```
+//!
+//! Frame `f` is rendered at scene time `f as f32 / fps` (in `f32`, as `hadou render --frames`
+//! computes it), with the spec's width and height overriding the scene's `[image]` size.
+//!
+//! What is left on disk:
+//! - **GIF**: the file is written to a temporary file beside the output (`.NAME.PID.N.tmp`) and
+//!   renamed into place after the last frame, so the output path holds either its old content or
+//!   the complete new animation. On cancel or on any error the temporary file is removed and the
+//!   output path is untouched. (This temporary file is not in [`crate::output`]'s list of pending
+//!   files, so an interrupt of the whole process by Ctrl-C does not remove it; a cancel through
+//!   the progress callback does.)
+//! - **PNG sequence**: every frame is written whole (temporary file, then rename) by
+//!   [`output::write_png_banded`], exactly as `hadou render --frames` writes it. A cancel is seen
+//!   between frames: the frames finished before it stay on disk, no partial file is left. An error
+//!   part-way also keeps the frames finished before it.
+
+use crate::output::{self, OutputError};
+use hadou_scene::{Backend, Frame, Image, RenderError, Scene};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// The largest image edge an export accepts (the CLI's `--width`/`--height` limit).
+pub const MAX_EDGE: u32 = 16384;
+
+/// NeuQuant's speed for GIF quantisation (1 = best, 30 = fastest; 10 is the crate's advised
+/// compromise).
+pub const GIF_QUANT_SPEED: i32 = 10;
+
+/// How an animation is written, chosen from the output path by [`AnimationFormat::from_path`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnimationFormat {
+    /// Numbered 8-bit sRGB PNGs in a directory, named by [`frame_file_name`].
+    PngSequence,
+    /// One looping animated GIF (at most 256 colours per frame).
+    Gif,
+}
+
+impl AnimationFormat {
+    /// The format for `path`: a path ending in a separator (`out/`) or naming an existing directory
+    /// is a PNG sequence into that directory; a `.gif` file name (case-insensitive) is a GIF.
+    /// Anything else is [`OutputError::BadPath`].
+    pub fn from_path(path: &Path) -> Result<Self, OutputError> {
+        let text = path.as_os_str().to_string_lossy();
+        if text.chars().last().is_some_and(std::path::is_separator) || path.is_dir() {
+            return Ok(AnimationFormat::PngSequence);
+        }
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+            Some("gif") => Ok(AnimationFormat::Gif),
+            _ => Err(OutputError::BadPath(format!(
+                "{}: unknown animation format; use a .gif file name or a directory (ending in `/`) for \
+                 a numbered PNG sequence",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// What to render: which frames, at what rate, at what size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnimationSpec {
+    /// Frame numbers (end excluded); frame `f` is at scene time `f as f32 / fps`.
+    pub frames: Range<u32>,
+    /// Frames per second: finite and > 0.
+    pub fps: f32,
+    /// Image width overriding the scene's (1..=[`MAX_EDGE`]); `None` keeps the scene's.
+    pub width: Option<u32>,
+    /// Image height overriding the scene's (1..=[`MAX_EDGE`]); `None` keeps the scene's.
+    pub height: Option<u32>,
+}
+
+impl AnimationSpec {
+    /// Checks the spec: a non-empty frame range, a finite `fps > 0` that gives every frame a finite
+    /// time, and size overrides in 1..=[`MAX_EDGE`].
+    pub fn validate(&self) -> Result<(), ExportError> {
+        let Range { start, end } = self.frames;
+        if end <= start {
+            return Err(ExportError::Spec(format!("frames {start}..{end}: the range is empty")));
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(ExportError::Spec(format!(
+                "fps {}: must be a finite number of frames per second > 0, e.g. 24",
+                self.fps
+            )));
+        }
+        let last = end - 1;
+        if !self.time_of(last).is_finite() {
+            return Err(ExportError::Spec(format!(
+                "fps {}: too small; frame {last} would be at {:.3e} s, beyond the largest time hadou can \
+                 represent (3.4e38 s)",
+                self.fps,
+                f64::from(last) / f64::from(self.fps)
+            )));
+        }
+        for (name, v) in [("width", self.width), ("height", self.height)] {
+            if let Some(v) = v {
+                if v == 0 || v > MAX_EDGE {
+                    return Err(ExportError::Spec(format!(
+                        "{name} {v}: image size must be in 1..={MAX_EDGE}"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The scene time of frame `f`: `f as f32 / fps`, as `hadou render --frames` computes it.
+    pub fn time_of(&self, f: u32) -> f32 {
+        f as f32 / self.fps
+    }
+
+    /// The scene at frame `f` with the spec's size overrides applied.
+    pub fn frame(&self, scene: &Scene, f: u32) -> Frame {
+        let mut frame = scene.at(self.time_of(f));
+        if let Some(w) = self.width {
+            frame.width = w;
+        }
+        if let Some(h) = self.height {
+            frame.height = h;
+        }
+        frame
+    }
+}
+
+/// Where an export stands, passed to the progress callback.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Frames finished so far.
+    pub done: u32,
+    /// Frames in the export.
+    pub total: u32,
+}
+
+/// The progress callback's answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Control {
+    /// Go on with the next frame.
+    Continue,
+    /// Stop now; see [`ExportOutcome::Cancelled`] for what stays on disk. The answer to the call
+    /// after the last frame is ignored: the export is complete and ends
+    /// [`ExportOutcome::Finished`].
+    Cancel,
+}
+
+/// How an export ended (errors aside).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExportOutcome {
+    /// Every frame was written.
+    Finished {
+        /// Frames written.
+        frames: u32,
+    },
+    /// The progress callback returned [`Control::Cancel`].
+    Cancelled {
+        /// Complete frame files left on disk: the PNG frames finished before the cancel; always 0
+        /// for a GIF, whose temporary file is removed and whose output path is left untouched.
+        frames_written: u32,
+    },
+}
+
+/// Why an export failed.
+#[derive(Debug)]
+pub enum ExportError {
+    /// The [`AnimationSpec`] is invalid (empty range, bad fps, bad size); a user error.
+    Spec(String),
+    /// The output path is unusable ([`OutputError::BadPath`], a user error) or writing failed
+    /// ([`OutputError::Io`]).
+    Output(OutputError),
+    /// The backend failed, or produced a non-finite value.
+    Render(RenderError),
+}
+
+impl std::fmt::Display for ExportError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExportError::Spec(m) => f.write_str(m),
+            ExportError::Output(e) => write!(f, "{e}"),
+            ExportError::Render(e) => write!(f, "render failed: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for ExportError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ExportError::Spec(_) => None,
+            ExportError::Output(e) => Some(e),
+            ExportError::Render(e) => Some(e),
+        }
+    }
+}
+
+impl From<OutputError> for ExportError {
+    fn from(e: OutputError) -> Self {
+        ExportError::Output(e)
+    }
+}
+
+impl From<RenderError> for ExportError {
+    fn from(e: RenderError) -> Self {
+        ExportError::Render(e)
+    }
+}
+
+/// The file name of frame `f` in a PNG sequence: `frame_00042.png` (at least five digits), the
+/// name `hadou render --frames` gives it.
+pub fn frame_file_name(f: u32) -> String {
+    format!("frame_{f:05}.png")
+}
+
+/// The GIF delay of the `k`-th frame of an animation (k = 0 for its first frame), in the GIF's
+/// unit of 1/100 s.
+///
+/// Rounding: frame `k` is shown from `round(100·k/fps)` to `round(100·(k+1)/fps)` centiseconds
+/// (halves away from zero), so delays alternate between the two nearest whole centiseconds and
+/// the animation's total length stays within 5 ms of `frames / fps` (24 fps: 4, 4, 5, 4, 4, 4 cs,
+/// repeating, 25 cs per 6 frames). Above 50 fps every delay is 2 cs (the animation plays at 50 fps,
+/// slower than asked), because browsers show 0 or 1 cs delays as 10 cs. Delays beyond 655.35 s
+/// (`fps` below about 0.0015) are capped at `u16::MAX`.
+pub fn gif_delay_cs(fps: f32, k: u32) -> u16 {
+    let fps = f64::from(fps);
+    if fps >= 50.0 {
+        return 2;
+    }
+    let at = |k: u32| (100.0 * f64::from(k) / fps).round();
+    (at(k + 1) - at(k)).clamp(2.0, f64::from(u16::MAX)) as u16
+}
+
+/// Renders `spec`'s frames of `scene` with `backend` and writes them to `path` in the format
+/// [`AnimationFormat::from_path`] picks, calling `progress` before the first frame (`done` = 0)
+/// and after each finished frame; it returns [`Control::Cancel`] to stop. Cancel is seen between
+/// frames. See the [module docs](self) for what stays on disk after a cancel or an error.
+///
+/// Everything about the path is checked before the first frame is rendered: the spec
+/// ([`AnimationSpec::validate`], as [`ExportError::Spec`]), the format, and that the directory
+/// exists and accepts new files ([`OutputError::BadPath`]; a PNG sequence's directory must exist
+/// already, as with `hadou render --frames`). Nothing is created on a failed check.
+pub fn export_animation(
+    scene: &Scene,
+    backend: &mut dyn Backend,
+    spec: &AnimationSpec,
+    path: &Path,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Result<ExportOutcome, ExportError> {
+    spec.validate()?;
+    match AnimationFormat::from_path(path)? {
+        AnimationFormat::PngSequence => export_png_sequence(scene, backend, spec, path, progress),
+        AnimationFormat::Gif => export_gif(scene, backend, spec, path, progress),
+    }
+}
+
+/// The last line of defence of the invariant that no NaN or infinity reaches an image.
+fn check_finite(image: &Image) -> Result<(), ExportError> {
+    let ok = image.color.iter().all(|c| c.iter().all(|v| v.is_finite()))
+        && image.energy.iter().all(|v| v.is_finite())
+        && image.depth.iter().all(|v| v.is_finite());
+    if ok {
+        Ok(())
+    } else {
+        Err(ExportError::Render(RenderError::Other(
+            "internal error: the renderer produced a non-finite value; the frame was not written".into(),
+        )))
+    }
+}
+
+/// The PNG sequence: the checks and the loop of `hadou render --frames`, with progress and cancel.
+fn export_png_sequence(
+    scene: &Scene,
+    backend: &mut dyn Backend,
+    spec: &AnimationSpec,
+    dir: &Path,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Result<ExportOutcome, ExportError> {
+    if !dir.is_dir() {
+        let what = if dir.exists() { "is not a directory" } else { "does not exist" };
+        return Err(OutputError::BadPath(format!(
+            "{}: {what}; a PNG sequence is written into an existing directory, create it first",
+            dir.display()
+        ))
+        .into());
+    }
+    let range = spec.frames.clone();
+    let frame_path = |f: u32| dir.join(frame_file_name(f));
+    // Every frame's path is checked before the first frame is rendered: the directory accepts new
+    // files, and no entry a frame would replace is a directory. Read from the directory's listing,
+    // not frame by frame, so a huge range costs nothing here.
+    output::check_writable(&frame_path(range.start))?;
+    let listing = std::fs::read_dir(dir).map_err(|e| {
+        OutputError::BadPath(format!("{}: cannot list the output directory: {e}", dir.display()))
+    })?;
+    for entry in listing.flatten() {
+        let name = entry.file_name();
+        let number =
+            name.to_str().and_then(|n| n.strip_prefix("frame_")?.strip_suffix(".png")?.parse::<u32>().ok());
+        if number.is_some_and(|f| range.contains(&f) && name == frame_path(f).file_name().unwrap_or_default())
+        {
+            output::check_directory(&entry.path())?;
+        }
+    }
+    let total = range.len() as u32;
+    let mut done = 0;
+    if progress(Progress { done, total }) == Control::Cancel {
+        return Ok(ExportOutcome::Cancelled { frames_written: 0 });
+    }
+    for f in range {
+        let frame = spec.frame(scene, f);
+        output::write_png_banded(&frame_path(f), frame.width, frame.height, |rows| {
+            let band = backend.render_rows(&frame, rows)?;
+            check_finite(&band)?;
+            Ok::<_, ExportError>(band)
+        })?;
+        done += 1;
+        if progress(Progress { done, total }) == Control::Cancel && done < total {
+            return Ok(ExportOutcome::Cancelled { frames_written: done });
+        }
+    }
+    Ok(ExportOutcome::Finished { frames: total })
+}
+
+/// Distinguishes the temporary files of exports running at once in one process.
+static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// A temporary file beside the output, removed on drop unless [`GifTemp::commit`] renamed it.
+struct GifTemp {
+    tmp: PathBuf,
+}
+
+impl GifTemp {
+    /// Creates `.NAME.PID.N.tmp` in `path`'s directory (never replacing an existing file).
+    fn create(path: &Path) -> Result<(GifTemp, File), OutputError> {
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+        let file = File::options().write(true).create_new(true).open(&tmp).map_err(|e| {
+            OutputError::BadPath(format!(
+                "{}: cannot create files in `{}` ({e}); check its permissions or choose another output path",
+                path.display(),
+                dir.display()
+            ))
+        })?;
+        Ok((GifTemp { tmp }, file))
+    }
+
+    /// Renames the finished temporary file to `path`.
+    fn commit(mut self, path: &Path) -> Result<(), String> {
+        std::fs::rename(&self.tmp, path).map_err(|e| e.to_string())?;
+        self.tmp = PathBuf::new();
+        Ok(())
+    }
+}
+
+impl Drop for GifTemp {
+    fn drop(&mut self) {
+        if !self.tmp.as_os_str().is_empty() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Renders `frame` band by band (as the PNG path does) into packed 8-bit sRGB RGBA, alpha 255.
+fn render_rgba(backend: &mut dyn Backend, frame: &Frame) -> Result<Vec<u8>, ExportError> {
+    let (w, h) = (frame.width, frame.height);
+    let mut rgba = Vec::with_capacity(w as usize * h as usize * 4);
+    let step = output::band_rows(w);
+    let mut y = 0;
+    while y < h {
+        let rows = y..(y + step).min(h);
+        let band = backend.render_rows(frame, rows.clone())?;
+        if band.width != w || band.height != rows.len() as u32 {
+            return Err(ExportError::Render(RenderError::Other(format!(
+                "internal error: a band of rows {}..{} came back {}×{}",
+                rows.start, rows.end, band.width, band.height
+            ))));
+        }
+        check_finite(&band)?;
+        for rgb in output::srgb8(&band).chunks_exact(3) {
+            rgba.extend_from_slice(&[rgb[0], rgb[1], rgb[2], 255]);
+        }
+        y = rows.end;
+    }
+    Ok(rgba)
+}
+
+/// The GIF: frames quantised one by one (NeuQuant, a palette per frame), looping forever, written
+/// to a temporary file and renamed into place at the end.
+fn export_gif(
+    scene: &Scene,
+    backend: &mut dyn Backend,
+    spec: &AnimationSpec,
+    path: &Path,
+    progress: &mut dyn FnMut(Progress) -> Control,
+) -> Result<ExportOutcome, ExportError> {
+    output::check_directory(path)?;
+    let first = spec.frame(scene, spec.frames.start);
+    let (w, h) = (first.width, first.height);
+    let mut first = Some(first);
+    let (Ok(w16), Ok(h16)) = (u16::try_from(w), u16::try_from(h)) else {
+        return Err(ExportError::Spec(format!(
+            "{}: {w}×{h} is too large for a GIF (65535 at most)",
+            path.display()
+        )));
+    };
+    let (temp, file) = GifTemp::create(path)?;
+    let io =
+        |e: String| ExportError::Output(OutputError::Io(format!("{}: write failed: {e}", path.display())));
+    let mut encoder =
+        gif::Encoder::new(BufWriter::new(file), w16, h16, &[]).map_err(|e| io(e.to_string()))?;
+    encoder.set_repeat(gif::Repeat::Infinite).map_err(|e| io(e.to_string()))?;
+    let total = spec.frames.len() as u32;
+    let mut done = 0;
+    if progress(Progress { done, total }) == Control::Cancel {
+        return Ok(ExportOutcome::Cancelled { frames_written: 0 });
+    }
+    for (k, f) in spec.frames.clone().enumerate() {
+        let frame = first.take().unwrap_or_else(|| spec.frame(scene, f));
+        if (frame.width, frame.height) != (w, h) {
+            return Err(ExportError::Render(RenderError::Other(format!(
+                "frame {f} is {}×{}, the GIF's first frame {w}×{h}; a GIF's frames share one size",
+                frame.width, frame.height
+            ))));
+        }
+        let mut rgba = render_rgba(backend, &frame)?;
+        let mut gif_frame = gif::Frame::from_rgba_speed(w16, h16, &mut rgba, GIF_QUANT_SPEED);
+        gif_frame.delay = gif_delay_cs(spec.fps, k as u32);
+        encoder.write_frame(&gif_frame).map_err(|e| io(e.to_string()))?;
+        done += 1;
+        if progress(Progress { done, total }) == Control::Cancel && done < total {
+            return Ok(ExportOutcome::Cancelled { frames_written: 0 });
+        }
+    }
+    let mut writer = encoder.into_inner().map_err(|e| io(e.to_string()))?;
+    writer.flush().map_err(|e| io(e.to_string()))?;
+    drop(writer);
+    temp.commit(path).map_err(io)?;
+    Ok(ExportOutcome::Finished { frames: total })
+}
