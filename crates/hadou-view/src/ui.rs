@@ -123,6 +123,11 @@ fn top_bar(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
             v.stats.frame_ms, v.stats.render_ms, v.stats.overhead_ms
         ))
         .on_hover_text(format!("render time: {}", v.stats.render_method));
+        if current == Some(BackendKind::Gpu)
+            && ui.small_button("measure").on_hover_text("time the GPU's passes on this frame").clicked()
+        {
+            v.requests.push(Request::MeasureGpu);
+        }
     });
     ui.horizontal_wrapped(|ui| {
         ui.label("Screenshot");
@@ -290,8 +295,7 @@ fn params(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
 }
 
 fn colour_mode(ui: &mut egui::Ui, v: &mut Viewer) {
-    let text = v.doc.text().to_string();
-    let filmic = !text.contains("mode = \"faithful\"");
+    let filmic = v.frame().color_mapping.mode == hadou_scene::ToneMode::Filmic;
     ui.horizontal(|ui| {
         ui.label("mode");
         for (m, on) in [("filmic", filmic), ("faithful", !filmic)] {
@@ -315,7 +319,11 @@ fn entity_actions(ui: &mut egui::Ui, v: &mut Viewer, e: &Entity) {
             {
                 v.selected_wave = if selected { None } else { Some(name.clone()) };
             }
-            let faithful = falloff_is_faithful(v.doc.text(), name);
+            let faithful = v
+                .frame()
+                .waves
+                .iter()
+                .any(|w| &w.name == name && w.falloff == hadou_math::energy::Falloff::Faithful);
             let next = if faithful { "inverse-square" } else { "faithful" };
             if ui
                 .button(if faithful { "faithful" } else { "inverse-square" })
@@ -336,25 +344,6 @@ fn entity_actions(ui: &mut egui::Ui, v: &mut Viewer, e: &Entity) {
         }
         _ => {}
     });
-}
-
-/// Whether the `[[wave]]` named `name` says `falloff = "faithful"` (a light scan of the text;
-/// the panel only needs it for the button's label).
-fn falloff_is_faithful(text: &str, name: &str) -> bool {
-    let mut in_wave = false;
-    for line in text.lines() {
-        let l = line.trim();
-        if l.starts_with('[') {
-            in_wave = false;
-        }
-        if l.starts_with("name") && l.contains(&format!("\"{name}\"")) {
-            in_wave = true;
-        }
-        if in_wave && l.starts_with("falloff") && l.contains("\"faithful\"") {
-            return true;
-        }
-    }
-    false
 }
 
 fn add_menu(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState, wave: bool) {
@@ -397,6 +386,14 @@ fn param_rows(ui: &mut egui::Ui, v: &mut Viewer, list: &[&ParamInfo]) {
             };
             ui.label(label).on_hover_text(range_text(p));
             changed |= value_widgets(ui, p, &mut value);
+            if let Some(t) = track {
+                let smooth = t.interpolation == hadou_scene::Interpolation::Smooth;
+                let (label, next) = if smooth { ("smooth", "linear") } else { ("linear", "smooth") };
+                if ui.small_button(label).on_hover_text(format!("interpolation; click for {next}")).clicked()
+                {
+                    v.apply(Edit::Interpolation { target: p.target.clone(), value: next.into() });
+                }
+            }
             let key_button = if key_here { "◆" } else { "◇" };
             let r = ui.small_button(key_button).on_hover_text(if key_here {
                 "remove the key at this time"

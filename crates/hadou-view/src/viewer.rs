@@ -90,6 +90,9 @@ pub enum Request {
     Probe([u32; 2]),
     /// Draw with this backend.
     Backend(BackendKind),
+    /// Time the GPU backend on the current frame (GPU timestamps per pass where the adapter has
+    /// them, else submit-and-wait wall clock); the figures go to [`Stats`].
+    MeasureGpu,
     /// Close the window.
     Quit,
 }

@@ -394,3 +394,39 @@ fn scripts_parse_with_positions_and_run() {
     let e = script::run(&mut v, &bad[0], &sp).unwrap_err();
     assert!(e.contains("s.txt:1:") && e.contains("fov"), "{e}");
 }
+
+#[test]
+fn choices_and_interpolation_edit_the_file() {
+    let (mut d, _) = doc("choices");
+    let faithful = |d: &Document| {
+        d.scene()
+            .at(0.0)
+            .waves
+            .iter()
+            .any(|w| w.name == "beam" && w.falloff == hadou_math::energy::Falloff::Faithful)
+    };
+    assert!(!faithful(&d));
+    d.apply(&Edit::Choice {
+        entity: hadou_scene::Entity::Wave("beam".into()),
+        key: "falloff".into(),
+        value: "faithful".into(),
+    })
+    .unwrap();
+    assert!(faithful(&d));
+    // A value the loader refuses is refused.
+    assert!(d
+        .apply(&Edit::Choice { entity: hadou_scene::Entity::Color, key: "mode".into(), value: "neon".into() })
+        .is_err());
+    d.apply(&Edit::Choice {
+        entity: hadou_scene::Entity::Color,
+        key: "mode".into(),
+        value: "faithful".into(),
+    })
+    .unwrap();
+    assert_eq!(d.scene().at(0.0).color_mapping.mode, hadou_scene::ToneMode::Faithful);
+    assert!(d.text().contains("[color]\nmode = \"faithful\""), "{}", d.text());
+    let t = "wave.beam.alpha_c";
+    d.apply(&Edit::Interpolation { target: t.into(), value: "smooth".into() }).unwrap();
+    assert_eq!(d.scene().tracks()[0].interpolation, hadou_scene::Interpolation::Smooth);
+    assert!(d.apply(&Edit::Interpolation { target: "camera.fov".into(), value: "smooth".into() }).is_err());
+}

@@ -513,6 +513,39 @@ impl App {
                     }
                 }
                 Request::Quit => self.script_pos = usize::MAX,
+                Request::MeasureGpu => {
+                    let frame = self.viewer.frame();
+                    match self.gfx.as_mut().and_then(|g| g.gpu.as_mut()) {
+                        Some(gpu) => match gpu.time_frame(&frame, 5) {
+                            Ok(t) => {
+                                let passes: Vec<String> = t
+                                    .passes
+                                    .iter()
+                                    .map(|p| format!("{} {:.2} ms", p.name, p.median_ms))
+                                    .collect();
+                                let how = if gpu.has_timestamps() {
+                                    "GPU timestamps"
+                                } else {
+                                    "submit-and-wait wall clock (no timestamp queries)"
+                                };
+                                self.viewer.stats.render_ms = t.median_ms;
+                                self.viewer.stats.render_method =
+                                    format!("{how}, median of 5: {}", passes.join(", "));
+                                self.viewer.say(format!(
+                                    "GPU frame {:.2} ms ({how}){}",
+                                    t.median_ms,
+                                    if passes.is_empty() {
+                                        String::new()
+                                    } else {
+                                        format!(": {}", passes.join(", "))
+                                    }
+                                ));
+                            }
+                            Err(e) => self.viewer.complain(format!("GPU timing failed: {e}")),
+                        },
+                        None => self.viewer.complain("the GPU backend is not available on this adapter"),
+                    }
+                }
             }
         }
     }
