@@ -16,7 +16,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Render a scene to a PNG/EXR image, or a numbered PNG sequence with --frames.
+    /// Render a scene to a PNG/EXR image, or with --frames a numbered PNG sequence or a GIF.
     Render(RenderArgs),
     /// Check a scene file; exit 0 if valid, 2 with `file:line:col: message` if not.
     Validate {
@@ -66,7 +66,8 @@ enum ViewBackend {
 struct RenderArgs {
     /// The scene file (TOML).
     scene: PathBuf,
-    /// Output file (.png or .exr), or a directory (ending in `/`) with --frames.
+    /// Output file (.png or .exr), or with --frames a directory (ending in `/`) for a PNG
+    /// sequence or a `.gif` file for an animated GIF.
     #[arg(short, long)]
     output: PathBuf,
     /// Scene time in seconds (≥ 0).
@@ -218,6 +219,36 @@ fn main() -> ExitCode {
             eprintln!("error: {}", f.message);
             ExitCode::from(f.code)
         }
+    }
+}
+
+/// `render --frames A..B -o OUT.gif`: an animated GIF through `hadou::export`, with progress.
+fn render_gif(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Result<(), Failure> {
+    use hadou::export::{export_animation, AnimationSpec, Control, ExportError, ExportOutcome};
+    let spec = AnimationSpec { frames: range.clone(), fps, width: a.width, height: a.height };
+    spec.validate().map_err(|e| Failure::input(e.to_string()))?;
+    hadou::export::AnimationFormat::from_path(&a.output)?;
+    output::check_directory(&a.output)?;
+    let scene = load_scene(&a.scene)?;
+    let mut backend = make_backend(a.backend)?;
+    let bar = indicatif::ProgressBar::new(range.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, eta {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let outcome = export_animation(&scene, backend.as_mut(), &spec, &a.output, &mut |p| {
+        bar.set_position(u64::from(p.done));
+        Control::Continue
+    });
+    bar.finish_and_clear();
+    match outcome {
+        Ok(ExportOutcome::Finished { frames }) | Ok(ExportOutcome::Cancelled { frames_written: frames }) => {
+            eprintln!("wrote {} ({frames} frames, {} backend)", a.output.display(), backend.name());
+            Ok(())
+        }
+        Err(ExportError::Spec(m)) => Err(Failure::input(m)),
+        Err(ExportError::Output(e)) => Err(e.into()),
+        Err(ExportError::Render(e)) => Err(e.into()),
     }
 }
 
@@ -427,6 +458,9 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
     };
     let range = parse_frames(frames)?;
     let fps = parse_fps(&a.fps, &range)?;
+    if a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("gif")) {
+        return render_gif(&a, range, fps);
+    }
     let dir = &a.output;
     if !dir.is_dir() {
         return Err(Failure::input(format!(

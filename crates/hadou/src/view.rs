@@ -285,6 +285,7 @@ impl App {
     }
 
     fn die(&mut self, event_loop: &ActiveEventLoop, e: ViewError) {
+        self.finish_export();
         self.fatal = Some(e);
         event_loop.exit();
     }
@@ -604,6 +605,15 @@ impl App {
         self.export = Some(ExportJob { done, total, cancel, result });
     }
 
+    /// Cancels a running export and waits (up to a minute) for it to stop, so that closing the
+    /// window leaves no temporary file behind.
+    fn finish_export(&mut self) {
+        if let Some(j) = self.export.take() {
+            j.cancel.store(true, Ordering::Relaxed);
+            let _ = j.result.recv_timeout(Duration::from_secs(60));
+        }
+    }
+
     fn poll_export(&mut self) {
         let Some(j) = &self.export else { return };
         self.viewer.export_progress = Some((j.done.load(Ordering::Relaxed), j.total));
@@ -886,7 +896,10 @@ impl ApplicationHandler for App {
             }
         }
         match event {
-            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::CloseRequested => {
+                self.finish_export();
+                event_loop.exit();
+            }
             WindowEvent::Resized(size) => {
                 self.resize(size.width, size.height);
                 if let Some(g) = &self.gfx {

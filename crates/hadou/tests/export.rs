@@ -341,3 +341,44 @@ fn bad_paths_are_bad_path_errors_and_create_nothing() {
     assert!(!missing.exists());
     assert_eq!(listing(&dir), ["a-file"]);
 }
+
+#[test]
+fn hadou_render_writes_a_gif_with_frames() {
+    let dir = tmpdir("cli-gif");
+    let out = dir.join("fire.gif");
+    let scene_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/kamehameha.toml");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args([
+            "render",
+            "--backend",
+            "cpu",
+            "--frames",
+            "0..4",
+            "--fps",
+            "10",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "-o",
+        ])
+        .arg(&out)
+        .arg(&scene_path)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let g = decode_gif(&out);
+    assert_eq!(g.frames.len(), 4);
+    assert_eq!(g.size, (48, 27));
+    assert_eq!(g.repeat, gif::Repeat::Infinite);
+    assert_eq!(listing(&dir), vec!["fire.gif".to_string()], "no temporary file is left");
+    // A GIF in a missing directory: exit 2, nothing created.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args(["render", "--frames", "0..2", "-o"])
+        .arg(dir.join("missing/fire.gif"))
+        .arg(&scene_path)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!dir.join("missing").exists());
+}
