@@ -102,14 +102,19 @@ impl Scene {
     /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
+        Self::parse(&Self::read_text(path)?, path)
+    }
+
+    /// The scene file's text, read as [`Scene::load`] reads it: a regular file of at most
+    /// [`crate::SCENE_MAX_BYTES`], UTF-8.
+    pub fn read_text(path: &Path) -> Result<String, SceneError> {
         let bytes = crate::files::read_regular_file(path, crate::files::SCENE_MAX_BYTES).map_err(|e| {
             SceneError::Io { path: path.to_path_buf(), message: format!("cannot read the scene file: {e}") }
         })?;
-        let text = String::from_utf8(bytes).map_err(|e| SceneError::Io {
+        String::from_utf8(bytes).map_err(|e| SceneError::Io {
             path: path.to_path_buf(),
             message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        })?;
-        Self::parse(&text, path)
+        })
     }
 
     /// Parses scene `text`; `path` names the file in messages and anchors relative asset paths.

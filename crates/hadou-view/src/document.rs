@@ -154,13 +154,7 @@ pub struct Document {
 impl Document {
     /// Reads and parses the scene file (the errors of `hadou render`).
     pub fn open(path: &Path) -> Result<Document, SceneError> {
-        let bytes = hadou_scene::read_regular_file(path, hadou_scene::SCENE_MAX_BYTES).map_err(|e| {
-            SceneError::Io { path: path.to_path_buf(), message: format!("cannot read the scene file: {e}") }
-        })?;
-        let text = String::from_utf8(bytes).map_err(|e| SceneError::Io {
-            path: path.to_path_buf(),
-            message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        })?;
+        let text = Scene::read_text(path)?;
         let mut d = Self::from_text(&text, path)?;
         d.disk_stamp = stamp(path);
         Ok(d)
@@ -324,21 +318,15 @@ impl Document {
             return Reload::Unchanged;
         }
         self.disk_stamp = now;
-        let text = match hadou_scene::read_regular_file(&self.path, hadou_scene::SCENE_MAX_BYTES) {
-            Ok(bytes) => match String::from_utf8(bytes) {
-                Ok(t) => t,
-                Err(e) => {
-                    let m = format!(
-                        "{}: the scene file is not UTF-8 text (byte {})",
-                        self.path.display(),
-                        e.utf8_error().valid_up_to()
-                    );
-                    self.reload_error = Some(m.clone());
-                    return Reload::Failed(m);
-                }
-            },
+        let text = match Scene::read_text(&self.path) {
+            Ok(t) => t,
             // Editors that save by replacing the file may leave it missing for a moment.
-            Err(_) => return Reload::Unchanged,
+            Err(_) if !self.path.exists() => return Reload::Unchanged,
+            Err(e) => {
+                let m = e.to_string();
+                self.reload_error = Some(m.clone());
+                return Reload::Failed(m);
+            }
         };
         if text == self.disk_text {
             self.reload_error = None;

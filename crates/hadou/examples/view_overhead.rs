@@ -75,17 +75,7 @@ fn main() {
         let t2 = Instant::now();
         hadou::view::srgba8_into(&image, &mut rgba);
         let t3 = Instant::now();
-        queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            &rgba,
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(h) },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        );
+        hadou::view::upload_rgba(queue, &texture, &rgba, [w, h]);
         queue.submit([]);
         let t4 = Instant::now();
         let _ = device.poll(wgpu::PollType::wait_indefinitely());

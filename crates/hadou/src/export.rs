@@ -268,10 +268,7 @@ pub fn export_animation(
 
 /// The last line of defence of the invariant that no NaN or infinity reaches an image.
 fn check_finite(image: &Image) -> Result<(), ExportError> {
-    let ok = image.color.iter().all(|c| c.iter().all(|v| v.is_finite()))
-        && image.energy.iter().all(|v| v.is_finite())
-        && image.depth.iter().all(|v| v.is_finite());
-    if ok {
+    if output::is_finite(image) {
         Ok(())
     } else {
         Err(ExportError::Render(RenderError::Other(

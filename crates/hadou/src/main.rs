@@ -222,13 +222,15 @@ fn main() -> ExitCode {
     }
 }
 
-/// `render --frames A..B -o OUT.gif`: an animated GIF through `hadou::export`, with progress.
-fn render_gif(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Result<(), Failure> {
+/// `render --frames A..B -o DIR/ | OUT.gif`: a PNG sequence or an animated GIF through
+/// `hadou::export` (every path checked before the first frame), with a progress bar.
+fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Result<(), Failure> {
     use hadou::export::{export_animation, AnimationSpec, Control, ExportError, ExportOutcome};
     let spec = AnimationSpec { frames: range.clone(), fps, width: a.width, height: a.height };
     spec.validate().map_err(|e| Failure::input(e.to_string()))?;
-    hadou::export::AnimationFormat::from_path(&a.output)?;
-    output::check_directory(&a.output)?;
+    if hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::Gif {
+        output::check_directory(&a.output)?;
+    }
     let scene = load_scene(&a.scene)?;
     let mut backend = make_backend(a.backend)?;
     let bar = indicatif::ProgressBar::new(range.len() as u64);
@@ -243,7 +245,7 @@ fn render_gif(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Result<(
     bar.finish_and_clear();
     match outcome {
         Ok(ExportOutcome::Finished { frames }) | Ok(ExportOutcome::Cancelled { frames_written: frames }) => {
-            eprintln!("wrote {} ({frames} frames, {} backend)", a.output.display(), backend.name());
+            eprintln!("wrote {frames} frames to {} ({} backend)", a.output.display(), backend.name());
             Ok(())
         }
         Err(ExportError::Spec(m)) => Err(Failure::input(m)),
@@ -458,59 +460,12 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
     };
     let range = parse_frames(frames)?;
     let fps = parse_fps(&a.fps, &range)?;
-    if a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("gif")) {
-        return render_gif(&a, range, fps);
-    }
-    let dir = &a.output;
-    if !dir.is_dir() {
-        return Err(Failure::input(format!(
-            "{}: with --frames the output must be an existing directory; create it first",
-            dir.display()
-        )));
-    }
-    // Every frame's path is checked before the first frame is rendered: the directory accepts new
-    // files, and no entry in it that a frame would replace is a directory. Read from the directory's
-    // listing (bounded by what is there), not frame by frame, so a huge range costs nothing here.
-    let frame_path = |f: u32| dir.join(format!("frame_{f:05}.png"));
-    output::check_writable(&frame_path(range.start))?;
-    let listing = std::fs::read_dir(dir)
-        .map_err(|e| Failure::input(format!("{}: cannot list the output directory: {e}", dir.display())))?;
-    for entry in listing.flatten() {
-        let name = entry.file_name();
-        let number =
-            name.to_str().and_then(|n| n.strip_prefix("frame_")?.strip_suffix(".png")?.parse::<u32>().ok());
-        if number.is_some_and(|f| range.contains(&f) && name == frame_path(f).file_name().unwrap_or_default())
-        {
-            output::check_directory(&entry.path())?;
-        }
-    }
-    let scene = load_scene(&a.scene)?;
-    let mut backend = make_backend(a.backend)?;
-    let bar = indicatif::ProgressBar::new(range.len() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, eta {eta}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    for f in range.clone() {
-        let frame = frame_at(&scene, f as f32 / fps, a.width, a.height);
-        output::write_png_banded(&frame_path(f), frame.width, frame.height, |rows| {
-            let band = backend.render_rows(&frame, rows)?;
-            check_finite(&band)?;
-            Ok::<_, Failure>(band)
-        })?;
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    eprintln!("wrote {} frames to {} ({} backend)", range.len(), dir.display(), backend.name());
-    Ok(())
+    render_animation(&a, range, fps)
 }
 
 /// The last line of defence of the invariant that no NaN or infinity reaches an image.
 fn check_finite(image: &Image) -> Result<(), Failure> {
-    let ok = image.color.iter().all(|c| c.iter().all(|v| v.is_finite()))
-        && image.energy.iter().all(|v| v.is_finite())
-        && image.depth.iter().all(|v| v.is_finite());
-    if ok {
+    if output::is_finite(image) {
         Ok(())
     } else {
         Err(Failure::runtime("internal error: the renderer produced a non-finite value; nothing was written"))

@@ -120,6 +120,14 @@ fn encode_png_into(image: &Image, sink: impl Write) -> Result<(), String> {
     w.finish().map_err(|e| e.to_string())
 }
 
+/// Whether every colour, energy and depth value of `image` is finite (the invariant that no NaN
+/// or infinity reaches an image, checked before writing).
+pub fn is_finite(image: &Image) -> bool {
+    image.color.iter().all(|c| c.iter().all(|v| v.is_finite()))
+        && image.energy.iter().all(|v| v.is_finite())
+        && image.depth.iter().all(|v| v.is_finite())
+}
+
 /// The image's colour as packed 8-bit sRGB triples ([`linear_to_srgb8`]), rows in parallel.
 pub fn srgb8(image: &Image) -> Vec<u8> {
     let mut data = vec![0u8; image.color.len() * 3];

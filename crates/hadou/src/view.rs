@@ -169,6 +169,25 @@ pub fn srgba8_into(image: &Image, out: &mut Vec<u8>) {
         .for_each(|(o, c)| hadou_math::shade::rgba_to_srgba8(c, o));
 }
 
+/// Writes 8-bit RGBA rows (`4 · size[0]` bytes each) into the whole of `texture`.
+pub fn upload_rgba(queue: &wgpu::Queue, texture: &wgpu::Texture, rgba: &[u8], size: [u32; 2]) {
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        rgba,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(4 * size[0]),
+            rows_per_image: Some(size[1]),
+        },
+        wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+    );
+}
+
 /// Timings of one new image, ms.
 #[derive(Clone, Copy)]
 struct Sample {
@@ -728,21 +747,7 @@ impl App {
                         g.cpu_texture = Some((tex, id, size));
                     }
                     if let Some((tex, id, _)) = &g.cpu_texture {
-                        g.queue.write_texture(
-                            wgpu::TexelCopyTextureInfo {
-                                texture: tex,
-                                mip_level: 0,
-                                origin: wgpu::Origin3d::ZERO,
-                                aspect: wgpu::TextureAspect::All,
-                            },
-                            &done.rgba,
-                            wgpu::TexelCopyBufferLayout {
-                                offset: 0,
-                                bytes_per_row: Some(4 * size[0]),
-                                rows_per_image: Some(size[1]),
-                            },
-                            wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-                        );
+                        upload_rgba(&g.queue, tex, &done.rgba, size);
                         self.image = Some(ViewportImage { texture: *id, size });
                     }
                     let _ = self.cpu.back.send(done.rgba);
