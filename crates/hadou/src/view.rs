@@ -447,6 +447,10 @@ impl App {
 
     /// Runs script commands until one needs frames to pass.
     fn step_script(&mut self, event_loop: &ActiveEventLoop) {
+        // A script waits for a running export to finish before its next command.
+        if self.export.is_some() {
+            return;
+        }
         if self.wait_frames > 0 {
             self.wait_frames -= 1;
             return;

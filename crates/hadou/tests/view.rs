@@ -110,6 +110,7 @@ fn scripted_session_matches_render() {
          undo\n\
          redo\n\
          save edited.toml\n\
+         export anim.gif 0..3 12\n\
          wait 2\n",
     )
     .unwrap();
@@ -138,6 +139,21 @@ fn scripted_session_matches_render() {
     assert_eq!(max, 0, "the CPU-backend screenshot must equal `hadou render` exactly");
     let (max, close) = compare(&dir.join("gpu.png"), &reference);
     assert!(close >= 0.995 && max <= 40, "GPU screenshot vs render: max {max}, within 2 codes {close}");
+    // The export ran to the end before the script went on: three frames, no temporary file.
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut gif = options.read_info(std::fs::File::open(dir.join("anim.gif")).unwrap()).unwrap();
+    let mut frames = 0;
+    while gif.read_next_frame().unwrap().is_some() {
+        frames += 1;
+    }
+    assert_eq!(frames, 3);
+    let stray: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(stray.is_empty(), "{stray:?}");
     // --stats printed the figures.
     let stats = String::from_utf8_lossy(&o.stdout);
     assert!(stats.contains("\"median_image_overhead_ms\""), "{stats}");
