@@ -91,7 +91,8 @@ pub fn run(opts: ViewOptions) -> Result<(), ViewError> {
     if let Some(t) = opts.time {
         viewer.timeline.time = t;
     }
-    let mut app = App::new(viewer, opts, script);
+    let cpu = CpuWorker::start().map_err(|e| fail(1, format!("cannot start the CPU render thread: {e}")))?;
+    let mut app = App::new(viewer, opts, script, cpu);
     event_loop.run_app(&mut app).map_err(|e| fail(1, format!("the window's event loop failed: {e}")))?;
     if let Some(e) = app.fatal.take() {
         return Err(e);
@@ -121,40 +122,37 @@ struct CpuWorker {
 }
 
 impl CpuWorker {
-    fn start() -> CpuWorker {
+    fn start() -> std::io::Result<CpuWorker> {
         let (jobs, job_rx) = mpsc::channel::<(u64, Frame)>();
         let (done_tx, done) = mpsc::channel();
         let (back, back_rx) = mpsc::channel::<Vec<u8>>();
-        std::thread::Builder::new()
-            .name("hadou-view-cpu".into())
-            .spawn(move || {
-                let mut backend = crate::CpuBackend::new();
-                let mut image = Image::new(1, 1);
-                let mut spare: Vec<Vec<u8>> = Vec::new();
-                while let Ok((mut generation, mut frame)) = job_rx.recv() {
-                    // Buffers the window has uploaded come back for reuse.
-                    while let Ok(b) = back_rx.try_recv() {
-                        spare.push(b);
-                    }
-                    // Only the newest frame matters.
-                    while let Ok(newer) = job_rx.try_recv() {
-                        (generation, frame) = newer;
-                    }
-                    let t0 = Instant::now();
-                    backend.render_into(&frame, &mut image);
-                    let render_ms = t0.elapsed().as_secs_f64() * 1e3;
-                    let t1 = Instant::now();
-                    let mut rgba = spare.pop().unwrap_or_default();
-                    srgba8_into(&image, &mut rgba);
-                    let convert_ms = t1.elapsed().as_secs_f64() * 1e3;
-                    let size = [image.width, image.height];
-                    if done_tx.send(CpuDone { generation, size, rgba, render_ms, convert_ms }).is_err() {
-                        break;
-                    }
+        std::thread::Builder::new().name("hadou-view-cpu".into()).spawn(move || {
+            let mut backend = crate::CpuBackend::new();
+            let mut image = Image::new(1, 1);
+            let mut spare: Vec<Vec<u8>> = Vec::new();
+            while let Ok((mut generation, mut frame)) = job_rx.recv() {
+                // Buffers the window has uploaded come back for reuse.
+                while let Ok(b) = back_rx.try_recv() {
+                    spare.push(b);
                 }
-            })
-            .expect("spawning the CPU render thread");
-        CpuWorker { jobs, done, back, busy: false }
+                // Only the newest frame matters.
+                while let Ok(newer) = job_rx.try_recv() {
+                    (generation, frame) = newer;
+                }
+                let t0 = Instant::now();
+                backend.render_into(&frame, &mut image);
+                let render_ms = t0.elapsed().as_secs_f64() * 1e3;
+                let t1 = Instant::now();
+                let mut rgba = spare.pop().unwrap_or_default();
+                srgba8_into(&image, &mut rgba);
+                let convert_ms = t1.elapsed().as_secs_f64() * 1e3;
+                let size = [image.width, image.height];
+                if done_tx.send(CpuDone { generation, size, rgba, render_ms, convert_ms }).is_err() {
+                    break;
+                }
+            }
+        })?;
+        Ok(CpuWorker { jobs, done, back, busy: false })
     }
 }
 
@@ -256,7 +254,12 @@ struct App {
 }
 
 impl App {
-    fn new(viewer: Viewer, opts: ViewOptions, script: Option<(Vec<script::Line>, PathBuf)>) -> App {
+    fn new(
+        viewer: Viewer,
+        opts: ViewOptions,
+        script: Option<(Vec<script::Line>, PathBuf)>,
+        cpu: CpuWorker,
+    ) -> App {
         App {
             viewer,
             ui: UiState::default(),
@@ -268,7 +271,7 @@ impl App {
             gfx: None,
             egui_ctx: egui::Context::default(),
             backend: BackendKind::Cpu,
-            cpu: CpuWorker::start(),
+            cpu,
             drawn: None,
             generation: 0,
             image: None,
