@@ -119,8 +119,8 @@ fn top_bar(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
         ui.label(&v.stats.backend_note).on_hover_text(format!("window adapter: {}", v.stats.adapter));
         ui.separator();
         ui.monospace(format!(
-            "frame {:.1} ms · render {:.1} ms · viewer {:.2} ms",
-            v.stats.frame_ms, v.stats.render_ms, v.stats.overhead_ms
+            "frame {:.1} ms · render {:.1} ms · viewer {:.2} ms · UI {:.1} ms",
+            v.stats.frame_ms, v.stats.render_ms, v.stats.overhead_ms, v.stats.ui_ms
         ))
         .on_hover_text(format!("render time: {}", v.stats.render_method));
         if current == Some(BackendKind::Gpu)
@@ -394,7 +394,7 @@ fn param_rows(ui: &mut egui::Ui, v: &mut Viewer, list: &[&ParamInfo]) {
                     v.apply(Edit::Interpolation { target: p.target.clone(), value: next.into() });
                 }
             }
-            let key_button = if key_here { "◆" } else { "◇" };
+            let key_button = if key_here { "unkey" } else { "key" };
             let r = ui.small_button(key_button).on_hover_text(if key_here {
                 "remove the key at this time"
             } else {

@@ -112,8 +112,11 @@ pub struct Stats {
     pub render_ms: f64,
     /// How that was measured.
     pub render_method: String,
-    /// The window's own time per frame on top of rendering (scene evaluation, upload, UI), ms.
+    /// The viewer's own time for the last new image on top of rendering (frame evaluation, and
+    /// on the CPU path the sRGB conversion and the upload), ms.
     pub overhead_ms: f64,
+    /// Building and drawing the UI in the last frame, ms.
+    pub ui_ms: f64,
 }
 
 /// A draggable point of a wave in the viewport.

@@ -849,9 +849,9 @@ impl App {
         }
         let ui_ms = ui_start.elapsed().as_secs_f64() * 1e3;
         self.viewer.stats.frame_ms = frame_ms;
+        self.viewer.stats.ui_ms = ui_ms;
         if let Some(ms) = viewer_ms {
-            // The viewer's cost for a new image: its own work plus drawing the UI around it.
-            self.viewer.stats.overhead_ms = ms + ui_ms;
+            self.viewer.stats.overhead_ms = ms;
             if self.frames_shown > 2 {
                 self.samples.push(Sample {
                     frame: frame_ms,
