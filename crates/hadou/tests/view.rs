@@ -29,6 +29,13 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
+/// One Xvfb at a time: `xvfb-run -a` picks a free display number by looking for lock files, and
+/// two started at once can pick the same one.
+fn xvfb_lock() -> std::sync::MutexGuard<'static, ()> {
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    LOCK.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 /// `xvfb-run` when present; `None` (skip) otherwise, a failure in CI.
 fn xvfb(test: &str) -> Option<Command> {
     let found =
@@ -84,6 +91,7 @@ fn render(scene: &Path, time: &str, out: &Path) {
 
 #[test]
 fn scripted_session_matches_render() {
+    let _x = xvfb_lock();
     let Some(mut view) = xvfb("scripted_session_matches_render") else { return };
     let dir = tmp("script");
     let scene = dir.join("scene.toml");
@@ -161,6 +169,7 @@ fn scripted_session_matches_render() {
 
 #[test]
 fn time_and_screenshot_without_script() {
+    let _x = xvfb_lock();
     let Some(mut view) = xvfb("time_and_screenshot_without_script") else { return };
     let dir = tmp("time");
     let shot = dir.join("shot.png");
@@ -231,6 +240,7 @@ fn no_display_names_the_variables_and_the_alternatives() {
 
 #[test]
 fn a_failing_script_command_is_an_error() {
+    let _x = xvfb_lock();
     let Some(mut view) = xvfb("a_failing_script_command_is_an_error") else { return };
     let dir = tmp("failing");
     let script = dir.join("s.txt");
