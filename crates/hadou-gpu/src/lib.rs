@@ -49,14 +49,18 @@
 //! into one full-frame [`PRESENT_FORMAT`] texture on the GPU (a present pass per tile,
 //! `shaders/present.wgsl`), with no read-back and no wait: the window samples the texture in its
 //! own pass on the same queue. The bytes equal `hadou_math::shade::linear_to_srgb8` of
-//! [`Backend::render`]'s colour within one code (`tests/present.rs`).
+//! [`Backend::render`]'s colour within one code (`tests/present.rs`). Where the device has
+//! timestamp queries, [`GpuBackend::last_present_timing`] gives the GPU time of a recent frame,
+//! read back asynchronously (a small ring of staging buffers, mapped without waiting), so a
+//! window can show it every frame without blocking.
 //!
 //! ## On the web (`wasm32`)
 //!
 //! The crate builds for `wasm32-unknown-unknown` on wgpu's WebGPU backend (WebGL2 lacks compute
 //! shaders). A browser may not block, so only the non-blocking path is compiled there:
 //! [`GpuBackend::from_device`] (the page requests the adapter and device asynchronously itself,
-//! with [`device_descriptor`]), [`GpuBackend::render_to_texture`] and the accessors. Everything
+//! with [`device_descriptor`]), [`GpuBackend::render_to_texture`],
+//! [`GpuBackend::last_present_timing`] and the accessors. Everything
 //! that waits for the GPU — [`GpuBackend::new`], [`find_adapter`], the [`Backend`] impl (it reads
 //! the image back), `render_soft` and [`GpuBackend::time_frame`] — exists only off the web. There,
 //! wgpu error scopes are not used (their results arrive asynchronously): errors reach the
@@ -76,7 +80,7 @@ mod twins;
 
 pub use present::{PresentedFrame, PRESENT_FORMAT, PRESENT_USAGE};
 pub use render::{MAX_TILE, SOFT_BYTES_PER_PIXEL};
-pub use timing::{FrameTiming, PassTime, TimingMethod};
+pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
 
@@ -106,7 +110,8 @@ pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), RenderError> {
 }
 
 /// The optional features hadou uses when `adapter` has them: only
-/// [`wgpu::Features::TIMESTAMP_QUERY`] (for [`GpuBackend::time_frame`]'s per-pass times); none is
+/// [`wgpu::Features::TIMESTAMP_QUERY`] (for [`GpuBackend::time_frame`]'s per-pass times and
+/// [`GpuBackend::last_present_timing`]); none is
 /// required. Part of [`device_descriptor`].
 pub fn required_features(adapter: &wgpu::Adapter) -> wgpu::Features {
     device::required_features(adapter)
@@ -164,6 +169,23 @@ impl GpuBackend {
         self.renderer.render_to_texture(frame)
     }
 
+    /// The GPU time of the most recent [`GpuBackend::render_to_texture`] frame whose timestamps
+    /// have come back, without waiting: `None` until one has, and always `None` on a device
+    /// without [`wgpu::Features::TIMESTAMP_QUERY`] (e.g. WebGL, or OpenGL without
+    /// `GL_ARB_timer_query`; Mesa's desktop GL has it). Once one has come back, the
+    /// latest stays returned until a newer one arrives ([`PresentTiming::serial`] says which frame
+    /// it was: usually a frame or two behind the one just drawn).
+    ///
+    /// Each frame's passes write timestamps; they are copied into one of a few staging buffers,
+    /// mapped asynchronously. This call polls the device without blocking (on the web the browser
+    /// completes the maps itself) and reads whatever has been mapped. A frame finding every
+    /// staging buffer still in flight is not timed, and neither is a frame with an
+    /// `[area_light]` (its whole-image soft-shadow passes run outside the tiles' passes): use
+    /// [`GpuBackend::time_frame`] for those.
+    pub fn last_present_timing(&mut self) -> Option<PresentTiming> {
+        self.renderer.last_present_timing()
+    }
+
     /// The device this backend draws with.
     pub fn device(&self) -> &wgpu::Device {
         &self.renderer.ctx.device
@@ -189,7 +211,8 @@ impl GpuBackend {
         self.renderer.ctx.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    /// Whether the device supports GPU timestamps (then [`GpuBackend::time_frame`] uses them).
+    /// Whether the device supports GPU timestamps (then [`GpuBackend::time_frame`] uses them and
+    /// [`GpuBackend::last_present_timing`] has times).
     pub fn has_timestamps(&self) -> bool {
         self.renderer.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
     }

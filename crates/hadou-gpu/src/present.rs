@@ -18,6 +18,7 @@ use crate::device::GpuContext;
 use crate::pipelines::compile_module;
 use crate::render::Renderer;
 use crate::shaders;
+use crate::timing::{PresentTimer, PresentTiming, PRESENT_PASSES_PER_TILE};
 use hadou_scene::{Frame, RenderError};
 
 /// The format of the texture [`crate::GpuBackend::render_to_texture`] draws into: 8-bit sRGB
@@ -44,6 +45,9 @@ pub struct PresentedFrame<'a> {
     /// window that registered the previous texture's view must register this one instead. While
     /// the size holds, the same texture is drawn over each frame.
     pub recreated: bool,
+    /// Which frame this is: 1 for the backend's first `render_to_texture`, one more each call
+    /// (the [`crate::PresentTiming::serial`] of its GPU time).
+    pub serial: u64,
 }
 
 /// The full-frame texture, kept while the frame size holds.
@@ -58,6 +62,10 @@ pub(crate) struct Present {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     target: Option<PresentTarget>,
+    /// The frames' timestamps, on a device with `TIMESTAMP_QUERY`.
+    timer: Option<PresentTimer>,
+    /// `render_to_texture` calls so far.
+    serial: u64,
 }
 
 impl Present {
@@ -127,7 +135,9 @@ impl Present {
                 multiview_mask: None,
                 cache: None,
             });
-            Self { pipeline, layout, target: None }
+            let timer =
+                ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| PresentTimer::new(&ctx.queue));
+            Self { pipeline, layout, target: None, timer, serial: 0 }
         })
     }
 
@@ -154,7 +164,12 @@ impl Present {
 }
 
 impl Renderer {
-    /// See [`crate::GpuBackend::render_to_texture`].
+    /// See [`crate::GpuBackend::render_to_texture`]. On a device with `TIMESTAMP_QUERY`, a frame
+    /// without an `[area_light]` writes timestamps at every pass (the shadow maps, then per tile
+    /// its passes and the present pass), resolved and copied into a staging buffer that is mapped
+    /// asynchronously ([`PresentTimer`]): see [`Renderer::last_present_timing`]. Frames with an
+    /// `[area_light]` are not timed (their whole-image soft-shadow passes run before the tiles,
+    /// in the frame's preparation), nor is a frame finding every staging buffer still in flight.
     pub(crate) fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
         let size = [frame.width, frame.height];
         let max = self.ctx.limits.max_texture_dimension_2d;
@@ -164,18 +179,33 @@ impl Renderer {
                 size[0], size[1]
             )));
         }
-        let prepared = self.prepare(frame, 0..frame.height)?;
         if self.present.is_none() {
             self.present = Some(Present::new(&self.ctx)?);
         }
+        let timed = self.present.as_ref().is_some_and(|p| p.timer.is_some()) && frame.area_light.is_none();
+        // When timed, the shadow maps are submitted below, with their timestamps.
+        let prepared = self.prepare_frame(frame, 0..frame.height, !timed)?;
         let present = self.present.as_mut().expect("made above");
+        present.serial += 1;
+        let serial = present.serial;
         let recreated = self
             .ctx
             .scoped("creating the window texture", || present.ensure_target(&self.ctx.device, size))?;
+        let queries = 2 * (PRESENT_PASSES_PER_TILE * prepared.tiles.len() as u32 + prepared.map_pass_count());
+        let timed_frame = match present.timer.as_mut().filter(|_| timed) {
+            Some(timer) => {
+                self.ctx.scoped("creating timestamp queries", || timer.begin(&self.ctx.device, queries))?
+            }
+            None => None,
+        };
         let present = self.present.as_ref().expect("made above");
         let target = present.target.as_ref().expect("made above");
         let tiles = self.targets.as_ref().expect("targets are created in prepare");
-        self.ctx.scoped("drawing the frame into the window texture", || {
+        let queries = self.ctx.scoped("drawing the frame into the window texture", || {
+            let mut q = timed_frame.as_ref().map(|f| f.queries());
+            if timed {
+                self.submit_shadow_maps(frame, &prepared, q.as_mut());
+            }
             let bind_group = self.ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("present"),
                 layout: &present.layout,
@@ -187,7 +217,7 @@ impl Renderer {
             for &tile in &prepared.tiles {
                 // Writes the tile's uniforms, which the present pass reads too (tile origin and
                 // size); submitted before the next tile rewrites them.
-                let mut enc = self.encode_tile(frame, &prepared, tile, false, None);
+                let mut enc = self.encode_tile(frame, &prepared, tile, false, q.as_mut());
                 let ([x, y], [w, h]) = tile;
                 {
                     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -200,7 +230,8 @@ impl Renderer {
                             ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
                         })],
                         depth_stencil_attachment: None,
-                        timestamp_writes: None,
+                        // In the tile's group of queries: its span ends with this pass.
+                        timestamp_writes: q.as_mut().and_then(|q| q.render("present")),
                         occlusion_query_set: None,
                         multiview_mask: None,
                     });
@@ -212,7 +243,23 @@ impl Renderer {
                 }
                 self.ctx.queue.submit([enc.finish()]);
             }
+            q
         })?;
-        Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated })
+        if let (Some(f), Some(q)) = (&timed_frame, queries) {
+            let (ctx, present) = (&self.ctx, self.present.as_mut().expect("made above"));
+            if let Some(timer) = present.timer.as_mut() {
+                ctx.scoped("reading the frame's timestamps back", || {
+                    timer.finish(&ctx.device, &ctx.queue, f, q, serial)
+                })?;
+            }
+        }
+        let target = self.present.as_ref().and_then(|p| p.target.as_ref()).expect("made above");
+        Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated, serial })
+    }
+
+    /// See [`crate::GpuBackend::last_present_timing`].
+    pub(crate) fn last_present_timing(&mut self) -> Option<PresentTiming> {
+        let timer = self.present.as_mut()?.timer.as_mut()?;
+        timer.latest(&self.ctx.device)
     }
 }

@@ -102,7 +102,6 @@ struct TileBindGroups {
 
 impl Prepared {
     /// The number of shadow-map passes (map casts) of the frame.
-    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn map_pass_count(&self) -> u32 {
         self.map_passes.len() as u32
     }
@@ -496,12 +495,26 @@ impl Renderer {
         });
     }
 
-    /// Validates the frame, uploads what it needs and plans the tiles covering the rows `rows`.
+    /// Validates the frame, uploads what it needs, plans the tiles covering the rows `rows` and
+    /// submits the shadow maps (and, with an `[area_light]`, the soft shadows).
     pub(crate) fn prepare(
         &mut self,
         frame: &Frame,
         rows: std::ops::Range<u32>,
     ) -> Result<Prepared, RenderError> {
+        self.prepare_frame(frame, rows, true)
+    }
+
+    /// [`Renderer::prepare`]; with `submit_maps` false the shadow maps are left for the caller to
+    /// submit ([`Renderer::submit_shadow_maps`], e.g. with timestamps) before the tiles. Only for
+    /// frames without an `[area_light]`, whose soft shadows are drawn here after the maps.
+    pub(crate) fn prepare_frame(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+        submit_maps: bool,
+    ) -> Result<Prepared, RenderError> {
+        debug_assert!(submit_maps || frame.area_light.is_none());
         self.ctx.check()?;
         validate_frame(frame)?;
         let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
@@ -719,7 +732,9 @@ impl Renderer {
                 raster,
                 groups: None,
             };
-            self.submit_shadow_maps(frame, &prepared, None);
+            if submit_maps || frame.area_light.is_some() {
+                self.submit_shadow_maps(frame, &prepared, None);
+            }
             if frame.area_light.is_some() {
                 self.ensure_soft(frame);
             }

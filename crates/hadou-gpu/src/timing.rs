@@ -8,6 +8,8 @@
 use crate::render::Renderer;
 #[cfg(not(target_arch = "wasm32"))]
 use hadou_scene::{Frame, RenderError};
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::Arc;
 #[cfg(not(target_arch = "wasm32"))]
 use std::time::Instant;
 
@@ -26,7 +28,8 @@ pub enum TimingMethod {
     WallClock,
 }
 
-/// The GPU time of one kind of pass in a frame, from [`crate::GpuBackend::time_frame`].
+/// The GPU time of one kind of pass in a frame, from [`crate::GpuBackend::time_frame`] (or, for one
+/// frame, [`crate::GpuBackend::last_present_timing`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTime {
     /// The pass: `"shadow maps"` (once per frame, every map layer), then per tile `"raster"`
@@ -127,6 +130,209 @@ impl<'a> PassQueries<'a> {
     /// Queries written so far.
     fn used(&self) -> u32 {
         2 * self.passes.len() as u32
+    }
+}
+
+/// The GPU time of one frame drawn by [`crate::GpuBackend::render_to_texture`], from
+/// [`crate::GpuBackend::last_present_timing`]: measured from GPU timestamps as
+/// [`TimingMethod::GpuTimestamps`] is, read back without waiting.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PresentTiming {
+    /// The frame's GPU time in milliseconds: the shadow-map passes' span plus, per tile, the span
+    /// from its first pass's beginning to its present pass's end, summed over the tiles (the gaps
+    /// between submissions excluded).
+    pub frame_ms: f64,
+    /// The frame split by pass, in the order the passes first run: those of
+    /// [`FrameTiming::passes`] and `"present"` (per tile, the copy into the window texture). Each
+    /// [`PassTime::median_ms`] is that pass's time in this one frame (summed over its tiles or map
+    /// layers), at most `frame_ms`; together they are at most `frame_ms`.
+    pub passes: Vec<PassTime>,
+    /// Which frame it was: the [`crate::PresentedFrame::serial`] `render_to_texture` returned.
+    pub serial: u64,
+}
+
+/// Staging buffers in the ring of [`PresentTimer`]: frames whose timestamps may be in flight at
+/// once (a window shows its GPU time a frame or two late; a frame finding all of them busy is not
+/// timed).
+const PRESENT_RING: usize = 3;
+
+/// Passes per tile of `render_to_texture` that may take timestamps: those of `PASSES_PER_TILE`,
+/// then the present pass.
+pub(crate) const PRESENT_PASSES_PER_TILE: u32 = PASSES_PER_TILE + 1;
+
+/// States of a staging buffer of [`PresentTimer`] (in an `AtomicU8`, set by the map callback).
+const FREE: u8 = 0;
+const MAPPING: u8 = 1;
+const MAPPED: u8 = 2;
+const FAILED: u8 = 3;
+
+/// One staging buffer of the ring and the frame it holds.
+struct Staging {
+    buffer: wgpu::Buffer,
+    /// [`FREE`], [`MAPPING`] (copy submitted, `map_async` asked), [`MAPPED`] or [`FAILED`].
+    state: Arc<AtomicU8>,
+    serial: u64,
+    /// The frame's passes (`PassQueries::passes`) and the queries it wrote.
+    passes: Vec<(&'static str, u32)>,
+    used: u32,
+}
+
+/// The timestamps of `render_to_texture` frames, read back without ever waiting: every pass of a
+/// frame writes its queries, which are resolved and copied into a free staging buffer of a small
+/// ring that is then mapped asynchronously; [`PresentTimer::latest`] polls the device without
+/// blocking and reads whatever has been mapped. Only on devices with `TIMESTAMP_QUERY`.
+pub(crate) struct PresentTimer {
+    /// Nanoseconds per timestamp tick (`Queue::get_timestamp_period`).
+    period_ns: f64,
+    /// Queries the set, the resolve buffer and each staging buffer hold (0 before the first frame).
+    capacity: u32,
+    set: Option<wgpu::QuerySet>,
+    resolve: Option<wgpu::Buffer>,
+    ring: Vec<Staging>,
+    /// The most recent frame read back.
+    latest: Option<PresentTiming>,
+}
+
+/// A frame being timed: the query set its passes write and its staging buffer.
+pub(crate) struct TimedFrame {
+    set: wgpu::QuerySet,
+    capacity: u32,
+    slot: usize,
+}
+
+impl TimedFrame {
+    /// The queries to hand to the frame's passes.
+    pub(crate) fn queries(&self) -> PassQueries<'_> {
+        PassQueries::new(&self.set, self.capacity)
+    }
+}
+
+impl PresentTimer {
+    pub(crate) fn new(queue: &wgpu::Queue) -> Self {
+        Self {
+            period_ns: queue.get_timestamp_period() as f64,
+            capacity: 0,
+            set: None,
+            resolve: None,
+            ring: Vec::new(),
+            latest: None,
+        }
+    }
+
+    /// Queries for a frame whose passes need `queries` of them, or `None` — the frame is simply
+    /// not timed — when every staging buffer still holds a frame in flight, or the frame needs more
+    /// than one query set holds. The set and buffers grow to fit (frames in flight then are lost).
+    pub(crate) fn begin(&mut self, device: &wgpu::Device, queries: u32) -> Option<TimedFrame> {
+        if queries == 0 || queries > wgpu::QUERY_SET_MAX_QUERIES {
+            return None;
+        }
+        if queries > self.capacity {
+            let capacity = queries.next_power_of_two().clamp(64, wgpu::QUERY_SET_MAX_QUERIES);
+            let bytes = capacity as u64 * 8;
+            // Free the old ones first (a pending map of a dropped buffer fails: that frame is lost).
+            self.ring.clear();
+            self.set = Some(device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("present timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: capacity,
+            }));
+            self.resolve = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("present timestamp resolve"),
+                size: bytes,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }));
+            self.ring = (0..PRESENT_RING)
+                .map(|_| Staging {
+                    buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("present timestamp read"),
+                        size: bytes,
+                        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                        mapped_at_creation: false,
+                    }),
+                    state: Arc::new(AtomicU8::new(FREE)),
+                    serial: 0,
+                    passes: Vec::new(),
+                    used: 0,
+                })
+                .collect();
+            self.capacity = capacity;
+        }
+        // Collect what came back first, so that its buffers are free again.
+        self.collect();
+        let slot = self.ring.iter().position(|s| s.state.load(Ordering::Acquire) == FREE)?;
+        Some(TimedFrame { set: self.set.clone()?, capacity: self.capacity, slot })
+    }
+
+    /// After the frame's passes are submitted, having written `queries`: resolves them, copies
+    /// them into the frame's staging buffer and asks for that to be mapped. Never waits.
+    pub(crate) fn finish(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &TimedFrame,
+        queries: PassQueries<'_>,
+        serial: u64,
+    ) {
+        let used = queries.used();
+        let (Some(resolve), Some(staging)) = (&self.resolve, self.ring.get_mut(frame.slot)) else { return };
+        if used == 0 || frame.capacity != self.capacity {
+            return;
+        }
+        let bytes = used as u64 * 8;
+        let mut enc = device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present timestamps") });
+        enc.resolve_query_set(&frame.set, 0..used, resolve, 0);
+        enc.copy_buffer_to_buffer(resolve, 0, &staging.buffer, 0, bytes);
+        queue.submit([enc.finish()]);
+        staging.state.store(MAPPING, Ordering::Release);
+        staging.serial = serial;
+        staging.passes = queries.passes;
+        staging.used = used;
+        let state = staging.state.clone();
+        staging.buffer.slice(..bytes).map_async(wgpu::MapMode::Read, move |r| {
+            state.store(if r.is_ok() { MAPPED } else { FAILED }, Ordering::Release);
+        });
+    }
+
+    /// Reads every staging buffer whose map has completed (and unmaps it for reuse), keeping the
+    /// most recent frame's timing. Does not poll.
+    fn collect(&mut self) {
+        for s in &mut self.ring {
+            match s.state.load(Ordering::Acquire) {
+                MAPPED => {
+                    if self.latest.as_ref().is_none_or(|l| l.serial < s.serial) {
+                        let ns: Vec<f64> = {
+                            let view = s.buffer.slice(..s.used as u64 * 8).get_mapped_range();
+                            view.chunks_exact(8)
+                                .map(|t| {
+                                    u64::from_ne_bytes(t.try_into().unwrap_or_default()) as f64
+                                        * self.period_ns
+                                })
+                                .collect()
+                        };
+                        let (frame_ms, per_pass) = split_frame(&s.passes, &ns);
+                        let passes = per_pass
+                            .into_iter()
+                            .map(|(name, ms)| PassTime { name: name.to_string(), median_ms: ms })
+                            .collect();
+                        self.latest = Some(PresentTiming { frame_ms, passes, serial: s.serial });
+                    }
+                    s.buffer.unmap();
+                    s.state.store(FREE, Ordering::Release);
+                }
+                FAILED => s.state.store(FREE, Ordering::Release),
+                _ => {}
+            }
+        }
+    }
+
+    /// See [`crate::GpuBackend::last_present_timing`]: polls the device without blocking (on the
+    /// web a no-op: the browser completes maps on its own) and reads what has come back.
+    pub(crate) fn latest(&mut self, device: &wgpu::Device) -> Option<PresentTiming> {
+        let _ = device.poll(wgpu::PollType::Poll);
+        self.collect();
+        self.latest.clone()
     }
 }
 

@@ -48,6 +48,11 @@ fn adapter() -> Result<wgpu::Adapter, String> {
 /// Opens a device as a window would and builds the backend on it. `Err(None)` when there is no
 /// usable adapter (a skip), `Err(Some(_))` on any other failure.
 fn open() -> Result<Gpu, Option<String>> {
+    open_with(|_| {})
+}
+
+/// [`open`], with `edit` changing the device descriptor first.
+fn open_with(edit: impl FnOnce(&mut wgpu::DeviceDescriptor<'static>)) -> Result<Gpu, Option<String>> {
     let adapter = adapter().map_err(|e| {
         eprintln!("no adapter: {e}");
         None
@@ -60,7 +65,9 @@ fn open() -> Result<Gpu, Option<String>> {
         }
         Err(e) => return Err(Some(e.to_string())),
     }
-    let (device, queue) = pollster::block_on(adapter.request_device(&hadou_gpu::device_descriptor(&adapter)))
+    let mut descriptor = hadou_gpu::device_descriptor(&adapter);
+    edit(&mut descriptor);
+    let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))
         .map_err(|e| Some(format!("request_device: {e}")))?;
     let backend =
         GpuBackend::from_device(&adapter, device.clone(), queue.clone()).map_err(|e| Some(e.to_string()))?;
@@ -221,4 +228,116 @@ fn two_sizes_in_a_row_and_several_tiles() {
     let wide = scene_frame("kamehameha.toml", 0.25, hadou_gpu::MAX_TILE + 20, 24);
     assert!(check(&mut gpu, "1044×24", &wide), "a new size makes a new texture");
     assert!(check(&mut gpu, "96×64 after 1044×24", &small), "and back");
+}
+
+/// Waits here (test code may) until the backend's latest present timing is of frame `serial` or
+/// later, calling `last_present_timing` (which never waits) between blocking polls; `None` if it
+/// never comes.
+fn timing_of(gpu: &mut Gpu, serial: u64) -> Option<hadou_gpu::PresentTiming> {
+    for _ in 0..20 {
+        gpu.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: Some(std::time::Duration::from_secs(300)),
+            })
+            .expect("waiting for the GPU");
+        if let Some(t) = gpu.backend.last_present_timing().filter(|t| t.serial >= serial) {
+            return Some(t);
+        }
+    }
+    None
+}
+
+/// The names of `t`'s passes, in order.
+fn pass_names(t: &hadou_gpu::PresentTiming) -> Vec<&str> {
+    t.passes.iter().map(|p| p.name.as_str()).collect()
+}
+
+/// `last_present_timing`: with timestamps (lavapipe; Mesa's desktop GL too, through
+/// `GL_ARB_timer_query`) the GPU time of the latest timed frame comes back, split into its passes
+/// (the present pass included), with increasing serials; a frame with an `[area_light]` is not
+/// timed. Without timestamps it is always `None` (see also the next test). The timed path draws
+/// the same image (shadow maps included).
+#[test]
+fn present_timing_comes_back_without_waiting() {
+    let Some(mut gpu) = gpu_or_skip("present: timing") else { return };
+    let has = gpu.backend.has_timestamps();
+    let mut serials = Vec::new();
+    for t in [0.0, 0.5, 1.0] {
+        let frame = scene_frame("kamehameha.toml", t, 128, 96);
+        let presented = gpu.backend.render_to_texture(&frame).expect("render_to_texture");
+        serials.push(presented.serial);
+        // Nothing here waited: asking right away never blocks (it may or may not have a time).
+        let _ = gpu.backend.last_present_timing();
+    }
+    assert!(serials.windows(2).all(|s| s[1] == s[0] + 1), "serials count frames: {serials:?}");
+    let last = *serials.last().expect("three frames");
+    if !has {
+        assert!(timing_of(&mut gpu, 0).is_none(), "no timestamps, no timing");
+        eprintln!("{}: no timestamp queries, no present timing", gpu.backend.adapter_name());
+        return;
+    }
+    let t = timing_of(&mut gpu, last).expect("a timing for the last frame");
+    eprintln!("{t:?}");
+    let check_timing = |t: &hadou_gpu::PresentTiming, expected: &[&str]| {
+        assert!(t.frame_ms > 0.0 && t.frame_ms.is_finite(), "{t:?}");
+        assert_eq!(pass_names(t), expected, "{t:?}");
+        assert!(
+            t.passes.iter().all(|p| p.median_ms >= 0.0 && p.median_ms <= t.frame_ms * (1.0 + 1e-9)),
+            "{t:?}"
+        );
+        let sum: f64 = t.passes.iter().map(|p| p.median_ms).sum();
+        assert!(sum <= t.frame_ms * (1.0 + 1e-9), "passes {sum} ms > frame {} ms: {t:?}", t.frame_ms);
+    };
+    check_timing(&t, &["raster", "wave", "present"]);
+    assert_eq!(t.serial, last);
+
+    // Shadow maps and plane shadows, two tiles: later frame, larger serial; and the same image.
+    let mut shadows = scene_frame("shadow-uneven.toml", 0.5, 128, 96);
+    check(&mut gpu, "shadow-uneven (timed)", &shadows);
+    shadows.width = hadou_gpu::MAX_TILE + 20;
+    shadows.height = 24;
+    let serial = gpu.backend.render_to_texture(&shadows).expect("render_to_texture").serial;
+    let t2 = timing_of(&mut gpu, serial).expect("a timing for the shadow frame");
+    eprintln!("{t2:?}");
+    assert_eq!(t2.serial, serial);
+    assert!(t2.serial > t.serial);
+    check_timing(&t2, &["shadow maps", "raster", "plane shadows", "wave", "present"]);
+
+    // An [area_light] frame is not timed: the latest timing stays the previous frame's.
+    let soft = scene_frame("soft-gradient.toml", 0.5, 96, 72);
+    assert!(soft.area_light.is_some());
+    let soft_serial = gpu.backend.render_to_texture(&soft).expect("render_to_texture").serial;
+    assert_eq!(soft_serial, serial + 1);
+    assert!(timing_of(&mut gpu, soft_serial).is_none(), "an area-light frame is not timed");
+    assert_eq!(gpu.backend.last_present_timing().map(|t| t.serial), Some(serial));
+
+    // Many frames without anyone polling: those finding the ring busy go untimed, nothing
+    // blocks, and the timing still comes back afterwards.
+    let frame = scene_frame("kamehameha.toml", 0.25, 64, 48);
+    let mut last = 0;
+    for _ in 0..8 {
+        last = gpu.backend.render_to_texture(&frame).expect("render_to_texture").serial;
+    }
+    let t3 = timing_of(&mut gpu, soft_serial + 1).expect("a timing after many frames");
+    assert!(t3.serial > soft_serial && t3.serial <= last, "{t3:?}");
+    check_timing(&t3, &["raster", "wave", "present"]);
+}
+
+/// A window that opened its device without `TIMESTAMP_QUERY` (as on an adapter lacking it, e.g.
+/// WebGL or GLES without timer queries) never gets a present timing, and draws the same image.
+#[test]
+fn no_present_timing_without_timestamp_queries() {
+    // Holding the shared backend's lock: one device renders at a time (see tests/common).
+    let Some(_shared) = gpu_or_skip("present: no timestamps") else { return };
+    let mut gpu = open_with(|d| d.required_features.remove(wgpu::Features::TIMESTAMP_QUERY))
+        .unwrap_or_else(|e| panic!("opening a device without timestamps: {e:?}"));
+    assert!(!gpu.backend.has_timestamps());
+    assert!(gpu.backend.last_present_timing().is_none(), "nothing drawn yet");
+    let frame = scene_frame("shadow-uneven.toml", 0.5, 96, 64);
+    check(&mut gpu, "shadow-uneven (untimed)", &frame);
+    for _ in 0..3 {
+        gpu.backend.render_to_texture(&frame).expect("render_to_texture");
+    }
+    assert!(timing_of(&mut gpu, 0).is_none(), "no timestamps, no timing");
 }
