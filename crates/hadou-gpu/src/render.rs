@@ -496,7 +496,9 @@ impl Renderer {
     }
 
     /// Validates the frame, uploads what it needs, plans the tiles covering the rows `rows` and
-    /// submits the shadow maps (and, with an `[area_light]`, the soft shadows).
+    /// submits the shadow maps (and, with an `[area_light]`, the soft shadows). Not on the web,
+    /// where only `render_to_texture` draws (through [`Renderer::prepare_frame`]).
+    #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn prepare(
         &mut self,
         frame: &Frame,
