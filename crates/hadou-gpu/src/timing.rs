@@ -58,8 +58,8 @@ pub struct FrameTiming {
     /// Minimum of `per_iteration_ms`.
     pub min_ms: f64,
     /// The frame split by pass, in the order the passes first run ([`PassTime`]). Only with
-    /// [`TimingMethod::GpuTimestamps`]; empty when the adapter has no timestamp queries (e.g.
-    /// OpenGL) or the frame is timed by wall clock. Each pass's median is at most `median_ms`,
+    /// [`TimingMethod::GpuTimestamps`]; empty when the adapter has no timestamp queries (some
+    /// GL and GLES drivers) or the frame is timed by wall clock. Each pass's median is at most `median_ms`,
     /// and in any one iteration the passes sum to at most the frame (the frame also holds the
     /// gaps between passes).
     pub passes: Vec<PassTime>,

@@ -27,7 +27,7 @@ fn names(t: &hadou_gpu::FrameTiming) -> Vec<&str> {
 }
 
 /// With timestamps every pass of the frame is timed (shadow maps, raster, plane shadows, wave)
-/// and, in one iteration, the passes sum to no more than the frame; without them (GL) there is no
+/// and, in one iteration, the passes sum to no more than the frame; without them (some GL drivers) there is no
 /// split. A frame with nothing to draw skips the raster pass.
 #[test]
 fn time_frame_splits_the_frame_into_its_passes() {
