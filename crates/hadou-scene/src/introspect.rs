@@ -20,6 +20,8 @@ pub enum Entity {
     Color,
     /// `[area_light]`.
     AreaLight,
+    /// `[image]` (no animatable keys; its size is structural).
+    Image,
     /// The `[[wave]]` with this name.
     Wave(String),
     /// The `[[object]]` with this name.
@@ -39,6 +41,7 @@ impl Entity {
             Entity::Light => "light",
             Entity::Color => "color",
             Entity::AreaLight => "area_light",
+            Entity::Image => "image",
             Entity::Wave(_) => "wave",
             Entity::Object(_) => "object",
             Entity::Material(_) => "material",
@@ -330,6 +333,7 @@ impl Scene {
             Entity::Light => &self.light,
             Entity::Color => &self.color,
             Entity::AreaLight => &self.area_light.as_ref()?.params,
+            Entity::Image => return None,
             Entity::Wave(n) => &self.waves.iter().find(|w| &w.name == n)?.params,
             Entity::Object(n) => &self.objects.iter().find(|o| &o.name == n)?.params,
             Entity::Material(n) => &self.materials.iter().find(|m| &m.name == n)?.params,

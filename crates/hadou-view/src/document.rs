@@ -55,6 +55,17 @@ pub enum Edit {
         /// The new value.
         value: String,
     },
+    /// Writes any key of a table as TOML text (`"[[0.5, 1, 1, 1]]"`, `"\"faithful\""`, `"64"`):
+    /// the keys the panel has no dedicated control for (ramps, textures, map sizes, integrator
+    /// settings, the image size, …). Empty text removes the key, so its default applies.
+    Raw {
+        /// The table.
+        entity: Entity,
+        /// The key.
+        key: String,
+        /// A TOML value, or empty.
+        value: String,
+    },
     /// Replaces a track's interpolation (`"linear"`, `"smooth"`).
     Interpolation {
         /// The track's target.
@@ -205,6 +216,30 @@ impl Document {
     /// The message of the last reload that failed, while the file on disk stays broken.
     pub fn reload_error(&self) -> Option<&str> {
         self.reload_error.as_deref()
+    }
+
+    /// The keys of `entity`'s table with their TOML text, other than `name` and the animatable
+    /// parameters (which have their own controls): what [`Edit::Raw`] edits. Sub-tables are left
+    /// out; an entity the file does not write has none.
+    pub fn other_keys(&self, entity: &Entity) -> Vec<(String, String)> {
+        let animatable: Vec<&'static str> =
+            self.scene.parameters().into_iter().filter(|p| &p.entity == entity).map(|p| p.key).collect();
+        let table = match entity.name() {
+            Some(name) => match self.doc.get(entity.table()) {
+                Some(Item::ArrayOfTables(a)) => {
+                    a.iter().find(|t| t.get("name").and_then(Item::as_str) == Some(name))
+                }
+                _ => None,
+            },
+            None if *entity == Entity::Top => Some(self.doc.as_table()),
+            None => self.doc.get(entity.table()).and_then(Item::as_table),
+        };
+        let Some(table) = table else { return Vec::new() };
+        table
+            .iter()
+            .filter(|(k, _)| *k != "name" && !animatable.contains(k))
+            .filter_map(|(k, item)| Some((k.to_string(), item.as_value()?.to_string().trim().to_string())))
+            .collect()
     }
 
     /// Whether [`Document::undo`] / [`Document::redo`] have a step to take.
@@ -598,6 +633,23 @@ fn edit_tree(doc: &mut DocumentMut, scene: &Scene, edit: &Edit) -> Result<(), Do
         Edit::Choice { entity, key, value } => {
             let table = entity_table(doc, entity)?;
             set_key(table, key, Value::from(value.as_str()));
+        }
+        Edit::Raw { entity, key, value } => {
+            if key.is_empty() || key == "name" || !key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            {
+                return err(format!(
+                    "`{key}`: give a key of the table (letters, digits and `_`; not `name`)"
+                ));
+            }
+            let table = entity_table(doc, entity)?;
+            if value.trim().is_empty() {
+                table.remove(key);
+            } else {
+                let v: Value = value.trim().parse().map_err(|e: toml_edit::TomlError| {
+                    DocError(format!("`{key}`: not a TOML value: {}", e.message()))
+                })?;
+                set_key(table, key, v);
+            }
         }
         Edit::Interpolation { target, value } => {
             let track = track_of(tracks(doc)?, target)

@@ -30,6 +30,10 @@ pub struct UiState {
     export_frames: String,
     /// Where the viewport was drawn last frame (points).
     pub viewport_rect: Option<Rect>,
+    /// Text being typed into the "other keys" fields, by (table, key).
+    raw: std::collections::HashMap<(String, String), String>,
+    /// The "add a key" row of each table: (key, value).
+    new_key: std::collections::HashMap<String, (String, String)>,
 }
 
 impl Default for UiState {
@@ -42,6 +46,8 @@ impl Default for UiState {
             fire_wave: None,
             export_frames: String::new(),
             viewport_rect: None,
+            raw: Default::default(),
+            new_key: Default::default(),
         }
     }
 }
@@ -249,14 +255,22 @@ fn group_of(e: &Entity) -> &'static str {
         Entity::Wave(_) => "Waves",
         Entity::Shadow(_) => "Shadows",
         Entity::AreaLight => "Area light",
+        Entity::Image => "Image",
     }
 }
 
 fn params(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
     let all = v.scene().parameters();
-    let groups = ["Camera", "Light", "Colour", "Objects", "Materials", "Waves", "Shadows", "Area light"];
+    let groups =
+        ["Image", "Camera", "Light", "Colour", "Objects", "Materials", "Waves", "Shadows", "Area light"];
     for g in groups {
         let in_group: Vec<&ParamInfo> = all.iter().filter(|p| group_of(&p.entity) == g).collect();
+        if g == "Image" {
+            egui::CollapsingHeader::new(g)
+                .default_open(false)
+                .show(ui, |ui| other_keys(ui, v, st, &Entity::Image));
+            continue;
+        }
         if in_group.is_empty() && !matches!(g, "Objects" | "Waves") {
             continue;
         }
@@ -278,10 +292,12 @@ fn params(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
                         |ui| {
                             entity_actions(ui, v, e);
                             param_rows(ui, v, &list);
+                            other_keys(ui, v, st, e);
                         },
                     );
                 } else {
                     param_rows(ui, v, &list);
+                    other_keys(ui, v, st, e);
                 }
             }
             if g == "Waves" {
@@ -292,6 +308,45 @@ fn params(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
             }
         });
     }
+}
+
+/// The table's keys without a control of their own (ramps, textures, map sizes, integrator
+/// settings, …) as TOML text, each applied when edited, plus a row to add a key.
+fn other_keys(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState, e: &Entity) {
+    let keys = v.doc.other_keys(e);
+    let id = e.describe();
+    egui::CollapsingHeader::new("other keys").id_salt(("other", &id)).default_open(false).show(ui, |ui| {
+        for (key, text) in keys {
+            let slot = (id.clone(), key.clone());
+            ui.horizontal(|ui| {
+                ui.label(&key);
+                let buf = st.raw.entry(slot.clone()).or_insert_with(|| text.clone());
+                let r = ui.add(egui::TextEdit::singleline(buf).code_editor().desired_width(220.0));
+                let commit = r.lost_focus() && *buf != text;
+                if !r.has_focus() && !commit {
+                    *buf = text.clone();
+                }
+                if commit {
+                    let value = buf.clone();
+                    st.raw.remove(&slot);
+                    v.apply(Edit::Raw { entity: e.clone(), key: key.clone(), value });
+                }
+            });
+        }
+        ui.horizontal(|ui| {
+            let (k, val) = st.new_key.entry(id.clone()).or_default();
+            ui.add(egui::TextEdit::singleline(k).hint_text("key").desired_width(90.0));
+            ui.add(
+                egui::TextEdit::singleline(val).hint_text("TOML value").code_editor().desired_width(140.0),
+            );
+            if ui.button("set").clicked() {
+                let (key, value) = (k.trim().to_string(), val.clone());
+                if v.apply(Edit::Raw { entity: e.clone(), key, value }) {
+                    st.new_key.remove(&id);
+                }
+            }
+        });
+    });
 }
 
 fn colour_mode(ui: &mut egui::Ui, v: &mut Viewer) {

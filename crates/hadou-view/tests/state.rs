@@ -430,3 +430,38 @@ fn choices_and_interpolation_edit_the_file() {
     assert_eq!(d.scene().tracks()[0].interpolation, hadou_scene::Interpolation::Smooth);
     assert!(d.apply(&Edit::Interpolation { target: "camera.fov".into(), value: "smooth".into() }).is_err());
 }
+
+#[test]
+fn other_keys_are_listed_and_edited_as_toml() {
+    use hadou_scene::Entity;
+    let (mut d, _) = doc("raw");
+    assert_eq!(
+        d.other_keys(&Entity::Image),
+        vec![("width".to_string(), "64".to_string()), ("height".to_string(), "48".to_string())]
+    );
+    // Animatable keys and names have their own controls; structural keys are listed.
+    let wave = Entity::Wave("curve".into());
+    let keys: Vec<String> = d.other_keys(&wave).into_iter().map(|(k, _)| k).collect();
+    assert_eq!(keys, vec!["kind"]);
+    d.apply(&Edit::Raw { entity: Entity::Image, key: "width".into(), value: "32".into() }).unwrap();
+    assert_eq!(d.scene().width(), 32);
+    assert!(d.text().contains("width = 32\n"));
+    let ramp = "[[-1, 0, 0.2, 0.4], [0, 0.9, 0.9, 1]]";
+    d.apply(&Edit::Raw { entity: wave.clone(), key: "light_ramp".into(), value: ramp.into() }).unwrap();
+    assert!(d.other_keys(&wave).contains(&("light_ramp".to_string(), ramp.to_string())));
+    // Not TOML, refused by the loader, or not a key: nothing changes.
+    let before = d.text().to_string();
+    let e =
+        d.apply(&Edit::Raw { entity: Entity::Image, key: "width".into(), value: "[1,".into() }).unwrap_err();
+    assert!(e.0.contains("not a TOML value"), "{e}");
+    let e =
+        d.apply(&Edit::Raw { entity: Entity::Image, key: "width".into(), value: "0".into() }).unwrap_err();
+    assert!(e.0.contains("width"), "{e}");
+    assert!(d.apply(&Edit::Raw { entity: Entity::Image, key: "name".into(), value: "1".into() }).is_err());
+    assert!(d.apply(&Edit::Raw { entity: Entity::Image, key: "a b".into(), value: "1".into() }).is_err());
+    assert_eq!(d.text(), before);
+    // Empty text removes the key: its default applies.
+    d.apply(&Edit::Raw { entity: Entity::Camera, key: "fov".into(), value: String::new() }).unwrap();
+    assert_eq!(d.scene().value_at("camera.fov", 0.0), Some(vec![45.0]));
+    assert!(!d.text().contains("fov"));
+}
