@@ -632,6 +632,14 @@ fn viewport(ui: &mut egui::Ui, v: &mut Viewer, image: Option<ViewportImage>, st:
             }
         }
     }
+    if let Some([x, y]) = v.probe_at {
+        let c = to_screen([x as f32 + 0.5, y as f32 + 0.5]);
+        let stroke = Stroke::new(1.0, Color32::from_rgb(255, 220, 80));
+        painter.line_segment([c - Vec2::new(7.0, 0.0), c - Vec2::new(2.0, 0.0)], stroke);
+        painter.line_segment([c + Vec2::new(2.0, 0.0), c + Vec2::new(7.0, 0.0)], stroke);
+        painter.line_segment([c - Vec2::new(0.0, 7.0), c - Vec2::new(0.0, 2.0)], stroke);
+        painter.line_segment([c + Vec2::new(0.0, 2.0), c + Vec2::new(0.0, 7.0)], stroke);
+    }
     if let Some(e) = v.doc.reload_error() {
         let r = Rect::from_min_size(avail.min + Vec2::splat(8.0), Vec2::new(avail.width() - 16.0, 0.0));
         painter.text(

@@ -155,6 +155,8 @@ pub struct Viewer {
     pub stats: Stats,
     /// The last probe's text.
     pub probe: Option<String>,
+    /// The pixel the last probe was taken at (marked in the viewport).
+    pub probe_at: Option<[u32; 2]>,
     /// What the window should do next; it drains this each frame.
     pub requests: Vec<Request>,
     /// A running export's progress `(done, total)`.
@@ -184,6 +186,7 @@ impl Viewer {
             selected_wave: None,
             stats: Stats::default(),
             probe: None,
+            probe_at: None,
             requests: Vec::new(),
             export_progress: None,
             fire_duration: 1.0,

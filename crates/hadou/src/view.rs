@@ -510,6 +510,7 @@ impl App {
                 }
                 Request::Probe([x, y]) => {
                     let frame = self.viewer.frame();
+                    self.viewer.probe_at = (x < frame.width && y < frame.height).then_some([x, y]);
                     self.viewer.probe = Some(match crate::probe(&frame, x, y) {
                         Some(p) => {
                             let waves: Vec<String> = p
