@@ -51,16 +51,7 @@ fn main() {
     };
     let (device, queue) = (gpu.device(), gpu.queue());
     let (w, h) = (scene.width(), scene.height());
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("viewport"),
-        size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8UnormSrgb,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let texture = hadou::view::viewport_texture(device, [w, h]);
     let mut cpu = hadou::CpuBackend::new();
     let mut image = hadou::Image::new(1, 1);
     let end = scene.duration().max(1.0);

@@ -167,6 +167,21 @@ pub fn srgba8_into(image: &Image, out: &mut Vec<u8>) {
         .for_each(|(o, c)| hadou_math::shade::rgba_to_srgba8(c, o));
 }
 
+/// The texture the CPU path's image is uploaded into: `size`, `Rgba8UnormSrgb` (the bytes are
+/// sRGB codes; sampling gives linear colour back), sampled and written.
+pub fn viewport_texture(device: &wgpu::Device, size: [u32; 2]) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("hadou view CPU image"),
+        size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    })
+}
+
 /// Writes 8-bit RGBA rows (`4 · size[0]` bytes each) into the whole of `texture`.
 pub fn upload_rgba(queue: &wgpu::Queue, texture: &wgpu::Texture, rgba: &[u8], size: [u32; 2]) {
     queue.write_texture(
@@ -736,20 +751,7 @@ impl App {
                     let size = done.size;
                     let needs_new = g.cpu_texture.as_ref().is_none_or(|t| t.2 != size);
                     if needs_new {
-                        let tex = g.device.create_texture(&wgpu::TextureDescriptor {
-                            label: Some("hadou view CPU image"),
-                            size: wgpu::Extent3d {
-                                width: size[0],
-                                height: size[1],
-                                depth_or_array_layers: 1,
-                            },
-                            mip_level_count: 1,
-                            sample_count: 1,
-                            dimension: wgpu::TextureDimension::D2,
-                            format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                            view_formats: &[],
-                        });
+                        let tex = viewport_texture(&g.device, size);
                         let view = tex.create_view(&Default::default());
                         let id = match g.cpu_texture.take() {
                             Some((_, id, _)) => {
