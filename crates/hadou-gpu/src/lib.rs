@@ -102,6 +102,15 @@ pub fn find_adapter() -> Result<wgpu::AdapterInfo, RenderError> {
     device::adapter_info()
 }
 
+/// The adapter [`GpuBackend::new`] opens: `WGPU_BACKEND`'s backends when set, otherwise the
+/// primary backends (Vulkan, Metal, DX12) and OpenGL only if none of those has one. For callers
+/// that open the device themselves ([`GpuBackend::from_device`]); `Err` says why there is none.
+/// Not on the web (it blocks).
+#[cfg(not(target_arch = "wasm32"))]
+pub fn request_adapter() -> Result<wgpu::Adapter, String> {
+    device::request_adapter()
+}
+
 /// Whether `adapter` can run hadou (the downlevel capabilities, limits and texture formats the
 /// passes use); check it before opening a device for [`GpuBackend::from_device`]. Every
 /// shortfall is listed in one [`RenderError::NoDevice`] starting "unsupported adapter".

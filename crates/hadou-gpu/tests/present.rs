@@ -19,30 +19,9 @@ struct Gpu {
     queue: wgpu::Queue,
 }
 
-/// The adapter `GpuBackend::new` would choose: `WGPU_BACKEND`'s backends when set, otherwise the
-/// primary backends (Vulkan, Metal, DX12) and OpenGL only if none of those has one.
+/// The adapter `GpuBackend::new` would choose.
 fn adapter() -> Result<wgpu::Adapter, String> {
-    let options = wgpu::RequestAdapterOptions {
-        power_preference: wgpu::PowerPreference::HighPerformance,
-        force_fallback_adapter: false,
-        compatible_surface: None,
-    };
-    let from_env = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-    let tries = if std::env::var_os("WGPU_BACKEND").is_some() {
-        vec![from_env.backends]
-    } else {
-        vec![wgpu::Backends::PRIMARY, wgpu::Backends::SECONDARY]
-    };
-    let mut errors = Vec::new();
-    for backends in tries {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        desc.backends = backends;
-        match pollster::block_on(wgpu::Instance::new(desc).request_adapter(&options)) {
-            Ok(a) => return Ok(a),
-            Err(e) => errors.push(e.to_string()),
-        }
-    }
-    Err(errors.join("; "))
+    hadou_gpu::request_adapter()
 }
 
 /// Opens a device as a window would and builds the backend on it. `Err(None)` when there is no

@@ -391,11 +391,12 @@ impl Document {
     }
 }
 
-/// Removes a leading `path:` from a loader message about the document's own (unsaved) text, so
-/// an edit's refusal reads as the rule it broke.
+/// Replaces a leading `path:` in a loader message about the document's own (unsaved) text: the
+/// line and column are of the edited text, not of the file on disk.
 fn strip_path(m: &str, path: &Path) -> String {
     let p = format!("{}:", path.display());
-    m.strip_prefix(&p).map_or_else(|| m.to_string(), |rest| format!("line {}", rest.trim_start()))
+    m.strip_prefix(&p)
+        .map_or_else(|| m.to_string(), |rest| format!("in the edited scene, line {}", rest.trim_start()))
 }
 
 /// Writes `bytes` to a temporary file in `path`'s directory and renames it over `path`.

@@ -96,6 +96,11 @@ fn refused_edits_change_nothing() {
     assert_eq!(d.text(), before);
     assert!(!d.can_undo());
     assert!(d.apply(&Edit::Set { target: "wave.nope.M".into(), value: vec![0.0; 3] }).is_err());
+    // Values of the wrong shape: too few or too many numbers, an odd count for a list of pairs.
+    assert!(d.apply(&Edit::Set { target: "camera.position".into(), value: vec![1.0] }).is_err());
+    assert!(d.apply(&Edit::Set { target: "camera.position".into(), value: vec![1.0; 4] }).is_err());
+    assert!(d.apply(&Edit::Set { target: "wave.curve.points".into(), value: vec![0.0; 5] }).is_err());
+    assert!(d.apply(&Edit::Key { target: "camera.fov".into(), time: 1.0, value: vec![] }).is_err());
     // Eye on the target: the camera rule of the loader.
     assert!(d.apply(&Edit::Set { target: "camera.position".into(), value: vec![0.0; 3] }).is_err());
     assert_eq!(d.text(), before);

@@ -73,8 +73,10 @@ pub fn run(opts: ViewOptions) -> Result<(), ViewError> {
         Some(p) => {
             let bytes = hadou_scene::read_regular_file(p, 1 << 20)
                 .map_err(|e| fail(2, format!("{}: cannot read the script: {e}", p.display())))?;
-            let text = String::from_utf8(bytes)
-                .map_err(|_| fail(2, format!("{}: the script is not UTF-8 text", p.display())))?;
+            let text = String::from_utf8(bytes).map_err(|e| {
+                let at = e.utf8_error().valid_up_to();
+                fail(2, format!("{}: the script is not UTF-8 text (byte {at})", p.display()))
+            })?;
             Some((script::parse(&text, p).map_err(|e| fail(2, e))?, p.clone()))
         }
         None => None,
@@ -267,6 +269,8 @@ struct App {
     eval_ms: f64,
     /// Whether the GPU backend has reported timestamps (then they are the render time shown).
     gpu_timed: bool,
+    /// The line of the script command run last (failures of what it asked for name it).
+    script_line: usize,
     pending_screenshot: bool,
 }
 
@@ -301,6 +305,7 @@ impl App {
             samples: Vec::new(),
             eval_ms: 0.0,
             gpu_timed: false,
+            script_line: 0,
         }
     }
 
@@ -481,6 +486,7 @@ impl App {
         // A command runs once the previous frame has been drawn (edits show before the next).
         if let Some(line) = lines.get(self.script_pos) {
             self.script_pos += 1;
+            self.script_line = line.line;
             match script::run(&mut self.viewer, line, &path) {
                 Ok(WindowOp::None) => {}
                 Ok(WindowOp::Wait(n)) => self.wait_frames = n,
@@ -496,6 +502,27 @@ impl App {
                 Ok(WindowOp::Quit) => self.script_pos = lines.len(),
                 Err(e) => self.die(event_loop, fail(2, e)),
             }
+        }
+    }
+
+    /// Carries out what the panel or the script asked for, and follows a running export.
+    fn service(&mut self) {
+        self.poll_export();
+        self.handle_requests();
+    }
+
+    /// In a scripted run, an error reported since `before` (a screenshot or export that failed, a
+    /// backend that is not there, a GPU render failure) stops the viewer with exit 2, naming the
+    /// script line that asked for it. Returns whether it stopped.
+    fn script_failed(&mut self, event_loop: &ActiveEventLoop, before: Option<(String, bool)>) -> bool {
+        let Some((_, path)) = &self.script else { return false };
+        match &self.viewer.message {
+            Some((m, true)) if self.viewer.message != before => {
+                let e = fail(2, format!("{}:{}: {m}", path.display(), self.script_line));
+                self.die(event_loop, e);
+                true
+            }
+            _ => false,
         }
     }
 
@@ -808,9 +835,12 @@ impl App {
             return;
         }
         self.viewer.tick(dt);
-        self.poll_export();
-        self.handle_requests();
+        let before = self.viewer.message.clone();
+        self.service();
         let viewer_ms = self.update_image();
+        if self.script_failed(event_loop, before) {
+            return;
+        }
         let ui_start = Instant::now();
         let Some(g) = &mut self.gfx else { return };
         let raw = g.egui_state.take_egui_input(&g.window);
@@ -959,8 +989,14 @@ impl ApplicationHandler for App {
                 // A scripted run keeps its script going while minimised.
                 event_loop
                     .set_control_flow(ControlFlow::WaitUntil(Instant::now() + Duration::from_millis(10)));
+                let before = self.viewer.message.clone();
+                self.service();
+                if self.script_failed(event_loop, before) {
+                    return;
+                }
                 self.step_script(event_loop);
-                if self.script_finished() && !self.pending_screenshot {
+                let idle = self.viewer.requests.is_empty() && self.export.is_none();
+                if self.script_finished() && !self.pending_screenshot && idle {
                     event_loop.exit();
                 }
             } else {

@@ -241,15 +241,48 @@ fn no_display_names_the_variables_and_the_alternatives() {
 #[test]
 fn a_failing_script_command_is_an_error() {
     let _x = xvfb_lock();
-    let Some(mut view) = xvfb("a_failing_script_command_is_an_error") else { return };
+    if xvfb("a_failing_script_command_is_an_error").is_none() {
+        return;
+    }
     let dir = tmp("failing");
+    // (script, what the message must name): an edit the loader refuses, and requests the window
+    // carries out later (a screenshot to an unknown format, an export into a missing directory, a
+    // screenshot asked for while minimised) must all stop the run with the line that asked.
+    let cases = [
+        ("wait 1\nset camera.fov 900\n", "s.txt:2:", "fov"),
+        ("wait 1\nscreenshot shot.txt\nwait 2\n", "s.txt:2:", "shot.txt"),
+        ("export missing/anim.gif 0..2 10\nwait 2\n", "s.txt:1:", "missing"),
+        ("resize 0 0\nscreenshot shot.bmp\n", "s.txt:2:", "shot.bmp"),
+    ];
+    for (text, line, needle) in cases {
+        let script = dir.join("s.txt");
+        std::fs::write(&script, text).unwrap();
+        let mut view = xvfb("a_failing_script_command_is_an_error").unwrap();
+        let o = run({
+            view.arg("view").arg(repo().join("scenes/fig4-1-sphere.toml")).arg("--script").arg(&script);
+            view
+        });
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{text}: {err}");
+        assert!(err.contains(line) && err.contains(needle), "{text}: {err}");
+    }
+    // A screenshot asked for while minimised is still written before the run ends.
     let script = dir.join("s.txt");
-    std::fs::write(&script, "wait 1\nset camera.fov 900\n").unwrap();
+    std::fs::write(&script, "resize 0 0\nscreenshot min.png\n").unwrap();
+    let mut view = xvfb("a_failing_script_command_is_an_error").unwrap();
     let o = run({
         view.arg("view").arg(repo().join("scenes/fig4-1-sphere.toml")).arg("--script").arg(&script);
         view
     });
+    assert!(o.status.success());
+    assert!(dir.join("min.png").is_file());
+    // A script that is not UTF-8 text: exit 2 naming the byte, before any window.
+    std::fs::write(&script, b"wait 1\n\xff\n").unwrap();
+    let o = run({
+        let mut c = hadou();
+        c.arg("view").arg(repo().join("scenes/fig4-1-sphere.toml")).arg("--script").arg(&script);
+        c
+    });
     assert_eq!(o.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("s.txt:2:") && err.contains("fov"), "{err}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("s.txt: the script is not UTF-8 text (byte 7)"));
 }
