@@ -8,6 +8,7 @@
 use crate::device::GpuContext;
 use crate::layout::{CurveBuffers, FALLOFF_FAITHFUL, FALLOFF_INVERSE_SQUARE};
 use crate::shaders;
+use crate::twin_kernel::{self, Rng};
 use bytemuck::{Pod, Zeroable};
 use hadou_math::curve::{self, CurveFrame, CurveShape, CurveWave, Integrator, PreparedCurve, Reduction};
 use hadou_math::energy::{Falloff, FieldParams, Ray};
@@ -27,8 +28,9 @@ struct CurveCase {
     span: [f32; 4],
 }
 
+/// The WGSL of one case's energy (see `twin_kernel::source`).
 const KERNEL: &str = r#"
-struct CurveCase {
+struct Case {
     curve: u32,
     falloff: u32,
     core_radius: f32,
@@ -37,34 +39,22 @@ struct CurveCase {
     dir: vec4<f32>,
     span: vec4<f32>,
 }
-@group(0) @binding(0) var<storage, read> cases: array<CurveCase>;
-@group(0) @binding(1) var<storage, read_write> results: array<f32>;
 
-@compute @workgroup_size(64, 1, 1)
-fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= arrayLength(&cases)) {
-        return;
-    }
-    let c = cases[id.x];
-    var t1 = c.span.y;
-    if (c.span.z != 0.0) {
-        t1 = T_OPEN;
-    }
-    let ray = Ray(c.origin.xyz, c.dir.xyz);
-    results[id.x] = curve_energy(curves[c.curve], c.falloff, c.core_radius, ray, c.span.x, t1, c.span.w);
+fn case_energy(c: Case, ray: Ray, t0: f32, t1: f32) -> f32 {
+    return curve_energy(curves[c.curve], c.falloff, c.core_radius, ray, t0, t1, c.span.w);
 }
 "#;
 
 /// Runs the WGSL curve integrators on `cases` with the curve data `data`.
 fn run_gpu(ctx: &GpuContext, data: &CurveBuffers, cases: &[CurveCase]) -> Result<Vec<f32>, RenderError> {
-    let source = shaders::compose(&[shaders::COMMON, shaders::ENERGY, shaders::CURVE, KERNEL]);
+    let source = twin_kernel::source(&[shaders::COMMON, shaders::ENERGY, shaders::CURVE], KERNEL);
     let inputs: [(u32, &[u8]); 4] = [
         (0, bytemuck::cast_slice(cases)),
         (5, bytemuck::cast_slice(&data.curves)),
         (6, bytemuck::cast_slice(&data.vec4s)),
         (7, bytemuck::cast_slice(&data.scalars)),
     ];
-    crate::twins::run_twin_kernel(ctx, "curve twins", &source, &inputs, cases.len())
+    twin_kernel::run(ctx, "curve twins", &source, &inputs, cases.len())
 }
 
 /// The Rust twin of one case: `hadou_math::curve::curve_energy`.
@@ -108,24 +98,6 @@ fn reference_full(prep: &PreparedCurve, c: &CurveCase, shift: [f64; 3]) -> f64 {
     let ray = Ray { origin: v(c.origin) + Vec3::new(shift[0], shift[1], shift[2]), dir: v(c.dir) };
     let t1 = if c.span[2] != 0.0 { f64::INFINITY } else { f64::from(c.span[1]) };
     curve::curve_energy_reference(prep, &p, &ray, f64::from(c.span[0]), t1, f64::from(c.span[3]), 1e-9)
-}
-
-/// A deterministic generator (splitmix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-    fn vec(&mut self, r: f32) -> Vec3f {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
 }
 
 /// The curves under test.

@@ -221,11 +221,11 @@ fn check_capabilities(
     }
     let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
     let formats = [
-        (crate::pipelines::SCENE_FORMAT, attach_and_read),
-        (crate::pipelines::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
-        (crate::pipelines::PLANE_SHADOW_FORMAT, attach_and_read),
-        (crate::pipelines::MAP_FORMAT, attach_and_read),
-        (crate::present::PRESENT_FORMAT, crate::present::PRESENT_USAGE),
+        (crate::formats::SCENE_FORMAT, attach_and_read),
+        (crate::formats::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
+        (crate::formats::PLANE_SHADOW_FORMAT, attach_and_read),
+        (crate::formats::MAP_FORMAT, attach_and_read),
+        (crate::formats::PRESENT_FORMAT, crate::formats::PRESENT_USAGE),
     ];
     for (format, usages) in formats {
         if !adapter.get_texture_format_features(format).allowed_usages.contains(usages) {

@@ -69,17 +69,28 @@
 #[cfg(test)]
 mod curve_twins;
 mod device;
+mod formats;
 pub mod layout;
-mod pipelines;
-mod present;
+mod meshes;
+mod overlay;
+mod passes;
+mod prepare;
 mod render;
 pub mod shaders;
+#[cfg(not(target_arch = "wasm32"))]
+mod time_frame;
 mod timing;
 #[cfg(test)]
+mod twin_kernel;
+#[cfg(test)]
 mod twins;
+mod window;
 
-pub use present::{PresentedFrame, PRESENT_FORMAT, PRESENT_USAGE};
-pub use render::{MAX_TILE, SOFT_BYTES_PER_PIXEL};
+pub use formats::{PRESENT_FORMAT, PRESENT_USAGE};
+pub use overlay::{DepthModel, OverlayBlend, OverlayTarget};
+pub use passes::present::PresentedFrame;
+pub use passes::soft::SOFT_BYTES_PER_PIXEL;
+pub use render::MAX_TILE;
 pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
@@ -178,6 +189,25 @@ impl GpuBackend {
         self.renderer.render_to_texture(frame)
     }
 
+    /// Records `frame`'s waves into `encoder`, drawn into a colour target and against a depth
+    /// buffer that the caller owns ([`OverlayTarget`]): per pixel the waves' light
+    /// `exposure · Σ rgb·a·I` along the pixel's ray, clipped at the surface the depth buffer holds
+    /// (002 §3.3.5), added to the target's colour or written over it, with no colour mapping
+    /// (the caller's own tone mapping and bloom follow). This is what a game engine calls inside
+    /// its frame (after its opaque pass, before tone mapping) and a page on its canvas: the same
+    /// light [`Backend::render`] adds to the scene before its colour mapping, without hadou's
+    /// objects, materials or shadows. Nothing is submitted or waited for; the buffers it uploads
+    /// live as long as the encoded commands. Errors: an invalid frame, a device limit, or (on
+    /// the next call, on the web) a target that does not fit the frame's size.
+    pub fn encode_wave_overlay(
+        &mut self,
+        frame: &Frame,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &OverlayTarget<'_>,
+    ) -> Result<(), RenderError> {
+        self.renderer.encode_wave_overlay(frame, encoder, target)
+    }
+
     /// The GPU time of the most recent [`GpuBackend::render_to_texture`] frame whose timestamps
     /// have come back, without waiting: `None` until one has, and always `None` on a device
     /// without [`wgpu::Features::TIMESTAMP_QUERY`] (e.g. WebGL, or OpenGL without
@@ -235,7 +265,7 @@ impl GpuBackend {
     pub fn render_soft(
         &mut self,
         frame: &Frame,
-    ) -> Result<(Image, Option<render::SoftReadback>), RenderError> {
+    ) -> Result<(Image, Option<passes::soft::SoftReadback>), RenderError> {
         let image = self.renderer.render(frame)?;
         let soft = self.renderer.read_soft(frame)?;
         Ok((image, soft))
@@ -260,7 +290,7 @@ impl GpuBackend {
     /// `passes` split the time by pass when the adapter has timestamp queries. Not on the web.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn time_frame(&mut self, frame: &Frame, iterations: u32) -> Result<FrameTiming, RenderError> {
-        timing::time_frame(&mut self.renderer, frame, iterations)
+        time_frame::time_frame(&mut self.renderer, frame, iterations)
     }
 }
 

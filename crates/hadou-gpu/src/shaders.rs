@@ -2,11 +2,15 @@
 //!
 //! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
 //! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
-//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `shading.wgsl` +
-//!   `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as lights, hard shadows,
-//!   energy integration, colour mapping);
+//! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
+//!   `shading.wgsl` + `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as
+//!   lights, hard shadows, energy integration, colour mapping);
+//! - wave overlay module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
+//!   `wave_overlay.wgsl` (the waves' light into a caller's colour target against its depth);
 //! - shadow module: `common.wgsl` + `shadow_raster.wgsl` (the plane-shadow pass and the shadow
 //!   maps);
+//! - soft-shadow modules: `common.wgsl` + `soft_map.wgsl` (the `[area_light]`'s maps) and
+//!   `common.wgsl` + `soft.wgsl` (classes, penumbra resolve, gather);
 //! - present module: `common.wgsl` + `present.wgsl` (a tile's colour into the window texture of
 //!   [`crate::GpuBackend::render_to_texture`]).
 //!
@@ -25,6 +29,10 @@ pub const SHADING: &str = include_str!("shaders/shading.wgsl");
 pub const RASTER: &str = include_str!("shaders/raster.wgsl");
 /// The wave pass.
 pub const WAVE: &str = include_str!("shaders/wave.wgsl");
+/// The waves' light on one pixel (shared by the wave pass and the wave overlay).
+pub const WAVE_ENERGY: &str = include_str!("shaders/wave_energy.wgsl");
+/// The wave overlay: the waves' light into a caller's colour target against its depth buffer.
+pub const WAVE_OVERLAY: &str = include_str!("shaders/wave_overlay.wgsl");
 /// The wave pass's hard-shadow lookups.
 pub const SHADOW_LOOKUP: &str = include_str!("shaders/shadow_lookup.wgsl");
 /// The plane-shadow pass and the shadow-map pass.
@@ -49,12 +57,16 @@ pub const FILES: &[(&str, &str)] = &[
     ("soft.wgsl", SOFT),
     ("soft_map.wgsl", SOFT_MAP),
     ("wave.wgsl", WAVE),
+    ("wave_energy.wgsl", WAVE_ENERGY),
+    ("wave_overlay.wgsl", WAVE_OVERLAY),
 ];
 
 /// The parts of the raster module, in order.
 pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
-pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, SHADING, SHADOW_LOOKUP, WAVE];
+pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE_ENERGY, SHADING, SHADOW_LOOKUP, WAVE];
+/// The parts of the wave overlay module, in order.
+pub const WAVE_OVERLAY_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE_ENERGY, WAVE_OVERLAY];
 /// The parts of the shadow module, in order.
 pub const SHADOW_PARTS: &[&str] = &[COMMON, SHADOW_RASTER];
 /// The parts of the soft-shadow map module, in order.
@@ -99,6 +111,7 @@ mod tests {
             ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
             ("present module", validate("present module", &compose(PRESENT_PARTS))),
+            ("wave overlay module", validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS))),
         ]
     }
 
@@ -106,19 +119,7 @@ mod tests {
     /// `dot3` in common.wgsl); the shaders use the written-out twins only.
     #[test]
     fn shaders_use_the_written_out_vector_products() {
-        for (name, source) in [
-            ("common.wgsl", COMMON),
-            ("energy.wgsl", ENERGY),
-            ("curve.wgsl", CURVE),
-            ("raster.wgsl", RASTER),
-            ("shading.wgsl", SHADING),
-            ("shadow_lookup.wgsl", SHADOW_LOOKUP),
-            ("shadow_raster.wgsl", SHADOW_RASTER),
-            ("soft.wgsl", SOFT),
-            ("soft_map.wgsl", SOFT_MAP),
-            ("wave.wgsl", WAVE),
-            ("present.wgsl", PRESENT),
-        ] {
+        for &(name, source) in FILES {
             for (i, line) in source.lines().enumerate() {
                 let code = line.split("//").next().unwrap_or("");
                 for builtin in ["dot(", "cross(", "length(", "normalize(", "distance("] {
@@ -197,6 +198,19 @@ mod tests {
 
     #[test]
     fn gpu_structs_match_their_rust_definitions() {
+        let overlay = validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS));
+        let (members, span) = wgsl_layout(&overlay, "OverlayUniforms");
+        let rust: Vec<(String, u32)> = [
+            ("depth_model", offset_of!(crate::layout::OverlayUniforms, depth_model)),
+            ("near", offset_of!(crate::layout::OverlayUniforms, near)),
+            ("far", offset_of!(crate::layout::OverlayUniforms, far)),
+            ("_pad", offset_of!(crate::layout::OverlayUniforms, _pad)),
+        ]
+        .iter()
+        .map(|&(n, o)| (n.to_string(), o as u32))
+        .collect();
+        assert_eq!(members, rust, "OverlayUniforms member offsets");
+        assert_eq!(span as usize, size_of::<crate::layout::OverlayUniforms>(), "OverlayUniforms size");
         let module = validate("wave module", &compose(WAVE_PARTS));
         macro_rules! check {
             ($ty:ty, $name:literal, [$($field:ident),* $(,)?]) => {{
@@ -369,6 +383,16 @@ mod tests {
         assert_eq!(value("HULL_BIT"), HULL_BIT);
         assert_eq!(value("CAST_PLANE"), CAST_PLANE);
         assert_eq!(value("SHADOW_CAST_WORDS"), SHADOW_CAST_WORDS);
+        let overlay = validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS));
+        let overlay_value = |name: &str| -> u32 {
+            let (_, c) = overlay.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);
+            match overlay.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v,
+                ref e => panic!("{name}: unexpected {e:?}"),
+            }
+        };
+        assert_eq!(overlay_value("DEPTH_STANDARD"), DEPTH_STANDARD);
+        assert_eq!(overlay_value("DEPTH_REVERSE_INFINITE"), DEPTH_REVERSE_INFINITE);
         let (_, on_plane) = module
             .constants
             .iter()

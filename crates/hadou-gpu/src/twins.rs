@@ -4,8 +4,8 @@
 
 use crate::device::GpuContext;
 use crate::layout::{GpuWave, FALLOFF_FAITHFUL, WAVE_BEAM, WAVE_CAPSULE, WAVE_CYLINDER, WAVE_SPHERE};
-use crate::pipelines::compile_module;
 use crate::shaders;
+use crate::twin_kernel::{self, Rng};
 use bytemuck::{Pod, Zeroable};
 use hadou_math::energy::{
     self, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
@@ -23,6 +23,7 @@ struct Case {
     span: [f32; 4],
 }
 
+/// The WGSL of one case's energy (see `twin_kernel::source`).
 const KERNEL: &str = r#"
 struct Case {
     wave: GpuWave,
@@ -30,23 +31,10 @@ struct Case {
     dir: vec4<f32>,
     span: vec4<f32>,
 }
-@group(0) @binding(0) var<storage, read> cases: array<Case>;
-@group(0) @binding(1) var<storage, read_write> results: array<f32>;
 
-@compute @workgroup_size(64, 1, 1)
-fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= arrayLength(&cases)) {
-        return;
-    }
-    let c = cases[id.x];
+fn case_energy(c: Case, ray: Ray, t0: f32, t1: f32) -> f32 {
     let w = c.wave;
     let p = FieldParams(w.falloff, w.core_radius);
-    let ray = Ray(c.origin.xyz, c.dir.xyz);
-    let t0 = c.span.x;
-    var t1 = c.span.y;
-    if (c.span.z != 0.0) {
-        t1 = T_OPEN;
-    }
     var e = 0.0;
     switch w.kind {
         case WAVE_SPHERE: { e = sphere_energy(p, ray, t0, t1, w.p0.xyz, w.p0.w); }
@@ -54,87 +42,14 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
         case WAVE_CAPSULE: { e = capsule_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w); }
         default: { e = beam_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z); }
     }
-    results[id.x] = e;
+    return e;
 }
 "#;
 
 /// Runs the WGSL energy functions on `cases`.
 fn run_gpu(ctx: &GpuContext, cases: &[Case]) -> Result<Vec<f32>, RenderError> {
-    let source = shaders::compose(&[shaders::COMMON, shaders::ENERGY, KERNEL]);
-    run_twin_kernel(ctx, "energy twins", &source, &[(0, bytemuck::cast_slice(cases))], cases.len())
-}
-
-/// Runs a twin-test compute kernel: `twin_main` over `count` cases in workgroups of 64, with each
-/// `(binding, bytes)` of `inputs` as a read-only storage buffer in group 0 and one `f32` result per
-/// case read back from binding 1. Shared by the energy and curve twin tests.
-pub(crate) fn run_twin_kernel(
-    ctx: &GpuContext,
-    label: &str,
-    source: &str,
-    inputs: &[(u32, &[u8])],
-    count: usize,
-) -> Result<Vec<f32>, RenderError> {
-    use wgpu::util::DeviceExt;
-    let module = compile_module(ctx, label, source)?;
-    let bytes = (count * 4) as u64;
-    let (pipeline, buffers, output, staging) = ctx.scoped(&format!("setting up {label}"), || {
-        let d = &ctx.device;
-        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: None,
-            module: &module,
-            entry_point: Some("twin_main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let buffers: Vec<(u32, wgpu::Buffer)> = inputs
-            .iter()
-            .map(|&(binding, contents)| {
-                let usage = wgpu::BufferUsages::STORAGE;
-                (
-                    binding,
-                    d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage }),
-                )
-            })
-            .collect();
-        let buffer = |usage| {
-            d.create_buffer(&wgpu::BufferDescriptor {
-                label: None,
-                size: bytes,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let staging = buffer(wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-        (pipeline, buffers, output, staging)
-    })?;
-    let submission =
-        ctx.scoped(&format!("running {label}"), || {
-            let d = &ctx.device;
-            let mut entries = vec![wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() }];
-            entries.extend(buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry {
-                binding: *binding,
-                resource: b.as_entire_binding(),
-            }));
-            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
-            let mut enc = d.create_command_encoder(&Default::default());
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &bg, &[]);
-                pass.dispatch_workgroups((count as u32).div_ceil(64), 1, 1);
-            }
-            enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
-            ctx.queue.submit([enc.finish()])
-        })?;
-    ctx.read_buffer(&staging, bytes, submission, |raw| {
-        raw.chunks_exact(4).map(|c| f32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect()
-    })
+    let source = twin_kernel::source(&[shaders::COMMON, shaders::ENERGY], KERNEL);
+    twin_kernel::run(ctx, "energy twins", &source, &[(0, bytemuck::cast_slice(cases))], cases.len())
 }
 
 /// The Rust twin of one case.
@@ -216,24 +131,6 @@ pub(crate) fn conditioned_error(
 
 /// Ray displacement, in ulps of the origin's largest coordinate, that [`conditioned_error`] tries.
 pub(crate) const CONDITION_ULPS: f64 = 2.0;
-
-/// A deterministic generator (splitmix64) for the random part of the cases.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-    fn vec(&mut self, r: f32) -> Vec3f {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-}
 
 fn wave(kind: u32, falloff: u32, core: f32, p0: [f32; 4], p1: [f32; 4], p2: [f32; 4]) -> GpuWave {
     GpuWave { color: [1.0; 4], kind, falloff, core_radius: core, _pad: 0, p0, p1, p2 }
@@ -422,7 +319,7 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let source = shaders::compose(&[shaders::COMMON, PRODUCTS]);
     let n = xs.len() / 2;
-    let gpu = run_twin_kernel(&ctx, "vector products", &source, &[(0, bytemuck::cast_slice(&xs))], 6 * n)
+    let gpu = twin_kernel::run(&ctx, "vector products", &source, &[(0, bytemuck::cast_slice(&xs))], 6 * n)
         .expect("GPU vector products");
     let v = |p: [f32; 4]| Vec3f::new(p[0], p[1], p[2]);
     // Mesa's llvmpipe (Vulkan and OpenGL) rounds every product; other compilers may fuse.

@@ -1,0 +1,112 @@
+//! [`crate::GpuBackend::encode_wave_overlay`]: a frame's waves drawn by the wave overlay pass
+//! (`passes/wave_overlay.rs`) into a colour target and against a depth buffer that the caller
+//! owns, recorded into the caller's command encoder. The frame's objects, materials and shadows
+//! are not drawn: the caller's renderer draws its own scene and hadou adds the waves' light to it.
+
+use crate::layout::{self, FrameUniforms, GpuWave, OverlayUniforms, DEPTH_REVERSE_INFINITE, DEPTH_STANDARD};
+use crate::passes::wave::WaveVariant;
+use crate::passes::wave_overlay::{OverlayInputs, WaveOverlayPass};
+use crate::prepare::{self, check_curves, or_zeroed, upload_curves};
+use crate::render::Renderer;
+use bytemuck::Zeroable;
+use hadou_scene::{Frame, RenderError};
+use wgpu::util::DeviceExt;
+
+/// How the values of a caller's depth buffer map to distance from the camera, for
+/// [`crate::GpuBackend::encode_wave_overlay`]. The near and far planes are the frame camera's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthModel {
+    /// Perspective depth 0 at the near plane, 1 at the far plane, cleared to 1 (hadou's own
+    /// raster pass, and most renderers).
+    Standard,
+    /// Reverse-Z with an infinite far plane: depth `near / z`, 1 at the near plane, cleared to 0
+    /// (Bevy's 3-D cameras).
+    ReverseInfinite,
+}
+
+/// How the overlay's light meets what the colour target holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OverlayBlend {
+    /// Added to the target's colour, alpha kept: the waves' light on the caller's linear image
+    /// (which needs a blendable format, e.g. `Rgba16Float`).
+    Add,
+    /// Written over the target's colour, alpha 0: the light alone.
+    Replace,
+}
+
+/// Where [`crate::GpuBackend::encode_wave_overlay`] draws: views the caller owns, at least the
+/// frame's `width × height`, pixel (x, y) of the frame at texel (x, y).
+#[derive(Clone, Copy, Debug)]
+pub struct OverlayTarget<'a> {
+    /// The colour target (a render attachment of `color_format`).
+    pub color: &'a wgpu::TextureView,
+    /// Its format (the pipeline is built for it).
+    pub color_format: wgpu::TextureFormat,
+    /// The depth buffer the waves are clipped against (a depth texture view with
+    /// `TEXTURE_BINDING`, e.g. `Depth32Float`), read as the frame's camera saw it.
+    pub depth: &'a wgpu::TextureView,
+    /// How to read `depth`.
+    pub depth_model: DepthModel,
+    /// How to meet `color`'s contents.
+    pub blend: OverlayBlend,
+}
+
+impl Renderer {
+    /// See [`crate::GpuBackend::encode_wave_overlay`].
+    pub(crate) fn encode_wave_overlay(
+        &mut self,
+        frame: &Frame,
+        enc: &mut wgpu::CommandEncoder,
+        target: &OverlayTarget<'_>,
+    ) -> Result<(), RenderError> {
+        self.ctx.check()?;
+        prepare::validate_frame(frame)?;
+        let (waves, curves, _) = layout::frame_waves(frame).map_err(RenderError::Other)?;
+        check_curves(&self.ctx.limits, &curves)?;
+        let faithful = frame.color_mapping.mode == hadou_scene::ToneMode::Faithful;
+        let variant = if self.passes.wave.specialise {
+            WaveVariant::of(&waves, &curves.curves, &[], &[], false, false, (false, false), false, faithful)
+        } else {
+            WaveVariant::UBER
+        };
+        if self.overlay.is_none() {
+            self.overlay = Some(WaveOverlayPass::new(&self.ctx)?);
+        }
+        let pass = self.overlay.as_mut().expect("made above");
+        let additive = target.blend == OverlayBlend::Add;
+        let pipeline = pass.pipeline(&self.ctx, variant, target.color_format, additive)?;
+        let pass = self.overlay.as_ref().expect("made above");
+        let (ctx, size) = (&self.ctx, [frame.width, frame.height]);
+        ctx.scoped("encoding the wave overlay", || {
+            let d = &ctx.device;
+            let basis = frame.camera.basis(frame.width, frame.height);
+            let uniform = |label: &str, contents: &[u8]| {
+                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::UNIFORM,
+                })
+            };
+            let frame_uniforms = FrameUniforms::new(frame, &basis, [0, 0], size);
+            let uniforms = uniform("overlay frame", bytemuck::bytes_of(&frame_uniforms));
+            let depth_model = match target.depth_model {
+                DepthModel::Standard => DEPTH_STANDARD,
+                DepthModel::ReverseInfinite => DEPTH_REVERSE_INFINITE,
+            };
+            let model =
+                OverlayUniforms { depth_model, near: frame.camera.near, far: frame.camera.far, _pad: 0 };
+            let overlay = uniform("overlay depth model", bytemuck::bytes_of(&model));
+            let waves = prepare::storage(d, "overlay waves", or_zeroed(&waves, &[GpuWave::zeroed()]));
+            let curves = upload_curves(d, &curves);
+            let inputs = OverlayInputs {
+                uniforms: &uniforms,
+                waves: &waves,
+                depth: target.depth,
+                overlay: &overlay,
+                curves: [&curves[0], &curves[1], &curves[2]],
+            };
+            let bind_group = pass.bind_group(d, &inputs);
+            pass.encode(enc, &pipeline, target.color, size, &bind_group);
+        })
+    }
+}

@@ -1,0 +1,387 @@
+//! The wave pass (`shaders/wave.wgsl`, a compute shader, with energy.wgsl, curve.wgsl,
+//! shading.wgsl and shadow_lookup.wgsl composed in): per pixel, the visible surface from the
+//! G-buffer shaded (materials, lights, textures, the waves as lights, hard shadows, the
+//! `[area_light]`'s term), then every wave's energy integral along the view ray clipped at that
+//! surface (002 §3.3.5), `scene + exposure·Σ rgb·a·I` and the colour mapping, written to an output
+//! buffer (colour, energy, eye distance per pixel) that the read-back or the present pass takes.
+//!
+//! The pass is specialised per frame ([`WaveVariant`]): the module declares pipeline-overridable
+//! `bool` constants, one per part, and each frame gets a pipeline with only what its data can
+//! reach compiled in, built on first use and cached.
+
+use super::setup::{self, Binding, Kind};
+use crate::device::GpuContext;
+use crate::layout;
+use crate::shaders;
+use hadou_scene::RenderError;
+use std::collections::HashMap;
+
+/// Workgroup edge of the wave pass (keep in sync with `@workgroup_size` in wave.wgsl).
+pub(crate) const WAVE_WORKGROUP: u32 = 8;
+
+const CS: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
+
+/// The bindings of the wave module (wave.wgsl 0–4, curve.wgsl 5–7, shading.wgsl 8–10,
+/// shadow_lookup.wgsl 11–12).
+pub(crate) const BINDINGS: [Binding; 13] = [
+    Binding::new(0, "frame", Kind::Uniform, CS),
+    Binding::new(1, "waves", Kind::Storage, CS),
+    Binding::new(2, "scene_texels", Kind::UintTexture, CS),
+    Binding::new(3, "attribute_texels", Kind::UintTexture, CS),
+    Binding::new(4, "out_buf", Kind::StorageRw, CS),
+    Binding::new(5, "curves", Kind::Storage, CS),
+    Binding::new(6, "curve_vec4", Kind::Storage, CS),
+    Binding::new(7, "curve_f32", Kind::Storage, CS),
+    Binding::new(8, "materials", Kind::Storage, CS),
+    Binding::new(9, "lights", Kind::Storage, CS),
+    Binding::new(10, "shading_data", Kind::Storage, CS),
+    Binding::new(11, "plane_shadow_texels", Kind::UintTexture, CS),
+    Binding::new(12, "shadow_maps", Kind::DepthArray, CS),
+];
+
+/// What the wave pass reads and writes, in the order of [`BINDINGS`].
+pub(crate) struct WaveInputs<'a> {
+    /// The tile's `layout::FrameUniforms`.
+    pub(crate) uniforms: &'a wgpu::Buffer,
+    /// The frame's `layout::GpuWave`s.
+    pub(crate) waves: &'a wgpu::Buffer,
+    /// The tile's G-buffer, as the raster pass drew it ([`crate::formats::SCENE_FORMAT`]).
+    pub(crate) surface: &'a wgpu::TextureView,
+    pub(crate) attributes: &'a wgpu::TextureView,
+    /// The output: per pixel colour (4), energy, eye distance as `f32` (see wave.wgsl binding 4).
+    pub(crate) output: &'a wgpu::Buffer,
+    /// The curve buffers (`layout::CurveBuffers`: curves, vec4s, scalars).
+    pub(crate) curves: [&'a wgpu::Buffer; 3],
+    /// Materials, lights and shading data (`layout::ShadingBuffers`).
+    pub(crate) materials: &'a wgpu::Buffer,
+    pub(crate) lights: &'a wgpu::Buffer,
+    pub(crate) shading_data: &'a wgpu::Buffer,
+    /// The plane-shadow pass's target of the tile.
+    pub(crate) plane_shadows: &'a wgpu::TextureView,
+    /// The frame's shadow maps (all layers).
+    pub(crate) shadow_maps: &'a wgpu::TextureView,
+}
+
+/// Which parts of the wave pass a frame needs: one bit per pipeline-overridable `USE_*` constant of
+/// the wave module (wave.wgsl, energy.wgsl, curve.wgsl, shading.wgsl, shadow_lookup.wgsl). A clear
+/// bit compiles its part out (the constant is `false`, so the branch is dead and the driver drops
+/// it); a set bit leaves the code exactly as the uber-shader's ([`WaveVariant::UBER`], every bit
+/// set). [`WaveVariant::of`] sets a bit for everything the frame's data can reach, so a frame
+/// renders identically with its variant and with the uber-shader.
+///
+/// Why: a software adapter such as llvmpipe runs a shader's branches under an execution mask,
+/// both sides of every `if` and every `switch` case, whichever the pixels take; the uber-shader
+/// made a one-sphere frame pay for every wave kind, the curve walker and the surface shading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct WaveVariant(u32);
+
+impl WaveVariant {
+    /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
+    pub(crate) const NAMES: [&'static str; 26] = [
+        // wave.wgsl
+        "USE_SPHERE",
+        "USE_CYLINDER",
+        "USE_CAPSULE",
+        "USE_BEAM",
+        "USE_CURVE",
+        "USE_SURFACES",
+        "USE_AREA",
+        "USE_TONE_FAITHFUL",
+        "USE_TONE_FILMIC",
+        // energy.wgsl
+        "USE_FAITHFUL",
+        "USE_INVERSE_SQUARE",
+        // curve.wgsl
+        "USE_CHORD",
+        "USE_SIMPSON",
+        "USE_HELIX",
+        "USE_TRIG",
+        "USE_BEZIER",
+        "USE_BSPLINE",
+        // shading.wgsl
+        "USE_TOON",
+        "USE_TEXTURES",
+        "USE_WAVE_LIGHTS",
+        "USE_LINE_POINT",
+        "USE_LINE_SEGMENT",
+        "USE_LINE_LINE",
+        "USE_LINE_POLYLINE",
+        // shadow_lookup.wgsl
+        "USE_PLANE_SHADOWS",
+        "USE_MAP_SHADOWS",
+    ];
+    /// Every part: the uber-shader, right for any frame.
+    pub(crate) const UBER: WaveVariant = WaveVariant((1 << Self::NAMES.len()) - 1);
+
+    /// The bit of override `name`.
+    fn bit(name: &str) -> u32 {
+        let i = Self::NAMES.iter().position(|n| *n == name).expect("a USE_* name");
+        1 << i
+    }
+
+    /// Whether the override `name` is set.
+    pub(crate) fn has(self, name: &str) -> bool {
+        self.0 & Self::bit(name) != 0
+    }
+
+    /// The variant with nothing but the overrides in `names` set.
+    pub(crate) fn from_names<'a>(names: impl IntoIterator<Item = &'a str>) -> Self {
+        WaveVariant(names.into_iter().fold(0, |v, n| v | Self::bit(n)))
+    }
+
+    /// The variant a frame needs, from what the wave pass will read: the waves, the curves, the
+    /// materials and lights (the lights shading.wgsl reads), whether anything is drawn, whether
+    /// some wave glows, the shadow casts (plane, map), the `[area_light]` and the colour mapping.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn of(
+        waves: &[layout::GpuWave],
+        curves: &[layout::GpuCurve],
+        materials: &[layout::GpuMaterial],
+        lights: &[layout::GpuLight],
+        any_glow: bool,
+        surfaces: bool,
+        shadows: (bool, bool),
+        area: bool,
+        tone_faithful: bool,
+    ) -> Self {
+        let mut on: Vec<&str> = Vec::new();
+        for w in waves {
+            on.push(match w.kind {
+                layout::WAVE_SPHERE => "USE_SPHERE",
+                layout::WAVE_CYLINDER => "USE_CYLINDER",
+                layout::WAVE_CAPSULE => "USE_CAPSULE",
+                layout::WAVE_BEAM => "USE_BEAM",
+                _ => "USE_CURVE",
+            });
+            on.push(if w.falloff == layout::FALLOFF_FAITHFUL {
+                "USE_FAITHFUL"
+            } else {
+                "USE_INVERSE_SQUARE"
+            });
+        }
+        for c in curves {
+            on.push(if c.integrator == layout::INTEGRATOR_SIMPSON { "USE_SIMPSON" } else { "USE_CHORD" });
+            on.push(match c.shape {
+                layout::SHAPE_HELIX => "USE_HELIX",
+                layout::SHAPE_TRIG => "USE_TRIG",
+                layout::SHAPE_BEZIER => "USE_BEZIER",
+                _ => "USE_BSPLINE",
+            });
+        }
+        if surfaces {
+            on.push("USE_SURFACES");
+            if materials.iter().any(|m| m.model == layout::MODEL_TOON) {
+                on.push("USE_TOON");
+            }
+            if materials.iter().any(|m| m.base_texture.offset != 0 || m.feature_texture.offset != 0) {
+                on.push("USE_TEXTURES");
+            }
+            let lit = !lights.is_empty() && (any_glow || materials.iter().any(|m| m.wave_blend > 0.0));
+            if lit {
+                on.push("USE_WAVE_LIGHTS");
+                for l in lights {
+                    on.push(match l.line_kind {
+                        layout::LINE_POINT => "USE_LINE_POINT",
+                        layout::LINE_SEGMENT => "USE_LINE_SEGMENT",
+                        layout::LINE_LINE => "USE_LINE_LINE",
+                        _ => "USE_LINE_POLYLINE",
+                    });
+                }
+            }
+            if shadows.0 {
+                on.push("USE_PLANE_SHADOWS");
+            }
+            if shadows.1 {
+                on.push("USE_MAP_SHADOWS");
+            }
+            if area {
+                on.push("USE_AREA");
+            }
+        }
+        on.push(if tone_faithful { "USE_TONE_FAITHFUL" } else { "USE_TONE_FILMIC" });
+        Self::from_names(on)
+    }
+
+    /// The override values of this variant (`1.0` true, `0.0` false), for the pipeline.
+    fn constants(self) -> Vec<(&'static str, f64)> {
+        Self::NAMES.iter().map(|&n| (n, if self.has(n) { 1.0 } else { 0.0 })).collect()
+    }
+}
+
+/// The wave module, its bind group layout and the pipelines built so far.
+pub(crate) struct WavePass {
+    /// The wave module (the uber-shader source; variants set its `USE_*` overrides).
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    layout: wgpu::BindGroupLayout,
+    /// The wave pipelines built so far, one per variant (see [`WavePass::pipeline`]).
+    variants: HashMap<WaveVariant, wgpu::ComputePipeline>,
+    /// Whether [`WavePass::pipeline`] specialises; `false` gives every frame the uber-shader.
+    pub(crate) specialise: bool,
+}
+
+impl WavePass {
+    /// Compiles the wave module; pipelines are built per variant on first use.
+    pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
+        let module = setup::compile_module(ctx, "wave", &shaders::compose(shaders::WAVE_PARTS))?;
+        ctx.scoped("building the wave pipeline layout", || {
+            let layout = setup::bind_group_layout(&ctx.device, "wave", &BINDINGS);
+            let pipeline_layout = setup::pipeline_layout(&ctx.device, "wave", &layout);
+            Self { module, pipeline_layout, layout, variants: HashMap::new(), specialise: true }
+        })
+    }
+
+    /// The wave pipeline of `variant` ([`WaveVariant::UBER`] when not specialising), built on first
+    /// use and kept: the same variant always gets the same pipeline. Also the variant it is.
+    pub(crate) fn pipeline(
+        &mut self,
+        ctx: &GpuContext,
+        variant: WaveVariant,
+    ) -> Result<(wgpu::ComputePipeline, WaveVariant), RenderError> {
+        let variant = if self.specialise { variant } else { WaveVariant::UBER };
+        if let Some(p) = self.variants.get(&variant) {
+            return Ok((p.clone(), variant));
+        }
+        let constants = variant.constants();
+        let pipeline = ctx.scoped("building the wave pipeline", || {
+            ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("wave"),
+                layout: Some(&self.pipeline_layout),
+                module: &self.module,
+                entry_point: Some("cs_main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
+                cache: None,
+            })
+        })?;
+        self.variants.insert(variant, pipeline.clone());
+        Ok((pipeline, variant))
+    }
+
+    /// How many wave pipelines have been built.
+    pub(crate) fn variant_count(&self) -> usize {
+        self.variants.len()
+    }
+
+    /// The bind group of `inputs`.
+    pub(crate) fn bind_group(&self, device: &wgpu::Device, inputs: &WaveInputs<'_>) -> wgpu::BindGroup {
+        let view = wgpu::BindingResource::TextureView;
+        let resources = vec![
+            inputs.uniforms.as_entire_binding(),
+            inputs.waves.as_entire_binding(),
+            view(inputs.surface),
+            view(inputs.attributes),
+            inputs.output.as_entire_binding(),
+            inputs.curves[0].as_entire_binding(),
+            inputs.curves[1].as_entire_binding(),
+            inputs.curves[2].as_entire_binding(),
+            inputs.materials.as_entire_binding(),
+            inputs.lights.as_entire_binding(),
+            inputs.shading_data.as_entire_binding(),
+            view(inputs.plane_shadows),
+            view(inputs.shadow_maps),
+        ];
+        setup::bind_group(device, "wave", &self.layout, &BINDINGS, resources)
+    }
+
+    /// Records the pass over a `size` tile with `pipeline` (a variant from [`WavePass::pipeline`]).
+    pub(crate) fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        bind_group: &wgpu::BindGroup,
+        size: [u32; 2],
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let mut pass =
+            enc.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("wave"), timestamp_writes });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        let g = WAVE_WORKGROUP;
+        pass.dispatch_workgroups(size[0].div_ceil(g), size[1].div_ceil(g), 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bytemuck::Zeroable;
+
+    /// `WaveVariant::NAMES` are exactly the wave module's overrides, each a `bool` defaulting to
+    /// true (so the module alone is the uber-shader).
+    #[test]
+    fn variant_names_are_the_wave_modules_overrides() {
+        let source = shaders::compose(shaders::WAVE_PARTS);
+        let module = naga::front::wgsl::parse_str(&source).expect("the wave module parses");
+        let mut overrides: Vec<&str> = Vec::new();
+        for (_, o) in module.overrides.iter() {
+            let name = o.name.as_deref().expect("named override");
+            assert_eq!(module.types[o.ty].inner, naga::TypeInner::Scalar(naga::Scalar::BOOL), "{name}");
+            let init = o.init.expect("a default");
+            assert!(
+                matches!(
+                    module.global_expressions[init],
+                    naga::Expression::Literal(naga::Literal::Bool(true))
+                ),
+                "{name} defaults to true"
+            );
+            overrides.push(name);
+        }
+        overrides.sort_unstable();
+        let mut names = WaveVariant::NAMES.to_vec();
+        names.sort_unstable();
+        assert_eq!(overrides, names);
+        assert!(WaveVariant::NAMES.iter().all(|n| WaveVariant::UBER.has(n)));
+        assert!(WaveVariant::UBER.constants().iter().all(|&(_, v)| v == 1.0));
+    }
+
+    /// `WaveVariant::of` sets a part exactly when the frame's data can reach it.
+    #[test]
+    fn a_variant_has_exactly_what_the_frame_uses() {
+        let wave = |kind, falloff| layout::GpuWave { kind, falloff, ..layout::GpuWave::zeroed() };
+        let waves = [wave(layout::WAVE_SPHERE, layout::FALLOFF_FAITHFUL), wave(layout::WAVE_CURVE, 1)];
+        let curve = layout::GpuCurve {
+            integrator: layout::INTEGRATOR_SIMPSON,
+            shape: layout::SHAPE_BEZIER,
+            ..Zeroable::zeroed()
+        };
+        let mut toon = layout::GpuMaterial::zeroed();
+        toon.model = layout::MODEL_TOON;
+        toon.wave_blend = 0.5;
+        let light = layout::GpuLight { line_kind: layout::LINE_POLYLINE, ..Zeroable::zeroed() };
+        let names = |v: WaveVariant| -> Vec<&str> {
+            WaveVariant::NAMES.iter().copied().filter(|n| v.has(n)).collect()
+        };
+        let v =
+            WaveVariant::of(&waves, &[curve], &[toon], &[light], false, true, (false, true), false, false);
+        assert_eq!(
+            names(v),
+            [
+                "USE_SPHERE",
+                "USE_CURVE",
+                "USE_SURFACES",
+                "USE_TONE_FILMIC",
+                "USE_FAITHFUL",
+                "USE_INVERSE_SQUARE",
+                "USE_SIMPSON",
+                "USE_BEZIER",
+                "USE_TOON",
+                "USE_WAVE_LIGHTS",
+                "USE_LINE_POLYLINE",
+                "USE_MAP_SHADOWS"
+            ]
+        );
+        // Without surfaces nothing of the shading is compiled in; without blending or glow, no
+        // wave lights.
+        let v = WaveVariant::of(&waves[..1], &[], &[toon], &[light], true, false, (true, true), true, true);
+        assert_eq!(names(v), ["USE_SPHERE", "USE_TONE_FAITHFUL", "USE_FAITHFUL"]);
+        toon.wave_blend = 0.0;
+        let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true);
+        assert_eq!(
+            names(v),
+            ["USE_SURFACES", "USE_AREA", "USE_TONE_FAITHFUL", "USE_TOON", "USE_PLANE_SHADOWS"]
+        );
+    }
+}

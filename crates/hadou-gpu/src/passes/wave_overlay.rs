@@ -1,0 +1,185 @@
+//! The wave overlay (`shaders/wave_overlay.wgsl`): the waves' light, exposure · Σ rgb·a·I, drawn
+//! into a colour target the caller owns (a game engine's HDR view target, a page's canvas)
+//! against that caller's depth buffer, added to what is there (or replacing it), with no colour
+//! mapping: the same light the wave pass adds to the scene colour (`wave_energy.wgsl`), for a
+//! renderer that shades its own surfaces. One full-screen triangle over a viewport the frame's
+//! size; specialised per frame like the wave pass ([`WaveVariant`]), a pipeline per variant,
+//! colour format and blend.
+
+use super::setup::{self, triangles, Binding, Kind};
+use super::wave::WaveVariant;
+use crate::device::GpuContext;
+use crate::shaders;
+use hadou_scene::RenderError;
+use std::collections::HashMap;
+
+const FS: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
+
+/// The bindings of the wave overlay module (wave_energy.wgsl 0–1, wave_overlay.wgsl 2–3,
+/// curve.wgsl 5–7).
+pub(crate) const BINDINGS: [Binding; 7] = [
+    Binding::new(0, "frame", Kind::Uniform, FS),
+    Binding::new(1, "waves", Kind::Storage, FS),
+    Binding::new(2, "depth_texels", Kind::Depth, FS),
+    Binding::new(3, "overlay", Kind::Uniform, FS),
+    Binding::new(5, "curves", Kind::Storage, FS),
+    Binding::new(6, "curve_vec4", Kind::Storage, FS),
+    Binding::new(7, "curve_f32", Kind::Storage, FS),
+];
+
+/// The overrides of the wave overlay module: the wave variant's wave kinds, falloffs and curve
+/// parts (the rest of [`WaveVariant::NAMES`] belongs to the wave pass's surfaces).
+pub(crate) const OVERRIDES: [&str; 13] = [
+    "USE_SPHERE",
+    "USE_CYLINDER",
+    "USE_CAPSULE",
+    "USE_BEAM",
+    "USE_CURVE",
+    "USE_FAITHFUL",
+    "USE_INVERSE_SQUARE",
+    "USE_CHORD",
+    "USE_SIMPSON",
+    "USE_HELIX",
+    "USE_TRIG",
+    "USE_BEZIER",
+    "USE_BSPLINE",
+];
+
+/// What the overlay reads, in the order of [`BINDINGS`].
+pub(crate) struct OverlayInputs<'a> {
+    /// The frame's `layout::FrameUniforms` (the whole frame as one tile).
+    pub(crate) uniforms: &'a wgpu::Buffer,
+    /// The frame's `layout::GpuWave`s.
+    pub(crate) waves: &'a wgpu::Buffer,
+    /// The caller's depth buffer (a `Depth32Float`-style depth texture view).
+    pub(crate) depth: &'a wgpu::TextureView,
+    /// `layout::OverlayUniforms`: how to read `depth`.
+    pub(crate) overlay: &'a wgpu::Buffer,
+    /// The curve buffers (`layout::CurveBuffers`: curves, vec4s, scalars).
+    pub(crate) curves: [&'a wgpu::Buffer; 3],
+}
+
+/// The overlay's module, bind group layout and pipelines.
+pub(crate) struct WaveOverlayPass {
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    layout: wgpu::BindGroupLayout,
+    pipelines: HashMap<(WaveVariant, wgpu::TextureFormat, bool), wgpu::RenderPipeline>,
+}
+
+impl WaveOverlayPass {
+    /// Compiles the overlay module; pipelines are built on first use.
+    pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
+        let module =
+            setup::compile_module(ctx, "wave overlay", &shaders::compose(shaders::WAVE_OVERLAY_PARTS))?;
+        ctx.scoped("building the wave overlay's layout", || {
+            let layout = setup::bind_group_layout(&ctx.device, "wave overlay", &BINDINGS);
+            let pipeline_layout = setup::pipeline_layout(&ctx.device, "wave overlay", &layout);
+            Self { module, pipeline_layout, layout, pipelines: HashMap::new() }
+        })
+    }
+
+    /// The pipeline drawing `variant`'s waves into a `format` target, adding to it when
+    /// `additive`, else replacing it; built on first use and kept.
+    pub(crate) fn pipeline(
+        &mut self,
+        ctx: &GpuContext,
+        variant: WaveVariant,
+        format: wgpu::TextureFormat,
+        additive: bool,
+    ) -> Result<wgpu::RenderPipeline, RenderError> {
+        let key = (variant, format, additive);
+        if let Some(p) = self.pipelines.get(&key) {
+            return Ok(p.clone());
+        }
+        let constants: Vec<(&str, f64)> =
+            OVERRIDES.iter().map(|&n| (n, if variant.has(n) { 1.0 } else { 0.0 })).collect();
+        let blend = additive.then_some(wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Zero,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+        });
+        let pipeline = ctx.scoped("building the wave overlay pipeline", || {
+            ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("wave overlay"),
+                layout: Some(&self.pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &self.module,
+                    entry_point: Some("vs_overlay"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: triangles(None),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &self.module,
+                    entry_point: Some("fs_overlay"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })?;
+        self.pipelines.insert(key, pipeline.clone());
+        Ok(pipeline)
+    }
+
+    /// The bind group of `inputs`.
+    pub(crate) fn bind_group(&self, device: &wgpu::Device, inputs: &OverlayInputs<'_>) -> wgpu::BindGroup {
+        let resources = vec![
+            inputs.uniforms.as_entire_binding(),
+            inputs.waves.as_entire_binding(),
+            wgpu::BindingResource::TextureView(inputs.depth),
+            inputs.overlay.as_entire_binding(),
+            inputs.curves[0].as_entire_binding(),
+            inputs.curves[1].as_entire_binding(),
+            inputs.curves[2].as_entire_binding(),
+        ];
+        setup::bind_group(device, "wave overlay", &self.layout, &BINDINGS, resources)
+    }
+
+    /// Records the overlay into `target` over a `size` viewport at its origin; the target is
+    /// loaded, not cleared.
+    pub(crate) fn encode(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::RenderPipeline,
+        target: &wgpu::TextureView,
+        size: [u32; 2],
+        bind_group: &wgpu::BindGroup,
+    ) {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("wave overlay"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_viewport(0.0, 0.0, size[0] as f32, size[1] as f32, 0.0, 1.0);
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

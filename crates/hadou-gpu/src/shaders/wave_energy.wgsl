@@ -1,0 +1,99 @@
+// The waves' light on one pixel, shared by the wave pass (wave.wgsl) and the wave overlay
+// (wave_overlay.wgsl): per wave the integration ray of hadou_scene::CameraBasis::wave_ray (002
+// eq. 3.12–3.13, clipped at the visible surface, 002 §3.3.5), its energy (energy.wgsl, curve.wgsl)
+// and Σ rgb·a·I. Prepended by common.wgsl, energy.wgsl and curve.wgsl; the frame's uniforms and
+// waves are bindings 0 and 1 of both modules.
+
+@group(0) @binding(0) var<uniform> frame: FrameUniforms;
+@group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
+// The wave kinds a frame contains (pipeline-overridable; see passes/wave.rs WaveVariant).
+override USE_SPHERE: bool = true;
+override USE_CYLINDER: bool = true;
+override USE_CAPSULE: bool = true;
+override USE_BEAM: bool = true;
+override USE_CURVE: bool = true;
+// Mirrors hadou_scene::CameraBasis::wave_ray: the ray and span of one pixel for one falloff.
+// `surface < 0` means nothing was drawn (None).
+fn wave_ray(falloff: u32, dir: vec3<f32>, surface: f32, span: ptr<function, vec2<f32>>) -> Ray {
+    let len = length3(dir);
+    let far_dist = frame.far * len;
+    if (falloff == FALLOFF_FAITHFUL) {
+        var g = 1.0;
+        if (surface >= 0.0) {
+            g = min(surface / far_dist, 1.0);
+        }
+        *span = vec2<f32>(0.0, g);
+        return Ray(frame.eye, dir * frame.far);
+    }
+    var t1 = T_OPEN;
+    if (surface >= 0.0) {
+        t1 = surface;
+    }
+    *span = vec2<f32>(0.0, t1);
+    return Ray(frame.eye, dir / len);
+}
+
+// Energy of one wave on one pixel; the dispatch over hadou_scene::WaveShape.
+fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
+    var span = vec2<f32>(0.0, 0.0);
+    let ray = wave_ray(w.falloff, dir, surface, &span);
+    let p = FieldParams(w.falloff, w.core_radius);
+    // Each kind's case is compiled in only when its USE_* is set (the variant has the frame's kinds).
+    switch w.kind {
+        case WAVE_SPHERE: {
+            if (USE_SPHERE) {
+                return sphere_energy(p, ray, span.x, span.y, w.p0.xyz, w.p0.w);
+            }
+        }
+        case WAVE_CYLINDER: {
+            if (USE_CYLINDER) {
+                return cylinder_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p0.w);
+            }
+        }
+        case WAVE_CAPSULE: {
+            if (USE_CAPSULE) {
+                return capsule_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
+            }
+        }
+        case WAVE_BEAM: {
+            if (USE_BEAM) {
+                return beam_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
+            }
+        }
+        case WAVE_CURVE: {
+            if (USE_CURVE) {
+                // t_far of hadou_scene::WaveRay: 1 (faithful, t ∈ [0, 1] to the far point) or the
+                // far point's distance (inverse square, unit direction).
+                var t_far = 1.0;
+                if (w.falloff != FALLOFF_FAITHFUL) {
+                    t_far = frame.far * length3(dir);
+                }
+                return curve_energy(curves[u32(w.p0.x)], w.falloff, w.core_radius, ray, span.x, span.y, t_far);
+            }
+        }
+        default: {}
+    }
+    return 0.0;
+}
+
+// The total energy Σ I and the light Σ rgb·a·I of every wave on the pixel with direction `dir`
+// (pixel_dir) whose visible surface is `surface` away (< 0: nothing drawn).
+struct WavesLight {
+    total: f32,
+    light: vec3<f32>,
+}
+
+fn waves_light(dir: vec3<f32>, surface: f32) -> WavesLight {
+    var total = 0.0;
+    var light = vec3<f32>(0.0);
+    for (var k = 0u; k < frame.wave_count; k++) {
+        let w = waves[k];
+        // As hadou-cpu's wave pass: energies saturate at f32::MAX (hadou_math::energy::saturate),
+        // and so do their sums, so a saturated pixel is full brightness, never 0 or NaN.
+        let e = energy_saturate(wave_energy(w, dir, surface));
+        total = energy_add(total, e);
+        let c = w.color.xyz * w.color.w;
+        light = vec3<f32>(energy_add(light.x, c.x * e), energy_add(light.y, c.y * e), energy_add(light.z, c.z * e));
+    }
+    return WavesLight(total, light);
+}

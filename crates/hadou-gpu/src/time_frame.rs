@@ -1,0 +1,134 @@
+//! [`crate::GpuBackend::time_frame`]: the GPU time of a frame, from timestamps at every pass
+//! boundary where the adapter has them (split by pass), else from the wall clock around waited-for
+//! submissions. Not on the web.
+
+use crate::render::Renderer;
+use crate::timing::{median, split_frame, FrameTiming, PassQueries, PassTime, TimingMethod, PASSES_PER_TILE};
+use hadou_scene::{Frame, RenderError};
+use std::time::Instant;
+
+/// See [`crate::GpuBackend::time_frame`].
+pub(crate) fn time_frame(
+    r: &mut Renderer,
+    frame: &Frame,
+    iterations: u32,
+) -> Result<FrameTiming, RenderError> {
+    if iterations == 0 {
+        return Err(RenderError::Other("time_frame needs at least one iteration".into()));
+    }
+    let prepared = r.prepare(frame, 0..frame.height)?;
+    let tiles = prepared.tiles.len() as u32;
+    // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
+    let last = r.ctx.scoped("warming up", || {
+        let maps = r.submit_shadow_maps(frame, &prepared, None);
+        r.submit_tiles(frame, &prepared, None).or(maps)
+    })?;
+    if let Some(s) = last {
+        r.ctx.wait(s)?;
+    }
+
+    let queries = 2 * (PASSES_PER_TILE * tiles + prepared.map_pass_count());
+    let soft = frame.area_light.is_some();
+    let use_timestamps = !soft
+        && r.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+        && queries <= wgpu::QUERY_SET_MAX_QUERIES;
+    let mut samples = Vec::with_capacity(iterations as usize);
+    if use_timestamps {
+        let bytes = queries as u64 * 8;
+        let (set, resolve, read) = r.ctx.scoped("creating timestamp queries", || {
+            let d = &r.ctx.device;
+            let set = d.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: queries,
+            });
+            let resolve = d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp resolve"),
+                size: bytes,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let read = d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp read"),
+                size: bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            (set, resolve, read)
+        })?;
+        let period_ns = r.ctx.queue.get_timestamp_period() as f64;
+        // Per pass name, its time in each iteration.
+        let mut passes: Vec<(&'static str, Vec<f64>)> = Vec::new();
+        for i in 0..iterations as usize {
+            let mut q = PassQueries::new(&set, queries);
+            let (last, used) = r.ctx.scoped("timing a frame", || {
+                r.submit_shadow_maps(frame, &prepared, Some(&mut q));
+                r.submit_tiles(frame, &prepared, Some(&mut q));
+                let used = q.used();
+                let mut enc = r.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("timestamp resolve"),
+                });
+                if used > 0 {
+                    enc.resolve_query_set(&set, 0..used, &resolve, 0);
+                    enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, used as u64 * 8);
+                }
+                (r.ctx.queue.submit([enc.finish()]), used)
+            })?;
+            if used == 0 {
+                break;
+            }
+            let ns = r.ctx.read_buffer(&read, used as u64 * 8, last, |raw| {
+                raw.chunks_exact(8)
+                    .map(|t| u64::from_ne_bytes(t.try_into().unwrap_or_default()) as f64 * period_ns)
+                    .collect::<Vec<f64>>()
+            })?;
+            let (frame_ms, per_pass) = split_frame(&q.passes, &ns);
+            samples.push(frame_ms);
+            for (name, ms) in per_pass {
+                match passes.iter_mut().find(|(n, _)| *n == name) {
+                    Some(p) => p.1.push(ms),
+                    None => {
+                        // A pass missing from earlier iterations took no time there.
+                        let mut v = vec![0.0; i];
+                        v.push(ms);
+                        passes.push((name, v));
+                    }
+                }
+            }
+            for (_, v) in passes.iter_mut() {
+                v.resize(i + 1, 0.0);
+            }
+        }
+        let mut timing = FrameTiming::from_samples(TimingMethod::GpuTimestamps, tiles, samples);
+        timing.passes = passes
+            .into_iter()
+            .map(|(name, v)| PassTime { name: name.to_string(), median_ms: median(&v) })
+            .collect();
+        return Ok(timing);
+    }
+    if soft {
+        for _ in 0..iterations {
+            let start = Instant::now();
+            // `prepare` draws the shadow maps and the soft shadows.
+            let prepared = r.prepare(frame, 0..frame.height)?;
+            let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))?;
+            if let Some(s) = last {
+                r.ctx.wait(s)?;
+            }
+            samples.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        return Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples));
+    }
+    for _ in 0..iterations {
+        let start = Instant::now();
+        let last = r.ctx.scoped("timing a frame", || {
+            let maps = r.submit_shadow_maps(frame, &prepared, None);
+            r.submit_tiles(frame, &prepared, None).or(maps)
+        })?;
+        if let Some(s) = last {
+            r.ctx.wait(s)?;
+        }
+        samples.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples))
+}

@@ -1,0 +1,85 @@
+//! Drawing a frame into a window: [`crate::GpuBackend::render_to_texture`] draws every tile as for
+//! a read-back (raster, plane shadows, soft-shadow gather, wave), then the present pass
+//! (`passes/present.rs`) copies each tile's colour into one full-frame texture. Nothing here waits
+//! for the GPU: the tiles are submitted and the texture's view returned; a window drawing the
+//! texture on the same queue sees the finished frame, as queue order guarantees. With timestamp
+//! queries each such frame's passes are timed without waiting (`timing::PresentTimer`).
+
+use crate::passes::present::{PresentedFrame, Presenter};
+use crate::render::Renderer;
+use crate::timing::{PresentTiming, PRESENT_PASSES_PER_TILE};
+use hadou_scene::{Frame, RenderError};
+
+impl Renderer {
+    /// See [`crate::GpuBackend::render_to_texture`]. On a device with `TIMESTAMP_QUERY`, a frame
+    /// without an `[area_light]` writes timestamps at every pass (the shadow maps, then per tile
+    /// its passes and the present pass), resolved and copied into a staging buffer that is mapped
+    /// asynchronously ([`PresentTimer`]): see [`Renderer::last_present_timing`]. Frames with an
+    /// `[area_light]` are not timed (their whole-image soft-shadow passes run before the tiles,
+    /// in the frame's preparation), nor is a frame finding every staging buffer still in flight.
+    pub(crate) fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
+        let size = [frame.width, frame.height];
+        let max = self.ctx.limits.max_texture_dimension_2d;
+        if size[0] > max || size[1] > max {
+            return Err(RenderError::Device(format!(
+                "a {}×{} frame does not fit this device's largest texture ({max}²) for drawing to a window",
+                size[0], size[1]
+            )));
+        }
+        if self.present.is_none() {
+            self.present = Some(Presenter::new(&self.ctx)?);
+        }
+        let timed = self.present.as_ref().is_some_and(|p| p.timer.is_some()) && frame.area_light.is_none();
+        // When timed, the shadow maps are submitted below, with their timestamps.
+        let prepared = self.prepare_frame(frame, 0..frame.height, !timed)?;
+        let present = self.present.as_mut().expect("made above");
+        present.serial += 1;
+        let serial = present.serial;
+        let recreated = self
+            .ctx
+            .scoped("creating the window texture", || present.ensure_target(&self.ctx.device, size))?;
+        let queries = 2 * (PRESENT_PASSES_PER_TILE * prepared.tiles.len() as u32 + prepared.map_pass_count());
+        let timed_frame = match present.timer.as_mut().filter(|_| timed) {
+            Some(timer) => {
+                self.ctx.scoped("creating timestamp queries", || timer.begin(&self.ctx.device, queries))?
+            }
+            None => None,
+        };
+        let present = self.present.as_ref().expect("made above");
+        let target = present.target.as_ref().expect("made above");
+        let tiles = self.targets.as_ref().expect("targets are created in prepare");
+        let queries = self.ctx.scoped("drawing the frame into the window texture", || {
+            let mut q = timed_frame.as_ref().map(|f| f.queries());
+            if timed {
+                self.submit_shadow_maps(frame, &prepared, q.as_mut());
+            }
+            let bind_group = present.pass.bind_group(&self.ctx.device, &tiles.uniforms, &tiles.output);
+            for &tile in &prepared.tiles {
+                // Writes the tile's uniforms, which the present pass reads too (tile origin and
+                // size); submitted before the next tile rewrites them.
+                let mut enc = self.encode_tile(frame, &prepared, tile, false, q.as_mut());
+                // In the tile's group of queries: its span ends with this pass.
+                let timestamps = q.as_mut().and_then(|q| q.render("present"));
+                present.pass.encode(&mut enc, &target.view, tile, &bind_group, timestamps);
+                self.ctx.queue.submit([enc.finish()]);
+            }
+            q
+        })?;
+        if let (Some(f), Some(q)) = (&timed_frame, queries) {
+            let (ctx, present) = (&self.ctx, self.present.as_mut().expect("made above"));
+            if let Some(timer) = present.timer.as_mut() {
+                ctx.scoped("reading the frame's timestamps back", || {
+                    timer.finish(&ctx.device, &ctx.queue, f, q, serial)
+                })?;
+            }
+        }
+        let target = self.present.as_ref().and_then(|p| p.target.as_ref()).expect("made above");
+        Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated, serial })
+    }
+
+    /// See [`crate::GpuBackend::last_present_timing`].
+    pub(crate) fn last_present_timing(&mut self) -> Option<PresentTiming> {
+        let timer = self.present.as_mut()?.timer.as_mut()?;
+        timer.latest(&self.ctx.device)
+    }
+}
