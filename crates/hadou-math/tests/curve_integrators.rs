@@ -62,8 +62,7 @@ fn simpson_converges_to_the_reference_as_m_grows() {
                 ws.integrator = Integrator::Simpson { m, reduction: None };
                 let cs = prepare(&ws);
                 // f64 evaluation isolates the rule's own error from f32 rounding.
-                let (e, n) =
-                    hadou_math::curve::integrate::curve_energy_f64(&cs, &p, &r.ray, r.t0, r.t1, r.t_far);
+                let (e, n) = hadou_math::curve::curve_energy_f64(&cs, &p, &r.ray, r.t0, r.t1, r.t_far);
                 let err = (e - rf).abs() / rf;
                 assert!(n > m, "{name}: Simpson counts at least m + 1 samples");
                 assert!(err < prev.max(1e-9), "{name} {falloff:?} m={m}: {err} ≥ {prev}");

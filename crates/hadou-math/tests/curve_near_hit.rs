@@ -5,8 +5,7 @@
 #[path = "curve_common/mod.rs"]
 mod support;
 
-use hadou_math::curve::integrate::curve_energy_f64;
-use hadou_math::curve::{curve_energy, curve_energy_reference, prepare, DEFAULT_SETTINGS};
+use hadou_math::curve::{curve_energy, curve_energy_f64, curve_energy_reference, prepare, DEFAULT_SETTINGS};
 use hadou_math::energy::{Falloff, FieldParams, Ray};
 use hadou_math::Vec3;
 

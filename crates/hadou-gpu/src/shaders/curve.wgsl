@@ -172,9 +172,9 @@ fn curve_eval(c: GpuCurve, s: f32) -> vec2<f32> {
     return vec2<f32>(0.0);
 }
 
-// ---- integrate.rs: LocalRay ----
+// ---- local_ray.rs: LocalRay ----
 
-// Mirrors integrate.rs `LocalRay`.
+// Mirrors local_ray.rs `LocalRay`.
 struct LocalRay {
     o: vec3<f32>,
     q: vec3<f32>,
@@ -535,7 +535,7 @@ fn curve_at(c: GpuCurve, x: f32) -> vec2<f32> {
     return curve_eval(c, clamp(x / c.gamma, 0.0, c.s_head));
 }
 
-// Mirrors integrate.rs `CurveReal::split` for f32: the lower 12 of 24 significand bits cleared,
+// Mirrors local_ray.rs `CurveReal::split` for f32: the lower 12 of 24 significand bits cleared,
 // so that products of such values with each other or with a remainder x − split(x) are exact.
 fn curve_split(x: f32) -> f32 {
     return bitcast<f32>(bitcast<u32>(x) & 0xfffff000u);
@@ -795,7 +795,8 @@ fn curve_integrate_span(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<fun
     curve_end_piece(c, r, !head_first, max(ta, tout), tb, acc);
 }
 
-// Mirrors integrate.rs `default_generic` (f32).
+// Mirrors integrate.rs `default_energy` (f32) at DEFAULT_SETTINGS: `LocalRay::new`, then
+// `default_generic`.
 fn curve_default(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
     var ok = false;
     let r = curve_local_ray(c, falloff, core_radius, ray, t0, t1, t_far, &ok);
@@ -845,8 +846,9 @@ fn curve_composite(c: GpuCurve, r: LocalRay, a: f32, b: f32, m: u32) -> f32 {
     return (curve_density(c, r, a) + 4.0 * odd + 2.0 * even + curve_density(c, r, b)) * h / 3.0;
 }
 
-// Mirrors simpson.rs `simpson_generic` (f32): m subintervals, m/n outside the bounding cylinder
-// of radius R + ε (002 §3.4.4, eq. 3.22), the default integrator for any tail past the far point.
+// Mirrors the Simpson arm of dispatch.rs `curve_energy_generic` (f32): simpson.rs `simpson_generic`
+// (m subintervals, m/n outside the bounding cylinder of radius R + ε, 002 §3.4.4, eq. 3.22), then
+// the default integrator for any tail past the far point.
 fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
     var ok = false;
     let r = curve_local_ray(c, falloff, core_radius, ray, t0, t1, t_far, &ok);

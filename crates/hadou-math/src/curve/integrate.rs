@@ -1,5 +1,5 @@
-//! hadou's default curve integrator, and the per-ray entry point [`curve_energy`] that dispatches
-//! on [`Integrator`].
+//! hadou's default curve integrator ([`Integrator::Default`](super::Integrator::Default)), run by
+//! [`curve_energy`](super::curve_energy) and, with explicit settings, by [`default_energy`].
 //!
 //! # Method
 //! The ray `P(t) = S + t·Q` is split where its axial coordinate `x(t)` crosses the end planes
@@ -37,7 +37,8 @@
 //! could get wrong on the rest falls below `τ/2` (the rest is one last part).
 //!
 //! # Per-ray algorithm (what the GPU mirrors)
-//! 1. Local ray: `o = ((S−O)·D, (S−O)·ŷ, (S−O)·ẑ)`, `q` likewise; resolve the span.
+//! 1. Local ray (`LocalRay::new`): `o = ((S−O)·D, (S−O)·ŷ, (S−O)·ẑ)`, `q` likewise; resolve the
+//!    span.
 //! 2. Slab crossing `t_in`, `t_out` from `x(t) = o.x + q.x·t ∈ [0, X]`.
 //! 3. End piece before the slab: `p = local(t_a) − end point`, `v = q` (3-D), exact.
 //! 4. Slab: if the `x`-range is below `10⁻⁶X`, one piece against the interpolated leaf point;
@@ -55,9 +56,8 @@
 //! attenuation together. Simpson counts one per integrand sample.
 
 use super::closed::{Quad, Segment};
+use super::local_ray::{CurveReal, LocalRay};
 use super::prepare::PreparedCurve;
-use super::shape::ShapeEval;
-use super::{simpson, Integrator};
 use crate::energy::{scaled, Falloff, FieldParams, Ray};
 use crate::{Real, Vec3};
 
@@ -82,6 +82,8 @@ pub struct DefaultSettings {
 /// and the curve tests): `τ = 2·10⁻³` gives a 99th-percentile relative error of 0.3–2.5·10⁻⁴ on
 /// the example scenes and the test configurations, 4–20× below faithful Simpson at `m = 500`
 /// and 20× below the 0.5 % bar.
+///
+/// [`Integrator::Default`]: super::Integrator::Default
 pub const DEFAULT_SETTINGS: DefaultSettings = DefaultSettings { tolerance: 2e-3 };
 
 /// How attenuated pieces are split: `(q, h_floor)` for exponent `j > 0` and tolerance `τ`.
@@ -109,54 +111,6 @@ pub fn attenuation_split(j: f64, tolerance: f64) -> (f64, f64) {
     (1.0 / (1.0 + x_max), h_floor)
 }
 
-/// The energy of one ray through a prepared curve, by the wave's integrator (002 §3.4).
-///
-/// `ray`, `t0`, `t1`, `t_far` come from the scene's wave-ray construction: for
-/// [`Falloff::Faithful`] `ray.dir = Q = E − S` and `t_far = 1`; for [`Falloff::InverseSquare`]
-/// `ray.dir` is a unit vector, `t_far` the far point's distance, and `t1` may be `+∞`.
-/// `[t0, t1]` is the span clipped at the visible surface (002 §3.3.5). Non-finite or empty input
-/// gives 0; the result is always finite.
-pub fn curve_energy(
-    c: &PreparedCurve,
-    p: &FieldParams<f32>,
-    ray: &Ray<f32>,
-    t0: f32,
-    t1: f32,
-    t_far: f32,
-) -> CurveSample {
-    let (e, n) = curve_energy_generic(c, p, ray, t0, t1, t_far);
-    CurveSample { energy: e, evaluations: n }
-}
-
-/// [`curve_energy`] in `f64`: the same algorithm, for tests that separate its own error from
-/// `f32` rounding.
-pub fn curve_energy_f64(
-    c: &PreparedCurve,
-    p: &FieldParams<f64>,
-    ray: &Ray<f64>,
-    t0: f64,
-    t1: f64,
-    t_far: f64,
-) -> (f64, u32) {
-    curve_energy_generic(c, p, ray, t0, t1, t_far)
-}
-
-fn curve_energy_generic<R: CurveReal>(
-    c: &PreparedCurve,
-    p: &FieldParams<R>,
-    ray: &Ray<R>,
-    t0: R,
-    t1: R,
-    t_far: R,
-) -> (R, u32) {
-    match c.wave.integrator {
-        Integrator::Simpson { m, reduction } => {
-            simpson::simpson_generic(c, p, ray, t0, t1, t_far, m, reduction)
-        }
-        Integrator::Default => default_generic(c, p, ray, t0, t1, t_far, &DEFAULT_SETTINGS),
-    }
-}
-
 /// The default integrator with explicit settings, in `f32` (for measurements and tuning).
 pub fn default_energy(
     c: &PreparedCurve,
@@ -167,144 +121,9 @@ pub fn default_energy(
     t_far: f32,
     settings: &DefaultSettings,
 ) -> CurveSample {
-    let (e, n) = default_generic(c, p, ray, t0, t1, t_far, settings);
+    let (e, n) =
+        LocalRay::new(c, p, ray, t0, t1, t_far).map_or((0.0, 0), |r| default_generic(c, &r, settings));
     CurveSample { energy: e, evaluations: n }
-}
-
-/// The precisions the curve integrators run in (`f32` renders, `f64` checks).
-pub(crate) trait CurveReal: Real {
-    /// The shape evaluator in this precision.
-    fn shape(c: &PreparedCurve) -> &ShapeEval<Self>;
-    /// The value with the lower half of its significand cleared (12 of 24 bits kept in `f32`,
-    /// 26 of 53 in `f64`), so that the product of two such values, or of one with the remainder
-    /// `x − x.split()`, is exact.
-    fn split(self) -> Self;
-}
-impl CurveReal for f32 {
-    fn shape(c: &PreparedCurve) -> &ShapeEval<f32> {
-        &c.shape32
-    }
-    #[inline]
-    fn split(self) -> f32 {
-        f32::from_bits(self.to_bits() & 0xffff_f000)
-    }
-}
-impl CurveReal for f64 {
-    fn shape(c: &PreparedCurve) -> &ShapeEval<f64> {
-        &c.shape64
-    }
-    #[inline]
-    fn split(self) -> f64 {
-        f64::from_bits(self.to_bits() & 0xffff_ffff_f800_0000)
-    }
-}
-
-/// A ray in the curve's local frame, with the span and the attenuation resolved.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LocalRay<R> {
-    /// Eye in local coordinates `(x, y, z)`.
-    pub o: Vec3<R>,
-    /// Direction in local coordinates.
-    pub q: Vec3<R>,
-    /// Span start.
-    pub t0: R,
-    /// Span end (finite unless inverse square without attenuation).
-    pub t1: R,
-    /// Far point parameter (`> 0`).
-    pub t_far: R,
-    /// Attenuation exponent `j` (0: none).
-    pub j: R,
-    /// Effective core radius squared.
-    pub rc2: R,
-    /// Density law.
-    pub falloff: Falloff,
-    /// Strength `α`.
-    pub alpha: R,
-    /// Axial length `X`.
-    pub x_head: R,
-}
-
-impl<R: Real> LocalRay<R> {
-    /// Resolves the span: `None` if it is empty or the input is not finite.
-    ///
-    /// Faithful mode integrates at most to the far point (`t1 = ∞` means `t_far`); with attenuation
-    /// `j > 0` the factor is 0 from the far point on, so the span ends there.
-    pub(crate) fn new(
-        c: &PreparedCurve,
-        p: &FieldParams<R>,
-        ray: &Ray<R>,
-        t0: R,
-        t1: R,
-        t_far: R,
-    ) -> Option<Self> {
-        if !(ray.origin.is_finite() && ray.dir.is_finite() && t0.is_finite() && !t1.to_f64().is_nan()) {
-            return None;
-        }
-        let t_far = if t_far.is_finite() && t_far > R::ZERO { t_far } else { R::ONE };
-        let j = R::from_f64(f64::from(c.wave.attenuation));
-        let mut t1 = t1;
-        if p.falloff == Falloff::Faithful && !t1.is_finite() {
-            t1 = t_far;
-        }
-        if j > R::ZERO {
-            t1 = t1.min(t_far);
-        }
-        if !(t1 > t0) {
-            return None;
-        }
-        let o64 = c.origin;
-        let conv = |v: Vec3<f64>| Vec3::new(R::from_f64(v.x), R::from_f64(v.y), R::from_f64(v.z));
-        let [d, y, z] = c.axes.map(conv);
-        let w = ray.origin - conv(o64);
-        Some(LocalRay {
-            o: Vec3::new(w.dot(d), w.dot(y), w.dot(z)),
-            q: Vec3::new(ray.dir.dot(d), ray.dir.dot(y), ray.dir.dot(z)),
-            t0,
-            t1,
-            t_far,
-            j,
-            rc2: {
-                let rc = c.effective_core_radius(p.core_radius);
-                rc * rc
-            },
-            falloff: p.falloff,
-            alpha: R::from_f64(f64::from(c.wave.alpha)),
-            x_head: R::from_f64(c.x_head),
-        })
-    }
-
-    /// Local point at `t`.
-    #[inline]
-    pub(crate) fn at(&self, t: R) -> Vec3<R> {
-        self.o + self.q * t
-    }
-
-    /// Attenuation `(1 − t/t_far)^j` (002 eq. 3.23), 0 beyond the far point, 1 for `j = 0`.
-    #[inline]
-    pub(crate) fn attenuation(&self, t: R) -> R {
-        if self.j == R::ZERO {
-            return R::ONE;
-        }
-        let u = R::ONE - t / self.t_far;
-        if u <= R::ZERO {
-            R::ZERO
-        } else {
-            u.powf(self.j)
-        }
-    }
-
-    /// The `t` where the ray crosses the end planes, in ray order, with the end point met before
-    /// the slab (`false` = `c(0)`, `true` = the head) — or `None` when `x` is constant.
-    #[inline]
-    pub(crate) fn slab(&self) -> Option<(R, R, bool)> {
-        let qx = self.q.x;
-        if qx == R::ZERO {
-            return None;
-        }
-        let ta = -self.o.x / qx;
-        let tb = (self.x_head - self.o.x) / qx;
-        Some(if qx > R::ZERO { (ta, tb, false) } else { (tb, ta, true) })
-    }
 }
 
 /// Accumulates pieces: energy and evaluation count.
@@ -453,23 +272,17 @@ impl<R: Real> ChordModel<R> {
     }
 }
 
-/// The default integrator, generic over the precision.
+/// The default integrator over the resolved span of `r`, generic over the precision:
+/// `(α·∫, evaluations)`.
 pub(crate) fn default_generic<R: CurveReal>(
     c: &PreparedCurve,
-    p: &FieldParams<R>,
-    ray: &Ray<R>,
-    t0: R,
-    t1: R,
-    t_far: R,
+    r: &LocalRay<R>,
     settings: &DefaultSettings,
 ) -> (R, u32) {
-    let Some(r) = LocalRay::new(c, p, ray, t0, t1, t_far) else {
-        return (R::ZERO, 0);
-    };
     let (q, h_floor) =
         if r.j > R::ZERO { attenuation_split(r.j.to_f64(), settings.tolerance) } else { (0.5, 0.0) };
     let mut acc = Acc { sum: R::ZERO, evals: 0, q: R::from_f64(q), h_floor: R::from_f64(h_floor) };
-    integrate_span(c, &r, r.t0, r.t1, settings, &mut acc);
+    integrate_span(c, r, r.t0, r.t1, settings, &mut acc);
     // α·Σ saturated at f32::MAX (energy module docs): an overflow is full brightness, not 0.
     (scaled(acc.sum, r.alpha), acc.evals)
 }
@@ -737,7 +550,7 @@ fn curve_at<R: CurveReal>(c: &PreparedCurve, x: R) -> [R; 2] {
     R::shape(c).eval(s)
 }
 
-/// Most levels [`leaf_walk`] descends below a leaf (`CURVE_SUB_LEVELS` in curve.wgsl): a
+/// Most levels `leaf_walk` descends below a leaf (`CURVE_SUB_LEVELS` in curve.wgsl): a
 /// sub-piece is then `2⁻¹⁶` of its leaf, its deviation about `4⁻¹⁶` of the leaf's.
 pub const MAX_SUB_LEVELS: usize = 16;
 
@@ -832,7 +645,7 @@ fn leaf_walk<R: CurveReal>(
 }
 
 #[cfg(test)]
-mod model_tests {
+mod tests {
     use super::*;
     use crate::curve::prepare;
 

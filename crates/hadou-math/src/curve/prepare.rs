@@ -2,8 +2,8 @@
 //! the bounding cylinder, and the tree of polylines the default integrator walks.
 
 use super::shape::{self, ShapeEval};
-use super::validate::sanitize;
-use super::{CurveError, CurveWave};
+use super::validate::{sanitize, CurveError};
+use super::wave::{CurveFrame, CurveShape, CurveWave};
 use crate::{Real, Vec3};
 
 /// Most leaf pieces of a [`PieceTable`].
@@ -118,7 +118,7 @@ pub fn prepare(wave: &CurveWave) -> PreparedCurve {
     let wave = sanitize(wave);
     let frame = wave.frame;
     let f64v = |v: Vec3<f32>| v.as_f64();
-    let fr = super::CurveFrame { origin: f64v(frame.origin), axis: f64v(frame.axis), up: f64v(frame.up) };
+    let fr = CurveFrame { origin: f64v(frame.origin), axis: f64v(frame.axis), up: f64v(frame.up) };
     let axes = fr.axes().unwrap_or([Vec3::X, Vec3::Y, Vec3::Z]);
     let shape64 = ShapeEval::<f64>::new(&wave.shape);
     let shape32 = ShapeEval::<f32>::new(&wave.shape);
@@ -216,14 +216,12 @@ fn build_table(wave: &CurveWave, shape: &ShapeEval<f64>, s_head: f64, x_head: f6
     // Initial uniform pieces: enough to see every feature (8 per period of the fastest harmonic,
     // 4 per control point or knot span), so bisection only refines.
     let features = match &wave.shape {
-        super::CurveShape::Helix { rate, .. } => f64::from(rate.abs()) * s_head / std::f64::consts::TAU,
-        super::CurveShape::TrigSum { rate, y_terms, z_terms, .. } => {
+        CurveShape::Helix { rate, .. } => f64::from(rate.abs()) * s_head / std::f64::consts::TAU,
+        CurveShape::TrigSum { rate, y_terms, z_terms, .. } => {
             let h = y_terms.len().max(z_terms.len()) as f64;
             h * f64::from(rate.abs()) * s_head / std::f64::consts::TAU
         }
-        super::CurveShape::Bezier { points } | super::CurveShape::BSpline { points, .. } => {
-            points.len() as f64 / 2.0
-        }
+        CurveShape::Bezier { points } | CurveShape::BSpline { points, .. } => points.len() as f64 / 2.0,
     };
     let n0 = ((features * 8.0).ceil() as usize).clamp(16, MAX_PIECES / 4);
     // Minimum piece length in s: keeps f32 node coordinates strictly increasing.

@@ -1,6 +1,7 @@
 //! The converged `f64` reference for curve energies: adaptive Gauss–Kronrod on the exact field.
 
-use super::integrate::{leaf_of, LocalRay};
+use super::integrate::leaf_of;
+use super::local_ray::LocalRay;
 use super::prepare::PreparedCurve;
 use super::simpson::density;
 use crate::energy::{FieldParams, Ray};
@@ -29,9 +30,11 @@ pub fn curve_energy_reference(
     t_far: f64,
     rel_tol: f64,
 ) -> f64 {
-    let Some(r) = LocalRay::new(c, p, ray, t0, t1, t_far) else {
-        return 0.0;
-    };
+    LocalRay::new(c, p, ray, t0, t1, t_far).map_or(0.0, |r| reference_integral(c, &r, rel_tol))
+}
+
+/// [`curve_energy_reference`] over the resolved span of `r`.
+fn reference_integral(c: &PreparedCurve, r: &LocalRay<f64>, rel_tol: f64) -> f64 {
     let mut breaks = vec![r.t0];
     let closest = |a: f64, b: f64, pnt: Vec3<f64>| {
         // Closest approach of the ray to a fixed local point, if inside (a, b).
@@ -132,7 +135,7 @@ pub fn curve_energy_reference(
     breaks.push(r.t1);
     breaks.sort_by(f64::total_cmp);
     breaks.dedup();
-    let q = integrate_adaptive_breaks(|t| density(c, &r, t), &breaks, rel_tol, 0.0);
+    let q = integrate_adaptive_breaks(|t| density(c, r, t), &breaks, rel_tol, 0.0);
     let e = q.value * r.alpha;
     if e.is_finite() {
         e

@@ -2,7 +2,7 @@
 //! [`Real`] so the per-ray integrators run in `f32` and the converged reference in `f64` from one
 //! source.
 
-use super::{CurveShape, MAX_ORDER};
+use super::wave::{CurveShape, MAX_ORDER};
 use crate::Real;
 
 /// A cross-section curve ready for evaluation in precision `R`: the shape's parameters converted

@@ -5,10 +5,10 @@
 //! compared: the exact curve is evaluated at every sample (002 eq. 3.17–3.21, with the
 //! cross-section pairing of SPEC.md §1.4 and the round ends of eq. 3.24).
 
-use super::integrate::{default_generic, CurveReal, LocalRay, DEFAULT_SETTINGS};
+use super::local_ray::{CurveReal, LocalRay};
 use super::prepare::PreparedCurve;
-use super::Reduction;
-use crate::energy::{saturate, scaled, Falloff, FieldParams, Ray};
+use super::wave::{Reduction, MAX_SIMPSON_M};
+use crate::energy::{scaled, Falloff};
 
 /// The exact density at ray parameter `t`, without `α`: `w(|P(t) − C(t)|)·(1 − t/t_far)^j`
 /// (002 eq. 3.17, 3.23), `C(t)` the curve point paired with `P(t)` by cross-section, clamped to
@@ -56,31 +56,26 @@ pub fn reduced_m(m: u32, n: u32) -> u32 {
     k + (k & 1)
 }
 
-/// The faithful Simpson integrator, generic over the precision: `(α·∫, evaluations)`.
+/// The faithful Simpson integrator over the resolved span of `r`, generic over the precision:
+/// `(α·∫, evaluations)`.
 ///
 /// The span `[t0, min(t1, t_far)]` (the thesis integrates from the eye to the far point, `u ∈
 /// [0, 1]`, and here stops early at the visible surface) gets `m` subintervals. With a reduction,
 /// the ray's entry and exit `u₁ < u₂` of the infinite cylinder of radius `R + ε` around the axis
 /// (002 eq. 3.22) split it into three regions: inside `m`, each outside part `m/n`; without two
 /// real roots the whole span uses `m/n`. Empty regions are skipped. Beyond the far point
-/// (inverse square, no attenuation, `t1 > t_far`) the thesis has no rule; that tail is added by
-/// the default integrator and counted.
-#[allow(clippy::too_many_arguments)]
+/// (inverse square, no attenuation, `t1 > t_far`) the thesis has no rule; [`curve_energy`]
+/// adds that tail by the default integrator and counts it.
+///
+/// [`curve_energy`]: super::curve_energy
 pub(crate) fn simpson_generic<R: CurveReal>(
     c: &PreparedCurve,
-    p: &FieldParams<R>,
-    ray: &Ray<R>,
-    t0: R,
-    t1: R,
-    t_far: R,
+    r: &LocalRay<R>,
     m: u32,
     reduction: Option<Reduction>,
 ) -> (R, u32) {
-    let Some(r) = LocalRay::new(c, p, ray, t0, t1, t_far) else {
-        return (R::ZERO, 0);
-    };
     let m = {
-        let m = m.clamp(2, super::MAX_SIMPSON_M);
+        let m = m.clamp(2, MAX_SIMPSON_M);
         m + (m & 1)
     };
     let te = r.t1.min(r.t_far);
@@ -91,7 +86,7 @@ pub(crate) fn simpson_generic<R: CurveReal>(
         evals += e;
     };
     match reduction {
-        None => add(composite(c, &r, r.t0, te, m)),
+        None => add(composite(c, r, r.t0, te, m)),
         Some(red) => {
             let mo = reduced_m(m, red.n);
             let rad = R::from_f64(c.bound + f64::from(red.epsilon));
@@ -104,17 +99,13 @@ pub(crate) fn simpson_generic<R: CurveReal>(
                 let sq = disc.sqrt();
                 let u1 = ((-b - sq) / a).clamp(r.t0, te);
                 let u2 = ((-b + sq) / a).clamp(r.t0, te);
-                add(composite(c, &r, r.t0, u1, mo));
-                add(composite(c, &r, u1, u2, m));
-                add(composite(c, &r, u2, te, mo));
+                add(composite(c, r, r.t0, u1, mo));
+                add(composite(c, r, u1, u2, m));
+                add(composite(c, r, u2, te, mo));
             } else {
-                add(composite(c, &r, r.t0, te, mo));
+                add(composite(c, r, r.t0, te, mo));
             }
         }
-    }
-    if r.t1 > r.t_far {
-        let (tail, n) = default_generic(c, p, ray, r.t_far, r.t1, r.t_far, &DEFAULT_SETTINGS);
-        return (saturate(scaled(sum, r.alpha) + tail), evals + n);
     }
     (scaled(sum, r.alpha), evals)
 }

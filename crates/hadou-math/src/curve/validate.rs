@@ -1,9 +1,10 @@
 //! Validation of a [`CurveWave`] (each error names the scene-file key and the fix) and the
-//! sanitizing that lets [`super::prepare`] accept any value without panicking.
+//! sanitizing that lets [`prepare`](fn@super::prepare) accept any value without panicking.
 
-use super::{
-    clamped_uniform_knots, CurveShape, CurveWave, Integrator, MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS,
-    MAX_ORDER, MAX_SIMPSON_M, MAX_TRIG_TERMS,
+use super::shape::clamped_uniform_knots;
+use super::wave::{
+    CurveShape, CurveWave, Integrator, MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS, MAX_ORDER, MAX_SIMPSON_M,
+    MAX_TRIG_TERMS,
 };
 use crate::Vec3;
 use core::fmt;

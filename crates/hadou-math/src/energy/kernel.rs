@@ -2,6 +2,7 @@
 //! `∫ dt / (Y² + H)` (inverse square) with `Y(t) = s·t + β` — see the module docs of
 //! [`crate::energy`] for the derivation and why each form is the stable one.
 
+use super::field::Falloff;
 use crate::{Real, Vec3};
 
 /// Floor on `H` (a squared length): keeps rays exactly through a centre or along an axis with
@@ -45,9 +46,6 @@ pub fn scaled<R: Real>(integral: R, alpha: R) -> R {
 /// integrates to infinity in closed form (the tail beyond is below `10⁻¹²/s²` absolute),
 /// [`Falloff::Faithful`] clamps there (its `1/r` integral diverges at infinity). Keeps `Y²` finite
 /// in `f32`.
-///
-/// [`Falloff::InverseSquare`]: super::Falloff::InverseSquare
-/// [`Falloff::Faithful`]: super::Falloff::Faithful
 pub const T_LIMIT: f64 = 1e12;
 
 /// A unit direction `û = u/|u|` and `s = |u|`, or `s = 0`, `û = 0` where `|u|²` is not a
@@ -203,10 +201,10 @@ impl<R: Real> RayQuadratic<R> {
 
     /// The integral for `falloff` (see [`Self::faithful`], [`Self::inverse_square`]).
     #[inline(always)]
-    pub fn integral(&self, falloff: super::Falloff, t0: R, t1: R) -> R {
+    pub fn integral(&self, falloff: Falloff, t0: R, t1: R) -> R {
         match falloff {
-            super::Falloff::Faithful => self.faithful(t0, t1),
-            super::Falloff::InverseSquare => self.inverse_square(t0, t1),
+            Falloff::Faithful => self.faithful(t0, t1),
+            Falloff::InverseSquare => self.inverse_square(t0, t1),
         }
     }
 }

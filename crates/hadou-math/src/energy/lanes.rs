@@ -10,8 +10,8 @@
 //!
 //! [`RayQuadratic`]: super::RayQuadratic
 
+use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
-use super::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use crate::Vec3;
 use wide::f32x8;
 
