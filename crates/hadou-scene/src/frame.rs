@@ -2,13 +2,12 @@
 //! to parse. Produced by `Scene::at`, consumed by every backend.
 
 use crate::area_light::AreaLight;
+use crate::shadow::Shadow;
 use hadou_math::curve::{CurveWave, PreparedCurve};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
 pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use std::sync::Arc;
-
-pub use crate::shadow::{Shadow, ShadowCast, ShadowLight, ShadowMethod};
 
 /// One instant of a scene, ready to draw.
 #[derive(Clone, Debug)]

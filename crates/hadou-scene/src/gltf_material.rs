@@ -15,6 +15,7 @@
 //! is checked against the array it points into first.
 
 use crate::frame::{Filter, Material, Ramp, ShadingModel, Texture, TextureRef, Wrap};
+use crate::gltf_uri::resolve_uri;
 use crate::texture::decode_texture;
 use serde_json::Value;
 use std::path::Path;
@@ -270,7 +271,7 @@ fn load_image(
             (bytes.to_vec(), format!("image {index} (bufferView {})", v.value()))
         }
         (None, Some(uri)) => {
-            let bytes = crate::gltf_load::resolve_uri(uri, src.dir, src.root, *bytes_left).map_err(fail)?;
+            let bytes = resolve_uri(uri, src.dir, src.root, *bytes_left).map_err(fail)?;
             *bytes_left = bytes_left.saturating_sub(bytes.len() as u64);
             let shown = if uri.starts_with("data:") { "data URI".to_string() } else { format!("`{uri}`") };
             (bytes, format!("image {index} ({shown})"))

@@ -13,12 +13,15 @@
 
 mod anim;
 mod area_light;
+mod area_light_def;
 mod backend;
+mod bounds;
 mod error;
 mod files;
 mod frame;
 mod gltf_load;
 mod gltf_material;
+mod gltf_uri;
 mod guard;
 mod image;
 mod introspect;
@@ -29,12 +32,15 @@ mod params;
 mod scene;
 mod schema;
 mod shadow;
+mod shadow_casts;
+mod shadow_def;
 mod texture;
 mod toml_read;
 
 pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
 pub use backend::{Backend, RenderError};
+pub use bounds::{object_bounds, object_center};
 pub use error::{Location, SceneError};
 pub use files::{read_regular_file, GLTF_MAX_BYTES, SCENE_MAX_BYTES};
 pub use frame::*;
@@ -44,6 +50,7 @@ pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_
 pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
 pub use scene::Scene;
 pub use shadow::{
-    object_bounds, object_center, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS, ON_PLANE,
+    Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,
+    ON_PLANE,
 };
 pub use texture::{decode_texture, encode_png, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS};

@@ -3,8 +3,10 @@
 //! `docs/scene-format.md`.
 
 use crate::anim::{Interpolation, Track};
-use crate::area_light::{check_area_light, parse_area_light, SOFT_MAX_PIXELS};
+use crate::area_light::SOFT_MAX_PIXELS;
+use crate::area_light_def::{check_area_light, parse_area_light};
 use crate::error::{hint, Location, SceneError};
+use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
 use crate::frame::{Mesh, ToneMode};
 use crate::gltf_load::Budget;
 use crate::limits::{
@@ -16,8 +18,9 @@ use crate::materials::{
 };
 use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
 use crate::params::{Constraint, ParamSet, Shape};
-use crate::scene::{IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
-use crate::shadow::{check_map_budget, check_shadow, parse_shadow, ShadowDef, MAX_SHADOWS};
+use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
+use crate::shadow::MAX_SHADOWS;
+use crate::shadow_def::{check_map_budget, check_shadow, parse_shadow, ShadowDef};
 use crate::toml_read::{number, read_numbers, type_name, Fallback, ParamReader, Res, Span, Src, Table, Val};
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
@@ -73,10 +76,30 @@ const ANY: Constraint = Constraint::Any;
 const V3: Shape = Shape::Vector(3);
 const S: Shape = Shape::Scalar;
 
-/// Whether `up` fixes a frame around unit `axis`: not zero and not parallel to it.
-pub(crate) fn up_is_usable(up: Vec3f, axis: Vec3f) -> bool {
-    let l = up.length();
-    l > 0.0 && l.is_finite() && up.cross(axis).length() > 1e-4 * l
+impl Scene {
+    /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        Self::parse(&Self::read_text(path)?, path)
+    }
+
+    /// The scene file's text, read as [`Scene::load`] reads it: a regular file of at most
+    /// [`SCENE_MAX_BYTES`], UTF-8.
+    pub fn read_text(path: &Path) -> Result<String, SceneError> {
+        let bytes = read_regular_file(path, SCENE_MAX_BYTES).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: format!("cannot read the scene file: {e}"),
+        })?;
+        String::from_utf8(bytes).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        })
+    }
+
+    /// Parses scene `text`; `path` names the file in messages and anchors relative asset paths.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        parse_scene(text, path)
+    }
 }
 
 /// Parses a whole scene.
@@ -155,11 +178,8 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut globals = ParamSet::default();
     rd.add(&root, &mut globals, "background", V3, NONNEG, Fallback::Value(&[0.0; 3]), false)?;
 
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut assets = Assets { dir, root: None, cache: HashMap::new(), budget: Budget::FULL };
+    let dir = parent_dir(path).to_path_buf();
+    let mut assets = Assets { dir: SceneDir::new(dir), cache: HashMap::new(), budget: Budget::FULL };
     let mut warnings = Vec::new();
 
     // [[material]]
@@ -168,8 +188,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let material_tables = root.array_of_tables("material")?;
     if !material_tables.is_empty() {
         let mut cache = TextureCache {
-            dir: assets.dir.clone(),
-            root: None,
+            dir: SceneDir::new(assets.dir.path.clone()),
             images: HashMap::new(),
             warnings: &mut warnings,
         };
@@ -341,25 +360,10 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
 /// What loading the objects' meshes shares: the glTF cache (by canonical path), the scene's
 /// triangle budget and the directory tree files may be read from.
 struct Assets {
-    /// The scene file's directory (as given).
-    dir: PathBuf,
-    /// Its canonical form, once needed.
-    root: Option<PathBuf>,
+    /// The scene file's directory.
+    dir: SceneDir,
     cache: HashMap<PathBuf, Arc<Mesh>>,
     budget: Budget,
-}
-
-impl Assets {
-    /// The canonical scene directory.
-    fn root(&mut self) -> Result<PathBuf, String> {
-        if let Some(r) = &self.root {
-            return Ok(r.clone());
-        }
-        let r = std::fs::canonicalize(&self.dir)
-            .map_err(|e| format!("cannot resolve the scene file's directory {}: {e}", self.dir.display()))?;
-        self.root = Some(r.clone());
-        Ok(r)
-    }
 }
 
 fn parse_object(
@@ -421,7 +425,7 @@ fn parse_object(
             let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
             let gltf_err =
                 |message: String, file: PathBuf| SceneError::Gltf { at: t.src.loc(&span), file, message };
-            let file = assets.dir.join(rel);
+            let file = assets.dir.path.join(rel);
             if Path::new(rel).is_absolute() || Path::new(rel).has_root() {
                 return Err(gltf_err(
                     "`path` must be relative to the scene file (glTF files must lie inside the scene \
@@ -432,7 +436,7 @@ fn parse_object(
             }
             let real = std::fs::canonicalize(&file)
                 .map_err(|e| gltf_err(format!("cannot read the file: {e}"), file.clone()))?;
-            let root = assets.root().map_err(|m| gltf_err(m, file.clone()))?;
+            let root = assets.dir.root().map_err(|m| gltf_err(m, file.clone()))?;
             if !real.starts_with(&root) {
                 return Err(gltf_err(
                     format!(
