@@ -1,4 +1,4 @@
-//! The [`Backend`] trait both renderers implement.
+//! The [`Backend`] trait both renderers implement, and [`RenderError`], why one could not render.
 
 use crate::frame::Frame;
 use crate::image::Image;

@@ -1,7 +1,8 @@
 //! Reading untrusted files: only regular files, never more than a cap. A FIFO would block
 //! forever and `/dev/zero` never ends, so the type is checked before opening and again on the
 //! opened handle, and the read itself stops one byte past the cap (a file that grows while it is
-//! read is caught too).
+//! read is caught too). [`SceneDir`] is the scene file's directory tree, which every file a scene
+//! names (textures, glTF files) must lie in.
 
 use std::fs::{File, OpenOptions};
 use std::io::Read;

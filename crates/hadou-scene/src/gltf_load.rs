@@ -18,7 +18,7 @@
 //! otherwise multiply the instances exponentially), and the triangles the default scene
 //! instantiates are counted against the scene's budget before any data is copied. Every accessor
 //! is bounds-checked before it is read, and every joint index against its skin. External buffer
-//! and image files must lie inside the asset root, every byte read counts against
+//! and image files must lie inside the asset root (`gltf_uri`), every byte read counts against
 //! [`GLTF_MAX_BYTES`] and decoded texels against
 //! [`crate::gltf_material::TEXEL_BUDGET_BYTES`]. Calls into the gltf crate and the image decoders
 //! run under [`guarded`], so even an unforeseen panic there is an error, never a crash.

@@ -9,10 +9,11 @@
 //!   `"extras": {"hadou": {"featureTexture": {"index": N, "texCoord": M}}}` (`texCoord` optional,
 //!   0 by default) → [`Material::feature_texture`].
 //!
-//! Images come from a bufferView or a URI (base64 data URI, or a file inside the asset root) and
-//! are decoded once each (PNG or JPEG, recognised by their bytes), only when a material uses them;
-//! the decoded texels of one glTF file are capped at [`TEXEL_BUDGET_BYTES`]. Every index read here
-//! is checked against the array it points into first.
+//! Images come from a bufferView or a URI (base64 data URI, or a file inside the asset root; both
+//! read by `gltf_uri`) and are decoded once each (PNG or JPEG, recognised by their bytes), only
+//! when a material uses them; the decoded texels of one glTF file are capped at
+//! [`TEXEL_BUDGET_BYTES`]. Every index read here is checked against the array it points into
+//! first.
 
 use crate::frame::{Filter, Material, Ramp, ShadingModel, Texture, TextureRef, Wrap};
 use crate::gltf_uri::resolve_uri;

@@ -8,8 +8,24 @@
 //! ```
 //!
 //! All validation happens in [`Scene::load`]/[`Scene::parse`]; errors are [`SceneError`]s whose
-//! `Display` is `path:line:col: message`. [`Scene::at`] never fails. The file format is described
-//! key by key in `docs/scene-format.md`.
+//! `Display` is `path:line:col: message`. [`Scene::at`] never fails. A backend that cannot render
+//! says why with a [`RenderError`]. The file format is described key by key in
+//! `docs/scene-format.md`.
+//!
+//! The files form layers; each uses only files of its own layer or the layers below (no import
+//! circles):
+//! 1. the frame's plain values (`frame.rs`, with `shadow.rs` and `area_light.rs`; `image.rs`) and
+//!    the helpers everything uses (`error.rs`, `limits.rs`, `files.rs`, `guard.rs`, `params.rs`,
+//!    `anim.rs`, `toml_read.rs`);
+//! 2. a frame's geometry and assets: `bounds.rs`, `mesh.rs`, `texture.rs`, `gltf_uri.rs`,
+//!    `gltf_material.rs`, `gltf_load.rs`; and `backend.rs`;
+//! 3. each feature read from the scene file and built at one set of values (`materials.rs`,
+//!    `shadow_def.rs`, `area_light_def.rs`), and `shadow_casts.rs` (`Frame::shadow_casts`);
+//! 4. `scene.rs`: [`Scene`] and [`Scene::at`];
+//! 5. `track_def.rs` (`[[track]]` targets resolved against a [`Scene`]) and `introspect.rs`;
+//! 6. `schema.rs`: [`Scene::load`], [`Scene::parse`].
+//!
+//! This file only declares the modules and re-exports the public items.
 
 mod anim;
 mod area_light;
@@ -36,6 +52,7 @@ mod shadow_casts;
 mod shadow_def;
 mod texture;
 mod toml_read;
+mod track_def;
 
 pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};

@@ -1,6 +1,8 @@
-//! `[[material]]` tables, the material keys of `[[object]]` and the light keys of `[[wave]]`:
-//! toon ramps, textures read from the scene's directory, outlines, and the animatable parts
-//! (`base_color`, `wave_blend`, `outline_width`, `outline_color`, `light_glow`).
+//! `[[material]]` tables and the material keys of `[[object]]`: toon ramps ([`parse_ramp`], which
+//! `[[wave]]`'s `light_ramp` uses too), textures read from the scene's directory ([`scene_file`],
+//! [`TextureCache`]), outlines, the object's material slots and overrides, and the animatable
+//! parts (`base_color`, `wave_blend`, `outline_width`, `outline_color`); [`build_material`] gives a
+//! slot's [`Material`] at one set of values.
 
 use crate::files::SceneDir;
 use crate::frame::{Filter, Material, Mesh, Outline, Ramp, RampKind, ShadingModel, TextureRef, Wrap};

@@ -1,5 +1,7 @@
-//! [`Scene`]: a loaded, validated scene file with its animation tracks; [`Scene::at`] evaluates
-//! it into a [`Frame`].
+//! [`Scene`]: a loaded, validated scene file with its animation tracks ([`ObjectDef`], [`WaveDef`]
+//! and the other parts as read); [`Scene::at`] evaluates it into a [`Frame`]: tracks applied,
+//! values clamped, then every object, wave (curves included), shadow and the area light built.
+//! [`Scene::load`] and [`Scene::parse`] are in `schema.rs`.
 
 use crate::anim::Track;
 use crate::area_light_def::{build_area_light, AreaLightDef};

@@ -1,5 +1,7 @@
 //! A hand-walk over toml's spanned document ([`toml::de::DeTable`]): typed reads that report the
-//! exact span of the offending key or value, and unknown-key detection with suggestions.
+//! exact span of the offending key or value (strings, choices, integers, booleans, lists of object
+//! names, numbers of any [`Shape`]), unknown-key detection with suggestions, and [`ParamReader`],
+//! which appends a table's numbers to the scene's parameter store.
 
 use crate::error::{hint, Location, SceneError};
 use crate::limits::fmt_f64;
