@@ -1,6 +1,7 @@
-//! The [`Backend`] trait both renderers implement.
+//! The [`Backend`] trait both renderers implement, and [`RenderError`], why one could not render.
 
-use crate::{Frame, Image};
+use crate::frame::Frame;
+use crate::image::Image;
 
 /// A renderer: turns a [`Frame`] into an [`Image`].
 pub trait Backend {

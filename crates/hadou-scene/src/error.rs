@@ -1,4 +1,5 @@
-//! [`SceneError`]: everything that can be wrong with a scene file, each with the place it happened.
+//! [`SceneError`]: everything that can be wrong with a scene file, each with the place it happened
+//! ([`Location`]), and the "did you mean" hints ([`hint`]) its messages end with.
 
 use std::fmt;
 use std::path::{Path, PathBuf};

@@ -1,11 +1,12 @@
 //! Reading untrusted files: only regular files, never more than a cap. A FIFO would block
 //! forever and `/dev/zero` never ends, so the type is checked before opening and again on the
 //! opened handle, and the read itself stops one byte past the cap (a file that grows while it is
-//! read is caught too).
+//! read is caught too). [`SceneDir`] is the scene file's directory tree, which every file a scene
+//! names (textures, glTF files) must lie in.
 
 use std::fs::{File, OpenOptions};
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Largest scene file read, in bytes (16 MiB).
 pub const SCENE_MAX_BYTES: u64 = 16 << 20;
@@ -93,4 +94,38 @@ pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, String> {
         return Err(format!("it grew past the limit of {} while it was read", describe_bytes(cap)));
     }
     Ok(out)
+}
+
+/// The directory of `path`, `.` for a bare file name.
+pub(crate) fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// The scene file's directory, the tree every file a scene names must lie in, and its canonical
+/// form, resolved when first needed.
+pub(crate) struct SceneDir {
+    /// The directory as given.
+    pub path: PathBuf,
+    root: Option<PathBuf>,
+}
+
+impl SceneDir {
+    /// The directory `path`, not yet resolved.
+    pub(crate) fn new(path: PathBuf) -> Self {
+        SceneDir { path, root: None }
+    }
+
+    /// The canonical directory (symbolic links followed), resolved once.
+    pub(crate) fn root(&mut self) -> Result<PathBuf, String> {
+        if let Some(r) = &self.root {
+            return Ok(r.clone());
+        }
+        let r = std::fs::canonicalize(&self.path)
+            .map_err(|e| format!("cannot resolve the scene file's directory {}: {e}", self.path.display()))?;
+        self.root = Some(r.clone());
+        Ok(r)
+    }
 }

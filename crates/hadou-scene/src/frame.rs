@@ -1,14 +1,16 @@
 //! [`Frame`]: the plain values a backend draws — one instant of a scene, nothing animated, nothing
-//! to parse. Produced by `Scene::at`, consumed by every backend.
+//! to parse. Produced by `Scene::at`, consumed by every backend. The camera and its basis
+//! ([`CameraBasis`]), the light, objects with their meshes, materials and textures, the waves and
+//! the colour mapping are here; the frame's shadows ([`Shadow`]) are in `shadow.rs` and its area
+//! light ([`AreaLight`]) in `area_light.rs`.
 
 use crate::area_light::AreaLight;
+use crate::shadow::Shadow;
 use hadou_math::curve::{CurveWave, PreparedCurve};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
 pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use std::sync::Arc;
-
-pub use crate::shadow::{Shadow, ShadowCast, ShadowLight, ShadowMethod};
 
 /// One instant of a scene, ready to draw.
 #[derive(Clone, Debug)]
@@ -54,7 +56,9 @@ pub struct Camera {
     pub far: f32,
 }
 
-/// The camera's orthonormal basis and per-pixel ray construction, shared by both backends.
+/// The camera's orthonormal basis, which both backends project and build their rays from, and the
+/// scalar per-pixel ray construction ([`CameraBasis::pixel_dir`], [`CameraBasis::wave_ray`]) their
+/// batched and WGSL ray builders mirror.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraBasis {
     /// Eye.
@@ -92,7 +96,8 @@ impl CameraBasis {
     /// Direction through the centre of pixel `(px, py)` (`py = 0` is the top row), scaled so its
     /// component along `forward` is exactly 1: the point at view depth `z` is `eye + z·dir`.
     /// `hadou-cpu`'s wave pass builds the same directions eight at a time with the same
-    /// operations (`waves::WavePass::rays`; keep in sync).
+    /// operations (`waves::WavePass::rays`), `hadou-gpu` per pixel in `shaders/common.wgsl`'s
+    /// `pixel_dir`; keep in sync.
     #[inline]
     pub fn pixel_dir(&self, px: f32, py: f32, width: u32, height: u32) -> Vec3f {
         let ndc_x = 2.0 * (px + 0.5) / width as f32 - 1.0;
@@ -112,8 +117,13 @@ impl CameraBasis {
     /// - [`Falloff::InverseSquare`]: `dir` unit, `t ∈ [0, d]` (or `[0, ∞)` with nothing drawn),
     ///   `t_far = |E − S|` (used only by attenuation).
     ///
-    /// Both backends build their rays with exactly this construction (`hadou-cpu`'s
-    /// `waves::WavePass::rays` lane for lane; keep in sync).
+    /// This is the scalar reference; no render path calls it. The backends mirror it:
+    /// `hadou-cpu`'s wave pass with the same operations, eight pixels at a time
+    /// (`waves::WavePass::rays`), and `hadou-gpu` per pixel in `shaders/wave.wgsl`'s `wave_ray`;
+    /// keep the three in sync. `hadou-cpu`'s `tests/lanes.rs` checks its batched pass against the
+    /// scalar kernels along these rays (pixels where nothing is drawn); the GPU is checked against
+    /// the CPU. `hadou bench` (its curve-accuracy samples and the kernel-only rows of its limit
+    /// table) builds its rays here too.
     #[inline]
     #[allow(clippy::too_many_arguments)]
     pub fn wave_ray(

@@ -9,12 +9,14 @@
 //!   `"extras": {"hadou": {"featureTexture": {"index": N, "texCoord": M}}}` (`texCoord` optional,
 //!   0 by default) → [`Material::feature_texture`].
 //!
-//! Images come from a bufferView or a URI (base64 data URI, or a file inside the asset root) and
-//! are decoded once each (PNG or JPEG, recognised by their bytes), only when a material uses them;
-//! the decoded texels of one glTF file are capped at [`TEXEL_BUDGET_BYTES`]. Every index read here
-//! is checked against the array it points into first.
+//! Images come from a bufferView or a URI (base64 data URI, or a file inside the asset root; both
+//! read by `gltf_uri`) and are decoded once each (PNG or JPEG, recognised by their bytes), only
+//! when a material uses them; the decoded texels of one glTF file are capped at
+//! [`TEXEL_BUDGET_BYTES`]. Every index read here is checked against the array it points into
+//! first.
 
 use crate::frame::{Filter, Material, Ramp, ShadingModel, Texture, TextureRef, Wrap};
+use crate::gltf_uri::resolve_uri;
 use crate::texture::decode_texture;
 use serde_json::Value;
 use std::path::Path;
@@ -270,7 +272,7 @@ fn load_image(
             (bytes.to_vec(), format!("image {index} (bufferView {})", v.value()))
         }
         (None, Some(uri)) => {
-            let bytes = crate::gltf_load::resolve_uri(uri, src.dir, src.root, *bytes_left).map_err(fail)?;
+            let bytes = resolve_uri(uri, src.dir, src.root, *bytes_left).map_err(fail)?;
             *bytes_left = bytes_left.saturating_sub(bytes.len() as u64);
             let shown = if uri.starts_with("data:") { "data URI".to_string() } else { format!("`{uri}`") };
             (bytes, format!("image {index} ({shown})"))

@@ -8,17 +8,36 @@
 //! ```
 //!
 //! All validation happens in [`Scene::load`]/[`Scene::parse`]; errors are [`SceneError`]s whose
-//! `Display` is `path:line:col: message`. [`Scene::at`] never fails. The file format is described
-//! key by key in `docs/scene-format.md`.
+//! `Display` is `path:line:col: message`. [`Scene::at`] never fails. A backend that cannot render
+//! says why with a [`RenderError`]. The file format is described key by key in
+//! `docs/scene-format.md`.
+//!
+//! The files form layers; each uses only files of its own layer or the layers below (no import
+//! circles):
+//! 1. the frame's plain values (`frame.rs`, with `shadow.rs` and `area_light.rs`; `image.rs`) and
+//!    the helpers everything uses (`error.rs`, `limits.rs`, `files.rs`, `guard.rs`, `params.rs`,
+//!    `anim.rs`, `toml_read.rs`);
+//! 2. a frame's geometry and assets: `bounds.rs`, `mesh.rs`, `texture.rs`, `gltf_uri.rs`,
+//!    `gltf_material.rs`, `gltf_load.rs`; and `backend.rs`;
+//! 3. each feature read from the scene file and built at one set of values (`materials.rs`,
+//!    `shadow_def.rs`, `area_light_def.rs`), and `shadow_casts.rs` (`Frame::shadow_casts`);
+//! 4. `scene.rs`: [`Scene`] and [`Scene::at`];
+//! 5. `track_def.rs` (`[[track]]` targets resolved against a [`Scene`]) and `introspect.rs`;
+//! 6. `schema.rs`: [`Scene::load`], [`Scene::parse`].
+//!
+//! This file only declares the modules and re-exports the public items.
 
 mod anim;
 mod area_light;
+mod area_light_def;
 mod backend;
+mod bounds;
 mod error;
 mod files;
 mod frame;
 mod gltf_load;
 mod gltf_material;
+mod gltf_uri;
 mod guard;
 mod image;
 mod introspect;
@@ -29,12 +48,16 @@ mod params;
 mod scene;
 mod schema;
 mod shadow;
+mod shadow_casts;
+mod shadow_def;
 mod texture;
 mod toml_read;
+mod track_def;
 
 pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
 pub use backend::{Backend, RenderError};
+pub use bounds::{object_bounds, object_center};
 pub use error::{Location, SceneError};
 pub use files::{read_regular_file, GLTF_MAX_BYTES, SCENE_MAX_BYTES};
 pub use frame::*;
@@ -44,6 +67,7 @@ pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_
 pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
 pub use scene::Scene;
 pub use shadow::{
-    object_bounds, object_center, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS, ON_PLANE,
+    Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,
+    ON_PLANE,
 };
 pub use texture::{decode_texture, encode_png, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS};

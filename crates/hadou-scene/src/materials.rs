@@ -1,7 +1,10 @@
-//! `[[material]]` tables, the material keys of `[[object]]` and the light keys of `[[wave]]`:
-//! toon ramps, textures read from the scene's directory, outlines, and the animatable parts
-//! (`base_color`, `wave_blend`, `outline_width`, `outline_color`, `light_glow`).
+//! `[[material]]` tables and the material keys of `[[object]]`: toon ramps ([`parse_ramp`], which
+//! `[[wave]]`'s `light_ramp` uses too), textures read from the scene's directory ([`scene_file`],
+//! [`TextureCache`]), outlines, the object's material slots and overrides, and the animatable
+//! parts (`base_color`, `wave_blend`, `outline_width`, `outline_color`); [`build_material`] gives a
+//! slot's [`Material`] at one set of values.
 
+use crate::files::SceneDir;
 use crate::frame::{Filter, Material, Mesh, Outline, Ramp, RampKind, ShadingModel, TextureRef, Wrap};
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::texture::load_texture_file;
@@ -195,12 +198,10 @@ pub(crate) fn scene_file(t: &Table<'_, '_>, key: &str, rel: &str, dir: &Path, ro
     Ok(real)
 }
 
-/// What reading textures shares: the scene's directory, its canonical form, decoded images by
-/// path, and the warnings.
+/// What reading textures shares: the scene's directory (resolved when the first texture is
+/// named), decoded images by path, and the warnings.
 pub(crate) struct TextureCache<'w> {
-    pub dir: PathBuf,
-    /// Canonical `dir`, resolved when the first texture is named.
-    pub root: Option<PathBuf>,
+    pub dir: SceneDir,
     pub images: HashMap<PathBuf, Arc<crate::frame::Texture>>,
     pub warnings: &'w mut Vec<String>,
 }
@@ -213,20 +214,8 @@ fn texture(
     filter: Filter,
 ) -> Res<Option<TextureRef>> {
     let Some((rel, span)) = t.opt_str(key)? else { return Ok(None) };
-    let root = match &cache.root {
-        Some(r) => r.clone(),
-        None => {
-            let r = std::fs::canonicalize(&cache.dir).map_err(|e| {
-                t.src.value_err(
-                    &span,
-                    format!("cannot resolve the scene file's directory {}: {e}", cache.dir.display()),
-                )
-            })?;
-            cache.root = Some(r.clone());
-            r
-        }
-    };
-    let real = scene_file(t, key, rel, &cache.dir, &root)?;
+    let root = cache.dir.root().map_err(|m| t.src.value_err(&span, m))?;
+    let real = scene_file(t, key, rel, &cache.dir.path, &root)?;
     let image = match cache.images.get(&real) {
         Some(i) => i.clone(),
         None => {
@@ -270,7 +259,7 @@ pub(crate) fn parse_material(
             .src
             .value_err(&t.key_span("ramp"), format!("`ramp` in {} applies to `model = \"toon\"`", t.what)));
     }
-    let outline = opt_bool(t, "outline")?;
+    let outline = t.opt_bool("outline")?;
     let mut params = ParamSet::default();
     rd.add(
         t,
@@ -311,20 +300,6 @@ pub(crate) fn parse_material(
     base.outline =
         outline.unwrap_or(false).then_some(Outline { width: DEFAULT_OUTLINE_WIDTH, color: [0.0; 3] });
     Ok(MaterialDef { name, base, params })
-}
-
-/// An optional boolean.
-pub(crate) fn opt_bool(t: &Table<'_, '_>, key: &str) -> Res<Option<bool>> {
-    match t.get(key) {
-        None => Ok(None),
-        Some(v) => match v.get_ref() {
-            DeValue::Boolean(b) => Ok(Some(*b)),
-            other => Err(t.src.type_err(
-                &v.span(),
-                format!("`{key}` in {} must be true or false, got {}", t.what, type_name(other)),
-            )),
-        },
-    }
 }
 
 /// Reads an object's material keys: `material = "name"` (every slot), or
@@ -424,7 +399,7 @@ pub(crate) fn parse_object_materials(
     }
     Ok(ObjectMaterials {
         slots,
-        outline: opt_bool(t, "outline")?,
+        outline: t.opt_bool("outline")?,
         color_given: t.get("color").is_some(),
         no_uvs,
     })

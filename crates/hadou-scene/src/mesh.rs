@@ -1,5 +1,7 @@
-//! Triangulated primitives for `[[object]]`: box, UV sphere and plane quad. Every mesh has
-//! counter-clockwise front faces seen from outside and outward unit normals.
+//! Triangulated primitives for `[[object]]`: box, UV sphere and plane quad, with texture
+//! coordinates. Every mesh has counter-clockwise front faces seen from outside and outward unit
+//! normals. Also the mesh operations the glTF loader uses ([`smooth_normals`], [`transform_mesh`],
+//! [`append_mesh`]) and the outline normals of the inverted hull ([`with_outline_normals`]).
 
 use crate::frame::Mesh;
 use hadou_math::{Mat4, Vec3f};

@@ -1,15 +1,16 @@
-//! [`Scene`]: a loaded, validated scene file with its animation tracks; [`Scene::at`] evaluates
-//! it into a [`Frame`].
+//! [`Scene`]: a loaded, validated scene file with its animation tracks ([`ObjectDef`], [`WaveDef`]
+//! and the other parts as read); [`Scene::at`] evaluates it into a [`Frame`]: tracks applied,
+//! values clamped, then every object, wave (curves included), shadow and the area light built.
+//! [`Scene::load`] and [`Scene::parse`] are in `schema.rs`.
 
 use crate::anim::Track;
-use crate::area_light::{build_area_light, AreaLightDef};
-use crate::error::SceneError;
+use crate::area_light_def::{build_area_light, AreaLightDef};
 use crate::frame::{
     Camera, ColorMapping, Frame, Light, Material, Mesh, Object, Ramp, ToneMode, Wave, WaveLight, WaveShape,
 };
 use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
-use crate::shadow::{build_shadow, ShadowDef};
+use crate::shadow_def::{build_shadow, ShadowDef};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
 use hadou_math::{Mat4, Vec3, Vec3f};
@@ -97,29 +98,6 @@ impl Scene {
     /// textures on meshes without texture coordinates, …); the CLI prints them.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
-    }
-
-    /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
-    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
-        let path = path.as_ref();
-        Self::parse(&Self::read_text(path)?, path)
-    }
-
-    /// The scene file's text, read as [`Scene::load`] reads it: a regular file of at most
-    /// [`crate::SCENE_MAX_BYTES`], UTF-8.
-    pub fn read_text(path: &Path) -> Result<String, SceneError> {
-        let bytes = crate::files::read_regular_file(path, crate::files::SCENE_MAX_BYTES).map_err(|e| {
-            SceneError::Io { path: path.to_path_buf(), message: format!("cannot read the scene file: {e}") }
-        })?;
-        String::from_utf8(bytes).map_err(|e| SceneError::Io {
-            path: path.to_path_buf(),
-            message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
-        })
-    }
-
-    /// Parses scene `text`; `path` names the file in messages and anchors relative asset paths.
-    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
-        crate::schema::parse_scene(text, path)
     }
 
     /// Image width in pixels.
@@ -328,9 +306,9 @@ impl Scene {
         let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));
         let axis = v3(vals, "D").try_normalize().unwrap_or_else(|| v3(base, "D").normalize_or(Vec3f::X));
         let mut up = v3(vals, "up");
-        if !crate::schema::up_is_usable(up, axis) {
+        if !up_is_usable(up, axis) {
             up = v3(base, "up");
-            if !crate::schema::up_is_usable(up, axis) {
+            if !up_is_usable(up, axis) {
                 up = axis.orthonormal_basis().0;
             }
         }
@@ -380,4 +358,10 @@ impl Scene {
             integrator,
         }
     }
+}
+
+/// Whether `up` fixes a frame around unit `axis`: not zero and not parallel to it.
+pub(crate) fn up_is_usable(up: Vec3f, axis: Vec3f) -> bool {
+    let l = up.length();
+    l > 0.0 && l.is_finite() && up.cross(axis).length() > 1e-4 * l
 }

@@ -1,10 +1,18 @@
 //! The scene schema: TOML tables → [`Scene`], with every value range-checked at load and every
 //! error pointing at the offending key or value. The schema is documented key by key in
 //! `docs/scene-format.md`.
+//!
+//! [`Scene::load`], [`Scene::read_text`] and [`Scene::parse`]; the readers of `[image]`,
+//! `[camera]`, `[light]`, `[color]`, `[[object]]` (primitives and glTF files within the triangle
+//! budget) and `[[wave]]` (analytic shapes, curves and their integrators); and the cross-key
+//! rules, checked on the file's values and again at every key time of every track.
+//! `[[material]]`, `[[shadow]]`, `[area_light]` and `[[track]]` are read by `materials.rs`,
+//! `shadow_def.rs`, `area_light_def.rs` and `track_def.rs`.
 
-use crate::anim::{Interpolation, Track};
-use crate::area_light::{check_area_light, parse_area_light, SOFT_MAX_PIXELS};
-use crate::error::{hint, Location, SceneError};
+use crate::area_light::SOFT_MAX_PIXELS;
+use crate::area_light_def::{check_area_light, parse_area_light};
+use crate::error::{Location, SceneError};
+use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
 use crate::frame::{Mesh, ToneMode};
 use crate::gltf_load::Budget;
 use crate::limits::{
@@ -16,15 +24,17 @@ use crate::materials::{
 };
 use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
 use crate::params::{Constraint, ParamSet, Shape};
-use crate::scene::{IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
-use crate::shadow::{check_map_budget, check_shadow, parse_shadow, ShadowDef, MAX_SHADOWS};
-use crate::toml_read::{number, read_numbers, type_name, Fallback, ParamReader, Res, Span, Src, Table, Val};
+use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
+use crate::shadow::MAX_SHADOWS;
+use crate::shadow_def::{check_map_budget, check_shadow, parse_shadow, ShadowDef};
+use crate::toml_read::{Fallback, ParamReader, Res, Span, Src, Table};
+use crate::track_def::parse_track;
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use toml::de::{DeTable, DeValue};
+use toml::de::DeTable;
 
 const ROOT_KEYS: &[&str] = &[
     "image",
@@ -58,7 +68,6 @@ const WAVE_COMMON: &[&str] = &[
 ];
 const CURVE_COMMON: &[&str] =
     &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
-const TRACK_KEYS: &[&str] = &["target", "interpolation", "keys"];
 
 /// Default base colour of a wave: the yellow of 002 Fig. 4.1.
 pub(crate) const DEFAULT_RGBA: [f32; 4] = [0.8, 0.8, 0.2, 1.0];
@@ -73,10 +82,30 @@ const ANY: Constraint = Constraint::Any;
 const V3: Shape = Shape::Vector(3);
 const S: Shape = Shape::Scalar;
 
-/// Whether `up` fixes a frame around unit `axis`: not zero and not parallel to it.
-pub(crate) fn up_is_usable(up: Vec3f, axis: Vec3f) -> bool {
-    let l = up.length();
-    l > 0.0 && l.is_finite() && up.cross(axis).length() > 1e-4 * l
+impl Scene {
+    /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        Self::parse(&Self::read_text(path)?, path)
+    }
+
+    /// The scene file's text, read as [`Scene::load`] reads it: a regular file of at most
+    /// [`SCENE_MAX_BYTES`], UTF-8.
+    pub fn read_text(path: &Path) -> Result<String, SceneError> {
+        let bytes = read_regular_file(path, SCENE_MAX_BYTES).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: format!("cannot read the scene file: {e}"),
+        })?;
+        String::from_utf8(bytes).map_err(|e| SceneError::Io {
+            path: path.to_path_buf(),
+            message: format!("the scene file is not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+        })
+    }
+
+    /// Parses scene `text`; `path` names the file in messages and anchors relative asset paths.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        parse_scene(text, path)
+    }
 }
 
 /// Parses a whole scene.
@@ -155,11 +184,8 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut globals = ParamSet::default();
     rd.add(&root, &mut globals, "background", V3, NONNEG, Fallback::Value(&[0.0; 3]), false)?;
 
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut assets = Assets { dir, root: None, cache: HashMap::new(), budget: Budget::FULL };
+    let dir = parent_dir(path).to_path_buf();
+    let mut assets = Assets { dir: SceneDir::new(dir), cache: HashMap::new(), budget: Budget::FULL };
     let mut warnings = Vec::new();
 
     // [[material]]
@@ -168,8 +194,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let material_tables = root.array_of_tables("material")?;
     if !material_tables.is_empty() {
         let mut cache = TextureCache {
-            dir: assets.dir.clone(),
-            root: None,
+            dir: SceneDir::new(assets.dir.path.clone()),
             images: HashMap::new(),
             warnings: &mut warnings,
         };
@@ -341,25 +366,10 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
 /// What loading the objects' meshes shares: the glTF cache (by canonical path), the scene's
 /// triangle budget and the directory tree files may be read from.
 struct Assets {
-    /// The scene file's directory (as given).
-    dir: PathBuf,
-    /// Its canonical form, once needed.
-    root: Option<PathBuf>,
+    /// The scene file's directory.
+    dir: SceneDir,
     cache: HashMap<PathBuf, Arc<Mesh>>,
     budget: Budget,
-}
-
-impl Assets {
-    /// The canonical scene directory.
-    fn root(&mut self) -> Result<PathBuf, String> {
-        if let Some(r) = &self.root {
-            return Ok(r.clone());
-        }
-        let r = std::fs::canonicalize(&self.dir)
-            .map_err(|e| format!("cannot resolve the scene file's directory {}: {e}", self.dir.display()))?;
-        self.root = Some(r.clone());
-        Ok(r)
-    }
 }
 
 fn parse_object(
@@ -421,7 +431,7 @@ fn parse_object(
             let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
             let gltf_err =
                 |message: String, file: PathBuf| SceneError::Gltf { at: t.src.loc(&span), file, message };
-            let file = assets.dir.join(rel);
+            let file = assets.dir.path.join(rel);
             if Path::new(rel).is_absolute() || Path::new(rel).has_root() {
                 return Err(gltf_err(
                     "`path` must be relative to the scene file (glTF files must lie inside the scene \
@@ -432,7 +442,7 @@ fn parse_object(
             }
             let real = std::fs::canonicalize(&file)
                 .map_err(|e| gltf_err(format!("cannot read the file: {e}"), file.clone()))?;
-            let root = assets.root().map_err(|m| gltf_err(m, file.clone()))?;
+            let root = assets.dir.root().map_err(|m| gltf_err(m, file.clone()))?;
             if !real.starts_with(&root) {
                 return Err(gltf_err(
                     format!(
@@ -829,303 +839,4 @@ fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// A parameter slice selected by a track target.
-struct Selection {
-    offset: usize,
-    len: usize,
-    shape: Shape,
-    rule: Constraint,
-    /// Component index of the first selected float within its vector (for per-component rules).
-    first: usize,
-    whole: bool,
-    broadcast: bool,
-}
-
-/// Resolves `target` (`wave.<name>.<key>[i].c`, `object.<name>.<key>`, `camera.<key>`,
-/// `light.<key>`, `area_light.<key>`, `color.exposure`, `background`) against the scene.
-fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
-    let segs: Vec<&str> = target.split('.').collect();
-    let head = segs[0];
-    let (set, rest, ent): (&ParamSet, &[&str], String) = match head.split('[').next().unwrap_or("") {
-        "background" => (&scene.globals, &segs[..], "the scene".into()),
-        "area_light" if segs.len() >= 2 => match &scene.area_light {
-            Some(a) => (&a.params, &segs[1..], "[area_light]".into()),
-            None => return Err(format!("target \"{target}\": the scene has no [area_light]")),
-        },
-        "camera" | "light" | "color" if segs.len() >= 2 => {
-            let set = match head {
-                "camera" => &scene.camera,
-                "light" => &scene.light,
-                _ => &scene.color,
-            };
-            (set, &segs[1..], format!("[{head}]"))
-        }
-        "wave" | "object" | "material" | "shadow" if segs.len() >= 3 => {
-            let name = segs[1];
-            let (set, names) = match head {
-                "shadow" => (
-                    scene.shadows.iter().find(|s| s.name == name).map(|s| &s.params),
-                    scene.shadows.iter().map(|s| s.name.as_str()).collect(),
-                ),
-                "wave" => {
-                    (scene.waves.iter().find(|w| w.name == name).map(|w| &w.params), scene.wave_names())
-                }
-                "material" => (
-                    scene.materials.iter().find(|m| m.name == name).map(|m| &m.params),
-                    scene.materials.iter().map(|m| m.name.as_str()).collect(),
-                ),
-                _ => (scene.objects.iter().find(|o| o.name == name).map(|o| &o.params), scene.object_names()),
-            };
-            match set {
-                Some(s) => (s, &segs[2..], format!("[[{head}]] \"{name}\"")),
-                None => {
-                    return Err(format!("no {head} is named \"{name}\"{}", hint(name, &names, "names")));
-                }
-            }
-        }
-        "camera" | "light" | "color" | "area_light" => {
-            return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
-        }
-        "wave" | "object" | "material" | "shadow" => {
-            return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
-        }
-        other => {
-            let heads = [
-                "wave",
-                "object",
-                "material",
-                "shadow",
-                "camera",
-                "light",
-                "area_light",
-                "color",
-                "background",
-            ];
-            return Err(format!(
-                "target \"{target}\" must start with `wave.`, `object.`, `material.`, `shadow.`, `camera.`, \
-                 `light.`, `area_light.`, `color.` or be `background`{}",
-                hint(other, &heads, "targets")
-            ));
-        }
-    };
-    if rest.is_empty() || rest.len() > 2 {
-        return Err(format!("target \"{target}\" is not of the form `<entity>.<key>[index].<component>`"));
-    }
-    // key[i][j]
-    let (key, mut indices) =
-        split_indices(rest[0]).ok_or_else(|| format!("bad index in target \"{target}\""))?;
-    let Some(param) = set.find(key) else {
-        let keys = set.keys();
-        return Err(format!("{ent} has no animatable key `{key}`{}", hint(key, &keys, "keys")));
-    };
-    if let Some(comp) = rest.get(1) {
-        let i = match *comp {
-            "x" | "r" => 0,
-            "y" | "g" => 1,
-            "z" | "b" => 2,
-            "w" | "a" => 3,
-            _ => {
-                return Err(format!(
-                    "unknown component `.{comp}` in \"{target}\"; use .x/.y/.z/.w, .r/.g/.b/.a or [i]"
-                ))
-            }
-        };
-        if !matches!(param.shape, Shape::Vector(_)) {
-            return Err(format!("`.{comp}` applies to vectors; select elements of `{key}` with [i]"));
-        }
-        indices.push(i);
-    }
-    let mut sel = Selection {
-        offset: param.offset,
-        len: param.len,
-        shape: param.shape,
-        rule: param.rule,
-        first: 0,
-        whole: true,
-        broadcast: param.broadcast,
-    };
-    for &i in &indices {
-        let (n, width, next) = match sel.shape {
-            Shape::Scalar => return Err(format!("`{key}` is a number; it has no components to select")),
-            Shape::Vector(n) => (n, 1, Shape::Scalar),
-            Shape::List(w) => (sel.len / w.max(1), w, if w == 1 { Shape::Scalar } else { Shape::Vector(w) }),
-        };
-        if i >= n {
-            return Err(format!("index {i} is out of range for `{key}` ({n} element(s))"));
-        }
-        sel = Selection {
-            offset: sel.offset + i * width,
-            len: width,
-            shape: next,
-            rule: sel.rule,
-            first: if width == 1 { i } else { 0 },
-            whole: false,
-            broadcast: false,
-        };
-    }
-    Ok(sel)
-}
-
-/// `"points[2][1]"` → `("points", [2, 1])`.
-fn split_indices(s: &str) -> Option<(&str, Vec<usize>)> {
-    let (key, mut rest) = match s.find('[') {
-        Some(i) => (&s[..i], &s[i..]),
-        None => return Some((s, Vec::new())),
-    };
-    let mut out = Vec::new();
-    while !rest.is_empty() {
-        let inner = rest.strip_prefix('[')?;
-        let close = inner.find(']')?;
-        out.push(inner[..close].trim().parse().ok()?);
-        rest = &inner[close + 1..];
-    }
-    Some((key, out))
-}
-
-fn parse_track(
-    t: &Table<'_, '_>,
-    scene: &Scene,
-    targets: &mut HashMap<String, Span>,
-) -> Res<(Track, Vec<Span>)> {
-    t.check_keys(TRACK_KEYS)?;
-    let (target, tspan) = t.req_str("target", "what to animate, e.g. \"wave.beam.M2\"")?;
-    let sel = resolve_target(scene, target).map_err(|m| t.src.track(&tspan, m))?;
-    if let Some(first) = targets.get(target) {
-        let line = t.src.loc(first).line;
-        return Err(t.src.duplicate(
-            &tspan,
-            format!("a track for \"{target}\" already exists (line {line}); merge their keys into one track"),
-        ));
-    }
-    targets.insert(target.to_string(), tspan.clone());
-    let what = format!("[[track]] \"{target}\"");
-    let interpolation = match t.choice("interpolation", &["linear", "smooth"], Some("linear"))? {
-        "smooth" => Interpolation::Smooth,
-        _ => Interpolation::Linear,
-    };
-    let keys_v: &Val<'_> = t
-        .get("keys")
-        .ok_or_else(|| t.src.missing(&t.span, format!("{what} needs `keys = [[time, value], …]`")))?;
-    let DeValue::Array(keys) = keys_v.get_ref() else {
-        return Err(t.src.type_err(
-            &keys_v.span(),
-            format!(
-                "`keys` in {what} must be an array of [time, value] pairs, got {}",
-                type_name(keys_v.get_ref())
-            ),
-        ));
-    };
-    if keys.is_empty() {
-        return Err(t
-            .src
-            .track(&keys_v.span(), format!("`keys` in {what} needs at least one [time, value] pair")));
-    }
-    let mut times = Vec::new();
-    let mut values = Vec::new();
-    let mut spans = Vec::new();
-    for key in keys.iter() {
-        let pair = match key.get_ref() {
-            DeValue::Array(a) if a.len() == 2 => a,
-            _ => {
-                return Err(t.src.track(
-                    &key.span(),
-                    format!(
-                        "each key of {what} must be a pair [time, value], e.g. [0.5, {}]",
-                        example(sel.shape)
-                    ),
-                ))
-            }
-        };
-        if crate::toml_read::too_large_integer(pair[0].get_ref()) {
-            return Err(t.src.type_err(
-                &pair[0].span(),
-                format!(
-                    "key time in {what} must be a number, got an integer that is too large (over 64 bits)"
-                ),
-            ));
-        }
-        let time = match number(pair[0].get_ref()) {
-            Some(x) if x.is_finite() && x >= 0.0 && x <= f64::from(COORD_MAX) => x as f32,
-            Some(x) if x.is_finite() && x >= 0.0 => {
-                return Err(t.src.value_err(
-                    &pair[0].span(),
-                    format!(
-                        "key time in {what} must be at most {} s, got {}",
-                        fmt_f32(COORD_MAX),
-                        fmt_f64(x)
-                    ),
-                ))
-            }
-            Some(x) => {
-                return Err(t.src.value_err(
-                    &pair[0].span(),
-                    format!("key time in {what} must be finite and ≥ 0, got {}", fmt_f64(x)),
-                ))
-            }
-            None => {
-                return Err(t.src.type_err(
-                    &pair[0].span(),
-                    format!(
-                        "key time in {what} must be a number of seconds, got {}",
-                        type_name(pair[0].get_ref())
-                    ),
-                ))
-            }
-        };
-        if let Some(&prev) = times.last() {
-            if time <= prev {
-                return Err(t.src.track(
-                    &pair[0].span(),
-                    format!(
-                        "key times in {what} must increase strictly: {} follows {}",
-                        fmt_f32(time),
-                        fmt_f32(prev)
-                    ),
-                ));
-            }
-        }
-        let vwhat = format!("key value in {what}");
-        let nums = read_numbers(&t.src, &pair[1], sel.shape, sel.broadcast, &vwhat)?;
-        if nums.len() != sel.len {
-            return Err(t.src.type_err(
-                &pair[1].span(),
-                format!("{vwhat} must be {}, like the scene's value", sel.shape.describe(sel.len)),
-            ));
-        }
-        let plain: Vec<f32> = nums.iter().map(|x| x.0).collect();
-        if let Err((i, msg)) = sel.rule.check(&plain, sel.first, sel.whole) {
-            let span =
-                if matches!(sel.rule, Constraint::NonZero) { pair[1].span() } else { nums[i].1.clone() };
-            return Err(t.src.value_err(&span, format!("{vwhat} {msg}")));
-        }
-        times.push(time);
-        values.extend(plain);
-        spans.push(key.span());
-    }
-    let track =
-        Track { target: target.to_string(), offset: sel.offset, len: sel.len, interpolation, times, values };
-    Ok((track, spans))
-}
-
-fn example(shape: Shape) -> &'static str {
-    match shape {
-        Shape::Scalar => "1.0",
-        Shape::Vector(_) => "[0.0, 1.0, 0.0]",
-        Shape::List(_) => "[[0.0, 1.0], …]",
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn index_suffixes_split() {
-        assert_eq!(split_indices("points[2][1]"), Some(("points", vec![2, 1])));
-        assert_eq!(split_indices("M2"), Some(("M2", vec![])));
-        assert_eq!(split_indices("points[x]"), None);
-        assert_eq!(split_indices("points[1"), None);
-    }
 }

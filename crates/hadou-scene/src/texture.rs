@@ -1,5 +1,6 @@
 //! Texture images: decoding untrusted PNG (and JPEG) bytes into a [`Texture`] with bounded
-//! memory, and reading texture files named by a scene.
+//! memory, reading texture files named by a scene, and [`encode_png`] for tests and generated
+//! assets.
 //!
 //! The image's header is read first and its size checked against [`TEXTURE_MAX_EDGE`] and
 //! [`TEXTURE_MAX_TEXELS`] before any pixel buffer is allocated; decoders run under

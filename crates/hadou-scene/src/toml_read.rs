@@ -1,5 +1,7 @@
 //! A hand-walk over toml's spanned document ([`toml::de::DeTable`]): typed reads that report the
-//! exact span of the offending key or value, and unknown-key detection with suggestions.
+//! exact span of the offending key or value (strings, choices, integers, booleans, lists of object
+//! names, numbers of any [`Shape`]), unknown-key detection with suggestions, and [`ParamReader`],
+//! which appends a table's numbers to the scene's parameter store.
 
 use crate::error::{hint, Location, SceneError};
 use crate::limits::fmt_f64;
@@ -274,6 +276,87 @@ impl<'t, 'i> Table<'t, 'i> {
                 format!("`{key}` in {} must be in {lo}..={hi}, got {}", self.what, display_raw(v.get_ref())),
             )),
         }
+    }
+
+    /// An optional boolean.
+    pub(crate) fn opt_bool(&self, key: &str) -> Res<Option<bool>> {
+        match self.get(key) {
+            None => Ok(None),
+            Some(v) => match v.get_ref() {
+                DeValue::Boolean(b) => Ok(Some(*b)),
+                other => Err(self.src.type_err(
+                    &v.span(),
+                    format!("`{key}` in {} must be true or false, got {}", self.what, type_name(other)),
+                )),
+            },
+        }
+    }
+
+    /// Reads a list of object names (`"a"` or `["a", "b"]`) into object indices; `objects` are the
+    /// scene's objects (name, is a `plane` primitive).
+    pub(crate) fn object_list(&self, key: &str, objects: &[(&str, bool)]) -> Res<Vec<u32>> {
+        let v = self.get(key).ok_or_else(|| {
+            self.src.missing(
+                &self.span,
+                format!("{} needs `{key}` (an object name or a list of them)", self.what),
+            )
+        })?;
+        let items: Vec<(&str, Span)> = match v.get_ref() {
+            DeValue::String(s) => vec![(s.as_ref(), v.span())],
+            DeValue::Array(a) => {
+                let mut out = Vec::new();
+                for item in a.iter() {
+                    let DeValue::String(s) = item.get_ref() else {
+                        return Err(self.src.type_err(
+                            &item.span(),
+                            format!(
+                                "`{key}` in {} must list object names, got {}",
+                                self.what,
+                                type_name(item.get_ref())
+                            ),
+                        ));
+                    };
+                    out.push((s.as_ref(), item.span()));
+                }
+                out
+            }
+            other => {
+                return Err(self.src.type_err(
+                    &v.span(),
+                    format!(
+                        "`{key}` in {} must be an object name or a list of them, got {}",
+                        self.what,
+                        type_name(other)
+                    ),
+                ))
+            }
+        };
+        if items.is_empty() {
+            return Err(self
+                .src
+                .value_err(&v.span(), format!("`{key}` in {} must name at least one object", self.what)));
+        }
+        let names: Vec<&str> = objects.iter().map(|o| o.0).collect();
+        let mut out: Vec<u32> = Vec::new();
+        for (name, span) in items {
+            let Some(i) = names.iter().position(|n| *n == name) else {
+                return Err(self.src.value_err(
+                    &span,
+                    format!(
+                        "`{key}` in {}: no [[object]] is named \"{name}\"{}",
+                        self.what,
+                        hint(name, &names, "names")
+                    ),
+                ));
+            };
+            if out.contains(&(i as u32)) {
+                return Err(self
+                    .src
+                    .duplicate(&span, format!("`{key}` in {} names \"{name}\" twice", self.what)));
+            }
+            out.push(i as u32);
+        }
+        Ok(out)
     }
 
     /// A sub-table (`[camera]` or `camera = { … }`).
