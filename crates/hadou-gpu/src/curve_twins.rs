@@ -226,10 +226,10 @@ fn cases(preps: &[PreparedCurve]) -> Vec<CurveCase> {
             }
             let mut rng = Rng(0xC0FFEE + ci as u64 * 7 + u64::from(falloff));
             for i in 0..120 {
-                let core = if i % 3 == 0 { 0.0 } else { rng.range(0.0, 0.2) };
-                let o = eye + rng.vec(6.0);
-                let target = on_curve(f64::from(rng.range(-0.1, 1.1)) * s_head) + rng.vec(1.5);
-                let end = if rng.next() < 0.5 { None } else { Some(rng.range(5.0, 40.0)) };
+                let core = if i % 3 == 0 { 0.0 } else { rng.range_f32(0.0, 0.2) };
+                let o = eye + rng.in_cube_f32(6.0);
+                let target = on_curve(f64::from(rng.range_f32(-0.1, 1.1)) * s_head) + rng.in_cube_f32(1.5);
+                let end = if rng.unit_f32() < 0.5 { None } else { Some(rng.range_f32(5.0, 40.0)) };
                 add(o, target, end, core);
             }
         }

@@ -121,7 +121,7 @@ const NEEDED_DOWNLEVEL: [(wgpu::DownlevelFlags, &str); 3] = [
     (wgpu::DownlevelFlags::FRAGMENT_STORAGE, "storage buffers in fragment shaders (per-object data)"),
 ];
 
-/// Storage buffers the wave pass binds in one compute stage (keep in sync with pipelines.rs):
+/// Storage buffers the wave pass binds in one compute stage (keep in sync with passes/wave.rs BINDINGS):
 /// waves, output, three curve buffers, materials, lights, shading data.
 const NEEDED_COMPUTE_STORAGE_BUFFERS: u32 = 8;
 /// Colour targets of the raster pass (the two G-buffer targets of raster.wgsl).

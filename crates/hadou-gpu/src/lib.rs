@@ -2,27 +2,41 @@
 //!
 //! hadou's wgpu backend: the real-time path, drawing the same picture as the CPU reference.
 //!
-//! [`GpuBackend`] renders a [`Frame`] in two passes per tile, headlessly (no window or surface of
-//! its own; see "In a window" below for drawing into one):
-//! 1. **raster** (`shaders/raster.wgsl`): the opaque meshes, depth-tested, shaded with the WGSL
-//!    twin of `hadou_math::shade::diffuse`, writing the scene colour and the Euclidean eye distance
-//!    of the visible surface;
-//! 2. **wave** (`shaders/wave.wgsl`, a compute shader): per pixel, the ray of
-//!    `hadou_scene::CameraBasis::wave_ray` clipped at that distance (002 §3.3.5), the exact energy
-//!    integral of every analytic wave (`shaders/energy.wgsl`, twins of `hadou_math::energy`) and
-//!    of every curved wave (`shaders/curve.wgsl`, twins of `hadou_math::curve`: the default
-//!    chord-walk integrator over the uploaded `PieceTable` and the faithful Simpson integrator),
-//!    `scene + exposure·Σ rgb·a·I` and the colour mapping.
+//! [`GpuBackend`] renders a [`Frame`] headlessly (no window or surface of its own; see "In a
+//! window" below for drawing into one) with a handful of passes, one file each under `passes/`,
+//! named like their shaders. Each pass owns its pipelines, declares its shader's bindings once and
+//! records itself into a command encoder on targets its caller owns:
+//! 1. **shadow maps** (`passes/shadow_maps.rs`, `shaders/shadow_raster.wgsl` `vs_map`), once per
+//!    frame: each map cast's casters into a layer of one depth array texture;
+//! 2. with an `[area_light]`, **soft** (`passes/soft.rs`, `shaders/soft_map.wgsl`,
+//!    `shaders/soft.wgsl`), once per frame: the light's two perspective maps, every pixel of the
+//!    image classed umbra / penumbra / lit and the penumbra resolved (003);
+//! 3. per tile, **raster** (`passes/raster.rs`, `shaders/raster.wgsl`): the opaque meshes and the
+//!    outline hulls, depth-tested into a G-buffer (normal and eye distance; texture coordinates,
+//!    vertex colour, material);
+//! 4. per tile with plane casts, **plane shadows** (`passes/plane_shadows.rs`,
+//!    `shaders/shadow_raster.wgsl`): the most opaque plane cast per pixel;
+//! 5. per tile, **wave** (`passes/wave.rs`, `shaders/wave.wgsl`, a compute shader): the visible
+//!    surface shaded from the G-buffer (`shaders/shading.wgsl`: materials, the waves as lights;
+//!    `shaders/shadow_lookup.wgsl`: hard shadows; the area light's visibility), then per pixel
+//!    every wave's exact energy integral along the view ray clipped at that surface (002 §3.3.5;
+//!    `shaders/wave_energy.wgsl`, `shaders/energy.wgsl` and `shaders/curve.wgsl`, the WGSL twins
+//!    of `hadou_math::energy` and `hadou_math::curve`, on the rays `hadou_scene::CameraBasis::wave_ray`
+//!    builds), `scene + exposure·Σ rgb·a·I` and the colour mapping, into an output buffer that is
+//!    read back, or that **present** (`passes/present.rs`) copies into a window's texture.
 //!
-//! Hard shadows (`Frame::shadows`) add a plane-shadow pass per tile between the two
-//! (`shaders/shadow_raster.wgsl`: each plane cast's casters projected onto its plane, keeping per
-//! pixel the most opaque cast), shadow maps drawn once per frame into a depth array texture, and
-//! the lookup in the wave pass (`shaders/shadow_lookup.wgsl`), mirroring `hadou-cpu`'s shadows.
+//! The renderer (`render.rs`) owns what a frame's passes share (the mesh cache, the tile
+//! targets, the shadow maps, the soft-shadow buffers), prepares each frame (`prepare.rs`: the
+//! checks against the device and the records every pass reads) and runs the tile loop. Images
+//! are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next (or
+//! presented), so GPU memory stays bounded whatever the image size. A frame with nothing to draw
+//! (waves only) skips the raster pass.
 //!
-//! Images are processed in tiles of at most [`MAX_TILE`]² pixels, each read back before the next
-//! (or, for a window, copied into the frame's texture by the present pass), so GPU memory stays
-//! bounded whatever the image size. A frame with nothing to draw (waves only)
-//! skips the raster pass.
+//! For a renderer that draws its own scene (a game engine's frame, a page's canvas),
+//! [`GpuBackend::encode_wave_overlay`] records the **wave overlay** (`passes/wave_overlay.rs`,
+//! `shaders/wave_overlay.wgsl`): the waves' light, the same `exposure·Σ rgb·a·I`, drawn into the
+//! caller's colour target against the caller's depth buffer ([`OverlayTarget`], [`DepthModel`]),
+//! added to it before the caller's tone mapping.
 //!
 //! The wave pass is specialised per frame: the wave module declares pipeline-overridable `bool`
 //! constants (`USE_SPHERE`, `USE_CURVE`, `USE_SURFACES`, `USE_TEXTURES`, …, all `true` by
@@ -32,7 +46,7 @@
 //! and Mesa's GL) runs every branch of a shader under an execution mask whichever way the pixels
 //! go, so with the uber-shader a one-sphere frame paid for every kind, the curve walker and the
 //! surface shading (about 0.8 s instead of 6 ms at 512²). A variant renders bit for bit what the
-//! uber-shader renders (`tests/variants.rs`).
+//! uber-shader renders (`tests/variants.rs`). The wave overlay is specialised the same way.
 //!
 //! Curved waves are prepared once per frame with `hadou_math::curve::prepare` (as the CPU backend
 //! does) and uploaded as storage buffers ([`layout::CurveBuffers`]).
@@ -60,6 +74,7 @@
 //! shaders). A browser may not block, so only the non-blocking path is compiled there:
 //! [`GpuBackend::from_device`] (the page requests the adapter and device asynchronously itself,
 //! with [`device_descriptor`]), [`GpuBackend::render_to_texture`],
+//! [`GpuBackend::encode_wave_overlay`],
 //! [`GpuBackend::last_present_timing`] and the accessors. Everything
 //! that waits for the GPU — [`GpuBackend::new`], [`find_adapter`], the [`Backend`] impl (it reads
 //! the image back), `render_soft` and [`GpuBackend::time_frame`] — exists only off the web. There,

@@ -5,7 +5,6 @@
 use crate::device::GpuContext;
 use crate::passes::setup::compile_module;
 use crate::shaders;
-use hadou_math::{Vec3, Vec3f};
 use hadou_scene::RenderError;
 
 /// The twin kernel's source: `parts` (the WGSL under test), then `case` (which defines the WGSL
@@ -110,26 +109,5 @@ pub(crate) fn run(
     })
 }
 
-/// A deterministic generator (splitmix64) for the random part of the cases.
-pub(crate) struct Rng(pub(crate) u64);
-
-impl Rng {
-    /// Uniform in `[0, 1)`, 24 bits.
-    pub(crate) fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform in `[lo, hi)`.
-    pub(crate) fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-
-    /// Each coordinate uniform in `[-r, r)`.
-    pub(crate) fn vec(&mut self, r: f32) -> Vec3f {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-}
+/// The generator of the random part of the cases (splitmix64).
+pub(crate) use hadou_math::rng::Rng;

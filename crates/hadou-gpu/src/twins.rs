@@ -205,22 +205,22 @@ fn cases() -> Vec<Case> {
         // Random rays and shapes.
         let mut rng = Rng(0x5EED + falloff as u64);
         for i in 0..400 {
-            let core = if i % 3 == 0 { 0.0 } else { rng.range(0.0, 0.2) };
-            let m = rng.vec(5.0);
-            let d = rng.vec(1.0).normalize_or(x);
-            let len = rng.range(0.0, 12.0);
+            let core = if i % 3 == 0 { 0.0 } else { rng.range_f32(0.0, 0.2) };
+            let m = rng.in_cube_f32(5.0);
+            let d = rng.in_cube_f32(1.0).normalize_or(x);
+            let len = rng.range_f32(0.0, 12.0);
             let kind = [WAVE_SPHERE, WAVE_CYLINDER, WAVE_CAPSULE, WAVE_BEAM][i % 4];
             let w = wave(
                 kind,
                 falloff,
                 core,
-                [m.x, m.y, m.z, rng.range(0.1, 20.0)],
-                [d.x, d.y, d.z, rng.range(0.1, 20.0)],
-                [len, rng.range(0.0, 5.0), rng.range(0.0, 5.0), 0.0],
+                [m.x, m.y, m.z, rng.range_f32(0.1, 20.0)],
+                [d.x, d.y, d.z, rng.range_f32(0.1, 20.0)],
+                [len, rng.range_f32(0.0, 5.0), rng.range_f32(0.0, 5.0), 0.0],
             );
-            let o = eye + rng.vec(3.0);
-            let target = m + d * rng.range(-2.0, len + 2.0) + rng.vec(1.0);
-            let end = if rng.next() < 0.5 { open } else { t1(rng.range(0.05, 0.5)) };
+            let o = eye + rng.in_cube_f32(3.0);
+            let target = m + d * rng.range_f32(-2.0, len + 2.0) + rng.in_cube_f32(1.0);
+            let end = if rng.unit_f32() < 0.5 { open } else { t1(rng.range_f32(0.05, 0.5)) };
             add(w, o, (target - o).normalize_or(x) * scale, 0.0, end);
         }
     }
@@ -299,13 +299,8 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
 "#;
     let Some((ctx, _gpu)) = crate::device::context_or_skip("vector products") else { return };
     // Nearly parallel and nearly orthogonal pairs, where rounding order shows most.
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32 * 60.0 - 30.0
-    };
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut next = || rng.range_f32(-30.0, 30.0);
     let mut xs: Vec<[f32; 4]> = Vec::new();
     for i in 0..4096 {
         let a = [next(), next(), next(), 0.0];

@@ -15,6 +15,7 @@ pub mod energy;
 mod mat4;
 pub mod quadrature;
 mod real;
+pub mod rng;
 pub mod shade;
 pub mod shadow;
 pub mod soft;

@@ -9,6 +9,7 @@ use hadou_math::energy::{
     beam_energy, capsule_energy, cylinder_energy, sphere_energy, BeamField, CapsuleField, CylinderField,
     Falloff, FieldParams, Ray, SphereField,
 };
+use hadou_math::rng::Rng;
 use hadou_math::{Vec3, Vec3f};
 
 /// One ray of a batch: direction and span (the origin is the batch's).
@@ -104,32 +105,14 @@ impl Shape {
     }
 }
 
-/// A small deterministic generator (xorshift), so failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * self.next()
-    }
-    fn vec(&mut self, r: f32) -> Vec3f {
-        Vec3::new(self.range(-r, r), self.range(-r, r), self.range(-r, r))
-    }
-}
-
 fn capsule(m: Vec3f, d: Vec3f, length: f32) -> CapsuleField<f32> {
     CapsuleField { m, d: d.normalize_or(Vec3::X), length, alpha_s: 1.5, alpha_c: 1.5 }
 }
 
 fn shapes(rng: &mut Rng) -> Vec<Shape> {
-    let m = rng.vec(3.0);
-    let d = rng.vec(1.0).normalize_or(Vec3::X);
-    let c = CapsuleField { m, d, length: rng.range(0.5, 8.0), alpha_s: 1.2, alpha_c: 0.7 };
+    let m = rng.in_cube_f32(3.0);
+    let d = rng.in_cube_f32(1.0).normalize_or(Vec3::X);
+    let c = CapsuleField { m, d, length: rng.range_f32(0.5, 8.0), alpha_s: 1.2, alpha_c: 0.7 };
     vec![
         Shape::Sphere(SphereField { center: m, alpha: 2.0 }),
         Shape::Cylinder(CylinderField { point: m, dir: d, alpha: 0.8 }),
@@ -154,11 +137,11 @@ fn random_rays_are_as_accurate_as_the_scalar_kernels() {
     let mut worst = 0.0f64;
     for _ in 0..300 {
         for law in [Falloff::Faithful, Falloff::InverseSquare] {
-            let p = FieldParams { falloff: law, core_radius: rng.range(0.0, 0.1) };
-            let origin = rng.vec(20.0);
+            let p = FieldParams { falloff: law, core_radius: rng.range_f32(0.0, 0.1) };
+            let origin = rng.in_cube_f32(20.0);
             let rays: [R; LANES] = std::array::from_fn(|_| {
-                let target = rng.vec(6.0);
-                let clip = if rng.next() < 0.3 { Some(rng.range(1.0, 50.0)) } else { None };
+                let target = rng.in_cube_f32(6.0);
+                let clip = if rng.unit_f32() < 0.3 { Some(rng.range_f32(1.0, 50.0)) } else { None };
                 ray_for(law, target - origin, clip)
             });
             for shape in shapes(&mut rng) {

@@ -45,12 +45,12 @@ fn near_hits_stay_within_tolerance() {
                 for &d in &distances {
                     let (mut w64, mut w32, mut evals, mut evals32) = (0.0f64, 0.0f64, 0u32, 0u32);
                     for _ in 0..12 {
-                        let s = (0.05 + 0.9 * rng.next()) * 20.0 / f64::from(w.gamma);
+                        let s = (0.05 + 0.9 * rng.unit()) * 20.0 / f64::from(w.gamma);
                         let s = s.min(c.axial_length() as f64 / f64::from(w.gamma));
                         let on = c.point(s);
                         // A direction across the axis, and an offset perpendicular to it and to
                         // the axis.
-                        let u = [rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5];
+                        let u = [rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5];
                         let dir = Vec3::new(0.3 * u[0], u[1], u[2] + 0.5).normalize_or(Vec3::Z);
                         let off = dir.cross(Vec3::X).normalize_or(Vec3::Y);
                         let target = on + off * d;

@@ -1,7 +1,7 @@
 // Present pass: one tile's final colour, straight from the wave pass's output buffer into the
 // full-frame texture a window draws (no read-back). Rust twin: render.rs `copy_tile` (the colour
 // part of the read-back) followed by hadou's `output::srgb8` (hadou_math::shade::linear_to_srgb8):
-// the buffer holds linear mapped colour, and the `Rgba8UnormSrgb` target (present::PRESENT_FORMAT)
+// the buffer holds linear mapped colour, and the `Rgba8UnormSrgb` target (formats.rs PRESENT_FORMAT)
 // clamps to [0, 1] and encodes to sRGB in hardware; alpha is stored as it is (linear).
 // Prepended by common.wgsl (FrameUniforms). Drawn as one full-screen triangle with the viewport
 // set to the tile's rectangle of the texture, so every fragment is one pixel of the tile.

@@ -2,7 +2,7 @@
 // projected with the camera basis exactly as the CPU rasterizer does (view-space x/z scaled by
 // 1/(tan_half·aspect), y/z by 1/tan_half), then the outline hulls (000 §2.3, vs_hull). It writes a
 // G-buffer for the wave pass, which shades (shading.wgsl), as the bits of 32-bit values in two
-// Rgba32Uint targets (pipelines::SCENE_FORMAT: renderable on every adapter):
+// Rgba32Uint targets (formats.rs SCENE_FORMAT: renderable on every adapter):
 // - target 0: world normal (x, y, z) as f32 bits, Euclidean eye distance as f32 bits (0 = nothing);
 // - target 1: u, v as f32 bits, the vertex colour as pack4x8unorm, the material index in the
 //   frame's material buffer (| HULL_BIT for an outline-hull fragment).

@@ -4,7 +4,7 @@
 // (cs_grid, cs_interp); cs_gather hands each tile's visibility to the wave pass. Prepended by
 // common.wgsl.
 //
-// Whole-image buffers, row-major, W·H pixels (render.rs `SoftTargets`):
+// Whole-image buffers, row-major, W·H pixels (passes/soft.rs `SoftTargets`):
 // soft_world[i] = (world point as f32 bits, class), soft_normal[i] = (unit normal as f32 bits,
 // nearest rows of the pixel's column: umbra in the low 16 bits, lit in the high 16, NO_ROW for
 // none), visibility[i]; grid[g] the faithful grid's values.

@@ -678,12 +678,12 @@ mod tests {
                 let mut rng = support::Rng(0x1234_5678_9abc_def1);
                 let mut bins: Vec<Vec<f64>> = vec![Vec::new(); edges.len() - 1];
                 for _ in 0..RAYS {
-                    let u = [rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0, rng.next() * 2.0 - 1.0];
+                    let u = [rng.unit() * 2.0 - 1.0, rng.unit() * 2.0 - 1.0, rng.unit() * 2.0 - 1.0];
                     let dirn = Vec3::new(u[0], u[1], u[2]).normalize_or(Vec3::X);
-                    let target = c.point(rng.next() * c.s_head)
-                        + Vec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5)
-                            * (4.0 * rng.next());
-                    let eye = target + dirn * (5.0 + 35.0 * rng.next());
+                    let target = c.point(rng.unit() * c.s_head)
+                        + Vec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5)
+                            * (4.0 * rng.unit());
+                    let eye = target + dirn * (5.0 + 35.0 * rng.unit());
                     let ray = Ray { origin: eye, dir: (target - eye).normalize_or(Vec3::X) };
                     let Some(r) = LocalRay::new(&c, &fp, &ray, 0.0, 80.0, 100.0) else { continue };
                     if r.q.x.abs() < 1e-6 {

@@ -11,46 +11,8 @@ use hadou_math::energy::{
 use hadou_math::quadrature::{integrate_adaptive_breaks, Quadrature};
 use hadou_math::{Real, Vec3, Vec3d};
 
-/// splitmix64: small, deterministic, good enough to scatter test rays.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)`.
-    pub fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform in `[a, b)`.
-    pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.unit()
-    }
-    /// Log-uniform in `[a, b)`, `0 < a < b`.
-    pub fn log_range(&mut self, a: f64, b: f64) -> f64 {
-        (a.ln() + (b.ln() - a.ln()) * self.unit()).exp()
-    }
-    /// Uniform in `0..n`.
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
-    }
-    /// Uniform on the unit sphere.
-    pub fn unit_vec(&mut self) -> Vec3d {
-        let z = self.range(-1.0, 1.0);
-        let phi = self.range(0.0, std::f64::consts::TAU);
-        let r = (1.0 - z * z).sqrt();
-        Vec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-    /// Uniform in the cube `[-h, h]³`.
-    pub fn in_cube(&mut self, h: f64) -> Vec3d {
-        Vec3::new(self.range(-h, h), self.range(-h, h), self.range(-h, h))
-    }
-}
+/// The workspace's deterministic generator (splitmix64).
+pub use hadou_math::rng::Rng;
 
 /// Which analytic shape a case integrates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -190,15 +190,6 @@ fn perpendicular_open_ray_pairs_with_its_own_cross_section() {
     }
 }
 
-/// A seedable xorshift generator of uniform numbers in [0, 1) (no dependency).
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// The next number in [0, 1).
-    pub fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// The workspace's deterministic generator (splitmix64).
+#[allow(unused_imports, reason = "not every test binary including this module draws random cases")]
+pub use hadou_math::rng::Rng;
