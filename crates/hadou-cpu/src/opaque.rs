@@ -17,8 +17,8 @@ use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
 
-/// A visible pixel's point for the soft shadows: the opaque pass keeps one per pixel with an
-/// `[area_light]` ([`OpaqueBuffers::soft`]), and [`crate::soft`] takes them.
+/// A visible pixel's point for the soft shadows: with an `[area_light]` the opaque pass keeps one
+/// per pixel, and the soft-shadow stage takes them ([`SoftInput`](crate::soft::SoftInput)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SoftPoint {
     /// World position.
