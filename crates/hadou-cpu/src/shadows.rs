@@ -1,5 +1,6 @@
 //! Hard shadows (`[[shadow]]`): the frame's projections ([`hadou_scene::Frame::shadow_casts`]),
-//! their shadow maps, and the per-pixel choice of the shadow a receiver pixel takes. The GPU
+//! their shadow maps, the plane casts' projected casters (which the opaque pass covers), and the
+//! per-pixel choice of the shadow a receiver pixel takes ([`ShadowCasts`]). The GPU
 //! backend mirrors this module: `shadow_raster.wgsl` (the plane-shadow pass and the map pass) and
 //! `shadow_lookup.wgsl` (the choice per pixel, in the wave pass).
 //!
@@ -14,10 +15,10 @@
 //! casters of one shadow therefore darken an overlap once, and a shadow shows only on its
 //! receivers.
 
-use crate::raster::{bin_rows, cover, ScreenTri, BAND};
+use crate::raster::{nearest_depths, ScreenProjection, ScreenTri, Vert};
 use hadou_math::shadow::MapFrame;
 use hadou_math::{Vec3, Vec3f};
-use hadou_scene::{Frame, LightLine, ShadowCast, ShadowMethod, ON_PLANE};
+use hadou_scene::{CameraBasis, Frame, LightLine, ShadowCast, ShadowMethod, ON_PLANE};
 use rayon::prelude::*;
 
 /// A pixel's chosen cast: `(effective opacity, cast index)`.
@@ -33,14 +34,14 @@ pub(crate) struct DepthMap {
 }
 
 /// The frame's shadow casts and the maps of its map casts.
-pub(crate) struct FrameShadows {
+pub(crate) struct ShadowCasts {
     /// In [`Frame::shadow_casts`] order.
     pub casts: Vec<ShadowCast>,
     /// One per cast (`None` for plane casts).
     maps: Vec<Option<DepthMap>>,
 }
 
-impl FrameShadows {
+impl ShadowCasts {
     /// Computes the casts from the waves' light `lines` and renders every map.
     pub(crate) fn new(frame: &Frame, lines: &[LightLine]) -> Self {
         let casts = if frame.shadows.is_empty() { Vec::new() } else { frame.shadow_casts(lines) };
@@ -51,12 +52,50 @@ impl FrameShadows {
                 _ => None,
             })
             .collect();
-        FrameShadows { casts, maps }
+        ShadowCasts { casts, maps }
     }
 
     /// Whether any cast projects onto a plane.
     pub(crate) fn any_plane(&self) -> bool {
         self.maps.iter().any(Option::is_none)
+    }
+
+    /// The plane casts' projected casters (001's flattened copies, 000 §2.4's shadow models): every
+    /// caster vertex `P` moved to `G = P + t·k` on the cast's plane
+    /// ([`hadou_math::shadow::project`]), with `t` carried in `uv[0]` for the per-pixel `t ≥ 0` test
+    /// (interpolated perspective-correctly, exact because `t` is affine on the projected triangle) and
+    /// the cast's index in `object`. Drawn double-sided.
+    pub(crate) fn plane_tris(&self, frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
+        let screen = ScreenProjection::new(frame, basis);
+        let mut out = Vec::new();
+        for (ci, cast) in self.casts.iter().enumerate() {
+            let ShadowMethod::Plane(plane) = frame.shadows[cast.shadow as usize].method else { continue };
+            for &o in &cast.casters {
+                let obj = &frame.objects[o as usize];
+                let mesh = &obj.mesh;
+                let verts: Vec<Vert> = mesh
+                    .positions
+                    .iter()
+                    .map(|p| {
+                        let world = obj.transform.transform_point(Vec3::from_array(*p));
+                        let (g, t) = hadou_math::shadow::project(world, cast.k, &plane);
+                        Vert {
+                            view: basis.to_view(g),
+                            world: g,
+                            normal: Vec3f::ZERO,
+                            uv: [t, 0.0],
+                            color: [0.0; 4],
+                        }
+                    })
+                    .collect();
+                for tri in mesh.indices.chunks_exact(3) {
+                    let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+                    let [Some(a), Some(b), Some(c)] = v else { continue };
+                    screen.push([a, b, c], ci as u32, 0, false, &mut out);
+                }
+            }
+        }
+        out
     }
 
     /// Plane cast `cast` covers a pixel whose visible object is `object`, point `world` at eye
@@ -160,21 +199,9 @@ fn render_map(frame: &Frame, c: &ShadowCast, m: MapFrame, size: u32) -> DepthMap
             depths.push([a[2], b[2], cc[2]]);
         }
     }
-    // Bands of rows in parallel, each drawing the triangles that reach it (the nearest depth
-    // wins, so the result does not depend on the banding).
-    let bins = bin_rows(&tris, n, &(0..n));
-    let mut depth = vec![1.0f32; n * n];
-    depth.par_chunks_mut(BAND * n).zip(&bins).enumerate().for_each(|(b, (band, bin))| {
-        let rows = band.len() / n;
-        for &ti in bin {
-            let dz = depths[ti as usize];
-            cover(&tris[ti as usize], b * BAND, rows, n, |i, w| {
-                let z = w[0] * dz[0] + w[1] * dz[1] + w[2] * dz[2];
-                if z < band[i] {
-                    band[i] = z;
-                }
-            });
-        }
+    let depth = nearest_depths(&tris, n, 1.0, |ti, w| {
+        let dz = depths[ti];
+        w[0] * dz[0] + w[1] * dz[1] + w[2] * dz[2]
     });
     DepthMap { frame: m, size, depth }
 }

@@ -13,24 +13,17 @@
 //!
 //! The GPU backend mirrors [`visibility`] (`soft.wgsl`).
 
-use crate::raster::{bin_rows, cover, spot_tris, BAND};
+use crate::opaque::draw_opaque;
+use crate::raster::{nearest_depths, ScreenProjection, ScreenTri, Vert};
+use crate::setup::FrameSetup;
 use hadou_math::soft::{
     bilinear, same_surface, segment_brightness, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
 };
-use hadou_math::Vec3f;
+use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame, SoftResolve};
 use rayon::prelude::*;
 
-/// A visible pixel's point for the soft shadows.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SoftPoint {
-    /// World position.
-    pub world: Vec3f,
-    /// Unit normal (zero if the surface has none).
-    pub normal: Vec3f,
-    /// What the area light adds there when fully visible (`shading::area_term`).
-    pub term: [f32; 3],
-}
+pub use crate::opaque::SoftPoint;
 
 /// The visible points of a whole frame, as the soft-shadow stage takes them.
 #[derive(Clone, Debug)]
@@ -47,11 +40,7 @@ pub struct SoftInput {
 /// points: what [`visibility`] and the references work on. `None` without an area light.
 pub fn soft_input(frame: &Frame) -> Option<SoftInput> {
     frame.area_light.as_ref()?;
-    let basis = frame.camera.basis(frame.width, frame.height);
-    let curves = crate::waves::prepare_curves(frame);
-    let lights = crate::shading::FrameLights::new(frame, &curves);
-    let shadows = crate::shadows::FrameShadows::new(frame, &lights.lines);
-    let opaque = crate::raster::draw_opaque(frame, &basis, &lights, &shadows, 0..frame.height as usize);
+    let opaque = draw_opaque(frame, &FrameSetup::new(frame), 0..frame.height as usize);
     Some(SoftInput { width: frame.width as usize, height: frame.height as usize, points: opaque.soft })
 }
 
@@ -70,22 +59,8 @@ impl SpotDepth {
     /// Renders the objects `casters` of `frame` (double-sided, top-left rule, perspective-correct
     /// depth, the nearest kept) into a `size²` map of frame `map`, bands of rows in parallel.
     pub fn render(frame: &Frame, casters: &[u32], map: &SpotMap, size: u32) -> SpotDepth {
-        let n = size as usize;
         let tris = spot_tris(frame, casters, map, size);
-        let bins = bin_rows(&tris, n, &(0..n));
-        let mut depth = vec![f32::INFINITY; n * n];
-        depth.par_chunks_mut(BAND * n).zip(&bins).enumerate().for_each(|(b, (band, bin))| {
-            let rows = band.len() / n;
-            for &ti in bin {
-                let t = &tris[ti as usize];
-                cover(t, b * BAND, rows, n, |i, w| {
-                    let z = t.depth_at(w);
-                    if z < band[i] {
-                        band[i] = z;
-                    }
-                });
-            }
-        });
+        let depth = nearest_depths(&tris, size as usize, f32::INFINITY, |ti, w| tris[ti].depth_at(w));
         SpotDepth { map: *map, size, depth }
     }
 
@@ -111,6 +86,32 @@ impl SpotDepth {
     }
 }
 
+/// The triangles of the objects `casters` (not the outline hulls) as seen from one of 003's
+/// soft-shadow maps: clipped at the map's near plane and projected to texel coordinates of a
+/// `size²` map (texel `(x, y)` covers `[x, x+1) × [y, y+1)`, row 0 at the frustum's top), `1/z`
+/// per vertex for the perspective-correct depth ([`ScreenTri::depth_at`]).
+fn spot_tris(frame: &Frame, casters: &[u32], map: &SpotMap, size: u32) -> Vec<ScreenTri> {
+    let screen = ScreenProjection::square(map.near, map.tan_half, size);
+    let mut out = Vec::new();
+    for obj in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
+        let verts: Vec<Vert> = obj
+            .mesh
+            .positions
+            .iter()
+            .map(|p| {
+                let world = obj.transform.transform_point(Vec3::from_array(*p));
+                Vert { view: map.to_view(world), world, normal: Vec3f::ZERO, uv: [0.0; 2], color: [0.0; 4] }
+            })
+            .collect();
+        for tri in obj.mesh.indices.chunks_exact(3) {
+            let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+            let [Some(a), Some(b), Some(c)] = v else { continue };
+            screen.push([a, b, c], 0, 0, false, &mut out);
+        }
+    }
+    out
+}
+
 /// Every pixel's class (003 §4.1) from the two maps.
 pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
     input
@@ -126,7 +127,7 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 
 /// The soft-shadow visibility of every pixel of `input` under `light` (0 in the umbra, 1 where
 /// lit, `k·D₁/(k·D₁ + D₂)` in the penumbra with `k` = [`AreaLight::penumbra_ratio`]; 0 where no
-/// point is): the two maps, the classes and the resolve `resolve`. What [`crate::render`]
+/// point is): the two maps, the classes and the resolve `resolve`. What [`crate::render()`]
 /// multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
     let maps = light.maps.map(|m| (m, light.map_size));

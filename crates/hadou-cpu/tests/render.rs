@@ -3,8 +3,10 @@
 use hadou_cpu::{probe, render};
 use hadou_math::energy::{BeamField, CapsuleField, Falloff, SphereField};
 use hadou_math::{Mat4, Vec3};
-use hadou_scene::{Camera, ColorMapping, Frame, Light, Mesh, Object, ToneMode, Wave, WaveShape};
+use hadou_scene::{Frame, Mesh, Object, Wave, WaveShape};
 use std::sync::Arc;
+
+mod common;
 
 /// An axis-aligned cube of side 2 centred at the origin.
 fn cube() -> Mesh {
@@ -12,26 +14,7 @@ fn cube() -> Mesh {
 }
 
 fn frame(objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
-    Frame {
-        width: 96,
-        height: 64,
-        time: 0.0,
-        camera: Camera {
-            position: Vec3::new(0.0, 0.0, 40.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 45.0,
-            near: 0.1,
-            far: 100.0,
-        },
-        background: [0.0; 3],
-        light: Light { direction: Vec3::new(-0.3, -1.0, -0.5), color: [1.0; 3], ambient: [0.1; 3] },
-        objects,
-        waves,
-        color_mapping: ColorMapping { mode: ToneMode::Filmic, exposure: 1.0 },
-        shadows: Vec::new(),
-        area_light: None,
-    }
+    common::frame(96, 64, common::camera(Vec3::new(0.0, 0.0, 40.0), 45.0), objects, waves)
 }
 
 fn cube_at(name: &str, z: f32) -> Object {

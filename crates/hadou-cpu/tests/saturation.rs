@@ -8,7 +8,9 @@ use hadou_cpu::{probe, render};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
 use hadou_math::Vec3;
-use hadou_scene::{Camera, ColorMapping, Frame, Light, ToneMode, Wave, WaveShape};
+use hadou_scene::{ColorMapping, Frame, ToneMode, Wave, WaveShape};
+
+mod common;
 
 /// Every kind (default curve integrator; [`bezier`] adds Simpson), on the axis `x = y = 0` along which the centre pixel's ray runs, with strength `a`.
 fn shapes(a: f32) -> Vec<WaveShape> {
@@ -57,25 +59,10 @@ fn bezier(a: f32) -> CurveWave {
 /// sum of two saturated energies is exercised too.
 fn frame(shape: WaveShape, falloff: Falloff, mode: ToneMode) -> Frame {
     let wave = Wave::new("w", [1.0, 0.5, 0.0, 1.0], falloff, 0.0, shape);
+    let camera = common::camera(Vec3::new(0.0, 0.0, 10.0), 45.0);
     Frame {
-        width: 3,
-        height: 3,
-        time: 0.0,
-        camera: Camera {
-            position: Vec3::new(0.0, 0.0, 10.0),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 45.0,
-            near: 0.1,
-            far: 100.0,
-        },
-        background: [0.0; 3],
-        light: Light { direction: Vec3::new(-0.3, -1.0, -0.5), color: [1.0; 3], ambient: [0.1; 3] },
-        objects: vec![],
-        waves: vec![wave.clone(), wave],
         color_mapping: ColorMapping { mode, exposure: 1.0 },
-        shadows: Vec::new(),
-        area_light: None,
+        ..common::frame(3, 3, camera, vec![], vec![wave.clone(), wave])
     }
 }
 

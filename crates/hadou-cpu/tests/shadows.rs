@@ -72,24 +72,21 @@ fn without_shadows(f: &Frame) -> Frame {
 const GROUND: &str =
     "[[object]]\nname = \"ground\"\nkind = \"plane\"\nsize = [12, 12]\nmaterial = \"white\"\n";
 
+/// An `[[object]]` table: a `kind` named `name` of `size` at `position` (the TOML arrays' items; no
+/// `position` key where it is empty) in `material`.
+fn object(name: &str, kind: &str, size: &str, position: &str, material: &str) -> String {
+    let position = if position.is_empty() { String::new() } else { format!("position = [{position}]\n") };
+    format!(
+        "\n[[object]]\nname = \"{name}\"\nkind = \"{kind}\"\nsize = [{size}]\n{position}material = \"{material}\"\n"
+    )
+}
+
 #[test]
 fn overlapping_shadows_of_several_casters_darken_once() {
+    let casters = object("a", "box", "1, 2, 1", "-0.4, 1, 0", "red")
+        + &object("b", "box", "1, 3, 1", "-1.2, 1.5, 0.5", "red");
     let f = frame(&format!(
-        "{GROUND}
-[[object]]
-name = \"a\"
-kind = \"box\"
-size = [1, 2, 1]
-position = [-0.4, 1, 0]
-material = \"red\"
-
-[[object]]
-name = \"b\"
-kind = \"box\"
-size = [1, 3, 1]
-position = [-1.2, 1.5, 0.5]
-material = \"red\"
-
+        "{GROUND}{casters}
 [[shadow]]
 name = \"sun\"
 kind = \"sun\"
@@ -132,34 +129,11 @@ opacity = 0.5
 #[test]
 fn shadows_stay_on_their_receivers() {
     // The receiver is a 3×3 green plane; the long shadow would run past it and across a red box.
-    let f = frame(
-        "[[object]]
-name = \"ground\"
-kind = \"plane\"
-size = [12, 12]
-material = \"white\"
-
-[[object]]
-name = \"mat\"
-kind = \"plane\"
-size = [3, 3]
-position = [0.5, 0.001, 0]
-material = \"green\"
-
-[[object]]
-name = \"post\"
-kind = \"box\"
-size = [0.5, 3, 0.5]
-position = [-1.5, 1.5, 0]
-material = \"red\"
-
-[[object]]
-name = \"block\"
-kind = \"box\"
-size = [0.8, 0.8, 0.8]
-position = [3, 0.4, 0]
-material = \"red\"
-
+    let objects = object("mat", "plane", "3, 3", "0.5, 0.001, 0", "green")
+        + &object("post", "box", "0.5, 3, 0.5", "-1.5, 1.5, 0", "red")
+        + &object("block", "box", "0.8, 0.8, 0.8", "3, 0.4, 0", "red");
+    let f = frame(&format!(
+        "{GROUND}{objects}
 [[shadow]]
 name = \"sun\"
 kind = \"sun\"
@@ -167,8 +141,8 @@ direction = [1, -0.6, 0]
 casters = [\"post\", \"block\"]
 receivers = \"mat\"
 opacity = 0.8
-",
-    );
+"
+    ));
     let img = hadou_cpu::render(&f);
     let plain = hadou_cpu::render(&without_shadows(&f));
     let mut on_mat = 0;
@@ -195,14 +169,9 @@ opacity = 0.8
 fn the_part_beyond_the_plane_casts_nothing() {
     // A tall box sunk half into the ground: t < 0 for its lower half, whose projection would
     // fall on the light's side (000 §2.4: fully transparent).
+    let sunk = object("sunk", "box", "0.6, 2, 0.6", "", "red");
     let f = frame(&format!(
-        "{GROUND}
-[[object]]
-name = \"sunk\"
-kind = \"box\"
-size = [0.6, 2, 0.6]
-material = \"red\"
-
+        "{GROUND}{sunk}
 [[shadow]]
 name = \"sun\"
 kind = \"sun\"
@@ -235,22 +204,10 @@ fn wave_shadows_fall_where_the_projection_puts_them() {
         "position = [0, 12, 0]\ntarget = [0, 0, 0]",
         "position = [-1.5, 12, 0]\ntarget = [-1.5, 0, 0]",
     );
+    let boxes = object("near", "box", "0.5, 0.5, 0.5", "0, 1, 0", "red")
+        + &object("far", "box", "0.5, 0.5, 0.5", "-4.5, 1, 0", "red");
     let f = parse(&format!(
-        "{view}{GROUND}
-[[object]]
-name = \"near\"
-kind = \"box\"
-size = [0.5, 0.5, 0.5]
-position = [0, 1, 0]
-material = \"red\"
-
-[[object]]
-name = \"far\"
-kind = \"box\"
-size = [0.5, 0.5, 0.5]
-position = [-4.5, 1, 0]
-material = \"red\"
-
+        "{view}{GROUND}{boxes}
 [[wave]]
 name = \"w\"
 kind = \"cylinder\"
@@ -312,28 +269,12 @@ const BALL: &str = "[[object]]\nname = \"ball\"\nkind = \"sphere\"\nradius = 0.7
 
 #[test]
 fn map_shadows_on_stairs_agree_with_exact_shadow_rays() {
-    let stairs = "
-[[object]]
-name = \"step1\"
-kind = \"box\"
-size = [1.5, 0.4, 4]
-position = [0.25, 0.2, 0]
-material = \"green\"
-
-[[object]]
-name = \"step2\"
-kind = \"box\"
-size = [1.5, 0.8, 4]
-position = [1.75, 0.4, 0]
-material = \"green\"
-
-[[object]]
-name = \"step3\"
-kind = \"box\"
-size = [1.5, 1.2, 4]
-position = [3.25, 0.6, 0]
-material = \"green\"
-";
+    let stairs = [
+        object("step1", "box", "1.5, 0.4, 4", "0.25, 0.2, 0", "green"),
+        object("step2", "box", "1.5, 0.8, 4", "1.75, 0.4, 0", "green"),
+        object("step3", "box", "1.5, 1.2, 4", "3.25, 0.6, 0", "green"),
+    ]
+    .concat();
     let shadow = |method: &str| {
         format!(
             "[[shadow]]\nname = \"sun\"\nkind = \"sun\"\ndirection = [1, -0.9, 0.2]\ncasters = \"ball\"\n\

@@ -8,35 +8,23 @@ use hadou_math::toon::{Filter, Ramp, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use hadou_scene::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
 use hadou_scene::{
-    Camera, ColorMapping, Frame, Image, Light, Material, Mesh, Object, Outline, ShadingModel, Texture,
-    TextureRef, ToneMode, Wave, WaveShape,
+    ColorMapping, Frame, Image, Light, Material, Mesh, Object, Outline, ShadingModel, Texture, TextureRef,
+    ToneMode, Wave, WaveShape,
 };
 use std::sync::Arc;
+
+mod common;
 
 const BG: [f32; 3] = [0.0, 0.0, 0.0];
 
 fn frame(size: u32, eye: Vec3f, objects: Vec<Object>, waves: Vec<Wave>) -> Frame {
     Frame {
-        width: size,
-        height: size,
-        time: 0.0,
-        camera: Camera {
-            position: eye,
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 40.0,
-            near: 0.1,
-            far: 100.0,
-        },
         background: BG,
         light: Light { direction: Vec3::new(0.0, -1.0, 0.0), color: [1.0; 3], ambient: [0.2; 3] },
-        objects,
-        waves,
         // Faithful mapping with a tiny exposure: the waves' own glow adds < 1e-6, so pixels show
         // the surface colour.
         color_mapping: ColorMapping { mode: ToneMode::Faithful, exposure: 1e-9 },
-        shadows: Vec::new(),
-        area_light: None,
+        ..common::frame(size, size, common::camera(eye, 40.0), objects, waves)
     }
 }
 

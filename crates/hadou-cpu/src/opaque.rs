@@ -1,0 +1,298 @@
+//! The opaque pass: the frame's objects and then their inverted-hull outlines (000 §2.3) drawn
+//! with [`crate::raster`] into the [`OpaqueBuffers`], each visible point shaded
+//! ([`crate::shading`]: the materials and the waves as lights) and darkened by the hard shadows
+//! ([`crate::shadows`]); with an `[area_light]`, each visible point is also kept for the soft
+//! shadows ([`SoftPoint`]).
+//!
+//! The depth test is `z < stored z` in submission order, so ties keep the earlier triangle and the
+//! result does not depend on the number of threads. Every object's triangles come first, then the
+//! outline hulls, of which only the back faces are drawn. The GPU backend's raster pass matches
+//! these conventions.
+
+use crate::raster::{bin_rows, cover, edge, perspective, ScreenProjection, ScreenTri, Vert, BAND};
+use crate::setup::FrameSetup;
+use crate::shading;
+use crate::shadows::NO_SHADOW;
+use hadou_math::{Vec3, Vec3f};
+use hadou_scene::{CameraBasis, Frame};
+use rayon::prelude::*;
+
+/// A visible pixel's point for the soft shadows: with an `[area_light]` the opaque pass keeps one
+/// per pixel, and the soft-shadow stage takes them ([`SoftInput`](crate::soft::SoftInput)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftPoint {
+    /// World position.
+    pub world: Vec3f,
+    /// Unit normal (zero if the surface has none).
+    pub normal: Vec3f,
+    /// What the area light adds there when fully visible (`shading::area_term`).
+    pub term: [f32; 3],
+}
+
+/// What the opaque pass leaves per pixel.
+#[derive(Default)]
+pub(crate) struct OpaqueBuffers {
+    /// Shaded linear RGB, background where nothing is drawn.
+    pub color: Vec<[f32; 3]>,
+    /// Eye distance to the visible surface, `None` where nothing is drawn.
+    pub surface: Vec<Option<f32>>,
+    /// Index into `frame.objects` of the visible object, if any.
+    pub object: Vec<Option<u32>>,
+    /// Index into `frame.shadows` of the shadow the pixel takes, if any.
+    pub shadow: Vec<Option<u32>>,
+    /// With an `[area_light]`: each pixel's visible point for the soft shadows (`None` for the
+    /// background and outline hulls); empty without one.
+    pub soft: Vec<Option<SoftPoint>>,
+    /// The soft-shadow visibility per pixel once resolved (empty before, and without an area
+    /// light).
+    pub visibility: Vec<f32>,
+}
+
+/// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
+/// Every pixel is decided by the triangles covering it alone, so a pixel's result does not depend
+/// on which rows are drawn with it.
+///
+/// Shadows (`[[shadow]]`) darken the shaded colour of receiver pixels here, before the waves:
+/// [`ShadowCasts::resolve`](crate::shadows::ShadowCasts::resolve) picks, per pixel, the cast of
+/// largest opacity among the plane casts whose projected casters cover the pixel and the map casts
+/// whose map shadows it.
+pub(crate) fn draw_opaque(frame: &Frame, setup: &FrameSetup, rows: std::ops::Range<usize>) -> OpaqueBuffers {
+    let mut out = OpaqueBuffers::default();
+    draw_opaque_into(frame, setup, rows, &mut out);
+    out
+}
+
+/// Resizes `v` to `n` copies of `x`, reusing its allocation (every element is rewritten, so a
+/// reused buffer costs a fill, not fresh pages).
+fn refill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    v.clear();
+    v.resize(n, x);
+}
+
+/// [`draw_opaque`] into `out`, reusing its buffers' allocations from an earlier frame. Bands of
+/// rows that no triangle or shadow touches are filled with the background without further work.
+pub(crate) fn draw_opaque_into(
+    frame: &Frame,
+    setup: &FrameSetup,
+    rows: std::ops::Range<usize>,
+    out: &mut OpaqueBuffers,
+) {
+    let FrameSetup { basis, lights, shadows, .. } = setup;
+    let (w, h) = (frame.width as usize, rows.len());
+    let tris = project_all(frame, basis);
+    let shadow_tris = if shadows.any_plane() { shadows.plane_tris(frame, basis) } else { Vec::new() };
+    let far = frame.camera.far;
+    let bins = bin_rows(&tris, frame.height as usize, &rows);
+    let shadow_bins = bin_rows(&shadow_tris, frame.height as usize, &rows);
+    let OpaqueBuffers { color, surface, object, shadow, soft, visibility } = out;
+    // Every element is written below: the fills only size the buffers.
+    refill(color, w * h, [0.0f32; 3]);
+    refill(surface, w * h, None);
+    refill(object, w * h, None);
+    refill(shadow, w * h, None);
+    visibility.clear();
+    let area = frame.area_light.as_ref();
+    refill(soft, if area.is_some() { w * h } else { 0 }, None);
+    if w * h == 0 {
+        return;
+    }
+    // Without an area light every band gets an empty slice.
+    let soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
+        soft.chunks_mut(BAND * w).collect()
+    } else {
+        (0..h.div_ceil(BAND)).map(|_| Default::default()).collect()
+    };
+    color
+        .par_chunks_mut(BAND * w)
+        .zip(surface.par_chunks_mut(BAND * w))
+        .zip(object.par_chunks_mut(BAND * w))
+        .zip(shadow.par_chunks_mut(BAND * w))
+        .zip(soft_chunks.into_par_iter())
+        .enumerate()
+        .for_each(|(b, ((((col, surf), obj), shad), soft))| {
+            let y_start = rows.start + b * BAND;
+            let rows = col.len() / w;
+            if bins[b].is_empty() && shadow_bins[b].is_empty() {
+                // Nothing drawn here (the refills left surface, object, shadow and soft empty).
+                col.fill(frame.background);
+                return;
+            }
+            let mut zbuf = vec![f32::INFINITY; rows * w];
+            let mut tri_id = vec![u32::MAX; rows * w];
+            for &ti in &bins[b] {
+                raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, &mut zbuf, &mut tri_id);
+            }
+            // The visible surface of every pixel.
+            let mut visible: Vec<Option<shading::Surface>> = vec![None; rows * w];
+            for r in 0..rows {
+                for x in 0..w {
+                    let i = r * w + x;
+                    if tri_id[i] == u32::MAX {
+                        continue;
+                    }
+                    let py = (y_start + r) as f32;
+                    let s = interpolate(&tris[tri_id[i] as usize], x as f32 + 0.5, py + 0.5);
+                    let d = (s.world - basis.eye).length();
+                    surf[i] = Some(if d.is_finite() { d } else { 0.0 });
+                    obj[i] = Some(tris[tri_id[i] as usize].object);
+                    visible[i] = Some(s);
+                }
+            }
+            // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
+            let mut best = vec![NO_SHADOW; rows * w];
+            let receiver = |i: usize| {
+                let t = tris.get(tri_id[i] as usize)?;
+                (!t.hull).then_some(t.object)
+            };
+            for &si in &shadow_bins[b] {
+                let st = &shadow_tris[si as usize];
+                cover(st, y_start, rows, w, |i, bary| {
+                    let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
+                    let t = perspective(st, bary, |k| st.uv[k][0]);
+                    shadows.plane_candidate(
+                        frame,
+                        st.object,
+                        o,
+                        t,
+                        s.world,
+                        surf[i].unwrap_or(0.0),
+                        &mut best[i],
+                    );
+                });
+            }
+            for r in 0..rows {
+                for x in 0..w {
+                    let i = r * w + x;
+                    let Some(s) = visible[i].as_ref() else {
+                        col[i] = frame.background;
+                        continue;
+                    };
+                    let t = &tris[tri_id[i] as usize];
+                    let material = frame.objects[t.object as usize].material(t.material);
+                    let c = match (t.hull, material.outline) {
+                        (true, Some(o)) => o.color,
+                        _ => shading::shade(frame, lights, material, s),
+                    };
+                    if t.hull {
+                        col[i] = c;
+                    } else {
+                        (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
+                        if let Some(al) = area {
+                            soft[i] = Some(SoftPoint {
+                                world: s.world,
+                                normal: s.normal.normalize_or(Vec3f::ZERO),
+                                term: shading::area_term(al, material, s),
+                            });
+                        }
+                    }
+                }
+            }
+        });
+}
+
+/// The objects' triangles and then their outline hulls, projected by the camera.
+fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
+    let screen = ScreenProjection::new(frame, basis);
+    let mut out = Vec::new();
+    for (oi, obj) in frame.objects.iter().enumerate() {
+        let nm = obj.transform.normal_matrix();
+        let mesh = &obj.mesh;
+        let verts: Vec<Vert> = (0..mesh.positions.len())
+            .map(|i| {
+                let world = obj.transform.transform_point(Vec3::from_array(mesh.positions[i]));
+                let normal =
+                    nm.transform_vector(Vec3::from_array(mesh.normals.get(i).copied().unwrap_or([0.0; 3])));
+                Vert {
+                    view: basis.to_view(world),
+                    world,
+                    normal,
+                    uv: mesh.uvs.get(i).copied().unwrap_or([0.0; 2]),
+                    color: mesh.colors.get(i).copied().unwrap_or([1.0; 4]),
+                }
+            })
+            .collect();
+        // The outline hull (000 §2.3): each vertex pushed along its world-space outline normal
+        // by `d·|z|` (`z` its view depth), which is `R' = R + d·|R_z|·U` in view space.
+        let outlined = obj.materials.iter().any(|m| m.outline.is_some_and(|o| o.width > 0.0));
+        let hull: Vec<Vert> = if outlined {
+            verts
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    let width = obj.material(mesh.material_of(i)).outline.map_or(0.0, |o| o.width);
+                    let dir =
+                        mesh.outline_normals.get(i).or(mesh.normals.get(i)).copied().unwrap_or([0.0; 3]);
+                    let u = nm.transform_vector(Vec3::from_array(dir)).normalize_or(Vec3f::ZERO);
+                    let world = v.world + u * (width * v.view.z.abs());
+                    Vert { view: basis.to_view(world), world, ..*v }
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let passes: &[(&[Vert], bool)] =
+            if outlined { &[(&verts, false), (&hull, true)] } else { &[(&verts, false)] };
+        for &(verts, is_hull) in passes {
+            for tri in mesh.indices.chunks_exact(3) {
+                let v = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).copied());
+                let [Some(a), Some(b), Some(c)] = v else { continue };
+                let material = mesh.material_of(tri[0] as usize);
+                if is_hull
+                    && obj.material(material).outline.is_none_or(|o| o.width.is_nan() || o.width <= 0.0)
+                {
+                    continue;
+                }
+                screen.push([a, b, c], oi as u32, material, is_hull, &mut out);
+            }
+        }
+    }
+    out
+}
+
+/// Draws triangle `id` into a band's depth buffer `zbuf` and triangle ids `tri_id` (both `rows × w`,
+/// the band's first row `y_start`): each covered pixel whose depth is below the stored one and not
+/// beyond `far` takes it. An outline hull triangle is drawn only where it shows its back face.
+#[allow(clippy::too_many_arguments)] // a hot inner routine: plain slices beat a bundling struct
+fn raster_tri(
+    t: &ScreenTri,
+    id: u32,
+    y_start: usize,
+    rows: usize,
+    w: usize,
+    far: f32,
+    zbuf: &mut [f32],
+    tri_id: &mut [u32],
+) {
+    // With y down, a triangle counter-clockwise seen from the eye (a front face) has area < 0;
+    // a hull shows only its back faces.
+    if t.hull && edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]) < 0.0 {
+        return;
+    }
+    cover(t, y_start, rows, w, |i, b| {
+        let iz = b[0] * t.inv_z[0] + b[1] * t.inv_z[1] + b[2] * t.inv_z[2];
+        let z = 1.0 / iz;
+        if z < zbuf[i] && z <= far {
+            zbuf[i] = z;
+            tri_id[i] = id;
+        }
+    });
+}
+
+/// Perspective-correct surface attributes at screen point `(px, py)`.
+fn interpolate(t: &ScreenTri, px: f32, py: f32) -> shading::Surface {
+    let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
+    let b = [
+        edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) / area,
+        edge(t.sx[2], t.sy[2], t.sx[0], t.sy[0], px, py) / area,
+        edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], px, py) / area,
+    ];
+    let wts = [b[0] * t.inv_z[0], b[1] * t.inv_z[1], b[2] * t.inv_z[2]];
+    let s = wts[0] + wts[1] + wts[2];
+    let wts = wts.map(|v| v / s);
+    let world = t.world[0] * wts[0] + t.world[1] * wts[1] + t.world[2] * wts[2];
+    let normal = t.normal[0] * wts[0] + t.normal[1] * wts[1] + t.normal[2] * wts[2];
+    let uv = std::array::from_fn(|k| t.uv[0][k] * wts[0] + t.uv[1][k] * wts[1] + t.uv[2][k] * wts[2]);
+    let color =
+        std::array::from_fn(|k| t.color[0][k] * wts[0] + t.color[1][k] * wts[1] + t.color[2][k] * wts[2]);
+    shading::Surface { world, normal, uv, color }
+}

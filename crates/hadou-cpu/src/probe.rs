@@ -1,0 +1,77 @@
+//! `hadou probe`: one pixel's opaque result and every wave's energy there ([`probe`]), through the
+//! same set-up, opaque pass and batched wave code as the render, so it reports exactly what the
+//! render drew.
+
+use crate::opaque::OpaqueBuffers;
+use crate::render::opaque_pass;
+use crate::setup::FrameSetup;
+use crate::waves::{self, WavePass};
+use hadou_scene::Frame;
+
+/// What `hadou probe` reports about one pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe {
+    /// Pixel x.
+    pub x: u32,
+    /// Pixel y (0 = top row).
+    pub y: u32,
+    /// Each wave's name, integrated energy and integrand evaluations, in scene order.
+    pub waves: Vec<WaveProbe>,
+    /// Final linear RGBA.
+    pub color: [f32; 4],
+    /// Eye distance to the visible surface or the far plane.
+    pub depth: f32,
+    /// Name of the visible object, if any.
+    pub object: Option<String>,
+    /// Name of the `[[shadow]]` darkening the pixel, if any.
+    pub shadow: Option<String>,
+    /// With an `[area_light]`, the pixel's soft-shadow visibility (0 umbra … 1 lit) where a
+    /// surface is visible.
+    pub soft: Option<f32>,
+}
+
+/// One wave's contribution at a probed pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WaveProbe {
+    /// Wave name.
+    pub name: String,
+    /// Integrated energy `I`.
+    pub energy: f32,
+    /// Integrand evaluations (closed-form pieces for analytic shapes).
+    pub evaluations: u32,
+}
+
+/// Probes one pixel: renders the opaque pass and evaluates every wave there. `None` if the pixel
+/// is outside the image.
+pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
+    if x >= frame.width || y >= frame.height {
+        return None;
+    }
+    let setup = FrameSetup::new(frame);
+    // The probed row alone (the opaque pass decides each pixel independently), or every row when
+    // the area light's penumbra search needs them.
+    let mut opaque = OpaqueBuffers::default();
+    let oy0 = opaque_pass(frame, &setup, y as usize..y as usize + 1, &mut opaque);
+    let i = (y as usize - oy0) * frame.width as usize + x as usize;
+    let surface = opaque.surface[i];
+    let mut light = [0.0f32; 3];
+    let mut out = Vec::new();
+    let pass = WavePass::new(frame, &setup.basis, &setup.curves);
+    let s = hadou_math::energy::lanes::Lanes::splat(surface.unwrap_or(f32::INFINITY));
+    let depth = pass.energies(x as usize, y as f32, s, 1, |wi, e, n| {
+        let wave = &frame.waves[wi];
+        let e = e.to_array()[0];
+        waves::accumulate(&mut light, wave, e);
+        out.push(WaveProbe { name: wave.name.clone(), energy: e, evaluations: n[0] });
+    });
+    Some(Probe {
+        x,
+        y,
+        waves: out,
+        color: waves::compose(frame, opaque.color[i], light),
+        depth: depth.to_array()[0],
+        object: opaque.object[i].map(|o| frame.objects[o as usize].name.clone()),
+        shadow: opaque.shadow[i].map(|s| frame.shadows[s as usize].name.clone()),
+        soft: opaque.visibility.get(i).copied().filter(|_| surface.is_some() && opaque.object[i].is_some()),
+    })
+}

@@ -1,0 +1,178 @@
+//! Rendering a frame on the CPU: the per-frame set-up ([`FrameSetup`]), the opaque pass with the
+//! area light's soft-shadowed term added ([`opaque_pass`]), then per row the wave pass and the
+//! colour mapping ([`crate::waves`]), timed pass by pass ([`PassTimes`]); [`CpuBackend`] keeps the
+//! opaque pass's buffers from frame to frame.
+
+use crate::opaque::{draw_opaque_into, OpaqueBuffers};
+use crate::setup::FrameSetup;
+use crate::soft;
+use crate::waves::WavePass;
+use hadou_scene::{Backend, Frame, Image, RenderError};
+use rayon::prelude::*;
+
+/// The CPU reference backend. It keeps the opaque pass's buffers between frames, so a frame
+/// drawn with [`CpuBackend::render_into`] into an image from an earlier frame allocates nothing
+/// that grows with the image.
+#[derive(Default)]
+pub struct CpuBackend {
+    scratch: OpaqueBuffers,
+}
+
+impl std::fmt::Debug for CpuBackend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CpuBackend").finish_non_exhaustive()
+    }
+}
+
+impl CpuBackend {
+    /// A backend using rayon's global thread pool.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Renders `frame` into `image` (resized to the frame, its allocations reused: what a viewer
+    /// or a benchmark drawing frame after frame wants) and returns the passes' times; the same
+    /// pixels as [`render`].
+    pub fn render_into(&mut self, frame: &Frame, image: &mut Image) -> PassTimes {
+        render_with(frame, 0..frame.height, &mut self.scratch, image)
+    }
+}
+
+impl Backend for CpuBackend {
+    fn name(&self) -> &str {
+        "cpu"
+    }
+
+    fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
+        Ok(render(frame))
+    }
+
+    fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
+        Ok(render_rows(frame, rows))
+    }
+}
+
+/// Renders `frame` on the CPU.
+pub fn render(frame: &Frame) -> Image {
+    render_rows(frame, 0..frame.height)
+}
+
+/// Renders the rows `rows` of `frame` (clamped to the image): the same pixels as those rows of
+/// [`render`], bit for bit, in an image `frame.width` wide and `rows.len()` high.
+pub fn render_rows(frame: &Frame, rows: std::ops::Range<u32>) -> Image {
+    render_timed(frame, rows).0
+}
+
+/// Wall-clock milliseconds of each pass of one CPU render (see [`render_timed`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimes {
+    /// Per-frame set-up (camera, curve tables, lights, shadow maps) and the opaque pass: meshes,
+    /// outlines, shading, hard and soft shadows.
+    pub opaque_ms: f64,
+    /// The energy integrals of every wave per pixel, clipped at the visible surface.
+    pub wave_ms: f64,
+    /// `scene + exposure·Σ rgb·a·I` and the colour mapping.
+    pub color_ms: f64,
+}
+
+/// [`render_rows`], also returning how long each pass took. The opaque pass runs first; then each
+/// row runs its wave pass and its colour mapping, and the wall time of that stage is split
+/// between the two in the proportion of the threads' time in each. The times add up to the
+/// render's.
+pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTimes) {
+    let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+    let mut img = Image::new(frame.width, y1.max(y0) - y0);
+    let times = render_with(frame, rows, &mut OpaqueBuffers::default(), &mut img);
+    (img, times)
+}
+
+/// [`render_timed`] with the opaque pass's buffers from `scratch` and into `img`, both resized
+/// and their allocations reused.
+fn render_with(
+    frame: &Frame,
+    rows: std::ops::Range<u32>,
+    scratch: &mut OpaqueBuffers,
+    img: &mut Image,
+) -> PassTimes {
+    let start = std::time::Instant::now();
+    let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+    let y1 = y1.max(y0);
+    let setup = FrameSetup::new(frame);
+    let oy0 = opaque_pass(frame, &setup, y0 as usize..y1 as usize, scratch);
+    let opaque = &*scratch;
+    let opaque_done = std::time::Instant::now();
+
+    let w = frame.width as usize;
+    let n = w * (y1 - y0) as usize;
+    (img.width, img.height) = (frame.width, y1 - y0);
+    // Every pixel is written below: the resizes only size the buffers.
+    img.color.resize(n, [0.0; 4]);
+    img.energy.resize(n, 0.0);
+    img.depth.resize(n, 0.0);
+    let pass = WavePass::new(frame, &setup.basis, &setup.curves);
+    let first = (y0 as usize - oy0) * w;
+    let surface = &opaque.surface[first..first + img.color.len()];
+    let scene = &opaque.color[first..first + img.color.len()];
+    // Each row: the wave pass into a row buffer, then the colour mapping from it; the threads'
+    // time in each, to split the wall time between them.
+    let wave_ns = std::sync::atomic::AtomicU64::new(0);
+    let color_ns = std::sync::atomic::AtomicU64::new(0);
+    img.color
+        .par_chunks_mut(w)
+        .zip(img.energy.par_chunks_mut(w))
+        .zip(img.depth.par_chunks_mut(w))
+        .zip(surface.par_chunks(w).zip(scene.par_chunks(w)))
+        .enumerate()
+        .for_each_init(Vec::new, |buf, (r, (((col, en), dep), (surf, scene)))| {
+            let t0 = std::time::Instant::now();
+            pass.row_light((y0 as usize + r) as f32, surf, buf);
+            let t1 = std::time::Instant::now();
+            pass.row_color(buf, scene, col, en, dep);
+            let t2 = std::time::Instant::now();
+            let ns = |d: std::time::Duration| d.as_nanos() as u64;
+            wave_ns.fetch_add(ns(t1 - t0), std::sync::atomic::Ordering::Relaxed);
+            color_ns.fetch_add(ns(t2 - t1), std::sync::atomic::Ordering::Relaxed);
+        });
+    let end = std::time::Instant::now();
+    let (wn, cn) = (wave_ns.into_inner() as f64, color_ns.into_inner() as f64);
+    let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };
+    let waves_done = opaque_done + (end - opaque_done).mul_f64(wave_share);
+    let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
+    PassTimes {
+        opaque_ms: ms(start, opaque_done),
+        wave_ms: ms(opaque_done, waves_done),
+        color_ms: ms(waves_done, end),
+    }
+}
+
+/// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which
+/// needs the whole image: then every row is drawn). Returns the buffers and their first row.
+pub(crate) fn opaque_pass(
+    frame: &Frame,
+    setup: &FrameSetup,
+    rows: std::ops::Range<usize>,
+    opaque: &mut OpaqueBuffers,
+) -> usize {
+    let Some(light) = &frame.area_light else {
+        let y0 = rows.start;
+        draw_opaque_into(frame, setup, rows, opaque);
+        return y0;
+    };
+    draw_opaque_into(frame, setup, 0..frame.height as usize, opaque);
+    let input = soft::SoftInput {
+        width: frame.width as usize,
+        height: frame.height as usize,
+        points: std::mem::take(&mut opaque.soft),
+    };
+    let vis = soft::visibility(frame, light, &input, light.resolve);
+    opaque.color.par_iter_mut().zip(&input.points).zip(&vis).for_each(|((c, p), &v)| {
+        if let Some(p) = p {
+            for (ck, tk) in c.iter_mut().zip(p.term) {
+                *ck = hadou_math::energy::saturate(*ck + v * tk);
+            }
+        }
+    });
+    opaque.soft = input.points;
+    opaque.visibility = vis;
+    0
+}
