@@ -8,6 +8,7 @@
 //! `HADOU_FUZZ_CASES=N` sets the number of cases (default 1000), `HADOU_FUZZ_SEED=S` the seed
 //! (printed, so a failure can be replayed; the failing case's own seed and text are reported).
 
+use hadou_math::rng::Rng;
 use hadou_scene::Scene;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
@@ -15,31 +16,6 @@ use std::time::{Duration, Instant};
 
 /// Longest one case (load and three frames) may take.
 const CASE_LIMIT: Duration = Duration::from_secs(5);
-
-/// xorshift64*: small, seedable, no dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        // splitmix64 of the seed, so nearby seeds give unrelated streams (never 0).
-        let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        Rng((z ^ (z >> 31)) | 1)
-    }
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-    fn pick<'a, T>(&mut self, v: &'a [T]) -> &'a T {
-        &v[self.below(v.len())]
-    }
-}
 
 const EXTREMES: &[&str] = &[
     "1e308",
@@ -118,7 +94,7 @@ fn mutate(rng: &mut Rng, text: &[u8], donors: &[Vec<u8>]) -> Vec<u8> {
     match rng.below(10) {
         0 if !t.is_empty() => {
             let i = rng.below(t.len());
-            t[i] = if rng.below(2) == 0 { t[i] ^ (1 << rng.below(8)) } else { rng.next() as u8 };
+            t[i] = if rng.below(2) == 0 { t[i] ^ (1 << rng.below(8)) } else { rng.next_u64() as u8 };
         }
         1 => {
             let mut l = lines(&t);
@@ -317,7 +293,7 @@ fn mutated_scenes_load_or_fail_cleanly_and_render_finite() {
     let (mut loaded, mut failures) = (0usize, Vec::new());
     for case in 0..cases {
         let case_seed = seed ^ case.wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let mut rng = Rng::new(case_seed);
+        let mut rng = Rng(case_seed);
         let (name, base) = rng.pick(&corpus).clone();
         let mut text = base;
         for _ in 0..1 + rng.below(4) {

@@ -143,7 +143,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 6);
+        assert_eq!(modules.len(), 7);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -163,6 +163,7 @@ mod tests {
                 .chain(SOFT_MAP_PARTS)
                 .chain(SOFT_PARTS)
                 .chain(PRESENT_PARTS)
+                .chain(WAVE_OVERLAY_PARTS)
                 .any(|p| std::ptr::eq(*p, *text));
             assert!(used, "{name} is not part of any module");
         }

@@ -65,12 +65,17 @@ mod tests {
                     }
                     (
                         _,
-                        naga::TypeInner::Image {
-                            class: naga::ImageClass::Depth { .. }, arrayed: false, ..
+                        &naga::TypeInner::Image {
+                            class: naga::ImageClass::Sampled { kind, .. },
+                            arrayed,
+                            ..
                         },
-                    ) => Kind::Depth,
-                    (_, naga::TypeInner::Image { arrayed: true, .. }) => Kind::DepthArray,
-                    (_, naga::TypeInner::Image { .. }) => Kind::UintTexture,
+                    ) => match (kind, arrayed) {
+                        (naga::ScalarKind::Uint, false) => Kind::UintTexture,
+                        (naga::ScalarKind::Float, false) => Kind::Depth,
+                        (naga::ScalarKind::Float, true) => Kind::DepthArray,
+                        other => panic!("{pass}: {name}: unexpected texture {other:?}"),
+                    },
                     other => panic!("{pass}: {name}: unexpected {other:?}"),
                 };
                 assert_eq!(b.kind, kind, "{pass}: {name}");

@@ -5,6 +5,7 @@
 //! opaque cast per pixel kept in a [`PLANE_SHADOW_FORMAT`] target that the wave pass reads
 //! (`shadow_lookup.wgsl`), as `hadou-cpu`'s `shadows` does.
 
+use super::setup::Stages;
 use super::setup::{
     self, cleared_color, cleared_depth, color_target, depth_test, triangles, vertex_layout, Binding, Draw,
     Kind, POSITION_ATTRIBUTE,
@@ -59,28 +60,19 @@ impl PlaneShadowPass {
         ctx.scoped("building the plane-shadow pipeline", || {
             let d = &ctx.device;
             let layout = setup::bind_group_layout(d, "plane shadows", &BINDINGS);
-            let pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("plane shadows"),
-                layout: Some(&setup::pipeline_layout(d, "plane shadows", &layout)),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_plane"),
-                    compilation_options: Default::default(),
-                    buffers: &[vertex_layout(&POSITION_ATTRIBUTE)],
-                },
-                // Double-sided, as the CPU draws casters.
-                primitive: triangles(None),
-                depth_stencil: Some(depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less)),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_plane"),
-                    compilation_options: Default::default(),
-                    targets: &[color_target(PLANE_SHADOW_FORMAT)],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+            let buffers = [vertex_layout(&POSITION_ATTRIBUTE)];
+            let targets = [color_target(PLANE_SHADOW_FORMAT)];
+            let stages = Stages {
+                module: &module,
+                vertex: "vs_plane",
+                buffers: &buffers,
+                fragment: Some(("fs_plane", &targets)),
+                constants: &[],
+            };
+            // Double-sided, as the CPU draws casters.
+            let depth = depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less);
+            let pipeline =
+                setup::render_pipeline(d, "plane shadows", &layout, &stages, triangles(None), Some(depth));
             Self { pipeline, layout }
         })
     }

@@ -7,7 +7,7 @@
 //! hardware's encoding is not required to be exact), alpha stored as it is. Rust twin:
 //! `copy_tile` (render.rs) followed by hadou's `output::srgb8`.
 
-use super::setup::{self, color_target, triangles, Binding, Kind};
+use super::setup::{self, color_target, triangles, Binding, Kind, Stages};
 use crate::device::GpuContext;
 use crate::formats::{PRESENT_FORMAT, PRESENT_USAGE};
 use crate::shaders;
@@ -59,27 +59,15 @@ impl PresentPass {
         ctx.scoped("building the present pipeline", || {
             let d = &ctx.device;
             let layout = setup::bind_group_layout(d, "present", &BINDINGS);
-            let pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("present"),
-                layout: Some(&setup::pipeline_layout(d, "present", &layout)),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_present"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: triangles(None),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_present"),
-                    compilation_options: Default::default(),
-                    targets: &[color_target(PRESENT_FORMAT)],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+            let targets = [color_target(PRESENT_FORMAT)];
+            let stages = Stages {
+                module: &module,
+                vertex: "vs_present",
+                buffers: &[],
+                fragment: Some(("fs_present", &targets)),
+                constants: &[],
+            };
+            let pipeline = setup::render_pipeline(d, "present", &layout, &stages, triangles(None), None);
             Self { pipeline, layout }
         })
     }

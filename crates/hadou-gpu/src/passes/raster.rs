@@ -2,6 +2,7 @@
 //! (000 §2.3, `vs_hull`, front faces culled), depth-tested into the G-buffer the later passes read
 //! ([`SCENE_FORMAT`]: normal and eye distance; texture coordinates, vertex colour and material).
 
+use super::setup::Stages;
 use super::setup::{
     self, cleared_color, cleared_depth, color_target, depth_test, triangles, vertex_layout, Binding, Draw,
     Kind, VERTEX_ATTRIBUTES,
@@ -57,30 +58,18 @@ impl RasterPass {
         ctx.scoped("building the raster pipelines", || {
             let d = &ctx.device;
             let layout = setup::bind_group_layout(d, "raster", &BINDINGS);
-            let pipeline_layout = setup::pipeline_layout(d, "raster", &layout);
             let targets = [color_target(SCENE_FORMAT), color_target(SCENE_FORMAT)];
+            let buffers = [vertex_layout(&VERTEX_ATTRIBUTES)];
             let pipeline = |label: &str, vs: &str, cull_mode: Option<wgpu::Face>| {
-                d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&pipeline_layout),
-                    vertex: wgpu::VertexState {
-                        module: &module,
-                        entry_point: Some(vs),
-                        compilation_options: Default::default(),
-                        buffers: &[vertex_layout(&VERTEX_ATTRIBUTES)],
-                    },
-                    primitive: triangles(cull_mode),
-                    depth_stencil: Some(depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less)),
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module,
-                        entry_point: Some("fs_main"),
-                        compilation_options: Default::default(),
-                        targets: &targets,
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+                let stages = Stages {
+                    module: &module,
+                    vertex: vs,
+                    buffers: &buffers,
+                    fragment: Some(("fs_main", &targets)),
+                    constants: &[],
+                };
+                let depth = depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less);
+                setup::render_pipeline(d, label, &layout, &stages, triangles(cull_mode), Some(depth))
             };
             // No culling: open meshes (planes) are visible from both sides, as on the CPU.
             let raster = pipeline("raster", "vs_main", None);

@@ -182,6 +182,52 @@ pub(crate) fn depth_test(
     }
 }
 
+/// The stages of a render pipeline: a vertex entry point reading `buffers`, and, unless it draws
+/// depth only, a fragment entry point writing `targets`.
+pub(crate) struct Stages<'a> {
+    pub(crate) module: &'a wgpu::ShaderModule,
+    pub(crate) vertex: &'a str,
+    pub(crate) buffers: &'a [wgpu::VertexBufferLayout<'a>],
+    pub(crate) fragment: Option<(&'a str, &'a [Option<wgpu::ColorTargetState>])>,
+    /// Pipeline-overridable constants of the fragment stage.
+    pub(crate) constants: &'a [(&'a str, f64)],
+}
+
+/// A render pipeline of `stages` on a pipeline layout of the one bind group layout `group`.
+pub(crate) fn render_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    group: &wgpu::BindGroupLayout,
+    stages: &Stages<'_>,
+    primitive: wgpu::PrimitiveState,
+    depth_stencil: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout(device, label, group)),
+        vertex: wgpu::VertexState {
+            module: stages.module,
+            entry_point: Some(stages.vertex),
+            compilation_options: Default::default(),
+            buffers: stages.buffers,
+        },
+        primitive,
+        depth_stencil,
+        multisample: Default::default(),
+        fragment: stages.fragment.map(|(entry, targets)| wgpu::FragmentState {
+            module: stages.module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: stages.constants,
+                ..Default::default()
+            },
+            targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// One colour target of `format`, no blending.
 pub(crate) fn color_target(format: wgpu::TextureFormat) -> Option<wgpu::ColorTargetState> {
     Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })

@@ -3,6 +3,7 @@
 //! a viewport per map cast), which the wave pass reads (`shadow_lookup.wgsl`). The texture is kept
 //! across frames while its size holds.
 
+use super::setup::Stages;
 use super::setup::{
     self, cleared_depth, depth_test, triangles, vertex_layout, Binding, Draw, Kind, POSITION_ATTRIBUTE,
 };
@@ -104,23 +105,18 @@ impl ShadowMapPass {
         ctx.scoped("building the shadow-map pipeline", || {
             let d = &ctx.device;
             let layout = setup::bind_group_layout(d, "shadow maps", &BINDINGS);
-            let pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("shadow maps"),
-                layout: Some(&setup::pipeline_layout(d, "shadow maps", &layout)),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_map"),
-                    compilation_options: Default::default(),
-                    buffers: &[vertex_layout(&POSITION_ATTRIBUTE)],
-                },
-                // Double-sided, as the CPU draws casters.
-                primitive: triangles(None),
-                depth_stencil: Some(depth_test(MAP_FORMAT, wgpu::CompareFunction::Less)),
-                multisample: Default::default(),
+            let buffers = [vertex_layout(&POSITION_ATTRIBUTE)];
+            let stages = Stages {
+                module: &module,
+                vertex: "vs_map",
+                buffers: &buffers,
                 fragment: None,
-                multiview_mask: None,
-                cache: None,
-            });
+                constants: &[],
+            };
+            // Double-sided, as the CPU draws casters.
+            let depth = depth_test(MAP_FORMAT, wgpu::CompareFunction::Less);
+            let pipeline =
+                setup::render_pipeline(d, "shadow maps", &layout, &stages, triangles(None), Some(depth));
             Self { pipeline, layout }
         })
     }

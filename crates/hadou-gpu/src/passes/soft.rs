@@ -8,6 +8,7 @@
 //! eye-distance slot, so the wave pass needs no binding of its own for it). The renderer's tile
 //! loop (`render.rs`) orders these around the other passes.
 
+use super::setup::Stages;
 use super::setup::{
     self, color_target, depth_test, triangles, vertex_layout, Binding, Draw, Kind, POSITION_ATTRIBUTE,
 };
@@ -232,29 +233,26 @@ impl SoftPass {
             let d = &ctx.device;
             let spot_map_layout = setup::bind_group_layout(d, "soft maps", &MAP_BINDINGS);
             let layout = setup::bind_group_layout(d, "soft", &BINDINGS);
-            let spot_map = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("soft maps"),
-                layout: Some(&setup::pipeline_layout(d, "soft maps", &spot_map_layout)),
-                vertex: wgpu::VertexState {
-                    module: &spot_module,
-                    entry_point: Some("vs_spot"),
-                    compilation_options: Default::default(),
-                    buffers: &[vertex_layout(&POSITION_ATTRIBUTE)],
-                },
-                // Double-sided, as the CPU draws casters.
-                primitive: triangles(None),
-                // Depth near/z: the nearest surface has the greatest.
-                depth_stencil: Some(depth_test(MAP_FORMAT, wgpu::CompareFunction::Greater)),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &spot_module,
-                    entry_point: Some("fs_spot"),
-                    compilation_options: Default::default(),
-                    targets: &[color_target(SPOT_FORMAT)],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+            let buffers = [vertex_layout(&POSITION_ATTRIBUTE)];
+            let targets = [color_target(SPOT_FORMAT)];
+            let stages = Stages {
+                module: &spot_module,
+                vertex: "vs_spot",
+                buffers: &buffers,
+                fragment: Some(("fs_spot", &targets)),
+                constants: &[],
+            };
+            // Double-sided, as the CPU draws casters; depth near/z: the nearest surface has the
+            // greatest.
+            let depth = depth_test(MAP_FORMAT, wgpu::CompareFunction::Greater);
+            let spot_map = setup::render_pipeline(
+                d,
+                "soft maps",
+                &spot_map_layout,
+                &stages,
+                triangles(None),
+                Some(depth),
+            );
             let soft_pl = setup::pipeline_layout(d, "soft", &layout);
             let pipeline = |entry: &str| {
                 d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

@@ -6,7 +6,7 @@
 //! size; specialised per frame like the wave pass ([`WaveVariant`]), a pipeline per variant,
 //! colour format and blend.
 
-use super::setup::{self, triangles, Binding, Kind};
+use super::setup::{self, triangles, Binding, Kind, Stages};
 use super::wave::WaveVariant;
 use crate::device::GpuContext;
 use crate::shaders;
@@ -62,7 +62,6 @@ pub(crate) struct OverlayInputs<'a> {
 /// The overlay's module, bind group layout and pipelines.
 pub(crate) struct WaveOverlayPass {
     module: wgpu::ShaderModule,
-    pipeline_layout: wgpu::PipelineLayout,
     layout: wgpu::BindGroupLayout,
     pipelines: HashMap<(WaveVariant, wgpu::TextureFormat, bool), wgpu::RenderPipeline>,
 }
@@ -74,8 +73,7 @@ impl WaveOverlayPass {
             setup::compile_module(ctx, "wave overlay", &shaders::compose(shaders::WAVE_OVERLAY_PARTS))?;
         ctx.scoped("building the wave overlay's layout", || {
             let layout = setup::bind_group_layout(&ctx.device, "wave overlay", &BINDINGS);
-            let pipeline_layout = setup::pipeline_layout(&ctx.device, "wave overlay", &layout);
-            Self { module, pipeline_layout, layout, pipelines: HashMap::new() }
+            Self { module, layout, pipelines: HashMap::new() }
         })
     }
 
@@ -107,34 +105,16 @@ impl WaveOverlayPass {
             },
         });
         let pipeline = ctx.scoped("building the wave overlay pipeline", || {
-            ctx.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("wave overlay"),
-                layout: Some(&self.pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &self.module,
-                    entry_point: Some("vs_overlay"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: triangles(None),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &self.module,
-                    entry_point: Some("fs_overlay"),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants: &constants,
-                        ..Default::default()
-                    },
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format,
-                        blend,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            let targets =
+                [Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })];
+            let stages = Stages {
+                module: &self.module,
+                vertex: "vs_overlay",
+                buffers: &[],
+                fragment: Some(("fs_overlay", &targets)),
+                constants: &constants,
+            };
+            setup::render_pipeline(&ctx.device, "wave overlay", &self.layout, &stages, triangles(None), None)
         })?;
         self.pipelines.insert(key, pipeline.clone());
         Ok(pipeline)

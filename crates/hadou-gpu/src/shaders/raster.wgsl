@@ -58,7 +58,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
 }
 
 // The outline hull (000 §2.3): the vertex pushed along its world outline normal by d·|z|, which is
-// R' = R + d·|R_z|·U in view space (hadou-cpu raster::project_all). Vertices of materials without
+// R' = R + d·|R_z|·U in view space (hadou-cpu opaque::project_all). Vertices of materials without
 // an outline collapse to one point outside the clip volume, so their triangles are empty.
 @vertex
 fn vs_hull(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {

@@ -93,7 +93,7 @@ fn spot_shadowed(k: u32, p: vec3<f32>, n: vec3<f32>) -> bool {
     return stored < v.z - BIAS_TEXELS * spot_texel(s, v.z);
 }
 
-// Per tile pixel (twin of hadou-cpu's raster soft points and soft::classify): the visible point,
+// Per tile pixel (twin of hadou-cpu's opaque-pass soft points (opaque.rs) and soft::classify): the visible point,
 // its unit normal and its class (hadou_math::soft::Class::of); background and outline hulls are
 // CLASS_NONE.
 @compute @workgroup_size(8, 8, 1)

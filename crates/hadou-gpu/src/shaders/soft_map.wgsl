@@ -1,5 +1,5 @@
 // The `[area_light]`'s two perspective shadow maps, once per frame (twin of hadou-cpu's
-// soft::SpotDepth::render with raster::spot_tris): every object's triangles (not the outline
+// soft::SpotDepth::render with soft::spot_tris): every object's triangles (not the outline
 // hulls), double-sided, seen from one map's light (GpuSpotMap). Clip space (x·c, y·c, near, z) with
 // (x, y, z) = SpotMap::to_view and c = 1/tan_half: the hardware clips at the near plane as
 // spot_tris does, maps texel (x, y) to s ∈ [x/size, (x+1)/size), 1 − t ∈ [y/size, (y+1)/size), and
