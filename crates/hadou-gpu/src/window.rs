@@ -14,7 +14,7 @@ impl Renderer {
     /// See [`crate::GpuBackend::render_to_texture`]. On a device with `TIMESTAMP_QUERY`, a frame
     /// without an `[area_light]` writes timestamps at every pass (the shadow maps, then per tile
     /// its passes and the present pass), resolved and copied into a staging buffer that is mapped
-    /// asynchronously ([`PresentTimer`]): see [`Renderer::last_present_timing`]. Frames with an
+    /// asynchronously ([`crate::timing::PresentTimer`]): see [`Renderer::last_present_timing`]. Frames with an
     /// `[area_light]` are not timed (their whole-image soft-shadow passes run before the tiles,
     /// in the frame's preparation), nor is a frame finding every staging buffer still in flight.
     pub(crate) fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
