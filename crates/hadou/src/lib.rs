@@ -11,10 +11,20 @@
 //! let image = CpuBackend::new().render(&frame).expect("render");
 //! hadou::output::write_png(&image, "kamehameha.png".as_ref()).expect("written");
 //! ```
+//!
+//! Modules: [`output`] writes images (PNG, EXR), [`export`] animations with progress and cancel,
+//! [`bench`](mod@bench) measures the thesis's tables, and `view` is the window of `hadou view`.
+//!
+//! ## Features
+//!
+//! - `view` (on by default): the `view` module and `hadou view`'s window, with what only they
+//!   build: winit, egui, egui-wgpu, egui-winit and `hadou-view`. A program that only renders
+//!   depends on hadou with `default-features = false` and builds none of them.
 
 pub mod bench;
 pub mod export;
 pub mod output;
+#[cfg(feature = "view")]
 pub mod view;
 
 pub use hadou_cpu::{probe, CpuBackend, Probe, WaveProbe};

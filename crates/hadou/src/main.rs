@@ -1,4 +1,6 @@
-//! The `hadou` command-line tool: render, validate, probe, bench.
+//! The `hadou` command-line tool: render, validate, probe, bench, view. `hadou view` opens its
+//! window only when built with the `view` feature (on by default); without it the subcommand is
+//! still listed and exits 2 saying how to get it.
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use hadou::output;
@@ -32,6 +34,7 @@ enum Command {
 }
 
 #[derive(Args, Debug)]
+#[cfg_attr(not(feature = "view"), allow(dead_code))]
 struct ViewArgs {
     /// The scene file (TOML).
     scene: PathBuf,
@@ -254,6 +257,7 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
     }
 }
 
+#[cfg(feature = "view")]
 fn view(a: ViewArgs) -> Result<(), Failure> {
     let time = a.time.as_deref().map(|t| parse_time("--time", t)).transpose()?;
     let opts = hadou::view::ViewOptions {
@@ -268,6 +272,17 @@ fn view(a: ViewArgs) -> Result<(), Failure> {
         stats: a.stats,
     };
     hadou::view::run(opts).map_err(|e| Failure { code: e.code, message: e.message })
+}
+
+/// Without the `view` feature there is no window to open.
+#[cfg(not(feature = "view"))]
+fn view(_: ViewArgs) -> Result<(), Failure> {
+    Err(Failure::input(
+        "hadou view: this hadou was built without its window (the `view` cargo feature, on by \
+         default); build it with the feature, e.g. `cargo build --release -p hadou --features view`. \
+         Without a window, `hadou render SCENE -o out.png` writes the same image and `hadou probe` \
+         reads single pixels",
+    ))
 }
 
 fn size_override(w: Option<u32>, h: Option<u32>) -> Result<(), Failure> {

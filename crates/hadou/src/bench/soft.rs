@@ -1,0 +1,146 @@
+//! The soft-shadow table (003): every resolve's soft-shadow stage on the CPU against the ground
+//! truth of a true disc light, and the whole frame with and without the area light.
+
+use super::table::{Cell, Column, Report, Row, Table};
+use super::timing::{median_ms, Timer};
+use hadou_scene::{AreaLight, Frame, RenderError, Scene};
+use std::path::Path;
+
+/// The scene of the soft-shadow table and the time it is taken at: 003's penumbra close-up (a
+/// pillar on a floor under a lamp-sized light).
+pub const SOFT_SCENE: (&str, f32) = ("soft-gradient.toml", 0.0);
+/// Points of the true disc light in the ground truth (each its own shadow map).
+pub const TRUTH_SAMPLES: u32 = 128;
+/// Largest shadow-map edge of the ground truth's maps (four map texels per image pixel, at least
+/// 256, at most this).
+pub const TRUTH_MAP: u32 = 2048;
+
+/// The ground truth's map edge for an image of `size²`.
+pub fn truth_map(size: u32) -> u32 {
+    (4 * size).clamp(256, TRUTH_MAP)
+}
+
+/// The methods of the soft-shadow table, in order: 003's faithful resolve at N = 1, 3, 5, 10 (with
+/// 003's linear brightness), hadou's exact resolve with 003's linear brightness (`exact-linear`:
+/// faithful N = 1's picture) and with its default segment brightness (`exact`), and PCSS.
+pub const SOFT_METHODS: [&str; 7] =
+    ["faithful-n1", "faithful-n3", "faithful-n5", "faithful-n10", "exact-linear", "exact", "pcss"];
+
+/// One row of the soft-shadow table.
+pub use hadou_cpu::soft::{disc_radius as soft_disc_radius, edge_errors as soft_errors};
+
+/// Measures the soft-shadow table: [`SOFT_SCENE`] at each size, every method's soft-shadow stage
+/// on the CPU against the ground truth ([`hadou_cpu::soft::truth`], a disc of radius
+/// `disc_radius`, by default [`soft_disc_radius`]), then the whole frame by `time` with and
+/// without the area light, all in one run. `progress` hears what is being done.
+///
+/// A row per method and size: the median milliseconds of the soft-shadow stage (its maps, the
+/// classes and the resolve, on the CPU) and the mean and 99th-percentile per-pixel visibility
+/// difference from the ground truth over the shadow-edge pixels; then the rows `frame` (the
+/// whole render with the scene's own resolve, by the bench's backend) and `frame-unlit` (the same
+/// without the area light), without errors. Its JSON `rows` are `{method, size, ms, fps,
+/// mean_error, p99_error}`.
+pub fn soft_table(
+    time: &mut Timer<'_>,
+    scenes: &Path,
+    sizes: &[u32],
+    iterations: u32,
+    backend: &str,
+    disc_radius: Option<f32>,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Report, RenderError> {
+    use hadou_cpu::soft;
+    use hadou_scene::{Penumbra, SoftResolve};
+    let (file, t) = SOFT_SCENE;
+    let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut rows = Vec::new();
+    let mut used_radius = 0.0;
+    for &size in sizes {
+        let mut frame = scene.at(t);
+        frame.width = size;
+        frame.height = size;
+        let light = frame
+            .area_light
+            .clone()
+            .ok_or_else(|| RenderError::Other(format!("{file} has no [area_light]")))?;
+        let radius = disc_radius.or_else(|| soft_disc_radius(&frame)).unwrap_or(light.size);
+        used_radius = radius;
+        progress(&format!("{size}²: visible points"));
+        let input = soft::soft_input(&frame).ok_or_else(|| RenderError::Other("no area light".into()))?;
+        let tm = truth_map(size);
+        progress(&format!("{size}²: ground truth ({TRUTH_SAMPLES} shadow maps of {tm}²)"));
+        let truth = soft::truth(&frame, &light, &input, radius, TRUTH_SAMPLES, tm);
+        let visible: Vec<bool> = input.points.iter().map(Option::is_some).collect();
+        for method in SOFT_METHODS {
+            progress(&format!("{size}²: {method}"));
+            let resolve = match method {
+                "exact" => Some((SoftResolve::Exact, Penumbra::Segment)),
+                "exact-linear" => Some((SoftResolve::Exact, Penumbra::Linear)),
+                "pcss" => None,
+                m => Some((
+                    SoftResolve::Faithful { n: m.trim_start_matches("faithful-n").parse().unwrap_or(1) },
+                    Penumbra::Linear,
+                )),
+            }
+            .map(|(r, penumbra)| (r, AreaLight { penumbra, ..light.clone() }));
+            let mut out = Vec::new();
+            let mut run = |_: &Frame| -> Result<(), RenderError> {
+                out = match &resolve {
+                    Some((r, light)) => soft::visibility(&frame, light, &input, *r),
+                    None => soft::pcss(&frame, &light, &input, radius),
+                };
+                Ok(())
+            };
+            let ms = median_ms(&mut run, &frame, iterations)?;
+            let (mean, p99) = soft_errors(&out, &truth, &visible);
+            rows.push(soft_row(method, method.into(), size, ms, Some(mean), Some(p99)));
+        }
+        progress(&format!("{size}²: whole frames"));
+        let unlit = Frame { area_light: None, ..frame.clone() };
+        for (method, label, f) in [
+            ("frame", format!("frame ({backend})"), &frame),
+            ("frame-unlit", "  no area light".into(), &unlit),
+        ] {
+            rows.push(soft_row(method, label, size, time(f, iterations)?.ms, None, None));
+        }
+    }
+    let title = format!(
+        "soft shadows, scene {file} ({iterations} runs, median; stage = maps + classes + resolve on the CPU; error = |visibility − \
+         truth| on shadow-edge pixels, truth = disc of radius {used_radius:.4} by {TRUTH_SAMPLES} maps of 4 texels a pixel)\n"
+    );
+    let columns = vec![
+        Column::left("method", 14),
+        Column::right("size", 6),
+        Column::right("ms", 10),
+        Column::right("fps", 9),
+        Column::right("mean error", 11),
+        Column::right("p99 error", 10),
+    ];
+    Ok(Report {
+        fields: vec![
+            ("table", "shadows".into()),
+            ("scene", file.into()),
+            ("iterations", iterations.into()),
+            ("disc_radius", used_radius.into()),
+            ("truth_samples", TRUTH_SAMPLES.into()),
+            ("truth_map_texels_per_pixel", 4.into()),
+            ("backend", backend.into()),
+        ],
+        tables: vec![Table { key: Some("rows"), title, columns, rows }],
+    })
+}
+
+/// One row of the soft-shadow table: `method` (shown as `label`) at `size`, its median
+/// milliseconds and its errors (`None` for the `frame` rows).
+fn soft_row(method: &str, label: String, size: u32, ms: f64, mean: Option<f64>, p99: Option<f64>) -> Row {
+    let err = |e: Option<f64>| e.map_or("—".to_string(), |e| format!("{e:.4}"));
+    vec![
+        Cell::json("method", method),
+        Cell::text("method", label),
+        Cell::new("size", size, format!("{size}²")),
+        Cell::new("ms", ms, format!("{ms:.2}")),
+        Cell::new("fps", 1e3 / ms, format!("{:.1}", 1e3 / ms)),
+        Cell::new("mean_error", mean, err(mean)),
+        Cell::new("p99_error", p99, err(p99)),
+    ]
+}

@@ -1,0 +1,88 @@
+//! How `hadou bench` times a frame: the [`Timer`] every table measures with, the CPU backend's
+//! ([`time_cpu`]) and the medians.
+
+use hadou_scene::{Frame, RenderError};
+
+/// What a [`Timer`] measured for one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Median milliseconds per frame: the whole render, without writing the output.
+    pub ms: f64,
+    /// The parts, in order, as (name, median milliseconds): on the CPU the opaque pass, the wave
+    /// pass and the colour mapping (which add up to the whole) and the output (8-bit sRGB and
+    /// PNG encoding into memory, after the render); on the GPU each pass's GPU timestamps where
+    /// the adapter has them, and the output. Empty where nothing finer was measured.
+    pub parts: Vec<(String, f64)>,
+}
+
+impl Timing {
+    /// A timing with no parts.
+    pub fn whole(ms: f64) -> Self {
+        Self { ms, parts: Vec::new() }
+    }
+}
+
+/// A timer: renders `frame` once untimed, then `iterations` timed times, and returns the medians.
+pub type Timer<'a> = dyn FnMut(&Frame, u32) -> Result<Timing, RenderError> + 'a;
+
+/// The median of `v` (0 when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// Times the CPU backend: `iterations` frames after a warm-up, drawn as a real-time loop draws
+/// them (one [`hadou_cpu::CpuBackend`] and one image reused from frame to frame), each split into
+/// its passes ([`hadou_cpu::CpuBackend::render_into`]), then the output of the image (sRGB and
+/// PNG encoding into memory) as many times. Medians of each.
+pub fn time_cpu(frame: &Frame, iterations: u32) -> Result<Timing, RenderError> {
+    let mut cpu = hadou_cpu::CpuBackend::new();
+    let mut image = hadou_scene::Image::new(0, 0);
+    cpu.render_into(frame, &mut image);
+    let (mut whole, mut opaque, mut wave, mut color, mut output) = (vec![], vec![], vec![], vec![], vec![]);
+    for _ in 0..iterations.max(1) {
+        let t = std::time::Instant::now();
+        let p = cpu.render_into(frame, &mut image);
+        whole.push(t.elapsed().as_secs_f64() * 1e3);
+        opaque.push(p.opaque_ms);
+        wave.push(p.wave_ms);
+        color.push(p.color_ms);
+    }
+    for _ in 0..iterations.max(1) {
+        output.push(output_ms(&image)?);
+    }
+    Ok(Timing {
+        ms: median(whole),
+        parts: vec![
+            ("opaque".into(), median(opaque)),
+            ("wave".into(), median(wave)),
+            ("colour".into(), median(color)),
+            ("output".into(), median(output)),
+        ],
+    })
+}
+
+/// Milliseconds to turn `image` into PNG bytes in memory, as `hadou render` does before writing.
+pub fn output_ms(image: &hadou_scene::Image) -> Result<f64, RenderError> {
+    let t = std::time::Instant::now();
+    let bytes = crate::output::encode_png(image).map_err(RenderError::Other)?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    std::hint::black_box(bytes);
+    Ok(ms)
+}
+
+/// Median wall-clock milliseconds of `iterations` calls of `render` after one warm-up.
+pub fn median_ms(
+    render: &mut dyn FnMut(&Frame) -> Result<(), RenderError>,
+    frame: &Frame,
+    iterations: u32,
+) -> Result<f64, RenderError> {
+    render(frame)?;
+    let mut v = Vec::with_capacity(iterations as usize);
+    for _ in 0..iterations.max(1) {
+        let t = std::time::Instant::now();
+        render(frame)?;
+        v.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(median(v))
+}

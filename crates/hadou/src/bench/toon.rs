@@ -1,0 +1,124 @@
+//! The toon table: the toon scene full and reduced to plain diffuse, and the shadow scene with
+//! and without its shadows, at each size in one run.
+
+use super::table::{Cell, Column, Report, Row, Table};
+use super::timing::Timer;
+use hadou_scene::{Frame, RenderError, Scene};
+use std::path::Path;
+
+/// The scene and time `hadou bench toon` renders: a toon character with textures, a feature
+/// texture and outlines, two outlined props and a toon ground, lit by a firing beam.
+pub const TOON_SCENE: (&str, f32) = ("light-from-front.toml", 1.2);
+
+/// The scene and time whose shadows `hadou bench toon` times on and off: sun shadows by shadow map
+/// (2048²) and by plane projection, and a wave shadow by shadow map, over toon materials.
+pub const SHADOW_SCENE: (&str, f32) = ("shadow-uneven.toml", 1.0);
+
+/// `frame` with every material reduced to plain diffuse shading of its base colour.
+pub fn plain_materials(frame: &Frame) -> Frame {
+    let mut f = frame.clone();
+    for o in &mut f.objects {
+        for m in &mut o.materials {
+            *m = hadou_scene::Material::diffuse(m.base_color);
+        }
+    }
+    for w in &mut f.waves {
+        w.light.glow = 0.0;
+    }
+    f
+}
+
+/// Measures the toon table: [`TOON_SCENE`] at each size, `full` (the scene as written) and
+/// `plain` (every material diffuse, no wave light, no outlines, no textures: the opaque pass hadou
+/// had before materials), then [`SHADOW_SCENE`] at each size, `shadows` (as written) and
+/// `no-shadows` (its `[[shadow]]`s removed), in one run. Its text pairs the two variants of each
+/// size with their ratio; its JSON `rows` are `{scene, size, variant, ms, fps}`.
+pub fn toon_table(
+    time: &mut Timer<'_>,
+    scenes: &Path,
+    sizes: &[u32],
+    iterations: u32,
+    backend: &str,
+    method: &str,
+) -> Result<Report, RenderError> {
+    let mut rows = Vec::new();
+    // Times both variants of one size: a JSON row each, and the text's line of the pair.
+    let mut pair = |scene: &'static str, size: u32, variants: [(&'static str, &Frame); 2]| {
+        let mut ms = [0.0; 2];
+        for (i, (variant, f)) in variants.into_iter().enumerate() {
+            ms[i] = time(f, iterations)?.ms;
+            rows.push(vec![
+                Cell::json("scene", scene),
+                Cell::json("size", size),
+                Cell::json("variant", variant),
+                Cell::json("ms", ms[i]),
+                Cell::json("fps", 1e3 / ms[i]),
+            ]);
+        }
+        let [on, off] = ms;
+        Ok::<Row, RenderError>(vec![
+            Cell::text("size", format!("{size}²")),
+            Cell::text("ms", format!("{on:.2}")),
+            Cell::text("fps", format!("{:.1}", 1e3 / on)),
+            Cell::text("ms", format!("{off:.2}")),
+            Cell::text("ratio", format!("{:.2}×", on / off)),
+        ])
+    };
+    let (file, t) = TOON_SCENE;
+    let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut toon = Vec::new();
+    for &size in sizes {
+        let mut frame = scene.at(t);
+        frame.width = size;
+        frame.height = size;
+        let plain = plain_materials(&frame);
+        toon.push(pair(file, size, [("full", &frame), ("plain", &plain)])?);
+    }
+    let (shadow_file, st) = SHADOW_SCENE;
+    let shadow_scene =
+        Scene::load(scenes.join(shadow_file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut shadows = Vec::new();
+    for &size in sizes {
+        let mut frame = shadow_scene.at(st);
+        frame.width = size;
+        frame.height = size;
+        let bare = Frame { shadows: Vec::new(), ..frame.clone() };
+        shadows.push(pair(shadow_file, size, [("shadows", &frame), ("no-shadows", &bare)])?);
+    }
+    let columns = |on: &str, fps: &str, off: &str| {
+        vec![
+            Column::left("size", 8),
+            Column::right(on, 12),
+            Column::right(fps, 10),
+            Column::right(off, 14),
+            Column::right("ratio", 10),
+        ]
+    };
+    let mut tables = vec![
+        Table { key: Some("rows"), rows, ..Table::default() },
+        Table {
+            key: None,
+            title: format!("toon scene {file} — backend {backend}, {method} ({iterations} runs, median)\n"),
+            columns: columns("full ms", "full fps", "plain ms"),
+            rows: toon,
+        },
+    ];
+    if !shadows.is_empty() {
+        tables.push(Table {
+            key: None,
+            title: format!("\nshadow scene {shadow_file}\n"),
+            columns: columns("shadows ms", "fps", "no-shadows ms"),
+            rows: shadows,
+        });
+    }
+    Ok(Report {
+        fields: vec![
+            ("table", "toon".into()),
+            ("scene", file.into()),
+            ("backend", backend.into()),
+            ("method", method.into()),
+            ("iterations", iterations.into()),
+        ],
+        tables,
+    })
+}
