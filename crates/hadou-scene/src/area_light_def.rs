@@ -5,6 +5,7 @@
 use crate::area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID};
 use crate::bounds::{box_corners, object_bounds, object_center};
 use crate::frame::Object;
+use crate::limits::fmt_f32;
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::shadow::MAX_MAP_SIZE;
 use crate::toml_read::{type_name, Fallback, ParamReader, Res, Table};
@@ -190,8 +191,10 @@ pub(crate) fn check_area_light(
         return Err((
             "size",
             format!(
-                "`size` ({size}) must be less than the distance from `position` to `target` ({d}): the nearer map L − l·P \
-                 would sit at or beyond the point of interest"
+                "`size` ({}) must be less than the distance from `position` to `target` ({}): the nearer map L − l·P \
+                 would sit at or beyond the point of interest",
+                fmt_f32(size),
+                fmt_f32(d)
             ),
         ));
     }

@@ -123,8 +123,9 @@ impl SceneDir {
         if let Some(r) = &self.root {
             return Ok(r.clone());
         }
-        let r = std::fs::canonicalize(&self.path)
-            .map_err(|e| format!("cannot resolve the scene file's directory {}: {e}", self.path.display()))?;
+        let r = std::fs::canonicalize(&self.path).map_err(|e| {
+            format!("cannot resolve the scene file's directory {}: {e}", crate::error::show_path(&self.path))
+        })?;
         self.root = Some(r.clone());
         Ok(r)
     }

@@ -19,8 +19,8 @@
 //! instantiates are counted against the scene's budget before any data is copied. Every accessor
 //! is bounds-checked before it is read, and every joint index against its skin. External buffer
 //! and image files must lie inside the asset root (`gltf_uri`), every byte read counts against
-//! [`GLTF_MAX_BYTES`] and decoded texels against
-//! [`crate::gltf_material::TEXEL_BUDGET_BYTES`]. Calls into the gltf crate and the image decoders
+//! [`GLTF_MAX_BYTES`] and decoded texels against what is left of the scene's
+//! [`MAX_SCENE_TEXELS`]. Calls into the gltf crate and the image decoders
 //! run under [`guarded`], so even an unforeseen panic there is an error, never a crash.
 
 use crate::files::{parent_dir, read_regular_file, GLTF_MAX_BYTES};
@@ -28,8 +28,9 @@ use crate::frame::Mesh;
 use crate::gltf_material::{load_materials, ImageSource, Materials, SUPPORTED_EXTENSIONS};
 use crate::gltf_uri::resolve_uri;
 use crate::guard::guarded;
-use crate::limits::{fmt_f32, COORD_MAX, MAX_TRIANGLES, MAX_VERTICES};
+use crate::limits::{fmt_f32, COORD_MAX, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES};
 use crate::mesh::{append_mesh, smooth_normals, transform_mesh};
+use crate::texture::MAX_SCENE_TEXELS;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::buffer::Source;
 use gltf::json;
@@ -40,18 +41,22 @@ use std::path::Path;
 /// Deepest node hierarchy followed (the recursion that bakes the transforms stays shallow).
 const MAX_DEPTH: usize = 64;
 
-/// Triangles and vertices still allowed in the scene being loaded (every instance counted).
+/// Triangles, vertices and texture texels still allowed in the scene being loaded (every
+/// instance counted; each decoded image once).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Budget {
     /// Triangles left.
     pub triangles: u64,
     /// glTF vertices left.
     pub vertices: u64,
+    /// Texels left of [`MAX_SCENE_TEXELS`].
+    pub texels: u64,
 }
 
 impl Budget {
     /// The whole budget of one scene.
-    pub(crate) const FULL: Budget = Budget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES };
+    pub(crate) const FULL: Budget =
+        Budget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES, texels: MAX_SCENE_TEXELS };
 }
 
 /// Loads the glTF/GLB file at `path` into one mesh in the file's scene space. External buffers
@@ -179,6 +184,7 @@ fn from_bytes_in(
         None => (0..doc.nodes.len()).filter(|&n| parent[n].is_none()).collect(),
     };
     let need = count_instances(doc, &roots)?;
+    let used_skins = skins_used(doc, &roots);
     if need.triangles > budget.triangles {
         return Err(format!(
             "its default scene has {} triangles (every node instance counted), more than the {} left of \
@@ -217,10 +223,22 @@ fn from_bytes_in(
     }
 
     let src = ImageSource { buffers: &buffers, dir, root };
-    let materials = guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, warnings))??;
+    let texels = &mut budget.texels;
+    let materials =
+        guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, texels, warnings))??;
     let out = guarded("glTF", || -> Result<Mesh, String> {
         let nodes: Vec<gltf::Node<'_>> = gltf.nodes().collect();
-        let ctx = Ctx { buffers: &buffers, materials: &materials, worlds: world_matrices(&nodes, &parent) };
+        let worlds = world_matrices(&nodes, &parent);
+        // Each skin's `J_k · IBM_k` once, for every skin a node of the default scene uses.
+        let mut skins: Vec<Option<Vec<Mat4>>> = vec![None; doc.skins.len()];
+        for skin in gltf.skins() {
+            if used_skins[skin.index()] {
+                let m = skin_matrices(&skin, &buffers, &worlds)
+                    .map_err(|e| format!("skin {}: {e}", skin.index()))?;
+                skins[skin.index()] = Some(m);
+            }
+        }
+        let ctx = Ctx { buffers: &buffers, materials: &materials, skins };
         let mut out = Mesh::default();
         for &r in &roots {
             add_node(&nodes[r], Mat4::IDENTITY, &ctx, &mut out, 0, warnings)?;
@@ -395,16 +413,38 @@ fn check_forest(r: &json::Root) -> Result<Vec<Option<usize>>, String> {
     Ok(parent)
 }
 
-/// Triangles and vertices the nodes under `roots` instantiate, from the JSON alone.
+/// Triangles and vertices the nodes under `roots` instantiate, from the JSON alone; errors where
+/// the skinned nodes or their skins' joints exceed [`MAX_SKINNED_NODES`] or [`MAX_SKIN_JOINTS`].
 fn count_instances(r: &json::Root, roots: &[usize]) -> Result<Budget, String> {
     let count = |a: json::Index<json::Accessor>| r.accessors[a.value()].count.0;
-    let mut total = Budget { triangles: 0, vertices: 0 };
+    let mut total = Budget { triangles: 0, vertices: 0, texels: 0 };
+    let (mut skinned, mut joints) = (0u64, 0u64);
+    let mut skin_seen = vec![false; r.skins.len()];
     let mut stack: Vec<(usize, usize)> = roots.iter().map(|&n| (n, 0)).collect();
     while let Some((i, depth)) = stack.pop() {
         if depth > MAX_DEPTH {
             return Err(format!("node hierarchy deeper than {MAX_DEPTH} levels at node {i}"));
         }
         let node = &r.nodes[i];
+        if let (Some(_), Some(s)) = (node.mesh, node.skin) {
+            skinned += 1;
+            if skinned > MAX_SKINNED_NODES {
+                return Err(format!(
+                    "its default scene has more than the limit of {MAX_SKINNED_NODES} skinned mesh nodes \
+                     (node {i} is one too many)"
+                ));
+            }
+            let s = s.value();
+            if !std::mem::replace(&mut skin_seen[s], true) {
+                joints += r.skins[s].joints.len() as u64;
+                if joints > MAX_SKIN_JOINTS {
+                    return Err(format!(
+                        "skin {s} brings the joints of the skins its default scene uses to {joints}, more than \
+                         the limit of {MAX_SKIN_JOINTS} joints per glTF file"
+                    ));
+                }
+            }
+        }
         if let Some(m) = node.mesh {
             for p in &r.meshes[m.value()].primitives {
                 let pos =
@@ -420,12 +460,27 @@ fn count_instances(r: &json::Root, roots: &[usize]) -> Result<Budget, String> {
     Ok(total)
 }
 
+/// Which skins the nodes under `roots` use (the graph is a forest and at most [`MAX_DEPTH`]
+/// deep: `count_instances` checked both).
+fn skins_used(r: &json::Root, roots: &[usize]) -> Vec<bool> {
+    let mut used = vec![false; r.skins.len()];
+    let mut stack: Vec<usize> = roots.to_vec();
+    while let Some(i) = stack.pop() {
+        let node = &r.nodes[i];
+        if let (Some(_), Some(s)) = (node.mesh, node.skin) {
+            used[s.value()] = true;
+        }
+        stack.extend(node.children.iter().flatten().map(|c| c.value()));
+    }
+    used
+}
+
 /// What every node of a load needs.
 struct Ctx<'a> {
     buffers: &'a [Vec<u8>],
     materials: &'a Materials,
-    /// Every node's world matrix (`None`: non-finite), for skin joints.
-    worlds: Vec<Option<Mat4>>,
+    /// Per skin, `J_k · IBM_k` for every joint `k` (computed once, for the skins in use).
+    skins: Vec<Option<Vec<Mat4>>>,
 }
 
 /// Every node's world matrix from the node hierarchy (the graph is a forest), without recursion.
@@ -461,7 +516,12 @@ fn add_node(
     let world = parent * local;
     if let Some(mesh) = node.mesh() {
         let skin = match node.skin() {
-            Some(skin) => Some(skin_matrices(&skin, ctx).map_err(|e| format!("skin {}: {e}", skin.index()))?),
+            Some(skin) => Some(
+                ctx.skins
+                    .get(skin.index())
+                    .and_then(Option::as_deref)
+                    .ok_or_else(|| format!("skin {} was not prepared", skin.index()))?,
+            ),
             None => None,
         };
         for prim in mesh.primitives() {
@@ -499,15 +559,20 @@ fn add_node(
     Ok(())
 }
 
-/// `J_k · IBM_k` for every joint `k` of `skin`.
-fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, String> {
+/// `J_k · IBM_k` for every joint `k` of `skin` (`worlds`: every node's world matrix, `None` where
+/// it is not finite).
+fn skin_matrices(
+    skin: &gltf::Skin<'_>,
+    buffers: &[Vec<u8>],
+    worlds: &[Option<Mat4>],
+) -> Result<Vec<Mat4>, String> {
     let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
     if joints.is_empty() {
         return Err("it has no joints".into());
     }
     let ibms: Vec<Mat4> = match skin.inverse_bind_matrices() {
         Some(acc) => {
-            check_accessor(&acc, &[Dimensions::Mat4], &[DataType::F32], ctx.buffers)
+            check_accessor(&acc, &[Dimensions::Mat4], &[DataType::F32], buffers)
                 .map_err(|e| format!("inverseBindMatrices: {e}"))?;
             if acc.count() != joints.len() {
                 return Err(format!(
@@ -516,7 +581,7 @@ fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, Stri
                     joints.len()
                 ));
             }
-            let get = |b: gltf::Buffer<'_>| ctx.buffers.get(b.index()).map(|d| d.as_slice());
+            let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(|d| d.as_slice());
             let m: Vec<Mat4> = skin
                 .reader(get)
                 .read_inverse_bind_matrices()
@@ -534,7 +599,7 @@ fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, Stri
         .iter()
         .zip(ibms)
         .map(|(&j, ibm)| {
-            let w = ctx.worlds[j].ok_or_else(|| format!("joint node {j} has a non-finite transform"))?;
+            let w = worlds[j].ok_or_else(|| format!("joint node {j} has a non-finite transform"))?;
             Ok(w * ibm)
         })
         .collect()
@@ -560,7 +625,15 @@ fn skin_mesh(
         if w.iter().any(|x| !x.is_finite() || *x < 0.0) {
             return Err(format!("vertex {v} has a negative or non-finite weight in WEIGHTS_0"));
         }
-        let sum: f32 = w.iter().sum();
+        // Normalised to sum 1; a sum that overflows (finite weights near f32::MAX) is taken
+        // relative to the largest weight instead, which cannot overflow.
+        let mut sum: f32 = w.iter().sum();
+        let mut w = *w;
+        if sum.is_infinite() {
+            let max = w.iter().fold(0.0f32, |a, &b| a.max(b));
+            w = w.map(|x| x / max);
+            sum = w.iter().sum();
+        }
         let m = if sum > 0.0 {
             let mut m = Mat4 { cols: [[0.0; 4]; 4] };
             for k in 0..4 {

@@ -49,6 +49,13 @@ pub(crate) const MAX_WAVES: usize = 256;
 pub const MAX_TRIANGLES: u64 = 20_000_000;
 /// Most vertices of all glTF primitives of one scene together, every instance counted.
 pub const MAX_VERTICES: u64 = 60_000_000;
+/// Most joints of all the skins one glTF file's default scene uses, each skin counted once (so
+/// also the most joints of one skin; `JOINTS_0` indices are 16-bit, so no skin can address more).
+/// Each skin's joint matrices are computed once, whatever the number of nodes using it.
+pub const MAX_SKIN_JOINTS: u64 = 65_536;
+/// Most skinned mesh nodes (nodes with both a mesh and a skin) one glTF file's default scene
+/// instantiates.
+pub const MAX_SKINNED_NODES: u64 = 16_384;
 
 /// A number for a message: shortest round-trip digits, in scientific notation where that is
 /// clearly shorter (`3e38` rather than 39 digits, `1e5` rather than `100000`).

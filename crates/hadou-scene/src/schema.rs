@@ -11,13 +11,13 @@
 
 use crate::area_light::SOFT_MAX_PIXELS;
 use crate::area_light_def::{check_area_light, parse_area_light};
-use crate::error::{Location, SceneError};
+use crate::error::{show_path, Location, SceneError};
 use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
 use crate::frame::{Mesh, ToneMode};
 use crate::gltf_load::Budget;
 use crate::limits::{
-    fmt_f32, fmt_f64, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_TRIANGLES, MAX_VERTICES,
-    MAX_WAVES, NEAR_MIN, SCALE_MIN,
+    fmt_f32, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_TRIANGLES, MAX_VERTICES, MAX_WAVES,
+    NEAR_MIN, SCALE_MIN,
 };
 use crate::materials::{
     parse_material, parse_object_materials, parse_ramp, MaterialDef, TextureCache, OBJECT_MATERIAL_KEYS,
@@ -196,6 +196,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         let mut cache = TextureCache {
             dir: SceneDir::new(assets.dir.path.clone()),
             images: HashMap::new(),
+            texels_left: &mut assets.budget.texels,
             warnings: &mut warnings,
         };
         for (i, (t, span)) in material_tables.into_iter().enumerate() {
@@ -448,8 +449,8 @@ fn parse_object(
                     format!(
                         "it resolves to {}, outside the scene file's directory {}; glTF files must \
                              lie inside the scene file's directory",
-                        real.display(),
-                        root.display()
+                        show_path(&real),
+                        show_path(&root)
                     ),
                     file,
                 ));
@@ -475,7 +476,7 @@ fn parse_object(
                     let mut notes = Vec::new();
                     let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut notes)
                         .map_err(|message| gltf_err(message, file.clone()))?;
-                    warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", file.display())));
+                    warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", show_path(&file))));
                     let mesh = Arc::new(with_outline_normals(mesh));
                     assets.cache.insert(real, mesh.clone());
                     mesh
@@ -751,7 +752,7 @@ fn check_camera(c: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)
             format!(
                 "`target` is only {} from `position`; keep them at least 1e-6 apart so the view \
                  direction is defined",
-                fmt_f64(dist)
+                fmt_f32(dist as f32)
             ),
         ));
     }
