@@ -209,25 +209,48 @@ pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-/// The candidate nearest to `word` if it is close enough to be a plausible typo.
+/// Longest word a "did you mean" looks for (a typo of a longer name is not worth the work).
+const SUGGEST_MAX_WORD: usize = 64;
+/// Most candidates a "did you mean" compares, in order (a scene may name 65 536 objects).
+const SUGGEST_MAX_CANDIDATES: usize = 4096;
+/// Most candidates a hint lists when none is close.
+const HINT_MAX_LISTED: usize = 16;
+
+/// The candidate nearest to `word` if it is close enough to be a plausible typo. The work is
+/// bounded whatever the file holds: words over [`SUGGEST_MAX_WORD`] characters get no
+/// suggestion, candidates whose length alone rules them out are skipped, and at most
+/// [`SUGGEST_MAX_CANDIDATES`] are compared.
 pub(crate) fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let limit = (word.chars().count() / 3).max(2);
+    let n = word.chars().count();
+    if n > SUGGEST_MAX_WORD {
+        return None;
+    }
+    let limit = (n / 3).max(2);
     candidates
         .into_iter()
+        .take(SUGGEST_MAX_CANDIDATES)
+        .filter(|c| c.len() <= 4 * (n + limit) && c.chars().count().abs_diff(n) <= limit)
         .map(|c| (edit_distance(word, c), c))
         .filter(|&(d, _)| d <= limit)
         .min_by_key(|&(d, _)| d)
         .map(|(_, c)| c)
 }
 
-/// `"; did you mean `x`?"` or, without a close match, `"; valid keys: a, b, c"`.
+/// `"; did you mean `x`?"` or, without a close match, `"; valid keys: a, b, c"` (at most
+/// [`HINT_MAX_LISTED`] of them, then how many there are).
 pub(crate) fn hint(word: &str, candidates: &[&str], noun: &str) -> String {
     match suggest(word, candidates.iter().copied()) {
         Some(s) => format!("; did you mean `{s}`?"),
         None if candidates.is_empty() => String::new(),
         None => {
-            let list: Vec<String> = candidates.iter().map(|c| format!("`{c}`")).collect();
-            format!("; valid {noun}: {}", list.join(", "))
+            let list: Vec<String> =
+                candidates.iter().take(HINT_MAX_LISTED).map(|c| format!("`{c}`")).collect();
+            let more = if candidates.len() > HINT_MAX_LISTED {
+                format!(", … ({} in all)", candidates.len())
+            } else {
+                String::new()
+            };
+            format!("; valid {noun}: {}{more}", list.join(", "))
         }
     }
 }

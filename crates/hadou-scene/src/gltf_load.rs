@@ -28,7 +28,9 @@ use crate::frame::Mesh;
 use crate::gltf_material::{load_materials, ImageSource, Materials, SUPPORTED_EXTENSIONS};
 use crate::gltf_uri::resolve_uri;
 use crate::guard::guarded;
-use crate::limits::{fmt_f32, COORD_MAX, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES};
+use crate::limits::{
+    fmt_f32, COORD_MAX, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
+};
 use crate::mesh::{append_mesh, smooth_normals, transform_mesh};
 use crate::texture::MAX_SCENE_TEXELS;
 use gltf::accessor::{DataType, Dimensions};
@@ -141,6 +143,13 @@ fn from_bytes_in(
             ));
         }
     }
+    if doc.materials.len() as u64 >= MAX_MATERIAL_SLOTS {
+        return Err(format!(
+            "it has {} materials; with its default material that is more than the limit of \
+             {MAX_MATERIAL_SLOTS} material slots per scene",
+            doc.materials.len()
+        ));
+    }
     let raw = raw_json(body)?;
     check_indices(doc)?;
     crate::gltf_material::check_raw(&raw, doc.textures.len())?;
@@ -168,14 +177,15 @@ fn from_bytes_in(
     let roots: Vec<usize> = match scene {
         Some(s) => {
             let roots: Vec<usize> = doc.scenes[s].nodes.iter().map(|n| n.value()).collect();
-            for (i, &r) in roots.iter().enumerate() {
+            let mut listed = vec![false; doc.nodes.len()];
+            for &r in &roots {
                 if let Some(p) = parent[r] {
                     return Err(format!(
                         "scene {s} lists node {r} as a root, but node {p} has it as a child (node graphs \
                          must be trees)"
                     ));
                 }
-                if roots[..i].contains(&r) {
+                if std::mem::replace(&mut listed[r], true) {
                     return Err(format!("scene {s} lists node {r} twice (node graphs must be trees)"));
                 }
             }

@@ -47,6 +47,14 @@ pub(crate) const DIR_MIN: f64 = 1e-6;
 pub(crate) const MAX_WAVES: usize = 256;
 /// Most triangles of all objects of one scene together, every glTF instance counted.
 pub const MAX_TRIANGLES: u64 = 20_000_000;
+/// Most material slots of all objects of one scene together (an object has one slot per material
+/// of its mesh, at least one; so also the most objects). Both backends keep a material record per
+/// slot of every object, and `Scene::at` builds each slot's material per frame.
+pub const MAX_MATERIAL_SLOTS: u64 = 65_536;
+/// Most checks of the rules between keys: for each part of a scene with such rules (the camera,
+/// the light, the area light with its target object, each shadow, each wave), its distinct key
+/// times times the numbers it holds, summed over the parts (2²⁶, well under a second of work).
+pub const MAX_KEY_CHECKS: u64 = 1 << 26;
 /// Most vertices of all glTF primitives of one scene together, every instance counted.
 pub const MAX_VERTICES: u64 = 60_000_000;
 /// Most joints of all the skins one glTF file's default scene uses, each skin counted once (so

@@ -327,10 +327,12 @@ pub(crate) fn parse_material(
 /// Reads an object's material keys: `material = "name"` (every slot), or
 /// `materials = { "<mesh material>" = "<scene material>", … }`, plus the object-wide overrides
 /// (read into `params` only when given).
+/// `by_name` maps each `[[material]]` name to its index in `scene_materials`.
 pub(crate) fn parse_object_materials(
     t: &Table<'_, '_>,
     mesh: &Mesh,
     scene_materials: &[MaterialDef],
+    by_name: &HashMap<&str, usize>,
     params: &mut ParamSet,
     rd: &mut ParamReader<'_>,
     warnings: &mut Vec<String>,
@@ -338,7 +340,7 @@ pub(crate) fn parse_object_materials(
     let n_slots = mesh.materials.len().max(1);
     let mut slots: Vec<SlotSource> = (0..n_slots).map(SlotSource::Mesh).collect();
     let find = |name: &str, span: &crate::toml_read::Span| -> Res<usize> {
-        scene_materials.iter().position(|m| m.name == name).ok_or_else(|| {
+        by_name.get(name).copied().ok_or_else(|| {
             let names: Vec<&str> = scene_materials.iter().map(|m| m.name.as_str()).collect();
             t.src.value_err(
                 span,
@@ -367,6 +369,11 @@ pub(crate) fn parse_object_materials(
                 ),
             ));
         };
+        // The mesh's materials by name (the first of equal names), built once per object.
+        let mut mesh_slots: HashMap<&str, usize> = HashMap::with_capacity(mesh.materials.len());
+        for (i, m) in mesh.materials.iter().enumerate() {
+            mesh_slots.entry(m.name.as_str()).or_insert(i);
+        }
         for (k, val) in map.iter() {
             let key = k.get_ref().as_ref();
             let DeValue::String(target) = val.get_ref() else {
@@ -375,16 +382,12 @@ pub(crate) fn parse_object_materials(
                     format!("`materials.{key}` in {} must be the name of a [[material]]", t.what),
                 ));
             };
-            let names: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect();
-            let Some(slot) = mesh.materials.iter().position(|m| m.name == key) else {
+            let Some(&slot) = mesh_slots.get(key) else {
+                let names: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect();
                 let have = if names.is_empty() {
                     " (the mesh has no named materials; use `material = \"…\"`)".to_string()
                 } else {
-                    format!(
-                        "{}; its materials are {}",
-                        crate::error::hint(key, &names, "names"),
-                        names.join(", ")
-                    )
+                    crate::error::hint(key, &names, "materials of the mesh")
                 };
                 return Err(t.src.value_err(
                     &k.span(),

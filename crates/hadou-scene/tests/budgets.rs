@@ -325,3 +325,183 @@ fn control_bytes_in_paths_are_escaped_in_messages() {
     assert!(!msg.contains('\0') && !msg.contains('\n') && !msg.contains('\u{1b}'), "{msg:?}");
     std::fs::remove_dir_all(&d).ok();
 }
+
+// ---------------------------------------------------------------------------------------------
+// Loops over counts from the file: each bounded by a documented limit, or linear.
+
+/// `n` boxes named `o0`, `o1`, … (a few bytes of TOML each).
+fn boxes(n: usize) -> String {
+    (0..n).map(|i| format!("[[object]]\nname = \"o{i}\"\nkind = \"box\"\n")).collect()
+}
+
+fn names(range: std::ops::Range<usize>) -> String {
+    range.map(|i| format!("\"o{i}\"")).collect::<Vec<_>>().join(", ")
+}
+
+#[test]
+fn material_slots_of_all_objects_are_bounded() {
+    let n = hadou_scene::MAX_MATERIAL_SLOTS as usize;
+    let s = Scene::parse(&boxes(n), Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.object_names().len(), n);
+    let e = err(&boxes(n + 1));
+    assert_eq!(at(&e), (3 * n + 3, 1), "{e}");
+    assert!(
+        e.to_string()
+            .contains(&format!("[[object]] \"o{n}\" brings the scene past the limit of {n} material slots")),
+        "{e}"
+    );
+    // A glTF file with more materials than a scene can hold is refused before they are read.
+    let mut b = Builder::default();
+    let pos = b.positions(&TRI);
+    let doc = json!({"scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+                     "meshes": [{"primitives": [{"attributes": {"POSITION": pos}}]}],
+                     "materials": vec![json!({}); n]});
+    let e = gltf_from_bytes(&b.finish(doc), Path::new(".")).unwrap_err();
+    assert!(
+        e.contains(&format!("it has {n} materials")) && e.contains(&format!("limit of {n} material slots")),
+        "{e}"
+    );
+}
+
+#[test]
+fn shadow_casters_are_bounded() {
+    let n = hadou_scene::MAX_SHADOW_CASTERS;
+    let sun = |k: usize, range: std::ops::Range<usize>| {
+        format!(
+            "[[shadow]]\nname = \"s{k}\"\nkind = \"sun\"\nmethod = \"plane\"\nplane_point = [0, 0, 0]\n\
+             plane_normal = [0, 1, 0]\ncasters = [{}]\nreceivers = [\"o0\"]\n",
+            names(range)
+        )
+    };
+    let ok = format!("{}{}{}", boxes(n + 1), sun(0, 1..n / 2 + 1), sun(1, n / 2 + 1..n + 1));
+    Scene::parse(&ok, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let e = err(&format!("{}{}{}", boxes(n + 1), sun(0, 1..n / 2 + 1), sun(1, n / 2..n + 1)));
+    let msg = e.to_string();
+    assert!(
+        msg.contains(&format!("casters of all shadows to {}", n + 1))
+            && msg.contains(&format!("at most {n} casters")),
+        "{msg}"
+    );
+    // The triangles the shadows cast: a dense sphere cast by many shadows.
+    let sphere = "[[object]]\nname = \"ball\"\nkind = \"sphere\"\nsegments = 1024\n";
+    let per = 2 * 1024 * 511u64;
+    let k = (hadou_scene::MAX_SHADOW_TRIANGLES / per + 1) as usize;
+    let shadows: String = (0..k)
+        .map(|i| {
+            format!(
+                "[[shadow]]\nname = \"s{i}\"\nkind = \"sun\"\nplane_point = [0, 0, 0]\nplane_normal = [0, 1, 0]\n\
+                 casters = \"ball\"\nreceivers = \"o0\"\n"
+            )
+        })
+        .collect();
+    if k <= hadou_scene::MAX_SHADOWS {
+        let msg = err(&format!("{}{sphere}{shadows}", boxes(1))).to_string();
+        assert!(msg.contains(&format!("triangles they cast to {}", k as u64 * per)), "{msg}");
+    }
+}
+
+#[test]
+fn shadow_lists_and_track_targets_resolve_by_name_in_linear_time() {
+    // 60 000 objects, one shadow receiving on all of them and 60 000 tracks: a scan per name
+    // would compare 3.6·10⁹ names.
+    let n = 60_000;
+    let mut text = boxes(n);
+    text.push_str(&format!(
+        "[[shadow]]\nname = \"s\"\nkind = \"sun\"\nmethod = \"map\"\ncasters = [\"o1\"]\nreceivers = [{}]\n",
+        (0..n).rev().map(|i| format!("\"o{i}\"")).collect::<Vec<_>>().join(", ")
+    ));
+    for i in 0..n {
+        text.push_str(&format!(
+            "[[track]]\ntarget = \"object.o{i}.position\"\nkeys = [[0, [0, 0, 0]], [1, [0, {i}, 0]]]\n"
+        ));
+    }
+    let start = std::time::Instant::now();
+    let s = Scene::parse(&text, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let f = s.at(0.5);
+    assert!(f.shadows[0].receives(0) && f.shadows[0].receives(n as u32 - 1));
+    assert!(f.shadows[0].receivers.windows(2).all(|w| w[0] < w[1]));
+    assert!(start.elapsed() < std::time::Duration::from_secs(30), "{:?}", start.elapsed());
+}
+
+#[test]
+fn key_time_checks_are_bounded() {
+    // A 4096-point B-spline animated at 9000 key times would validate its 8200 numbers 9000 times.
+    let pts: Vec<String> = (0..4096).map(|i| format!("[{i}, 0]")).collect();
+    let wave = format!(
+        "[[wave]]\nname = \"w\"\nkind = \"bspline\"\nO = [0, 0, 0]\nD = [1, 0, 0]\nalpha = 1\npoints = [{}]\n",
+        pts.join(", ")
+    );
+    let keys = |n: usize| (0..n).map(|i| format!("[{i}, {}]", i % 7)).collect::<Vec<_>>().join(", ");
+    let text = format!("{wave}[[track]]\ntarget = \"wave.w.points[3][1]\"\nkeys = [{}]\n", keys(9000));
+    let e = err(&text);
+    assert!(matches!(e, SceneError::Track { .. }), "{e:?}");
+    assert!(
+        e.to_string().contains(&format!("limit of {} (key times × numbers)", hadou_scene::MAX_KEY_CHECKS)),
+        "{e}"
+    );
+    // The same curve at 1000 key times, and 100 000 camera keys, are checked.
+    let text = format!("{wave}[[track]]\ntarget = \"wave.w.points[3][1]\"\nkeys = [{}]\n", keys(1000));
+    Scene::parse(&text, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let cam = (0..100_000).map(|i| format!("[{i}, {}]", 30 + i % 20)).collect::<Vec<_>>().join(", ");
+    Scene::parse(&format!("[[track]]\ntarget = \"camera.fov\"\nkeys = [{cam}]\n"), Path::new("x.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    // Tracks no rule reads (objects, materials) cost no checks however many keys they have.
+    let keys: String =
+        (0..200_000).map(|i| format!("[{i}, [0, {}, 0]]", i % 5)).collect::<Vec<_>>().join(", ");
+    let text = format!("{}[[track]]\ntarget = \"object.o0.position\"\nkeys = [{keys}]\n", boxes(2000));
+    Scene::parse(&text, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn area_light_rules_follow_its_target_object_keys() {
+    // The light's target object moves onto the light at t = 2: an error at that key.
+    let text = format!(
+        "{}[area_light]\nposition = [0, 5, 0]\nsize = 0.5\ntarget = \"o1\"\n\
+         [[track]]\ntarget = \"object.o1.position\"\nkeys = [[0, [0, 0, 0]], [2, [0, 4.8, 0]]]\n",
+        boxes(2)
+    );
+    let e = err(&text);
+    assert_eq!(at(&e), (13, 25), "{e}");
+    assert!(
+        e.to_string().contains("at t = 2 s (this key of `object.o1.position`)")
+            && e.to_string().contains("`size` (0.5)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn did_you_mean_hints_are_bounded() {
+    // A long unknown name among 60 000 objects: no suggestion work over the whole list, and at
+    // most 16 names listed.
+    let n = 60_000;
+    let long = "q".repeat(100_000);
+    let text = format!(
+        "{}[[shadow]]\nname = \"s\"\nkind = \"sun\"\nmethod = \"map\"\ncasters = [\"{long}\"]\nreceivers = [\"o0\"]\n",
+        boxes(n)
+    );
+    let msg = err(&text).to_string();
+    assert!(msg.contains(&format!(", … ({n} in all)")), "{}", &msg[msg.len() - 300..]);
+    assert!(msg.len() < long.len() + 2000, "{}", msg.len());
+    let text = format!(
+        "{}[[shadow]]\nname = \"s\"\nkind = \"sun\"\nmethod = \"map\"\ncasters = [\"o1x\"]\nreceivers = [\"o0\"]\n",
+        boxes(20)
+    );
+    assert!(err(&text).to_string().contains("did you mean `o1`?"));
+}
+
+#[test]
+fn gltf_scene_roots_are_checked_in_linear_time() {
+    // 200 000 roots: checking each against those before it would take 2·10¹⁰ steps.
+    let n = 200_000;
+    let doc = json!({"asset": {"version": "2.0"}, "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
+                     "nodes": vec![json!({}); n]});
+    let start = std::time::Instant::now();
+    let e = gltf_from_bytes(&serde_json::to_vec(&doc).unwrap(), Path::new(".")).unwrap_err();
+    assert!(e.contains("no triangles"), "{e}");
+    assert!(start.elapsed() < std::time::Duration::from_secs(20), "{:?}", start.elapsed());
+    let mut roots: Vec<usize> = (0..n).collect();
+    roots.push(17);
+    let doc = json!({"asset": {"version": "2.0"}, "scenes": [{"nodes": roots}], "nodes": vec![json!({}); n]});
+    let e = gltf_from_bytes(&serde_json::to_vec(&doc).unwrap(), Path::new(".")).unwrap_err();
+    assert!(e.contains("lists node 17 twice"), "{e}");
+}
