@@ -23,7 +23,10 @@
 //! [`MAX_SCENE_TEXELS`]. Calls into the gltf crate and the image decoders
 //! run under [`guarded`], so even an unforeseen panic there is an error, never a crash.
 
-use crate::files::{parent_dir, read_regular_file, GLTF_MAX_BYTES};
+use crate::files::{
+    parent_dir, read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS,
+    GLTF_MAX_JSON_VALUES,
+};
 use crate::frame::Mesh;
 use crate::gltf_material::{load_materials, ImageSource, Materials, SUPPORTED_EXTENSIONS};
 use crate::gltf_uri::resolve_uri;
@@ -77,7 +80,7 @@ pub(crate) fn load_gltf_in(
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let bytes = read_regular_file(path, GLTF_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
-    from_bytes_in(&bytes, parent_dir(path), root, budget, warnings)
+    from_bytes_in(std::borrow::Cow::Owned(bytes), parent_dir(path), root, budget, warnings)
 }
 
 /// Parses glTF or GLB `bytes`; external buffers are resolved relative to `dir` and must lie inside
@@ -91,21 +94,69 @@ pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
 pub fn gltf_from_bytes_with_warnings(bytes: &[u8], dir: &Path) -> Result<(Mesh, Vec<String>), String> {
     let mut budget = Budget::FULL;
     let mut warnings = Vec::new();
-    let mesh = from_bytes_in(bytes, dir, dir, &mut budget, &mut warnings)?;
+    let mesh = from_bytes_in(std::borrow::Cow::Borrowed(bytes), dir, dir, &mut budget, &mut warnings)?;
     Ok((mesh, warnings))
+}
+
+/// The JSON text of the file: the `.gltf` itself or a `.glb`'s JSON chunk.
+fn json_text(body: &[u8]) -> Result<std::borrow::Cow<'_, [u8]>, String> {
+    if body.starts_with(b"glTF") {
+        let glb = guarded("GLB", || gltf::Glb::from_slice(body))?
+            .map_err(|e| format!("not a valid GLB file: {e}"))?;
+        Ok(glb.json)
+    } else {
+        Ok(std::borrow::Cow::Borrowed(body))
+    }
 }
 
 /// The raw JSON of the file, for what the typed document does not keep (names, extensions,
 /// extras). serde_json limits its nesting depth, so hostile JSON cannot exhaust the stack.
-fn raw_json(body: &[u8]) -> Result<serde_json::Value, String> {
-    let json: Vec<u8> = if body.starts_with(b"glTF") {
-        let glb = guarded("GLB", || gltf::Glb::from_slice(body))?
-            .map_err(|e| format!("not a valid GLB file: {e}"))?;
-        glb.json.into_owned()
-    } else {
-        body.to_vec()
-    };
-    serde_json::from_slice(&json).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))
+fn raw_json(json: &[u8]) -> Result<serde_json::Value, String> {
+    serde_json::from_slice(json).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))
+}
+
+/// Checks the JSON text against [`GLTF_MAX_JSON_BYTES`], [`GLTF_MAX_JSON_OBJECTS`] and
+/// [`GLTF_MAX_JSON_VALUES`] before it is parsed (twice: the typed document and the raw tree each
+/// take a few hundred bytes per object), counting lexically: objects are the `{` outside strings,
+/// values and keys at most the `{`, `[`, `,` and `:` outside strings.
+fn check_json_size(json: &[u8]) -> Result<(), String> {
+    if json.len() as u64 > GLTF_MAX_JSON_BYTES {
+        return Err(format!(
+            "its JSON is {} bytes, more than the limit of {} MiB (large buffers and images belong in binary \
+             chunks or files)",
+            json.len(),
+            GLTF_MAX_JSON_BYTES >> 20
+        ));
+    }
+    let (mut objects, mut values) = (0u64, 0u64);
+    let (mut in_string, mut escaped) = (false, false);
+    for &b in json {
+        if in_string {
+            match (escaped, b) {
+                (true, _) => escaped = false,
+                (false, b'\\') => escaped = true,
+                (false, b'"') => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_string = true,
+            b'{' => {
+                objects += 1;
+                values += 1;
+            }
+            b'[' | b',' | b':' => values += 1,
+            _ => {}
+        }
+    }
+    if objects > GLTF_MAX_JSON_OBJECTS || values > GLTF_MAX_JSON_VALUES {
+        return Err(format!(
+            "its JSON holds {objects} objects and up to {values} values; at most {GLTF_MAX_JSON_OBJECTS} \
+             objects and {GLTF_MAX_JSON_VALUES} values fit a glTF file"
+        ));
+    }
+    Ok(())
 }
 
 /// The JSON text of a `.gltf` (a UTF-8 byte-order mark dropped) or the whole `.glb`; anything
@@ -124,16 +175,27 @@ fn sniff(bytes: &[u8]) -> Result<&[u8], String> {
     }
 }
 
+/// Loads the glTF or GLB `bytes`; the file's own bytes are dropped once parsed (a GLB's binary
+/// chunk lives on in the document), so a large file is not held twice.
 fn from_bytes_in(
-    bytes: &[u8],
+    bytes: std::borrow::Cow<'_, [u8]>,
     dir: &Path,
     root: &Path,
     budget: &mut Budget,
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
-    let body = sniff(bytes)?;
-    let gltf = guarded("glTF", || gltf::Gltf::from_slice_without_validation(body))?
-        .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+    let file_len = bytes.len() as u64;
+    let (mut gltf, raw) = {
+        let body = sniff(&bytes)?;
+        let json = json_text(body)?;
+        check_json_size(&json)?;
+        let gltf = guarded("glTF", || gltf::Gltf::from_slice_without_validation(body))?
+            .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+        (gltf, raw_json(&json))
+    };
+    drop(bytes);
+    // The binary chunk moves into the buffers below instead of being copied.
+    let mut blob = gltf.blob.take();
     let doc = gltf.document.as_json();
     for ext in &doc.extensions_required {
         if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
@@ -150,7 +212,7 @@ fn from_bytes_in(
             doc.materials.len()
         ));
     }
-    let raw = raw_json(body)?;
+    let raw = raw?;
     check_indices(doc)?;
     crate::gltf_material::check_raw(&raw, doc.textures.len())?;
     let parent = check_forest(doc)?;
@@ -210,11 +272,11 @@ fn from_bytes_in(
         ));
     }
 
-    let mut bytes_left = GLTF_MAX_BYTES.saturating_sub(bytes.len() as u64);
+    let mut bytes_left = GLTF_MAX_BYTES.saturating_sub(file_len);
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
-            Source::Bin => gltf.blob.clone().ok_or_else(|| {
+            Source::Bin => blob.take().ok_or_else(|| {
                 format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index())
             })?,
             Source::Uri(uri) => resolve_uri(uri, dir, root, bytes_left)

@@ -59,7 +59,10 @@ pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS
 pub use backend::{Backend, RenderError};
 pub use bounds::{object_bounds, object_center};
 pub use error::{Location, SceneError};
-pub use files::{read_regular_file, GLTF_MAX_BYTES, SCENE_MAX_BYTES};
+pub use files::{
+    read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS, GLTF_MAX_JSON_VALUES,
+    SCENE_MAX_BYTES,
+};
 pub use frame::*;
 pub use gltf_load::{gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf};
 pub use image::Image;

@@ -23,7 +23,7 @@ use crate::limits::{
 use crate::materials::{
     parse_material, parse_object_materials, parse_ramp, MaterialDef, TextureCache, OBJECT_MATERIAL_KEYS,
 };
-use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
+use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, sphere_size, with_outline_normals};
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
 use crate::shadow::{MAX_SHADOWS, MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES};
@@ -455,6 +455,8 @@ fn parse_object(
         "sphere" => {
             scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
             let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
+            let (tris, verts) = sphere_size(segments);
+            primitive_budget(t, &mut assets.budget.clone(), tris, verts)?;
             Arc::new(with_outline_normals(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments)))
         }
         _ => {
@@ -514,17 +516,9 @@ fn parse_object(
         }
     };
     if kind != "gltf" {
-        let tris = (mesh.indices.len() / 3) as u64;
-        if tris > assets.budget.triangles {
-            return Err(t.src.value_err(
-                &t.key_span("kind"),
-                format!(
-                    "{} brings the scene past the limit of {MAX_TRIANGLES} triangles of all objects together",
-                    t.what
-                ),
-            ));
-        }
-        assets.budget.triangles -= tris;
+        // A sphere's size was checked before it was built; boxes and planes are small.
+        let (tris, verts) = ((mesh.indices.len() / 3) as u64, mesh.positions.len() as u64);
+        primitive_budget(t, &mut assets.budget, tris, verts)?;
     }
 
     let mut params = ParamSet::default();
@@ -548,6 +542,24 @@ fn parse_object(
     assets.slots_left -= slots;
     let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
     Ok(ObjectDef { name, mesh, params, materials, is_plane: kind == "plane" })
+}
+
+/// Takes a primitive's `tris` triangles and `verts` vertices from the scene's budget, or says
+/// which limit it crosses (located at its `kind`).
+fn primitive_budget(t: &Table<'_, '_>, budget: &mut Budget, tris: u64, verts: u64) -> Res<()> {
+    if tris > budget.triangles || verts > budget.vertices {
+        return Err(t.src.value_err(
+            &t.key_span("kind"),
+            format!(
+                "{} ({tris} triangles, {verts} vertices) brings the scene past the limit of {MAX_TRIANGLES} \
+                 triangles and {MAX_VERTICES} vertices of all objects together",
+                t.what
+            ),
+        ));
+    }
+    budget.triangles -= tris;
+    budget.vertices -= verts;
+    Ok(())
 }
 
 fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<WaveDef> {

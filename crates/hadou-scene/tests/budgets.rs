@@ -505,3 +505,87 @@ fn gltf_scene_roots_are_checked_in_linear_time() {
     let e = gltf_from_bytes(&serde_json::to_vec(&doc).unwrap(), Path::new(".")).unwrap_err();
     assert!(e.contains("lists node 17 twice"), "{e}");
 }
+
+#[test]
+fn dense_spheres_past_the_triangle_limit_are_refused_before_they_are_built() {
+    // Ten spheres of 1024 segments (10.5 M triangles) once needed more than 4 GB to render a
+    // 32×24 image; two fill the scene's triangle limit, the third is refused from its size.
+    let sphere = |i: usize| format!("[[object]]\nname = \"s{i}\"\nkind = \"sphere\"\nsegments = 1024\n");
+    let two: String = (0..2).map(sphere).collect();
+    Scene::parse(&two, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let ten: String = (0..10).map(sphere).collect();
+    let e = err(&ten);
+    assert_eq!(at(&e), (11, 1), "{e}");
+    let msg = e.to_string();
+    assert!(msg.contains("[[object]] \"s2\" (1046528 triangles, 525825 vertices)"), "{msg}");
+    assert!(msg.contains(&format!("limit of {} triangles", hadou_scene::MAX_TRIANGLES)), "{msg}");
+}
+
+#[test]
+fn gltf_json_structure_is_bounded_before_it_is_parsed() {
+    // 9 MB of empty nodes once took 1.2 GB to parse; past 2²⁰ objects the file is refused from a
+    // lexical count, before either JSON tree exists.
+    let n = hadou_scene::GLTF_MAX_JSON_OBJECTS as usize;
+    let doc = |nodes: usize| {
+        format!("{{\"asset\":{{\"version\":\"2.0\"}},\"nodes\":[{}]}}", vec!["{}"; nodes].join(","))
+    };
+    let e = gltf_from_bytes(doc(n).as_bytes(), Path::new(".")).unwrap_err();
+    // The document and its `asset` are objects too.
+    assert!(
+        e.contains(&format!("holds {} objects", n + 2)) && e.contains(&format!("at most {n} objects")),
+        "{e}"
+    );
+    let e = gltf_from_bytes(doc(n - 2).as_bytes(), Path::new(".")).unwrap_err();
+    assert!(!e.contains("objects"), "{e}");
+    // Values: a scene listing 2²² roots; braces and commas inside strings do not count.
+    let v = hadou_scene::GLTF_MAX_JSON_VALUES as usize;
+    let many = format!(
+        "{{\"asset\":{{\"version\":\"2.0\"}},\"scenes\":[{{\"nodes\":[{}]}}]}}",
+        vec!["0"; v].join(",")
+    );
+    let e = gltf_from_bytes(many.as_bytes(), Path::new(".")).unwrap_err();
+    assert!(e.contains(&format!("at most {n} objects and {v} values")), "{e}");
+    let quoted =
+        format!("{{\"asset\":{{\"version\":\"2.0\",\"generator\":\"{}\\\"{{\"}}}}", "{[,:".repeat(v));
+    let e = gltf_from_bytes(quoted.as_bytes(), Path::new(".")).unwrap_err();
+    assert!(!e.contains("values fit"), "{e}");
+}
+
+#[test]
+fn limits_in_the_docs_match_the_code() {
+    // docs/scene-format.md writes numbers of five digits or more in groups of three.
+    let grouped = |n: u64| {
+        let s = n.to_string();
+        if s.len() <= 4 {
+            return s;
+        }
+        let mut out = String::new();
+        for (i, c) in s.chars().enumerate() {
+            if i > 0 && (s.len() - i).is_multiple_of(3) {
+                out.push(' ');
+            }
+            out.push(c);
+        }
+        out
+    };
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md")).unwrap();
+    let limits = &doc[doc.find("## Limits").unwrap()..doc.find("## Paths").unwrap()];
+    for (what, n) in [
+        ("MAX_TRIANGLES", hadou_scene::MAX_TRIANGLES),
+        ("MAX_VERTICES", hadou_scene::MAX_VERTICES),
+        ("MAX_MATERIAL_SLOTS", hadou_scene::MAX_MATERIAL_SLOTS),
+        ("MAX_SCENE_TEXELS", MAX_SCENE_TEXELS),
+        ("MAX_SKIN_JOINTS", MAX_SKIN_JOINTS),
+        ("MAX_SKINNED_NODES", MAX_SKINNED_NODES),
+        ("MAX_KEY_CHECKS", hadou_scene::MAX_KEY_CHECKS),
+        ("MAX_SHADOW_CASTERS", hadou_scene::MAX_SHADOW_CASTERS as u64),
+        ("GLTF_MAX_JSON_OBJECTS", hadou_scene::GLTF_MAX_JSON_OBJECTS),
+        ("GLTF_MAX_JSON_VALUES", hadou_scene::GLTF_MAX_JSON_VALUES),
+    ] {
+        assert!(limits.contains(&grouped(n)), "{what} = {n} ({}) is not in the Limits section", grouped(n));
+    }
+    assert_eq!(hadou_scene::MAX_SHADOW_TRIANGLES, hadou_scene::MAX_TRIANGLES);
+    assert_eq!(hadou_scene::GLTF_MAX_JSON_BYTES, 256 << 20);
+    assert!(limits.contains("| 256 MiB, at most"));
+}
