@@ -214,7 +214,7 @@ const SUGGEST_MAX_WORD: usize = 64;
 /// Most candidates a "did you mean" compares, in order (a scene may name 65 536 objects).
 const SUGGEST_MAX_CANDIDATES: usize = 4096;
 /// Most candidates a hint lists when none is close.
-const HINT_MAX_LISTED: usize = 16;
+const HINT_MAX_LISTED: usize = 40;
 
 /// The candidate nearest to `word` if it is close enough to be a plausible typo. The work is
 /// bounded whatever the file holds: words over [`SUGGEST_MAX_WORD`] characters get no

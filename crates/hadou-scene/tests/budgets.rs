@@ -472,7 +472,7 @@ fn area_light_rules_follow_its_target_object_keys() {
 #[test]
 fn did_you_mean_hints_are_bounded() {
     // A long unknown name among 60 000 objects: no suggestion work over the whole list, and at
-    // most 16 names listed.
+    // most 40 names listed.
     let n = 60_000;
     let long = "q".repeat(100_000);
     let text = format!(
