@@ -9,7 +9,7 @@
 //! outline hulls, of which only the back faces are drawn. The GPU backend's raster pass matches
 //! these conventions.
 
-use crate::raster::{bin_rows, cover, edge, perspective, ScreenProjection, ScreenTri, Vert, BAND};
+use crate::raster::{cover, edge, perspective, Bands, ScreenProjection, ScreenTri, Tris, Vert, BAND, BATCH};
 use crate::setup::FrameSetup;
 use crate::shading;
 use crate::shadows::NO_SHADOW;
@@ -80,10 +80,10 @@ pub(crate) fn draw_opaque_into(
     let FrameSetup { basis, lights, shadows, .. } = setup;
     let (w, h) = (frame.width as usize, rows.len());
     let tris = project_all(frame, basis);
-    let shadow_tris = if shadows.any_plane() { shadows.plane_tris(frame, basis) } else { Vec::new() };
+    let shadow_tris = if shadows.any_plane() { shadows.plane_tris(frame, basis) } else { Tris::default() };
     let far = frame.camera.far;
-    let bins = bin_rows(&tris, frame.height as usize, &rows);
-    let shadow_bins = bin_rows(&shadow_tris, frame.height as usize, &rows);
+    let bands = Bands::new(&tris, frame.height as usize, &rows);
+    let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
     let OpaqueBuffers { color, surface, object, shadow, soft, visibility } = out;
     // Every element is written below: the fills only size the buffers.
     refill(color, w * h, [0.0f32; 3]);
@@ -97,103 +97,121 @@ pub(crate) fn draw_opaque_into(
         return;
     }
     // Without an area light every band gets an empty slice.
-    let soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
+    let mut soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
         soft.chunks_mut(BAND * w).collect()
     } else {
         (0..h.div_ceil(BAND)).map(|_| Default::default()).collect()
     };
-    color
-        .par_chunks_mut(BAND * w)
-        .zip(surface.par_chunks_mut(BAND * w))
-        .zip(object.par_chunks_mut(BAND * w))
-        .zip(shadow.par_chunks_mut(BAND * w))
-        .zip(soft_chunks.into_par_iter())
-        .enumerate()
-        .for_each(|(b, ((((col, surf), obj), shad), soft))| {
-            let y_start = rows.start + b * BAND;
-            let rows = col.len() / w;
-            if bins[b].is_empty() && shadow_bins[b].is_empty() {
-                // Nothing drawn here (the refills left surface, object, shadow and soft empty).
-                col.fill(frame.background);
-                return;
-            }
-            let mut zbuf = vec![f32::INFINITY; rows * w];
-            let mut tri_id = vec![u32::MAX; rows * w];
-            for &ti in &bins[b] {
-                raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, &mut zbuf, &mut tri_id);
-            }
-            // The visible surface of every pixel.
-            let mut visible: Vec<Option<shading::Surface>> = vec![None; rows * w];
-            for r in 0..rows {
-                for x in 0..w {
-                    let i = r * w + x;
-                    if tri_id[i] == u32::MAX {
-                        continue;
-                    }
-                    let py = (y_start + r) as f32;
-                    let s = interpolate(&tris[tri_id[i] as usize], x as f32 + 0.5, py + 0.5);
-                    let d = (s.world - basis.eye).length();
-                    surf[i] = Some(if d.is_finite() { d } else { 0.0 });
-                    obj[i] = Some(tris[tri_id[i] as usize].object);
-                    visible[i] = Some(s);
+    // Batches of bands, one after the other, each listing the triangles that reach it once; the
+    // bands of a batch in parallel, each drawing (in submission order) those that reach it.
+    let batch_px = BATCH * BAND * w;
+    let batches = color
+        .chunks_mut(batch_px)
+        .zip(surface.chunks_mut(batch_px))
+        .zip(object.chunks_mut(batch_px))
+        .zip(shadow.chunks_mut(batch_px));
+    for (k, (((color, surface), object), shadow)) in batches.enumerate() {
+        let first = k * BATCH;
+        let count = color.len().div_ceil(BAND * w);
+        let list = bands.batch(first, count);
+        let shadow_list = shadow_bands.batch(first, count);
+        let soft_batch: Vec<&mut [Option<SoftPoint>]> = soft_chunks.drain(..count).collect();
+        color
+            .par_chunks_mut(BAND * w)
+            .zip(surface.par_chunks_mut(BAND * w))
+            .zip(object.par_chunks_mut(BAND * w))
+            .zip(shadow.par_chunks_mut(BAND * w))
+            .zip(soft_batch.into_par_iter())
+            .enumerate()
+            .for_each(|(j, ((((col, surf), obj), shad), soft))| {
+                let b = first + j;
+                let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
+                let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
+                let y_start = rows.start + b * BAND;
+                let rows = col.len() / w;
+                if mine().next().is_none() && mine_shadows().next().is_none() {
+                    // Nothing drawn here (the refills left surface, object, shadow and soft empty).
+                    col.fill(frame.background);
+                    return;
                 }
-            }
-            // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
-            let mut best = vec![NO_SHADOW; rows * w];
-            let receiver = |i: usize| {
-                let t = tris.get(tri_id[i] as usize)?;
-                (!t.hull).then_some(t.object)
-            };
-            for &si in &shadow_bins[b] {
-                let st = &shadow_tris[si as usize];
-                cover(st, y_start, rows, w, |i, bary| {
-                    let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
-                    let t = perspective(st, bary, |k| st.uv[k][0]);
-                    shadows.plane_candidate(
-                        frame,
-                        st.object,
-                        o,
-                        t,
-                        s.world,
-                        surf[i].unwrap_or(0.0),
-                        &mut best[i],
-                    );
-                });
-            }
-            for r in 0..rows {
-                for x in 0..w {
-                    let i = r * w + x;
-                    let Some(s) = visible[i].as_ref() else {
-                        col[i] = frame.background;
-                        continue;
-                    };
-                    let t = &tris[tri_id[i] as usize];
-                    let material = frame.objects[t.object as usize].material(t.material);
-                    let c = match (t.hull, material.outline) {
-                        (true, Some(o)) => o.color,
-                        _ => shading::shade(frame, lights, material, s),
-                    };
-                    if t.hull {
-                        col[i] = c;
-                    } else {
-                        (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
-                        if let Some(al) = area {
-                            soft[i] = Some(SoftPoint {
-                                world: s.world,
-                                normal: s.normal.normalize_or(Vec3f::ZERO),
-                                term: shading::area_term(al, material, s),
-                            });
+                let mut zbuf = vec![f32::INFINITY; rows * w];
+                let mut tri_id = vec![u32::MAX; rows * w];
+                for ti in mine() {
+                    raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, &mut zbuf, &mut tri_id);
+                }
+                // The visible surface of every pixel.
+                let mut visible: Vec<Option<shading::Surface>> = vec![None; rows * w];
+                for r in 0..rows {
+                    for x in 0..w {
+                        let i = r * w + x;
+                        if tri_id[i] == u32::MAX {
+                            continue;
+                        }
+                        let py = (y_start + r) as f32;
+                        let s = interpolate(&tris[tri_id[i] as usize], x as f32 + 0.5, py + 0.5);
+                        let d = (s.world - basis.eye).length();
+                        surf[i] = Some(if d.is_finite() { d } else { 0.0 });
+                        obj[i] = Some(tris[tri_id[i] as usize].object);
+                        visible[i] = Some(s);
+                    }
+                }
+                // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
+                let mut best = vec![NO_SHADOW; rows * w];
+                let receiver = |i: usize| {
+                    let t = tris.get(tri_id[i] as usize)?;
+                    (!t.hull).then_some(t.object)
+                };
+                for si in mine_shadows() {
+                    let st = &shadow_tris[si as usize];
+                    cover(st, y_start, rows, w, |i, bary| {
+                        let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
+                        let t = perspective(st, bary, |k| st.uv[k][0]);
+                        shadows.plane_candidate(
+                            frame,
+                            st.object,
+                            o,
+                            t,
+                            s.world,
+                            surf[i].unwrap_or(0.0),
+                            &mut best[i],
+                        );
+                    });
+                }
+                for r in 0..rows {
+                    for x in 0..w {
+                        let i = r * w + x;
+                        let Some(s) = visible[i].as_ref() else {
+                            col[i] = frame.background;
+                            continue;
+                        };
+                        let t = &tris[tri_id[i] as usize];
+                        let material = frame.objects[t.object as usize].material(t.material);
+                        let c = match (t.hull, material.outline) {
+                            (true, Some(o)) => o.color,
+                            _ => shading::shade(frame, lights, material, s),
+                        };
+                        if t.hull {
+                            col[i] = c;
+                        } else {
+                            (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
+                            if let Some(al) = area {
+                                soft[i] = Some(SoftPoint {
+                                    world: s.world,
+                                    normal: s.normal.normalize_or(Vec3f::ZERO),
+                                    term: shading::area_term(al, material, s),
+                                });
+                            }
                         }
                     }
                 }
-            }
-        });
+            });
+    }
 }
 
 /// The objects' triangles and then their outline hulls, projected by the camera.
-fn project_all(frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
+fn project_all(frame: &Frame, basis: &CameraBasis) -> Tris {
     let screen = ScreenProjection::new(frame, basis);
-    let mut out = Vec::new();
+    let mut out = Tris::default();
     for (oi, obj) in frame.objects.iter().enumerate() {
         let nm = obj.transform.normal_matrix();
         let mesh = &obj.mesh;

@@ -1,7 +1,12 @@
 //! The triangle rasterizer every pass draws with: view-space vertices clipped at the near plane
-//! and projected to screen (or map) coordinates ([`ScreenProjection`]), triangles binned into bands
-//! of [`BAND`] rows ([`bin_rows`]), and the pixel centres a triangle covers under the top-left fill
-//! rule with their barycentric weights ([`cover`]). It knows nothing of the passes that use it: the
+//! and projected to screen (or map) coordinates ([`ScreenProjection`]) into a [`Tris`] list,
+//! triangles sorted into bands of [`BAND`] rows ([`Bands`]), and the pixel centres a triangle
+//! covers under the top-left fill rule with their barycentric weights ([`cover`]).
+//!
+//! Memory follows the triangle count, not the image: a [`Tris`] list grows in fixed chunks (no
+//! doubling and copying), and [`Bands`] keeps one band range per triangle and lists the triangles
+//! of [`BATCH`] bands at a time, so a triangle spanning every row of a 16384-row image costs
+//! 8 bytes there, not 4 bytes for each of its 1024 bands. It knows nothing of the passes that use it: the
 //! opaque pass (`crate::opaque`), the hard shadows' maps and plane casts (`crate::shadows`) and the
 //! soft shadows' maps (`crate::soft`) set up their own triangles and decide what a covered pixel
 //! does.
@@ -17,6 +22,60 @@ use rayon::prelude::*;
 
 /// Rows per parallel band.
 pub(crate) const BAND: usize = 16;
+/// Bands drawn together (in parallel) from one list of the triangles that reach them.
+pub(crate) const BATCH: usize = 16;
+/// Items per chunk of a [`Chunked`] list.
+const CHUNK: usize = 1 << 14;
+
+/// A list that grows in chunks of [`CHUNK`] items: pushing never moves what is stored, and at
+/// most one chunk is allocated but unused (a `Vec` doubles, holding up to three times its length
+/// while it grows).
+pub(crate) struct Chunked<T> {
+    chunks: Vec<Vec<T>>,
+}
+
+impl<T> Default for Chunked<T> {
+    fn default() -> Self {
+        Chunked { chunks: Vec::new() }
+    }
+}
+
+impl<T> Chunked<T> {
+    /// Appends `x`.
+    #[inline]
+    pub(crate) fn push(&mut self, x: T) {
+        match self.chunks.last_mut() {
+            Some(c) if c.len() < CHUNK => c.push(x),
+            _ => {
+                let mut c = Vec::with_capacity(CHUNK);
+                c.push(x);
+                self.chunks.push(c);
+            }
+        }
+    }
+
+    /// The items in order.
+    pub(crate) fn iter(&self) -> impl Iterator<Item = &T> {
+        self.chunks.iter().flatten()
+    }
+
+    /// Item `i`, if any.
+    #[inline]
+    pub(crate) fn get(&self, i: usize) -> Option<&T> {
+        self.chunks.get(i / CHUNK)?.get(i % CHUNK)
+    }
+}
+
+impl<T> std::ops::Index<usize> for Chunked<T> {
+    type Output = T;
+    #[inline]
+    fn index(&self, i: usize) -> &T {
+        &self.chunks[i / CHUNK][i % CHUNK]
+    }
+}
+
+/// Projected triangles, in submission order.
+pub(crate) type Tris = Chunked<ScreenTri>;
 
 /// One vertex after transform: view-space position (for clipping/projection) and world-space
 /// attributes (for shading).
@@ -85,21 +144,50 @@ impl ScreenTri {
     }
 }
 
-/// For each band of `BAND` rows of `rows`, the triangles that may cover it, in submission order.
-pub(crate) fn bin_rows(tris: &[ScreenTri], height: usize, rows: &std::ops::Range<usize>) -> Vec<Vec<u32>> {
-    let h = rows.len();
-    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); h.div_ceil(BAND)];
-    for (i, t) in tris.iter().enumerate() {
-        let (y0, y1) = y_range(t, height);
-        let (y0, y1) = (y0.max(rows.start), y1.min(rows.end.saturating_sub(1)));
-        if y0 > y1 || h == 0 {
-            continue;
-        }
-        for bin in &mut bins[((y0 - rows.start) / BAND)..=((y1 - rows.start) / BAND)] {
-            bin.push(i as u32);
-        }
+/// Which bands of [`BAND`] rows of `rows` each triangle may cover: its first and last band
+/// (8 bytes per triangle, whatever its height). [`Bands::batch`] lists the triangles reaching a
+/// batch of bands, and [`Bands::reaches`] picks a band's own: in submission order, the same
+/// triangles a list per band would hold.
+pub(crate) struct Bands {
+    /// Per triangle: first and last band (relative to `rows.start`), `(1, 0)` for none.
+    ranges: Vec<(u32, u32)>,
+}
+
+impl Bands {
+    /// The bands of `rows` (of an image `height` rows high) each of `tris` may cover.
+    pub(crate) fn new(tris: &Tris, height: usize, rows: &std::ops::Range<usize>) -> Self {
+        let ranges = tris
+            .iter()
+            .map(|t| {
+                let (y0, y1) = y_range(t, height);
+                let (y0, y1) = (y0.max(rows.start), y1.min(rows.end.saturating_sub(1)));
+                if y0 > y1 || rows.is_empty() {
+                    (1, 0)
+                } else {
+                    (((y0 - rows.start) / BAND) as u32, ((y1 - rows.start) / BAND) as u32)
+                }
+            })
+            .collect();
+        Bands { ranges }
     }
-    bins
+
+    /// The triangles that may cover any of the bands `first..first + count`, in submission order.
+    pub(crate) fn batch(&self, first: usize, count: usize) -> Vec<u32> {
+        let (lo, hi) = (first as u32, (first + count) as u32);
+        (0..self.ranges.len() as u32)
+            .filter(|&i| {
+                let (a, b) = self.ranges[i as usize];
+                a <= b && a < hi && b >= lo
+            })
+            .collect()
+    }
+
+    /// Whether triangle `i` may cover band `b`.
+    #[inline]
+    pub(crate) fn reaches(&self, i: u32, b: usize) -> bool {
+        let (a, z) = self.ranges[i as usize];
+        a as usize <= b && b <= z as usize
+    }
 }
 
 /// A perspective projection of view-space triangles to [`ScreenTri`]s, clipped at the near plane:
@@ -134,14 +222,7 @@ impl ScreenProjection {
 
     /// Clips `tri` at the near plane and appends the projected pieces (a fan, those with finite
     /// coordinates) to `out`.
-    pub(crate) fn push(
-        &self,
-        tri: [Vert; 3],
-        object: u32,
-        material: u32,
-        hull: bool,
-        out: &mut Vec<ScreenTri>,
-    ) {
+    pub(crate) fn push(&self, tri: [Vert; 3], object: u32, material: u32, hull: bool, out: &mut Tris) {
         let mut poly = [tri[0]; 4];
         let n = clip_near(tri, self.near, &mut poly);
         for k in 1..n.saturating_sub(1) {
@@ -330,24 +411,32 @@ pub(crate) fn perspective(t: &ScreenTri, b: [f32; 3], attr: impl Fn(usize) -> f3
 /// `empty` where no triangle covers the texel. Bands of rows in parallel, each drawing the
 /// triangles that reach it (the nearest depth wins, so the result does not depend on the banding).
 pub(crate) fn nearest_depths(
-    tris: &[ScreenTri],
+    tris: &Tris,
     size: usize,
     empty: f32,
     z: impl Fn(usize, [f32; 3]) -> f32 + Sync,
 ) -> Vec<f32> {
     let n = size;
-    let bins = bin_rows(tris, n, &(0..n));
+    let bands = Bands::new(tris, n, &(0..n));
     let mut depth = vec![empty; n * n];
-    depth.par_chunks_mut(BAND * n).zip(&bins).enumerate().for_each(|(b, (band, bin))| {
-        let rows = band.len() / n;
-        for &ti in bin {
-            cover(&tris[ti as usize], b * BAND, rows, n, |i, w| {
-                let z = z(ti as usize, w);
-                if z < band[i] {
-                    band[i] = z;
-                }
-            });
-        }
-    });
+    if n == 0 {
+        return depth;
+    }
+    for (k, batch) in depth.chunks_mut(BATCH * BAND * n).enumerate() {
+        let first = k * BATCH;
+        let list = bands.batch(first, batch.len().div_ceil(BAND * n));
+        batch.par_chunks_mut(BAND * n).enumerate().for_each(|(j, band)| {
+            let b = first + j;
+            let rows = band.len() / n;
+            for &ti in list.iter().filter(|&&ti| bands.reaches(ti, b)) {
+                cover(&tris[ti as usize], b * BAND, rows, n, |i, w| {
+                    let z = z(ti as usize, w);
+                    if z < band[i] {
+                        band[i] = z;
+                    }
+                });
+            }
+        });
+    }
     depth
 }

@@ -15,7 +15,7 @@
 //! casters of one shadow therefore darken an overlap once, and a shadow shows only on its
 //! receivers.
 
-use crate::raster::{nearest_depths, ScreenProjection, ScreenTri, Vert};
+use crate::raster::{nearest_depths, Chunked, ScreenProjection, ScreenTri, Tris, Vert};
 use hadou_math::shadow::MapFrame;
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{CameraBasis, Frame, LightLine, ShadowCast, ShadowMethod, ON_PLANE};
@@ -65,9 +65,9 @@ impl ShadowCasts {
     /// ([`hadou_math::shadow::project`]), with `t` carried in `uv[0]` for the per-pixel `t ≥ 0` test
     /// (interpolated perspective-correctly, exact because `t` is affine on the projected triangle) and
     /// the cast's index in `object`. Drawn double-sided.
-    pub(crate) fn plane_tris(&self, frame: &Frame, basis: &CameraBasis) -> Vec<ScreenTri> {
+    pub(crate) fn plane_tris(&self, frame: &Frame, basis: &CameraBasis) -> Tris {
         let screen = ScreenProjection::new(frame, basis);
-        let mut out = Vec::new();
+        let mut out = Tris::default();
         for (ci, cast) in self.casts.iter().enumerate() {
             let ShadowMethod::Plane(plane) = frame.shadows[cast.shadow as usize].method else { continue };
             for &o in &cast.casters {
@@ -179,8 +179,8 @@ impl DepthMap {
 fn render_map(frame: &Frame, c: &ShadowCast, m: MapFrame, size: u32) -> DepthMap {
     let n = size as usize;
     let nf = size as f32;
-    let mut tris: Vec<ScreenTri> = Vec::new();
-    let mut depths: Vec<[f32; 3]> = Vec::new();
+    let mut tris = Tris::default();
+    let mut depths: Chunked<[f32; 3]> = Chunked::default();
     for &o in &c.casters {
         let obj = &frame.objects[o as usize];
         let pts: Vec<[f32; 3]> = obj

@@ -14,7 +14,7 @@
 //! The GPU backend mirrors [`visibility`] (`soft.wgsl`).
 
 use crate::opaque::draw_opaque;
-use crate::raster::{nearest_depths, ScreenProjection, ScreenTri, Vert};
+use crate::raster::{nearest_depths, ScreenProjection, Tris, Vert};
 use crate::setup::FrameSetup;
 use hadou_math::soft::{
     bilinear, same_surface, segment_brightness, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
@@ -90,9 +90,9 @@ impl SpotDepth {
 /// soft-shadow maps: clipped at the map's near plane and projected to texel coordinates of a
 /// `size²` map (texel `(x, y)` covers `[x, x+1) × [y, y+1)`, row 0 at the frustum's top), `1/z`
 /// per vertex for the perspective-correct depth ([`ScreenTri::depth_at`]).
-fn spot_tris(frame: &Frame, casters: &[u32], map: &SpotMap, size: u32) -> Vec<ScreenTri> {
+fn spot_tris(frame: &Frame, casters: &[u32], map: &SpotMap, size: u32) -> Tris {
     let screen = ScreenProjection::square(map.near, map.tan_half, size);
-    let mut out = Vec::new();
+    let mut out = Tris::default();
     for obj in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
         let verts: Vec<Vert> = obj
             .mesh

@@ -320,8 +320,9 @@ fn shadows_match_cpu() {
             method: ShadowMethod::Map { size: 512 },
             up: Vec3::Y,
             casters: vec![floater, post],
-            // The post casts on the stairs and the ground but not on itself.
-            receivers: stairs.iter().copied().chain([ground]).collect(),
+            // The post casts on the stairs and the ground but not on itself (ascending, as
+            // `Shadow::receivers` must be).
+            receivers: [ground].into_iter().chain(stairs.iter().copied()).collect(),
             color: [0.0, 0.02, 0.0],
             opacity: 0.7,
         },

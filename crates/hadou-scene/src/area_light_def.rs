@@ -5,6 +5,7 @@
 use crate::area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID};
 use crate::bounds::{box_corners, object_bounds, object_center};
 use crate::frame::Object;
+use crate::limits::fmt_f32;
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::shadow::MAX_MAP_SIZE;
 use crate::toml_read::{type_name, Fallback, ParamReader, Res, Table};
@@ -159,23 +160,28 @@ pub(crate) fn parse_area_light(
 
 /// `G` of the light at these values.
 fn interest(def: &AreaLightDef, vals: &[f32], objects: &[Object]) -> Vec3f {
+    interest_at(def, vals, |o| {
+        object_center(&objects[o]).unwrap_or(objects[o].transform.transform_point(Vec3f::ZERO))
+    })
+}
+
+/// `G` of the light at these values, `centre(o)` giving the centre of object `o` (its mesh's
+/// bounding box centre placed in the world, its origin for an empty mesh).
+pub(crate) fn interest_at(def: &AreaLightDef, vals: &[f32], centre: impl FnOnce(usize) -> Vec3f) -> Vec3f {
     match def.target {
-        Target::Object(o) => {
-            object_center(&objects[o]).unwrap_or(objects[o].transform.transform_point(Vec3f::ZERO))
-        }
+        Target::Object(o) => centre(o),
         Target::Point => Vec3f::from_array(def.params.arr(vals, "target")),
     }
 }
 
-/// Cross-key rule at one set of values: `G ≠ L` and `l < |L − G|` (else `L₂` would sit at or beyond
-/// `G`). The error names the key to change.
+/// Cross-key rule at one set of values, `g` being `G` there ([`interest_at`]): `G ≠ L` and
+/// `l < |L − G|` (else `L₂` would sit at or beyond `G`). The error names the key to change.
 pub(crate) fn check_area_light(
     def: &AreaLightDef,
     vals: &[f32],
-    objects: &[Object],
+    g: Vec3f,
 ) -> Result<(), (&'static str, String)> {
     let l = Vec3f::from_array(def.params.arr(vals, "position"));
-    let g = interest(def, vals, objects);
     let d = (l - g).length();
     let key = if def.target == Target::Point { "target" } else { "position" };
     if d.is_nan() || d <= 1e-6 {
@@ -190,8 +196,10 @@ pub(crate) fn check_area_light(
         return Err((
             "size",
             format!(
-                "`size` ({size}) must be less than the distance from `position` to `target` ({d}): the nearer map L − l·P \
-                 would sit at or beyond the point of interest"
+                "`size` ({}) must be less than the distance from `position` to `target` ({}): the nearer map L − l·P \
+                 would sit at or beyond the point of interest",
+                fmt_f32(size),
+                fmt_f32(d)
             ),
         ));
     }

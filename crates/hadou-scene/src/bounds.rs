@@ -2,7 +2,7 @@
 //! ([`object_bounds`]) and its centre `B` ([`object_center`]), as shadows and the area light use
 //! them.
 
-use crate::frame::Object;
+use crate::frame::{Mesh, Object};
 use hadou_math::{Vec3, Vec3f};
 
 /// World-space axis-aligned bounds of an object's mesh: the 8 transformed corners of its local
@@ -38,9 +38,19 @@ pub(crate) fn box_corners(lo: Vec3f, hi: Vec3f) -> [Vec3f; 8] {
     })
 }
 
+/// The centre of a mesh's bounding box in its own space (`None` when it has no vertices).
+pub(crate) fn mesh_center(mesh: &Mesh) -> Option<Vec3f> {
+    let (lo, hi) = mesh_bounds(mesh)?;
+    Some((lo + hi) * 0.5)
+}
+
 /// The object-space bounding box of an object's mesh (`None` when it has no vertices).
 fn local_bounds(o: &Object) -> Option<(Vec3f, Vec3f)> {
-    let mut it = o.mesh.positions.iter().map(|p| Vec3f::from_array(*p));
+    mesh_bounds(&o.mesh)
+}
+
+fn mesh_bounds(mesh: &Mesh) -> Option<(Vec3f, Vec3f)> {
+    let mut it = mesh.positions.iter().map(|p| Vec3f::from_array(*p));
     let first = it.next()?;
     Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }

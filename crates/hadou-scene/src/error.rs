@@ -1,8 +1,37 @@
 //! [`SceneError`]: everything that can be wrong with a scene file, each with the place it happened
 //! ([`Location`]), and the "did you mean" hints ([`hint`]) its messages end with.
 
+use std::borrow::Cow;
 use std::fmt;
 use std::path::{Path, PathBuf};
+
+/// `text` with every control character (NUL, newline, ESC, …) and every bidirectional-text
+/// override written as an escape (`\0`, `\n`, `\u{1b}`, `\u{202e}`), so a name or path read from a
+/// file cannot break a message's line or drive the terminal that prints it.
+pub(crate) fn escape_controls(text: &str) -> Cow<'_, str> {
+    let bad = |c: char| c.is_control() || matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    if !text.chars().any(bad) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        match c {
+            '\0' => out.push_str("\\0"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if bad(c) => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// A path for a message: as `Path::display` shows it, control characters escaped
+/// ([`escape_controls`]).
+pub(crate) fn show_path(path: &Path) -> String {
+    escape_controls(&path.display().to_string()).into_owned()
+}
 
 /// A place in a scene file: the file and the 1-based line and column (in characters) of the
 /// offending key or value.
@@ -33,7 +62,7 @@ impl Location {
 
 impl fmt::Display for Location {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.path.display(), self.line, self.col)
+        write!(f, "{}:{}:{}", show_path(&self.path), self.line, self.col)
     }
 }
 
@@ -146,14 +175,16 @@ impl SceneError {
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            SceneError::Io { path, message } => write!(f, "{}: {message}", path.display()),
+            SceneError::Io { path, message } => {
+                write!(f, "{}: {}", show_path(path), escape_controls(message))
+            }
             SceneError::Gltf { at, file, message } => {
-                write!(f, "{at}: glTF file {}: {message}", file.display())
+                write!(f, "{at}: glTF file {}: {}", show_path(file), escape_controls(message))
             }
             other => {
                 // every remaining variant has a location
                 let at = other.location().expect("positioned variant");
-                write!(f, "{at}: {}", other.message())
+                write!(f, "{at}: {}", escape_controls(other.message()))
             }
         }
     }
@@ -178,25 +209,48 @@ pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
-/// The candidate nearest to `word` if it is close enough to be a plausible typo.
+/// Longest word a "did you mean" looks for (a typo of a longer name is not worth the work).
+const SUGGEST_MAX_WORD: usize = 64;
+/// Most candidates a "did you mean" compares, in order (a scene may name 65 536 objects).
+const SUGGEST_MAX_CANDIDATES: usize = 4096;
+/// Most candidates a hint lists when none is close.
+const HINT_MAX_LISTED: usize = 40;
+
+/// The candidate nearest to `word` if it is close enough to be a plausible typo. The work is
+/// bounded whatever the file holds: words over [`SUGGEST_MAX_WORD`] characters get no
+/// suggestion, candidates whose length alone rules them out are skipped, and at most
+/// [`SUGGEST_MAX_CANDIDATES`] are compared.
 pub(crate) fn suggest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let limit = (word.chars().count() / 3).max(2);
+    let n = word.chars().count();
+    if n > SUGGEST_MAX_WORD {
+        return None;
+    }
+    let limit = (n / 3).max(2);
     candidates
         .into_iter()
+        .take(SUGGEST_MAX_CANDIDATES)
+        .filter(|c| c.len() <= 4 * (n + limit) && c.chars().count().abs_diff(n) <= limit)
         .map(|c| (edit_distance(word, c), c))
         .filter(|&(d, _)| d <= limit)
         .min_by_key(|&(d, _)| d)
         .map(|(_, c)| c)
 }
 
-/// `"; did you mean `x`?"` or, without a close match, `"; valid keys: a, b, c"`.
+/// `"; did you mean `x`?"` or, without a close match, `"; valid keys: a, b, c"` (at most
+/// [`HINT_MAX_LISTED`] of them, then how many there are).
 pub(crate) fn hint(word: &str, candidates: &[&str], noun: &str) -> String {
     match suggest(word, candidates.iter().copied()) {
         Some(s) => format!("; did you mean `{s}`?"),
         None if candidates.is_empty() => String::new(),
         None => {
-            let list: Vec<String> = candidates.iter().map(|c| format!("`{c}`")).collect();
-            format!("; valid {noun}: {}", list.join(", "))
+            let list: Vec<String> =
+                candidates.iter().take(HINT_MAX_LISTED).map(|c| format!("`{c}`")).collect();
+            let more = if candidates.len() > HINT_MAX_LISTED {
+                format!(", … ({} in all)", candidates.len())
+            } else {
+                String::new()
+            };
+            format!("; valid {noun}: {}{more}", list.join(", "))
         }
     }
 }
@@ -211,6 +265,14 @@ mod tests {
         assert_eq!(edit_distance("", "abc"), 3);
         assert_eq!(suggest("alpah_s", ["alpha_s", "alpha_c", "M"]), Some("alpha_s"));
         assert_eq!(suggest("zzzzzz", ["alpha_s", "M"]), None);
+    }
+
+    #[test]
+    fn control_characters_are_escaped() {
+        assert_eq!(escape_controls("plain/ü.png"), "plain/ü.png");
+        assert_eq!(escape_controls("a\0b\nc\u{1b}[31m"), "a\\0b\\nc\\u{1b}[31m");
+        assert_eq!(escape_controls("x\u{202e}y"), "x\\u{202e}y");
+        assert_eq!(show_path(Path::new("d/\tf")), "d/\\tf");
     }
 
     #[test]

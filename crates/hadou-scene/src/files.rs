@@ -13,6 +13,16 @@ pub const SCENE_MAX_BYTES: u64 = 16 << 20;
 /// Largest `.gltf`/`.glb` file, and the most bytes one glTF file may read in all (the file plus
 /// every external buffer), in bytes (1 GiB).
 pub const GLTF_MAX_BYTES: u64 = 1 << 30;
+/// Largest JSON text of a glTF file (the `.gltf` file or a `.glb`'s JSON chunk), in bytes
+/// (256 MiB): the JSON is parsed into two trees (its strings, data URIs included, held three
+/// times with the decoded bytes), so it is bounded on its own, below what binary buffers may
+/// take; [`GLTF_MAX_JSON_OBJECTS`] and [`GLTF_MAX_JSON_VALUES`] bound the structure.
+pub const GLTF_MAX_JSON_BYTES: u64 = 256 << 20;
+/// Most JSON objects in a glTF file's JSON (2²⁰: about 400 MiB once parsed, at most).
+pub const GLTF_MAX_JSON_OBJECTS: u64 = 1 << 20;
+/// Most JSON values and keys in a glTF file's JSON (2²², counted as its `{`, `[`, `,` and `:`
+/// outside strings).
+pub const GLTF_MAX_JSON_VALUES: u64 = 1 << 22;
 
 /// What kind of file system entry `meta` describes, for messages.
 fn kind(meta: &std::fs::Metadata) -> &'static str {
@@ -123,8 +133,9 @@ impl SceneDir {
         if let Some(r) = &self.root {
             return Ok(r.clone());
         }
-        let r = std::fs::canonicalize(&self.path)
-            .map_err(|e| format!("cannot resolve the scene file's directory {}: {e}", self.path.display()))?;
+        let r = std::fs::canonicalize(&self.path).map_err(|e| {
+            format!("cannot resolve the scene file's directory {}: {e}", crate::error::show_path(&self.path))
+        })?;
         self.root = Some(r.clone());
         Ok(r)
     }

@@ -19,17 +19,23 @@
 //! instantiates are counted against the scene's budget before any data is copied. Every accessor
 //! is bounds-checked before it is read, and every joint index against its skin. External buffer
 //! and image files must lie inside the asset root (`gltf_uri`), every byte read counts against
-//! [`GLTF_MAX_BYTES`] and decoded texels against
-//! [`crate::gltf_material::TEXEL_BUDGET_BYTES`]. Calls into the gltf crate and the image decoders
+//! [`GLTF_MAX_BYTES`] and decoded texels against what is left of the scene's
+//! [`MAX_SCENE_TEXELS`]. Calls into the gltf crate and the image decoders
 //! run under [`guarded`], so even an unforeseen panic there is an error, never a crash.
 
-use crate::files::{parent_dir, read_regular_file, GLTF_MAX_BYTES};
+use crate::files::{
+    parent_dir, read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS,
+    GLTF_MAX_JSON_VALUES,
+};
 use crate::frame::Mesh;
 use crate::gltf_material::{load_materials, ImageSource, Materials, SUPPORTED_EXTENSIONS};
 use crate::gltf_uri::resolve_uri;
 use crate::guard::guarded;
-use crate::limits::{fmt_f32, COORD_MAX, MAX_TRIANGLES, MAX_VERTICES};
+use crate::limits::{
+    fmt_f32, COORD_MAX, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
+};
 use crate::mesh::{append_mesh, smooth_normals, transform_mesh};
+use crate::texture::MAX_SCENE_TEXELS;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::buffer::Source;
 use gltf::json;
@@ -40,18 +46,22 @@ use std::path::Path;
 /// Deepest node hierarchy followed (the recursion that bakes the transforms stays shallow).
 const MAX_DEPTH: usize = 64;
 
-/// Triangles and vertices still allowed in the scene being loaded (every instance counted).
+/// Triangles, vertices and texture texels still allowed in the scene being loaded (every
+/// instance counted; each decoded image once).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Budget {
     /// Triangles left.
     pub triangles: u64,
     /// glTF vertices left.
     pub vertices: u64,
+    /// Texels left of [`MAX_SCENE_TEXELS`].
+    pub texels: u64,
 }
 
 impl Budget {
     /// The whole budget of one scene.
-    pub(crate) const FULL: Budget = Budget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES };
+    pub(crate) const FULL: Budget =
+        Budget { triangles: MAX_TRIANGLES, vertices: MAX_VERTICES, texels: MAX_SCENE_TEXELS };
 }
 
 /// Loads the glTF/GLB file at `path` into one mesh in the file's scene space. External buffers
@@ -70,7 +80,7 @@ pub(crate) fn load_gltf_in(
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
     let bytes = read_regular_file(path, GLTF_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
-    from_bytes_in(&bytes, parent_dir(path), root, budget, warnings)
+    from_bytes_in(std::borrow::Cow::Owned(bytes), parent_dir(path), root, budget, warnings)
 }
 
 /// Parses glTF or GLB `bytes`; external buffers are resolved relative to `dir` and must lie inside
@@ -84,21 +94,69 @@ pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
 pub fn gltf_from_bytes_with_warnings(bytes: &[u8], dir: &Path) -> Result<(Mesh, Vec<String>), String> {
     let mut budget = Budget::FULL;
     let mut warnings = Vec::new();
-    let mesh = from_bytes_in(bytes, dir, dir, &mut budget, &mut warnings)?;
+    let mesh = from_bytes_in(std::borrow::Cow::Borrowed(bytes), dir, dir, &mut budget, &mut warnings)?;
     Ok((mesh, warnings))
+}
+
+/// The JSON text of the file: the `.gltf` itself or a `.glb`'s JSON chunk.
+fn json_text(body: &[u8]) -> Result<std::borrow::Cow<'_, [u8]>, String> {
+    if body.starts_with(b"glTF") {
+        let glb = guarded("GLB", || gltf::Glb::from_slice(body))?
+            .map_err(|e| format!("not a valid GLB file: {e}"))?;
+        Ok(glb.json)
+    } else {
+        Ok(std::borrow::Cow::Borrowed(body))
+    }
 }
 
 /// The raw JSON of the file, for what the typed document does not keep (names, extensions,
 /// extras). serde_json limits its nesting depth, so hostile JSON cannot exhaust the stack.
-fn raw_json(body: &[u8]) -> Result<serde_json::Value, String> {
-    let json: Vec<u8> = if body.starts_with(b"glTF") {
-        let glb = guarded("GLB", || gltf::Glb::from_slice(body))?
-            .map_err(|e| format!("not a valid GLB file: {e}"))?;
-        glb.json.into_owned()
-    } else {
-        body.to_vec()
-    };
-    serde_json::from_slice(&json).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))
+fn raw_json(json: &[u8]) -> Result<serde_json::Value, String> {
+    serde_json::from_slice(json).map_err(|e| format!("not a valid glTF 2.0 file: {e}"))
+}
+
+/// Checks the JSON text against [`GLTF_MAX_JSON_BYTES`], [`GLTF_MAX_JSON_OBJECTS`] and
+/// [`GLTF_MAX_JSON_VALUES`] before it is parsed (twice: the typed document and the raw tree each
+/// take a few hundred bytes per object), counting lexically: objects are the `{` outside strings,
+/// values and keys at most the `{`, `[`, `,` and `:` outside strings.
+fn check_json_size(json: &[u8]) -> Result<(), String> {
+    if json.len() as u64 > GLTF_MAX_JSON_BYTES {
+        return Err(format!(
+            "its JSON is {} bytes, more than the limit of {} MiB (large buffers and images belong in binary \
+             chunks or files)",
+            json.len(),
+            GLTF_MAX_JSON_BYTES >> 20
+        ));
+    }
+    let (mut objects, mut values) = (0u64, 0u64);
+    let (mut in_string, mut escaped) = (false, false);
+    for &b in json {
+        if in_string {
+            match (escaped, b) {
+                (true, _) => escaped = false,
+                (false, b'\\') => escaped = true,
+                (false, b'"') => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        match b {
+            b'"' => in_string = true,
+            b'{' => {
+                objects += 1;
+                values += 1;
+            }
+            b'[' | b',' | b':' => values += 1,
+            _ => {}
+        }
+    }
+    if objects > GLTF_MAX_JSON_OBJECTS || values > GLTF_MAX_JSON_VALUES {
+        return Err(format!(
+            "its JSON holds {objects} objects and up to {values} values; at most {GLTF_MAX_JSON_OBJECTS} \
+             objects and {GLTF_MAX_JSON_VALUES} values fit a glTF file"
+        ));
+    }
+    Ok(())
 }
 
 /// The JSON text of a `.gltf` (a UTF-8 byte-order mark dropped) or the whole `.glb`; anything
@@ -117,16 +175,27 @@ fn sniff(bytes: &[u8]) -> Result<&[u8], String> {
     }
 }
 
+/// Loads the glTF or GLB `bytes`; the file's own bytes are dropped once parsed (a GLB's binary
+/// chunk lives on in the document), so a large file is not held twice.
 fn from_bytes_in(
-    bytes: &[u8],
+    bytes: std::borrow::Cow<'_, [u8]>,
     dir: &Path,
     root: &Path,
     budget: &mut Budget,
     warnings: &mut Vec<String>,
 ) -> Result<Mesh, String> {
-    let body = sniff(bytes)?;
-    let gltf = guarded("glTF", || gltf::Gltf::from_slice_without_validation(body))?
-        .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+    let file_len = bytes.len() as u64;
+    let (mut gltf, raw) = {
+        let body = sniff(&bytes)?;
+        let json = json_text(body)?;
+        check_json_size(&json)?;
+        let gltf = guarded("glTF", || gltf::Gltf::from_slice_without_validation(body))?
+            .map_err(|e| format!("not a valid glTF 2.0 file: {e}"))?;
+        (gltf, raw_json(&json))
+    };
+    drop(bytes);
+    // The binary chunk moves into the buffers below instead of being copied.
+    let mut blob = gltf.blob.take();
     let doc = gltf.document.as_json();
     for ext in &doc.extensions_required {
         if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
@@ -136,7 +205,14 @@ fn from_bytes_in(
             ));
         }
     }
-    let raw = raw_json(body)?;
+    if doc.materials.len() as u64 >= MAX_MATERIAL_SLOTS {
+        return Err(format!(
+            "it has {} materials; with its default material that is more than the limit of \
+             {MAX_MATERIAL_SLOTS} material slots per scene",
+            doc.materials.len()
+        ));
+    }
+    let raw = raw?;
     check_indices(doc)?;
     crate::gltf_material::check_raw(&raw, doc.textures.len())?;
     let parent = check_forest(doc)?;
@@ -163,14 +239,15 @@ fn from_bytes_in(
     let roots: Vec<usize> = match scene {
         Some(s) => {
             let roots: Vec<usize> = doc.scenes[s].nodes.iter().map(|n| n.value()).collect();
-            for (i, &r) in roots.iter().enumerate() {
+            let mut listed = vec![false; doc.nodes.len()];
+            for &r in &roots {
                 if let Some(p) = parent[r] {
                     return Err(format!(
                         "scene {s} lists node {r} as a root, but node {p} has it as a child (node graphs \
                          must be trees)"
                     ));
                 }
-                if roots[..i].contains(&r) {
+                if std::mem::replace(&mut listed[r], true) {
                     return Err(format!("scene {s} lists node {r} twice (node graphs must be trees)"));
                 }
             }
@@ -179,6 +256,7 @@ fn from_bytes_in(
         None => (0..doc.nodes.len()).filter(|&n| parent[n].is_none()).collect(),
     };
     let need = count_instances(doc, &roots)?;
+    let used_skins = skins_used(doc, &roots);
     if need.triangles > budget.triangles {
         return Err(format!(
             "its default scene has {} triangles (every node instance counted), more than the {} left of \
@@ -194,11 +272,11 @@ fn from_bytes_in(
         ));
     }
 
-    let mut bytes_left = GLTF_MAX_BYTES.saturating_sub(bytes.len() as u64);
+    let mut bytes_left = GLTF_MAX_BYTES.saturating_sub(file_len);
     let mut buffers: Vec<Vec<u8>> = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
-            Source::Bin => gltf.blob.clone().ok_or_else(|| {
+            Source::Bin => blob.take().ok_or_else(|| {
                 format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index())
             })?,
             Source::Uri(uri) => resolve_uri(uri, dir, root, bytes_left)
@@ -217,10 +295,22 @@ fn from_bytes_in(
     }
 
     let src = ImageSource { buffers: &buffers, dir, root };
-    let materials = guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, warnings))??;
+    let texels = &mut budget.texels;
+    let materials =
+        guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, texels, warnings))??;
     let out = guarded("glTF", || -> Result<Mesh, String> {
         let nodes: Vec<gltf::Node<'_>> = gltf.nodes().collect();
-        let ctx = Ctx { buffers: &buffers, materials: &materials, worlds: world_matrices(&nodes, &parent) };
+        let worlds = world_matrices(&nodes, &parent);
+        // Each skin's `J_k · IBM_k` once, for every skin a node of the default scene uses.
+        let mut skins: Vec<Option<Vec<Mat4>>> = vec![None; doc.skins.len()];
+        for skin in gltf.skins() {
+            if used_skins[skin.index()] {
+                let m = skin_matrices(&skin, &buffers, &worlds)
+                    .map_err(|e| format!("skin {}: {e}", skin.index()))?;
+                skins[skin.index()] = Some(m);
+            }
+        }
+        let ctx = Ctx { buffers: &buffers, materials: &materials, skins };
         let mut out = Mesh::default();
         for &r in &roots {
             add_node(&nodes[r], Mat4::IDENTITY, &ctx, &mut out, 0, warnings)?;
@@ -395,16 +485,38 @@ fn check_forest(r: &json::Root) -> Result<Vec<Option<usize>>, String> {
     Ok(parent)
 }
 
-/// Triangles and vertices the nodes under `roots` instantiate, from the JSON alone.
+/// Triangles and vertices the nodes under `roots` instantiate, from the JSON alone; errors where
+/// the skinned nodes or their skins' joints exceed [`MAX_SKINNED_NODES`] or [`MAX_SKIN_JOINTS`].
 fn count_instances(r: &json::Root, roots: &[usize]) -> Result<Budget, String> {
     let count = |a: json::Index<json::Accessor>| r.accessors[a.value()].count.0;
-    let mut total = Budget { triangles: 0, vertices: 0 };
+    let mut total = Budget { triangles: 0, vertices: 0, texels: 0 };
+    let (mut skinned, mut joints) = (0u64, 0u64);
+    let mut skin_seen = vec![false; r.skins.len()];
     let mut stack: Vec<(usize, usize)> = roots.iter().map(|&n| (n, 0)).collect();
     while let Some((i, depth)) = stack.pop() {
         if depth > MAX_DEPTH {
             return Err(format!("node hierarchy deeper than {MAX_DEPTH} levels at node {i}"));
         }
         let node = &r.nodes[i];
+        if let (Some(_), Some(s)) = (node.mesh, node.skin) {
+            skinned += 1;
+            if skinned > MAX_SKINNED_NODES {
+                return Err(format!(
+                    "its default scene has more than the limit of {MAX_SKINNED_NODES} skinned mesh nodes \
+                     (node {i} is one too many)"
+                ));
+            }
+            let s = s.value();
+            if !std::mem::replace(&mut skin_seen[s], true) {
+                joints += r.skins[s].joints.len() as u64;
+                if joints > MAX_SKIN_JOINTS {
+                    return Err(format!(
+                        "skin {s} brings the joints of the skins its default scene uses to {joints}, more than \
+                         the limit of {MAX_SKIN_JOINTS} joints per glTF file"
+                    ));
+                }
+            }
+        }
         if let Some(m) = node.mesh {
             for p in &r.meshes[m.value()].primitives {
                 let pos =
@@ -420,12 +532,27 @@ fn count_instances(r: &json::Root, roots: &[usize]) -> Result<Budget, String> {
     Ok(total)
 }
 
+/// Which skins the nodes under `roots` use (the graph is a forest and at most [`MAX_DEPTH`]
+/// deep: `count_instances` checked both).
+fn skins_used(r: &json::Root, roots: &[usize]) -> Vec<bool> {
+    let mut used = vec![false; r.skins.len()];
+    let mut stack: Vec<usize> = roots.to_vec();
+    while let Some(i) = stack.pop() {
+        let node = &r.nodes[i];
+        if let (Some(_), Some(s)) = (node.mesh, node.skin) {
+            used[s.value()] = true;
+        }
+        stack.extend(node.children.iter().flatten().map(|c| c.value()));
+    }
+    used
+}
+
 /// What every node of a load needs.
 struct Ctx<'a> {
     buffers: &'a [Vec<u8>],
     materials: &'a Materials,
-    /// Every node's world matrix (`None`: non-finite), for skin joints.
-    worlds: Vec<Option<Mat4>>,
+    /// Per skin, `J_k · IBM_k` for every joint `k` (computed once, for the skins in use).
+    skins: Vec<Option<Vec<Mat4>>>,
 }
 
 /// Every node's world matrix from the node hierarchy (the graph is a forest), without recursion.
@@ -461,7 +588,12 @@ fn add_node(
     let world = parent * local;
     if let Some(mesh) = node.mesh() {
         let skin = match node.skin() {
-            Some(skin) => Some(skin_matrices(&skin, ctx).map_err(|e| format!("skin {}: {e}", skin.index()))?),
+            Some(skin) => Some(
+                ctx.skins
+                    .get(skin.index())
+                    .and_then(Option::as_deref)
+                    .ok_or_else(|| format!("skin {} was not prepared", skin.index()))?,
+            ),
             None => None,
         };
         for prim in mesh.primitives() {
@@ -499,15 +631,20 @@ fn add_node(
     Ok(())
 }
 
-/// `J_k · IBM_k` for every joint `k` of `skin`.
-fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, String> {
+/// `J_k · IBM_k` for every joint `k` of `skin` (`worlds`: every node's world matrix, `None` where
+/// it is not finite).
+fn skin_matrices(
+    skin: &gltf::Skin<'_>,
+    buffers: &[Vec<u8>],
+    worlds: &[Option<Mat4>],
+) -> Result<Vec<Mat4>, String> {
     let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
     if joints.is_empty() {
         return Err("it has no joints".into());
     }
     let ibms: Vec<Mat4> = match skin.inverse_bind_matrices() {
         Some(acc) => {
-            check_accessor(&acc, &[Dimensions::Mat4], &[DataType::F32], ctx.buffers)
+            check_accessor(&acc, &[Dimensions::Mat4], &[DataType::F32], buffers)
                 .map_err(|e| format!("inverseBindMatrices: {e}"))?;
             if acc.count() != joints.len() {
                 return Err(format!(
@@ -516,7 +653,7 @@ fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, Stri
                     joints.len()
                 ));
             }
-            let get = |b: gltf::Buffer<'_>| ctx.buffers.get(b.index()).map(|d| d.as_slice());
+            let get = |b: gltf::Buffer<'_>| buffers.get(b.index()).map(|d| d.as_slice());
             let m: Vec<Mat4> = skin
                 .reader(get)
                 .read_inverse_bind_matrices()
@@ -534,7 +671,7 @@ fn skin_matrices(skin: &gltf::Skin<'_>, ctx: &Ctx<'_>) -> Result<Vec<Mat4>, Stri
         .iter()
         .zip(ibms)
         .map(|(&j, ibm)| {
-            let w = ctx.worlds[j].ok_or_else(|| format!("joint node {j} has a non-finite transform"))?;
+            let w = worlds[j].ok_or_else(|| format!("joint node {j} has a non-finite transform"))?;
             Ok(w * ibm)
         })
         .collect()
@@ -560,7 +697,15 @@ fn skin_mesh(
         if w.iter().any(|x| !x.is_finite() || *x < 0.0) {
             return Err(format!("vertex {v} has a negative or non-finite weight in WEIGHTS_0"));
         }
-        let sum: f32 = w.iter().sum();
+        // Normalised to sum 1; a sum that overflows (finite weights near f32::MAX) is taken
+        // relative to the largest weight instead, which cannot overflow.
+        let mut sum: f32 = w.iter().sum();
+        let mut w = *w;
+        if sum.is_infinite() {
+            let max = w.iter().fold(0.0f32, |a, &b| a.max(b));
+            w = w.map(|x| x / max);
+            sum = w.iter().sum();
+        }
         let m = if sum > 0.0 {
             let mut m = Mat4 { cols: [[0.0; 4]; 4] };
             for k in 0..4 {

@@ -11,20 +11,17 @@
 //!
 //! Images come from a bufferView or a URI (base64 data URI, or a file inside the asset root; both
 //! read by `gltf_uri`) and are decoded once each (PNG or JPEG, recognised by their bytes), only
-//! when a material uses them; the decoded texels of one glTF file are capped at
-//! [`TEXEL_BUDGET_BYTES`]. Every index read here is checked against the array it points into
-//! first.
+//! when a material uses them, one at a time, against what is left of the scene's
+//! [`MAX_SCENE_TEXELS`](crate::texture::MAX_SCENE_TEXELS). Every index read here is checked
+//! against the array it points into first.
 
+use crate::error::escape_controls;
 use crate::frame::{Filter, Material, Ramp, ShadingModel, Texture, TextureRef, Wrap};
 use crate::gltf_uri::resolve_uri;
-use crate::texture::decode_texture;
+use crate::texture::decode_texture_within;
 use serde_json::Value;
 use std::path::Path;
 use std::sync::Arc;
-
-/// Most bytes of decoded texels (4 per texel, after any downscale) one glTF file may bring
-/// (512 MiB).
-pub(crate) const TEXEL_BUDGET_BYTES: u64 = 512 << 20;
 
 /// The glTF extensions hadou maps (a file may list them in `extensionsRequired`).
 pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_materials_unlit", "VRMC_materials_mtoon"];
@@ -132,19 +129,20 @@ fn wrap_of(mode: gltf::texture::WrappingMode) -> Wrap {
     }
 }
 
-/// Loads every material of the file, decoding the images they use.
+/// Loads every material of the file, decoding the images they use; their texels are taken from
+/// `texels_left` (the scene's texture budget).
 pub(crate) fn load_materials(
     gltf: &gltf::Gltf,
     raw: &Value,
     src: &ImageSource<'_>,
     bytes_left: &mut u64,
+    texels_left: &mut u64,
     warnings: &mut Vec<String>,
 ) -> Result<Materials, String> {
     let doc = gltf.document.as_json();
     let n_tex = doc.textures.len();
     let raw_mats = raw.get("materials").and_then(Value::as_array).map_or(&[][..], |v| v.as_slice());
     let mut images: Vec<Option<Arc<Texture>>> = vec![None; doc.images.len()];
-    let mut texel_bytes = 0u64;
     let mut list = Vec::with_capacity(doc.materials.len() + 1);
     let mut uv_set = Vec::with_capacity(doc.materials.len());
     for (i, m) in doc.materials.iter().enumerate() {
@@ -154,7 +152,7 @@ pub(crate) fn load_materials(
             .get("name")
             .and_then(Value::as_str)
             .filter(|s| !s.is_empty())
-            .map_or_else(|| format!("material {i}"), str::to_string);
+            .map_or_else(|| format!("material {i}"), |s| escape_controls(s).into_owned());
         let pbr = &m.pbr_metallic_roughness;
         let f = pbr.base_color_factor.0;
         if f.iter().any(|c| !c.is_finite()) {
@@ -201,15 +199,14 @@ pub(crate) fn load_materials(
             let texture = match &images[image] {
                 Some(t) => t.clone(),
                 None => {
-                    let t = Arc::new(load_image(gltf, image, src, bytes_left, warnings)?);
-                    texel_bytes = texel_bytes.saturating_add(t.texels.len() as u64 * 4);
-                    if texel_bytes > TEXEL_BUDGET_BYTES {
-                        return Err(format!(
-                            "image {image}: the images of this file decode to more than the limit of {} MiB of \
-                             texels per glTF file",
-                            TEXEL_BUDGET_BYTES >> 20
-                        ));
-                    }
+                    let t = load_image(gltf, image, src, bytes_left, *texels_left, warnings).map_err(
+                        |e| match rm.get("name").and_then(Value::as_str) {
+                            Some(n) if !n.is_empty() => format!("material `{name}` ({what}): {e}"),
+                            _ => format!("{what}: {e}"),
+                        },
+                    )?;
+                    *texels_left -= t.texels.len() as u64;
+                    let t = Arc::new(t);
                     images[image] = Some(t.clone());
                     t
                 }
@@ -246,12 +243,13 @@ pub(crate) fn load_materials(
     Ok(Materials { list, uv_set })
 }
 
-/// The bytes of image `index`, decoded.
+/// The bytes of image `index`, decoded, if it keeps at most `texels_left` texels.
 fn load_image(
     gltf: &gltf::Gltf,
     index: usize,
     src: &ImageSource<'_>,
     bytes_left: &mut u64,
+    texels_left: u64,
     warnings: &mut Vec<String>,
 ) -> Result<Texture, String> {
     // The JSON itself, not the gltf crate's `Image::source`, which requires a `mimeType` with a
@@ -274,12 +272,16 @@ fn load_image(
         (None, Some(uri)) => {
             let bytes = resolve_uri(uri, src.dir, src.root, *bytes_left).map_err(fail)?;
             *bytes_left = bytes_left.saturating_sub(bytes.len() as u64);
-            let shown = if uri.starts_with("data:") { "data URI".to_string() } else { format!("`{uri}`") };
+            let shown = if uri.starts_with("data:") {
+                "data URI".to_string()
+            } else {
+                format!("`{}`", escape_controls(uri))
+            };
             (bytes, format!("image {index} ({shown})"))
         }
         (None, None) => return Err(fail("it has neither a `bufferView` nor a `uri`".into())),
     };
-    decode_texture(&bytes, &name, warnings).map_err(fail)
+    decode_texture_within(&bytes, &name, texels_left, warnings).map_err(|e| format!("{name}: {e}"))
 }
 
 /// Checks the raw JSON indices this module reads beyond what `check_indices` covers (the feature

@@ -2,6 +2,7 @@
 //! or a relative, percent-encoded file path that must resolve inside the asset root, read with a
 //! byte cap. Used by `gltf_load` (buffers) and `gltf_material` (images).
 
+use crate::error::{escape_controls, show_path};
 use crate::files::{describe_bytes, read_regular_file, GLTF_MAX_BYTES};
 use std::path::{Path, PathBuf};
 
@@ -13,24 +14,25 @@ pub(crate) fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Resul
             rest.split_once(";base64,").ok_or("only base64 data URIs are supported (`data:…;base64,…`)")?;
         return base64_decode(payload).ok_or_else(|| "invalid base64 in data URI".to_string());
     }
+    let shown = escape_controls(uri);
     if uri.contains("://") {
-        return Err(format!("cannot fetch `{uri}`: only relative file paths and data URIs are supported"));
+        return Err(format!("cannot fetch `{shown}`: only relative file paths and data URIs are supported"));
     }
     let rel = PathBuf::from(percent_decode(uri));
     if rel.is_absolute() || rel.has_root() {
         return Err(format!(
-            "`{uri}` is an absolute path; buffer and image files must be named relative to the glTF file and lie \
+            "`{shown}` is an absolute path; buffer and image files must be named relative to the glTF file and lie \
              inside the scene file's directory"
         ));
     }
     let file = dir.join(&rel);
-    let real = std::fs::canonicalize(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-    let top = std::fs::canonicalize(root).map_err(|e| format!("cannot resolve {}: {e}", root.display()))?;
+    let real = std::fs::canonicalize(&file).map_err(|e| format!("cannot read {}: {e}", show_path(&file)))?;
+    let top = std::fs::canonicalize(root).map_err(|e| format!("cannot resolve {}: {e}", show_path(root)))?;
     if !real.starts_with(&top) {
         return Err(format!(
-            "`{uri}` resolves to {}, outside {}; buffer and image files must lie inside the scene file's directory",
-            real.display(),
-            top.display()
+            "`{shown}` resolves to {}, outside {}; buffer and image files must lie inside the scene file's directory",
+            show_path(&real),
+            show_path(&top)
         ));
     }
     read_regular_file(&real, cap).map_err(|e| {
@@ -39,7 +41,7 @@ pub(crate) fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Resul
         } else {
             String::new()
         };
-        format!("cannot read {}: {e}{hint}", file.display())
+        format!("cannot read {}: {e}{hint}", show_path(&file))
     })
 }
 

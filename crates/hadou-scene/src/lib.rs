@@ -59,15 +59,23 @@ pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS
 pub use backend::{Backend, RenderError};
 pub use bounds::{object_bounds, object_center};
 pub use error::{Location, SceneError};
-pub use files::{read_regular_file, GLTF_MAX_BYTES, SCENE_MAX_BYTES};
+pub use files::{
+    read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS, GLTF_MAX_JSON_VALUES,
+    SCENE_MAX_BYTES,
+};
 pub use frame::*;
 pub use gltf_load::{gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf};
 pub use image::Image;
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
-pub use limits::{MAX_TRIANGLES, MAX_VERTICES};
+pub use limits::{
+    MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
+};
 pub use scene::Scene;
 pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,
-    ON_PLANE,
+    MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES, ON_PLANE,
 };
-pub use texture::{decode_texture, encode_png, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS};
+pub use texture::{
+    decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE,
+    TEXTURE_MAX_TEXELS,
+};

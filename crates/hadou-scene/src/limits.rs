@@ -45,10 +45,30 @@ pub(crate) const SCALE_MIN: f32 = 1e-6;
 pub(crate) const DIR_MIN: f64 = 1e-6;
 /// Most `[[wave]]` tables in one scene.
 pub(crate) const MAX_WAVES: usize = 256;
-/// Most triangles of all objects of one scene together, every glTF instance counted.
-pub const MAX_TRIANGLES: u64 = 20_000_000;
-/// Most vertices of all glTF primitives of one scene together, every instance counted.
-pub const MAX_VERTICES: u64 = 60_000_000;
+/// Most triangles of all objects of one scene together, every glTF instance counted: 2²¹
+/// (two spheres of 1024 segments). The CPU backend keeps about 200 bytes per projected triangle
+/// (an object's, its outline hull's, and each shadow's copy of its casters'), so a scene at its
+/// limits renders in well under 4 GB (docs/scene-format.md, "Memory").
+pub const MAX_TRIANGLES: u64 = 1 << 21;
+/// Most material slots of all objects of one scene together (an object has one slot per material
+/// of its mesh, at least one; so also the most objects). Both backends keep a material record per
+/// slot of every object, and `Scene::at` builds each slot's material per frame.
+pub const MAX_MATERIAL_SLOTS: u64 = 65_536;
+/// Most checks of the rules between keys: for each part of a scene with such rules (the camera,
+/// the light, the area light with its target object, each shadow, each wave), its distinct key
+/// times times the numbers it holds, summed over the parts (2²⁶, well under a second of work).
+pub const MAX_KEY_CHECKS: u64 = 1 << 26;
+/// Most vertices of all objects of one scene together (primitives' and glTF primitives', every
+/// instance counted): three per triangle of [`MAX_TRIANGLES`], what a mesh without shared vertices
+/// needs.
+pub const MAX_VERTICES: u64 = 3 * MAX_TRIANGLES;
+/// Most joints of all the skins one glTF file's default scene uses, each skin counted once (so
+/// also the most joints of one skin; `JOINTS_0` indices are 16-bit, so no skin can address more).
+/// Each skin's joint matrices are computed once, whatever the number of nodes using it.
+pub const MAX_SKIN_JOINTS: u64 = 65_536;
+/// Most skinned mesh nodes (nodes with both a mesh and a skin) one glTF file's default scene
+/// instantiates.
+pub const MAX_SKINNED_NODES: u64 = 16_384;
 
 /// A number for a message: shortest round-trip digits, in scientific notation where that is
 /// clearly shorter (`3e38` rather than 39 digits, `1e5` rather than `100000`).

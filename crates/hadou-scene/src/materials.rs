@@ -6,6 +6,7 @@
 
 use crate::files::SceneDir;
 use crate::frame::{Filter, Material, Mesh, Outline, Ramp, RampKind, ShadingModel, TextureRef, Wrap};
+use crate::limits::fmt_f32;
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::texture::load_texture_file;
 use crate::toml_read::{read_numbers, type_name, Fallback, ParamReader, Res, Table};
@@ -106,7 +107,11 @@ pub(crate) fn parse_ramp(t: &Table<'_, '_>, key: &str) -> Res<Option<Ramp>> {
         if !(-1.0..=1.0).contains(&th) {
             return Err(t.src.value_err(
                 span,
-                format!("threshold of row {} of {what} must be in [-1, 1] (m = N·L), got {th}", i + 1),
+                format!(
+                    "threshold of row {} of {what} must be in [-1, 1] (m = N·L), got {}",
+                    i + 1,
+                    fmt_f32(th)
+                ),
             ));
         }
         if let Some(&(prev, _)) = stops.last() {
@@ -114,16 +119,18 @@ pub(crate) fn parse_ramp(t: &Table<'_, '_>, key: &str) -> Res<Option<Ramp>> {
                 return Err(t.src.value_err(
                     span,
                     format!(
-                        "thresholds of {what} must be sorted: row {} has {th} after {prev}; list the bands from \
+                        "thresholds of {what} must be sorted: row {} has {} after {}; list the bands from \
                          the darkest (m = -1) up",
-                        i + 1
+                        i + 1,
+                        fmt_f32(th),
+                        fmt_f32(prev)
                     ),
                 ));
             }
             if th == prev {
                 return Err(t.src.value_err(
                     span,
-                    format!("rows {} and {} of {what} overlap: both start at m = {th}", i, i + 1),
+                    format!("rows {} and {} of {what} overlap: both start at m = {}", i, i + 1, fmt_f32(th)),
                 ));
             }
         }
@@ -131,7 +138,14 @@ pub(crate) fn parse_ramp(t: &Table<'_, '_>, key: &str) -> Res<Option<Ramp>> {
         for k in 0..3 {
             let (x, s) = &row[k + 1];
             if !(0.0..=crate::limits::COORD_MAX).contains(x) {
-                return Err(t.src.value_err(s, format!("colour components of {what} must be ≥ 0, got {x}")));
+                return Err(t.src.value_err(
+                    s,
+                    format!(
+                        "colour components of {what} must be in [0, {}], got {}",
+                        fmt_f32(crate::limits::COORD_MAX),
+                        fmt_f32(*x)
+                    ),
+                ));
             }
             c[k] = *x;
         }
@@ -155,7 +169,7 @@ pub(crate) fn parse_ramp(t: &Table<'_, '_>, key: &str) -> Res<Option<Ramp>> {
                 if !(0.0..=2.0).contains(&x[0].0) {
                     return Err(t.src.value_err(
                         &x[0].1,
-                        format!("`{smooth_key}` in {} must be in [0, 2], got {}", t.what, x[0].0),
+                        format!("`{smooth_key}` in {} must be in [0, 2], got {}", t.what, fmt_f32(x[0].0)),
                     ));
                 }
                 smoothing = x[0].0;
@@ -181,7 +195,10 @@ pub(crate) fn scene_file(t: &Table<'_, '_>, key: &str, rel: &str, dir: &Path, ro
         ));
     }
     let real = std::fs::canonicalize(&file).map_err(|e| {
-        t.src.value_err(&span, format!("`{key}` in {}: cannot read {}: {e}", t.what, file.display()))
+        t.src.value_err(
+            &span,
+            format!("`{key}` in {}: cannot read {}: {e}", t.what, crate::error::show_path(&file)),
+        )
     })?;
     if !real.starts_with(root) {
         return Err(t.src.value_err(
@@ -189,9 +206,9 @@ pub(crate) fn scene_file(t: &Table<'_, '_>, key: &str, rel: &str, dir: &Path, ro
             format!(
                 "`{key}` in {}: {} resolves to {}, outside the scene file's directory {}",
                 t.what,
-                rel,
-                real.display(),
-                root.display()
+                crate::error::escape_controls(rel),
+                crate::error::show_path(&real),
+                crate::error::show_path(root)
             ),
         ));
     }
@@ -199,10 +216,12 @@ pub(crate) fn scene_file(t: &Table<'_, '_>, key: &str, rel: &str, dir: &Path, ro
 }
 
 /// What reading textures shares: the scene's directory (resolved when the first texture is
-/// named), decoded images by path, and the warnings.
+/// named), decoded images by path, the texels left of the scene's budget
+/// ([`crate::texture::MAX_SCENE_TEXELS`]) and the warnings.
 pub(crate) struct TextureCache<'w> {
     pub dir: SceneDir,
     pub images: HashMap<PathBuf, Arc<crate::frame::Texture>>,
+    pub texels_left: &'w mut u64,
     pub warnings: &'w mut Vec<String>,
 }
 
@@ -219,8 +238,11 @@ fn texture(
     let image = match cache.images.get(&real) {
         Some(i) => i.clone(),
         None => {
-            let img = load_texture_file(&real, cache.warnings)
-                .map_err(|m| t.src.value_err(&span, format!("`{key}` in {}: texture {rel}: {m}", t.what)))?;
+            let img = load_texture_file(&real, *cache.texels_left, cache.warnings).map_err(|m| {
+                let rel = crate::error::escape_controls(rel);
+                t.src.value_err(&span, format!("`{key}` in {}: texture {rel}: {m}", t.what))
+            })?;
+            *cache.texels_left -= img.texels.len() as u64;
             let img = Arc::new(img);
             cache.images.insert(real, img.clone());
             img
@@ -305,10 +327,12 @@ pub(crate) fn parse_material(
 /// Reads an object's material keys: `material = "name"` (every slot), or
 /// `materials = { "<mesh material>" = "<scene material>", … }`, plus the object-wide overrides
 /// (read into `params` only when given).
+/// `by_name` maps each `[[material]]` name to its index in `scene_materials`.
 pub(crate) fn parse_object_materials(
     t: &Table<'_, '_>,
     mesh: &Mesh,
     scene_materials: &[MaterialDef],
+    by_name: &HashMap<&str, usize>,
     params: &mut ParamSet,
     rd: &mut ParamReader<'_>,
     warnings: &mut Vec<String>,
@@ -316,7 +340,7 @@ pub(crate) fn parse_object_materials(
     let n_slots = mesh.materials.len().max(1);
     let mut slots: Vec<SlotSource> = (0..n_slots).map(SlotSource::Mesh).collect();
     let find = |name: &str, span: &crate::toml_read::Span| -> Res<usize> {
-        scene_materials.iter().position(|m| m.name == name).ok_or_else(|| {
+        by_name.get(name).copied().ok_or_else(|| {
             let names: Vec<&str> = scene_materials.iter().map(|m| m.name.as_str()).collect();
             t.src.value_err(
                 span,
@@ -345,6 +369,11 @@ pub(crate) fn parse_object_materials(
                 ),
             ));
         };
+        // The mesh's materials by name (the first of equal names), built once per object.
+        let mut mesh_slots: HashMap<&str, usize> = HashMap::with_capacity(mesh.materials.len());
+        for (i, m) in mesh.materials.iter().enumerate() {
+            mesh_slots.entry(m.name.as_str()).or_insert(i);
+        }
         for (k, val) in map.iter() {
             let key = k.get_ref().as_ref();
             let DeValue::String(target) = val.get_ref() else {
@@ -353,16 +382,12 @@ pub(crate) fn parse_object_materials(
                     format!("`materials.{key}` in {} must be the name of a [[material]]", t.what),
                 ));
             };
-            let names: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect();
-            let Some(slot) = mesh.materials.iter().position(|m| m.name == key) else {
+            let Some(&slot) = mesh_slots.get(key) else {
+                let names: Vec<&str> = mesh.materials.iter().map(|m| m.name.as_str()).collect();
                 let have = if names.is_empty() {
                     " (the mesh has no named materials; use `material = \"…\"`)".to_string()
                 } else {
-                    format!(
-                        "{}; its materials are {}",
-                        crate::error::hint(key, &names, "names"),
-                        names.join(", ")
-                    )
+                    crate::error::hint(key, &names, "materials of the mesh")
                 };
                 return Err(t.src.value_err(
                     &k.span(),

@@ -35,6 +35,13 @@ pub fn box_mesh(size: [f32; 3]) -> Mesh {
     m
 }
 
+/// The triangles and vertices of [`sphere_mesh`] with `segments`, without building it.
+pub fn sphere_size(segments: u32) -> (u64, u64) {
+    let slices = u64::from(segments.max(3));
+    let stacks = u64::from((segments / 2).max(2));
+    (2 * slices * (stacks - 1), (stacks + 1) * (slices + 1))
+}
+
 /// A UV sphere of `radius` around the origin with `segments` slices around the y axis and
 /// `max(2, segments / 2)` stacks; the pole caps are triangles.
 pub fn sphere_mesh(radius: f32, segments: u32) -> Mesh {
@@ -205,6 +212,10 @@ mod tests {
 
     #[test]
     fn sphere_is_closed_and_outward() {
+        for s in [3, 4, 5, 16, 1024] {
+            let m = sphere_mesh(1.0, s);
+            assert_eq!(sphere_size(s), ((m.indices.len() / 3) as u64, m.positions.len() as u64), "{s}");
+        }
         let m = sphere_mesh(2.0, 16);
         check_outward(&m);
         for p in &m.positions {

@@ -98,7 +98,7 @@ impl Constraint {
                         0,
                         format!(
                             "is too short to give a direction: length {}, at least {}",
-                            fmt_f64(len),
+                            fmt_f32(len as f32),
                             fmt_f64(DIR_MIN)
                         ),
                     ))

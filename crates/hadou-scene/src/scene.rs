@@ -55,6 +55,14 @@ pub(crate) struct ObjectDef {
     pub is_plane: bool,
 }
 
+impl ObjectDef {
+    /// Object → world at these values (`T·R·S`).
+    pub(crate) fn transform(&self, vals: &[f32]) -> Mat4 {
+        let v3 = |key: &str| Vec3f::from_array(self.params.arr::<3>(vals, key));
+        Mat4::from_trs(v3("position"), v3("rotation"), v3("scale"))
+    }
+}
+
 /// The wave kinds of the schema.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum WaveKind {
@@ -163,18 +171,20 @@ impl Scene {
             .chain(self.shadows.iter().map(|s| &s.params))
             .chain(self.area_light.iter().map(|a| &a.params));
         for set in sets {
-            for p in &set.params {
-                let r = p.offset..p.offset + p.len;
-                if let (Some(v), Some(base)) =
-                    (vals.get(r.clone()).map(|s| s.to_vec()), self.values.get(r.clone()))
-                {
-                    let mut v = v;
-                    p.rule.clamp(&mut v, base);
-                    vals[r].copy_from_slice(&v);
-                }
-            }
+            self.clamp_params(set, &mut vals);
         }
         vals
+    }
+
+    /// Clamps the values of `set` in `vals` into their ranges, non-finite ones falling back to the
+    /// file's values.
+    pub(crate) fn clamp_params(&self, set: &ParamSet, vals: &mut [f32]) {
+        for p in &set.params {
+            let r = p.offset..p.offset + p.len;
+            if let (Some(v), Some(base)) = (vals.get_mut(r.clone()), self.values.get(r)) {
+                p.rule.clamp(v, base);
+            }
+        }
     }
 
     /// Builds the frame from a (valid) value store.
@@ -225,17 +235,13 @@ impl Scene {
 
     /// The frame's objects at these values.
     pub(crate) fn build_objects(&self, vals: &[f32]) -> Vec<Object> {
-        let v3 = |set: &ParamSet, key: &str| Vec3f::from_array(set.arr::<3>(vals, key));
         self.objects
             .iter()
-            .map(|o| {
-                let p = &o.params;
-                Object {
-                    name: o.name.clone(),
-                    mesh: o.mesh.clone(),
-                    transform: Mat4::from_trs(v3(p, "position"), v3(p, "rotation"), v3(p, "scale")),
-                    materials: self.object_materials(o, vals),
-                }
+            .map(|o| Object {
+                name: o.name.clone(),
+                mesh: o.mesh.clone(),
+                transform: o.transform(vals),
+                materials: self.object_materials(o, vals),
             })
             .collect()
     }

@@ -10,25 +10,26 @@
 //! `shadow_def.rs`, `area_light_def.rs` and `track_def.rs`.
 
 use crate::area_light::SOFT_MAX_PIXELS;
-use crate::area_light_def::{check_area_light, parse_area_light};
-use crate::error::{Location, SceneError};
+use crate::area_light_def::{check_area_light, interest_at, parse_area_light, Target};
+use crate::bounds::mesh_center;
+use crate::error::{show_path, Location, SceneError};
 use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
 use crate::frame::{Mesh, ToneMode};
 use crate::gltf_load::Budget;
 use crate::limits::{
-    fmt_f32, fmt_f64, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_TRIANGLES, MAX_VERTICES,
-    MAX_WAVES, NEAR_MIN, SCALE_MIN,
+    fmt_f32, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS,
+    MAX_TRIANGLES, MAX_VERTICES, MAX_WAVES, NEAR_MIN, SCALE_MIN,
 };
 use crate::materials::{
     parse_material, parse_object_materials, parse_ramp, MaterialDef, TextureCache, OBJECT_MATERIAL_KEYS,
 };
-use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
+use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, sphere_size, with_outline_normals};
 use crate::params::{Constraint, ParamSet, Shape};
 use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
-use crate::shadow::MAX_SHADOWS;
+use crate::shadow::{MAX_SHADOWS, MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES};
 use crate::shadow_def::{check_map_budget, check_shadow, parse_shadow, ShadowDef};
 use crate::toml_read::{Fallback, ParamReader, Res, Span, Src, Table};
-use crate::track_def::parse_track;
+use crate::track_def::{parse_track, Names, Owner};
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
 use std::collections::HashMap;
@@ -185,7 +186,12 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     rd.add(&root, &mut globals, "background", V3, NONNEG, Fallback::Value(&[0.0; 3]), false)?;
 
     let dir = parent_dir(path).to_path_buf();
-    let mut assets = Assets { dir: SceneDir::new(dir), cache: HashMap::new(), budget: Budget::FULL };
+    let mut assets = Assets {
+        dir: SceneDir::new(dir),
+        cache: HashMap::new(),
+        budget: Budget::FULL,
+        slots_left: MAX_MATERIAL_SLOTS,
+    };
     let mut warnings = Vec::new();
 
     // [[material]]
@@ -196,6 +202,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         let mut cache = TextureCache {
             dir: SceneDir::new(assets.dir.path.clone()),
             images: HashMap::new(),
+            texels_left: &mut assets.budget.texels,
             warnings: &mut warnings,
         };
         for (i, (t, span)) in material_tables.into_iter().enumerate() {
@@ -209,11 +216,14 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     // [[object]]
     let mut objects: Vec<ObjectDef> = Vec::new();
     let mut names: HashMap<String, Span> = HashMap::new();
+    let material_index: HashMap<&str, usize> =
+        materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i)).collect();
     for (i, (t, span)) in root.array_of_tables("object")?.into_iter().enumerate() {
         let table = Table { src, t, span, what: format!("[[object]] #{}", i + 1) };
         let name = entity_name(&table, &mut names, "object")?;
         let table = Table { what: format!("[[object]] \"{name}\""), ..table };
-        objects.push(parse_object(&table, name, &mut rd, &mut assets, &materials, &mut warnings)?);
+        let mats = (&materials[..], &material_index);
+        objects.push(parse_object(&table, name, &mut rd, &mut assets, mats, &mut warnings)?);
     }
 
     // [[wave]]
@@ -241,6 +251,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     {
         let object_names: Vec<(&str, bool)> = objects.iter().map(|o| (o.name.as_str(), o.is_plane)).collect();
         let wave_names: Vec<&str> = waves.iter().map(|w| w.name.as_str()).collect();
+        let (mut casters, mut cast_triangles) = (0usize, 0u64);
         for (i, (t, span)) in root.array_of_tables("shadow")?.into_iter().enumerate() {
             if i == MAX_SHADOWS {
                 return Err(src.value_err(
@@ -254,6 +265,22 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
             let def = parse_shadow(&table, name, &object_names, &wave_names, &mut rd)?;
             if let Err((key, msg)) = check_shadow(&def, rd.values) {
                 return Err(src.value_err(&table.key_span(key), format!("{msg} in {}", table.what)));
+            }
+            // What every frame's casts cost: one per caster of a wave shadow, and each caster's
+            // triangles projected or rasterized once per shadow.
+            casters += def.casters.len();
+            cast_triangles +=
+                def.casters.iter().map(|&c| (objects[c as usize].mesh.indices.len() / 3) as u64).sum::<u64>();
+            if casters > MAX_SHADOW_CASTERS || cast_triangles > MAX_SHADOW_TRIANGLES {
+                return Err(src.value_err(
+                    &table.key_span("casters"),
+                    format!(
+                        "{} brings the casters of all shadows to {casters} and the triangles they cast to \
+                         {cast_triangles}; at most {MAX_SHADOW_CASTERS} casters and {MAX_SHADOW_TRIANGLES} \
+                         triangles (each shadow's casters counted) fit a scene",
+                        table.what
+                    ),
+                ));
             }
             shadows.push(def);
             shadow_tables.push(table);
@@ -310,32 +337,33 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     }
 
     if let (Some(a), Some(t)) = (&scene.area_light, &area_table) {
-        if let Err((key, msg)) = check_area_light(a, &scene.values, &scene.build_objects(&scene.values)) {
+        let vals = &scene.values;
+        let g = interest_at(a, vals, |o| {
+            let local = mesh_center(&scene.objects[o].mesh).unwrap_or(Vec3f::ZERO);
+            scene.objects[o].transform(vals).transform_point(local)
+        });
+        if let Err((key, msg)) = check_area_light(a, vals, g) {
             return Err(src.value_err(&t.key_span(key), format!("{msg} in [area_light]")));
         }
     }
 
     // [[track]]
     let mut targets: HashMap<String, Span> = HashMap::new();
+    let mut tracks = Vec::new();
+    let mut owners = Vec::new();
     let mut key_spans: Vec<Vec<Span>> = Vec::new();
-    for (i, (t, span)) in root.array_of_tables("track")?.into_iter().enumerate() {
-        let table = Table { src, t, span, what: format!("[[track]] #{}", i + 1) };
-        let (track, spans) = parse_track(&table, &scene, &mut targets)?;
-        scene.tracks.push(track);
-        key_spans.push(spans);
-    }
-    // Rules that tie several values together, at every key time of every track.
-    for (track, spans) in scene.tracks.iter().zip(&key_spans) {
-        for (&time, span) in track.times.iter().zip(spans) {
-            let vals = scene.values_at(time);
-            if let Err(msg) = check_all(&scene, &vals) {
-                return Err(src.track(
-                    span,
-                    format!("at t = {} s (this key of `{}`): {msg}", fmt_f32(time), track.target),
-                ));
-            }
+    {
+        let names = Names::of(&scene);
+        for (i, (t, span)) in root.array_of_tables("track")?.into_iter().enumerate() {
+            let table = Table { src, t, span, what: format!("[[track]] #{}", i + 1) };
+            let (track, owner, spans) = parse_track(&table, &scene, &names, &mut targets)?;
+            tracks.push(track);
+            owners.push(owner);
+            key_spans.push(spans);
         }
     }
+    scene.tracks = tracks;
+    check_key_times(&scene, &owners, &key_spans, &src)?;
     Ok(scene)
 }
 
@@ -364,12 +392,14 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
 }
 
 /// What loading the objects' meshes shares: the glTF cache (by canonical path), the scene's
-/// triangle budget and the directory tree files may be read from.
+/// triangle budget, the material slots left of [`MAX_MATERIAL_SLOTS`] and the directory tree
+/// files may be read from.
 struct Assets {
     /// The scene file's directory.
     dir: SceneDir,
     cache: HashMap<PathBuf, Arc<Mesh>>,
     budget: Budget,
+    slots_left: u64,
 }
 
 fn parse_object(
@@ -377,7 +407,7 @@ fn parse_object(
     name: String,
     rd: &mut ParamReader<'_>,
     assets: &mut Assets,
-    materials: &[MaterialDef],
+    (materials, material_index): (&[MaterialDef], &HashMap<&str, usize>),
     warnings: &mut Vec<String>,
 ) -> Res<ObjectDef> {
     let kind = t.choice("kind", OBJECT_KINDS, None)?;
@@ -425,6 +455,8 @@ fn parse_object(
         "sphere" => {
             scratch.add(t, &mut shape_set, "radius", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
             let segments = t.opt_int("segments", 3, 1024)?.map_or(32, |v| v.0 as u32);
+            let (tris, verts) = sphere_size(segments);
+            primitive_budget(t, &mut assets.budget.clone(), tris, verts)?;
             Arc::new(with_outline_normals(sphere_mesh(shape_set.f(&scratch_v, "radius"), segments)))
         }
         _ => {
@@ -448,8 +480,8 @@ fn parse_object(
                     format!(
                         "it resolves to {}, outside the scene file's directory {}; glTF files must \
                              lie inside the scene file's directory",
-                        real.display(),
-                        root.display()
+                        show_path(&real),
+                        show_path(&root)
                     ),
                     file,
                 ));
@@ -475,7 +507,7 @@ fn parse_object(
                     let mut notes = Vec::new();
                     let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut notes)
                         .map_err(|message| gltf_err(message, file.clone()))?;
-                    warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", file.display())));
+                    warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", show_path(&file))));
                     let mesh = Arc::new(with_outline_normals(mesh));
                     assets.cache.insert(real, mesh.clone());
                     mesh
@@ -484,17 +516,9 @@ fn parse_object(
         }
     };
     if kind != "gltf" {
-        let tris = (mesh.indices.len() / 3) as u64;
-        if tris > assets.budget.triangles {
-            return Err(t.src.value_err(
-                &t.key_span("kind"),
-                format!(
-                    "{} brings the scene past the limit of {MAX_TRIANGLES} triangles of all objects together",
-                    t.what
-                ),
-            ));
-        }
-        assets.budget.triangles -= tris;
+        // A sphere's size was checked before it was built; boxes and planes are small.
+        let (tris, verts) = ((mesh.indices.len() / 3) as u64, mesh.positions.len() as u64);
+        primitive_budget(t, &mut assets.budget, tris, verts)?;
     }
 
     let mut params = ParamSet::default();
@@ -503,8 +527,39 @@ fn parse_object(
     let scale = Constraint::Range { lo: SCALE_MIN, hi: COORD_MAX, lo_open: false, hi_open: false };
     rd.add(t, &mut params, "scale", V3, scale, Fallback::Value(&[1.0; 3]), true)?;
     rd.add(t, &mut params, "color", V3, NONNEG, Fallback::Value(&[0.8; 3]), false)?;
-    let materials = parse_object_materials(t, &mesh, materials, &mut params, rd, warnings)?;
+    let slots = mesh.materials.len().max(1) as u64;
+    if slots > assets.slots_left {
+        let key = if kind == "gltf" { "path" } else { "kind" };
+        return Err(t.src.value_err(
+            &t.key_span(key),
+            format!(
+                "{} brings the scene past the limit of {MAX_MATERIAL_SLOTS} material slots of all objects \
+                 together (an object has one per material of its mesh, at least one)",
+                t.what
+            ),
+        ));
+    }
+    assets.slots_left -= slots;
+    let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
     Ok(ObjectDef { name, mesh, params, materials, is_plane: kind == "plane" })
+}
+
+/// Takes a primitive's `tris` triangles and `verts` vertices from the scene's budget, or says
+/// which limit it crosses (located at its `kind`).
+fn primitive_budget(t: &Table<'_, '_>, budget: &mut Budget, tris: u64, verts: u64) -> Res<()> {
+    if tris > budget.triangles || verts > budget.vertices {
+        return Err(t.src.value_err(
+            &t.key_span("kind"),
+            format!(
+                "{} ({tris} triangles, {verts} vertices) brings the scene past the limit of {MAX_TRIANGLES} \
+                 triangles and {MAX_VERTICES} vertices of all objects together",
+                t.what
+            ),
+        ));
+    }
+    budget.triangles -= tris;
+    budget.vertices -= verts;
+    Ok(())
 }
 
 fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<WaveDef> {
@@ -751,7 +806,7 @@ fn check_camera(c: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)
             format!(
                 "`target` is only {} from `position`; keep them at least 1e-6 apart so the view \
                  direction is defined",
-                fmt_f64(dist)
+                fmt_f32(dist as f32)
             ),
         ));
     }
@@ -808,35 +863,167 @@ fn validate_curve(scene: &Scene, w: &WaveDef, vals: &[f32]) -> Result<(), (&'sta
     })
 }
 
-/// Every cross-key rule of the scene, for the values at one time.
-fn check_all(scene: &Scene, vals: &[f32]) -> Result<(), String> {
-    check_camera(&scene.camera, vals).map_err(|e| format!("{} in [camera]", e.1))?;
-    if Vec3f::from_array(scene.light.arr(vals, "direction")).try_normalize().is_none() {
-        return Err("`direction` in [light] must not be the zero vector".into());
+/// The parts of a scene with rules between their keys: each is checked at the key times of the
+/// tracks that animate it (the area light also at those of its target object), on its own values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Rules {
+    Camera,
+    Light,
+    AreaLight,
+    Shadow(usize),
+    Wave(usize),
+}
+
+/// The rules a track animating `owner` can break (`None`: no rule reads its values).
+fn rules_of(scene: &Scene, owner: Owner) -> Option<Rules> {
+    match owner {
+        Owner::Camera => Some(Rules::Camera),
+        Owner::Light => Some(Rules::Light),
+        Owner::AreaLight => Some(Rules::AreaLight),
+        Owner::Object(i) if scene.area_light.as_ref().is_some_and(|a| a.target == Target::Object(i)) => {
+            Some(Rules::AreaLight)
+        }
+        Owner::Shadow(i) => Some(Rules::Shadow(i)),
+        Owner::Wave(i) => Some(Rules::Wave(i)),
+        Owner::Globals | Owner::Color | Owner::Object(_) | Owner::Material(_) => None,
     }
-    if let Some(a) = &scene.area_light {
-        check_area_light(a, vals, &scene.build_objects(vals))
-            .map_err(|e| format!("{} in [area_light]", e.1))?;
+}
+
+/// The parameter sets `rules` reads.
+fn rule_sets(scene: &Scene, rules: Rules) -> Vec<&ParamSet> {
+    match rules {
+        Rules::Camera => vec![&scene.camera],
+        Rules::Light => vec![&scene.light],
+        Rules::AreaLight => {
+            let Some(a) = &scene.area_light else { return Vec::new() };
+            match a.target {
+                Target::Object(o) => vec![&a.params, &scene.objects[o].params],
+                Target::Point => vec![&a.params],
+            }
+        }
+        Rules::Shadow(i) => vec![&scene.shadows[i].params],
+        Rules::Wave(i) => vec![&scene.waves[i].params],
     }
-    for s in &scene.shadows {
-        check_shadow(s, vals).map_err(|e| format!("{} in [[shadow]] \"{}\"", e.1, s.name))?;
+}
+
+/// The rules between keys, checked at every key time of the tracks that animate each part of the
+/// scene ([`Rules`]), on that part's values there (its tracks applied and clamped as
+/// [`Scene::at`] does). A part nothing animates keeps the file's values, checked at load.
+/// The work, key times × the numbers of the part, is bounded by [`MAX_KEY_CHECKS`] first.
+fn check_key_times(scene: &Scene, owners: &[Owner], key_spans: &[Vec<Span>], src: &Src<'_>) -> Res<()> {
+    let groups: Vec<Option<Rules>> = owners.iter().map(|&o| rules_of(scene, o)).collect();
+    // The tracks of each part, in file order, and its distinct key times.
+    let mut members: HashMap<Rules, Vec<usize>> = HashMap::new();
+    let mut times: HashMap<Rules, std::collections::HashSet<u32>> = HashMap::new();
+    for (i, g) in groups.iter().enumerate() {
+        if let Some(g) = *g {
+            members.entry(g).or_default().push(i);
+            times.entry(g).or_default().extend(scene.tracks[i].times.iter().map(|t| t.to_bits()));
+        }
     }
-    for w in &scene.waves {
-        let what = format!("[[wave]] \"{}\"", w.name);
-        match w.kind {
-            WaveKind::Sphere => {}
-            WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => {
-                if w.params.find("D").is_some()
-                    && Vec3f::from_array(w.params.arr(vals, "D")).try_normalize().is_none()
-                {
-                    return Err(format!("`D` in {what} must not be the zero vector"));
+    let mut work = 0u64;
+    for (i, g) in groups.iter().enumerate() {
+        let Some(g) = *g else { continue };
+        if members[&g][0] != i {
+            continue;
+        }
+        let numbers: usize =
+            rule_sets(scene, g).iter().map(|s| s.params.iter().map(|p| p.len).sum::<usize>()).sum();
+        let keys = times[&g].len() as u64;
+        work = work.saturating_add(keys.saturating_mul(numbers as u64));
+        if work > MAX_KEY_CHECKS {
+            return Err(src.track(
+                &key_spans[i][0],
+                format!(
+                    "the rules between keys are checked at each key time of the tracks of the part they \
+                     concern; `{}` and the other tracks of its part have {keys} key times over {numbers} \
+                     numbers, which brings the scene's checks past the limit of {MAX_KEY_CHECKS} (key times \
+                     × numbers); use fewer keys",
+                    scene.tracks[i].target
+                ),
+            ));
+        }
+    }
+    // The target object's centre in its own space (its mesh's bounds are fixed).
+    let target_center = scene.area_light.as_ref().and_then(|a| match a.target {
+        Target::Object(o) => Some((o, mesh_center(&scene.objects[o].mesh).unwrap_or(Vec3f::ZERO))),
+        Target::Point => None,
+    });
+    let mut vals = scene.values.clone();
+    let mut done: std::collections::HashSet<(Rules, u32)> = std::collections::HashSet::new();
+    for ((track, spans), g) in scene.tracks.iter().zip(key_spans).zip(&groups) {
+        let Some(g) = *g else { continue };
+        for (&time, span) in track.times.iter().zip(spans) {
+            if !done.insert((g, time.to_bits())) {
+                continue;
+            }
+            for &j in &members[&g] {
+                let t = &scene.tracks[j];
+                if let Some(out) = vals.get_mut(t.offset..t.offset + t.len) {
+                    t.eval(time, out);
                 }
             }
-            _ => {
-                check_curve(w, &w.params, vals).map_err(|e| format!("{} in {what}", e.1))?;
-                validate_curve(scene, w, vals).map_err(|(key, msg)| format!("`{key}` in {what} {msg}"))?;
+            for set in rule_sets(scene, g) {
+                scene.clamp_params(set, &mut vals);
+            }
+            let centre = |o: usize, vals: &[f32]| {
+                let local = target_center.map_or(Vec3f::ZERO, |(_, c)| c);
+                scene.objects[o].transform(vals).transform_point(local)
+            };
+            if let Err(msg) = check_rules(scene, g, &vals, centre) {
+                return Err(src.track(
+                    span,
+                    format!("at t = {} s (this key of `{}`): {msg}", fmt_f32(time), track.target),
+                ));
             }
         }
     }
     Ok(())
+}
+
+/// The cross-key rules of one part of the scene for the values `vals` (`centre(o, vals)`: the
+/// centre of object `o` there).
+fn check_rules(
+    scene: &Scene,
+    rules: Rules,
+    vals: &[f32],
+    centre: impl Fn(usize, &[f32]) -> Vec3f,
+) -> Result<(), String> {
+    match rules {
+        Rules::Camera => check_camera(&scene.camera, vals).map_err(|e| format!("{} in [camera]", e.1)),
+        Rules::Light => {
+            if Vec3f::from_array(scene.light.arr(vals, "direction")).try_normalize().is_none() {
+                return Err("`direction` in [light] must not be the zero vector".into());
+            }
+            Ok(())
+        }
+        Rules::AreaLight => {
+            let Some(a) = &scene.area_light else { return Ok(()) };
+            let g = interest_at(a, vals, |o| centre(o, vals));
+            check_area_light(a, vals, g).map_err(|e| format!("{} in [area_light]", e.1))
+        }
+        Rules::Shadow(i) => {
+            let s = &scene.shadows[i];
+            check_shadow(s, vals).map_err(|e| format!("{} in [[shadow]] \"{}\"", e.1, s.name))
+        }
+        Rules::Wave(i) => {
+            let w = &scene.waves[i];
+            let what = format!("[[wave]] \"{}\"", w.name);
+            match w.kind {
+                WaveKind::Sphere => Ok(()),
+                WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => {
+                    if w.params.find("D").is_some()
+                        && Vec3f::from_array(w.params.arr(vals, "D")).try_normalize().is_none()
+                    {
+                        return Err(format!("`D` in {what} must not be the zero vector"));
+                    }
+                    Ok(())
+                }
+                _ => {
+                    check_curve(w, &w.params, vals).map_err(|e| format!("{} in {what}", e.1))?;
+                    validate_curve(scene, w, vals).map_err(|(key, msg)| format!("`{key}` in {what} {msg}"))
+                }
+            }
+        }
+    }
 }

@@ -15,6 +15,13 @@ pub const MAX_MAP_SIZE: u32 = 8192;
 pub const MAX_MAP_TEXELS: u64 = 1 << 26;
 /// Most maps of one frame (a sun shadow needs one, a wave shadow one per caster).
 pub const MAX_MAPS: usize = 64;
+/// Most casters of all `[[shadow]]`s together, each shadow's list counted (so also the most casts
+/// of a frame: a wave shadow casts once per caster).
+pub const MAX_SHADOW_CASTERS: usize = 1024;
+/// Most triangles the shadows cast: each shadow's casters' triangles, summed over the shadows
+/// (what the plane casts project and the maps rasterize per frame), the same as the scene's
+/// triangle budget [`MAX_TRIANGLES`](crate::MAX_TRIANGLES).
+pub const MAX_SHADOW_TRIANGLES: u64 = crate::limits::MAX_TRIANGLES;
 /// A visible point counts as on a receiver plane within `ON_PLANE · (1 + eye distance)` of it.
 pub const ON_PLANE: f32 = 1e-3;
 
@@ -60,7 +67,7 @@ pub struct Shadow {
     pub up: Vec3f,
     /// Casting objects (indices into [`Frame::objects`](crate::Frame::objects)).
     pub casters: Vec<u32>,
-    /// Receiving objects (indices into [`Frame::objects`](crate::Frame::objects)).
+    /// Receiving objects (indices into [`Frame::objects`](crate::Frame::objects)), ascending.
     pub receivers: Vec<u32>,
     /// Linear RGB of the shadow.
     pub color: [f32; 3],
@@ -87,9 +94,9 @@ pub struct ShadowCast {
 }
 
 impl Shadow {
-    /// Whether object `o` receives this shadow.
+    /// Whether object `o` receives this shadow (a binary search: the renderers ask per pixel).
     #[inline]
     pub fn receives(&self, o: u32) -> bool {
-        self.receivers.contains(&o)
+        self.receivers.binary_search(&o).is_ok()
     }
 }

@@ -51,6 +51,7 @@ pub(crate) struct ShadowDef {
     pub plane: Option<PlaneSource>,
     pub map_size: u32,
     pub casters: Vec<u32>,
+    /// Ascending ([`Shadow::receives`] searches them).
     pub receivers: Vec<u32>,
     pub params: ParamSet,
 }
@@ -72,7 +73,7 @@ pub(crate) fn parse_shadow(
     let kind = t.choice("kind", &["sun", "wave"], None)?;
     let method = t.choice("method", &["plane", "map"], Some("plane"))?;
     let casters = t.object_list("casters", objects)?;
-    let receivers = t.object_list("receivers", objects)?;
+    let mut receivers = t.object_list("receivers", objects)?;
     let refuse = |key: &str, why: &str| -> Res<()> {
         if t.get(key).is_some() {
             return Err(t.src.value_err(&t.key_span(key), format!("`{key}` in {} {why}", t.what)));
@@ -218,6 +219,7 @@ pub(crate) fn parse_shadow(
     let map_size = t.opt_int("map_size", 1, i64::from(MAX_MAP_SIZE))?.map_or(1024, |v| v.0 as u32);
     rd.add(t, &mut params, "color", V3, Constraint::NonNeg, Fallback::Value(&[0.0; 3]), false)?;
     rd.add(t, &mut params, "opacity", Shape::Scalar, UNIT, Fallback::Value(&[0.6]), false)?;
+    receivers.sort_unstable();
     let def = ShadowDef { name, wave, own_direction, plane, map_size, casters, receivers, params };
     Ok(def)
 }

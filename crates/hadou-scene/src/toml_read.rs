@@ -336,10 +336,14 @@ impl<'t, 'i> Table<'t, 'i> {
                 .src
                 .value_err(&v.span(), format!("`{key}` in {} must name at least one object", self.what)));
         }
-        let names: Vec<&str> = objects.iter().map(|o| o.0).collect();
-        let mut out: Vec<u32> = Vec::new();
+        // By name through a map, duplicates through a set: linear in the list and the objects.
+        let index: std::collections::HashMap<&str, u32> =
+            objects.iter().enumerate().map(|(i, o)| (o.0, i as u32)).collect();
+        let mut seen = std::collections::HashSet::new();
+        let mut out: Vec<u32> = Vec::with_capacity(items.len().min(objects.len()));
         for (name, span) in items {
-            let Some(i) = names.iter().position(|n| *n == name) else {
+            let Some(&i) = index.get(name) else {
+                let names: Vec<&str> = objects.iter().map(|o| o.0).collect();
                 return Err(self.src.value_err(
                     &span,
                     format!(
@@ -349,12 +353,12 @@ impl<'t, 'i> Table<'t, 'i> {
                     ),
                 ));
             };
-            if out.contains(&(i as u32)) {
+            if !seen.insert(i) {
                 return Err(self
                     .src
                     .duplicate(&span, format!("`{key}` in {} names \"{name}\" twice", self.what)));
             }
-            out.push(i as u32);
+            out.push(i);
         }
         Ok(out)
     }

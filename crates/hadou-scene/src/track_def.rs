@@ -13,6 +13,52 @@ use toml::de::DeValue;
 
 const TRACK_KEYS: &[&str] = &["target", "interpolation", "keys"];
 
+/// The part of a scene a track animates (whose parameter set holds its slice).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Owner {
+    /// `background`.
+    Globals,
+    /// `[camera]`.
+    Camera,
+    /// `[light]`.
+    Light,
+    /// `[color]`.
+    Color,
+    /// `[area_light]`.
+    AreaLight,
+    /// `[[object]]` by index.
+    Object(usize),
+    /// `[[material]]` by index.
+    Material(usize),
+    /// `[[wave]]` by index.
+    Wave(usize),
+    /// `[[shadow]]` by index.
+    Shadow(usize),
+}
+
+/// The scene's entities by name, built once for all its tracks (a lookup per track, not a scan).
+pub(crate) struct Names<'s> {
+    objects: HashMap<&'s str, usize>,
+    materials: HashMap<&'s str, usize>,
+    waves: HashMap<&'s str, usize>,
+    shadows: HashMap<&'s str, usize>,
+}
+
+impl<'s> Names<'s> {
+    /// The names of `scene`'s objects, materials, waves and shadows.
+    pub(crate) fn of(scene: &'s Scene) -> Self {
+        fn index<'a>(names: impl Iterator<Item = &'a str>) -> HashMap<&'a str, usize> {
+            names.enumerate().map(|(i, n)| (n, i)).collect()
+        }
+        Names {
+            objects: index(scene.objects.iter().map(|o| o.name.as_str())),
+            materials: index(scene.materials.iter().map(|m| m.name.as_str())),
+            waves: index(scene.waves.iter().map(|w| w.name.as_str())),
+            shadows: index(scene.shadows.iter().map(|s| s.name.as_str())),
+        }
+    }
+}
+
 /// A parameter slice selected by a track target.
 struct Selection {
     offset: usize,
@@ -26,72 +72,76 @@ struct Selection {
 }
 
 /// Resolves `target` (`wave.<name>.<key>[i].c`, `object.<name>.<key>`, `camera.<key>`,
-/// `light.<key>`, `area_light.<key>`, `color.exposure`, `background`) against the scene.
-fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
+/// `light.<key>`, `area_light.<key>`, `color.exposure`, `background`) against the scene, whose
+/// entities `names` indexes; also says which part of the scene it animates.
+fn resolve_target(scene: &Scene, names: &Names<'_>, target: &str) -> Result<(Selection, Owner), String> {
     let segs: Vec<&str> = target.split('.').collect();
     let head = segs[0];
-    let (set, rest, ent): (&ParamSet, &[&str], String) = match head.split('[').next().unwrap_or("") {
-        "background" => (&scene.globals, &segs[..], "the scene".into()),
-        "area_light" if segs.len() >= 2 => match &scene.area_light {
-            Some(a) => (&a.params, &segs[1..], "[area_light]".into()),
-            None => return Err(format!("target \"{target}\": the scene has no [area_light]")),
-        },
-        "camera" | "light" | "color" if segs.len() >= 2 => {
-            let set = match head {
-                "camera" => &scene.camera,
-                "light" => &scene.light,
-                _ => &scene.color,
-            };
-            (set, &segs[1..], format!("[{head}]"))
-        }
-        "wave" | "object" | "material" | "shadow" if segs.len() >= 3 => {
-            let name = segs[1];
-            let (set, names) = match head {
-                "shadow" => (
-                    scene.shadows.iter().find(|s| s.name == name).map(|s| &s.params),
-                    scene.shadows.iter().map(|s| s.name.as_str()).collect(),
-                ),
-                "wave" => {
-                    (scene.waves.iter().find(|w| w.name == name).map(|w| &w.params), scene.wave_names())
-                }
-                "material" => (
-                    scene.materials.iter().find(|m| m.name == name).map(|m| &m.params),
-                    scene.materials.iter().map(|m| m.name.as_str()).collect(),
-                ),
-                _ => (scene.objects.iter().find(|o| o.name == name).map(|o| &o.params), scene.object_names()),
-            };
-            match set {
-                Some(s) => (s, &segs[2..], format!("[[{head}]] \"{name}\"")),
-                None => {
-                    return Err(format!("no {head} is named \"{name}\"{}", hint(name, &names, "names")));
+    let (set, rest, ent, owner): (&ParamSet, &[&str], String, Owner) =
+        match head.split('[').next().unwrap_or("") {
+            "background" => (&scene.globals, &segs[..], "the scene".into(), Owner::Globals),
+            "area_light" if segs.len() >= 2 => match &scene.area_light {
+                Some(a) => (&a.params, &segs[1..], "[area_light]".into(), Owner::AreaLight),
+                None => return Err(format!("target \"{target}\": the scene has no [area_light]")),
+            },
+            "camera" | "light" | "color" if segs.len() >= 2 => {
+                let (set, owner) = match head {
+                    "camera" => (&scene.camera, Owner::Camera),
+                    "light" => (&scene.light, Owner::Light),
+                    _ => (&scene.color, Owner::Color),
+                };
+                (set, &segs[1..], format!("[{head}]"), owner)
+            }
+            "wave" | "object" | "material" | "shadow" if segs.len() >= 3 => {
+                let name = segs[1];
+                let found = match head {
+                    "shadow" => {
+                        names.shadows.get(name).map(|&i| (&scene.shadows[i].params, Owner::Shadow(i)))
+                    }
+                    "wave" => names.waves.get(name).map(|&i| (&scene.waves[i].params, Owner::Wave(i))),
+                    "material" => {
+                        names.materials.get(name).map(|&i| (&scene.materials[i].params, Owner::Material(i)))
+                    }
+                    _ => names.objects.get(name).map(|&i| (&scene.objects[i].params, Owner::Object(i))),
+                };
+                match found {
+                    Some((s, owner)) => (s, &segs[2..], format!("[[{head}]] \"{name}\""), owner),
+                    None => {
+                        let all: Vec<&str> = match head {
+                            "shadow" => scene.shadows.iter().map(|s| s.name.as_str()).collect(),
+                            "wave" => scene.wave_names(),
+                            "material" => scene.materials.iter().map(|m| m.name.as_str()).collect(),
+                            _ => scene.object_names(),
+                        };
+                        return Err(format!("no {head} is named \"{name}\"{}", hint(name, &all, "names")));
+                    }
                 }
             }
-        }
-        "camera" | "light" | "color" | "area_light" => {
-            return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
-        }
-        "wave" | "object" | "material" | "shadow" => {
-            return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
-        }
-        other => {
-            let heads = [
-                "wave",
-                "object",
-                "material",
-                "shadow",
-                "camera",
-                "light",
-                "area_light",
-                "color",
-                "background",
-            ];
-            return Err(format!(
+            "camera" | "light" | "color" | "area_light" => {
+                return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
+            }
+            "wave" | "object" | "material" | "shadow" => {
+                return Err(format!("target \"{target}\" needs a name and a key: `{head}.<name>.<key>`"));
+            }
+            other => {
+                let heads = [
+                    "wave",
+                    "object",
+                    "material",
+                    "shadow",
+                    "camera",
+                    "light",
+                    "area_light",
+                    "color",
+                    "background",
+                ];
+                return Err(format!(
                 "target \"{target}\" must start with `wave.`, `object.`, `material.`, `shadow.`, `camera.`, \
                  `light.`, `area_light.`, `color.` or be `background`{}",
                 hint(other, &heads, "targets")
             ));
-        }
-    };
+            }
+        };
     if rest.is_empty() || rest.len() > 2 {
         return Err(format!("target \"{target}\" is not of the form `<entity>.<key>[index].<component>`"));
     }
@@ -147,7 +197,7 @@ fn resolve_target(scene: &Scene, target: &str) -> Result<Selection, String> {
             broadcast: false,
         };
     }
-    Ok(sel)
+    Ok((sel, owner))
 }
 
 /// `"points[2][1]"` → `("points", [2, 1])`.
@@ -166,16 +216,18 @@ fn split_indices(s: &str) -> Option<(&str, Vec<usize>)> {
     Some((key, out))
 }
 
-/// Reads one `[[track]]` against `scene`; `targets` holds the targets of the tracks read before
-/// (each may be animated once). Returns the track and the span of each key.
+/// Reads one `[[track]]` against `scene` (its entities indexed by `names`); `targets` holds the
+/// targets of the tracks read before (each may be animated once). Returns the track, the part
+/// of the scene it animates and the span of each key.
 pub(crate) fn parse_track(
     t: &Table<'_, '_>,
     scene: &Scene,
+    names: &Names<'_>,
     targets: &mut HashMap<String, Span>,
-) -> Res<(Track, Vec<Span>)> {
+) -> Res<(Track, Owner, Vec<Span>)> {
     t.check_keys(TRACK_KEYS)?;
     let (target, tspan) = t.req_str("target", "what to animate, e.g. \"wave.beam.M2\"")?;
-    let sel = resolve_target(scene, target).map_err(|m| t.src.track(&tspan, m))?;
+    let (sel, owner) = resolve_target(scene, names, target).map_err(|m| t.src.track(&tspan, m))?;
     if let Some(first) = targets.get(target) {
         let line = t.src.loc(first).line;
         return Err(t.src.duplicate(
@@ -290,7 +342,7 @@ pub(crate) fn parse_track(
     }
     let track =
         Track { target: target.to_string(), offset: sel.offset, len: sel.len, interpolation, times, values };
-    Ok((track, spans))
+    Ok((track, owner, spans))
 }
 
 fn example(shape: Shape) -> &'static str {

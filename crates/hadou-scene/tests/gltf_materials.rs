@@ -430,7 +430,9 @@ fn hostile_images_are_clear_errors() {
     // A PNG header claiming 100000 × 100000 texels: refused from the header.
     let e = load_err(&with_image(&png_header(100_000, 100_000), |v| json!({"bufferView": v})));
     assert!(
-        e.starts_with("image 0") && e.contains("100000×100000") && e.contains("larger than the limit"),
+        e.starts_with("material 0: image 0")
+            && e.contains("100000×100000")
+            && e.contains("larger than the limit"),
         "{e}"
     );
 
@@ -438,9 +440,9 @@ fn hostile_images_are_clear_errors() {
     let mut garbage = vec![0xFF, 0xD8, 0xFF];
     garbage.extend((0..200u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8));
     let e = load_err(&with_image(&garbage, |v| json!({"bufferView": v})));
-    assert!(e.starts_with("image 0") && e.contains("JPEG"), "{e}");
+    assert!(e.starts_with("material 0: image 0") && e.contains("JPEG"), "{e}");
     let e = load_err(&with_image(&tiny_jpeg(60000, 60000), |v| json!({"bufferView": v})));
-    assert!(e.starts_with("image 0") && e.contains("JPEG"), "{e}");
+    assert!(e.starts_with("material 0: image 0") && e.contains("JPEG"), "{e}");
     // Not an image at all, and a truncated PNG.
     let e = load_err(&with_image(b"GIF89a....", |v| json!({"bufferView": v})));
     assert!(e.contains("image 0") && e.contains("not a PNG or JPEG"), "{e}");
@@ -456,12 +458,12 @@ fn hostile_images_are_clear_errors() {
     std::fs::write(inner.join("ok.png"), png_2x2()).unwrap();
     let file = with_image(&png_2x2(), |_| json!({"uri": "../x.png"}));
     let e = gltf_from_bytes(&file, &inner).unwrap_err();
-    assert!(e.starts_with("image 0") && e.contains("outside"), "{e}");
+    assert!(e.starts_with("material 0: image 0") && e.contains("outside"), "{e}");
     let file = with_image(&png_2x2(), |_| json!({"uri": "ok.png"}));
     let m = gltf_from_bytes(&file, &inner).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.materials[0].base_texture.as_ref().unwrap().image.width, 2);
     let file = with_image(&png_2x2(), |_| json!({"uri": "missing.png"}));
-    assert!(gltf_from_bytes(&file, &inner).unwrap_err().starts_with("image 0: cannot read"));
+    assert!(gltf_from_bytes(&file, &inner).unwrap_err().starts_with("material 0: image 0: cannot read"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
