@@ -7,6 +7,7 @@ mod support;
 
 use hadou_math::curve::{
     curve_energy, curve_energy_reference, prepare, CurveShape, CurveWave, Integrator, Reduction,
+    MAX_SIMPSON_M, MAX_SLOPE, MAX_TURNS,
 };
 use hadou_math::energy::{Falloff, FieldParams, Ray};
 use hadou_math::Vec3;
@@ -109,6 +110,80 @@ fn every_invalid_parameter_names_its_field() {
                 }
             }),
         ),
+        // The bounds on a ray's work (cost.rs).
+        (
+            "rate",
+            Box::new(|w| w.shape = CurveShape::Helix { radius: 0.8, rate: -1e6, phase: 0.0, length: 11.0 }),
+        ),
+        (
+            "rate",
+            Box::new(|w| {
+                w.shape = CurveShape::TrigSum {
+                    rate: 1.0,
+                    y_terms: vec![[1.0, 0.0]; 64],
+                    z_terms: vec![],
+                    length: 13.0,
+                }
+            }),
+        ),
+        (
+            "y_terms",
+            Box::new(|w| {
+                w.shape = CurveShape::TrigSum {
+                    rate: 1e-3,
+                    y_terms: vec![[1.0, 0.0]; 65],
+                    z_terms: vec![],
+                    length: 1.0,
+                }
+            }),
+        ),
+        (
+            "points",
+            Box::new(|w| {
+                w.shape = CurveShape::BSpline { points: vec![[0.0, 0.0]; 513], order: 4, knots: None }
+            }),
+        ),
+        (
+            "gamma",
+            Box::new(|w| {
+                w.shape = CurveShape::Helix { radius: 1e3, rate: 1.0, phase: 0.0, length: 1.0 };
+                w.gamma = 1e-3;
+            }),
+        ),
+        (
+            "gamma",
+            Box::new(|w| {
+                w.shape = CurveShape::Bezier { points: vec![[1e6, 0.0], [-1e6, 0.0], [1e6, 1e6]] };
+                w.gamma = 1.0;
+            }),
+        ),
+        (
+            "knots",
+            Box::new(|w| {
+                w.shape = CurveShape::BSpline {
+                    points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [1.0, 0.0]],
+                    order: 2,
+                    knots: Some(vec![0.0, 0.0, 0.5, 0.500_000_1, 1.0, 1.0]),
+                }
+            }),
+        ),
+        (
+            "knots",
+            Box::new(|w| {
+                w.shape = CurveShape::BSpline {
+                    points: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [1.0, 0.0]],
+                    order: 2,
+                    knots: Some(vec![0.0, 0.0, 0.5, 0.5, 1.0, 1.0]),
+                }
+            }),
+        ),
+        (
+            "m",
+            Box::new(|w| {
+                w.shape = CurveShape::Bezier { points: vec![[0.0, 1.0]; 64] };
+                w.integrator = Integrator::Simpson { m: 5000, reduction: None };
+            }),
+        ),
         ("m", Box::new(|w| w.integrator = Integrator::Simpson { m: 0, reduction: None })),
         ("m", Box::new(|w| w.integrator = Integrator::Simpson { m: 101, reduction: None })),
         ("m", Box::new(|w| w.integrator = Integrator::Simpson { m: 100_002, reduction: None })),
@@ -131,11 +206,21 @@ fn every_invalid_parameter_names_its_field() {
         let mut w = base.clone();
         edit(&mut w);
         assert_eq!(field_of(&w), Some(*field), "{w:?}");
-        // Invalid input is sanitized, never a panic, and renders finitely.
+        // Invalid input is sanitized, never a panic, and renders finitely; what is prepared keeps
+        // the bounds on a ray's work.
         let c = prepare(&w);
+        assert!(c.wave.turns().is_none_or(|t| t <= MAX_TURNS), "{field}: {:?}", c.wave.turns());
+        assert!(c.wave.steepness() <= MAX_SLOPE, "{field}: {}", c.wave.steepness());
+        if let Integrator::Simpson { m, .. } = c.wave.integrator {
+            assert!(f64::from(m) * c.wave.point_cost() <= f64::from(MAX_SIMPSON_M), "{field}: m = {m}");
+        }
         let r = pixel_ray(256.0, 256.0, Falloff::Faithful);
         let s = curve_energy(&c, &params32(&params(Falloff::Faithful)), &r.ray32(), 0.0, 1.0, 1.0);
         assert!(s.energy.is_finite());
+    }
+    // Valid waves are prepared unchanged, so the integrator's arithmetic for them is untouched.
+    for (name, w) in shapes() {
+        assert_eq!(prepare(&w).wave, w, "{name}");
     }
     // Legal edge values.
     let mut w = base.clone();

@@ -8,12 +8,17 @@
 //!   Object `scale ≤ 1e6`, so a world vertex is at most `1e6 · 1e6 · √3 + 1e6 < 2e12` from the
 //!   origin, and every squared distance the renderers form (view-space depth, `|v|²`, `|û × v|²`
 //!   in `hadou_math::energy::kernel`, the curves' squared distances) is below `(4e12)² = 1.6e25`.
-//!   Trigonometric curves sum at most 1024 terms of `≤ 1e6`: `|y|, |z| ≤ 2e9`.
+//!   Trigonometric curves sum at most 64 terms of `≤ 1e6`: `|y|, |z| ≤ 1e8`.
 //! - `far ≤ FAR_MAX = 1e7` and `fov ≤ FOV_MAX = 179°`: `tan(fov/2) ≤ 115`, the aspect ratio is at
 //!   most 16384, so a pixel direction (`CameraBasis::pixel_dir`, forward component 1) is shorter
 //!   than `2e6`; the far distance `far · |dir|` (the depth of an empty pixel, the faithful ray
 //!   `Q = far · dir`) is below `2e13` and `Y = s·t + β` of the faithful kernel (`t ≤ 1`) below
 //!   `3e13`, `Y² < 1e27`. Inverse-square rays are unit and clamp `t` at `T_LIMIT = 1e12`.
+//! - A curve is at most `MAX_SLOPE = 1e5` steep (`hadou_math::curve::CurveWave::steepness`, the
+//!   cross-section's motion per unit of axial travel), so the chord walk's relative speed
+//!   `|q_⊥ − q_x·m|` of a ray against a piece of slope `m` is below `2e13 · (1 + 1e5)` and its
+//!   square below `4e36`; turns, terms, control points and Simpson's `m × point cost` bound a
+//!   ray's work (docs/scene-format.md, "Work per ray").
 //! - `fov ≥ FOV_MIN = 0.001°` and `near ≥ NEAR_MIN = 1e-6`: the rasterizer's `1/tan(fov/2)`
 //!   (`≤ 1.2e5`, times the aspect ≤ 16384 gives `≤ 2e9`) and `1/z ≤ 1e6` stay finite, so a
 //!   projected vertex is below `2e12 · 1e6 · 2e9 · 16384 < 1e32`.

@@ -25,6 +25,12 @@
 //!   a precomputed tree of polylines ([`integrate`], [`PieceTable`]).
 //! - [`curve_energy_reference`]: converged `f64` adaptive Gauss–Kronrod on the exact field.
 //!
+//! # Work per ray
+//! The parameters that multiply a ray's work — turns, terms, control points, steepness and
+//! Simpson's `m` times the price of a curve point — are bounded by [`CurveWave::validate`] and
+//! brought within those bounds by [`prepare`] (`cost.rs`), so that no ray through a valid curve
+//! takes more than about 10⁵ evaluations.
+//!
 //! Every public entry point — [`curve_energy`] / [`curve_energy_f64`] (which dispatch on the
 //! wave's [`Integrator`]), [`integrate::default_energy`] and [`curve_energy_reference`] — resolves
 //! the ray's span in the curve's local frame once and hands that resolved ray to its integrator;
@@ -40,6 +46,7 @@
 )]
 
 mod closed;
+mod cost;
 mod dispatch;
 pub mod integrate;
 mod local_ray;
@@ -63,5 +70,5 @@ pub use shape::clamped_uniform_knots;
 pub use validate::CurveError;
 pub use wave::{
     CurveFrame, CurveShape, CurveWave, Integrator, Reduction, MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS,
-    MAX_ORDER, MAX_SIMPSON_M, MAX_TRIG_TERMS,
+    MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
 };

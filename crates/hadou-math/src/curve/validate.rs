@@ -4,7 +4,7 @@
 use super::shape::clamped_uniform_knots;
 use super::wave::{
     CurveShape, CurveWave, Integrator, MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS, MAX_ORDER, MAX_SIMPSON_M,
-    MAX_TRIG_TERMS,
+    MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
 };
 use crate::Vec3;
 use core::fmt;
@@ -54,6 +54,19 @@ fn finite_points(field: &'static str, p: &[[f32; 2]]) -> Result<(), CurveError> 
     }
 }
 
+/// `x` to about four significant digits: plain between `1e-3` and `1e5`, scientific otherwise
+/// (`175`, `0.5`, `1.751e6`, `8.042e13`).
+fn short(x: f64) -> String {
+    let sci = format!("{x:.3e}");
+    let (mantissa, exp) = sci.split_once('e').unwrap_or((&sci, "0"));
+    let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+    let sci = format!("{mantissa}e{exp}");
+    match sci.parse::<f64>() {
+        Ok(v) if v == 0.0 || (1e-3..1e5).contains(&v.abs()) => format!("{v}"),
+        _ => sci,
+    }
+}
+
 fn positive_length(v: f32) -> Result<(), CurveError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -71,7 +84,11 @@ impl CurveWave {
     /// B-spline whose order is outside `2 ≤ k ≤ min(n + 1, MAX_ORDER)` (fewer control points than
     /// `k = degree + 1`), whose knot vector does not have `n + k + 1` entries, decreases, or has an
     /// empty valid range `[x_{k−1}, x_{n+1}]`; Simpson `m` odd, zero or above
-    /// [`MAX_SIMPSON_M`]; reduction `n < 1` or `ε < 0`.
+    /// [`MAX_SIMPSON_M`]; reduction `n < 1` or `ε < 0`. And the bounds on a ray's work
+    /// (`cost.rs`): a helix or trigonometric sum making more than [`MAX_TURNS`] turns
+    /// ([`CurveWave::turns`]); a curve steeper than [`MAX_SLOPE`] ([`CurveWave::steepness`]; a
+    /// B-spline that jumps at an interior knot repeated `order` times is infinitely steep);
+    /// Simpson `m` above [`CurveWave::max_simpson_m`] (`m × point cost ≤ MAX_SIMPSON_M`).
     ///
     /// Legal although degenerate (they render finite values): coincident control points, radius 0,
     /// empty trigonometric sums.
@@ -122,6 +139,98 @@ impl CurveWave {
                         format!("bounding-cylinder offset must be finite and ≥ 0, got {}", r.epsilon),
                     );
                 }
+            }
+        }
+        self.validate_cost()
+    }
+
+    /// The bounds on a ray's work (`cost.rs`), on a wave whose values are otherwise valid.
+    fn validate_cost(&self) -> Result<(), CurveError> {
+        if let Some(turns) = self.turns() {
+            if turns > MAX_TURNS {
+                let what = match &self.shape {
+                    CurveShape::TrigSum { y_terms, z_terms, .. } => format!(
+                        "makes the fastest harmonic (term {}) turn {} times over `length` \
+                         (terms × |rate| × length / 2π)",
+                        y_terms.len().max(z_terms.len()),
+                        short(turns)
+                    ),
+                    _ => format!(
+                        "makes the helix turn {} times over `length` (|rate| × length / 2π)",
+                        short(turns)
+                    ),
+                };
+                return err(
+                    "rate",
+                    format!(
+                        "{what}; at most {MAX_TURNS} turns, since the work of a ray grows with the turns it \
+                         passes: lower `rate` or `length`"
+                    ),
+                );
+            }
+        }
+        let slope = self.steepness();
+        if !(slope <= MAX_SLOPE) {
+            let points_fix = "raise `gamma` or bring the control points closer together";
+            let (field, formula, fix) = match &self.shape {
+                CurveShape::Helix { .. } => {
+                    ("gamma", "radius × |rate| / gamma", "raise `gamma` or lower `radius` or `rate`")
+                }
+                CurveShape::TrigSum { .. } => (
+                    "gamma",
+                    "Σ n × |rate| × |coefficients| / gamma",
+                    "raise `gamma` or lower `rate` or the coefficients",
+                ),
+                CurveShape::Bezier { .. } => {
+                    ("gamma", "degree × the longest step between control points / gamma", points_fix)
+                }
+                CurveShape::BSpline { points, order, knots } => {
+                    let formula = "the derivative's largest control point × the knot range / gamma";
+                    if slope.is_infinite() {
+                        return err(
+                            "knots",
+                            "repeat an interior knot `order` times, which makes the B-spline jump across its \
+                             axis; repeat an interior knot at most `order` − 1 times",
+                        );
+                    }
+                    let uniform = CurveWave {
+                        shape: CurveShape::BSpline { points: points.clone(), order: *order, knots: None },
+                        ..self.clone()
+                    };
+                    if knots.is_some() && uniform.steepness() <= MAX_SLOPE {
+                        (
+                            "knots",
+                            formula,
+                            "the knots crowd the change of the control points into too short a stretch; \
+                             spread them out",
+                        )
+                    } else {
+                        ("gamma", formula, points_fix)
+                    }
+                }
+            };
+            return err(
+                field,
+                format!(
+                    "leaves the curve too steep: it moves {} across its axis per unit of travel along it \
+                     ({formula}); at most {} keeps the integrator's arithmetic finite: {fix}",
+                    short(slope),
+                    short(MAX_SLOPE)
+                ),
+            );
+        }
+        if let Integrator::Simpson { m, .. } = self.integrator {
+            let max = self.max_simpson_m();
+            if m > max {
+                let cost = short(self.point_cost());
+                return err(
+                    "m",
+                    format!(
+                        "must be at most {max} for this curve, got {m}: Simpson evaluates the curve m + 1 times \
+                         per ray, one point of it costs {cost} helix points, and m × {cost} may be at most \
+                         {MAX_SIMPSON_M}"
+                    ),
+                );
             }
         }
         Ok(())
@@ -239,7 +348,12 @@ fn fin_points(p: &[[f32; 2]]) -> Vec<[f32; 2]> {
 /// A copy of `w` with every invalid value replaced by the nearest legal one (non-finite numbers
 /// by 0 or 1, out-of-range scalars clamped, a bad axis or up vector by `x` / `y`, bad B-spline
 /// knots by the clamped uniform vector, a too-short point list padded), so that preparing and
-/// integrating never panic whatever the input. Valid waves come back unchanged.
+/// integrating never panic whatever the input; then brought within the bounds on a ray's work
+/// (`cost.rs`), which only values between the keys of an animation (or a caller that skipped
+/// [`CurveWave::validate`]) can break: a rate making more than [`MAX_TURNS`] turns is lowered
+/// to that many, a B-spline that jumps at a repeated knot gets the clamped uniform knots, `γ` is
+/// raised until the curve is no steeper than [`MAX_SLOPE`], and Simpson's `m` lowered to
+/// [`CurveWave::max_simpson_m`]. Valid waves come back unchanged.
 pub(crate) fn sanitize(w: &CurveWave) -> CurveWave {
     let mut w = w.clone();
     let v = |v: Vec3<f32>, fb: Vec3<f32>| if v.is_finite() { v } else { fb };
@@ -303,6 +417,7 @@ pub(crate) fn sanitize(w: &CurveWave) -> CurveWave {
             CurveShape::BSpline { points: p, order: k as u32, knots }
         }
     };
+    sanitize_cost(&mut w);
     if let Integrator::Simpson { m, reduction } = &mut w.integrator {
         *m = (*m).clamp(2, MAX_SIMPSON_M);
         *m += *m & 1;
@@ -311,5 +426,36 @@ pub(crate) fn sanitize(w: &CurveWave) -> CurveWave {
             r.epsilon = if r.epsilon.is_finite() { r.epsilon.max(0.0) } else { 0.0 };
         }
     }
+    let max_m = w.max_simpson_m();
+    if let Integrator::Simpson { m, .. } = &mut w.integrator {
+        *m = (*m).min(max_m);
+    }
     w
+}
+
+/// The turns and steepness of [`sanitize`] (on a wave whose values are otherwise legal).
+fn sanitize_cost(w: &mut CurveWave) {
+    if let Some(turns) = w.turns() {
+        if turns > MAX_TURNS {
+            // Just below the bound after rounding to f32.
+            let f = MAX_TURNS / turns * (1.0 - 1e-6);
+            if let CurveShape::Helix { rate, .. } | CurveShape::TrigSum { rate, .. } = &mut w.shape {
+                *rate = (f64::from(*rate) * f) as f32;
+            }
+        }
+    }
+    let mut slope = w.steepness();
+    if slope > MAX_SLOPE && f64::from(w.gamma) * slope / MAX_SLOPE >= f64::from(f32::MAX) {
+        // A jump, or knots so crowded that no γ makes up for them.
+        if let CurveShape::BSpline { points, order, knots: knots @ Some(_) } = &mut w.shape {
+            *knots = Some(
+                clamped_uniform_knots(points.len(), *order as usize).into_iter().map(|x| x as f32).collect(),
+            );
+            slope = w.steepness();
+        }
+    }
+    if slope > MAX_SLOPE {
+        let g = f64::from(w.gamma) * slope / MAX_SLOPE * (1.0 + 1e-6);
+        w.gamma = g.min(f64::from(f32::MAX)) as f32;
+    }
 }

@@ -9,12 +9,20 @@ use crate::{Real, Vec3};
 pub const MAX_ORDER: usize = 16;
 /// Most control points of a Bézier curve (degree ≤ 63).
 pub const MAX_BEZIER_POINTS: usize = 64;
-/// Most control points of a B-spline.
-pub const MAX_BSPLINE_POINTS: usize = 4096;
-/// Most terms in each trigonometric sum.
-pub const MAX_TRIG_TERMS: usize = 1024;
-/// Largest number of Simpson subintervals `m`.
+/// Most control points of a B-spline (a control polygon of 511 edges: by the
+/// variation-diminishing property the curve oscillates no more often; see `cost.rs`).
+pub const MAX_BSPLINE_POINTS: usize = 512;
+/// Most terms in each trigonometric sum (each costs a sine and a cosine per curve point).
+pub const MAX_TRIG_TERMS: usize = 64;
+/// Largest number of Simpson subintervals `m`; with a curve point dearer than a helix's,
+/// `m × point cost` ([`CurveWave::point_cost`]) is held to it.
 pub const MAX_SIMPSON_M: u32 = 100_000;
+/// Most turns a helix, or the fastest harmonic of a trigonometric sum, may make over the curve's
+/// length ([`CurveWave::turns`]): the work of a ray grows with the turns it passes.
+pub const MAX_TURNS: f64 = 128.0;
+/// Largest steepness `max |dc_⊥/dx|` of a curve ([`CurveWave::steepness`]): keeps the chord
+/// walk's squared relative speeds finite for every ray a scene can make.
+pub const MAX_SLOPE: f64 = 1e5;
 
 /// The local frame of a curve: launch point `O`, unit travel axis `D`, and an up vector that fixes
 /// the cross-section axes; see [`CurveFrame::axes`] for the exact construction.
