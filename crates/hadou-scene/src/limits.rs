@@ -32,6 +32,31 @@
 //!   wave light may saturate to `+∞`, which the colour mappings turn into white (a finite value),
 //!   and no NaN can arise because every term is `≥ 0`.
 
+/// Largest image edge in pixels, for `[image]`, command-line sizes and the viewer alike.
+pub const MAX_IMAGE_EDGE: u32 = 16384;
+
+/// Checks an image size against the rules a scene's `[image]` follows: each edge in
+/// `1..=MAX_IMAGE_EDGE`, and at most [`crate::SOFT_MAX_PIXELS`] pixels when the scene has an
+/// `[area_light]`. Every path that can set a size (the file, `--width/--height`, a track, a viewer
+/// script, the viewer's window) calls this, so one limit holds everywhere. The message names the
+/// size; callers prefix where it came from (a flag, a script line, a file position).
+pub fn check_image_size(width: u32, height: u32, area_light: bool) -> Result<(), String> {
+    for (edge, v) in [("width", width), ("height", height)] {
+        if v == 0 || v > MAX_IMAGE_EDGE {
+            return Err(format!("image {edge} {v} is outside 1..={MAX_IMAGE_EDGE} pixels"));
+        }
+    }
+    if area_light && u64::from(width) * u64::from(height) > crate::SOFT_MAX_PIXELS {
+        return Err(format!(
+            "a scene with an [area_light] renders images of at most {} pixels (4096²; the penumbra \
+             search works on the whole image at once); {width}×{height} is {} pixels",
+            crate::SOFT_MAX_PIXELS,
+            u64::from(width) * u64::from(height)
+        ));
+    }
+    Ok(())
+}
+
 /// Bound on the magnitude of every scene number without a tighter rule.
 pub(crate) const COORD_MAX: f32 = 1e6;
 /// Largest `far`.

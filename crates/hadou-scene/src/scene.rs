@@ -118,6 +118,12 @@ impl Scene {
         self.height
     }
 
+    /// Checks a size for this scene's images (from a flag or the viewer) against the rules its
+    /// `[image]` follows: [`crate::check_image_size`].
+    pub fn check_image_size(&self, width: u32, height: u32) -> Result<(), String> {
+        crate::limits::check_image_size(width, height, self.area_light.is_some())
+    }
+
     /// Time of the last key of any track in seconds (0 for a static scene).
     pub fn duration(&self) -> f32 {
         self.tracks.iter().map(Track::end).fold(0.0, f32::max)
