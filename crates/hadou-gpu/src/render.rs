@@ -98,6 +98,14 @@ impl Prepared {
     }
 }
 
+/// One tile's commands: the render passes that write its G-buffer and plane shadows (`None` when
+/// the frame draws no surfaces), then the compute passes that read them, to which a caller may
+/// append (the window's present pass). See [`Renderer::submit_tile`].
+pub(crate) struct TileEncoders {
+    surfaces: Option<wgpu::CommandEncoder>,
+    pub(crate) shading: wgpu::CommandEncoder,
+}
+
 /// What a tile's passes are recorded for.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum TileWork {
@@ -351,18 +359,18 @@ impl Renderer {
                 SoftTargets::ensure(&mut self.soft, &self.ctx, frame);
             }
             prepared.groups = Some(self.tile_bind_groups(frame, &prepared));
-            if frame.area_light.is_some() {
-                self.draw_soft(frame, &prepared);
-            }
-            prepared
+            let soft = if frame.area_light.is_some() { self.draw_soft(frame, &prepared) } else { Ok(()) };
+            (prepared, soft)
         };
+        let (prepared, soft) = prepared;
         self.ctx.close_scopes(scopes, "uploading the frame")?;
+        soft?;
         Ok(prepared)
     }
 
     /// The `[area_light]`'s soft shadows over the whole image: its two maps, every tile rasterized
     /// and classified, then the resolve; the wave passes read the visibility.
-    fn draw_soft(&self, frame: &Frame, prepared: &Prepared) {
+    fn draw_soft(&self, frame: &Frame, prepared: &Prepared) -> Result<(), RenderError> {
         let soft = self.soft.as_ref().expect("created in prepare");
         let groups = prepared.groups.as_ref().expect("bind groups are made in prepare");
         let bind_group = groups.soft.as_ref().expect("made with an area light");
@@ -380,14 +388,15 @@ impl Renderer {
         for y in (0..frame.height).step_by(tile[1] as usize) {
             for x in (0..frame.width).step_by(tile[0] as usize) {
                 let t = ([x, y], [tile[0].min(frame.width - x), tile[1].min(frame.height - y)]);
-                let enc = self.encode_tile_work(frame, prepared, t, TileWork::Classify, None);
-                self.ctx.queue.submit([enc.finish()]);
+                let encoders = self.encode_tile_work(frame, prepared, t, TileWork::Classify, None);
+                self.submit_tile(encoders)?;
             }
         }
         let mut enc =
             d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft resolve") });
         self.passes.soft.encode_resolve(&mut enc, bind_group, frame);
         self.ctx.queue.submit([enc.finish()]);
+        Ok(())
     }
 
     /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
@@ -438,13 +447,13 @@ impl Renderer {
         frame: &Frame,
         prepared: &Prepared,
         mut timestamps: Option<&mut PassQueries<'_>>,
-    ) -> Option<wgpu::SubmissionIndex> {
+    ) -> Result<Option<wgpu::SubmissionIndex>, RenderError> {
         let mut last = None;
         for &t in &prepared.tiles {
-            let enc = self.encode_tile(frame, prepared, t, false, timestamps.as_deref_mut());
-            last = Some(self.ctx.queue.submit([enc.finish()]));
+            let encoders = self.encode_tile(frame, prepared, t, false, timestamps.as_deref_mut());
+            last = Some(self.submit_tile(encoders)?);
         }
-        last
+        Ok(last)
     }
 
     /// The bind groups of `prepared`'s tiles (after its shadow maps and soft-shadow resources
@@ -493,10 +502,11 @@ impl Renderer {
         TileBindGroups { raster, wave, plane, soft }
     }
 
-    /// Records one tile's passes — raster (unless the frame skips it), plane shadows, the soft
-    /// shadows' gather, wave — and, when `readback`, the copy to the staging buffer, after writing
-    /// its uniforms. The tiles share one uniform buffer, so submit each tile before encoding the
-    /// next. `timestamps`: every pass gets a query pair, the tile a group of its own.
+    /// Records one tile's passes — raster (unless the frame skips it) and plane shadows into
+    /// [`TileEncoders::surfaces`]; the soft shadows' gather, wave and, when `readback`, the copy to
+    /// the staging buffer into [`TileEncoders::shading`] — after writing its uniforms. The tiles
+    /// share one uniform buffer, so submit each tile ([`Renderer::submit_tile`]) before encoding
+    /// the next. `timestamps`: every pass gets a query pair, the tile a group of its own.
     pub(crate) fn encode_tile(
         &self,
         frame: &Frame,
@@ -504,8 +514,28 @@ impl Renderer {
         tile: ([u32; 2], [u32; 2]),
         readback: bool,
         timestamps: Option<&mut PassQueries<'_>>,
-    ) -> wgpu::CommandEncoder {
+    ) -> TileEncoders {
         self.encode_tile_work(frame, prepared, tile, TileWork::Draw { readback }, timestamps)
+    }
+
+    /// Submits a tile's two command buffers in order, each on its own, and returns the second's
+    /// submission. The compute passes never share a submission with the render passes whose
+    /// targets they read: on Mesa's llvmpipe through EGL, a wave pass recorded after the raster
+    /// pass in one command buffer sometimes read the G-buffer as the previous frame had left it
+    /// (under load, about one test run in twelve; `tests/determinism.rs`), and split submissions
+    /// never did in sixty runs. On OpenGL the shading also waits for the surfaces' fence, the one
+    /// ordering every GL driver must honour.
+    pub(crate) fn submit_tile(&self, tile: TileEncoders) -> Result<wgpu::SubmissionIndex, RenderError> {
+        if let Some(surfaces) = tile.surfaces {
+            let submission = self.ctx.queue.submit([surfaces.finish()]);
+            #[cfg(not(target_arch = "wasm32"))]
+            if self.ctx.info.backend == wgpu::Backend::Gl {
+                self.ctx.wait(submission)?;
+            }
+            #[cfg(target_arch = "wasm32")]
+            let _ = submission;
+        }
+        Ok(self.ctx.queue.submit([tile.shading.finish()]))
     }
 
     /// The passes of one tile for `work` (see [`Renderer::encode_tile`]).
@@ -516,7 +546,7 @@ impl Renderer {
         tile: ([u32; 2], [u32; 2]),
         work: TileWork,
         mut timestamps: Option<&mut PassQueries<'_>>,
-    ) -> wgpu::CommandEncoder {
+    ) -> TileEncoders {
         if let Some(q) = timestamps.as_deref_mut() {
             q.next_group();
         }
@@ -528,11 +558,14 @@ impl Renderer {
         self.ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let groups = prepared.groups.as_ref().expect("bind groups are made in prepare");
         let passes = &self.passes;
-        let mut enc =
-            self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("tile") });
+        let encoder = |label| {
+            self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
+        };
+        let mut surfaces = None;
         if prepared.raster || work == TileWork::Classify {
+            let enc = surfaces.get_or_insert_with(|| encoder("tile surfaces"));
             passes.raster.encode(
-                &mut enc,
+                enc,
                 &t.g_buffer(),
                 size,
                 &groups.raster,
@@ -543,19 +576,20 @@ impl Renderer {
                 timestamps.as_deref_mut().and_then(|q| q.render("raster")),
             );
         }
+        let mut shading = encoder("tile shading");
         let soft_bg = groups.soft.as_ref().filter(|_| frame.area_light.is_some());
         let readback = match work {
             TileWork::Classify => {
                 if let Some(bg) = soft_bg {
-                    passes.soft.encode_classify(&mut enc, bg, size);
+                    passes.soft.encode_classify(&mut shading, bg, size);
                 }
-                return enc;
+                return TileEncoders { surfaces, shading };
             }
             TileWork::Draw { readback } => readback,
         };
         if let Some(bg) = &groups.plane {
             passes.plane_shadows.encode(
-                &mut enc,
+                surfaces.get_or_insert_with(|| encoder("tile surfaces")),
                 &t.plane_shadow_view,
                 &t.depth_view,
                 size,
@@ -567,15 +601,15 @@ impl Renderer {
             );
         }
         if let Some(bg) = soft_bg {
-            passes.soft.encode_gather(&mut enc, bg, size, timestamps.as_deref_mut());
+            passes.soft.encode_gather(&mut shading, bg, size, timestamps.as_deref_mut());
         }
         let wave_timestamps = timestamps.and_then(|q| q.compute("wave"));
-        passes.wave.encode(&mut enc, &prepared.wave_pipeline, &groups.wave, size, wave_timestamps);
+        passes.wave.encode(&mut shading, &prepared.wave_pipeline, &groups.wave, size, wave_timestamps);
         if readback {
             let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
-            enc.copy_buffer_to_buffer(&t.output, 0, &t.staging, 0, bytes);
+            shading.copy_buffer_to_buffer(&t.output, 0, &t.staging, 0, bytes);
         }
-        enc
+        TileEncoders { surfaces, shading }
     }
 
     /// Renders `frame` into a new [`Image`].
@@ -598,9 +632,9 @@ impl Renderer {
         let mut image = alloc_image(frame.width, rows.len() as u32)?;
         for &tile in &prepared.tiles {
             let submission = self.ctx.scoped("rendering a tile", || {
-                let enc = self.encode_tile(frame, &prepared, tile, true, None);
-                self.ctx.queue.submit([enc.finish()])
-            })?;
+                let encoders = self.encode_tile(frame, &prepared, tile, true, None);
+                self.submit_tile(encoders)
+            })??;
             let (origin, size) = tile;
             let origin = [origin[0], origin[1] - rows.start];
             let n = size[0] as usize * size[1] as usize;

@@ -21,8 +21,8 @@ pub(crate) fn time_frame(
     // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
     let last = r.ctx.scoped("warming up", || {
         let maps = r.submit_shadow_maps(frame, &prepared, None);
-        r.submit_tiles(frame, &prepared, None).or(maps)
-    })?;
+        r.submit_tiles(frame, &prepared, None).map(|tiles| tiles.or(maps))
+    })??;
     if let Some(s) = last {
         r.ctx.wait(s)?;
     }
@@ -63,7 +63,7 @@ pub(crate) fn time_frame(
             let mut q = PassQueries::new(&set, queries);
             let (last, used) = r.ctx.scoped("timing a frame", || {
                 r.submit_shadow_maps(frame, &prepared, Some(&mut q));
-                r.submit_tiles(frame, &prepared, Some(&mut q));
+                r.submit_tiles(frame, &prepared, Some(&mut q))?;
                 let used = q.used();
                 let mut enc = r.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("timestamp resolve"),
@@ -72,8 +72,8 @@ pub(crate) fn time_frame(
                     enc.resolve_query_set(&set, 0..used, &resolve, 0);
                     enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, used as u64 * 8);
                 }
-                (r.ctx.queue.submit([enc.finish()]), used)
-            })?;
+                Ok::<_, RenderError>((r.ctx.queue.submit([enc.finish()]), used))
+            })??;
             if used == 0 {
                 break;
             }
@@ -111,7 +111,7 @@ pub(crate) fn time_frame(
             let start = Instant::now();
             // `prepare` draws the shadow maps and the soft shadows.
             let prepared = r.prepare(frame, 0..frame.height)?;
-            let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))?;
+            let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))??;
             if let Some(s) = last {
                 r.ctx.wait(s)?;
             }
@@ -123,8 +123,8 @@ pub(crate) fn time_frame(
         let start = Instant::now();
         let last = r.ctx.scoped("timing a frame", || {
             let maps = r.submit_shadow_maps(frame, &prepared, None);
-            r.submit_tiles(frame, &prepared, None).or(maps)
-        })?;
+            r.submit_tiles(frame, &prepared, None).map(|tiles| tiles.or(maps))
+        })??;
         if let Some(s) = last {
             r.ctx.wait(s)?;
         }

@@ -57,14 +57,14 @@ impl Renderer {
             for &tile in &prepared.tiles {
                 // Writes the tile's uniforms, which the present pass reads too (tile origin and
                 // size); submitted before the next tile rewrites them.
-                let mut enc = self.encode_tile(frame, &prepared, tile, false, q.as_mut());
+                let mut encoders = self.encode_tile(frame, &prepared, tile, false, q.as_mut());
                 // In the tile's group of queries: its span ends with this pass.
                 let timestamps = q.as_mut().and_then(|q| q.render("present"));
-                present.pass.encode(&mut enc, &target.view, tile, &bind_group, timestamps);
-                self.ctx.queue.submit([enc.finish()]);
+                present.pass.encode(&mut encoders.shading, &target.view, tile, &bind_group, timestamps);
+                self.submit_tile(encoders)?;
             }
-            q
-        })?;
+            Ok(q)
+        })??;
         if let (Some(f), Some(q)) = (&timed_frame, queries) {
             let (ctx, present) = (&self.ctx, self.present.as_mut().expect("made above"));
             if let Some(timer) = present.timer.as_mut() {
