@@ -1,12 +1,20 @@
-//! Mutation fuzzing of the whole path from a scene file to pixels: every example scene (and a few
-//! glTF files written here) is mutated at random (byte flips, lines deleted, duplicated, swapped or
+//! Mutation fuzzing of the whole path from a scene file to pixels: every example scene, the
+//! hand-made hostile cases of `fuzz_corpus` (curves at the corners of their parameter boxes,
+//! scenes past the triangle and image limits, textured materials whose PNG carries ancillary
+//! chunks, a skin whose weights overflow, every shadow kind with an `[area_light]`, tracks with
+//! extreme key times, control bytes in paths), and the files they name (a few glTF files, the
+//! examples' skinned and textured `hero.glb`, a PNG) are mutated at random (byte flips, lines deleted, duplicated, swapped or
 //! spliced in from another scene, numbers replaced by extreme values, keys swapped, truncation),
 //! written to a temporary directory and loaded with `Scene::load`. Each case must not panic, must
 //! finish in bounded time, and when it loads, its frames at t = 0, 0.5 and 3 rendered by the CPU
-//! backend at 24×16 must hold only finite colour, energy and depth.
+//! backend at 24×16 must hold only finite colour, energy and depth. An error is one line without
+//! control characters. Before mutating, each hand-made case runs as written and must load, or
+//! fail with the message its limit promises.
 //!
 //! `HADOU_FUZZ_CASES=N` sets the number of cases (default 1000), `HADOU_FUZZ_SEED=S` the seed
 //! (printed, so a failure can be replayed; the failing case's own seed and text are reported).
+
+mod fuzz_corpus;
 
 use hadou_math::rng::Rng;
 use hadou_scene::Scene;
@@ -230,16 +238,17 @@ fn env_u64(key: &str) -> Option<u64> {
     std::env::var(key).ok().and_then(|v| v.trim().parse().ok())
 }
 
-/// Loads and renders one case; `Err` says what went wrong.
-fn run_case(path: &Path) -> Result<bool, String> {
+/// Loads and renders one case: `Ok(Ok(()))` when it loaded and rendered, `Ok(Err(message))`
+/// when it failed cleanly; the outer `Err` says what went wrong.
+fn run_case(path: &Path) -> Result<Result<(), String>, String> {
     let scene = match Scene::load(path) {
         Ok(s) => s,
         Err(e) => {
             let msg = e.to_string();
-            if msg.is_empty() || msg.contains('\n') {
-                return Err(format!("error message is not one line: {msg:?}"));
+            if msg.is_empty() || msg.chars().any(char::is_control) {
+                return Err(format!("error message is not one line of text: {msg:?}"));
             }
-            return Ok(false);
+            return Ok(Err(msg));
         }
     };
     for t in [0.0, 0.5, 3.0] {
@@ -259,7 +268,19 @@ fn run_case(path: &Path) -> Result<bool, String> {
             return Err(format!("non-finite {what} at pixel ({}, {}) at t = {t}", i % 24, i / 24));
         }
     }
-    Ok(true)
+    Ok(Ok(()))
+}
+
+/// What a hand-made case must do as written: load (`None`), or fail with a message containing
+/// the text.
+fn seed_expectation(name: &str) -> Option<&'static str> {
+    match name {
+        "helix at rate -1e6" => Some("at most 128 turns"),
+        "ten 1024-segment spheres" => Some("triangles"),
+        "area light over a 4097×4096 image" => Some("16777216 pixels"),
+        "control bytes in a path" => Some("a\\0b\\u{1b}[2J.glb"),
+        _ => None,
+    }
 }
 
 #[test]
@@ -274,6 +295,9 @@ fn mutated_scenes_load_or_fail_cleanly_and_render_finite() {
     corpus.sort();
     assert!(corpus.len() >= 10, "example scenes not found in {}", root.display());
     corpus.push(("gltf-scene".into(), GLTF_SCENE.as_bytes().to_vec()));
+    let seeds = fuzz_corpus::seeds();
+    corpus.extend(seeds.iter().cloned());
+    let aux = fuzz_corpus::aux_files();
     let donors: Vec<Vec<u8>> = corpus.iter().map(|c| c.1.clone()).collect();
 
     let blob = triangle_blob();
@@ -287,7 +311,29 @@ fn mutated_scenes_load_or_fail_cleanly_and_render_finite() {
 
     let dir = std::env::temp_dir().join(format!("hadou-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("assets")).unwrap();
-    std::fs::copy(root.join("assets/crystal.glb"), dir.join("assets/crystal.glb")).unwrap();
+    for asset in ["crystal.glb", "hero.glb"] {
+        std::fs::copy(root.join("assets").join(asset), dir.join("assets").join(asset)).unwrap();
+    }
+    for (name, bytes) in &aux {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+
+    // The hand-made cases as written.
+    let path = dir.join("case.toml");
+    for (name, text) in &seeds {
+        std::fs::write(&path, text).unwrap();
+        let t0 = Instant::now();
+        let outcome = catch_unwind(AssertUnwindSafe(|| run_case(&path)))
+            .unwrap_or_else(|_| panic!("{name}: panicked"))
+            .unwrap_or_else(|why| panic!("{name}: {why}"));
+        assert!(t0.elapsed() < CASE_LIMIT, "{name}: took {:?}", t0.elapsed());
+        match (seed_expectation(name), outcome) {
+            (None, Err(msg)) => panic!("{name}: should load, failed: {msg}"),
+            (Some(want), Ok(())) => panic!("{name}: should fail with \"{want}\", loaded"),
+            (Some(want), Err(msg)) => assert!(msg.contains(want), "{name}: wanted \"{want}\" in: {msg}"),
+            (None, Ok(())) => {}
+        }
+    }
 
     let started = Instant::now();
     let (mut loaded, mut failures) = (0usize, Vec::new());
@@ -321,7 +367,16 @@ fn mutated_scenes_load_or_fail_cleanly_and_render_finite() {
             text = String::from_utf8_lossy(&text).replace("m.gltf", "m.glb").into_bytes();
         }
         std::fs::write(dir.join(gltf_name), &gltf_bytes).unwrap();
-        let path = dir.join("case.toml");
+        // The hand-made cases' PNG and skinned glTF: as made, or mutated.
+        for (aux_name, bytes) in &aux {
+            let mut b = bytes.clone();
+            if rng.below(3) == 0 {
+                for _ in 0..1 + rng.below(3) {
+                    b = mutate(&mut rng, &b, std::slice::from_ref(bytes));
+                }
+            }
+            std::fs::write(dir.join(aux_name), &b).unwrap();
+        }
         std::fs::write(&path, &text).unwrap();
 
         let t0 = Instant::now();
@@ -335,8 +390,8 @@ fn mutated_scenes_load_or_fail_cleanly_and_render_finite() {
             )
         };
         match outcome {
-            Ok(Ok(true)) => loaded += 1,
-            Ok(Ok(false)) => {}
+            Ok(Ok(Ok(()))) => loaded += 1,
+            Ok(Ok(Err(_))) => {}
             Ok(Err(why)) => failures.push(report(why)),
             Err(_) => failures.push(report("panicked".into())),
         }

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 /// `text` with every control character (NUL, newline, ESC, …) and every bidirectional-text
 /// override written as an escape (`\0`, `\n`, `\u{1b}`, `\u{202e}`), so a name or path read from a
 /// file cannot break a message's line or drive the terminal that prints it.
-pub(crate) fn escape_controls(text: &str) -> Cow<'_, str> {
+pub fn escape_controls(text: &str) -> Cow<'_, str> {
     let bad = |c: char| c.is_control() || matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
     if !text.chars().any(bad) {
         return Cow::Borrowed(text);

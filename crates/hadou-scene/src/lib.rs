@@ -58,7 +58,7 @@ pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
 pub use backend::{Backend, RenderError};
 pub use bounds::{object_bounds, object_center};
-pub use error::{Location, SceneError};
+pub use error::{escape_controls, Location, SceneError};
 pub use files::{
     read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS, GLTF_MAX_JSON_VALUES,
     SCENE_MAX_BYTES,

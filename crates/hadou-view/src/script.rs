@@ -25,6 +25,7 @@
 //! | `quit` | stop here |
 
 use crate::viewer::{BackendKind, Request, Viewer};
+use hadou_scene::escape_controls;
 use std::path::{Path, PathBuf};
 
 /// One parsed command.
@@ -96,7 +97,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Line>, String> {
         let line = raw.split('#').next().unwrap_or("");
         let words: Vec<(usize, &str)> = words(line);
         let Some(&(col, name)) = words.first() else { continue };
-        let at = |col: usize, m: String| format!("{}:{}:{}: {m}", path.display(), i + 1, col + 1);
+        let at = |col: usize, m: String| {
+            let place = format!("{}:{}:{}", path.display(), i + 1, col + 1);
+            format!("{}: {}", escape_controls(&place), escape_controls(&m))
+        };
         let args = &words[1..];
         let command = parse_command(name, args, dir).map_err(|(c, m)| at(c.unwrap_or(col), m))?;
         out.push(Line { line: i + 1, command });
@@ -391,6 +395,7 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
         Ok(WindowOp::None)
     } else {
         let why = viewer.message.as_ref().map_or("it did nothing".to_string(), |m| m.0.clone());
-        Err(format!("{}:{}: {why}", path.display(), line.line))
+        let place = format!("{}:{}", path.display(), line.line);
+        Err(format!("{}: {}", escape_controls(&place), escape_controls(&why)))
     }
 }
