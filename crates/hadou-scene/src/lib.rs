@@ -16,7 +16,7 @@
 //! circles):
 //! 1. the frame's plain values (`frame.rs`, with `shadow.rs` and `area_light.rs`; `image.rs`) and
 //!    the helpers everything uses (`error.rs`, `limits.rs`, `files.rs`, `guard.rs`, `params.rs`,
-//!    `anim.rs`, `toml_read.rs`);
+//!    `anim.rs`, `toml_read.rs`) and `temp_file.rs` (how every writer of the workspace writes);
 //! 2. a frame's geometry and assets: `bounds.rs`, `mesh.rs`, `texture.rs`, `gltf_uri.rs`,
 //!    `gltf_material.rs`, `gltf_load.rs`; and `backend.rs`;
 //! 3. each feature read from the scene file and built at one set of values (`materials.rs`,
@@ -50,6 +50,7 @@ mod schema;
 mod shadow;
 mod shadow_casts;
 mod shadow_def;
+mod temp_file;
 mod texture;
 mod toml_read;
 mod track_def;
@@ -76,6 +77,7 @@ pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,
     MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES, ON_PLANE,
 };
+pub use temp_file::{remove_pending_temp_files, TempFile};
 pub use texture::{
     decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE,
     TEXTURE_MAX_TEXELS,

@@ -399,26 +399,15 @@ fn strip_path(m: &str, path: &Path) -> String {
         .map_or_else(|| m.to_string(), |rest| format!("in the edited scene, line {}", rest.trim_start()))
 }
 
-/// Writes `bytes` to a temporary file in `path`'s directory and renames it over `path`.
+/// Writes `bytes` to a temporary file in `path`'s directory ([`hadou_scene::TempFile`], registered
+/// for the interrupt handler's clean-up before its first byte) and renames it over `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     use std::io::Write;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.hadou-save-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    let (tmp, mut file) = hadou_scene::TempFile::create(path)?;
+    file.write_all(bytes)?;
+    file.sync_all()?;
+    drop(file);
+    tmp.commit(path)
 }
 
 // ---------------------------------------------------------------------------------------------

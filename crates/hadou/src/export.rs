@@ -18,27 +18,49 @@
 //! computes it), with the spec's width and height overriding the scene's `[image]` size.
 //!
 //! What is left on disk:
-//! - **GIF**: the file is written to a temporary file beside the output (`.NAME.PID.N.tmp`) and
-//!   renamed into place after the last frame, so the output path holds either its old content or
-//!   the complete new animation. On cancel or on any error the temporary file is removed and the
-//!   output path is untouched. (This temporary file is not in [`crate::output`]'s list of pending
-//!   files, so an interrupt of the whole process by Ctrl-C does not remove it; a cancel through
-//!   the progress callback does.)
+//! - **GIF**: the file is written to a temporary file beside the output (`.NAME.PID.N.tmp`, a
+//!   [`hadou_scene::TempFile`]) and renamed into place after the last frame, so the output path
+//!   holds either its old content or the complete new animation. On cancel, on any error and on
+//!   an interrupt of the process ([`output::install_interrupt_cleanup`]) the temporary file is
+//!   removed and the output path is untouched.
 //! - **PNG sequence**: every frame is written whole (temporary file, then rename) by
 //!   [`output::write_png_banded`], exactly as `hadou render --frames` writes it. A cancel is seen
 //!   between frames: the frames finished before it stay on disk, no partial file is left. An error
-//!   part-way also keeps the frames finished before it.
+//!   or an interrupt part-way also keeps the frames finished before it.
+//!
+//! Sizes: every frame has the spec's size (the overrides, else the scene's `[image]`; tracks cannot
+//! change it), checked before the first frame against the scene's image limits
+//! ([`Scene::check_image_size`]) and, for a GIF, [`GIF_MAX_PIXELS`].
 
 use crate::output::{self, OutputError};
 use hadou_scene::{Backend, Frame, Image, RenderError, Scene};
-use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::ops::Range;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 
-/// The largest image edge an export accepts (the CLI's `--width`/`--height` limit).
-pub const MAX_EDGE: u32 = 16384;
+/// The largest image edge an export accepts (the scene's `[image]` and the CLI's
+/// `--width`/`--height` limit).
+pub const MAX_EDGE: u32 = hadou_scene::MAX_IMAGE_EDGE;
+
+/// The most pixels of a GIF frame: 16,777,216 (4096²). A GIF frame is quantised whole (NeuQuant
+/// needs all its colours at once), which costs about 5 bytes a pixel on top of the rendered bands
+/// (80 MB at this limit, 1.3 GB at 16384²); larger animations are written as a PNG sequence,
+/// band by band.
+pub const GIF_MAX_PIXELS: u64 = 1 << 24;
+
+/// Checks a GIF frame size against [`GIF_MAX_PIXELS`]; the message names the size, callers
+/// prefix where it came from.
+pub fn check_gif_size(width: u32, height: u32) -> Result<(), String> {
+    let n = u64::from(width) * u64::from(height);
+    if n > GIF_MAX_PIXELS {
+        return Err(format!(
+            "a GIF frame is at most {GIF_MAX_PIXELS} pixels (4096²; each frame is quantised whole); \
+             {width}×{height} is {n} pixels: choose a smaller size, or write a PNG sequence (an output \
+             directory ending in `/`), which has no such limit"
+        ));
+    }
+    Ok(())
+}
 
 /// NeuQuant's speed for GIF quantisation (1 = best, 30 = fastest; 10 is the crate's advised
 /// compromise).
@@ -124,6 +146,12 @@ impl AnimationSpec {
     /// The scene time of frame `f`: `f as f32 / fps`, as `hadou render --frames` computes it.
     pub fn time_of(&self, f: u32) -> f32 {
         f as f32 / self.fps
+    }
+
+    /// The size of every frame: the spec's overrides, else the scene's `[image]` size (no track can
+    /// change it).
+    pub fn size(&self, scene: &Scene) -> (u32, u32) {
+        (self.width.unwrap_or(scene.width()), self.height.unwrap_or(scene.height()))
     }
 
     /// The scene at frame `f` with the spec's size overrides applied.
@@ -249,7 +277,9 @@ pub fn gif_delay_cs(fps: f32, k: u32) -> u16 {
 /// frames. See the [module docs](self) for what stays on disk after a cancel or an error.
 ///
 /// Everything about the path is checked before the first frame is rendered: the spec
-/// ([`AnimationSpec::validate`], as [`ExportError::Spec`]), the format, and that the directory
+/// ([`AnimationSpec::validate`], as [`ExportError::Spec`]), the frame size against the scene's
+/// image limits ([`Scene::check_image_size`]) and a GIF's ([`check_gif_size`]), both as
+/// [`ExportError::Spec`], the format, and that the directory
 /// exists and accepts new files ([`OutputError::BadPath`]; a PNG sequence's directory must exist
 /// already, as with `hadou render --frames`). Nothing is created on a failed check.
 pub fn export_animation(
@@ -260,6 +290,8 @@ pub fn export_animation(
     progress: &mut dyn FnMut(Progress) -> Control,
 ) -> Result<ExportOutcome, ExportError> {
     spec.validate()?;
+    let (w, h) = spec.size(scene);
+    scene.check_image_size(w, h).map_err(ExportError::Spec)?;
     match AnimationFormat::from_path(path)? {
         AnimationFormat::PngSequence => export_png_sequence(scene, backend, spec, path, progress),
         AnimationFormat::Gif => export_gif(scene, backend, spec, path, progress),
@@ -331,50 +363,6 @@ fn export_png_sequence(
     Ok(ExportOutcome::Finished { frames: total })
 }
 
-/// Distinguishes the temporary files of exports running at once in one process.
-static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
-
-/// A temporary file beside the output, removed on drop unless [`GifTemp::commit`] renamed it.
-struct GifTemp {
-    tmp: PathBuf,
-}
-
-impl GifTemp {
-    /// Creates `.NAME.PID.N.tmp` in `path`'s directory (never replacing an existing file).
-    fn create(path: &Path) -> Result<(GifTemp, File), OutputError> {
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
-        let file = File::options().write(true).create_new(true).open(&tmp).map_err(|e| {
-            OutputError::BadPath(format!(
-                "{}: cannot create files in `{}` ({e}); check its permissions or choose another output path",
-                path.display(),
-                dir.display()
-            ))
-        })?;
-        Ok((GifTemp { tmp }, file))
-    }
-
-    /// Renames the finished temporary file to `path`.
-    fn commit(mut self, path: &Path) -> Result<(), String> {
-        std::fs::rename(&self.tmp, path).map_err(|e| e.to_string())?;
-        self.tmp = PathBuf::new();
-        Ok(())
-    }
-}
-
-impl Drop for GifTemp {
-    fn drop(&mut self) {
-        if !self.tmp.as_os_str().is_empty() {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
-    }
-}
-
 /// Renders `frame` band by band (as the PNG path does) into packed 8-bit sRGB RGBA, alpha 255.
 fn render_rgba(backend: &mut dyn Backend, frame: &Frame) -> Result<Vec<u8>, ExportError> {
     let (w, h) = (frame.width, frame.height);
@@ -412,13 +400,14 @@ fn export_gif(
     let first = spec.frame(scene, spec.frames.start);
     let (w, h) = (first.width, first.height);
     let mut first = Some(first);
+    check_gif_size(w, h).map_err(|m| ExportError::Spec(format!("{}: {m}", path.display())))?;
     let (Ok(w16), Ok(h16)) = (u16::try_from(w), u16::try_from(h)) else {
         return Err(ExportError::Spec(format!(
             "{}: {w}×{h} is too large for a GIF (65535 at most)",
             path.display()
         )));
     };
-    let (temp, file) = GifTemp::create(path)?;
+    let (temp, file) = output::create_temp(path)?;
     let io =
         |e: String| ExportError::Output(OutputError::Io(format!("{}: write failed: {e}", path.display())));
     let mut encoder =
@@ -449,6 +438,6 @@ fn export_gif(
     let mut writer = encoder.into_inner().map_err(|e| io(e.to_string()))?;
     writer.flush().map_err(|e| io(e.to_string()))?;
     drop(writer);
-    temp.commit(path).map_err(io)?;
+    temp.commit(path).map_err(|e| io(e.to_string()))?;
     Ok(ExportOutcome::Finished { frames: total })
 }

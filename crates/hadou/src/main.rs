@@ -82,10 +82,11 @@ struct RenderArgs {
     /// Frames per second for --frames.
     #[arg(long, default_value = "24", allow_hyphen_values = true)]
     fps: String,
-    /// Override the image width.
+    /// Override the image width (the scene's `[image]` limits hold: 1..=16384, and at most 4096²
+    /// pixels with an `[area_light]`).
     #[arg(long, allow_hyphen_values = true)]
     width: Option<u32>,
-    /// Override the image height.
+    /// Override the image height (the same limits).
     #[arg(long, allow_hyphen_values = true)]
     height: Option<u32>,
     /// Which backend renders.
@@ -103,10 +104,11 @@ struct ProbeArgs {
     /// Scene time in seconds (≥ 0).
     #[arg(long, default_value = "0", allow_hyphen_values = true)]
     time: String,
-    /// Override the image width.
+    /// Override the image width (the scene's `[image]` limits hold: 1..=16384, and at most 4096²
+    /// pixels with an `[area_light]`).
     #[arg(long, allow_hyphen_values = true)]
     width: Option<u32>,
-    /// Override the image height.
+    /// Override the image height (the same limits).
     #[arg(long, allow_hyphen_values = true)]
     height: Option<u32>,
     /// Which backend evaluates the pixel (the CPU also counts integrand evaluations).
@@ -235,6 +237,12 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
         output::check_directory(&a.output)?;
     }
     let scene = load_scene(&a.scene)?;
+    let (w, h) = check_image_size(&scene, &a.scene, a.width, a.height)?;
+    if hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::Gif {
+        hadou::export::check_gif_size(w, h).map_err(|m| {
+            Failure::input(format!("{}: {m}", size_origin(&scene, &a.scene, a.width, a.height)))
+        })?;
+    }
     let mut backend = make_backend(a.backend)?;
     let bar = indicatif::ProgressBar::new(range.len() as u64);
     bar.set_style(
@@ -259,6 +267,8 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
 
 #[cfg(feature = "view")]
 fn view(a: ViewArgs) -> Result<(), Failure> {
+    // Ctrl-C, SIGTERM and SIGHUP remove the temporary files of screenshots, exports and saves.
+    output::install_interrupt_cleanup().map_err(Failure::runtime)?;
     let time = a.time.as_deref().map(|t| parse_time("--time", t)).transpose()?;
     let opts = hadou::view::ViewOptions {
         scene: a.scene,
@@ -294,12 +304,42 @@ fn size_override(w: Option<u32>, h: Option<u32>) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Image edges are 1..=16384 pixels; `flag` names the option the value came from.
+/// Image edges are 1..=[`hadou::MAX_IMAGE_EDGE`] pixels; `flag` names the option the value came
+/// from. Checked before the scene is loaded; [`check_image_size`] checks the whole size after.
 fn check_size(flag: &str, v: u32) -> Result<(), Failure> {
-    if v == 0 || v > 16384 {
-        return Err(Failure::input(format!("{flag} {v}: image size must be in 1..=16384")));
+    let max = hadou::MAX_IMAGE_EDGE;
+    if v == 0 || v > max {
+        return Err(Failure::input(format!("{flag} {v}: image size must be in 1..={max}")));
     }
     Ok(())
+}
+
+/// The image size `--width`/`--height` give `scene` (each flag overriding its edge of the scene's
+/// `[image]`), checked against the limits of the scene's `[image]` ([`Scene::check_image_size`]:
+/// edges, and the pixel count of a scene with an `[area_light]`) before anything is rendered or
+/// written; the message names the flags.
+fn check_image_size(
+    scene: &Scene,
+    path: &std::path::Path,
+    w: Option<u32>,
+    h: Option<u32>,
+) -> Result<(u32, u32), Failure> {
+    let (width, height) = (w.unwrap_or(scene.width()), h.unwrap_or(scene.height()));
+    scene
+        .check_image_size(width, height)
+        .map_err(|m| Failure::input(format!("{}: {m}", size_origin(scene, path, w, h))))?;
+    Ok((width, height))
+}
+
+/// Where an image size came from, for a message: the flags as given, with the edge the scene
+/// file gave when only one flag is, or the scene's `[image]` when neither is.
+fn size_origin(scene: &Scene, path: &std::path::Path, w: Option<u32>, h: Option<u32>) -> String {
+    match (w, h) {
+        (Some(w), Some(h)) => format!("--width {w} --height {h}"),
+        (Some(w), None) => format!("--width {w} (height {} from the scene's [image])", scene.height()),
+        (None, Some(h)) => format!("--height {h} (width {} from the scene's [image])", scene.width()),
+        (None, None) => format!("{}: [image] {}×{}", path.display(), scene.width(), scene.height()),
+    }
 }
 
 /// Parses a time in seconds as typed after `flag`: a finite number ≥ 0. Messages echo the text
@@ -445,25 +485,19 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
     output::install_interrupt_cleanup().map_err(Failure::runtime)?;
     let Some(frames) = &a.frames else {
         let time = parse_time("--time", &a.time)?;
-        let format = output::Format::from_path(&a.output)?;
+        output::Format::from_path(&a.output)?;
         output::check_directory(&a.output)?;
         let scene = load_scene(&a.scene)?;
+        check_image_size(&scene, &a.scene, a.width, a.height)?;
         let frame = frame_at(&scene, time, a.width, a.height);
         let mut backend = make_backend(a.backend)?;
-        match format {
-            // PNG is rendered and encoded band by band: memory follows the band, not the image.
-            output::Format::Png => output::write_png_banded(&a.output, frame.width, frame.height, |rows| {
-                let band = backend.render_rows(&frame, rows)?;
-                check_finite(&band)?;
-                Ok::<_, Failure>(band)
-            })?,
-            output::Format::Exr => {
-                output::check_writable(&a.output)?;
-                let image = backend.render(&frame)?;
-                check_finite(&image)?;
-                output::write(&image, &a.output)?;
-            }
-        }
+        // Both formats are rendered and encoded band by band: memory follows the band, not the
+        // image.
+        output::write_banded(&a.output, frame.width, frame.height, |rows| {
+            let band = backend.render_rows(&frame, rows)?;
+            check_finite(&band)?;
+            Ok::<_, Failure>(band)
+        })?;
         eprintln!(
             "wrote {} ({}×{}, {} backend)",
             a.output.display(),
@@ -513,6 +547,7 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     let (x, y) = parse_pixel(&a.pixel)?;
     let time = parse_time("--time", &a.time)?;
     let scene = load_scene(&a.scene)?;
+    check_image_size(&scene, &a.scene, a.width, a.height)?;
     let frame = frame_at(&scene, time, a.width, a.height);
     let outside = || {
         Failure::input(format!(
@@ -561,16 +596,17 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Probes a pixel with a whole-frame backend: one render for colour and depth, then one render per
-/// wave alone for its energy. Integrand evaluations are not counted there (reported as 0).
+/// Probes a pixel with a whole-frame backend: one render of the pixel's row for colour and depth,
+/// then one per wave alone for its energy (a row, not the image, so memory stays small at any
+/// size). Integrand evaluations are not counted there (reported as 0).
 fn gpu_probe(backend: &mut dyn Backend, frame: &Frame, x: u32, y: u32) -> Result<hadou::Probe, Failure> {
-    let img = backend.render(frame)?;
-    let i = img.index(x, y);
+    let img = backend.render_rows(frame, y..y + 1)?;
+    let i = img.index(x, 0);
     let mut waves = Vec::new();
     for w in &frame.waves {
         let mut single = frame.clone();
         single.waves = vec![w.clone()];
-        let e = backend.render(&single)?.energy[i];
+        let e = backend.render_rows(&single, y..y + 1)?.energy[i];
         waves.push(hadou::WaveProbe { name: w.name.clone(), energy: e, evaluations: 0 });
     }
     let (object, shadow, soft) =
@@ -628,12 +664,15 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
     }
     if toon || shadows {
         let file = if toon { hadou::bench::TOON_SCENE.0 } else { hadou::bench::SOFT_SCENE.0 };
-        Scene::load(a.scenes.join(file)).map_err(|e| {
+        let scene = Scene::load(a.scenes.join(file)).map_err(|e| {
             Failure::input(format!(
                 "--scenes {}: this bench needs the example scenes (scenes/ of the repository): {e}",
                 a.scenes.display()
             ))
         })?;
+        for &s in &sizes {
+            scene.check_image_size(s, s).map_err(|m| Failure::input(format!("--sizes {s}: {m} ({file})")))?;
+        }
     }
     let (mut timer, name, method) = make_timer(a.backend)?;
     let bar = indicatif::ProgressBar::new_spinner();

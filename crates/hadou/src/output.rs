@@ -1,14 +1,15 @@
-//! Encoders: 8-bit sRGB PNG, float EXR, numbered sequences. Every write goes to a temporary file
-//! in the destination directory and is renamed into place, so a failed or interrupted write never
-//! leaves a half-written output.
+//! Encoders: 8-bit sRGB PNG, float EXR, numbered sequences. Every write goes to a
+//! [`hadou_scene::TempFile`] in the destination directory (registered for the interrupt handler's
+//! clean-up before its first byte) and is renamed into place, so a failed or interrupted write
+//! never leaves a half-written output. Both formats can be written band by band
+//! ([`write_png_banded`], [`write_exr_banded`]): memory follows the band, not the image.
 
 use hadou_math::shade::linear_to_srgb8;
-use hadou_scene::Image;
+use hadou_scene::{Image, TempFile};
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 /// Why an output could not be written.
 #[derive(Debug)]
@@ -57,8 +58,7 @@ impl Format {
 pub fn check_writable(path: &Path) -> Result<Format, OutputError> {
     let format = Format::from_path(path)?;
     check_directory(path)?;
-    let probe = TempFile::create(path)?;
-    drop(probe);
+    drop(create_temp(path)?);
     Ok(format)
 }
 
@@ -93,6 +93,20 @@ pub fn write(image: &Image, path: &Path) -> Result<(), OutputError> {
     match Format::from_path(path)? {
         Format::Png => write_png(image, path),
         Format::Exr => write_exr(image, path),
+    }
+}
+
+/// Writes a `width × height` image to `path` in the format its extension names, band by band
+/// ([`write_png_banded`], [`write_exr_banded`]): memory follows the band, not the image.
+pub fn write_banded<E: From<OutputError>>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+) -> Result<(), E> {
+    match Format::from_path(path)? {
+        Format::Png => write_png_banded(path, width, height, band),
+        Format::Exr => write_exr_banded(path, width, height, band),
     }
 }
 
@@ -142,27 +156,9 @@ pub fn srgb8(image: &Image) -> Vec<u8> {
 }
 
 /// Writes a float EXR with channels `R, G, B, A` (linear colour after mapping), `energy` and
-/// `depth`.
+/// `depth` ([`write_exr_banded`] over the image's rows).
 pub fn write_exr(image: &Image, path: &Path) -> Result<(), OutputError> {
-    use exr::prelude::*;
-    let ch = |name: &str, v: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(v));
-    let comp = |k: usize| image.color.iter().map(|c| c[k]).collect::<Vec<f32>>();
-    let channels = AnyChannels::sort(SmallVec::from_vec(vec![
-        ch("R", comp(0)),
-        ch("G", comp(1)),
-        ch("B", comp(2)),
-        ch("A", comp(3)),
-        ch("energy", image.energy.clone()),
-        ch("depth", image.depth.clone()),
-    ]));
-    let size = (image.width as usize, image.height as usize);
-    let layer = Layer::new(size, LayerAttributes::named("hadou"), Encoding::FAST_LOSSLESS, channels);
-    let img = exr::image::Image::from_layer(layer);
-    atomic_write(path, |file| {
-        let mut w = BufWriter::new(file);
-        img.write().to_buffered(&mut w).map_err(|e| e.to_string())?;
-        w.flush().map_err(|e| e.to_string())
-    })
+    write_exr_banded(path, image.width, image.height, |rows| Ok::<_, OutputError>(image.crop_rows(rows)))
 }
 
 fn parent_dir(path: &Path) -> PathBuf {
@@ -172,97 +168,44 @@ fn parent_dir(path: &Path) -> PathBuf {
     }
 }
 
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()))
-}
-
-/// Temporary files that exist right now; [`remove_pending`] deletes them when the process is
-/// interrupted. An entry is added when a [`TempFile`] is created and removed, under the same lock,
-/// when it is renamed into place or deleted, so an interrupt sees either the temporary file or
-/// the finished output, never a half-renamed state.
-static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-
-fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
-    PENDING.lock().unwrap_or_else(|p| p.into_inner())
-}
-
-/// Deletes every temporary output file being written and returns how many there were. Called by
-/// the interrupt handler; it keeps the lock, so no rename can start afterwards.
+/// Deletes every temporary output file being written and returns how many it deleted. Called by
+/// the interrupt handler; no temporary file can be created or renamed into place afterwards
+/// ([`hadou_scene::remove_pending_temp_files`]).
 pub fn remove_pending() -> usize {
-    let mut files = pending();
-    for f in files.iter() {
-        let _ = std::fs::remove_file(f);
-    }
-    let n = files.len();
-    files.clear();
-    std::mem::forget(files); // keep the lock held until the process exits
-    n
+    hadou_scene::remove_pending_temp_files()
 }
 
 /// Makes Ctrl-C, SIGTERM and SIGHUP remove partial outputs: the handler deletes every pending
-/// temporary file, says so on stderr and exits with status 130.
+/// temporary file (of any writer: images, animations, saved scenes), says how many on stderr and
+/// exits with status 130. Outputs finished before the interrupt (earlier frames of a sequence)
+/// stay.
 pub fn install_interrupt_cleanup() -> Result<(), String> {
     ctrlc::set_handler(|| {
         let n = remove_pending();
-        eprintln!("\ninterrupted: removed {n} partial output file(s); nothing was written");
+        eprintln!("\ninterrupted: removed {n} partial output file(s)");
         std::process::exit(130);
     })
     .map_err(|e| format!("cannot install the interrupt handler: {e}"))
 }
 
-/// A temporary file beside an output path, registered in [`PENDING`]; removed on drop unless
-/// [`TempFile::commit`] renamed it into place.
-struct TempFile {
-    tmp: PathBuf,
-    file: Option<File>,
-}
-
-impl TempFile {
-    fn create(path: &Path) -> Result<TempFile, OutputError> {
-        let tmp = temp_path(path);
-        let mut list = pending();
-        let file = File::create(&tmp).map_err(|e| {
-            OutputError::BadPath(format!(
-                "{}: cannot create files in `{}` ({e}); check its permissions or choose another output path",
-                path.display(),
-                parent_dir(path).display()
-            ))
-        })?;
-        list.push(tmp.clone());
-        Ok(TempFile { tmp, file: Some(file) })
-    }
-
-    /// Renames the finished file to `path`.
-    fn commit(mut self, path: &Path) -> Result<(), String> {
-        drop(self.file.take());
-        let mut list = pending();
-        std::fs::rename(&self.tmp, path).map_err(|e| e.to_string())?;
-        list.retain(|p| p != &self.tmp);
-        self.tmp = PathBuf::new();
-        Ok(())
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if self.tmp.as_os_str().is_empty() {
-            return;
-        }
-        drop(self.file.take());
-        let mut list = pending();
-        let _ = std::fs::remove_file(&self.tmp);
-        list.retain(|p| p != &self.tmp);
-    }
+/// A new [`TempFile`] beside `path`, with the open file to write into; a failure to create it is
+/// the path's fault ([`OutputError::BadPath`]).
+pub(crate) fn create_temp(path: &Path) -> Result<(TempFile, File), OutputError> {
+    TempFile::create(path).map_err(|e| {
+        OutputError::BadPath(format!(
+            "{}: cannot create files in `{}` ({e}); check its permissions or choose another output path",
+            path.display(),
+            parent_dir(path).display()
+        ))
+    })
 }
 
 /// Runs `write` on a temporary file beside `path`, then renames it into place; on any failure the
 /// temporary file is removed and `path` is untouched.
 fn atomic_write(path: &Path, write: impl FnOnce(File) -> Result<(), String>) -> Result<(), OutputError> {
-    let mut tmp = TempFile::create(path)?;
-    let file = tmp.file.take().expect("a new temp file is open");
+    let (tmp, file) = create_temp(path)?;
     write(file)
-        .and_then(|_| tmp.commit(path))
+        .and_then(|_| tmp.commit(path).map_err(|e| e.to_string()))
         .map_err(|e| OutputError::Io(format!("{}: write failed: {e}", path.display())))
 }
 
@@ -288,9 +231,8 @@ pub fn write_png_banded<E: From<OutputError>>(
 ) -> Result<(), E> {
     Format::from_path(path)?;
     check_directory(path)?;
-    let mut tmp = TempFile::create(path)?;
+    let (tmp, file) = create_temp(path)?;
     let io = |e: String| OutputError::Io(format!("{}: write failed: {e}", path.display()));
-    let file = tmp.file.take().expect("a new temp file is open");
     let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
@@ -318,6 +260,110 @@ pub fn write_png_banded<E: From<OutputError>>(
         stream.finish().map_err(|e| io(e.to_string()))?;
     }
     w.finish().map_err(|e| io(e.to_string()))?;
-    tmp.commit(path).map_err(io)?;
+    tmp.commit(path).map_err(|e| io(e.to_string()))?;
+    Ok(())
+}
+
+/// Reads one EXR channel's value of pixel `i` from an image.
+type ExrSample = fn(&Image, usize) -> f32;
+
+/// The EXR's channels in the order the file stores them (sorted by name, as OpenEXR requires),
+/// each with the pixel value it holds.
+const EXR_CHANNELS: [(&str, ExrSample); 6] = [
+    ("A", |im, i| im.color[i][3]),
+    ("B", |im, i| im.color[i][2]),
+    ("G", |im, i| im.color[i][1]),
+    ("R", |im, i| im.color[i][0]),
+    ("depth", |im, i| im.depth[i]),
+    ("energy", |im, i| im.energy[i]),
+];
+
+/// Writes a `width × height` float EXR (channels `R, G, B, A`: linear colour after mapping,
+/// `energy` and `depth`; RLE-compressed scan lines, layer `hadou`) to `path`, asking `band` for
+/// the image rows `y0..y1` in turn (each at most [`band_rows`] rows) and writing each band's
+/// lines before asking for the next, so memory follows the band, not the image. The file is
+/// created (and registered for interrupt clean-up) before the first band is requested, and
+/// renamed into place after the last; on any error nothing is left behind.
+pub fn write_exr_banded<E: From<OutputError>>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+) -> Result<(), E> {
+    use exr::block::writer::ChunksWriter;
+    use exr::block::{BlockIndex, UncompressedBlock};
+    use exr::meta::attribute::{ChannelDescription, SampleType};
+    use exr::meta::header::Header;
+    use exr::meta::BlockDescription;
+    use exr::prelude::*;
+    Format::from_path(path)?;
+    check_directory(path)?;
+    let (tmp, file) = create_temp(path)?;
+    let io = |e: String| OutputError::Io(format!("{}: write failed: {e}", path.display()));
+    let channels = EXR_CHANNELS.iter().map(|&(n, _)| ChannelDescription::named(n, SampleType::F32)).collect();
+    let header = Header::new("hadou".into(), (width as usize, height as usize), channels).with_encoding(
+        Compression::RLE,
+        BlockDescription::ScanLines,
+        LineOrder::Increasing,
+    );
+    // RLE compresses one scan line per block, so block `y` is line `y`.
+    debug_assert_eq!(header.compression.scan_lines_per_block(), 1);
+    // An error of `band` (or a band of the wrong size) stops the writer; it is kept here.
+    let mut failure: Option<E> = None;
+    let written =
+        exr::block::write(BufWriter::new(file), SmallVec::from_vec(vec![header]), true, |meta, chunks| {
+            let step = band_rows(width);
+            let mut y = 0;
+            while y < height {
+                let rows = y..(y + step).min(height);
+                let image = match band(rows.clone()) {
+                    Ok(image) if image.width == width && image.height == rows.len() as u32 => image,
+                    Ok(image) => {
+                        failure = Some(
+                            io(format!(
+                                "a band of rows {}..{} came back {}×{}",
+                                rows.start, rows.end, image.width, image.height
+                            ))
+                            .into(),
+                        );
+                        return Err(exr::error::Error::Aborted);
+                    }
+                    Err(e) => {
+                        failure = Some(e);
+                        return Err(exr::error::Error::Aborted);
+                    }
+                };
+                let w = width as usize;
+                let compressed: Vec<_> = (0..rows.len())
+                    .into_par_iter()
+                    .map(|r| {
+                        let line = r * w..(r + 1) * w;
+                        let mut data = Vec::with_capacity(w * 4 * EXR_CHANNELS.len());
+                        for (_, sample) in EXR_CHANNELS {
+                            for i in line.clone() {
+                                data.extend_from_slice(&sample(&image, i).to_ne_bytes());
+                            }
+                        }
+                        let index = BlockIndex {
+                            layer: 0,
+                            pixel_position: Vec2(0, rows.start as usize + r),
+                            pixel_size: Vec2(w, 1),
+                            level: Vec2(0, 0),
+                        };
+                        UncompressedBlock { index, data }.compress_to_chunk(&meta.headers)
+                    })
+                    .collect();
+                for (r, chunk) in compressed.into_iter().enumerate() {
+                    chunks.write_chunk(rows.start as usize + r, chunk?)?;
+                }
+                y = rows.end;
+            }
+            Ok(())
+        });
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    written.map_err(|e| io(e.to_string()))?;
+    tmp.commit(path).map_err(|e| io(e.to_string()))?;
     Ok(())
 }

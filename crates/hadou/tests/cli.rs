@@ -550,35 +550,215 @@ fn png_memory_follows_the_band_not_the_image() {
     eprintln!("8192² PNG: peak resident memory {} MiB", peak / 1024);
 }
 
-#[test]
-fn an_interrupted_render_leaves_no_temporary_file() {
-    let dir = tmpdir("interrupt");
-    let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 16384\nheight = 16384"));
-    let out = dir.join("slow.png");
-    for signal in ["-TERM", "-INT"] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_hadou"))
-            .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"])
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
-        // The temporary file exists from the first band on.
-        let tmp_exists = || {
-            std::fs::read_dir(&dir)
-                .unwrap()
-                .any(|e| e.unwrap().file_name().to_string_lossy().ends_with(".tmp"))
-        };
-        let start = std::time::Instant::now();
-        while !tmp_exists() && start.elapsed().as_secs() < 30 {
-            std::thread::sleep(std::time::Duration::from_millis(10));
-        }
-        assert!(tmp_exists(), "no temporary file appeared");
-        let kill = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap();
-        assert!(kill.success());
-        let status = child.wait().unwrap();
-        assert_eq!(status.code(), Some(130), "{signal}");
-        assert!(!tmp_exists(), "{signal}: the temporary file was left behind");
-        assert!(!out.exists(), "{signal}: a partial output appeared");
+/// Sends `signal` (`-TERM`, `-INT`, `-HUP`) to `hadou render ARGS` once a temporary file exists
+/// in `dir`, and returns its exit status and stderr.
+#[cfg(unix)]
+fn interrupt_once_writing(args: &[&str], dir: &Path, signal: &str) -> (Option<i32>, String) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args(args)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let tmp_exists = || {
+        std::fs::read_dir(dir).unwrap().any(|e| e.unwrap().file_name().to_string_lossy().ends_with(".tmp"))
+    };
+    // A file seen twice 100 ms apart: the writer's, not the instant probe of a writable directory.
+    let writing =
+        || tmp_exists() && (std::thread::sleep(std::time::Duration::from_millis(100)), tmp_exists()).1;
+    let start = std::time::Instant::now();
+    while !writing() && start.elapsed().as_secs() < 30 {
+        assert!(child.try_wait().unwrap().is_none(), "{args:?}: ended before a temporary file appeared");
+        std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    assert!(tmp_exists(), "{args:?}: no temporary file appeared");
+    let kill = Command::new("kill").args([signal, &child.id().to_string()]).status().unwrap();
+    assert!(kill.success());
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    (status.code(), err)
+}
+
+/// Every writer (PNG, EXR, a PNG sequence, a GIF) stopped by each signal the handler catches,
+/// once its temporary file exists: the file is removed, the message counts it, and the output
+/// directory is left empty.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_writer_leaves_nothing_for_every_signal() {
+    let dir = tmpdir("interrupt");
+    // 4096² on the CPU takes seconds; each run is stopped as soon as its file appears.
+    let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 4096\nheight = 4096"));
+    let out = dir.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let s = scene.to_str().unwrap();
+    let (png, exr, gif) = (out.join("a.png"), out.join("a.exr"), out.join("a.gif"));
+    let seq = format!("{}/", out.display());
+    let writers: [(&str, Vec<&str>); 4] = [
+        ("png", vec!["render", s, "-o", png.to_str().unwrap()]),
+        ("exr", vec!["render", s, "-o", exr.to_str().unwrap()]),
+        ("sequence", vec!["render", s, "-o", &seq, "--frames", "0..3"]),
+        ("gif", vec!["render", s, "-o", gif.to_str().unwrap(), "--frames", "0..3"]),
+    ];
+    for (what, args) in &writers {
+        for signal in ["-TERM", "-INT", "-HUP"] {
+            let args: Vec<&str> = args.iter().copied().chain(["--backend", "cpu"]).collect();
+            let (code, err) = interrupt_once_writing(&args, &out, signal);
+            assert_eq!(code, Some(130), "{what} {signal}: {err}");
+            assert!(err.contains("interrupted: removed 1 partial output file(s)"), "{what} {signal}: {err}");
+            let left: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+            assert!(left.is_empty(), "{what} {signal}: left {left:?}");
+        }
+    }
+}
+
+/// The scene `GOOD` with an `[area_light]` (whose images are at most 4096² pixels) and an
+/// `[image]` of `w×h`.
+fn area_light_scene(w: u32, h: u32) -> String {
+    let light = "\n[[object]]\nname = \"floor\"\nkind = \"plane\"\nsize = [80.0, 80.0]\nposition = [0.0, -3.0, -20.0]\n\n[area_light]\nposition = [0.0, 20.0, -20.0]\nsize = 1.0\ntarget = \"cube\"\n";
+    format!("{GOOD}{light}").replace("width = 64\nheight = 48", &format!("width = {w}\nheight = {h}"))
+}
+
+#[test]
+fn sizes_from_flags_obey_the_area_light_pixel_limit_on_every_path() {
+    let dir = tmpdir("flag-sizes");
+    let scene = write_scene(&dir, &area_light_scene(64, 4096));
+    let s = scene.to_str().unwrap();
+    let out = dir.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let (png, exr, gif) = (out.join("a.png"), out.join("a.exr"), out.join("a.gif"));
+    let seq = format!("{}/", out.display());
+    let both = ["--width", "4097", "--height", "4096"];
+    let cases: [Vec<&str>; 5] = [
+        vec!["render", s, "-o", png.to_str().unwrap()],
+        vec!["render", s, "-o", exr.to_str().unwrap()],
+        vec!["render", s, "-o", &seq, "--frames", "0..2"],
+        vec!["render", s, "-o", gif.to_str().unwrap(), "--frames", "0..2"],
+        vec!["probe", s, "--pixel", "0,0"],
+    ];
+    for args in &cases {
+        for backend in ["cpu", "gpu"] {
+            let full: Vec<&str> = args.iter().chain(&both).copied().chain(["--backend", backend]).collect();
+            assert_exit_2(&full, &["--width 4097 --height 4096", "at most 16777216 pixels", "[area_light]"]);
+        }
+        // One flag with the other edge from the file: both are named.
+        let one: Vec<&str> = args.iter().copied().chain(["--width", "4097"]).collect();
+        assert_exit_2(
+            &one,
+            &["--width 4097 (height 4096 from the scene's [image])", "4097×4096 is 16781312 pixels"],
+        );
+    }
+    // The soft-shadow bench's sizes obey its scene's limit too.
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    assert_exit_2(
+        &["bench", "shadows", "--sizes", "4097", "--scenes", scenes.to_str().unwrap()],
+        &["--sizes 4097", "at most 16777216 pixels"],
+    );
+    // Within the limit it renders.
+    let o = hadou(&["probe", s, "--pixel", "0,0", "--width", "4096", "--height", "4096"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let left: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "written: {left:?}");
+}
+
+#[test]
+fn a_gif_frame_past_its_pixel_limit_exits_2() {
+    let dir = tmpdir("gif-size");
+    let out = dir.join("a.gif");
+    let o = out.to_str().unwrap();
+    // From the flags, and from a scene file's [image] (valid: no [area_light]).
+    let s = write_scene(&dir, GOOD);
+    assert_exit_2(
+        &["render", s.to_str().unwrap(), "-o", o, "--frames", "0..2", "--width", "4097", "--height", "4096"],
+        &["--width 4097 --height 4096", "a GIF frame is at most 16777216 pixels", "PNG sequence"],
+    );
+    let s = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 16384\nheight = 16384"));
+    assert_exit_2(
+        &["render", s.to_str().unwrap(), "-o", o, "--frames", "0..2"],
+        &["scene.toml: [image] 16384×16384", "a GIF frame is at most 16777216 pixels"],
+    );
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "output written");
+}
+
+#[test]
+fn an_exr_rendered_in_bands_equals_the_whole_frame() {
+    let dir = tmpdir("exr-bands");
+    let scene = write_scene(&dir, GOOD);
+    // 4096 wide: 1024 rows a band, so 2100 rows take three bands, the last one partial.
+    let (w, h) = (4096u32, 2100u32);
+    assert!(hadou::output::band_rows(w) < h / 2);
+    let out = dir.join("b.exr");
+    let (ws, hs) = (w.to_string(), h.to_string());
+    let args =
+        ["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--width", &ws, "--height", &hs];
+    let o = hadou(&[&args[..], &["--backend", "cpu"]].concat());
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    use hadou::Backend;
+    let mut frame = hadou::Scene::load(&scene).unwrap().at(0.0);
+    frame.width = w;
+    frame.height = h;
+    let whole = hadou::CpuBackend::new().render(&frame).unwrap();
+    let img = exr::prelude::read_all_flat_layers_from_file(&out).unwrap();
+    let layer = &img.layer_data[0];
+    assert_eq!((layer.size.0, layer.size.1), (w as usize, h as usize));
+    assert_eq!(layer.attributes.layer_name.as_ref().map(|n| n.to_string()).as_deref(), Some("hadou"));
+    let channel = |name: &str| -> Vec<f32> {
+        let c = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("no {name}"));
+        c.sample_data.values_as_f32().collect()
+    };
+    for (k, name) in ["R", "G", "B", "A"].iter().enumerate() {
+        assert!(channel(name) == whole.color.iter().map(|c| c[k]).collect::<Vec<_>>(), "{name} differs");
+    }
+    assert!(channel("energy") == whole.energy, "energy differs");
+    assert!(channel("depth") == whole.depth, "depth differs");
+}
+
+#[test]
+fn a_gpu_probe_renders_one_row_at_the_largest_size() {
+    if !gpu_available() || !Path::new("/proc/self/status").exists() {
+        return;
+    }
+    let dir = tmpdir("gpu-probe-size");
+    let scene = write_scene(&dir, GOOD);
+    // The whole 16384² image would take 6 GiB of floats; the pixel's row takes 1.5 MiB.
+    let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args(["probe", scene.to_str().unwrap(), "--pixel", "8192,8192", "--backend", "gpu"])
+        .args(["--width", "16384", "--height", "16384"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let (status, peak) = peak_rss_kib(child);
+    assert!(status.success(), "{status}");
+    assert!(peak > 0 && peak < 1024 * 1024, "peak resident memory {peak} KiB");
+}
+
+#[test]
+fn exr_memory_follows_the_band_not_the_image() {
+    if !Path::new("/proc/self/status").exists() {
+        eprintln!("SKIPPED: no /proc to read peak memory from");
+        return;
+    }
+    let dir = tmpdir("exr-memory");
+    // An 8192² frame: 1.6 GB as one float image (and as much again for the old channel copies).
+    let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 8192\nheight = 8192"));
+    let out = dir.join("big.exr");
+    let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (status, peak) = peak_rss_kib(child);
+    assert!(status.success());
+    let img = exr::prelude::read_first_flat_layer_from_file(&out).unwrap();
+    assert_eq!((img.layer_data.size.0, img.layer_data.size.1), (8192, 8192));
+    assert!(peak > 0 && peak < 600 * 1024, "peak resident memory {peak} KiB");
+    eprintln!("8192² EXR: peak resident memory {} MiB", peak / 1024);
 }
 
 #[test]

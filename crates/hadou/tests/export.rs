@@ -314,6 +314,33 @@ fn bad_specs_are_errors_and_write_nothing() {
 }
 
 #[test]
+fn sizes_past_the_scenes_limits_are_spec_errors_and_write_nothing() {
+    let dir = tmpdir("sizes");
+    let soft = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/soft-gradient.toml")).unwrap();
+    let big = AnimationSpec { width: Some(4097), height: Some(4096), ..spec(0..2, 24.0) };
+    let cases = [
+        // An [area_light]'s image limit holds for sizes from the spec, on both formats.
+        (&soft, big.clone(), dir.join("a.gif"), "at most 16777216 pixels"),
+        (&soft, big.clone(), dir.clone(), "at most 16777216 pixels"),
+        // A GIF frame's limit holds without one.
+        (&scene(), big, dir.join("a.gif"), "a GIF frame is at most 16777216 pixels"),
+    ];
+    for (scene, s, path, needle) in cases {
+        let mut called = false;
+        let r = export_animation(scene, &mut CpuBackend::new(), &s, &path, &mut |_| {
+            called = true;
+            Control::Continue
+        });
+        match r {
+            Err(e @ ExportError::Spec(_)) => assert!(e.to_string().contains(needle), "{e} lacks {needle}"),
+            other => panic!("{}: {other:?}", path.display()),
+        }
+        assert!(!called, "{}: progress was called", path.display());
+    }
+    assert!(listing(&dir).is_empty(), "{:?}", listing(&dir));
+}
+
+#[test]
 fn bad_paths_are_bad_path_errors_and_create_nothing() {
     let dir = tmpdir("paths");
     let scene = scene();

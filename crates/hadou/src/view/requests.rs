@@ -3,6 +3,7 @@
 
 use super::app::App;
 use super::export_job::ExportJob;
+use crate::export::ExportError;
 use crate::output;
 use hadou_cpu::CpuBackend;
 use hadou_scene::Backend;
@@ -110,16 +111,20 @@ impl App {
     }
 
     /// Renders the scene at the current time and size with the active backend and writes it as
-    /// `hadou render` does.
+    /// `hadou render` does: band by band, through a temporary file registered for the interrupt
+    /// handler's clean-up.
     pub(super) fn screenshot(&mut self, path: &std::path::Path) -> Result<(), String> {
         output::check_writable(path).map_err(|e| e.to_string())?;
         let frame = self.viewer.frame();
-        let image = match (self.backend, self.gfx.as_mut().and_then(|g| g.gpu.as_mut())) {
-            (BackendKind::Gpu, Some(gpu)) => gpu.render(&frame),
-            _ => CpuBackend::new().render(&frame),
-        }
-        .map_err(|e| format!("render failed: {e}"))?;
-        output::write(&image, path).map_err(|e| e.to_string())
+        let mut cpu = CpuBackend::new();
+        let backend: &mut dyn Backend = match (self.backend, self.gfx.as_mut().and_then(|g| g.gpu.as_mut())) {
+            (BackendKind::Gpu, Some(gpu)) => gpu,
+            _ => &mut cpu,
+        };
+        output::write_banded(path, frame.width, frame.height, |rows| {
+            Ok::<_, ExportError>(backend.render_rows(&frame, rows)?)
+        })
+        .map_err(|e| e.to_string())
     }
 
     fn start_export(&mut self, path: PathBuf, frames: std::ops::Range<u32>, fps: f32) {
