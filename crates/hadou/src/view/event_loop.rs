@@ -104,7 +104,8 @@ impl ApplicationHandler<Wake> for App {
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         if let Some(g) = &mut self.gfx {
             let r = g.egui_state.on_window_event(&g.window, &event);
-            if r.repaint {
+            // egui asks for a repaint after every redraw too; following that would draw forever.
+            if r.repaint && !matches!(event, WindowEvent::RedrawRequested) {
                 g.window.request_redraw();
             }
         }

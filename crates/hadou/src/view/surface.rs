@@ -248,6 +248,10 @@ impl Gfx {
         }
         let raw = self.egui_state.take_egui_input(&self.window);
         let out = egui_ctx.run_ui(raw, ui);
+        // egui wants another pass at once (after input, while it animates): one more frame.
+        if out.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero()) {
+            self.window.request_redraw();
+        }
         self.egui_state.handle_platform_output(&self.window, out.platform_output);
         let jobs = egui_ctx.tessellate(out.shapes, out.pixels_per_point);
         for (id, delta) in &out.textures_delta.set {
