@@ -1,7 +1,9 @@
 //! `hadou view SCENE --script FILE`: drives the viewer from a text file, one command per line,
 //! for tests and reproducible demos. `#` starts a comment. Commands run in order, each in its own
 //! window frame; `wait N` lets `N` frames pass. The viewer exits after the last command (writing
-//! `--screenshot` first, if given).
+//! `--screenshot` first, if given). A command that fails stops the run with `file:line:col: …`
+//! ([`run`]); one that names a wave, object or parameter the scene does not have lists the names
+//! it could be.
 //!
 //! | command | effect |
 //! |---|---|
@@ -84,8 +86,17 @@ pub enum Command {
 pub struct Line {
     /// Line number.
     pub line: usize,
+    /// The column (1-based, in bytes) of each word: the command's, then each argument's.
+    pub cols: Vec<usize>,
     /// The command.
     pub command: Command,
+}
+
+impl Line {
+    /// The column of argument `k` (the command's own when there is no such argument).
+    pub fn arg_col(&self, k: usize) -> usize {
+        self.cols.get(k.saturating_add(1)).or(self.cols.first()).copied().unwrap_or(1)
+    }
 }
 
 /// Parses a script; errors read `file:line:col: message`. Paths in the script are relative to
@@ -103,7 +114,8 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Line>, String> {
         };
         let args = &words[1..];
         let command = parse_command(name, args, dir).map_err(|(c, m)| at(c.unwrap_or(col), m))?;
-        out.push(Line { line: i + 1, command });
+        let cols = words.iter().map(|&(c, _)| c + 1).collect();
+        out.push(Line { line: i + 1, cols, command });
     }
     Ok(out)
 }
@@ -309,9 +321,32 @@ pub enum WindowOp {
 }
 
 /// Carries out one command on the viewer. Failures of edits are errors (a script that does not
-/// do what it says should not pass silently): `Err` has the message, prefixed by the line.
+/// do what it says should not pass silently): `Err` has the message, prefixed by
+/// `file:line:col:`. A command naming a wave, object or parameter the scene does not have
+/// (`select`, `fire`, `set`, `key`, `unkey`, `remove`) fails before it does anything, at the
+/// name's column, listing the names it could be.
 pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, String> {
     viewer.message = None;
+    let at = |k: Option<usize>, m: &str| {
+        let col = match k {
+            Some(k) => line.arg_col(k),
+            None => line.cols.first().copied().unwrap_or(1),
+        };
+        let place = format!("{}:{}:{col}", path.display(), line.line);
+        format!("{}: {}", escape_controls(&place), escape_controls(m))
+    };
+    let named = match &line.command {
+        Command::Set(target, _) | Command::Key(target) => viewer.check_target(target),
+        Command::Unkey(target) => viewer.check_target(target).and_then(|()| viewer.check_track(target)),
+        Command::Fire(wave, _) | Command::Select(Some(wave)) => viewer.check_wave(wave),
+        Command::Remove(true, name) => viewer.check_wave(name),
+        Command::Remove(false, name) => viewer.check_object(name),
+        _ => Ok(()),
+    };
+    if let Err(m) = named {
+        let k = if matches!(line.command, Command::Remove(..)) { 1 } else { 0 };
+        return Err(at(Some(k), &m));
+    }
     let ok = match &line.command {
         Command::Wait(n) => return Ok(WindowOp::Wait(*n)),
         Command::Resize(w, h) => return Ok(WindowOp::Resize(*w, *h)),
@@ -395,7 +430,6 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
         Ok(WindowOp::None)
     } else {
         let why = viewer.message.as_ref().map_or("it did nothing".to_string(), |m| m.0.clone());
-        let place = format!("{}:{}", path.display(), line.line);
-        Err(format!("{}: {}", escape_controls(&place), escape_controls(&why)))
+        Err(at(None, &why))
     }
 }

@@ -257,6 +257,70 @@ impl Viewer {
         self.report(r)
     }
 
+    /// `Ok` when the scene has the whole parameter `target`; otherwise the message names it and
+    /// lists what it could be: the parameters of its table when the table exists, else the tables.
+    pub fn check_target(&self, target: &str) -> Result<(), String> {
+        let params = self.scene().parameters();
+        if params.iter().any(|p| p.target == target) {
+            return Ok(());
+        }
+        let table = target.rsplit_once('.').map_or("", |(t, _)| t);
+        let keys: Vec<&str> = params
+            .iter()
+            .filter(|p| p.target.rsplit_once('.').map_or("", |(t, _)| t) == table)
+            .map(|p| p.key)
+            .collect();
+        let hint = if !keys.is_empty() {
+            let whose = if table.is_empty() { "the top level".to_string() } else { format!("`{table}`") };
+            format!("; {whose} has {}", listed(&keys))
+        } else {
+            let mut tables: Vec<&str> =
+                params.iter().filter_map(|p| p.target.rsplit_once('.').map(|(t, _)| t)).collect();
+            tables.dedup();
+            format!(
+                "; `{}` is none of the scene's tables, which are {}",
+                table.escape_debug(),
+                listed(&tables)
+            )
+        };
+        Err(format!("the scene has no parameter `{}`{hint}", target.escape_debug()))
+    }
+
+    /// `Ok` when a track animates the whole parameter `target`; otherwise the message lists the
+    /// animated parameters.
+    pub fn check_track(&self, target: &str) -> Result<(), String> {
+        let tracks = self.scene().tracks();
+        if tracks.iter().any(|t| t.target == target) {
+            return Ok(());
+        }
+        let mut animated: Vec<&str> = tracks.iter().map(|t| t.target.as_str()).collect();
+        animated.dedup();
+        let hint = if animated.is_empty() {
+            "; nothing is animated".into()
+        } else {
+            format!("; the tracks animate {}", listed(&animated))
+        };
+        Err(format!("no track animates `{}`{hint}", target.escape_debug()))
+    }
+
+    /// `Ok` when the scene has a wave named `name`; otherwise the message lists the waves.
+    pub fn check_wave(&self, name: &str) -> Result<(), String> {
+        let names = self.scene().wave_names();
+        if names.contains(&name) {
+            return Ok(());
+        }
+        Err(format!("no wave is named {name:?}; the waves are {}", listed(&names)))
+    }
+
+    /// `Ok` when the scene has an object named `name`; otherwise the message lists the objects.
+    pub fn check_object(&self, name: &str) -> Result<(), String> {
+        let names = self.scene().object_names();
+        if names.contains(&name) {
+            return Ok(());
+        }
+        Err(format!("no object is named {name:?}; the objects are {}", listed(&names)))
+    }
+
     /// Sets a key at the current time holding `target`'s current value.
     pub fn key_current(&mut self, target: &str) -> bool {
         let Some(value) = self.scene().value_at(target, self.timeline.time) else {
@@ -303,15 +367,20 @@ impl Viewer {
         }
     }
 
-    /// Takes in a new version of the file saved by another program.
-    pub fn poll_disk(&mut self) {
+    /// Takes in a new version of the file saved by another program; `true` when something
+    /// changed (the scene was reloaded, or the reload failed and says so).
+    pub fn poll_disk(&mut self) -> bool {
         match self.doc.poll_disk() {
-            Reload::Unchanged => {}
+            Reload::Unchanged => false,
             Reload::Reloaded => {
                 let m = format!("reloaded {}", self.doc.path().display());
                 self.say(m);
+                true
             }
-            Reload::Failed(m) => self.complain(format!("reload failed, showing the last good scene: {m}")),
+            Reload::Failed(m) => {
+                self.complain(format!("reload failed, showing the last good scene: {m}"));
+                true
+            }
         }
     }
 
@@ -462,6 +531,21 @@ fn curve_axes(scene: &Scene, name: &str, time: f32) -> Option<[Vec3f; 4]> {
     };
     let [d, y, z] = frame.axes()?;
     Some([o, d, y, z])
+}
+
+/// Most names a message lists.
+const MAX_LISTED: usize = 40;
+
+/// "`a`, `b`, `c`" (at most [`MAX_LISTED`], then how many there are), or "none".
+fn listed(names: &[&str]) -> String {
+    if names.is_empty() {
+        return "none".into();
+    }
+    let list: Vec<String> =
+        names.iter().take(MAX_LISTED).map(|n| format!("`{}`", n.escape_debug())).collect();
+    let more =
+        if names.len() > MAX_LISTED { format!(", … ({} in all)", names.len()) } else { String::new() };
+    list.join(", ") + &more
 }
 
 /// Whether a parameter is a colour (shown with a colour picker next to its numbers).

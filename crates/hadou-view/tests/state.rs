@@ -470,3 +470,66 @@ fn other_keys_are_listed_and_edited_as_toml() {
     assert_eq!(d.scene().value_at("camera.fov", 0.0), Some(vec![45.0]));
     assert!(!d.text().contains("fov"));
 }
+
+/// Every script command that names a wave, object or parameter fails the same way when the scene
+/// has no such thing: an error at the name's `file:line:col`, listing what it could be, and
+/// nothing changed (`select nobody` used to pass silently).
+#[test]
+fn script_commands_naming_nothing_fail_at_the_name_with_the_candidates() {
+    let (d, p) = doc("names");
+    let sp = p.parent().unwrap().join("s.txt");
+    let mut v = Viewer::new(d);
+    let before = v.doc.text().to_string();
+    let cases = [
+        ("select nobody", "s.txt:1:8: no wave is named \"nobody\"; the waves are `beam`, `curve`"),
+        ("fire nobody 0.5", "s.txt:1:6: no wave is named \"nobody\"; the waves are `beam`, `curve`"),
+        ("remove wave nobody", "s.txt:1:13: no wave is named \"nobody\"; the waves are `beam`, `curve`"),
+        ("remove object nobody", "s.txt:1:15: no object is named \"nobody\"; the objects are `ground`"),
+        (
+            "set wave.nobody.alpha 1",
+            "s.txt:1:5: the scene has no parameter `wave.nobody.alpha`; `wave.nobody` is none of the \
+             scene's tables, which are `camera`,",
+        ),
+        (
+            "set wave.beam.alpah_s 1",
+            "s.txt:1:5: the scene has no parameter `wave.beam.alpah_s`; `wave.beam` has `",
+        ),
+        ("  key wave.nobody.k", "s.txt:1:7: the scene has no parameter `wave.nobody.k`"),
+        ("unkey wave.nobody.k", "s.txt:1:7: the scene has no parameter `wave.nobody.k`"),
+        (
+            "unkey wave.beam.length",
+            "s.txt:1:7: no track animates `wave.beam.length`; the tracks animate `wave.beam.alpha_c`",
+        ),
+    ];
+    for (text, want) in cases {
+        let lines = script::parse(text, &sp).unwrap();
+        let e = script::run(&mut v, &lines[0], &sp).unwrap_err();
+        assert!(e.contains(want), "{text}: {e}");
+        assert!(v.requests.is_empty() && v.selected_wave.is_none(), "{text}");
+        assert_eq!(v.doc.text(), before, "{text} changed the document");
+    }
+    // The names it lists include the parameters of the table it names.
+    let lines = script::parse("set wave.beam.alpah_s 1", &sp).unwrap();
+    let e = script::run(&mut v, &lines[0], &sp).unwrap_err();
+    assert!(e.contains("`alpha_s`") && e.contains("`length`"), "{e}");
+    // The same commands on names the scene has pass.
+    for text in
+        ["select beam", "select none", "fire curve 0.5", "set wave.beam.alpha_s 0.1", "key wave.beam.length"]
+    {
+        let lines = script::parse(text, &sp).unwrap();
+        script::run(&mut v, &lines[0], &sp).unwrap_or_else(|e| panic!("{text}: {e}"));
+    }
+    assert_eq!(v.selected_wave, None);
+    // A long list is cut at 40 names, with the count.
+    let mut many = String::from("[camera]\nposition = [0.0, 0.0, 10.0]\n");
+    for i in 0..50 {
+        many +=
+            &format!("[[wave]]\nname = \"w{i}\"\nkind = \"sphere\"\nM = [0.0, 0.0, 0.0]\nalpha_s = 0.1\n");
+    }
+    let many_path = p.parent().unwrap().join("many.toml");
+    std::fs::write(&many_path, &many).unwrap();
+    let mut v = Viewer::new(Document::open(&many_path).unwrap());
+    let lines = script::parse("select nobody", &sp).unwrap();
+    let e = script::run(&mut v, &lines[0], &sp).unwrap_err();
+    assert!(e.contains("`w39`, … (50 in all)") && !e.contains("`w40`"), "{e}");
+}

@@ -38,6 +38,12 @@ fn xvfb_lock() -> std::sync::MutexGuard<'static, ()> {
 
 /// `xvfb-run` when present; `None` (skip) otherwise, a failure in CI.
 fn xvfb(test: &str) -> Option<Command> {
+    xvfb_with(test, &[])
+}
+
+/// [`xvfb`] with `hadou` run through `wrapper` (a command line that ends by running its last
+/// argument, `hadou`, with the arguments the caller adds).
+fn xvfb_with(test: &str, wrapper: &[&str]) -> Option<Command> {
     let found =
         Command::new("sh").args(["-c", "command -v xvfb-run"]).output().is_ok_and(|o| o.status.success());
     if !found {
@@ -49,7 +55,7 @@ fn xvfb(test: &str) -> Option<Command> {
         return None;
     }
     let mut c = Command::new("xvfb-run");
-    c.args(["-a", "-s", "-screen 0 1600x1200x24"]).arg(env!("CARGO_BIN_EXE_hadou"));
+    c.args(["-a", "-s", "-screen 0 1600x1200x24"]).args(wrapper).arg(env!("CARGO_BIN_EXE_hadou"));
     Some(c)
 }
 
@@ -253,6 +259,10 @@ fn a_failing_script_command_is_an_error() {
         ("wait 1\nscreenshot shot.txt\nwait 2\n", "s.txt:2:", "shot.txt"),
         ("export missing/anim.gif 0..2 10\nwait 2\n", "s.txt:1:", "missing"),
         ("resize 0 0\nscreenshot shot.bmp\n", "s.txt:2:", "shot.bmp"),
+        // A command naming a wave the scene lacks, whatever the command (`select` used to pass).
+        ("wait 1\nselect nobody\n", "s.txt:2:8:", "no wave is named \"nobody\"; the waves are `sphere`"),
+        ("fire nobody\n", "s.txt:1:6:", "no wave is named \"nobody\"; the waves are `sphere`"),
+        ("set wave.nobody.alpha_s 1\n", "s.txt:1:5:", "`wave.nobody` is none of the scene's tables"),
     ];
     for (text, line, needle) in cases {
         let script = dir.join("s.txt");
@@ -285,4 +295,125 @@ fn a_failing_script_command_is_an_error() {
     });
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("s.txt: the script is not UTF-8 text (byte 7)"));
+}
+
+/// The longest a scripted run that must end may take (a hang is killed and fails the test).
+const HANG_LIMIT_S: &str = "180";
+
+/// A script that switches from the CPU backend to the GPU backend while the CPU render thread has
+/// a frame in flight ends (the worker used to stay marked busy, and the viewer spun forever).
+#[test]
+fn a_backend_switch_with_a_cpu_frame_in_flight_ends() {
+    let _x = xvfb_lock();
+    let test = "a_backend_switch_with_a_cpu_frame_in_flight_ends";
+    if xvfb(test).is_none() {
+        return;
+    }
+    let dir = tmp("switch");
+    let script = dir.join("s.txt");
+    for text in
+        ["backend gpu\nquit\n", "backend gpu\nbackend cpu\nbackend gpu\nwait 2\n", "time 0.3\nbackend gpu\n"]
+    {
+        std::fs::write(&script, text).unwrap();
+        let mut view = xvfb_with(test, &["timeout", "-s", "KILL", HANG_LIMIT_S]).unwrap();
+        let o = run({
+            view.arg("view")
+                .arg(repo().join("scenes/fig4-13-extension.toml"))
+                .args(["--backend", "cpu", "--stats", "--script"])
+                .arg(&script);
+            view
+        });
+        assert!(o.status.success(), "{text}: {:?} {}", o.status, String::from_utf8_lossy(&o.stderr));
+        let stats: serde_json::Value = serde_json::from_slice(&o.stdout).expect("--stats prints JSON");
+        assert_eq!(stats["backend"], "GPU", "{text}");
+    }
+}
+
+/// `--stats` prints strict JSON when no image was timed (a static scene drawn once): a figure
+/// without samples is `null`, never `NaN`.
+#[test]
+fn stats_without_timed_images_are_json() {
+    let _x = xvfb_lock();
+    let test = "stats_without_timed_images_are_json";
+    let Some(mut view) = xvfb_with(test, &["timeout", "-s", "KILL", HANG_LIMIT_S]) else { return };
+    let dir = tmp("stats");
+    let script = dir.join("s.txt");
+    std::fs::write(&script, "wait 3\n").unwrap();
+    let o = run({
+        view.arg("view")
+            .arg(repo().join("scenes/fig4-1-sphere.toml"))
+            .args(["--backend", "cpu", "--stats", "--script"])
+            .arg(&script);
+        view
+    });
+    assert!(o.status.success(), "{:?}", o.status);
+    let text = String::from_utf8_lossy(&o.stdout);
+    let stats: serde_json::Value =
+        serde_json::from_str(text.trim()).unwrap_or_else(|e| panic!("{e}: {text}"));
+    let frames = stats["frames"].as_u64().expect("frames");
+    for key in ["median_frame_ms", "median_render_ms", "median_image_overhead_ms", "median_ui_ms"] {
+        let v = &stats[key];
+        assert!(v.is_null() || v.as_f64().is_some_and(f64::is_finite), "{key}: {text}");
+        assert_eq!(v.is_null(), frames == 0, "{key}: {text}");
+    }
+}
+
+/// A script's `resize` is checked against the limits an image of the scene has before the window
+/// changes: a scene with an `[area_light]` takes at most 16,777,216 pixels, so `resize 5000 4000`
+/// stops the run with exit 2 at the size's `file:line:col`.
+#[test]
+fn a_resize_past_the_scenes_image_limit_exits_2() {
+    let _x = xvfb_lock();
+    let test = "a_resize_past_the_scenes_image_limit_exits_2";
+    let Some(mut view) = xvfb_with(test, &["timeout", "-s", "KILL", HANG_LIMIT_S]) else { return };
+    let dir = tmp("resize-limit");
+    let script = dir.join("s.txt");
+    std::fs::write(&script, "wait 1\nresize 5000 4000\nwait 2\n").unwrap();
+    let o = run({
+        view.arg("view").arg(repo().join("scenes/soft-gradient.toml")).arg("--script").arg(&script);
+        view
+    });
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("s.txt:2:8: the window cannot be 5000×4000 pixels: a scene with an [area_light] renders images of at most 16777216 pixels"),
+        "{err}"
+    );
+}
+
+/// A surface the device cannot configure (`resize 16384 16384`, the script's largest, under a
+/// 4 GiB address-space cap: lavapipe's swapchain images do not fit) is reported with the script
+/// line and exit 2, the surface kept at the last size that worked; it used to be configured
+/// again every frame, forever, with no message. Vulkan only: OpenGL configures its surface lazily
+/// and draws the huge window instead (slowly, but it ends).
+#[test]
+fn a_surface_that_cannot_be_configured_exits_2_with_the_line() {
+    let test = "a_surface_that_cannot_be_configured_exits_2_with_the_line";
+    if std::env::var("HADOU_EXPECT_BACKEND").is_ok_and(|b| b == "gl") {
+        eprintln!("SKIPPED {test}: OpenGL configures surfaces lazily");
+        return;
+    }
+    let _x = xvfb_lock();
+    let wrapper =
+        ["timeout", "-s", "KILL", HANG_LIMIT_S, "sh", "-c", "ulimit -v 4194304; exec \"$0\" \"$@\""];
+    let Some(mut view) = xvfb_with(test, &wrapper) else { return };
+    let dir = tmp("surface-oom");
+    let script = dir.join("s.txt");
+    std::fs::write(&script, "wait 1\nresize 16384 16384\nresize 0 0\n").unwrap();
+    let o = run({
+        view.arg("view").arg(repo().join("scenes/fig4-1-sphere.toml")).arg("--script").arg(&script);
+        view
+    });
+    let err = String::from_utf8_lossy(&o.stderr);
+    // Where the surface did fit after all the run ends normally; it must never hang or crash.
+    if o.status.success() {
+        eprintln!("{test}: the 16384² surface was configured under the cap here");
+        return;
+    }
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("s.txt:2:8: the window's surface cannot be configured at 16384×16384 pixels")
+            && err.contains("it stays"),
+        "{err}"
+    );
 }

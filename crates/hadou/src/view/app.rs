@@ -8,12 +8,17 @@ use super::cpu_worker::CpuWorker;
 use super::export_job::ExportJob;
 use super::options::{ViewError, ViewOptions};
 use super::surface::Gfx;
+use hadou_scene::Scene;
 use hadou_view::script;
 use hadou_view::ui::{UiState, ViewportImage};
 use hadou_view::viewer::{BackendKind, Viewer};
 use std::path::PathBuf;
 use std::time::Instant;
 use winit::event_loop::ActiveEventLoop;
+
+/// The event loop's user event: the CPU render thread finished a frame.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Wake;
 
 /// Timings of one new image, ms.
 #[derive(Clone, Copy)]
@@ -96,15 +101,13 @@ impl App {
         }
     }
 
+    /// The `--stats` figures as one JSON object: medians over the new images shown, `null` for a
+    /// figure with no sample (a static scene's single image may never be timed).
     pub(super) fn stats_json(&self) -> String {
-        let median = |f: fn(&Sample) -> f64| {
-            let mut v: Vec<f64> = self.samples.iter().map(f).filter(|x| x.is_finite()).collect();
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-        };
+        let median = |f: fn(&Sample) -> f64| median_json(self.samples.iter().map(f));
         let frame = self.viewer.frame();
         format!(
-            "{{\"backend\": \"{}\", \"size\": [{}, {}], \"frames\": {}, \"median_frame_ms\": {:.3}, \"median_render_ms\": {:.3}, \"median_image_overhead_ms\": {:.3}, \"median_ui_ms\": {:.3}}}",
+            "{{\"backend\": \"{}\", \"size\": [{}, {}], \"frames\": {}, \"median_frame_ms\": {}, \"median_render_ms\": {}, \"median_image_overhead_ms\": {}, \"median_ui_ms\": {}}}",
             self.backend.label(),
             frame.width,
             frame.height,
@@ -132,13 +135,42 @@ impl App {
         Ok(())
     }
 
-    pub(super) fn resize(&mut self, w: u32, h: u32) {
+    /// The window is `w × h` pixels: configures the surface for it (0 on either edge is a
+    /// minimised window: nothing is drawn). A size past the limits ([`check_window_size`]) or one
+    /// the surface cannot take is refused: `Err` says why, and the surface keeps the last size
+    /// that worked.
+    pub(super) fn resize(&mut self, w: u32, h: u32) -> Result<(), String> {
         self.minimised = w == 0 || h == 0;
-        if let Some(g) = &mut self.gfx {
-            if !self.minimised {
-                g.configure(w, h);
-            }
+        let Some(g) = &mut self.gfx else { return Ok(()) };
+        if self.minimised {
+            return Ok(());
         }
+        check_window_size(self.viewer.scene(), g.max_edge(), w, h)?;
+        if g.size() == [w, h] && g.last_good() == [w, h] {
+            return Ok(());
+        }
+        g.configure(w, h)
+    }
+
+    /// The window became `w × h` pixels (the user, the window manager or a script resized it): a
+    /// size that is refused is reported in the status line and the window asked back to the last
+    /// size that worked.
+    pub(super) fn window_resized(&mut self, w: u32, h: u32) {
+        if let Err(e) = self.resize(w, h) {
+            self.refuse_size(e);
+        }
+    }
+
+    /// Reports a window size the surface does not take and asks the window back to the last size
+    /// that worked (the surface is configured at it).
+    pub(super) fn refuse_size(&mut self, why: String) {
+        let Some(g) = &mut self.gfx else { return };
+        let [gw, gh] = g.last_good();
+        if g.size() != [gw, gh] {
+            let _ = g.configure(gw, gh);
+        }
+        let _ = g.window.request_inner_size(winit::dpi::PhysicalSize::new(gw, gh));
+        self.viewer.complain(why);
     }
 
     /// Cancels a running export and waits (up to a minute) for it to stop, so that closing the
@@ -147,5 +179,38 @@ impl App {
         if let Some(j) = self.export.take() {
             j.finish();
         }
+    }
+}
+
+/// The median of the finite `values` as a JSON number with 3 decimals; `null` when there is none.
+fn median_json(values: impl Iterator<Item = f64>) -> String {
+    let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).map_or_else(|| "null".to_string(), |m| format!("{m:.3}"))
+}
+
+/// Checks a window size before the surface is configured: the rules an image of the scene follows
+/// ([`Scene::check_image_size`]: each edge in `1..=16384`, and fewer pixels with an
+/// `[area_light]`) and the adapter's largest surface edge `max_edge`.
+pub(super) fn check_window_size(scene: &Scene, max_edge: u32, w: u32, h: u32) -> Result<(), String> {
+    scene.check_image_size(w, h).map_err(|e| format!("the window cannot be {w}×{h} pixels: {e}"))?;
+    if w > max_edge || h > max_edge {
+        return Err(format!(
+            "the window cannot be {w}×{h} pixels: this adapter's surfaces are at most {max_edge} pixels \
+             on each edge"
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median_json;
+
+    #[test]
+    fn a_median_without_samples_is_null_not_nan() {
+        assert_eq!(median_json(std::iter::empty()), "null");
+        assert_eq!(median_json([f64::NAN, f64::INFINITY].into_iter()), "null");
+        assert_eq!(median_json([3.0, 1.0, f64::NAN, 2.0].into_iter()), "2.000");
     }
 }

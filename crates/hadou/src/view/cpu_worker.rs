@@ -1,5 +1,11 @@
 //! The CPU path's render thread: the CPU backend renders the newest frame there while the window
 //! keeps handling input, and converts its image to the sRGB bytes the viewport texture takes.
+//!
+//! Whether a frame is in flight is not a flag the window sets and clears: [`CpuWorker::collect`]
+//! derives it from the generations sent and received, and the window calls it every frame
+//! whatever it draws with, so no change of state while a frame renders (a backend switch, a scene
+//! reload, a resize) can leave the worker looking busy. The thread wakes the event loop when a
+//! frame is done, so the window waits for it instead of polling.
 
 use hadou_cpu::CpuBackend;
 use hadou_scene::{Frame, Image};
@@ -17,15 +23,20 @@ pub(super) struct CpuDone {
 
 /// The CPU backend on its own thread: one frame in flight at a time.
 pub(super) struct CpuWorker {
-    pub(super) jobs: mpsc::Sender<(u64, Frame)>,
-    pub(super) done: mpsc::Receiver<CpuDone>,
+    jobs: mpsc::Sender<(u64, Frame)>,
+    done: mpsc::Receiver<CpuDone>,
     /// Uploaded pixel buffers, returned to the worker for reuse.
-    pub(super) back: mpsc::Sender<Vec<u8>>,
-    pub(super) busy: bool,
+    back: mpsc::Sender<Vec<u8>>,
+    /// The generation of the frame sent last and not yet returned.
+    in_flight: Option<u64>,
+    /// Set when the thread has stopped (it cannot take frames any more).
+    stopped: bool,
 }
 
 impl CpuWorker {
-    pub(super) fn start() -> std::io::Result<CpuWorker> {
+    /// Starts the thread; `wake` is called on it after each finished frame (it wakes the event
+    /// loop).
+    pub(super) fn start(wake: impl Fn() + Send + 'static) -> std::io::Result<CpuWorker> {
         let (jobs, job_rx) = mpsc::channel::<(u64, Frame)>();
         let (done_tx, done) = mpsc::channel();
         let (back, back_rx) = mpsc::channel::<Vec<u8>>();
@@ -53,9 +64,61 @@ impl CpuWorker {
                 if done_tx.send(CpuDone { generation, size, rgba, render_ms, convert_ms }).is_err() {
                     break;
                 }
+                wake();
             }
         })?;
-        Ok(CpuWorker { jobs, done, back, busy: false })
+        Ok(CpuWorker { jobs, done, back, in_flight: None, stopped: false })
+    }
+
+    /// Whether a frame is rendering (sent and not yet collected).
+    pub(super) fn busy(&self) -> bool {
+        self.in_flight.is_some()
+    }
+
+    /// Sends frame `generation` to the thread; `false` when it is busy or has stopped.
+    pub(super) fn send(&mut self, generation: u64, frame: Frame) -> bool {
+        if self.busy() || self.stopped {
+            return false;
+        }
+        if self.jobs.send((generation, frame)).is_err() {
+            self.stopped = true;
+            return false;
+        }
+        self.in_flight = Some(generation);
+        true
+    }
+
+    /// Takes the frames the thread has finished and returns the newest (older ones' buffers go
+    /// back for reuse). A frame returned ends the one in flight whatever its generation; a thread
+    /// that has stopped ends it too (its `Err` says so, once).
+    pub(super) fn collect(&mut self) -> Result<Option<CpuDone>, String> {
+        let mut newest: Option<CpuDone> = None;
+        loop {
+            match self.done.try_recv() {
+                Ok(d) => {
+                    if self.in_flight.is_some_and(|g| d.generation >= g) {
+                        self.in_flight = None;
+                    }
+                    if let Some(old) = newest.replace(d) {
+                        self.recycle(old.rgba);
+                    }
+                }
+                Err(mpsc::TryRecvError::Empty) => return Ok(newest),
+                Err(mpsc::TryRecvError::Disconnected) => {
+                    self.in_flight = None;
+                    if self.stopped {
+                        return Ok(newest);
+                    }
+                    self.stopped = true;
+                    return Err("the CPU render thread stopped".into());
+                }
+            }
+        }
+    }
+
+    /// Returns an uploaded pixel buffer for reuse.
+    pub(super) fn recycle(&self, rgba: Vec<u8>) {
+        let _ = self.back.send(rgba);
     }
 }
 

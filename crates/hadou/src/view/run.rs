@@ -2,7 +2,7 @@
 //! before any window opens (bad input is exit 2 with its position); then winit's event loop runs
 //! the [`App`] until the window closes or the script ends.
 
-use super::app::App;
+use super::app::{App, Wake};
 use super::cpu_worker::CpuWorker;
 use super::options::{fail, no_display_message, ViewError, ViewOptions};
 use crate::output;
@@ -33,12 +33,20 @@ pub fn run(opts: ViewOptions) -> Result<(), ViewError> {
     if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
         return Err(fail(1, no_display_message("DISPLAY and WAYLAND_DISPLAY are both unset")));
     }
-    let event_loop = EventLoop::new().map_err(|e| fail(1, no_display_message(&e.to_string())))?;
+    let event_loop = EventLoop::<Wake>::with_user_event()
+        .build()
+        .map_err(|e| fail(1, no_display_message(&e.to_string())))?;
     let mut viewer = Viewer::new(doc);
     if let Some(t) = opts.time {
         viewer.timeline.time = t;
     }
-    let cpu = CpuWorker::start().map_err(|e| fail(1, format!("cannot start the CPU render thread: {e}")))?;
+    // The render thread wakes the event loop when a frame is done (the loop sleeps meanwhile).
+    let proxy = event_loop.create_proxy();
+    let wake = move || {
+        let _ = proxy.send_event(Wake);
+    };
+    let cpu =
+        CpuWorker::start(wake).map_err(|e| fail(1, format!("cannot start the CPU render thread: {e}")))?;
     let mut app = App::new(viewer, opts, script, cpu);
     event_loop.run_app(&mut app).map_err(|e| fail(1, format!("the window's event loop failed: {e}")))?;
     if let Some(e) = app.fatal.take() {

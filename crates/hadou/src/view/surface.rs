@@ -26,7 +26,29 @@ pub(super) struct Gfx {
     pub(super) cpu_texture: Option<(wgpu::Texture, egui::TextureId, [u32; 2])>,
     pub(super) adapter_software: bool,
     pub(super) adapter_name: String,
+    /// The last size the surface was configured at without an error (the fallback).
+    good: [u32; 2],
+    /// Frames in a row that had no surface texture to draw into.
+    misses: u32,
+    /// Set when the surface gave no texture for [`MAX_MISSES`] frames in a row: drawing stops
+    /// until the surface is configured again (a resize), so a broken surface does not spin.
+    broken: bool,
 }
+
+/// What drawing one frame came to.
+pub(super) enum Drawn {
+    /// Drawn and presented.
+    Presented,
+    /// Not drawn: the surface had no texture this time (occluded, timed out, or configured again
+    /// to try the next frame).
+    Skipped,
+    /// The surface gave no texture for [`MAX_MISSES`] frames in a row, even configured again;
+    /// nothing is drawn until it is configured again. The message says why.
+    Failed(String),
+}
+
+/// Frames in a row without a surface texture before drawing stops.
+const MAX_MISSES: u32 = 3;
 
 impl Gfx {
     /// Opens the window on `viewer`'s scene, its surface and device, and the GPU backend on that
@@ -88,18 +110,20 @@ impl Gfx {
             wgpu::PresentMode::AutoVsync
         };
         let inner = window.inner_size();
+        let max = device.limits().max_texture_dimension_2d;
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             format,
-            width: inner.width.max(1),
-            height: inner.height.max(1),
+            width: inner.width.clamp(1, max),
+            height: inner.height.clamp(1, max),
             present_mode,
             desired_maximum_frame_latency: 2,
             alpha_mode: caps.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
             view_formats: vec![],
         };
         if inner.width > 0 && inner.height > 0 {
-            surface.configure(&device, &config);
+            configure_scoped(&surface, &device, &config)
+                .map_err(|e| fail(1, format!("cannot draw into the window: {e}")))?;
         }
         let egui_renderer = egui_wgpu::Renderer::new(&device, format, egui_wgpu::RendererOptions::default());
         let egui_state = egui_winit::State::new(
@@ -145,6 +169,7 @@ impl Gfx {
         viewer.stats.backend = Some(backend);
         viewer.stats.backend_note = note;
         viewer.stats.adapter = format!("{} ({:?})", info.name, info.backend);
+        let good = [config.width, config.height];
         let gfx = Gfx {
             window,
             surface,
@@ -158,22 +183,75 @@ impl Gfx {
             cpu_texture: None,
             adapter_software: software,
             adapter_name: info.name.clone(),
+            good,
+            misses: 0,
+            broken: false,
         };
         Ok((gfx, backend))
     }
 
-    /// Configures the surface for a window of `w × h` pixels (both > 0).
-    pub(super) fn configure(&mut self, w: u32, h: u32) {
-        self.config.width = w;
-        self.config.height = h;
-        self.surface.configure(&self.device, &self.config);
+    /// The largest edge a surface may have on this device.
+    pub(super) fn max_edge(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
     }
 
-    /// Runs one egui frame of `ui` and presents it on the window's surface; returns whether it was
-    /// presented (not when the surface had no texture to draw into; it is configured again then).
-    pub(super) fn draw(&mut self, egui_ctx: &egui::Context, ui: impl FnMut(&mut egui::Ui)) -> bool {
+    /// The size the surface is configured at.
+    pub(super) fn size(&self) -> [u32; 2] {
+        [self.config.width, self.config.height]
+    }
+
+    /// The last size the surface was configured at without an error.
+    pub(super) fn last_good(&self) -> [u32; 2] {
+        self.good
+    }
+
+    /// Configures the surface at `w × h` pixels (both > 0; the caller has checked them against
+    /// [`Gfx::max_edge`] and the scene's limits). An error the device reports (out of memory, a
+    /// size the surface refuses) configures it back at the last size that worked and is returned.
+    pub(super) fn configure(&mut self, w: u32, h: u32) -> Result<(), String> {
+        let max = self.max_edge();
+        if w == 0 || h == 0 || w > max || h > max {
+            return Err(format!("the window's surface cannot be {w}×{h} pixels (1..={max} on this adapter)"));
+        }
+        self.config.width = w;
+        self.config.height = h;
+        self.misses = 0;
+        self.broken = false;
+        match configure_scoped(&self.surface, &self.device, &self.config) {
+            Ok(()) => {
+                self.good = [w, h];
+                Ok(())
+            }
+            Err(e) => {
+                let [gw, gh] = self.good;
+                self.config.width = gw;
+                self.config.height = gh;
+                let back = match configure_scoped(&self.surface, &self.device, &self.config) {
+                    Ok(()) => format!("it stays {gw}×{gh}"),
+                    Err(e2) => {
+                        self.broken = true;
+                        format!("nor at {gw}×{gh} ({e2})")
+                    }
+                };
+                Err(format!("the window's surface cannot be configured at {w}×{h} pixels ({e}); {back}"))
+            }
+        }
+    }
+
+    /// Runs one egui frame of `ui` and presents it on the window's surface. When the surface has
+    /// no texture to draw into it is configured again for the next frame; after [`MAX_MISSES`]
+    /// frames in a row without one (or when it cannot be configured) drawing stops with
+    /// [`Drawn::Failed`] until [`Gfx::configure`] is called again.
+    pub(super) fn draw(&mut self, egui_ctx: &egui::Context, ui: impl FnMut(&mut egui::Ui)) -> Drawn {
+        if self.broken {
+            return Drawn::Skipped;
+        }
         let raw = self.egui_state.take_egui_input(&self.window);
         let out = egui_ctx.run_ui(raw, ui);
+        // egui wants another pass at once (after input, while it animates): one more frame.
+        if out.viewport_output.get(&egui::ViewportId::ROOT).is_some_and(|v| v.repaint_delay.is_zero()) {
+            self.window.request_redraw();
+        }
         self.egui_state.handle_platform_output(&self.window, out.platform_output);
         let jobs = egui_ctx.tessellate(out.shapes, out.pixels_per_point);
         for (id, delta) in &out.textures_delta.set {
@@ -183,14 +261,38 @@ impl Gfx {
             size_in_pixels: [self.config.width, self.config.height],
             pixels_per_point: out.pixels_per_point,
         };
+        let mut drawn = Drawn::Presented;
         let surface_texture = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => Some(t),
-            _ => {
-                self.surface.configure(&self.device, &self.config);
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => {
+                self.misses = 0;
+                Some(t)
+            }
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                drawn = Drawn::Skipped;
+                None
+            }
+            other => {
+                self.misses += 1;
+                let configured = configure_scoped(&self.surface, &self.device, &self.config);
+                drawn = match configured {
+                    Err(e) => Drawn::Failed(format!(
+                        "the window's surface gave no texture ({other:?}) and cannot be configured \
+                         again at {}×{} pixels: {e}",
+                        self.config.width, self.config.height
+                    )),
+                    Ok(()) if self.misses >= MAX_MISSES => Drawn::Failed(format!(
+                        "the window's surface gave no texture at {}×{} pixels {MAX_MISSES} frames in a \
+                         row ({other:?})",
+                        self.config.width, self.config.height
+                    )),
+                    Ok(()) => Drawn::Skipped,
+                };
+                if matches!(drawn, Drawn::Failed(_)) {
+                    self.broken = true;
+                }
                 None
             }
         };
-        let presented = surface_texture.is_some();
         if let Some(st) = surface_texture {
             let view = st.texture.create_view(&Default::default());
             let mut enc = self.device.create_command_encoder(&Default::default());
@@ -223,6 +325,29 @@ impl Gfx {
         for id in &out.textures_delta.free {
             self.egui_renderer.free_texture(id);
         }
-        presented
+        drawn
+    }
+}
+
+/// Configures `surface` inside error scopes, so that an error the device reports (out of memory, a
+/// configuration the surface refuses) comes back here instead of going to the device's handler.
+fn configure_scoped(
+    surface: &wgpu::Surface<'_>,
+    device: &wgpu::Device,
+    config: &wgpu::SurfaceConfiguration,
+) -> Result<(), String> {
+    let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let internal = device.push_error_scope(wgpu::ErrorFilter::Internal);
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    surface.configure(device, config);
+    // Popped in reverse order of pushing; wgpu-core pops at once (no wait).
+    let errors = [
+        pollster::block_on(validation.pop()),
+        pollster::block_on(internal.pop()),
+        pollster::block_on(oom.pop()),
+    ];
+    match errors.into_iter().flatten().next() {
+        Some(e) => Err(e.to_string()),
+        None => Ok(()),
     }
 }
