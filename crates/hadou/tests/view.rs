@@ -358,29 +358,6 @@ fn stats_without_timed_images_are_json() {
     }
 }
 
-/// A script's `resize` is checked against the limits an image of the scene has before the window
-/// changes: a scene with an `[area_light]` takes at most 16,777,216 pixels, so `resize 5000 4000`
-/// stops the run with exit 2 at the size's `file:line:col`.
-#[test]
-fn a_resize_past_the_scenes_image_limit_exits_2() {
-    let _x = xvfb_lock();
-    let test = "a_resize_past_the_scenes_image_limit_exits_2";
-    let Some(mut view) = xvfb_with(test, &["timeout", "-s", "KILL", HANG_LIMIT_S]) else { return };
-    let dir = tmp("resize-limit");
-    let script = dir.join("s.txt");
-    std::fs::write(&script, "wait 1\nresize 5000 4000\nwait 2\n").unwrap();
-    let o = run({
-        view.arg("view").arg(repo().join("scenes/soft-gradient.toml")).arg("--script").arg(&script);
-        view
-    });
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("s.txt:2:8: the window cannot be 5000×4000 pixels: a scene with an [area_light] renders images of at most 16777216 pixels"),
-        "{err}"
-    );
-}
-
 /// A surface the device cannot configure (`resize 16384 16384`, the script's largest, under a
 /// 4 GiB address-space cap: lavapipe's swapchain images do not fit) is reported with the script
 /// line and exit 2, the surface kept at the last size that worked; it used to be configured

@@ -8,7 +8,6 @@ use super::cpu_worker::CpuWorker;
 use super::export_job::ExportJob;
 use super::options::{ViewError, ViewOptions};
 use super::surface::Gfx;
-use hadou_scene::Scene;
 use hadou_view::script;
 use hadou_view::ui::{UiState, ViewportImage};
 use hadou_view::viewer::{BackendKind, Viewer};
@@ -145,7 +144,7 @@ impl App {
         if self.minimised {
             return Ok(());
         }
-        check_window_size(self.viewer.scene(), g.max_edge(), w, h)?;
+        check_window_size(g.max_edge(), w, h)?;
         if g.size() == [w, h] && g.last_good() == [w, h] {
             return Ok(());
         }
@@ -189,23 +188,39 @@ fn median_json(values: impl Iterator<Item = f64>) -> String {
     v.get(v.len() / 2).map_or_else(|| "null".to_string(), |m| format!("{m:.3}"))
 }
 
-/// Checks a window size before the surface is configured: the rules an image of the scene follows
-/// ([`Scene::check_image_size`]: each edge in `1..=16384`, and fewer pixels with an
-/// `[area_light]`) and the adapter's largest surface edge `max_edge`.
-pub(super) fn check_window_size(scene: &Scene, max_edge: u32, w: u32, h: u32) -> Result<(), String> {
-    scene.check_image_size(w, h).map_err(|e| format!("the window cannot be {w}×{h} pixels: {e}"))?;
-    if w > max_edge || h > max_edge {
-        return Err(format!(
-            "the window cannot be {w}×{h} pixels: this adapter's surfaces are at most {max_edge} pixels \
-             on each edge"
-        ));
+/// Checks a window size before the surface is configured: each edge in `1..=MAX_IMAGE_EDGE`
+/// (16384, the most a script's `resize` may ask for) and at most the adapter's largest surface
+/// edge `max_edge`. The window only shows the image; the image keeps the scene's `[image]` size
+/// (checked by the loader), so a scene's own image rules (an `[area_light]`'s pixel limit) do not
+/// bound the window.
+pub(super) fn check_window_size(max_edge: u32, w: u32, h: u32) -> Result<(), String> {
+    let limit = max_edge.min(hadou_scene::MAX_IMAGE_EDGE);
+    if w == 0 || h == 0 || w > limit || h > limit {
+        let why = if max_edge < hadou_scene::MAX_IMAGE_EDGE {
+            format!("this adapter's surfaces are 1..={max_edge} pixels on each edge")
+        } else {
+            format!("window edges are 1..={} pixels", hadou_scene::MAX_IMAGE_EDGE)
+        };
+        return Err(format!("the window cannot be {w}×{h} pixels: {why}"));
     }
     Ok(())
 }
 
 #[cfg(test)]
 mod tests {
-    use super::median_json;
+    use super::{check_window_size, median_json};
+
+    #[test]
+    fn window_sizes_follow_the_edge_limits_and_the_adapter() {
+        // A window larger than an [area_light] scene's image limit only shows the image.
+        assert!(check_window_size(16384, 5000, 4000).is_ok());
+        assert!(check_window_size(16384, 16384, 16384).is_ok());
+        let e = check_window_size(16384, 16385, 10).unwrap_err();
+        assert!(e.contains("16385×10") && e.contains("1..=16384"), "{e}");
+        let e = check_window_size(8192, 8193, 100).unwrap_err();
+        assert!(e.contains("adapter") && e.contains("1..=8192"), "{e}");
+        assert!(check_window_size(8192, 0, 100).is_err());
+    }
 
     #[test]
     fn a_median_without_samples_is_null_not_nan() {

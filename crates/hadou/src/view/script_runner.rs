@@ -32,7 +32,7 @@ impl App {
                     let at = format!("{}:{}:{}", path.display(), line.line, line.arg_col(0));
                     if let Some(g) = &self.gfx {
                         if w > 0 && h > 0 {
-                            if let Err(e) = check_window_size(self.viewer.scene(), g.max_edge(), w, h) {
+                            if let Err(e) = check_window_size(g.max_edge(), w, h) {
                                 self.die(event_loop, fail(2, format!("{at}: {e}")));
                                 return;
                             }
