@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::base64;
+use common::{base64, png_header_only};
 
 use hadou_scene::{encode_png, gltf_from_bytes, gltf_from_bytes_with_warnings, Mesh, RampKind, ShadingModel};
 use hadou_scene::{Filter, Wrap};
@@ -330,38 +330,6 @@ fn with_image(bytes: &[u8], image: impl FnOnce(usize) -> Value) -> Vec<u8> {
     b.finish(doc)
 }
 
-fn crc32(data: &[u8]) -> u32 {
-    let mut c = !0u32;
-    for &b in data {
-        c ^= b as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
-        }
-    }
-    !c
-}
-
-/// A PNG whose header claims `w × h` RGBA texels (with almost no pixel data).
-fn png_header(w: u32, h: u32) -> Vec<u8> {
-    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
-    let mut ihdr = b"IHDR".to_vec();
-    ihdr.extend_from_slice(&w.to_be_bytes());
-    ihdr.extend_from_slice(&h.to_be_bytes());
-    ihdr.extend_from_slice(&[8, 6, 0, 0, 0]);
-    out.extend_from_slice(&13u32.to_be_bytes());
-    out.extend_from_slice(&ihdr);
-    out.extend_from_slice(&crc32(&ihdr).to_be_bytes());
-    // A few bytes of (truncated) image data, so the header is all a decoder can go on.
-    let idat = b"IDATx\x9c\x01\x00";
-    out.extend_from_slice(&4u32.to_be_bytes());
-    out.extend_from_slice(idat);
-    out.extend_from_slice(&crc32(idat).to_be_bytes());
-    out.extend_from_slice(&0u32.to_be_bytes());
-    out.extend_from_slice(b"IEND");
-    out.extend_from_slice(&crc32(b"IEND").to_be_bytes());
-    out
-}
-
 /// A baseline 8×8 grey JPEG: one component, DC and AC Huffman tables of one code each, every
 /// coefficient 0 (so every texel is 128).
 fn tiny_jpeg(w: u16, h: u16) -> Vec<u8> {
@@ -428,7 +396,7 @@ fn hostile_images_are_clear_errors() {
     assert!(e.contains("image 0 refers to bufferView 9"), "{e}");
 
     // A PNG header claiming 100000 × 100000 texels: refused from the header.
-    let e = load_err(&with_image(&png_header(100_000, 100_000), |v| json!({"bufferView": v})));
+    let e = load_err(&with_image(&png_header_only(100_000, 100_000), |v| json!({"bufferView": v})));
     assert!(
         e.starts_with("material 0: image 0")
             && e.contains("100000×100000")

@@ -2,27 +2,10 @@
 //! inflates to 1 GiB is skipped unread. Its own test binary, so the process's peak resident size
 //! measures this one decode.
 
+mod common;
+
+use common::chunk;
 use hadou_scene::{decode_texture, encode_png};
-
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut c = 0xFFFF_FFFFu32;
-    for &b in bytes {
-        c ^= u32::from(b);
-        for _ in 0..8 {
-            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
-        }
-    }
-    !c
-}
-
-fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
-    let mut out = (data.len() as u32).to_be_bytes().to_vec();
-    let mut body = kind.to_vec();
-    body.extend_from_slice(data);
-    out.extend_from_slice(&body);
-    out.extend_from_slice(&crc32(&body).to_be_bytes());
-    out
-}
 
 /// Bits written least significant first, as deflate packs them.
 #[derive(Default)]

@@ -1,4 +1,4 @@
-//! Helpers shared by the scene crate's error tests.
+//! Helpers shared by the scene crate's tests: errors and their places, base64, PNG chunks.
 #![allow(dead_code)]
 
 use hadou_scene::{Scene, SceneError};
@@ -29,4 +29,39 @@ pub fn base64(data: &[u8]) -> String {
         }
     }
     s
+}
+
+/// CRC-32 (ISO 3309, as PNG uses) of `bytes`.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = 0xFFFF_FFFFu32;
+    for &b in bytes {
+        c ^= u32::from(b);
+        for _ in 0..8 {
+            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+        }
+    }
+    !c
+}
+
+/// A PNG chunk: length, type, data, CRC.
+pub fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+    let mut out = (data.len() as u32).to_be_bytes().to_vec();
+    let mut body = kind.to_vec();
+    body.extend_from_slice(data);
+    out.extend_from_slice(&body);
+    out.extend_from_slice(&crc32(&body).to_be_bytes());
+    out
+}
+
+/// A PNG whose header says `w × h` RGBA8 texels but whose pixel data is a few bytes: enough for
+/// the header check, which must refuse it before anything is decoded.
+pub fn png_header_only(w: u32, h: u32) -> Vec<u8> {
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 6, 0, 0, 0]);
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    out.extend(chunk(b"IHDR", &ihdr));
+    out.extend(chunk(b"IDAT", &[0x78, 0x01, 0x03, 0x00]));
+    out.extend(chunk(b"IEND", &[]));
+    out
 }
