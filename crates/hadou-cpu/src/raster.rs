@@ -268,6 +268,10 @@ fn clip_near(tri: [Vert; 3], near: f32, out: &mut [Vert; 4]) -> usize {
             n += 1;
         }
         if ina != inb {
+            // The crossing computed from the edge's endpoints in one order whichever way the
+            // triangle runs along it, so two triangles sharing the edge get the same clipped
+            // vertex, bit for bit, and no crack opens between them.
+            let (a, b) = if a.view.to_array() <= b.view.to_array() { (a, b) } else { (b, a) };
             let s = (near - a.view.z) / (b.view.z - a.view.z);
             let lerp = |p: Vec3f, q: Vec3f| p + (q - p) * s;
             let mix = |p: f32, q: f32| p + (q - p) * s;
@@ -316,9 +320,55 @@ fn owns_boundary(ax: f32, ay: f32, bx: f32, by: f32, sign: f32) -> bool {
     (dy == 0.0 && dx > 0.0) || dy < 0.0
 }
 
+/// One edge of a triangle for the coverage test: its endpoints in a canonical order (by `y`, then
+/// `x`) and the factor (±1) that turns [`edge`] of that order into the triangle's inside-positive
+/// value. Two triangles sharing the edge evaluate the same products on the same numbers, so their
+/// values at any point are exact negatives of each other: a pixel centre near a shared edge is
+/// inside exactly one of them however the rounding falls, and one exactly on it goes to the
+/// triangle whose side owns it under the top-left rule ([`owns_boundary`]). That is what makes the
+/// rasterizer watertight (no pixel between two triangles, none drawn twice).
+///
+/// Evaluated in f64: a vertex clipped at the near plane can project millions of pixels away, where
+/// f32 products of coordinates would misplace the edge by pixels.
+#[derive(Clone, Copy)]
+struct CanonicalEdge {
+    a: [f64; 2],
+    b: [f64; 2],
+    factor: f64,
+    owns: bool,
+}
+
+impl CanonicalEdge {
+    fn new(a: [f32; 2], b: [f32; 2], sign: f32) -> Self {
+        let owns = owns_boundary(a[0], a[1], b[0], b[1], sign);
+        let (a64, b64) = (a.map(f64::from), b.map(f64::from));
+        if (a[1], a[0]) <= (b[1], b[0]) {
+            CanonicalEdge { a: a64, b: b64, factor: f64::from(sign), owns }
+        } else {
+            CanonicalEdge { a: b64, b: a64, factor: -f64::from(sign), owns }
+        }
+    }
+
+    /// The edge's inside-positive value at `(px, py)` (twice the area of the edge and the point,
+    /// signed by the triangle's orientation).
+    #[inline(always)]
+    fn at(&self, px: f64, py: f64) -> f64 {
+        let [ax, ay] = self.a;
+        let [bx, by] = self.b;
+        ((bx - ax) * (py - ay) - (by - ay) * (px - ax)) * self.factor
+    }
+
+    #[inline(always)]
+    fn inside(&self, e: f64) -> bool {
+        e > 0.0 || (e == 0.0 && self.owns)
+    }
+}
+
 /// Calls `f(i, b)` for every pixel centre of the rows `y_start..y_start + rows` (`i` indexing a
 /// `rows × w` buffer) that `t` covers under the top-left rule, with the screen-space barycentric
 /// weights `b` of the centre. Degenerate (zero-area or non-finite) triangles cover nothing.
+/// Watertight: triangles sharing an edge (the same two screen points) cover every pixel centre
+/// near it exactly once ([`CanonicalEdge`]).
 #[inline(always)]
 pub(crate) fn cover(
     t: &ScreenTri,
@@ -327,12 +377,13 @@ pub(crate) fn cover(
     w: usize,
     mut f: impl FnMut(usize, [f32; 3]),
 ) {
-    let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
+    let [ax, bx, cx] = t.sx.map(f64::from);
+    let [ay, by, cy] = t.sy.map(f64::from);
+    let area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
     if area == 0.0 || !area.is_finite() {
         return;
     }
-    let sign = area.signum();
-    let inv_area = 1.0 / area;
+    let sign = area.signum() as f32;
     let xmin = t.sx[0].min(t.sx[1]).min(t.sx[2]);
     let xmax = t.sx[0].max(t.sx[1]).max(t.sx[2]);
     if xmax < 0.0 || xmin > w as f32 {
@@ -346,11 +397,20 @@ pub(crate) fn cover(
     let x1 = x1 as usize;
     let ylo = t.sy[0].min(t.sy[1]).min(t.sy[2]);
     let yhi = t.sy[0].max(t.sy[1]).max(t.sy[2]);
-    let own = [
-        owns_boundary(t.sx[1], t.sy[1], t.sx[2], t.sy[2], sign),
-        owns_boundary(t.sx[2], t.sy[2], t.sx[0], t.sy[0], sign),
-        owns_boundary(t.sx[0], t.sy[0], t.sx[1], t.sy[1], sign),
+    let v = |k: usize| [t.sx[k], t.sy[k]];
+    let edges = [
+        CanonicalEdge::new(v(1), v(2), sign),
+        CanonicalEdge::new(v(2), v(0), sign),
+        CanonicalEdge::new(v(0), v(1), sign),
     ];
+    // Edge 0's value at vertex 0 is the triangle's doubled area, inside-positive: each edge's
+    // value over it is a barycentric weight.
+    let inv_area = 1.0 / edges[0].at(f64::from(t.sx[0]), f64::from(t.sy[0]));
+    // How far the rows' spans below may stray from the edge tests, in pixels: a few units of f64
+    // rounding of coordinates as large as the triangle's (a vertex far off screen makes them
+    // large), so the spans are widened by that much and never miss a pixel the tests accept.
+    let magnitude = [xmin, xmax, ylo, yhi].iter().fold(1.0f64, |m, &c| m.max(f64::from(c).abs()));
+    let slack = 1.5 + magnitude * 1e-9;
     // Only the rows whose centres may lie within [ylo, yhi] (the test below still decides).
     let r0 = ((ylo - 0.5).ceil() - y_start as f32 - 1.0).max(0.0) as usize;
     let r1 = ((yhi - 0.5).floor() - y_start as f32 + 2.0).clamp(0.0, rows as f32) as usize;
@@ -359,41 +419,40 @@ pub(crate) fn cover(
         if py < ylo || py > yhi {
             continue;
         }
-        // The row's span of the triangle, widened by a pixel against rounding: only its pixels
-        // are tested (the exact edge tests below decide), so long thin triangles cost their
-        // area, not their bounding box.
-        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        // The row's span of the triangle (in f64), widened by `slack`: only its pixels are tested
+        // (the edge tests decide), so long thin triangles cost their area, not their bounding box.
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let pyd = f64::from(py);
         for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-            let (ay, by) = (t.sy[a], t.sy[b]);
-            if (ay <= py && py <= by) || (by <= py && py <= ay) {
+            let (ax, ay, bx, by) =
+                (f64::from(t.sx[a]), f64::from(t.sy[a]), f64::from(t.sx[b]), f64::from(t.sy[b]));
+            if (ay <= pyd && pyd <= by) || (by <= pyd && pyd <= ay) {
                 let x = if ay == by {
-                    lo = lo.min(t.sx[a].min(t.sx[b]));
-                    t.sx[a].max(t.sx[b])
+                    lo = lo.min(ax.min(bx));
+                    ax.max(bx)
                 } else {
-                    t.sx[a] + (py - ay) * ((t.sx[b] - t.sx[a]) / (by - ay))
+                    ax + (pyd - ay) * ((bx - ax) / (by - ay))
                 };
                 lo = lo.min(x);
                 hi = hi.max(x);
             }
         }
-        if lo.partial_cmp(&hi) == Some(std::cmp::Ordering::Greater) || lo.is_nan() || hi.is_nan() {
+        if lo.is_nan() || hi.is_nan() || lo > hi {
             continue;
         }
-        let xs = ((lo - 1.5).ceil().max(x0 as f32)) as usize;
-        let xe = ((hi + 0.5).floor().min(x1 as f32)).max(-1.0);
-        if xe < xs as f32 {
+        let xs = (lo - slack - 0.5).ceil().max(x0 as f64) as usize;
+        let xe = (hi + slack - 0.5).floor().min(x1 as f64);
+        if xe < xs as f64 {
             continue;
         }
         for x in xs..=xe as usize {
-            let px = x as f32 + 0.5;
-            let e0 = edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) * sign;
-            let e1 = edge(t.sx[2], t.sy[2], t.sx[0], t.sy[0], px, py) * sign;
-            let e2 = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], px, py) * sign;
-            let inside = |e: f32, o: bool| e > 0.0 || (e == 0.0 && o);
-            if !(inside(e0, own[0]) && inside(e1, own[1]) && inside(e2, own[2])) {
+            let px = x as f64 + 0.5;
+            let e = [edges[0].at(px, pyd), edges[1].at(px, pyd), edges[2].at(px, pyd)];
+            if !(edges[0].inside(e[0]) && edges[1].inside(e[1]) && edges[2].inside(e[2])) {
                 continue;
             }
-            f(r * w + x, [e0 * inv_area * sign, e1 * inv_area * sign, e2 * inv_area * sign]);
+            let b = e.map(|e| (e * inv_area) as f32);
+            f(r * w + x, b);
         }
     }
 }
@@ -439,4 +498,162 @@ pub(crate) fn nearest_depths(
         });
     }
     depth
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hadou_math::rng::Rng;
+
+    /// How many times `cover` reaches each pixel of a `w × h` image, over all of `tris`.
+    fn coverage(tris: &[ScreenTri], w: usize, h: usize) -> Vec<u32> {
+        let mut count = vec![0u32; w * h];
+        for t in tris {
+            cover(t, 0, h, w, |i, b| {
+                assert!(b.iter().all(|x| x.is_finite()), "{b:?}");
+                count[i] += 1;
+            });
+        }
+        count
+    }
+
+    /// Two triangles per cell of a jittered `n × n` grid over `[x0, x1] × [y0, y1]` (corners and
+    /// sides kept on the square's boundary; `jitter` below 0.5 keeps every cell convex), each cell
+    /// split along a random diagonal, each
+    /// triangle wound at random.
+    fn tiled_square(rng: &mut Rng, n: usize, lo: [f32; 2], hi: [f32; 2], jitter: f32) -> Vec<ScreenTri> {
+        let mut p = vec![[0.0f32; 2]; (n + 1) * (n + 1)];
+        for j in 0..=n {
+            for i in 0..=n {
+                let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+                let mut x = lo[0] + u * (hi[0] - lo[0]);
+                let mut y = lo[1] + v * (hi[1] - lo[1]);
+                let cell = [(hi[0] - lo[0]) / n as f32, (hi[1] - lo[1]) / n as f32];
+                if i > 0 && i < n {
+                    x += (rng.unit() as f32 - 0.5) * jitter * cell[0];
+                }
+                if j > 0 && j < n {
+                    y += (rng.unit() as f32 - 0.5) * jitter * cell[1];
+                }
+                p[j * (n + 1) + i] = [x, y];
+            }
+        }
+        let mut tris = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let k = |a: usize, b: usize| p[(j + b) * (n + 1) + i + a];
+                let (a, b, c, d) = (k(0, 0), k(1, 0), k(1, 1), k(0, 1));
+                let halves = if rng.below(2) == 0 { [[a, b, c], [a, c, d]] } else { [[a, b, d], [b, c, d]] };
+                for mut t in halves {
+                    if rng.below(2) == 0 {
+                        t.swap(1, 2);
+                    }
+                    tris.push(ScreenTri::flat([t[0][0], t[1][0], t[2][0]], [t[0][1], t[1][1], t[2][1]]));
+                }
+            }
+        }
+        tris
+    }
+
+    #[test]
+    fn tiled_squares_cover_every_pixel_exactly_once() {
+        let mut rng = Rng(0x7761_7465_7274_6967);
+        let (w, h) = (96, 80);
+        for case in 0..40 {
+            // Small cells, big ones, and squares reaching far past the image (vertices up to
+            // 1e5 pixels away, as a ground plane seen from above has).
+            let (lo, hi, n) = match case % 4 {
+                0 => ([0.0, 0.0], [w as f32, h as f32], 40),
+                1 => ([0.0, 0.0], [w as f32, h as f32], 7),
+                2 => ([-3000.0, -2000.0], [3100.0, 2500.0], 60),
+                _ => ([-1e5, -7e4], [1.2e5, 9e4], 12),
+            };
+            let tris = tiled_square(&mut rng, n, lo, hi, 0.4);
+            let count = coverage(&tris, w, h);
+            let bad: Vec<(usize, usize, u32)> =
+                (0..w * h).filter(|&i| count[i] != 1).map(|i| (i % w, i / w, count[i])).take(8).collect();
+            assert!(bad.is_empty(), "case {case}: {} triangles; (x, y, times covered): {bad:?}", tris.len());
+        }
+    }
+
+    #[test]
+    fn pixel_centres_on_shared_edges_are_covered_once() {
+        // Quads split along a diagonal through pixel centres (slopes 1, 2, 1/3, -1), corners far
+        // outside the image, as a ground plane seen from straight above has: every centre on the
+        // diagonal lies exactly on both triangles' edge, where rounding once dropped it from both.
+        let (w, h) = (64, 48);
+        for (k, (dx, dy)) in [(1.0f32, 1.0f32), (1.0, 2.0), (3.0, 1.0), (1.0, -1.0)].into_iter().enumerate() {
+            for far in [100.0f32, 3000.0, 70_000.0] {
+                let c = [20.5f32 + k as f32, 17.5];
+                let a = [c[0] - far * dx, c[1] - far * dy];
+                let b = [c[0] + far * dx, c[1] + far * dy];
+                // The other two corners, far off each side of the diagonal.
+                let (nx, ny) = (-dy * far * 3.0, dx * far * 3.0);
+                let p = [c[0] + nx, c[1] + ny];
+                let q = [c[0] - nx, c[1] - ny];
+                let tris = [
+                    ScreenTri::flat([a[0], b[0], p[0]], [a[1], b[1], p[1]]),
+                    ScreenTri::flat([b[0], a[0], q[0]], [b[1], a[1], q[1]]),
+                ];
+                let count = coverage(&tris, w, h);
+                let bad: Vec<(usize, usize, u32)> =
+                    (0..w * h).filter(|&i| count[i] != 1).map(|i| (i % w, i / w, count[i])).take(8).collect();
+                assert!(
+                    bad.is_empty(),
+                    "slope ({dx}, {dy}), corners {far} px away: (x, y, times covered): {bad:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_ground_reaching_behind_the_camera_has_no_crack() {
+        // A huge ground quad under a camera looking ahead, split along a random diagonal that
+        // crosses the near plane: both triangles are clipped there, and every pixel below the
+        // horizon must be covered exactly once. The clipped ends of the shared diagonal once
+        // differed in the last bit between the two triangles, and the crack showed as single
+        // background pixels along it (kamehameha.toml at 640×360, t = 1, pixel (516, 282)).
+        let mut rng = Rng(0x6772_6f75_6e64);
+        let size = 160;
+        for case in 0..60 {
+            let near = [1e-3f32, 0.05, 0.5][case % 3];
+            let height = 0.2 + 3.0 * rng.unit() as f32;
+            let yaw = rng.unit() as f32 * std::f32::consts::TAU;
+            let extent = [50.0f32, 2000.0, 1e5][(case / 3) % 3];
+            let proj = ScreenProjection::square(near, 25f32.to_radians().tan(), size as u32);
+            let (c, s) = (yaw.cos(), yaw.sin());
+            let corner = |x: f32, z: f32| {
+                let view = Vec3f::new(c * x - s * z, -height, s * x + c * z);
+                Vert { view, world: view, normal: Vec3f::Y, uv: [0.0; 2], color: [1.0; 4] }
+            };
+            let q = [
+                corner(-extent, -extent),
+                corner(extent, -extent),
+                corner(extent, extent),
+                corner(-extent, extent),
+            ];
+            let mut tris = Tris::default();
+            proj.push([q[0], q[1], q[2]], 0, 0, false, &mut tris);
+            proj.push([q[0], q[2], q[3]], 0, 0, false, &mut tris);
+            let tris: Vec<ScreenTri> = tris.iter().copied().collect();
+            let count = coverage(&tris, size, size);
+            // The horizon is the middle row; below it, the ground fills every row whose ray meets
+            // it (at depth `height / slope`, and at most √2 times that from the eye across the
+            // view) well within the disc of radius `extent` the quad covers whatever its yaw.
+            let tan_half = 25f32.to_radians().tan();
+            let on_ground = |row: usize| {
+                let slope = ((row as f32 + 0.5) / (size as f32 / 2.0) - 1.0) * tan_half;
+                slope > 0.0 && height / slope * 1.5 < extent * 0.9
+            };
+            let bad: Vec<(usize, usize, u32)> = (0..size * size)
+                .filter(|&i| on_ground(i / size) && count[i] != 1)
+                .map(|i| (i % size, i / size, count[i]))
+                .take(8)
+                .collect();
+            assert!(
+                bad.is_empty(),
+                "case {case} (near {near}, extent {extent}): (x, y, times covered): {bad:?}"
+            );
+        }
+    }
 }
