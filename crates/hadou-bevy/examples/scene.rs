@@ -2,12 +2,17 @@
 //!
 //! ```text
 //! cargo run --release --example scene -- SCENE.toml [--time T] [--screenshot OUT.png]
-//!     [--tonemapping none|tony-mc-mapface|agx|aces] [--bloom]
+//!     [--tonemapping none|tony-mc-mapface|agx|aces] [--bloom] [--compare REF.png [--max-diff D]]
 //! ```
 //! `--time T` freezes the clock at `T` seconds; `--screenshot OUT.png` saves one frame (once the
 //! scene has loaded and been drawn) and exits. The window has the scene's `[image]` size.
+//! `--compare REF.png` (with `--screenshot`) prints the mean absolute 8-bit difference of the
+//! screenshot's RGB against a PNG of the same size (e.g. `hadou render`'s), and `--max-diff D`
+//! makes a larger one exit with code 1.
 
+use bevy::asset::RenderAssetUsages;
 use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::image::{CompressedImageFormats, ImageSampler, ImageType};
 use bevy::post_process::bloom::Bloom;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{save_to_disk, Screenshot, ScreenshotCaptured};
@@ -25,10 +30,12 @@ struct Options {
     screenshot: Option<PathBuf>,
     tonemapping: Tonemapping,
     bloom: bool,
+    compare: Option<PathBuf>,
+    max_diff: Option<f64>,
 }
 
 const USAGE: &str = "usage: scene SCENE.toml [--time T] [--screenshot OUT.png] \
-                     [--tonemapping none|tony-mc-mapface|agx|aces] [--bloom]";
+                     [--tonemapping none|tony-mc-mapface|agx|aces] [--bloom] [--compare REF.png [--max-diff D]]";
 
 fn parse_args() -> Result<Options, String> {
     let mut args = std::env::args().skip(1);
@@ -38,6 +45,8 @@ fn parse_args() -> Result<Options, String> {
         screenshot: None,
         tonemapping: Tonemapping::TonyMcMapface,
         bloom: false,
+        compare: None,
+        max_diff: None,
     };
     let mut scene = None;
     while let Some(arg) = args.next() {
@@ -62,12 +71,20 @@ fn parse_args() -> Result<Options, String> {
                 }
             }
             "--bloom" => options.bloom = true,
+            "--compare" => options.compare = Some(PathBuf::from(value("--compare")?)),
+            "--max-diff" => {
+                let v = value("--max-diff")?;
+                options.max_diff = Some(v.parse().map_err(|_| format!("--max-diff: `{v}` is not a number"))?);
+            }
             _ if arg.starts_with("--") => return Err(format!("unknown flag `{arg}`")),
             _ if scene.is_none() => scene = Some(PathBuf::from(arg)),
             _ => return Err(format!("unexpected argument `{arg}`")),
         }
     }
     options.scene = scene.ok_or("no scene file given")?;
+    if options.compare.is_some() && options.screenshot.is_none() {
+        return Err("--compare needs --screenshot".into());
+    }
     Ok(options)
 }
 
@@ -147,11 +164,57 @@ fn screenshot(
     *frames += 1;
     if *frames == SETTLE_FRAMES {
         let mut save = save_to_disk(out.clone());
+        let (compare, max_diff) = (options.compare.clone(), options.max_diff);
         commands.spawn(Screenshot::primary_window()).observe(
             move |captured: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                let shot = captured.image.clone();
                 save(captured);
-                exit.write(AppExit::Success);
+                let Some(reference) = &compare else {
+                    exit.write(AppExit::Success);
+                    return;
+                };
+                match mean_difference(shot, reference) {
+                    Ok((mean, max)) => {
+                        println!(
+                            "mean absolute 8-bit difference against {}: {mean:.3} (largest {max})",
+                            reference.display()
+                        );
+                        let too_large = max_diff.is_some_and(|limit| mean > limit);
+                        exit.write(if too_large { AppExit::error() } else { AppExit::Success });
+                    }
+                    Err(e) => {
+                        eprintln!("error: --compare: {e}");
+                        exit.write(AppExit::error());
+                    }
+                }
             },
         );
     }
+}
+
+/// The mean and the largest absolute difference of the 8-bit RGB values of `shot` and the PNG
+/// at `reference` (alpha ignored), which must have the same size.
+fn mean_difference(shot: Image, reference: &std::path::Path) -> Result<(f64, u8), String> {
+    let bytes = std::fs::read(reference).map_err(|e| format!("{}: {e}", reference.display()))?;
+    let reference = Image::from_buffer(
+        &bytes,
+        ImageType::Extension("png"),
+        CompressedImageFormats::NONE,
+        true,
+        ImageSampler::Default,
+        RenderAssetUsages::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    let a = shot.try_into_dynamic().map_err(|e| e.to_string())?.to_rgb8();
+    let b = reference.try_into_dynamic().map_err(|e| e.to_string())?.to_rgb8();
+    if a.dimensions() != b.dimensions() {
+        return Err(format!("sizes differ: {:?} and {:?}", a.dimensions(), b.dimensions()));
+    }
+    let (mut sum, mut max) = (0u64, 0u8);
+    for (x, y) in a.as_raw().iter().zip(b.as_raw()) {
+        let d = x.abs_diff(*y);
+        sum += u64::from(d);
+        max = max.max(d);
+    }
+    Ok((sum as f64 / a.as_raw().len().max(1) as f64, max))
 }
