@@ -30,7 +30,9 @@ mod wave;
 
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera};
-pub use spawn::{bevy_material, bevy_mesh, scene_time, HadouSceneRoot, SceneClock, SpawnedScene};
+pub use spawn::{
+    bevy_material, bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene,
+};
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 
 use bevy::asset::io::file::FileAssetReader;

@@ -115,6 +115,44 @@ fn object_transform(object: &hadou_scene::Object) -> Transform {
     Transform::from_matrix(bevy::math::Mat4::from_cols_array_2d(&object.transform.cols))
 }
 
+/// What a frame uses that the plugin does not draw yet, one line each (empty when nothing):
+/// logged as one warning when a scene is spawned.
+pub fn unsupported(frame: &Frame) -> Vec<String> {
+    let mut out = Vec::new();
+    if !frame.shadows.is_empty() {
+        out.push(format!("{} [[shadow]] (wave and sun shadows)", frame.shadows.len()));
+    }
+    if frame.area_light.is_some() {
+        out.push("the [area_light] (soft shadows)".into());
+    }
+    if frame.color_mapping.mode == hadou_scene::ToneMode::Filmic {
+        out.push("[color] mode = \"filmic\" (Bevy's tone mapping runs instead)".into());
+    }
+    for object in &frame.objects {
+        let mut what = Vec::new();
+        let materials = &object.materials;
+        if materials.len() > 1 {
+            what.push(format!("{} material slots (the first is used)", materials.len()));
+        }
+        if materials.iter().any(|m| m.model == ShadingModel::Toon) {
+            what.push("toon ramps".into());
+        }
+        if materials.iter().any(|m| m.wave_blend > 0.0) {
+            what.push("wave_blend (the wave as a light)".into());
+        }
+        if materials.iter().any(|m| m.base_texture.is_some() || m.feature_texture.is_some()) {
+            what.push("textures".into());
+        }
+        if materials.iter().any(|m| m.outline.is_some()) {
+            what.push("outlines".into());
+        }
+        if !what.is_empty() {
+            out.push(format!("object \"{}\": {}", object.name, what.join(", ")));
+        }
+    }
+    out
+}
+
 /// The time a root shows at `elapsed` seconds since spawning, for a scene of `duration` seconds.
 pub fn scene_time(clock: SceneClock, elapsed: f32, duration: f32) -> f32 {
     match clock {
@@ -134,6 +172,14 @@ pub(crate) fn spawn_scenes(
     for (root, spawn) in &roots {
         let Some(HadouScene(scene)) = scenes.get(&spawn.scene) else { continue };
         let frame = scene.at(scene_time(spawn.clock, 0.0, scene.duration()));
+        let missing = unsupported(&frame);
+        if !missing.is_empty() {
+            warn!(
+                "{}: not drawn in Bevy yet (see docs/bevy.md): {}",
+                scene.path().display(),
+                missing.join("; ")
+            );
+        }
         let camera = commands
             .spawn((
                 Name::new("camera"),

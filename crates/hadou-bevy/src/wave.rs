@@ -26,7 +26,7 @@ impl HadouWave {
 }
 
 /// Put on an entity whose [`HadouWave`] failed [`check_wave`] (and removed once it passes): the
-/// wave is not drawn. The failure is logged once per change, naming the entity and the key.
+/// wave is not drawn. The failure is logged once per bad key, naming the entity and the key.
 #[derive(Component, Clone, Debug, PartialEq)]
 pub struct WaveRejected(pub WaveError);
 
@@ -132,7 +132,8 @@ pub fn rejection_message(entity: Entity, name: Option<&Name>, error: &WaveError)
 type WaveToCheck = (Entity, &'static HadouWave, Option<&'static Name>, Option<&'static WaveRejected>);
 
 /// Checks every added or changed [`HadouWave`]: a failing one gets [`WaveRejected`] and one error
-/// log line ([`rejection_message`]); a passing one loses any [`WaveRejected`].
+/// log line ([`rejection_message`]) each time the key it fails on changes; a passing one loses
+/// any [`WaveRejected`].
 pub(crate) fn check_changed_waves(mut commands: Commands, waves: Query<WaveToCheck, Changed<HadouWave>>) {
     for (entity, wave, name, rejected) in &waves {
         match check_wave(&wave.wave) {
@@ -142,7 +143,8 @@ pub(crate) fn check_changed_waves(mut commands: Commands, waves: Query<WaveToChe
                 }
             }
             Err(error) => {
-                if rejected.map(|r| &r.0) != Some(&error) {
+                // Logged when the bad key changes, not on every frame of an animated bad value.
+                if rejected.map(|r| r.0.key) != Some(error.key) {
                     error!("{}", rejection_message(entity, name, &error));
                     commands.entity(entity).insert(WaveRejected(error));
                 }

@@ -5,7 +5,8 @@
 use bevy::asset::LoadState;
 use bevy::prelude::*;
 use hadou_bevy::{
-    parse_scene, HadouCamera, HadouPlugin, HadouScene, HadouSceneRoot, HadouWave, SceneClock, SpawnedScene,
+    parse_scene, unsupported, HadouCamera, HadouPlugin, HadouScene, HadouSceneRoot, HadouWave, SceneClock,
+    SpawnedScene,
 };
 use hadou_math::energy::BeamField;
 use hadou_scene::WaveShape;
@@ -107,4 +108,15 @@ fn a_loaded_scene_spawns_its_entities_at_the_frozen_time() {
     let expected = length(&reference.waves[0].shape);
     assert!(expected > 1.0, "the track has moved the head by t = 1.5");
     assert_eq!(length(&wave.wave.shape), expected);
+}
+
+#[test]
+fn what_is_not_drawn_yet_is_named() {
+    let scenes = repo_scenes();
+    let frame = hadou_scene::Scene::load(scenes.join("shadow-wave-top.toml")).unwrap().at(1.0);
+    let missing = unsupported(&frame).join("; ");
+    assert!(missing.contains("[[shadow]]"), "{missing}");
+    let mut frame = hadou_scene::Scene::load(scenes.join("kamehameha.toml")).unwrap().at(1.5);
+    frame.color_mapping.mode = hadou_scene::ToneMode::Faithful;
+    assert_eq!(unsupported(&frame), Vec::<String>::new(), "a faithful kamehameha uses nothing unsupported");
 }
