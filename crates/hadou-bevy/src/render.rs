@@ -83,7 +83,6 @@ pub(crate) fn view_frame(
 
 /// The wave pass of the current view: adds the waves' light into the view's HDR target, clipped
 /// at its depth buffer.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn wave_pass(
     view: ViewQuery<(&ExtractedView, &ViewTarget, &ViewDepthTexture, &HadouCamera, &Msaa)>,
     waves: Res<ExtractedWaves>,
