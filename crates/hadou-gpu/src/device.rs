@@ -289,27 +289,42 @@ impl GpuContext {
 
     /// A context on a device someone else opened on `adapter` (a window's, compatible with its
     /// surface): checks the adapter and the device's limits as [`GpuContext::new`] does, and
-    /// installs the error and device-loss handlers (replacing any the device had). Never blocks.
+    /// installs the error and device-loss handlers (replacing any the device had) when
+    /// `install_handlers`; without, the owner's handlers stay and see every error outside this
+    /// context's error scopes. Never blocks.
     pub(crate) fn from_device(
         adapter: &wgpu::Adapter,
         device: wgpu::Device,
         queue: wgpu::Queue,
+        install_handlers: bool,
     ) -> Result<Self, RenderError> {
         let info = adapter.get_info();
         check_capabilities(adapter, &info, &device.limits(), "device")?;
-        Ok(Self::with_device(device, queue, info))
+        if install_handlers {
+            Ok(Self::with_device(device, queue, info))
+        } else {
+            Ok(Self::without_handlers(device, queue, info))
+        }
     }
 
     fn with_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        let context = Self::without_handlers(device, queue, info);
+        let r = context.reports.clone();
+        context
+            .device
+            .on_uncaptured_error(Arc::new(move |e: wgpu::Error| lock(&r).uncaptured.push(e.to_string())));
+        let r = context.reports.clone();
+        context.device.set_device_lost_callback(move |reason, message| {
+            lock(&r).lost = Some(format!("{reason:?}: {message}"));
+        });
+        context
+    }
+
+    /// A context whose reports stay empty: errors reach it only through its error scopes.
+    fn without_handlers(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
         // What the device was granted, which for one opened elsewhere may be less than the adapter's.
         let (limits, features) = (device.limits(), device.features());
         let reports = Arc::new(Mutex::new(Reports::default()));
-        let r = reports.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| lock(&r).uncaptured.push(e.to_string())));
-        let r = reports.clone();
-        device.set_device_lost_callback(move |reason, message| {
-            lock(&r).lost = Some(format!("{reason:?}: {message}"));
-        });
         Self { device, queue, info, limits, features, reports }
     }
 

@@ -189,7 +189,21 @@ impl GpuBackend {
         device: wgpu::Device,
         queue: wgpu::Queue,
     ) -> Result<GpuBackend, RenderError> {
-        let ctx = device::GpuContext::from_device(adapter, device, queue)?;
+        let ctx = device::GpuContext::from_device(adapter, device, queue, true)?;
+        Ok(Self { renderer: render::Renderer::from_context(ctx)? })
+    }
+
+    /// As [`GpuBackend::from_device`], but leaves the device's uncaptured-error handler and
+    /// device-lost callback alone: for an engine that installed its own and must keep seeing
+    /// every error (Bevy's renderer does). The backend still catches the errors of its own work
+    /// with error scopes and returns them as [`RenderError`]s; an error outside them, or the
+    /// device's loss, is the owner's handler's to report.
+    pub fn from_shared_device(
+        adapter: &wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Result<GpuBackend, RenderError> {
+        let ctx = device::GpuContext::from_device(adapter, device, queue, false)?;
         Ok(Self { renderer: render::Renderer::from_context(ctx)? })
     }
 

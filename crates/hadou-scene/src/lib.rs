@@ -69,8 +69,8 @@ pub use gltf_load::{gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf};
 pub use image::Image;
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
 pub use limits::{
-    check_image_size, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS,
-    MAX_TRIANGLES, MAX_VERTICES,
+    check_image_size, ALPHA_MAX, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES,
+    MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
 };
 pub use scene::Scene;
 pub use shadow::{

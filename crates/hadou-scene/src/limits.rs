@@ -68,7 +68,7 @@ pub(crate) const FOV_MIN: f32 = 1e-3;
 /// Largest field of view in degrees.
 pub(crate) const FOV_MAX: f32 = 179.0;
 /// Largest wave strength (`alpha_s`, `alpha_c`, `head_alpha`, `muzzle_alpha`, `alpha`).
-pub(crate) const ALPHA_MAX: f32 = 1e5;
+pub const ALPHA_MAX: f32 = 1e5;
 /// Smallest object scale.
 pub(crate) const SCALE_MIN: f32 = 1e-6;
 /// Shortest direction vector (before normalisation).

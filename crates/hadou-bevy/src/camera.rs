@@ -1,0 +1,67 @@
+//! [`HadouCamera`]: the per-camera settings of the wave pass, and the hadou camera a Bevy view is
+//! drawn with ([`frame_camera`]).
+
+use bevy::camera::Camera3dDepthTextureUsage;
+use bevy::prelude::*;
+use bevy::render::extract_component::ExtractComponent;
+use bevy::render::render_resource::TextureUsages;
+use hadou_math::Vec3f;
+
+/// Put on a `Camera3d` (with `Hdr`, and `Msaa::Off` for now) to draw the [`crate::HadouWave`]s
+/// into its view: after Bevy's main passes, before bloom and tone mapping.
+#[derive(Component, Clone, Copy, Debug, PartialEq, ExtractComponent)]
+pub struct HadouCamera {
+    /// Multiplier of the waves' light (`[color] exposure` of a scene file): the pass adds
+    /// `exposure · Σ rgb·a·I` (002 §3.3).
+    pub exposure: f32,
+    /// The far plane of the waves' rays (`[camera] far`): the length scale of the thesis falloff
+    /// and of a curve's attenuation (002 eq. 3.12, 3.23). Bevy's own depth has no far plane.
+    pub far: f32,
+}
+
+impl Default for HadouCamera {
+    fn default() -> Self {
+        HadouCamera { exposure: 1.0, far: 1000.0 }
+    }
+}
+
+/// Lets the wave pass read the depth buffer of every camera that gained a [`HadouCamera`].
+pub(crate) fn bind_depth(mut cameras: Query<&mut Camera3d, Added<HadouCamera>>) {
+    for mut camera in &mut cameras {
+        let usages = camera.depth_texture_usages.0 | TextureUsages::TEXTURE_BINDING.bits();
+        camera.depth_texture_usages = Camera3dDepthTextureUsage(usages);
+    }
+}
+
+fn v(p: Vec3) -> Vec3f {
+    Vec3f::new(p.x, p.y, p.z)
+}
+
+/// The hadou camera that sees what a Bevy perspective view sees: eye and axes from
+/// `world_from_view` (looking down its −Z, up its +Y), the vertical field of view from
+/// `clip_from_view`'s `f = 1 / tan(fov_y / 2)` (its `[1][1]`) and the near plane from its
+/// `[3][2]` (Bevy's infinite reverse-Z perspective), `far` from [`HadouCamera`]. `None` for a
+/// projection that is not such a perspective (orthographic, or a far plane not beyond the near).
+pub fn frame_camera(world_from_view: &Mat4, clip_from_view: &Mat4, far: f32) -> Option<hadou_scene::Camera> {
+    let is_perspective = clip_from_view.w_axis.w == 0.0 && clip_from_view.z_axis.w == -1.0;
+    let f = clip_from_view.y_axis.y;
+    let near = clip_from_view.w_axis.z;
+    let planes_ok = near > 0.0 && far > near && far.is_finite();
+    if !(is_perspective && f > 0.0 && f.is_finite() && planes_ok) {
+        return None;
+    }
+    let eye = world_from_view.transform_point3(Vec3::ZERO);
+    let forward = world_from_view.transform_vector3(Vec3::NEG_Z);
+    let up = world_from_view.transform_vector3(Vec3::Y);
+    if !(eye.is_finite() && forward.is_finite() && up.is_finite()) {
+        return None;
+    }
+    Some(hadou_scene::Camera {
+        position: v(eye),
+        target: v(eye + forward),
+        up: v(up),
+        fov_y_deg: (2.0 * (1.0 / f).atan()).to_degrees(),
+        near,
+        far,
+    })
+}

@@ -1,0 +1,100 @@
+//! hadou's energy waves in Bevy.
+//!
+//! [`HadouPlugin`] draws every [`HadouWave`] into every camera with a [`HadouCamera`], through
+//! hadou-gpu's own wave pass on Bevy's `RenderDevice` (`GpuBackend::encode_wave_overlay`): per
+//! pixel the waves' light along the view ray, clipped at the camera's depth buffer (002 §3.3.5),
+//! added into the view's HDR target after Bevy's main passes and before bloom and tone mapping.
+//! A hadou scene file (`.toml`) is a Bevy asset ([`HadouScene`]); a [`HadouSceneRoot`] spawns it
+//! (camera, light, objects, waves) and plays its tracks.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use hadou_bevy::{HadouPlugin, HadouSceneRoot, SceneClock};
+//!
+//! fn main() {
+//!     App::new()
+//!         .add_plugins((DefaultPlugins, HadouPlugin::default()))
+//!         .add_systems(Startup, |mut commands: Commands, assets: Res<AssetServer>| {
+//!             let scene = assets.load("kamehameha.toml");
+//!             commands.spawn(HadouSceneRoot { scene, clock: SceneClock::Running });
+//!         })
+//!         .run();
+//! }
+//! ```
+
+mod asset;
+mod camera;
+mod render;
+mod spawn;
+mod wave;
+
+pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
+pub use camera::{frame_camera, HadouCamera};
+pub use spawn::{
+    bevy_material, bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene,
+};
+pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
+
+use bevy::asset::io::file::FileAssetReader;
+use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::prelude::*;
+use bevy::render::extract_component::ExtractComponentPlugin;
+use bevy::render::{ExtractSchedule, RenderApp, RenderStartup};
+use std::path::PathBuf;
+
+/// Bevy plugin: hadou's waves in every [`HadouCamera`]'s view, hadou scene files as assets.
+/// Works without a renderer too (e.g. under `MinimalPlugins`): waves are then only checked.
+pub struct HadouPlugin {
+    /// The directory asset paths are relative to (Bevy's `AssetPlugin::file_path` resolved), from
+    /// which a scene's glTF models and textures are read. Default: `assets` under Bevy's base
+    /// path (`BEVY_ASSET_ROOT`, else `CARGO_MANIFEST_DIR`, else the executable's directory).
+    pub asset_root: PathBuf,
+}
+
+impl Default for HadouPlugin {
+    fn default() -> Self {
+        HadouPlugin { asset_root: FileAssetReader::get_base_path().join("assets") }
+    }
+}
+
+/// The main-world systems of [`HadouPlugin`], for ordering against them.
+#[derive(SystemSet, Clone, Debug, PartialEq, Eq, Hash)]
+pub enum HadouSystems {
+    /// Spawning loaded scenes and setting their entities from the tracks (`Update`).
+    Scenes,
+    /// Checking changed waves (`PostUpdate`).
+    CheckWaves,
+}
+
+impl Plugin for HadouPlugin {
+    fn build(&self, app: &mut App) {
+        if app.is_plugin_added::<AssetPlugin>() {
+            app.init_asset::<HadouScene>()
+                .register_asset_loader(HadouSceneLoader { root: self.asset_root.clone() });
+            if app.world().contains_resource::<Assets<Mesh>>()
+                && app.world().contains_resource::<Assets<StandardMaterial>>()
+            {
+                app.add_systems(
+                    Update,
+                    (spawn::spawn_scenes, spawn::animate_scenes).chain().in_set(HadouSystems::Scenes),
+                );
+            }
+        }
+        app.add_systems(PostUpdate, wave::check_changed_waves.in_set(HadouSystems::CheckWaves))
+            .add_systems(PostUpdate, camera::bind_depth);
+        if app.get_sub_app(RenderApp).is_none() {
+            return;
+        }
+        app.add_plugins(ExtractComponentPlugin::<HadouCamera>::default());
+        let render_app = app.sub_app_mut(RenderApp);
+        render_app
+            .init_resource::<render::ExtractedWaves>()
+            .init_resource::<render::Warned>()
+            .add_systems(RenderStartup, render::init_renderer)
+            .add_systems(ExtractSchedule, render::extract_waves)
+            .add_systems(
+                Core3d,
+                render::wave_pass.after(Core3dSystems::MainPass).before(Core3dSystems::EarlyPostProcess),
+            );
+    }
+}

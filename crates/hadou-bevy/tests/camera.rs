@@ -1,0 +1,40 @@
+//! `frame_camera`: the hadou camera rebuilt from a Bevy view's matrices sees what the view sees.
+
+use bevy::camera::CameraProjection;
+use bevy::prelude::*;
+use hadou_bevy::frame_camera;
+
+#[test]
+fn a_perspective_view_becomes_the_same_hadou_camera() {
+    let projection =
+        PerspectiveProjection { fov: 50f32.to_radians(), near: 0.1, aspect_ratio: 16.0 / 9.0, ..default() };
+    let clip_from_view = projection.get_clip_from_view();
+    let eye = Vec3::new(0.0, 3.0, 16.0);
+    let target = Vec3::new(1.0, 0.5, 0.0);
+    let world_from_view = Transform::from_translation(eye).looking_at(target, Vec3::Y).to_matrix();
+    let camera = frame_camera(&world_from_view, &clip_from_view, 200.0).expect("a perspective view");
+    assert!((camera.fov_y_deg - 50.0).abs() < 1e-3, "fov {}", camera.fov_y_deg);
+    assert!((camera.near - 0.1).abs() < 1e-7, "near {}", camera.near);
+    assert_eq!(camera.far, 200.0);
+    let basis = camera.basis(640, 360);
+    let forward = (target - eye).normalize();
+    let f = basis.forward;
+    assert!((Vec3::new(f.x, f.y, f.z) - forward).length() < 1e-5);
+    assert!((basis.eye.x - eye.x).abs() < 1e-5 && (basis.eye.z - eye.z).abs() < 1e-5);
+
+    // The top-left pixel's ray projects to Bevy's top-left NDC corner.
+    let dir = basis.pixel_dir(0.0, 0.0, 640, 360);
+    let p = Vec3::new(eye.x + dir.x, eye.y + dir.y, eye.z + dir.z);
+    let clip = clip_from_view * world_from_view.inverse() * p.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    assert!((ndc.x - (-1.0 + 1.0 / 640.0)).abs() < 1e-4, "ndc x {}", ndc.x);
+    assert!((ndc.y - (1.0 - 1.0 / 360.0)).abs() < 1e-4, "ndc y {}", ndc.y);
+}
+
+#[test]
+fn an_orthographic_view_has_no_hadou_camera() {
+    let clip_from_view = OrthographicProjection::default_3d().get_clip_from_view();
+    assert!(frame_camera(&Mat4::IDENTITY, &clip_from_view, 100.0).is_none());
+    let clip_from_view = PerspectiveProjection::default().get_clip_from_view();
+    assert!(frame_camera(&Mat4::IDENTITY, &clip_from_view, 1e-4).is_none(), "far before near");
+}
