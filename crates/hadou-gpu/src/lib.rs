@@ -314,6 +314,16 @@ impl GpuBackend {
         self.renderer.wave_variants_built()
     }
 
+    /// Measures [`GpuBackend::encode_wave_overlay`] alone: `frame`'s waves drawn additively into
+    /// an `Rgba16Float` target against a cleared `Depth32Float` buffer of the frame's size (what a
+    /// game engine's HDR view gives it), each iteration encoded, submitted and waited for, after
+    /// one untimed warm-up; wall clock ([`TimingMethod::WallClock`]). The figure an engine's
+    /// own frame timing of the same pass is compared with. Not on the web.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn time_wave_overlay(&mut self, frame: &Frame, iterations: u32) -> Result<FrameTiming, RenderError> {
+        time_frame::time_wave_overlay(&mut self.renderer, frame, iterations)
+    }
+
     /// Measures the GPU time of drawing `frame` (its shadow maps, then every pass of every tile,
     /// no read-back), `iterations` times after one untimed warm-up; see [`FrameTiming`], whose
     /// `passes` split the time by pass when the adapter has timestamp queries. Not on the web.

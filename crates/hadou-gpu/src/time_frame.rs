@@ -132,3 +132,76 @@ pub(crate) fn time_frame(
     }
     Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples))
 }
+
+/// See [`crate::GpuBackend::time_wave_overlay`].
+pub(crate) fn time_wave_overlay(
+    r: &mut Renderer,
+    frame: &Frame,
+    iterations: u32,
+) -> Result<FrameTiming, RenderError> {
+    use crate::overlay::{DepthModel, OverlayBlend, OverlayTarget};
+    if iterations == 0 {
+        return Err(RenderError::Other("time_wave_overlay needs at least one iteration".into()));
+    }
+    crate::prepare::validate_frame(frame)?;
+    let size = wgpu::Extent3d { width: frame.width, height: frame.height, depth_or_array_layers: 1 };
+    let (color, depth) = r.ctx.scoped("creating the overlay's targets", || {
+        let texture = |label, format, usage| {
+            r.ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color =
+            texture("overlay timing colour", OVERLAY_COLOR_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let depth = texture(
+            "overlay timing depth",
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        (color.create_view(&Default::default()), depth.create_view(&Default::default()))
+    })?;
+    // The depth buffer as an engine's would be with nothing drawn: cleared to the far plane.
+    let mut enc = r.ctx.device.create_command_encoder(&Default::default());
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("overlay timing depth clear"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &depth,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    r.ctx.queue.submit([enc.finish()]);
+    let target = OverlayTarget {
+        color: &color,
+        color_format: OVERLAY_COLOR_FORMAT,
+        depth: &depth,
+        depth_model: DepthModel::Standard,
+        blend: OverlayBlend::Add,
+    };
+    let once = |r: &mut Renderer| -> Result<f64, RenderError> {
+        let start = Instant::now();
+        let mut enc = r.ctx.device.create_command_encoder(&Default::default());
+        r.encode_wave_overlay(frame, &mut enc, &target)?;
+        let submission = r.ctx.queue.submit([enc.finish()]);
+        r.ctx.wait(submission)?;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    };
+    // Warm-up: the pipeline and first-use costs stay out of the measurement.
+    once(r)?;
+    let samples = (0..iterations).map(|_| once(r)).collect::<Result<Vec<_>, _>>()?;
+    Ok(FrameTiming::from_samples(TimingMethod::WallClock, 1, samples))
+}
+
+/// The colour format [`time_wave_overlay`] draws into: an engine's HDR target.
+const OVERLAY_COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

@@ -75,3 +75,21 @@ fn time_frame_times_an_area_light_frame_by_the_wall_clock() {
     assert_eq!(t.per_iteration_ms.len(), 2);
     assert!(t.per_iteration_ms.iter().all(|&ms| ms > 0.0 && ms.is_finite()), "{t:?}");
 }
+
+/// `time_wave_overlay` times the overlay pass alone (wall clock): one sample per iteration, each
+/// finite and positive; zero iterations and an invalid frame are errors, not panics.
+#[test]
+fn time_wave_overlay_reports_positive_times_and_refuses_nonsense() {
+    let Some(mut gpu) = gpu_or_skip("time_wave_overlay") else { return };
+    let frame = kamehameha_frame(160, 120);
+    let t = gpu.time_wave_overlay(&frame, 3).expect("timing");
+    assert_eq!(t.method, TimingMethod::WallClock);
+    assert_eq!(t.per_iteration_ms.len(), 3);
+    assert!(t.per_iteration_ms.iter().all(|&ms| ms > 0.0 && ms.is_finite()), "{t:?}");
+    assert!(t.min_ms <= t.median_ms && t.passes.is_empty(), "{t:?}");
+    eprintln!("{}: overlay median {:.3} ms", gpu.adapter_name(), t.median_ms);
+    assert!(gpu.time_wave_overlay(&frame, 0).is_err());
+    let mut bad = frame.clone();
+    bad.width = 0;
+    assert!(gpu.time_wave_overlay(&bad, 1).is_err());
+}
