@@ -4,7 +4,8 @@
 
 mod common;
 
-use common::{at, base64, err, png_header_only};
+use common::gltf::Builder;
+use common::{at, err, png_header_only};
 use hadou_scene::{
     gltf_from_bytes, gltf_from_bytes_with_warnings, Scene, SceneError, MAX_SCENE_TEXELS, MAX_SKINNED_NODES,
     MAX_SKIN_JOINTS,
@@ -41,50 +42,6 @@ fn png_black(w: u32, h: u32) -> Vec<u8> {
         wr.write_image_data(&vec![0u8; w as usize * h as usize]).unwrap();
     }
     out
-}
-
-/// Accumulates one binary buffer, its bufferViews and accessors (a `.gltf` with a data URI).
-#[derive(Default)]
-struct Builder {
-    bin: Vec<u8>,
-    views: Vec<Value>,
-    accessors: Vec<Value>,
-}
-
-impl Builder {
-    fn acc(&mut self, bytes: &[u8], component: u32, count: usize, ty: &str) -> usize {
-        while !self.bin.len().is_multiple_of(4) {
-            self.bin.push(0);
-        }
-        self.views.push(json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()}));
-        self.bin.extend_from_slice(bytes);
-        self.accessors.push(json!({"bufferView": self.views.len() - 1, "componentType": component,
-                                   "count": count, "type": ty}));
-        self.accessors.len() - 1
-    }
-
-    fn f32s(&mut self, values: &[f32], count: usize, ty: &str) -> usize {
-        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        self.acc(&bytes, 5126, count, ty)
-    }
-
-    fn positions(&mut self, p: &[[f32; 3]]) -> usize {
-        let a = self.f32s(p.as_flattened(), p.len(), "VEC3");
-        let lo: Vec<f32> = (0..3).map(|i| p.iter().map(|v| v[i]).fold(f32::INFINITY, f32::min)).collect();
-        let hi: Vec<f32> = (0..3).map(|i| p.iter().map(|v| v[i]).fold(f32::NEG_INFINITY, f32::max)).collect();
-        self.accessors[a]["min"] = json!(lo);
-        self.accessors[a]["max"] = json!(hi);
-        a
-    }
-
-    fn finish(self, mut doc: Value) -> Vec<u8> {
-        let uri = format!("data:application/octet-stream;base64,{}", base64(&self.bin));
-        doc["asset"] = json!({"version": "2.0"});
-        doc["buffers"] = json!([{"byteLength": self.bin.len(), "uri": uri}]);
-        doc["bufferViews"] = Value::Array(self.views);
-        doc["accessors"] = Value::Array(self.accessors);
-        serde_json::to_vec(&doc).unwrap()
-    }
 }
 
 const TRI: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
@@ -161,7 +118,7 @@ fn gltf_textures_count_against_the_scene_texel_budget() {
 fn skinned_file(nodes: usize, joints: usize, skins: usize) -> Vec<u8> {
     let mut b = Builder::default();
     let pos = b.positions(&TRI);
-    let j = b.acc(&[0u8; 12], 5121, 3, "VEC4");
+    let j = b.acc(&[0u8; 12], 5121, 3, "VEC4", false);
     let w = b.f32s(&[1.0, 0.0, 0.0, 0.0].repeat(3), 3, "VEC4");
     let mut node_list: Vec<Value> = Vec::new();
     // Node 0: the root of the joints; nodes 1..=joints: the joints.
@@ -221,7 +178,7 @@ fn overflowing_skin_weights_are_normalised_without_collapsing() {
     // f32, but the vertex must land halfway, not at the origin.
     let mut b = Builder::default();
     let pos = b.positions(&TRI);
-    let j = b.acc(&[0, 1, 0, 0].repeat(3), 5121, 3, "VEC4");
+    let j = b.acc(&[0, 1, 0, 0].repeat(3), 5121, 3, "VEC4", false);
     let w = b.f32s(&[3e38, 3e38, 0.0, 0.0].repeat(3), 3, "VEC4");
     let doc = json!({
         "scenes": [{"nodes": [0, 1, 2]}],

@@ -1,6 +1,8 @@
 //! Helpers shared by the scene crate's tests: errors and their places, base64, PNG chunks.
 #![allow(dead_code)]
 
+pub mod gltf;
+
 use hadou_scene::{Scene, SceneError};
 use std::path::Path;
 
