@@ -1,7 +1,8 @@
 //! The same picture as `hadou render`: `scenes/kamehameha.toml` at t = 1.5, spawned by
 //! `HadouSceneRoot` (hadou's colour mapping, `HadouMaterial` objects, no bloom, no MSAA) and drawn
 //! by Bevy into an image of the scene's size, against hadou-cpu's render of the same frame
-//! (what `hadou render` writes on a machine without a GPU). Skips with a message when there is no
+//! (what `hadou render` writes on a machine without a GPU); then the same with the camera switched
+//! to hadou's faithful mapping, against the faithful render. Skips with a message when there is no
 //! usable adapter; fails instead under `HADOU_REQUIRE_GPU=1`.
 
 use bevy::camera::RenderTarget;
@@ -18,7 +19,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 /// The largest mean absolute difference of the 8-bit RGB values accepted. Measured on Mesa's
-/// lavapipe: 0.05 (the ground, the objects and the sky shaded and mapped by the same formulas on
+/// lavapipe: 0.05 with either mapping (the ground, the objects and the sky shaded and mapped by the same formulas on
 /// both sides, the rest is rounding and rasterization at triangle edges).
 const MAX_MEAN: f64 = 2.0;
 
@@ -39,19 +40,33 @@ fn adapter_or_skip(test: &str) -> bool {
     }
 }
 
-/// The image every spawned scene camera renders into.
+/// The image every spawned scene camera renders into, and the mapping it is given instead of the
+/// scene's, if any.
 #[derive(Resource)]
-struct Target(Handle<Image>);
+struct Target(Handle<Image>, Option<ViewMapping>);
 
-fn into_image(mut commands: Commands, cameras: Query<Entity, Added<HadouCamera>>, target: Res<Target>) {
-    for camera in &cameras {
+fn into_image(
+    mut commands: Commands,
+    mut cameras: Query<(Entity, &mut HadouCamera), Added<HadouCamera>>,
+    target: Res<Target>,
+) {
+    for (camera, mut settings) in &mut cameras {
         commands.entity(camera).insert(RenderTarget::Image(target.0.clone().into()));
+        if let Some(mapping) = target.1 {
+            settings.mapping = mapping;
+        }
     }
 }
 
-/// The scene `file` at `time` drawn by Bevy into a `width × height` image: its sRGB bytes,
-/// 4 per pixel, and the spawned camera's mapping.
-fn bevy_picture(file: &str, time: f32, width: u32, height: u32) -> (Vec<u8>, ViewMapping) {
+/// The scene `file` at `time` drawn by Bevy into a `width × height` image (with `mapping`
+/// instead of the scene's colour mapping, if given): its sRGB bytes, 4 per pixel, and the spawned
+/// camera's mapping.
+fn bevy_picture(
+    file: &str,
+    time: f32,
+    (width, height): (u32, u32),
+    mapping: Option<ViewMapping>,
+) -> (Vec<u8>, ViewMapping) {
     let root = scenes().canonicalize().expect("the scenes folder");
     let mut app = App::new();
     app.add_plugins(
@@ -65,7 +80,7 @@ fn bevy_picture(file: &str, time: f32, width: u32, height: u32) -> (Vec<u8>, Vie
     .add_plugins(HadouPlugin { asset_root: root.clone() });
     let image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
     let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
-    app.insert_resource(Target(image.clone())).add_systems(Update, into_image);
+    app.insert_resource(Target(image.clone(), mapping)).add_systems(Update, into_image);
     let scene = app.world().resource::<AssetServer>().load(file.to_string());
     let root = app.world_mut().spawn(HadouSceneRoot { scene, clock: SceneClock::Frozen(time) }).id();
     app.finish();
@@ -124,7 +139,7 @@ fn kamehameha_in_bevy_is_the_picture_of_hadou_render() {
     let frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
     assert_eq!(frame.color_mapping.mode, hadou_scene::ToneMode::Filmic);
     let reference = hadou_cpu::render(&frame);
-    let (bevy, mapping) = bevy_picture("kamehameha.toml", 1.5, frame.width, frame.height);
+    let (bevy, mapping) = bevy_picture("kamehameha.toml", 1.5, (frame.width, frame.height), None);
     assert_eq!(
         mapping,
         ViewMapping::Hadou(hadou_scene::ToneMode::Filmic),
@@ -136,4 +151,26 @@ fn kamehameha_in_bevy_is_the_picture_of_hadou_render() {
     // Not a picture that matches anything: the beam is there, bright, on both sides.
     let brightest = bevy.chunks_exact(4).map(|p| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])).max();
     assert!(brightest.unwrap() > 600, "the beam's white core is drawn");
+}
+
+#[test]
+fn kamehameha_with_the_faithful_mapping_is_the_picture_of_hadou_render() {
+    let test = "kamehameha_with_the_faithful_mapping_is_the_picture_of_hadou_render";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let mut frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    frame.color_mapping.mode = hadou_scene::ToneMode::Faithful;
+    let reference = hadou_cpu::render(&frame);
+    let faithful = ViewMapping::Hadou(hadou_scene::ToneMode::Faithful);
+    let (bevy, mapping) = bevy_picture("kamehameha.toml", 1.5, (frame.width, frame.height), Some(faithful));
+    assert_eq!(mapping, faithful);
+    let (mean, max) = difference(&bevy, &reference);
+    eprintln!("kamehameha.toml at t = 1.5, faithful: mean {mean:.3}, largest {max}");
+    assert!(mean <= MAX_MEAN, "mean absolute 8-bit difference {mean:.3} > {MAX_MEAN} (largest {max})");
+    // And not the filmic picture: the mapping did change.
+    frame.color_mapping.mode = hadou_scene::ToneMode::Filmic;
+    let (filmic_mean, _) = difference(&bevy, &hadou_cpu::render(&frame));
+    assert!(filmic_mean > 2.0 * MAX_MEAN, "the faithful picture is the filmic one ({filmic_mean:.3})");
+    eprintln!("against the filmic picture: mean {filmic_mean:.3}");
 }
