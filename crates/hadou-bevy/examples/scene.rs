@@ -5,7 +5,9 @@
 //!     [--tonemapping none|tony-mc-mapface|agx|aces] [--bloom] [--compare REF.png [--max-diff D]]
 //! ```
 //! `--time T` freezes the clock at `T` seconds; `--screenshot OUT.png` saves one frame (once the
-//! scene has loaded and been drawn) and exits. The window has the scene's `[image]` size.
+//! scene has loaded and been drawn) and exits. The window has the scene's `[image]` size. The
+//! scene's own colour mapping (`[color] mode`) maps the picture unless `--tonemapping` picks one of
+//! Bevy's (`none` is Bevy's clamp).
 //! `--compare REF.png` (with `--screenshot`) prints the mean absolute 8-bit difference of the
 //! screenshot's RGB against a PNG of the same size (e.g. `hadou render`'s), and `--max-diff D`
 //! makes a larger one exit with code 1.
@@ -18,7 +20,7 @@ use bevy::prelude::*;
 use bevy::render::view::screenshot::{save_to_disk, Screenshot, ScreenshotCaptured};
 use bevy::render::RenderPlugin;
 use bevy::window::WindowResolution;
-use hadou_bevy::{HadouCamera, HadouPlugin, HadouSceneRoot, SceneClock, SpawnedScene};
+use hadou_bevy::{HadouCamera, HadouPlugin, HadouSceneRoot, SceneClock, SpawnedScene, ViewMapping};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -28,7 +30,8 @@ struct Options {
     scene: PathBuf,
     time: Option<f32>,
     screenshot: Option<PathBuf>,
-    tonemapping: Tonemapping,
+    /// Bevy's tone mapping instead of the scene's colour mapping.
+    tonemapping: Option<Tonemapping>,
     bloom: bool,
     compare: Option<PathBuf>,
     max_diff: Option<f64>,
@@ -43,7 +46,7 @@ fn parse_args() -> Result<Options, String> {
         scene: PathBuf::new(),
         time: None,
         screenshot: None,
-        tonemapping: Tonemapping::TonyMcMapface,
+        tonemapping: None,
         bloom: false,
         compare: None,
         max_diff: None,
@@ -62,13 +65,13 @@ fn parse_args() -> Result<Options, String> {
             }
             "--screenshot" => options.screenshot = Some(PathBuf::from(value("--screenshot")?)),
             "--tonemapping" => {
-                options.tonemapping = match value("--tonemapping")?.as_str() {
+                options.tonemapping = Some(match value("--tonemapping")?.as_str() {
                     "none" => Tonemapping::None,
                     "tony-mc-mapface" => Tonemapping::TonyMcMapface,
                     "agx" => Tonemapping::AgX,
                     "aces" => Tonemapping::AcesFitted,
                     other => return Err(format!("--tonemapping: unknown `{other}`")),
-                }
+                })
             }
             "--bloom" => options.bloom = true,
             "--compare" => options.compare = Some(PathBuf::from(value("--compare")?)),
@@ -137,10 +140,17 @@ fn spawn(mut commands: Commands, assets: Res<AssetServer>, options: Res<Options>
 }
 
 /// The command line's tone mapping and bloom on the scene's camera.
-fn style_camera(mut commands: Commands, cameras: Query<Entity, Added<HadouCamera>>, options: Res<Options>) {
-    for camera in &cameras {
+fn style_camera(
+    mut commands: Commands,
+    mut cameras: Query<(Entity, &mut HadouCamera), Added<HadouCamera>>,
+    options: Res<Options>,
+) {
+    for (camera, mut settings) in &mut cameras {
         let mut camera = commands.entity(camera);
-        camera.insert(options.tonemapping);
+        if let Some(tonemapping) = options.tonemapping {
+            settings.mapping = ViewMapping::Bevy;
+            camera.insert(tonemapping);
+        }
         if options.bloom {
             camera.insert(Bloom::NATURAL);
         }

@@ -7,6 +7,20 @@ use bevy::render::extract_component::ExtractComponent;
 use bevy::render::render_resource::TextureUsages;
 use hadou_math::Vec3f;
 
+/// How a [`HadouCamera`]'s view turns its HDR image into the colours it shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ViewMapping {
+    /// Bevy's own tone mapping: the camera's `Tonemapping` component, untouched.
+    #[default]
+    Bevy,
+    /// hadou's colour mapping of this mode (a scene's `[color] mode`): `map_faithful`, the
+    /// thesis's clamp (002 §3.3), or `map_filmic`, hadou's white-core filmic curve
+    /// (`hadou_math::shade`), run by hadou-gpu's WGSL on the HDR image after bloom, in place of
+    /// Bevy's tone mapping (the plugin sets the camera's `Tonemapping` to `None`; set it back
+    /// yourself when switching to [`ViewMapping::Bevy`]).
+    Hadou(hadou_scene::ToneMode),
+}
+
 /// Put on a `Camera3d` (with `Hdr`, and `Msaa::Off` for now) to draw the [`crate::HadouWave`]s
 /// into its view: after Bevy's main passes, before bloom and tone mapping.
 #[derive(Component, Clone, Copy, Debug, PartialEq, ExtractComponent)]
@@ -17,11 +31,14 @@ pub struct HadouCamera {
     /// The far plane of the waves' rays (`[camera] far`): the length scale of the thesis falloff
     /// and of a curve's attenuation (002 eq. 3.12, 3.23). Bevy's own depth has no far plane.
     pub far: f32,
+    /// Bevy's tone mapping (the default) or hadou's colour mapping (what a spawned scene uses:
+    /// its `[color] mode`).
+    pub mapping: ViewMapping,
 }
 
 impl Default for HadouCamera {
     fn default() -> Self {
-        HadouCamera { exposure: 1.0, far: 1000.0 }
+        HadouCamera { exposure: 1.0, far: 1000.0, mapping: ViewMapping::Bevy }
     }
 }
 

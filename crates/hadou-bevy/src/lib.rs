@@ -4,8 +4,12 @@
 //! hadou-gpu's own wave pass on Bevy's `RenderDevice` (`GpuBackend::encode_wave_overlay`): per
 //! pixel the waves' light along the view ray, clipped at the camera's depth buffer (002 §3.3.5),
 //! added into the view's HDR target after Bevy's main passes and before bloom and tone mapping.
-//! A hadou scene file (`.toml`) is a Bevy asset ([`HadouScene`]); a [`HadouSceneRoot`] spawns it
-//! (camera, light, objects, waves) and plays its tracks.
+//! A camera's [`HadouCamera::mapping`] picks Bevy's tone mapping or hadou's own colour mapping
+//! ([`ViewMapping::Hadou`]: hadou-gpu's `map_faithful` / `map_filmic` on the HDR image, after
+//! bloom, in place of Bevy's tone mapping). [`HadouMaterial`] shades a mesh with hadou's Lambert
+//! model under a hadou light. A hadou scene file (`.toml`) is a Bevy asset ([`HadouScene`]); a
+//! [`HadouSceneRoot`] spawns it (camera with the scene's colour mapping, light, objects with
+//! [`HadouMaterial`]s, waves) and plays its tracks.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -24,19 +28,22 @@
 
 mod asset;
 mod camera;
+mod material;
 mod render;
 mod spawn;
+mod tone;
 mod wave;
 
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
-pub use camera::{frame_camera, HadouCamera};
-pub use spawn::{
-    bevy_material, bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene,
-};
+pub use camera::{frame_camera, HadouCamera, ViewMapping};
+pub use material::{HadouMaterial, HadouSurface};
+pub use spawn::{bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene};
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 
 use bevy::asset::io::file::FileAssetReader;
+use bevy::core_pipeline::fullscreen_material::FullscreenMaterialPlugin;
 use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
+use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::{ExtractSchedule, RenderApp, RenderStartup};
@@ -68,12 +75,16 @@ pub enum HadouSystems {
 
 impl Plugin for HadouPlugin {
     fn build(&self, app: &mut App) {
+        let renders = app.get_sub_app(RenderApp).is_some();
         if app.is_plugin_added::<AssetPlugin>() {
             app.init_asset::<HadouScene>()
                 .register_asset_loader(HadouSceneLoader { root: self.asset_root.clone() });
-            if app.world().contains_resource::<Assets<Mesh>>()
-                && app.world().contains_resource::<Assets<StandardMaterial>>()
-            {
+            if renders {
+                app.add_plugins(MaterialPlugin::<HadouMaterial>::default());
+            } else {
+                app.init_asset::<HadouMaterial>();
+            }
+            if app.world().contains_resource::<Assets<Mesh>>() {
                 app.add_systems(
                     Update,
                     (spawn::spawn_scenes, spawn::animate_scenes).chain().in_set(HadouSystems::Scenes),
@@ -81,11 +92,26 @@ impl Plugin for HadouPlugin {
             }
         }
         app.add_systems(PostUpdate, wave::check_changed_waves.in_set(HadouSystems::CheckWaves))
-            .add_systems(PostUpdate, camera::bind_depth);
-        if app.get_sub_app(RenderApp).is_none() {
+            .add_systems(PostUpdate, (camera::bind_depth, tone::apply_mapping))
+            .add_observer(tone::remove_mapping);
+        if !renders {
             return;
         }
-        app.add_plugins(ExtractComponentPlugin::<HadouCamera>::default());
+        if let Some(mut shaders) = app.world_mut().get_resource_mut::<Assets<Shader>>() {
+            shaders
+                .insert(&tone::SHADER, Shader::from_wgsl(tone::shader_source(), "hadou_bevy/tone_map.wgsl"))
+                .expect("a shader under a fixed handle can be inserted");
+            shaders
+                .insert(
+                    &material::SHADER,
+                    Shader::from_wgsl(material::shader_source(), "hadou_bevy/material.wgsl"),
+                )
+                .expect("a shader under a fixed handle can be inserted");
+        }
+        app.add_plugins((
+            ExtractComponentPlugin::<HadouCamera>::default(),
+            FullscreenMaterialPlugin::<tone::ToneMapPass>::default(),
+        ));
         let render_app = app.sub_app_mut(RenderApp);
         render_app
             .init_resource::<render::ExtractedWaves>()

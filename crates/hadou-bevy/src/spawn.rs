@@ -3,7 +3,8 @@
 //! tracks at the root's clock set the waves, the object transforms and the camera.
 
 use crate::asset::HadouScene;
-use crate::camera::HadouCamera;
+use crate::camera::{HadouCamera, ViewMapping};
+use crate::material::HadouMaterial;
 use crate::wave::HadouWave;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
@@ -53,10 +54,11 @@ fn vec3(v: hadou_math::Vec3f) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)
 }
 
-/// Bevy's directional light "illuminance" giving hadou's Lambert term `light · max(0, N·(−L))`
-/// (`hadou_math::shade::diffuse`) on a rough, non-metallic `StandardMaterial` under a camera of
-/// `Exposure { ev100: 0.0 }`: Bevy's diffuse lobe is about `1/π` and that exposure scales by
-/// `1/1.2`.
+/// Bevy's directional light "illuminance" giving about hadou's Lambert term
+/// `light · max(0, N·(−L))` (`hadou_math::shade::diffuse`) on a rough, non-metallic
+/// `StandardMaterial` under a camera of `Exposure { ev100: 0.0 }` (Bevy's diffuse lobe is about
+/// `1/π` and that exposure scales by `1/1.2`), for a game's own meshes added to a spawned scene;
+/// the scene's objects are shaded by [`HadouMaterial`] with the scene's light itself.
 const ILLUMINANCE: f32 = std::f32::consts::PI * 1.2;
 /// Bevy's ambient brightness giving hadou's `albedo · ambient` under that exposure.
 const AMBIENT_BRIGHTNESS: f32 = 1.2;
@@ -75,19 +77,6 @@ pub fn bevy_mesh(mesh: &hadou_scene::Mesh) -> Mesh {
     }
     out.insert_indices(Indices::U32(mesh.indices.clone()));
     out
-}
-
-/// A `StandardMaterial` of a hadou material's base colour: unlit for hadou's unlit model, else
-/// rough and without specular reflection (hadou's diffuse light has none).
-pub fn bevy_material(material: &hadou_scene::Material) -> StandardMaterial {
-    StandardMaterial {
-        base_color: linear(material.base_color),
-        perceptual_roughness: 1.0,
-        reflectance: 0.0,
-        metallic: 0.0,
-        unlit: material.model == ShadingModel::Unlit,
-        ..default()
-    }
 }
 
 fn camera_transform(frame: &Frame) -> Transform {
@@ -125,9 +114,6 @@ pub fn unsupported(frame: &Frame) -> Vec<String> {
     if frame.area_light.is_some() {
         out.push("the [area_light] (soft shadows)".into());
     }
-    if frame.color_mapping.mode == hadou_scene::ToneMode::Filmic {
-        out.push("[color] mode = \"filmic\" (Bevy's tone mapping runs instead)".into());
-    }
     for object in &frame.objects {
         let mut what = Vec::new();
         let materials = &object.materials;
@@ -135,7 +121,7 @@ pub fn unsupported(frame: &Frame) -> Vec<String> {
             what.push(format!("{} material slots (the first is used)", materials.len()));
         }
         if materials.iter().any(|m| m.model == ShadingModel::Toon) {
-            what.push("toon ramps".into());
+            what.push("toon ramps (shaded as diffuse)".into());
         }
         if materials.iter().any(|m| m.wave_blend > 0.0) {
             what.push("wave_blend (the wave as a light)".into());
@@ -167,7 +153,7 @@ pub(crate) fn spawn_scenes(
     roots: Query<(Entity, &HadouSceneRoot), Without<SpawnedScene>>,
     scenes: Res<Assets<HadouScene>>,
     mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut materials: ResMut<Assets<HadouMaterial>>,
 ) {
     for (root, spawn) in &roots {
         let Some(HadouScene(scene)) = scenes.get(&spawn.scene) else { continue };
@@ -195,7 +181,12 @@ pub(crate) fn spawn_scenes(
                 },
                 camera_transform(&frame),
                 camera_projection(&frame),
-                HadouCamera { exposure: frame.color_mapping.exposure, far: frame.camera.far },
+                bevy::core_pipeline::tonemapping::Tonemapping::None,
+                HadouCamera {
+                    exposure: frame.color_mapping.exposure,
+                    far: frame.camera.far,
+                    mapping: ViewMapping::Hadou(frame.color_mapping.mode),
+                },
                 ChildOf(root),
             ))
             .id();
@@ -215,7 +206,7 @@ pub(crate) fn spawn_scenes(
                     .spawn((
                         Name::new(object.name.clone()),
                         Mesh3d(meshes.add(bevy_mesh(&object.mesh))),
-                        MeshMaterial3d(materials.add(bevy_material(object.material(0)))),
+                        MeshMaterial3d(materials.add(HadouMaterial::new(object.material(0), &frame.light))),
                         object_transform(object),
                         ChildOf(root),
                     ))

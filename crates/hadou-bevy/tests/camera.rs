@@ -1,8 +1,11 @@
 //! `frame_camera`: the hadou camera rebuilt from a Bevy view's matrices sees what the view sees.
+//! `HadouCamera::mapping`: hadou's colour mapping turns Bevy's tone mapping off on its camera.
 
 use bevy::camera::CameraProjection;
+use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use hadou_bevy::frame_camera;
+use hadou_bevy::{frame_camera, HadouCamera, HadouPlugin, ViewMapping};
+use hadou_scene::ToneMode;
 
 #[test]
 fn a_perspective_view_becomes_the_same_hadou_camera() {
@@ -37,4 +40,21 @@ fn an_orthographic_view_has_no_hadou_camera() {
     assert!(frame_camera(&Mat4::IDENTITY, &clip_from_view, 100.0).is_none());
     let clip_from_view = PerspectiveProjection::default().get_clip_from_view();
     assert!(frame_camera(&Mat4::IDENTITY, &clip_from_view, 1e-4).is_none(), "far before near");
+}
+
+#[test]
+fn hadou_mapping_replaces_bevy_tonemapping_and_bevy_mapping_keeps_it() {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, HadouPlugin::default()));
+    let hadou = HadouCamera { mapping: ViewMapping::Hadou(ToneMode::Filmic), ..default() };
+    let mapped = app.world_mut().spawn((hadou, Tonemapping::TonyMcMapface)).id();
+    let bevy = app.world_mut().spawn((HadouCamera::default(), Tonemapping::AgX)).id();
+    app.update();
+    assert_eq!(app.world().get::<Tonemapping>(mapped), Some(&Tonemapping::None));
+    assert_eq!(app.world().get::<Tonemapping>(bevy), Some(&Tonemapping::AgX), "Bevy's mapping is left alone");
+
+    // Switching the second camera to hadou's faithful mapping turns its tone mapping off too.
+    app.world_mut().get_mut::<HadouCamera>(bevy).unwrap().mapping = ViewMapping::Hadou(ToneMode::Faithful);
+    app.update();
+    assert_eq!(app.world().get::<Tonemapping>(bevy), Some(&Tonemapping::None));
 }

@@ -5,8 +5,8 @@
 use bevy::asset::LoadState;
 use bevy::prelude::*;
 use hadou_bevy::{
-    parse_scene, unsupported, HadouCamera, HadouPlugin, HadouScene, HadouSceneRoot, HadouWave, SceneClock,
-    SpawnedScene,
+    parse_scene, unsupported, HadouCamera, HadouMaterial, HadouPlugin, HadouScene, HadouSceneRoot, HadouWave,
+    SceneClock, SpawnedScene, ViewMapping,
 };
 use hadou_math::energy::BeamField;
 use hadou_scene::WaveShape;
@@ -36,7 +36,6 @@ fn app(root: &Path) -> App {
         AssetPlugin { file_path: root.display().to_string(), ..default() },
         bevy::mesh::MeshPlugin,
     ));
-    app.init_asset::<StandardMaterial>();
     app.add_plugins(HadouPlugin { asset_root: root.to_path_buf() });
     app
 }
@@ -98,7 +97,16 @@ fn a_loaded_scene_spawns_its_entities_at_the_frozen_time() {
     assert_eq!(spawned.waves.len(), reference.waves.len());
     let camera = app.world().get::<HadouCamera>(spawned.camera).expect("the camera gets the wave pass");
     assert_eq!(camera.far, reference.camera.far);
+    assert_eq!(camera.mapping, ViewMapping::Hadou(reference.color_mapping.mode), "the scene's [color] mode");
     assert!(app.world().get::<Mesh3d>(spawned.objects[0]).is_some());
+    let material =
+        app.world().get::<MeshMaterial3d<HadouMaterial>>(spawned.objects[0]).expect("hadou's shading");
+    let surface = app.world().resource::<Assets<HadouMaterial>>().get(&material.0).unwrap().surface;
+    let ground = reference.objects[0].material(0).base_color;
+    assert_eq!(surface.base_color.truncate().to_array(), ground);
+    let d = reference.light.direction;
+    assert_eq!(surface.light_direction.truncate().to_array(), [d.x, d.y, d.z], "the scene's light");
+    assert_eq!(surface.ambient.truncate().to_array(), reference.light.ambient);
 
     let length = |shape: &WaveShape| match shape {
         WaveShape::Beam(BeamField { capsule, .. }) => capsule.length,
@@ -116,7 +124,9 @@ fn what_is_not_drawn_yet_is_named() {
     let frame = hadou_scene::Scene::load(scenes.join("shadow-wave-top.toml")).unwrap().at(1.0);
     let missing = unsupported(&frame).join("; ");
     assert!(missing.contains("[[shadow]]"), "{missing}");
-    let mut frame = hadou_scene::Scene::load(scenes.join("kamehameha.toml")).unwrap().at(1.5);
-    frame.color_mapping.mode = hadou_scene::ToneMode::Faithful;
-    assert_eq!(unsupported(&frame), Vec::<String>::new(), "a faithful kamehameha uses nothing unsupported");
+    let frame = hadou_scene::Scene::load(scenes.join("light-normal-vs-wave.toml")).unwrap().at(0.75);
+    let missing = unsupported(&frame).join("; ");
+    assert!(missing.contains("toon ramps") && missing.contains("wave_blend"), "{missing}");
+    let frame = hadou_scene::Scene::load(scenes.join("kamehameha.toml")).unwrap().at(1.5);
+    assert_eq!(unsupported(&frame), Vec::<String>::new(), "kamehameha (filmic) uses nothing unsupported");
 }

@@ -1,0 +1,176 @@
+//! The same picture as `hadou render`: `scenes/kamehameha.toml` at t = 1.5, spawned by
+//! `HadouSceneRoot` (hadou's colour mapping, `HadouMaterial` objects, no bloom, no MSAA) and drawn
+//! by Bevy into an image of the scene's size, against hadou-cpu's render of the same frame
+//! (what `hadou render` writes on a machine without a GPU); then the same with the camera switched
+//! to hadou's faithful mapping, against the faithful render. Skips with a message when there is no
+//! usable adapter; fails instead under `HADOU_REQUIRE_GPU=1`.
+
+use bevy::camera::RenderTarget;
+use bevy::image::Image;
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::render::RenderPlugin;
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use hadou_bevy::{HadouCamera, HadouPlugin, HadouSceneRoot, SceneClock, SpawnedScene, ViewMapping};
+use hadou_math::shade::linear_to_srgb8;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// The largest mean absolute difference of the 8-bit RGB values accepted. Measured on Mesa's
+/// lavapipe: 0.05 with either mapping (the ground, the objects and the sky shaded and mapped by the same formulas on
+/// both sides, the rest is rounding and rasterization at triangle edges).
+const MAX_MEAN: f64 = 2.0;
+
+fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+fn adapter_or_skip(test: &str) -> bool {
+    match hadou_gpu::request_adapter() {
+        Ok(_) => true,
+        Err(e) if std::env::var("HADOU_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
+            panic!("{test}: HADOU_REQUIRE_GPU=1 but no usable GPU adapter ({e})")
+        }
+        Err(e) => {
+            eprintln!("SKIPPED {test}: {e}; set HADOU_REQUIRE_GPU=1 to make this a failure");
+            false
+        }
+    }
+}
+
+/// The image every spawned scene camera renders into, and the mapping it is given instead of the
+/// scene's, if any.
+#[derive(Resource)]
+struct Target(Handle<Image>, Option<ViewMapping>);
+
+fn into_image(
+    mut commands: Commands,
+    mut cameras: Query<(Entity, &mut HadouCamera), Added<HadouCamera>>,
+    target: Res<Target>,
+) {
+    for (camera, mut settings) in &mut cameras {
+        commands.entity(camera).insert(RenderTarget::Image(target.0.clone().into()));
+        if let Some(mapping) = target.1 {
+            settings.mapping = mapping;
+        }
+    }
+}
+
+/// The scene `file` at `time` drawn by Bevy into a `width × height` image (with `mapping`
+/// instead of the scene's colour mapping, if given): its sRGB bytes, 4 per pixel, and the spawned
+/// camera's mapping.
+fn bevy_picture(
+    file: &str,
+    time: f32,
+    (width, height): (u32, u32),
+    mapping: Option<ViewMapping>,
+) -> (Vec<u8>, ViewMapping) {
+    let root = scenes().canonicalize().expect("the scenes folder");
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .build()
+            .disable::<WinitPlugin>()
+            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
+            .set(AssetPlugin { file_path: root.display().to_string(), ..default() })
+            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() }),
+    )
+    .add_plugins(HadouPlugin { asset_root: root.clone() });
+    let image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+    let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
+    app.insert_resource(Target(image.clone(), mapping)).add_systems(Update, into_image);
+    let scene = app.world().resource::<AssetServer>().load(file.to_string());
+    let root = app.world_mut().spawn(HadouSceneRoot { scene, clock: SceneClock::Frozen(time) }).id();
+    app.finish();
+    app.cleanup();
+
+    let shot: Arc<Mutex<Option<Image>>> = Arc::default();
+    let mut drawn = 0;
+    for _ in 0..2000 {
+        app.update();
+        if app.world().get::<SpawnedScene>(root).is_some() {
+            drawn += 1;
+        }
+        // A few frames after spawning, once the meshes and pipelines are ready.
+        if drawn == 5 {
+            let shot = shot.clone();
+            app.world_mut().spawn(Screenshot::image(image.clone())).observe(
+                move |captured: On<ScreenshotCaptured>| {
+                    *shot.lock().unwrap() = Some(captured.image.clone());
+                },
+            );
+        }
+        if shot.lock().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let image = shot.lock().unwrap().take().expect("the screenshot came back");
+    assert_eq!((image.width(), image.height()), (width, height));
+    assert_eq!(image.texture_descriptor.format, TextureFormat::Rgba8UnormSrgb);
+    let camera = app.world().get::<SpawnedScene>(root).unwrap().camera;
+    let mapping = app.world().get::<HadouCamera>(camera).unwrap().mapping;
+    (image.data.expect("a captured image has its bytes"), mapping)
+}
+
+/// The mean and the largest absolute difference of the RGB bytes of `bevy` (4 per pixel) and
+/// hadou-cpu's `image` encoded as `hadou render` encodes it.
+fn difference(bevy: &[u8], image: &hadou_scene::Image) -> (f64, u8) {
+    assert_eq!(bevy.len(), image.color.len() * 4);
+    let (mut sum, mut max) = (0u64, 0u8);
+    for (b, c) in bevy.chunks_exact(4).zip(&image.color) {
+        for channel in 0..3 {
+            let d = b[channel].abs_diff(linear_to_srgb8(c[channel]));
+            sum += u64::from(d);
+            max = max.max(d);
+        }
+    }
+    (sum as f64 / (image.color.len() * 3) as f64, max)
+}
+
+#[test]
+fn kamehameha_in_bevy_is_the_picture_of_hadou_render() {
+    let test = "kamehameha_in_bevy_is_the_picture_of_hadou_render";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    assert_eq!(frame.color_mapping.mode, hadou_scene::ToneMode::Filmic);
+    let reference = hadou_cpu::render(&frame);
+    let (bevy, mapping) = bevy_picture("kamehameha.toml", 1.5, (frame.width, frame.height), None);
+    assert_eq!(
+        mapping,
+        ViewMapping::Hadou(hadou_scene::ToneMode::Filmic),
+        "a spawned scene maps as hadou does"
+    );
+    let (mean, max) = difference(&bevy, &reference);
+    eprintln!("kamehameha.toml at t = 1.5, {}×{}: mean {mean:.3}, largest {max}", frame.width, frame.height);
+    assert!(mean <= MAX_MEAN, "mean absolute 8-bit difference {mean:.3} > {MAX_MEAN} (largest {max})");
+    // Not a picture that matches anything: the beam is there, bright, on both sides.
+    let brightest = bevy.chunks_exact(4).map(|p| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])).max();
+    assert!(brightest.unwrap() > 600, "the beam's white core is drawn");
+}
+
+#[test]
+fn kamehameha_with_the_faithful_mapping_is_the_picture_of_hadou_render() {
+    let test = "kamehameha_with_the_faithful_mapping_is_the_picture_of_hadou_render";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let mut frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    frame.color_mapping.mode = hadou_scene::ToneMode::Faithful;
+    let reference = hadou_cpu::render(&frame);
+    let faithful = ViewMapping::Hadou(hadou_scene::ToneMode::Faithful);
+    let (bevy, mapping) = bevy_picture("kamehameha.toml", 1.5, (frame.width, frame.height), Some(faithful));
+    assert_eq!(mapping, faithful);
+    let (mean, max) = difference(&bevy, &reference);
+    eprintln!("kamehameha.toml at t = 1.5, faithful: mean {mean:.3}, largest {max}");
+    assert!(mean <= MAX_MEAN, "mean absolute 8-bit difference {mean:.3} > {MAX_MEAN} (largest {max})");
+    // And not the filmic picture: the mapping did change.
+    frame.color_mapping.mode = hadou_scene::ToneMode::Filmic;
+    let (filmic_mean, _) = difference(&bevy, &hadou_cpu::render(&frame));
+    assert!(filmic_mean > 2.0 * MAX_MEAN, "the faithful picture is the filmic one ({filmic_mean:.3})");
+    eprintln!("against the filmic picture: mean {filmic_mean:.3}");
+}
