@@ -7,9 +7,9 @@
 //! A camera's [`HadouCamera::mapping`] picks Bevy's tone mapping or hadou's own colour mapping
 //! ([`ViewMapping::Hadou`]: hadou-gpu's `map_faithful` / `map_filmic` on the HDR image, after
 //! bloom, in place of Bevy's tone mapping). [`HadouMaterial`] shades a mesh with hadou's Lambert
-//! model under a hadou light. A hadou scene file (`.toml`) is a Bevy asset ([`HadouScene`]); a
-//! [`HadouSceneRoot`] spawns it (camera with the scene's colour mapping, light, objects with
-//! [`HadouMaterial`]s, waves) and plays its tracks.
+//! or toon model under a hadou light. A hadou scene file (`.toml`) is a Bevy asset
+//! ([`HadouScene`]); a [`HadouSceneRoot`] spawns it (camera with the scene's colour mapping,
+//! light, objects with [`HadouMaterial`]s, waves) and plays its tracks.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -36,7 +36,7 @@ mod wave;
 
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera, ViewMapping};
-pub use material::{HadouMaterial, HadouSurface};
+pub use material::{HadouMaterial, HadouRamp, HadouSurface};
 pub use spawn::{bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene};
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 

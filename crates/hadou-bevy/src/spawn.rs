@@ -9,7 +9,7 @@ use crate::wave::HadouWave;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
-use hadou_scene::{Frame, ShadingModel};
+use hadou_scene::Frame;
 
 /// Spawns the scene `scene` under this entity once it has loaded (nothing, with the loader's
 /// error logged by Bevy's asset server, if it fails to load).
@@ -119,9 +119,6 @@ pub fn unsupported(frame: &Frame) -> Vec<String> {
         let materials = &object.materials;
         if materials.len() > 1 {
             what.push(format!("{} material slots (the first is used)", materials.len()));
-        }
-        if materials.iter().any(|m| m.model == ShadingModel::Toon) {
-            what.push("toon ramps (shaded as diffuse)".into());
         }
         if materials.iter().any(|m| m.wave_blend > 0.0) {
             what.push("wave_blend (the wave as a light)".into());

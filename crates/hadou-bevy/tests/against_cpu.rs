@@ -2,7 +2,8 @@
 //! `HadouSceneRoot` (hadou's colour mapping, `HadouMaterial` objects, no bloom, no MSAA) and drawn
 //! by Bevy into an image of the scene's size, against hadou-cpu's render of the same frame
 //! (what `hadou render` writes on a machine without a GPU); then the same with the camera switched
-//! to hadou's faithful mapping, against the faithful render. Skips with a message when there is no
+//! to hadou's faithful mapping, against the faithful render; and a scene of toon materials (banded
+//! and gradient ramps, no waves) against hadou-cpu's render of it. Skips with a message when there is no
 //! usable adapter; fails instead under `HADOU_REQUIRE_GPU=1`.
 
 use bevy::camera::RenderTarget;
@@ -19,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 /// The largest mean absolute difference of the 8-bit RGB values accepted. Measured on Mesa's
-/// lavapipe: 0.05 with either mapping (the ground, the objects and the sky shaded and mapped by the same formulas on
+/// lavapipe: 0.001 for the toon scene, 0.05 for kamehameha with either mapping (the ground, the objects and the sky shaded and mapped by the same formulas on
 /// both sides, the rest is rounding and rasterization at triangle edges).
 const MAX_MEAN: f64 = 2.0;
 
@@ -64,10 +65,21 @@ fn into_image(
 fn bevy_picture(
     file: &str,
     time: f32,
+    size: (u32, u32),
+    mapping: Option<ViewMapping>,
+) -> (Vec<u8>, ViewMapping) {
+    picture_in(&scenes(), file, time, size, mapping)
+}
+
+/// [`bevy_picture`] of the scene `file` in the folder `root`.
+fn picture_in(
+    root: &Path,
+    file: &str,
+    time: f32,
     (width, height): (u32, u32),
     mapping: Option<ViewMapping>,
 ) -> (Vec<u8>, ViewMapping) {
-    let root = scenes().canonicalize().expect("the scenes folder");
+    let root = root.canonicalize().expect("the scenes folder");
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
@@ -173,4 +185,99 @@ fn kamehameha_with_the_faithful_mapping_is_the_picture_of_hadou_render() {
     let (filmic_mean, _) = difference(&bevy, &hadou_cpu::render(&frame));
     assert!(filmic_mean > 2.0 * MAX_MEAN, "the faithful picture is the filmic one ({filmic_mean:.3})");
     eprintln!("against the filmic picture: mean {filmic_mean:.3}");
+}
+
+/// Toon materials without waves: a sphere with three smoothed bands, a box with two hard bands, a
+/// ground with a gradient ramp, under a slanted light.
+const TOON_SCENE: &str = r#"
+background = [0.5, 0.6, 0.75]
+
+[image]
+width = 320
+height = 240
+
+[camera]
+position = [0.0, 2.2, 5.0]
+target = [0.0, 0.6, 0.0]
+fov = 45.0
+
+[light]
+direction = [0.6, -0.8, -0.45]
+color = [1.0, 0.97, 0.9]
+ambient = [0.3, 0.32, 0.38]
+
+[[material]]
+name = "ground"
+model = "toon"
+base_color = [0.45, 0.62, 0.38]
+ramp = [[-1.0, 0.3, 0.3, 0.4], [-0.2, 0.6, 0.6, 0.7], [0.5, 1.0, 1.0, 1.0]]
+ramp_kind = "gradient"
+
+[[material]]
+name = "ball"
+model = "toon"
+base_color = [0.9, 0.55, 0.3]
+ramp = [[-1.0, 0.35, 0.3, 0.45], [-0.1, 0.7, 0.65, 0.75], [0.45, 1.0, 1.0, 1.0]]
+ramp_smoothing = 0.08
+
+[[material]]
+name = "crate"
+model = "toon"
+base_color = [0.4, 0.5, 0.9]
+ramp = [[-1.0, 0.5, 0.45, 0.55], [0.0, 1.0, 1.0, 1.0]]
+
+[[object]]
+name = "ball"
+kind = "sphere"
+radius = 0.7
+segments = 48
+position = [-0.7, 0.7, 0.0]
+material = "ball"
+
+[[object]]
+name = "crate"
+kind = "box"
+size = [0.8, 0.8, 0.8]
+position = [1.1, 0.4, -0.4]
+rotation = [0.0, 30.0, 0.0]
+material = "crate"
+
+[[object]]
+name = "ground"
+kind = "plane"
+size = [10.0, 8.0]
+material = "ground"
+"#;
+
+#[test]
+fn toon_materials_in_bevy_are_the_picture_of_hadou_render() {
+    let test = "toon_materials_in_bevy_are_the_picture_of_hadou_render";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("hadou-bevy-toon-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("toon.toml"), TOON_SCENE).unwrap();
+    let mut frame = hadou_scene::Scene::load(dir.join("toon.toml")).unwrap().at(0.0);
+    assert!(frame.waves.is_empty() && frame.shadows.is_empty());
+    assert!(frame
+        .objects
+        .iter()
+        .all(|o| o.materials.iter().all(|m| m.model == hadou_scene::ShadingModel::Toon)));
+    let reference = hadou_cpu::render(&frame);
+    let (bevy, _) = picture_in(&dir, "toon.toml", 0.0, (frame.width, frame.height), None);
+    std::fs::remove_dir_all(&dir).ok();
+    let (mean, max) = difference(&bevy, &reference);
+    eprintln!("toon scene, {}×{}: mean {mean:.3}, largest {max}", frame.width, frame.height);
+    assert!(mean <= MAX_MEAN, "mean absolute 8-bit difference {mean:.3} > {MAX_MEAN} (largest {max})");
+    // And not the diffuse picture: the ramps are what shaded it, and the bound above tells them
+    // apart (measured on lavapipe: 0.001 against the toon render, 2.74 against the diffuse one).
+    for object in &mut frame.objects {
+        for material in &mut object.materials {
+            material.model = hadou_scene::ShadingModel::Diffuse;
+        }
+    }
+    let (diffuse_mean, _) = difference(&bevy, &hadou_cpu::render(&frame));
+    eprintln!("against the same scene shaded as diffuse: mean {diffuse_mean:.3}");
+    assert!(diffuse_mean > MAX_MEAN, "the toon picture is the diffuse one ({diffuse_mean:.3})");
 }

@@ -1,7 +1,8 @@
 //! The energy wave as a light on toon-shaded surfaces (000 §2.1–2.2, SPEC.md §2.1–2.2): colour
 //! ramps over the unclamped `m = N·L`, the nearest point of a wave's centre line (the per-point
 //! light position), how several waves share a surface, and bilinear texture sampling. Mirrored in
-//! WGSL by `hadou-gpu` (keep in sync with `crates/hadou-gpu/src/shaders/shading.wgsl`).
+//! WGSL by `hadou-gpu` (keep in sync with `crates/hadou-gpu/src/shaders/shading.wgsl` and, for the
+//! ramps, `common.wgsl`).
 
 use crate::Vec3f;
 

@@ -21,37 +21,6 @@ override USE_LINE_SEGMENT: bool = true;
 override USE_LINE_LINE: bool = true;
 override USE_LINE_POLYLINE: bool = true;
 
-// Mirrors hadou_math::toon::band_step.
-fn band_step(m: f32, t: f32, w: f32) -> f32 {
-    if (w <= 0.0) {
-        return select(0.0, 1.0, m >= t);
-    }
-    let x = clamp((m - t) / w + 0.5, 0.0, 1.0);
-    return x * x * (3.0 - 2.0 * x);
-}
-
-// Mirrors hadou_math::toon::Ramp::eval (m is never NaN here: it comes from wave_m or a clamped dot).
-fn ramp_eval(r: GpuRamp, m: f32) -> vec3<f32> {
-    if (r.count == 0u) {
-        return vec3<f32>(0.0);
-    }
-    var c = r.stops[0].yzw;
-    for (var k = 1u; k < min(r.count, 8u); k++) {
-        let prev = r.stops[k - 1u];
-        let cur = r.stops[k];
-        var s = 0.0;
-        if (r.kind == RAMP_BANDS) {
-            s = band_step(m, cur.x, r.smoothing);
-        } else if (cur.x > prev.x) {
-            s = clamp((m - prev.x) / (cur.x - prev.x), 0.0, 1.0);
-        } else {
-            s = select(0.0, 1.0, m >= cur.x);
-        }
-        c = c + (cur.yzw - prev.yzw) * s;
-    }
-    return c;
-}
-
 // Mirrors hadou_math::toon::nearest_on_segment.
 fn nearest_on_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     let d = b - a;
