@@ -1,6 +1,9 @@
 //! The `hadou` binary end to end: every bad-input class exits 2 with a `file:line:col` message and
 //! writes nothing; good input renders, probes and validates.
 
+mod common;
+
+use common::Scratch;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -12,12 +15,8 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A fresh empty directory for one test.
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hadou-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tmpdir(name: &str) -> Scratch {
+    Scratch::new("cli", name)
 }
 
 const GOOD: &str = r#"[image]
@@ -508,11 +507,21 @@ fn a_png_rendered_in_bands_equals_the_whole_frame() {
     assert!(pixels == hadou::output::srgb8(&whole), "banded PNG differs from the whole-frame render");
 }
 
-/// The peak resident memory of a child process, polled from /proc until it exits (Linux only).
-fn peak_rss_kib(mut child: std::process::Child) -> (std::process::ExitStatus, u64) {
+/// Runs `hadou ARGS` (stdout discarded, stderr kept in `dir/stderr.txt`) and polls its peak
+/// resident memory from /proc until it exits (Linux only): its exit status, the peak in KiB and
+/// what it printed on stderr (for the failure message). Stderr goes to a file, not a pipe, so a
+/// chatty child can never block on a full pipe nobody reads.
+fn run_measuring_peak(args: &[&str], dir: &Path) -> (std::process::ExitStatus, u64, String) {
+    let err_path = dir.join("stderr.txt");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::fs::File::create(&err_path).unwrap())
+        .spawn()
+        .unwrap();
     let status_file = format!("/proc/{}/status", child.id());
     let mut peak = 0;
-    loop {
+    let status = loop {
         if let Ok(text) = std::fs::read_to_string(&status_file) {
             if let Some(line) = text.lines().find(|l| l.starts_with("VmHWM:")) {
                 let kib: u64 = line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(0);
@@ -520,10 +529,11 @@ fn peak_rss_kib(mut child: std::process::Child) -> (std::process::ExitStatus, u6
             }
         }
         if let Some(status) = child.try_wait().unwrap() {
-            return (status, peak);
+            break status;
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
-    }
+    };
+    (status, peak, std::fs::read_to_string(&err_path).unwrap_or_default())
 }
 
 #[test]
@@ -536,13 +546,9 @@ fn png_memory_follows_the_band_not_the_image() {
     // An 8192² frame: 1.6 GB as one float image, about 100 MB per band.
     let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 8192\nheight = 8192"));
     let out = dir.join("big.png");
-    let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
-        .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let (status, peak) = peak_rss_kib(child);
-    assert!(status.success());
+    let args = ["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"];
+    let (status, peak, err) = run_measuring_peak(&args, &dir);
+    assert!(status.success(), "{status}: {err}");
     assert!(out.exists());
     // The bound: a few bands of float image and opaque buffers (~55 bytes a pixel each), never
     // the image (8192² × 24 bytes = 1.6 GB for its floats alone).
@@ -726,15 +732,10 @@ fn a_gpu_probe_renders_one_row_at_the_largest_size() {
     let dir = tmpdir("gpu-probe-size");
     let scene = write_scene(&dir, GOOD);
     // The whole 16384² image would take 6 GiB of floats; the pixel's row takes 1.5 MiB.
-    let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
-        .args(["probe", scene.to_str().unwrap(), "--pixel", "8192,8192", "--backend", "gpu"])
-        .args(["--width", "16384", "--height", "16384"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let (status, peak) = peak_rss_kib(child);
-    assert!(status.success(), "{status}");
+    let args = ["probe", scene.to_str().unwrap(), "--pixel", "8192,8192", "--backend", "gpu"];
+    let (status, peak, err) =
+        run_measuring_peak(&[&args[..], &["--width", "16384", "--height", "16384"]].concat(), &dir);
+    assert!(status.success(), "{status}: {err}");
     assert!(peak > 0 && peak < 1024 * 1024, "peak resident memory {peak} KiB");
 }
 
@@ -748,13 +749,9 @@ fn exr_memory_follows_the_band_not_the_image() {
     // An 8192² frame: 1.6 GB as one float image (and as much again for the old channel copies).
     let scene = write_scene(&dir, &GOOD.replace("width = 64\nheight = 48", "width = 8192\nheight = 8192"));
     let out = dir.join("big.exr");
-    let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
-        .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"])
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let (status, peak) = peak_rss_kib(child);
-    assert!(status.success());
+    let args = ["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"];
+    let (status, peak, err) = run_measuring_peak(&args, &dir);
+    assert!(status.success(), "{status}: {err}");
     let img = exr::prelude::read_first_flat_layer_from_file(&out).unwrap();
     assert_eq!((img.layer_data.size.0, img.layer_data.size.1), (8192, 8192));
     assert!(peak > 0 && peak < 600 * 1024, "peak resident memory {peak} KiB");

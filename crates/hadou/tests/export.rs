@@ -1,6 +1,9 @@
 //! `hadou::export`: a PNG sequence equals what `hadou render` writes, a GIF decodes to the right
 //! frames, size, delays and colours, cancel and errors leave nothing half-written.
 
+mod common;
+
+use common::Scratch;
 use hadou::export::{
     export_animation, frame_file_name, gif_delay_cs, AnimationFormat, AnimationSpec, Control, ExportError,
     ExportOutcome, Progress,
@@ -21,12 +24,8 @@ fn spec(frames: std::ops::Range<u32>, fps: f32) -> AnimationSpec {
     AnimationSpec { frames, fps, width: Some(W), height: Some(H) }
 }
 
-/// A fresh empty directory for one test.
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hadou-export-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tmpdir(name: &str) -> Scratch {
+    Scratch::new("export", name)
 }
 
 fn listing(dir: &Path) -> Vec<String> {
@@ -295,7 +294,7 @@ fn bad_specs_are_errors_and_write_nothing() {
         (AnimationSpec { height: Some(20000), ..spec(0..3, 24.0) }, "height 20000"),
     ];
     for (s, needle) in cases {
-        for path in [dir.join("a.gif"), dir.clone()] {
+        for path in [dir.join("a.gif"), dir.to_path_buf()] {
             let mut called = false;
             let r = export_animation(&scene, &mut CpuBackend::new(), &s, &path, &mut |_| {
                 called = true;
@@ -321,7 +320,7 @@ fn sizes_past_the_scenes_limits_are_spec_errors_and_write_nothing() {
     let cases = [
         // An [area_light]'s image limit holds for sizes from the spec, on both formats.
         (&soft, big.clone(), dir.join("a.gif"), "at most 16777216 pixels"),
-        (&soft, big.clone(), dir.clone(), "at most 16777216 pixels"),
+        (&soft, big.clone(), dir.to_path_buf(), "at most 16777216 pixels"),
         // A GIF frame's limit holds without one.
         (&scene(), big, dir.join("a.gif"), "a GIF frame is at most 16777216 pixels"),
     ];

@@ -10,6 +10,9 @@
 //!
 //! Needs `xvfb-run` (`apt-get install xvfb`); without it the tests skip with a message, and
 //! fail under `HADOU_REQUIRE_GPU=1` (CI).
+mod common;
+
+use common::Scratch;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -22,11 +25,8 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hadou-view-e2e-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn tmp(name: &str) -> Scratch {
+    Scratch::new("view-e2e", name)
 }
 
 /// One Xvfb at a time: `xvfb-run -a` picks a free display number by looking for lock files, and
