@@ -6,14 +6,15 @@
 //! and gradient ramps, no waves) against hadou-cpu's render of it. Skips with a message when there is no
 //! usable adapter; fails instead under `HADOU_REQUIRE_GPU=1`.
 
+mod common;
+
+use common::adapter_or_skip;
+
 use bevy::camera::RenderTarget;
 use bevy::image::Image;
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::render::RenderPlugin;
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 use hadou_bevy::{HadouCamera, HadouPlugin, HadouSceneRoot, SceneClock, SpawnedScene, ViewMapping};
 use hadou_math::shade::linear_to_srgb8;
 use std::path::{Path, PathBuf};
@@ -26,19 +27,6 @@ const MAX_MEAN: f64 = 2.0;
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
-
-fn adapter_or_skip(test: &str) -> bool {
-    match hadou_gpu::request_adapter() {
-        Ok(_) => true,
-        Err(e) if std::env::var("HADOU_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("{test}: HADOU_REQUIRE_GPU=1 but no usable GPU adapter ({e})")
-        }
-        Err(e) => {
-            eprintln!("SKIPPED {test}: {e}; set HADOU_REQUIRE_GPU=1 to make this a failure");
-            false
-        }
-    }
 }
 
 /// The image every spawned scene camera renders into, and the mapping it is given instead of the
@@ -82,12 +70,7 @@ fn picture_in(
     let root = root.canonicalize().expect("the scenes folder");
     let mut app = App::new();
     app.add_plugins(
-        DefaultPlugins
-            .build()
-            .disable::<WinitPlugin>()
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-            .set(AssetPlugin { file_path: root.display().to_string(), ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() }),
+        common::windowless().set(AssetPlugin { file_path: root.display().to_string(), ..default() }),
     )
     .add_plugins(HadouPlugin { asset_root: root.clone() });
     let image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);

@@ -5,6 +5,10 @@
 //! sees none. Skips with a message when there is no usable adapter; fails instead under
 //! `HADOU_REQUIRE_GPU=1`.
 
+mod common;
+
+use common::adapter_or_skip;
+
 use bevy::camera::{Hdr, RenderTarget};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::image::Image;
@@ -12,9 +16,6 @@ use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::render::view::Msaa;
-use bevy::render::RenderPlugin;
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 use hadou_bevy::{HadouCamera, HadouPlugin, HadouWave};
 use hadou_math::energy::{Falloff, SphereField};
 use hadou_math::Vec3f;
@@ -25,19 +26,6 @@ use std::sync::{Arc, Mutex};
 const SIZE: u32 = 64;
 
 type Shots = Arc<Mutex<HashMap<&'static str, Image>>>;
-
-fn adapter_or_skip(test: &str) -> bool {
-    match hadou_gpu::request_adapter() {
-        Ok(_) => true,
-        Err(e) if std::env::var("HADOU_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("{test}: HADOU_REQUIRE_GPU=1 but no usable GPU adapter ({e})")
-        }
-        Err(e) => {
-            eprintln!("SKIPPED {test}: {e}; set HADOU_REQUIRE_GPU=1 to make this a failure");
-            false
-        }
-    }
-}
 
 /// The sRGB bytes of pixel (x, y) of a captured `Rgba8UnormSrgb` image.
 fn pixel(image: &Image, x: u32, y: u32) -> [u8; 3] {
@@ -108,16 +96,10 @@ fn each_camera_gets_its_own_wave_pass_clipped_at_its_own_depth() {
         return;
     }
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .build()
-            .disable::<WinitPlugin>()
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() }),
-    )
-    .add_plugins(HadouPlugin::default())
-    .init_resource::<Targets>()
-    .add_systems(Startup, setup);
+    app.add_plugins(common::windowless())
+        .add_plugins(HadouPlugin::default())
+        .init_resource::<Targets>()
+        .add_systems(Startup, setup);
     app.finish();
     app.cleanup();
 

@@ -11,7 +11,7 @@ use crate::meshes::MeshCache;
 use crate::passes::plane_shadows::{PlaneShadowInputs, PlaneShadowPass};
 use crate::passes::present::Presenter;
 use crate::passes::raster::{GBuffer, RasterInputs, RasterPass};
-use crate::passes::setup::Draw;
+use crate::passes::setup::{texture_view, Draw};
 use crate::passes::shadow_maps::{MapPass, ShadowMapInputs, ShadowMapPass, ShadowMaps};
 #[cfg(not(target_arch = "wasm32"))]
 use crate::passes::soft::SoftReadback;
@@ -217,20 +217,7 @@ impl Renderer {
         }
         self.targets = None; // free the old ones first
         let d = &self.ctx.device;
-        let extent = wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 };
-        let texture = |label, format, usage| {
-            d.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: extent,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-            .create_view(&Default::default())
-        };
+        let texture = |label, format, usage| texture_view(d, label, size, format, usage);
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let scene_view = texture("normal and distance", SCENE_FORMAT, attach_and_read);
         let attributes_view = texture("uv, colour and material", SCENE_FORMAT, attach_and_read);

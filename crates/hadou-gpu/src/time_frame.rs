@@ -140,43 +140,33 @@ pub(crate) fn time_wave_overlay(
     iterations: u32,
 ) -> Result<FrameTiming, RenderError> {
     use crate::overlay::{DepthModel, OverlayBlend, OverlayTarget};
+    use crate::passes::setup::{cleared_depth, texture_view};
+    use wgpu::TextureUsages;
     if iterations == 0 {
         return Err(RenderError::Other("time_wave_overlay needs at least one iteration".into()));
     }
     crate::prepare::validate_frame(frame)?;
-    let size = wgpu::Extent3d { width: frame.width, height: frame.height, depth_or_array_layers: 1 };
+    let size = [frame.width, frame.height];
     let (color, depth) = r.ctx.scoped("creating the overlay's targets", || {
-        let texture = |label, format, usage| {
-            r.ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let color =
-            texture("overlay timing colour", OVERLAY_COLOR_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
-        let depth = texture(
-            "overlay timing depth",
-            wgpu::TextureFormat::Depth32Float,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        let d = &r.ctx.device;
+        let color = texture_view(
+            d,
+            "overlay timing colour",
+            size,
+            OVERLAY_COLOR_FORMAT,
+            TextureUsages::RENDER_ATTACHMENT,
         );
-        (color.create_view(&Default::default()), depth.create_view(&Default::default()))
+        let depth_usage = TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING;
+        let depth =
+            texture_view(d, "overlay timing depth", size, wgpu::TextureFormat::Depth32Float, depth_usage);
+        (color, depth)
     })?;
     // The depth buffer as an engine's would be with nothing drawn: cleared to the far plane.
     let mut enc = r.ctx.device.create_command_encoder(&Default::default());
     enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("overlay timing depth clear"),
         color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &depth,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-            stencil_ops: None,
-        }),
+        depth_stencil_attachment: cleared_depth(&depth, wgpu::StoreOp::Store),
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,

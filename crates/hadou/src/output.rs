@@ -218,6 +218,35 @@ pub fn band_rows(width: u32) -> u32 {
 /// Pixels per band of a streamed PNG (4 Mi: about 100 MB of float image per band).
 pub const BAND_PIXELS: u32 = 1 << 22;
 
+/// The start of every banded write: `path`'s format and directory checked, and its temporary
+/// file created (registered for interrupt clean-up) before the first band is asked for.
+fn begin_banded(path: &Path) -> Result<(TempFile, File), OutputError> {
+    Format::from_path(path)?;
+    check_directory(path)?;
+    create_temp(path)
+}
+
+/// An I/O failure while writing `path`.
+fn write_failed(path: &Path, e: impl std::fmt::Display) -> OutputError {
+    OutputError::Io(format!("{}: write failed: {e}", path.display()))
+}
+
+/// The band of rows `rows` from `band`, refused unless it is `width × rows.len()`.
+fn next_band<E: From<OutputError>>(
+    band: &mut impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+    rows: std::ops::Range<u32>,
+    width: u32,
+    path: &Path,
+) -> Result<Image, E> {
+    let image = band(rows.clone())?;
+    if image.width != width || image.height != rows.len() as u32 {
+        let got =
+            format!("a band of rows {}..{} came back {}×{}", rows.start, rows.end, image.width, image.height);
+        return Err(write_failed(path, got).into());
+    }
+    Ok(image)
+}
+
 /// Writes a `width × height` 8-bit sRGB PNG to `path`, asking `band` for the image rows
 /// `y0..y1` in turn (each at most [`band_rows`] rows) and streaming them into the encoder, so
 /// memory follows the band, not the image. The file is created (and registered for interrupt
@@ -229,10 +258,8 @@ pub fn write_png_banded<E: From<OutputError>>(
     height: u32,
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
-    Format::from_path(path)?;
-    check_directory(path)?;
-    let (tmp, file) = create_temp(path)?;
-    let io = |e: String| OutputError::Io(format!("{}: write failed: {e}", path.display()));
+    let (tmp, file) = begin_banded(path)?;
+    let io = |e: String| write_failed(path, e);
     let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
@@ -246,14 +273,7 @@ pub fn write_png_banded<E: From<OutputError>>(
         let mut y = 0;
         while y < height {
             let rows = y..(y + step).min(height);
-            let image = band(rows.clone())?;
-            if image.width != width || image.height != rows.len() as u32 {
-                return Err(io(format!(
-                    "a band of rows {}..{} came back {}×{}",
-                    rows.start, rows.end, image.width, image.height
-                ))
-                .into());
-            }
+            let image = next_band(&mut band, rows.clone(), width, path)?;
             stream.write_all(&srgb8(&image)).map_err(|e| io(e.to_string()))?;
             y = rows.end;
         }
@@ -296,10 +316,8 @@ pub fn write_exr_banded<E: From<OutputError>>(
     use exr::meta::header::Header;
     use exr::meta::BlockDescription;
     use exr::prelude::*;
-    Format::from_path(path)?;
-    check_directory(path)?;
-    let (tmp, file) = create_temp(path)?;
-    let io = |e: String| OutputError::Io(format!("{}: write failed: {e}", path.display()));
+    let (tmp, file) = begin_banded(path)?;
+    let io = |e: String| write_failed(path, e);
     let channels = EXR_CHANNELS.iter().map(|&(n, _)| ChannelDescription::named(n, SampleType::F32)).collect();
     let header = Header::new("hadou".into(), (width as usize, height as usize), channels).with_encoding(
         Compression::RLE,
@@ -316,18 +334,8 @@ pub fn write_exr_banded<E: From<OutputError>>(
             let mut y = 0;
             while y < height {
                 let rows = y..(y + step).min(height);
-                let image = match band(rows.clone()) {
-                    Ok(image) if image.width == width && image.height == rows.len() as u32 => image,
-                    Ok(image) => {
-                        failure = Some(
-                            io(format!(
-                                "a band of rows {}..{} came back {}×{}",
-                                rows.start, rows.end, image.width, image.height
-                            ))
-                            .into(),
-                        );
-                        return Err(exr::error::Error::Aborted);
-                    }
+                let image = match next_band(&mut band, rows.clone(), width, path) {
+                    Ok(image) => image,
                     Err(e) => {
                         failure = Some(e);
                         return Err(exr::error::Error::Aborted);

@@ -10,7 +10,8 @@
 
 use super::setup::Stages;
 use super::setup::{
-    self, color_target, depth_test, triangles, vertex_layout, Binding, Draw, Kind, POSITION_ATTRIBUTE,
+    self, color_target, depth_test, texture_view, triangles, vertex_layout, Binding, Draw, Kind,
+    POSITION_ATTRIBUTE,
 };
 use crate::device::GpuContext;
 use crate::formats::{MAP_FORMAT, SPOT_FORMAT};
@@ -123,19 +124,8 @@ impl SoftTargets {
             *soft = None; // free the old ones first
             let d = &ctx.device;
             let size = key.2;
-            let texture = |label, format| {
-                d.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-            };
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+            let texture = |label, format| texture_view(d, label, [size, size], format, usage);
             let buffer = |label, size: u64, usage| {
                 d.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(label),
