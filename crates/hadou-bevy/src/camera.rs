@@ -42,6 +42,25 @@ impl Default for HadouCamera {
     }
 }
 
+/// The largest `exposure` (the scene format's bound on `[color] exposure`, 1e6: with a wave's
+/// strength and colour bounded too, `exposure · α · rgb` stays far inside f32).
+pub const EXPOSURE_MAX: f32 = 1e6;
+
+impl HadouCamera {
+    /// Why the wave pass cannot draw with these settings, if it cannot: an `exposure` that is not
+    /// a number in `0..=EXPOSURE_MAX` would put NaN or infinity into the image. (`far` is checked
+    /// with the view's projection, in [`frame_camera`].)
+    pub fn check(&self) -> Result<(), String> {
+        if !(0.0..=EXPOSURE_MAX).contains(&self.exposure) {
+            return Err(format!(
+                "HadouCamera::exposure must be in 0..={EXPOSURE_MAX}, got {}",
+                self.exposure
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Lets the wave pass read the depth buffer of every camera that gained a [`HadouCamera`].
 pub(crate) fn bind_depth(mut cameras: Query<&mut Camera3d, Added<HadouCamera>>) {
     for mut camera in &mut cameras {
@@ -81,4 +100,19 @@ pub fn frame_camera(world_from_view: &Mat4, clip_from_view: &Mat4, far: f32) -> 
         near,
         far,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exposures_that_would_put_nan_or_infinity_into_the_image_are_refused() {
+        assert!(HadouCamera::default().check().is_ok());
+        for exposure in [f32::NAN, f32::INFINITY, -1.0, 2e6] {
+            let e = HadouCamera { exposure, ..default() }.check().unwrap_err();
+            assert!(e.contains("exposure") && e.contains("1000000"), "{e}");
+        }
+        assert!(HadouCamera { exposure: 0.0, ..default() }.check().is_ok());
+    }
 }

@@ -35,7 +35,7 @@ mod tone;
 mod wave;
 
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
-pub use camera::{frame_camera, HadouCamera, ViewMapping};
+pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
 pub use material::{HadouMaterial, HadouRamp, HadouSurface};
 pub use spawn::{bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene};
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};

@@ -102,6 +102,10 @@ pub(crate) fn wave_pass(
         });
         return;
     }
+    if let Err(why) = settings.check() {
+        warned.once(entity, "settings", || format!("hadou waves are not drawn into view {entity}: {why}"));
+        return;
+    }
     let viewport = extracted.viewport;
     if viewport.z == 0 || viewport.w == 0 {
         return; // a minimised window: nothing to draw into
