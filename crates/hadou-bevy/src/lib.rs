@@ -29,6 +29,7 @@
 mod asset;
 mod camera;
 mod material;
+mod outline;
 mod render;
 mod spawn;
 mod tone;
@@ -36,8 +37,15 @@ mod wave;
 
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
-pub use material::{HadouMaterial, HadouRamp, HadouSurface};
-pub use spawn::{bevy_mesh, scene_time, unsupported, HadouSceneRoot, SceneClock, SpawnedScene};
+pub use material::{
+    light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS, NO_TEXTURES, WAVE_LIGHTS,
+    WAVE_LIGHT_DATA,
+};
+pub use outline::{outline_mesh, HadouOutline, HadouOutlineUniform};
+pub use spawn::{
+    bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, unsupported, HadouSceneRoot, SceneClock,
+    SpawnedScene,
+};
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 
 use bevy::asset::io::file::FileAssetReader;
@@ -46,6 +54,7 @@ use bevy::core_pipeline::schedule::{Core3d, Core3dSystems};
 use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
+use bevy::render::storage::ShaderBuffer;
 use bevy::render::{ExtractSchedule, RenderApp, RenderStartup};
 use std::path::PathBuf;
 
@@ -71,6 +80,9 @@ pub enum HadouSystems {
     Scenes,
     /// Checking changed waves (`PostUpdate`).
     CheckWaves,
+    /// Writing the waves as lights for the [`HadouMaterial`]s (`PostUpdate`, after
+    /// [`HadouSystems::CheckWaves`]).
+    Lights,
 }
 
 impl Plugin for HadouPlugin {
@@ -80,10 +92,21 @@ impl Plugin for HadouPlugin {
             app.init_asset::<HadouScene>()
                 .register_asset_loader(HadouSceneLoader { root: self.asset_root.clone() });
             if renders {
-                app.add_plugins(MaterialPlugin::<HadouMaterial>::default());
+                app.add_plugins((
+                    MaterialPlugin::<HadouMaterial>::default(),
+                    MaterialPlugin::<HadouOutline>::default(),
+                ));
             } else {
-                app.init_asset::<HadouMaterial>();
+                app.init_asset::<HadouMaterial>().init_asset::<HadouOutline>();
             }
+            if !app.world().contains_resource::<Assets<ShaderBuffer>>() {
+                app.init_asset::<ShaderBuffer>();
+            }
+            material::insert_buffers(&mut app.world_mut().resource_mut::<Assets<ShaderBuffer>>());
+            app.add_systems(
+                PostUpdate,
+                material::update_wave_lights.in_set(HadouSystems::Lights).after(HadouSystems::CheckWaves),
+            );
             if app.world().contains_resource::<Assets<Mesh>>() {
                 app.add_systems(
                     Update,
@@ -106,6 +129,9 @@ impl Plugin for HadouPlugin {
                     &material::SHADER,
                     Shader::from_wgsl(material::shader_source(), "hadou_bevy/material.wgsl"),
                 )
+                .expect("a shader under a fixed handle can be inserted");
+            shaders
+                .insert(&outline::SHADER, Shader::from_wgsl(outline::SOURCE, "hadou_bevy/outline.wgsl"))
                 .expect("a shader under a fixed handle can be inserted");
         }
         app.add_plugins((

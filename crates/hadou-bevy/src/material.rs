@@ -1,63 +1,127 @@
-//! [`HadouMaterial`]: a Bevy material that shades a mesh as hadou does, under a hadou light, with
-//! hadou-gpu's own WGSL (`common.wgsl`'s `diffuse` and `ramp_eval`, the twins of
-//! `hadou_math::shade::diffuse` and `hadou_math::toon::Ramp::eval`) rather than Bevy's physically
-//! based lighting.
+//! [`HadouMaterial`]: a Bevy material that shades a mesh as hadou does, under a hadou light and the
+//! waves' light, with hadou-gpu's own WGSL: `shading.wgsl`'s `shade_surface` (the twin of
+//! hadou-cpu's `shading::shade`: the own look, the waves' looks weighted by their dominance, glow,
+//! base and feature textures), fed by Bevy's mesh vertex output. The waves' light records are the
+//! plugin's, shared by every material ([`WAVE_LIGHTS`], [`WAVE_LIGHT_DATA`], refreshed each frame
+//! from the [`crate::HadouWave`]s by [`update_wave_lights`]); a material's textures are in its
+//! own buffer ([`HadouMaterial::textures`]).
 
-use bevy::asset::uuid_handle;
+use crate::wave::{HadouWave, WaveRejected};
+use bevy::asset::{uuid_handle, RenderAssetUsages};
 use bevy::pbr::Material;
 use bevy::prelude::*;
 use bevy::render::render_resource::{AsBindGroup, ShaderType};
+use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
-use hadou_scene::ShadingModel;
+use hadou_gpu::layout::{self, GpuLight, GpuTexture, TextureStore};
+use hadou_scene::{Light, Wave};
 
 /// The fragment shader of [`HadouMaterial`], composed at start-up (see [`shader_source`]).
 pub(crate) const SHADER: Handle<Shader> = uuid_handle!("0b7e55c1-2f4a-4c63-8d3e-6a9d1f2b7c44");
 
-/// The fragment stage: the albedo (base colour times vertex colour), then hadou's Lambert model
-/// `albedo · (ambient + light · max(0, N·(−L)))` (SPEC.md §2.1's diffuse model), the toon model
-/// `albedo · ramp(N·(−L))` with the unclamped `m = N·(−L)` (000 §2.1, SPEC.md §2.1) or, unlit,
-/// the albedo itself (`diffuse`, `ramp_eval`, `GpuRamp`, `MODEL_*` from hadou-gpu's
-/// `common.wgsl`, prepended by [`shader_source`]). The normal is normalised as hadou-gpu's
-/// `shade_surface` does (a zero or non-finite normal gives `m = 0`).
+/// The plugin's wave-light records: one `GpuLight` (hadou-gpu's layout) per drawn wave, room for
+/// [`MAX_WAVE_LIGHTS`]; every [`HadouMaterial`] binds it.
+pub const WAVE_LIGHTS: Handle<ShaderBuffer> = uuid_handle!("5c1d7e0a-93b2-4f6e-a8c1-2d4e6f8a0b13");
+/// The plugin's wave-light words: the number of lights, whether any glows, two unused words, then
+/// the lights' polyline points (3 `f32` bit patterns each); every [`HadouMaterial`] binds it.
+pub const WAVE_LIGHT_DATA: Handle<ShaderBuffer> = uuid_handle!("7a2f4c6e-1b3d-4e5f-9a7c-8d0e2f4a6c15");
+/// The texture words of a material without textures: hadou's sRGB table only.
+pub const NO_TEXTURES: Handle<ShaderBuffer> = uuid_handle!("9e4a6c8e-3d5f-4a7b-8c9d-0f1e3a5c7e17");
+
+/// The most waves that light a surface (hadou-gpu's `MAX_LIGHTS` in shading.wgsl, hadou-scene's
+/// per-scene limit); past it the first by entity are used, and a warning says so once.
+pub const MAX_WAVE_LIGHTS: usize = 256;
+
+/// Words before the polyline points in [`WAVE_LIGHT_DATA`].
+const LIGHT_DATA_HEADER: usize = 4;
+
+/// The fragment stage: hadou-gpu's `shade_surface` (shading.wgsl; SPEC.md §2.1–2.2: own look
+/// `albedo · (ambient + light · max(0, N·(−L)))`, toon `albedo · ramp(N·(−L))` with the unclamped
+/// `m`, then `c + β·(look − c)` with the waves' looks weighted by `(ρᵢ/ρ_max)²` (the densities'
+/// dominance rule), glow, the feature texture) for the material's record, at the fragment's world
+/// point, normal, texture coordinates and vertex colour (quantised to 8 bits as hadou's G-buffer
+/// holds it). `lights`, `shading_data` and `polyline_point` are declared here in place of the
+/// wave pass's (`shading_bindings.wgsl`), `frame` is a private copy of what shading.wgsl reads
+/// of hadou's frame uniforms.
 const FRAGMENT: &str = r"
 struct HadouSurface {
     base_color: vec4<f32>,
     light_direction: vec4<f32>,
     light_color: vec4<f32>,
     ambient: vec4<f32>,
+    outline: vec4<f32>,
     model: u32,
+    wave_blend: f32,
+    pad0: u32,
+    pad1: u32,
+    base_texture: vec4<u32>,
+    feature_texture: vec4<u32>,
     ramp: GpuRamp,
 }
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> surface: HadouSurface;
+@group(#{MATERIAL_BIND_GROUP}) @binding(1) var<storage, read> lights: array<GpuLight>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> light_data: array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> shading_data: array<u32>;
+
+fn polyline_point(offset: u32, i: u32) -> vec3<f32> {
+    let o = offset + 3u * i;
+    return vec3<f32>(bitcast<f32>(light_data[o]), bitcast<f32>(light_data[o + 1u]), bitcast<f32>(light_data[o + 2u]));
+}
+
+struct HadouShadeFrame {
+    light_dir: vec3<f32>,
+    light_color: vec3<f32>,
+    ambient: vec3<f32>,
+    wave_count: u32,
+    any_glow: u32,
+    area_position: vec3<f32>,
+    area_color: vec3<f32>,
+}
+var<private> frame: HadouShadeFrame;
+
+fn texture_record(t: vec4<u32>) -> GpuTexture {
+    return GpuTexture(t.x, t.y, t.z, t.w);
+}
 
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
-    var albedo = surface.base_color.xyz;
-#ifdef VERTEX_COLORS
-    albedo = albedo * in.color.xyz;
+    frame.light_dir = surface.light_direction.xyz;
+    frame.light_color = surface.light_color.xyz;
+    frame.ambient = surface.ambient.xyz;
+    frame.wave_count = light_data[0];
+    frame.any_glow = light_data[1];
+    let m = GpuMaterial(
+        surface.base_color.xyz, surface.model, surface.outline.xyz, surface.wave_blend,
+        surface.outline.w, 0u, 0u, 0u,
+        texture_record(surface.base_texture), texture_record(surface.feature_texture), surface.ramp);
+    var uv = vec2<f32>(0.0);
+#ifdef VERTEX_UVS_A
+    uv = in.uv;
 #endif
-    var c = albedo;
-    if (surface.model == MODEL_DIFFUSE) {
-        c = diffuse(albedo, in.world_normal, surface.light_direction.xyz, surface.light_color.xyz, surface.ambient.xyz);
-    } else if (surface.model == MODEL_TOON) {
-        let len = length3(in.world_normal);
-        var n = vec3<f32>(0.0);
-        if (len > 0.0 && len < 3.0e38) {
-            n = in.world_normal / len;
-        }
-        c = albedo * ramp_eval(surface.ramp, dot3(n, -surface.light_direction.xyz));
-    }
+    var color = vec4<f32>(1.0);
+#ifdef VERTEX_COLORS
+    color = unpack4x8unorm(pack4x8unorm(in.color));
+#endif
+    let c = shade_surface(m, in.world_position.xyz, in.world_normal, uv, color);
     return vec4<f32>(c, 1.0);
 }
 ";
 
-/// The WGSL of [`HadouMaterial`]: Bevy's mesh vertex output, hadou-gpu's `common.wgsl`, then
-/// [`FRAGMENT`].
-pub(crate) fn shader_source() -> String {
-    format!("#import bevy_pbr::forward_io::VertexOutput\n{}\n{FRAGMENT}", hadou_gpu::shaders::COMMON)
+/// hadou-gpu's pipeline-overridable switches become constants (all true: the uber-shader's code).
+fn constants(wgsl: &str) -> String {
+    wgsl.replace("override USE_", "const USE_")
 }
 
-/// What [`HadouMaterial`]'s shader reads (its uniform).
+/// The WGSL of [`HadouMaterial`]: Bevy's mesh vertex output, hadou-gpu's `common.wgsl`,
+/// `energy.wgsl` and `shading.wgsl` (its switches as constants), then [`FRAGMENT`].
+pub(crate) fn shader_source() -> String {
+    use hadou_gpu::shaders::{COMMON, ENERGY, SHADING};
+    let (energy, shading) = (constants(ENERGY), constants(SHADING));
+    format!("#import bevy_pbr::forward_io::VertexOutput\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}")
+}
+
+/// What [`HadouMaterial`]'s shader reads (its uniform): a hadou `[[material]]`'s record (hadou-gpu's
+/// `GpuMaterial`) and the scene's `[light]`.
 #[derive(Clone, Copy, Debug, PartialEq, ShaderType)]
 pub struct HadouSurface {
     /// Linear RGB base colour (`w` unused).
@@ -68,8 +132,21 @@ pub struct HadouSurface {
     pub light_color: Vec4,
     /// The ambient term, linear RGB (`w` unused).
     pub ambient: Vec4,
+    /// The outline colour (`xyz`) and width `d` (`w`; 0 = none), for [`crate::HadouOutline`].
+    pub outline: Vec4,
     /// hadou-gpu's shading model code (`layout::MODEL_DIFFUSE`, `MODEL_TOON` or `MODEL_UNLIT`).
     pub model: u32,
+    /// `wave_blend` β: 0 keeps the own look, 1 takes the waves' (000 §2.1).
+    pub wave_blend: f32,
+    /// Padding.
+    pub pad0: u32,
+    /// Padding.
+    pub pad1: u32,
+    /// The base-colour texture (`GpuTexture`: word offset in the material's texture buffer, width,
+    /// height, sampling flags); offset 0 = none.
+    pub base_texture: UVec4,
+    /// The feature texture, likewise.
+    pub feature_texture: UVec4,
     /// The toon ramp (read by `MODEL_TOON` only).
     pub ramp: HadouRamp,
 }
@@ -94,7 +171,10 @@ impl HadouRamp {
     /// `ramp` in hadou-gpu's layout (`layout::GpuRamp::new`: stops beyond eight are dropped, the
     /// scene loader refuses them).
     pub fn new(ramp: &hadou_math::toon::Ramp) -> Self {
-        let g = hadou_gpu::layout::GpuRamp::new(ramp);
+        Self::from_gpu(&layout::GpuRamp::new(ramp))
+    }
+
+    fn from_gpu(g: &layout::GpuRamp) -> Self {
         HadouRamp {
             stops: g.stops.map(Vec4::from_array),
             count: g.count,
@@ -105,41 +185,105 @@ impl HadouRamp {
     }
 }
 
-/// A material shaded as a hadou `[[material]]` under a hadou `[light]` (SPEC.md §2.1):
-/// `model = "diffuse"` gives `albedo · (ambient + light · max(0, N·(−L)))`, `"toon"` gives
-/// `albedo · ramp(N·(−L))` (000 §2.1, the unclamped `m`; `ramp`, `ramp_kind`, `ramp_smoothing`),
-/// `"unlit"` the albedo, with `albedo` the base colour times the mesh's vertex colours, `N` the
-/// interpolated world normal. It writes linear colour into the HDR target, before the waves'
-/// light and the colour mapping, as hadou's opaque pass does. Textures, `wave_blend`, glow and
-/// outlines are not drawn yet.
+fn texture_words(t: GpuTexture) -> UVec4 {
+    UVec4::new(t.offset, t.width, t.height, t.flags)
+}
+
+impl HadouSurface {
+    /// The uniform of `material` under `light`, its textures at the word offsets of `textures`
+    /// (`[0, 0, 0, 0]`: none).
+    pub fn new(material: &hadou_scene::Material, light: &Light, textures: [UVec4; 2]) -> Self {
+        let mut store = TextureStore::default();
+        let g = layout::material_record(material, 0, &mut Vec::new(), &mut store);
+        let v = |c: [f32; 3], w: f32| Vec4::new(c[0], c[1], c[2], w);
+        let d = light.direction;
+        HadouSurface {
+            base_color: v(g.base_color, 1.0),
+            light_direction: Vec4::new(d.x, d.y, d.z, 0.0),
+            light_color: v(light.color, 0.0),
+            ambient: v(light.ambient, 0.0),
+            outline: v(g.outline_color, g.outline_width),
+            model: g.model,
+            wave_blend: g.wave_blend,
+            pad0: 0,
+            pad1: 0,
+            base_texture: textures[0],
+            feature_texture: textures[1],
+            ramp: HadouRamp::from_gpu(&g.ramp),
+        }
+    }
+}
+
+/// A material shaded as a hadou `[[material]]` under a hadou `[light]` and the waves' light
+/// (SPEC.md §2.1–2.2, hadou-gpu's `shade_surface`): `model = "diffuse"` gives
+/// `albedo · (ambient + light · max(0, N·(−L)))`, `"toon"` gives `albedo · ramp(N·(−L))` (000
+/// §2.1, the unclamped `m`), `"unlit"` the albedo, with `albedo` the base colour times the base
+/// texture times the mesh's vertex colours and `N` the interpolated world normal; then
+/// `wave_blend` β moves it towards the waves' looks (each wave's `light_ramp` over
+/// `m = N·(e − p)/|e − p|` at its nearest centre-line point `e`, weighted by the densities'
+/// dominance rule), glowing waves add their light, and the feature texture multiplies the result.
+/// It writes linear colour into the HDR target, before the waves' light and the colour mapping,
+/// as hadou's wave pass does.
 #[derive(Asset, TypePath, AsBindGroup, Clone, Debug, PartialEq)]
 pub struct HadouMaterial {
     /// The uniform.
     #[uniform(0)]
     pub surface: HadouSurface,
+    /// The waves as lights ([`WAVE_LIGHTS`], kept by the plugin).
+    #[storage(1, read_only)]
+    pub lights: Handle<ShaderBuffer>,
+    /// Their count and polyline points ([`WAVE_LIGHT_DATA`], kept by the plugin).
+    #[storage(2, read_only)]
+    pub light_data: Handle<ShaderBuffer>,
+    /// The sRGB table and this material's texels ([`NO_TEXTURES`] without textures).
+    #[storage(3, read_only)]
+    pub textures: Handle<ShaderBuffer>,
 }
 
 impl HadouMaterial {
-    /// hadou's shading of `material` (its model, base colour and ramp) under `light`.
-    pub fn new(material: &hadou_scene::Material, light: &hadou_scene::Light) -> Self {
-        let [r, g, b] = material.base_color;
-        let v = |c: [f32; 3]| Vec4::new(c[0], c[1], c[2], 0.0);
-        let d = light.direction;
-        let model = match material.model {
-            ShadingModel::Unlit => hadou_gpu::layout::MODEL_UNLIT,
-            ShadingModel::Diffuse => hadou_gpu::layout::MODEL_DIFFUSE,
-            ShadingModel::Toon => hadou_gpu::layout::MODEL_TOON,
-        };
+    /// hadou's shading of `material` (its model, base colour, ramp, `wave_blend`, outline) under
+    /// `light` and the plugin's waves, without textures (see [`HadouMaterial::with_textures`]).
+    pub fn new(material: &hadou_scene::Material, light: &Light) -> Self {
         HadouMaterial {
-            surface: HadouSurface {
-                base_color: Vec4::new(r, g, b, 1.0),
-                light_direction: Vec4::new(d.x, d.y, d.z, 0.0),
-                light_color: v(light.color),
-                ambient: v(light.ambient),
-                model,
-                ramp: HadouRamp::new(&material.ramp),
-            },
+            surface: HadouSurface::new(material, light, [UVec4::ZERO; 2]),
+            lights: WAVE_LIGHTS,
+            light_data: WAVE_LIGHT_DATA,
+            textures: NO_TEXTURES,
         }
+    }
+
+    /// As [`HadouMaterial::new`], with `material`'s base and feature textures (sampled as hadou
+    /// samples them: level 0, bilinear in linear light or nearest, its wrap modes) in a buffer of
+    /// their own added to `buffers`.
+    pub fn with_textures(
+        material: &hadou_scene::Material,
+        light: &Light,
+        buffers: &mut Assets<ShaderBuffer>,
+    ) -> Self {
+        if material.base_texture.is_none() && material.feature_texture.is_none() {
+            return Self::new(material, light);
+        }
+        let mut data: Vec<u32> = layout::srgb_words().collect();
+        let mut store = TextureStore::default();
+        let base = store.texture(&mut data, &material.base_texture);
+        let feature = store.texture(&mut data, &material.feature_texture);
+        let textures = buffers.add(ShaderBuffer::new(bytes(&data), RenderAssetUsages::default()));
+        HadouMaterial {
+            surface: HadouSurface::new(material, light, [texture_words(base), texture_words(feature)]),
+            lights: WAVE_LIGHTS,
+            light_data: WAVE_LIGHT_DATA,
+            textures,
+        }
+    }
+
+    /// Sets the uniform from `material` and `light`, keeping the textures (e.g. when a track
+    /// changes `wave_blend`); false when nothing changed.
+    pub fn update(&mut self, material: &hadou_scene::Material, light: &Light) -> bool {
+        let textures = [self.surface.base_texture, self.surface.feature_texture];
+        let surface = HadouSurface::new(material, light, textures);
+        let changed = surface != self.surface;
+        self.surface = surface;
+        changed
     }
 }
 
@@ -147,4 +291,89 @@ impl Material for HadouMaterial {
     fn fragment_shader() -> ShaderRef {
         ShaderRef::Handle(SHADER)
     }
+}
+
+fn bytes(words: &[u32]) -> &[u8] {
+    bytemuck::cast_slice(words)
+}
+
+/// The initial contents of the plugin's buffers (no lights; no textures).
+pub(crate) fn insert_buffers(buffers: &mut Assets<ShaderBuffer>) {
+    let lights = vec![0u8; MAX_WAVE_LIGHTS * std::mem::size_of::<GpuLight>()];
+    let empty = |b: &[u8]| ShaderBuffer::new(b, RenderAssetUsages::default());
+    let data = vec![0u32; LIGHT_DATA_MIN_WORDS];
+    let srgb: Vec<u32> = layout::srgb_words().collect();
+    for (handle, buffer) in [
+        (&WAVE_LIGHTS, empty(&lights)),
+        (&WAVE_LIGHT_DATA, empty(bytes(&data))),
+        (&NO_TEXTURES, empty(bytes(&srgb))),
+    ] {
+        buffers.insert(handle, buffer).expect("a buffer under a fixed handle can be inserted");
+    }
+}
+
+/// The smallest size of [`WAVE_LIGHT_DATA`], in words; it grows by doubling.
+const LIGHT_DATA_MIN_WORDS: usize = 1024;
+
+/// What [`update_wave_lights`] last wrote.
+#[derive(Default)]
+pub(crate) struct LightsWritten {
+    lights: Vec<GpuLight>,
+    data: Vec<u32>,
+    capacity: usize,
+    warned: bool,
+}
+
+/// The records of `waves` as lights: the `GpuLight`s and the words of [`WAVE_LIGHT_DATA`]
+/// (count, any glow, then polyline points), at most [`MAX_WAVE_LIGHTS`].
+pub fn light_records(waves: &[Wave]) -> (Vec<GpuLight>, Vec<u32>) {
+    let waves = &waves[..waves.len().min(MAX_WAVE_LIGHTS)];
+    let mut data = vec![0u32; LIGHT_DATA_HEADER];
+    let lights = layout::wave_lights(waves, &[], &mut data);
+    data[0] = lights.len() as u32;
+    data[1] = u32::from(waves.iter().any(|w| w.light.glow > 0.0));
+    (lights, data)
+}
+
+/// Writes the enabled, accepted [`HadouWave`]s (by entity) into [`WAVE_LIGHTS`] and
+/// [`WAVE_LIGHT_DATA`] when they changed. The buffers keep their size while they can (the
+/// materials' bind groups then stay valid); when the points outgrow [`WAVE_LIGHT_DATA`] it doubles
+/// and every [`HadouMaterial`] is marked changed so that Bevy binds the new buffer.
+pub(crate) fn update_wave_lights(
+    waves: Query<(Entity, &HadouWave), Without<WaveRejected>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+    mut materials: ResMut<Assets<HadouMaterial>>,
+    mut written: Local<LightsWritten>,
+) {
+    let mut drawn: Vec<(Entity, &Wave)> =
+        waves.iter().filter(|(_, w)| w.enabled).map(|(e, w)| (e, &w.wave)).collect();
+    drawn.sort_by_key(|(e, _)| *e);
+    if drawn.len() > MAX_WAVE_LIGHTS && !written.warned {
+        written.warned = true;
+        warn!(
+            "{} waves are drawn; the first {MAX_WAVE_LIGHTS} (by entity) light the HadouMaterials",
+            drawn.len()
+        );
+    }
+    let owned: Vec<Wave> = drawn.into_iter().map(|(_, w)| w.clone()).collect();
+    let (lights, data) = light_records(&owned);
+    if written.capacity != 0 && lights == written.lights && data == written.data {
+        return;
+    }
+    let mut light_bytes = vec![0u8; MAX_WAVE_LIGHTS * std::mem::size_of::<GpuLight>()];
+    let used: &[u8] = bytemuck::cast_slice(&lights);
+    light_bytes[..used.len()].copy_from_slice(used);
+    let capacity = data.len().next_power_of_two().max(LIGHT_DATA_MIN_WORDS).max(written.capacity);
+    let mut words = data.clone();
+    words.resize(capacity, 0);
+    if let Some(mut b) = buffers.get_mut(&WAVE_LIGHTS) {
+        b.data = Some(light_bytes);
+    }
+    if let Some(mut b) = buffers.get_mut(&WAVE_LIGHT_DATA) {
+        b.data = Some(bytes(&words).to_vec());
+    }
+    if written.capacity != 0 && capacity != written.capacity {
+        for _ in materials.iter_mut() {}
+    }
+    *written = LightsWritten { lights, data, capacity, warned: written.warned };
 }

@@ -5,10 +5,12 @@
 use crate::asset::HadouScene;
 use crate::camera::{HadouCamera, ViewMapping};
 use crate::material::HadouMaterial;
+use crate::outline::{outline_mesh, HadouOutline};
 use crate::wave::HadouWave;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
+use bevy::render::storage::ShaderBuffer;
 use hadou_scene::Frame;
 
 /// Spawns the scene `scene` under this entity once it has loaded (nothing, with the loader's
@@ -40,8 +42,12 @@ pub struct SpawnedScene {
     pub camera: Entity,
     /// The directional light.
     pub light: Entity,
-    /// One entity per `[[object]]`.
+    /// One entity per `[[object]]` (its transform), with a child per material slot that has
+    /// triangles (`Mesh3d`, `HadouMaterial`) and one per outlined slot (`HadouOutline`).
     pub objects: Vec<Entity>,
+    /// Per object, the material of each slot (the object's materials in order), set from the
+    /// scene every frame (tracks may change `wave_blend`, colours, the light).
+    pub materials: Vec<Vec<Handle<HadouMaterial>>>,
     /// One entity per `[[wave]]`.
     pub waves: Vec<Entity>,
 }
@@ -76,6 +82,34 @@ pub fn bevy_mesh(mesh: &hadou_scene::Mesh) -> Mesh {
         out.insert_attribute(Mesh::ATTRIBUTE_COLOR, mesh.colors.clone());
     }
     out.insert_indices(Indices::U32(mesh.indices.clone()));
+    out
+}
+
+/// The slot a triangle of `mesh` is drawn with, of `slots` (its first vertex's, clamped as
+/// `Object::material` clamps it).
+fn triangle_slot(mesh: &hadou_scene::Mesh, first: u32, slots: usize) -> u32 {
+    mesh.material_of(first as usize).min(slots.saturating_sub(1) as u32)
+}
+
+/// The indices of `mesh`'s triangles drawn with material slot `slot` of `slots` (see
+/// `Object::material`: a slot past the last is the last).
+pub fn slot_indices_of(mesh: &hadou_scene::Mesh, slot: u32, slots: usize) -> Vec<u32> {
+    mesh.indices
+        .chunks_exact(3)
+        .filter(|t| triangle_slot(mesh, t[0], slots) == slot)
+        .flatten()
+        .copied()
+        .collect()
+}
+
+pub(crate) fn slot_indices(mesh: &hadou_scene::Mesh, slot: u32) -> Vec<u32> {
+    slot_indices_of(mesh, slot, mesh.materials.len().max(1))
+}
+
+/// [`bevy_mesh`] with only the triangles of material slot `slot` of `slots`.
+pub fn bevy_slot_mesh(mesh: &hadou_scene::Mesh, slot: u32, slots: usize) -> Mesh {
+    let mut out = bevy_mesh(mesh);
+    out.insert_indices(Indices::U32(slot_indices_of(mesh, slot, slots)));
     out
 }
 
@@ -114,25 +148,6 @@ pub fn unsupported(frame: &Frame) -> Vec<String> {
     if frame.area_light.is_some() {
         out.push("the [area_light] (soft shadows)".into());
     }
-    for object in &frame.objects {
-        let mut what = Vec::new();
-        let materials = &object.materials;
-        if materials.len() > 1 {
-            what.push(format!("{} material slots (the first is used)", materials.len()));
-        }
-        if materials.iter().any(|m| m.wave_blend > 0.0) {
-            what.push("wave_blend (the wave as a light)".into());
-        }
-        if materials.iter().any(|m| m.base_texture.is_some() || m.feature_texture.is_some()) {
-            what.push("textures".into());
-        }
-        if materials.iter().any(|m| m.outline.is_some()) {
-            what.push("outlines".into());
-        }
-        if !what.is_empty() {
-            out.push(format!("object \"{}\": {}", object.name, what.join(", ")));
-        }
-    }
     out
 }
 
@@ -151,6 +166,8 @@ pub(crate) fn spawn_scenes(
     scenes: Res<Assets<HadouScene>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<HadouMaterial>>,
+    mut outlines: ResMut<Assets<HadouOutline>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
     for (root, spawn) in &roots {
         let Some(HadouScene(scene)) = scenes.get(&spawn.scene) else { continue };
@@ -195,21 +212,48 @@ pub(crate) fn spawn_scenes(
                 ChildOf(root),
             ))
             .id();
-        let objects = frame
-            .objects
-            .iter()
-            .map(|object| {
-                commands
-                    .spawn((
-                        Name::new(object.name.clone()),
-                        Mesh3d(meshes.add(bevy_mesh(&object.mesh))),
-                        MeshMaterial3d(materials.add(HadouMaterial::new(object.material(0), &frame.light))),
-                        object_transform(object),
-                        ChildOf(root),
-                    ))
-                    .id()
-            })
-            .collect();
+        let mut objects = Vec::with_capacity(frame.objects.len());
+        let mut object_materials = Vec::with_capacity(frame.objects.len());
+        for object in &frame.objects {
+            let entity = commands
+                .spawn((
+                    Name::new(object.name.clone()),
+                    object_transform(object),
+                    Visibility::default(),
+                    ChildOf(root),
+                ))
+                .id();
+            let slots = object.materials.len().max(1);
+            let mut handles = Vec::with_capacity(slots);
+            for slot in 0..slots as u32 {
+                let material = object.material(slot);
+                let handle =
+                    materials.add(HadouMaterial::with_textures(material, &frame.light, &mut buffers));
+                handles.push(handle.clone());
+                let indices = slot_indices_of(&object.mesh, slot, slots);
+                if indices.is_empty() {
+                    continue;
+                }
+                let mut mesh = bevy_mesh(&object.mesh);
+                mesh.insert_indices(Indices::U32(indices));
+                commands.spawn((
+                    Name::new(format!("{} slot {slot}", object.name)),
+                    Mesh3d(meshes.add(mesh)),
+                    MeshMaterial3d(handle),
+                    ChildOf(entity),
+                ));
+                if let Some(outline) = material.outline.filter(|o| o.width > 0.0) {
+                    commands.spawn((
+                        Name::new(format!("{} slot {slot} outline", object.name)),
+                        Mesh3d(meshes.add(outline_mesh(&object.mesh, slot))),
+                        MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
+                        ChildOf(entity),
+                    ));
+                }
+            }
+            objects.push(entity);
+            object_materials.push(handles);
+        }
         let waves = frame
             .waves
             .iter()
@@ -219,7 +263,14 @@ pub(crate) fn spawn_scenes(
                     .id()
             })
             .collect();
-        commands.entity(root).insert(SpawnedScene { elapsed: 0.0, camera, light, objects, waves });
+        commands.entity(root).insert(SpawnedScene {
+            elapsed: 0.0,
+            camera,
+            light,
+            objects,
+            materials: object_materials,
+            waves,
+        });
     }
 }
 
@@ -230,6 +281,7 @@ pub(crate) fn animate_scenes(
     mut transforms: Query<&mut Transform, Without<HadouSceneRoot>>,
     mut cameras: Query<(&mut Projection, &mut HadouCamera)>,
     mut waves: Query<&mut HadouWave>,
+    mut materials: ResMut<Assets<HadouMaterial>>,
 ) {
     for (root, mut spawned) in &mut roots {
         let Some(HadouScene(scene)) = scenes.get(&root.scene) else { continue };
@@ -246,9 +298,23 @@ pub(crate) fn animate_scenes(
         if let Ok(mut t) = transforms.get_mut(spawned.light) {
             *t = light_transform(&frame);
         }
-        for (&entity, object) in spawned.objects.iter().zip(&frame.objects) {
+        for ((&entity, handles), object) in spawned.objects.iter().zip(&spawned.materials).zip(&frame.objects)
+        {
             if let Ok(mut t) = transforms.get_mut(entity) {
                 *t = object_transform(object);
+            }
+            for (slot, handle) in handles.iter().enumerate() {
+                let material = object.material(slot as u32);
+                // Only a material whose uniform changes is marked changed (and uploaded again).
+                let changed = materials.get(handle).is_some_and(|m| {
+                    let mut next = m.clone();
+                    next.update(material, &frame.light)
+                });
+                if changed {
+                    if let Some(mut m) = materials.get_mut(handle) {
+                        m.update(material, &frame.light);
+                    }
+                }
             }
         }
         for (&entity, wave) in spawned.waves.iter().zip(&frame.waves) {

@@ -347,30 +347,117 @@ fn wrap_bits(w: Wrap) -> u32 {
     }
 }
 
+/// Texels stored once per image in a data buffer of 32-bit words (RGBA8 packed little-endian),
+/// for [`material_record`]: the shading data of the wave pass, or one material's own buffer.
+#[derive(Debug, Default)]
+pub struct TextureStore {
+    stored: std::collections::HashMap<usize, u32>,
+}
+
+impl TextureStore {
+    /// Where `t`'s texels are in `data` (appended the first time this image is seen) and how it
+    /// is sampled; no texture gives a zeroed record (`offset` 0: opaque white).
+    pub fn texture(&mut self, data: &mut Vec<u32>, t: &Option<TextureRef>) -> GpuTexture {
+        let Some(t) = t else { return GpuTexture::zeroed() };
+        let key = std::sync::Arc::as_ptr(&t.image) as usize;
+        let offset = *self.stored.entry(key).or_insert_with(|| {
+            let o = data.len() as u32;
+            data.extend(t.image.texels.iter().map(|p| u32::from_le_bytes(*p)));
+            o
+        });
+        GpuTexture {
+            offset,
+            width: t.image.width,
+            height: t.image.height,
+            flags: wrap_bits(t.wrap[0])
+                | wrap_bits(t.wrap[1]) << 2
+                | u32::from(t.filter == Filter::Nearest) << 4,
+        }
+    }
+}
+
+/// The sRGB → linear table as the first 256 words of a shading data buffer (shading.wgsl's
+/// `srgb` reads it there).
+pub fn srgb_words() -> impl Iterator<Item = u32> {
+    hadou_math::toon::srgb_table().iter().map(|v| v.to_bits())
+}
+
+/// `m`'s record, its textures stored in `data` through `textures` (whose first 256 words must be
+/// [`srgb_words`]); `shadow_mask` as [`GpuMaterial::shadow_mask`].
+pub fn material_record(
+    m: &hadou_scene::Material,
+    shadow_mask: u32,
+    data: &mut Vec<u32>,
+    textures: &mut TextureStore,
+) -> GpuMaterial {
+    GpuMaterial {
+        base_color: m.base_color,
+        model: match m.model {
+            ShadingModel::Diffuse => MODEL_DIFFUSE,
+            ShadingModel::Toon => MODEL_TOON,
+            ShadingModel::Unlit => MODEL_UNLIT,
+        },
+        outline_color: m.outline.map_or([0.0; 3], |o| o.color),
+        wave_blend: m.wave_blend,
+        outline_width: m.outline.map_or(0.0, |o| o.width),
+        shadow_mask,
+        _pad1: 0,
+        _pad2: 0,
+        base_texture: textures.texture(data, &m.base_texture),
+        feature_texture: textures.texture(data, &m.feature_texture),
+        ramp: GpuRamp::new(&m.ramp),
+    }
+}
+
+/// The waves as lights (000 §2.1): one record per wave, its centre line (`Wave::light_line`),
+/// strength, glow, falloff, core radius and ramp; a polyline's points are appended to `data` (3
+/// `f32` bit patterns each) and the record holds their word offset in `data`. `curves` are the
+/// waves' prepared curves (`None` for an analytic wave, or to prepare it here).
+pub fn wave_lights(waves: &[Wave], curves: &[Option<PreparedCurve>], data: &mut Vec<u32>) -> Vec<GpuLight> {
+    let mut lights = Vec::with_capacity(waves.len());
+    for (i, w) in waves.iter().enumerate() {
+        let mut l = GpuLight::zeroed();
+        l.inverse_square = u32::from(w.falloff == Falloff::InverseSquare);
+        l.color = [w.color[0], w.color[1], w.color[2], w.core_radius];
+        l.ramp = GpuRamp::new(&w.light.ramp);
+        let (strength, glow) = (w.light_strength(), w.light.glow);
+        match w.light_line(curves.get(i).and_then(Option::as_ref)) {
+            LightLine::Point(p) => {
+                l.line_kind = LINE_POINT;
+                l.a = v4(p, strength);
+                l.b = v4(p, glow);
+            }
+            LightLine::Segment(p, q) => {
+                l.line_kind = LINE_SEGMENT;
+                l.a = v4(p, strength);
+                l.b = v4(q, glow);
+            }
+            LightLine::Line(p, d) => {
+                l.line_kind = LINE_LINE;
+                l.a = v4(p, strength);
+                l.b = v4(d, glow);
+            }
+            LightLine::Polyline(pts) => {
+                l.line_kind = LINE_POLYLINE;
+                l.point_offset = data.len() as u32;
+                l.point_count = pts.len() as u32;
+                data.extend(pts.iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]));
+                l.a = [0.0, 0.0, 0.0, strength];
+                l.b = [0.0, 0.0, 0.0, glow];
+            }
+        }
+        lights.push(l);
+    }
+    lights
+}
+
 impl ShadingBuffers {
     /// Builds the buffers of `frame`; `curves` are the frame's prepared curves (one per wave,
     /// `None` for analytic ones). Textures shared between materials are stored once.
     pub fn new(frame: &Frame, curves: &[Option<PreparedCurve>]) -> Self {
         let mut b = ShadingBuffers::default();
-        b.data.extend(hadou_math::toon::srgb_table().iter().map(|v| v.to_bits()));
-        let mut stored: std::collections::HashMap<usize, u32> = std::collections::HashMap::new();
-        let mut texture = |data: &mut Vec<u32>, t: &Option<TextureRef>| -> GpuTexture {
-            let Some(t) = t else { return GpuTexture::zeroed() };
-            let key = std::sync::Arc::as_ptr(&t.image) as usize;
-            let offset = *stored.entry(key).or_insert_with(|| {
-                let o = data.len() as u32;
-                data.extend(t.image.texels.iter().map(|p| u32::from_le_bytes(*p)));
-                o
-            });
-            GpuTexture {
-                offset,
-                width: t.image.width,
-                height: t.image.height,
-                flags: wrap_bits(t.wrap[0])
-                    | wrap_bits(t.wrap[1]) << 2
-                    | u32::from(t.filter == Filter::Nearest) << 4,
-            }
-        };
+        b.data.extend(srgb_words());
+        let mut textures = TextureStore::default();
         for (oi, o) in frame.objects.iter().enumerate() {
             b.material_base.push(b.materials.len() as u32);
             let shadow_mask = frame
@@ -384,58 +471,10 @@ impl ShadingBuffers {
             let mats: &[hadou_scene::Material] =
                 if o.materials.is_empty() { &fallback } else { &o.materials };
             for m in mats {
-                b.materials.push(GpuMaterial {
-                    base_color: m.base_color,
-                    model: match m.model {
-                        ShadingModel::Diffuse => MODEL_DIFFUSE,
-                        ShadingModel::Toon => MODEL_TOON,
-                        ShadingModel::Unlit => MODEL_UNLIT,
-                    },
-                    outline_color: m.outline.map_or([0.0; 3], |o| o.color),
-                    wave_blend: m.wave_blend,
-                    outline_width: m.outline.map_or(0.0, |o| o.width),
-                    shadow_mask,
-                    _pad1: 0,
-                    _pad2: 0,
-                    base_texture: texture(&mut b.data, &m.base_texture),
-                    feature_texture: texture(&mut b.data, &m.feature_texture),
-                    ramp: GpuRamp::new(&m.ramp),
-                });
+                b.materials.push(material_record(m, shadow_mask, &mut b.data, &mut textures));
             }
         }
-        for (w, c) in frame.waves.iter().zip(curves) {
-            let mut l = GpuLight::zeroed();
-            l.inverse_square = u32::from(w.falloff == Falloff::InverseSquare);
-            l.color = [w.color[0], w.color[1], w.color[2], w.core_radius];
-            l.ramp = GpuRamp::new(&w.light.ramp);
-            let (strength, glow) = (w.light_strength(), w.light.glow);
-            match w.light_line(c.as_ref()) {
-                LightLine::Point(p) => {
-                    l.line_kind = LINE_POINT;
-                    l.a = v4(p, strength);
-                    l.b = v4(p, glow);
-                }
-                LightLine::Segment(p, q) => {
-                    l.line_kind = LINE_SEGMENT;
-                    l.a = v4(p, strength);
-                    l.b = v4(q, glow);
-                }
-                LightLine::Line(p, d) => {
-                    l.line_kind = LINE_LINE;
-                    l.a = v4(p, strength);
-                    l.b = v4(d, glow);
-                }
-                LightLine::Polyline(pts) => {
-                    l.line_kind = LINE_POLYLINE;
-                    l.point_offset = b.data.len() as u32;
-                    l.point_count = pts.len() as u32;
-                    b.data.extend(pts.iter().flat_map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]));
-                    l.a = [0.0, 0.0, 0.0, strength];
-                    l.b = [0.0, 0.0, 0.0, glow];
-                }
-            }
-            b.lights.push(l);
-        }
+        b.lights = wave_lights(&frame.waves, curves, &mut b.data);
         b
     }
 }

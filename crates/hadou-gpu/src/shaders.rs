@@ -3,7 +3,7 @@
 //! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
 //! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
 //! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
-//!   `shading.wgsl` + `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as
+//!   `shading_bindings.wgsl` + `shading.wgsl` + `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as
 //!   lights, hard shadows, energy integration, colour mapping);
 //! - wave overlay module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
 //!   `wave_overlay.wgsl` (the waves' light into a caller's colour target against its depth);
@@ -23,8 +23,13 @@ pub const COMMON: &str = include_str!("shaders/common.wgsl");
 pub const ENERGY: &str = include_str!("shaders/energy.wgsl");
 /// WGSL twins of `hadou_math::curve` (shape evaluation, default and Simpson integrators).
 pub const CURVE: &str = include_str!("shaders/curve.wgsl");
-/// WGSL twins of `hadou_math::toon` and `hadou-cpu`'s surface shading.
+/// WGSL twins of `hadou_math::toon` and `hadou-cpu`'s surface shading. It reads the bindings of
+/// [`SHADING_BINDINGS`] (or a composer's own with the same names: `lights`, `shading_data`,
+/// `polyline_point`) and a `frame` with the light, the wave count and `any_glow`.
 pub const SHADING: &str = include_str!("shaders/shading.wgsl");
+/// The wave pass's bindings of [`SHADING`] (materials, lights, shading data) and its
+/// `polyline_point`.
+pub const SHADING_BINDINGS: &str = include_str!("shaders/shading_bindings.wgsl");
 /// The opaque geometry pass.
 pub const RASTER: &str = include_str!("shaders/raster.wgsl");
 /// The wave pass.
@@ -52,6 +57,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("present.wgsl", PRESENT),
     ("raster.wgsl", RASTER),
     ("shading.wgsl", SHADING),
+    ("shading_bindings.wgsl", SHADING_BINDINGS),
     ("shadow_lookup.wgsl", SHADOW_LOOKUP),
     ("shadow_raster.wgsl", SHADOW_RASTER),
     ("soft.wgsl", SOFT),
@@ -64,7 +70,8 @@ pub const FILES: &[(&str, &str)] = &[
 /// The parts of the raster module, in order.
 pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
-pub const WAVE_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE_ENERGY, SHADING, SHADOW_LOOKUP, WAVE];
+pub const WAVE_PARTS: &[&str] =
+    &[COMMON, ENERGY, CURVE, WAVE_ENERGY, SHADING_BINDINGS, SHADING, SHADOW_LOOKUP, WAVE];
 /// The parts of the wave overlay module, in order.
 pub const WAVE_OVERLAY_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE_ENERGY, WAVE_OVERLAY];
 /// The parts of the shadow module, in order.

@@ -1,14 +1,9 @@
 // Surface shading of the wave pass: twins of hadou_math::toon (ramps, nearest points of centre
 // lines, dominance weights, texture sampling) and of hadou-cpu's shading::shade (000 §2.1–2.2,
-// SPEC.md §2.1–2.2). Prepended to wave.wgsl; the bindings are part of the wave pass's group.
-
-// One per material of every object (layout::ShadingBuffers::materials).
-@group(0) @binding(8) var<storage, read> materials: array<GpuMaterial>;
-// One per wave (layout::ShadingBuffers::lights).
-@group(0) @binding(9) var<storage, read> lights: array<GpuLight>;
-// Words: the sRGB → linear table (256 f32 bit patterns), texels (RGBA8, little-endian), polyline
-// points (3 f32 bit patterns each). layout::ShadingBuffers::data.
-@group(0) @binding(10) var<storage, read> shading_data: array<u32>;
+// SPEC.md §2.1–2.2). It reads `lights`, `shading_data` and `polyline_point` from
+// shading_bindings.wgsl (the wave pass) or from whoever composes it in their place (hadou-bevy's
+// material declares its own), and `frame`'s light_dir, light_color, ambient, wave_count,
+// any_glow, area_position and area_color.
 
 // The shading the frame's materials and lights need (pipeline-overridable; see USE_SPHERE in
 // wave.wgsl): toon-model materials, textures (base or feature), the waves as lights (some material
@@ -30,11 +25,6 @@ fn nearest_on_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     }
     let t = clamp(dot3(p - a, d) / dd, 0.0, 1.0);
     return a + d * t;
-}
-
-fn polyline_point(offset: u32, i: u32) -> vec3<f32> {
-    let o = offset + 3u * i;
-    return vec3<f32>(bitcast<f32>(shading_data[o]), bitcast<f32>(shading_data[o + 1u]), bitcast<f32>(shading_data[o + 2u]));
 }
 
 // Mirrors hadou_scene::LightLine::nearest.

@@ -1,0 +1,153 @@
+//! [`HadouOutline`]: hadou's inverted-hull outline (000 §2.3, SPEC.md §2.3) as a Bevy material, for
+//! a second mesh entity drawn over the same mesh: each vertex pushed along its world outline
+//! normal by `d·|z|` (its view depth `z`, so the line keeps its width on screen), front faces
+//! culled, so only the hull's back faces show around the silhouette, in the outline colour. The
+//! twin of hadou-gpu's `vs_hull` (raster.wgsl) and hadou-cpu's `opaque::project_all`.
+
+use bevy::asset::uuid_handle;
+use bevy::mesh::MeshVertexBufferLayoutRef;
+use bevy::pbr::{Material, MaterialPipeline, MaterialPipelineKey};
+use bevy::prelude::*;
+use bevy::render::render_resource::{
+    AsBindGroup, Face, RenderPipelineDescriptor, ShaderType, SpecializedMeshPipelineError,
+};
+use bevy::shader::ShaderRef;
+
+/// The shader of [`HadouOutline`] (vertex and fragment), inserted at start-up.
+pub(crate) const SHADER: Handle<Shader> = uuid_handle!("3f6b8d0a-2c4e-4a6f-9b1d-3e5f7a9c1b19");
+
+/// The WGSL of [`HadouOutline`].
+pub(crate) const SOURCE: &str = r"
+#import bevy_pbr::mesh_functions
+#import bevy_pbr::view_transformations::position_world_to_clip
+#import bevy_pbr::mesh_view_bindings::view
+
+struct HadouOutlineUniform {
+    color: vec4<f32>,
+    width: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+@group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> outline: HadouOutlineUniform;
+
+struct Vertex {
+    @builtin(instance_index) instance_index: u32,
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+}
+
+// The hull vertex (000 §2.3): R' = R + d·|R_z|·U, U the unit world outline normal, R_z the view
+// depth of the vertex (hadou-gpu's vs_hull).
+@vertex
+fn vertex(v: Vertex) -> @builtin(position) vec4<f32> {
+    let world_from_local = mesh_functions::get_world_from_local(v.instance_index);
+    let base = mesh_functions::mesh_position_local_to_world(world_from_local, vec4<f32>(v.position, 1.0)).xyz;
+    let n = mesh_functions::mesh_normal_local_to_world(v.normal, v.instance_index);
+    let len = length(n);
+    var u = vec3<f32>(0.0);
+    if (len > 0.0 && len < 3.0e38) {
+        u = n / len;
+    }
+    let forward = -normalize(view.world_from_view[2].xyz);
+    let z = dot(base - view.world_position, forward);
+    return position_world_to_clip(base + u * (outline.width * abs(z)));
+}
+
+@fragment
+fn fragment() -> @location(0) vec4<f32> {
+    return vec4<f32>(outline.color.xyz, 1.0);
+}
+";
+
+/// The outline's colour and width, as the shader reads them.
+#[derive(Clone, Copy, Debug, PartialEq, ShaderType)]
+pub struct HadouOutlineUniform {
+    /// Linear RGB outline colour (`w` unused).
+    pub color: Vec4,
+    /// `outline_width` `d`: the push along the normal per unit of view depth.
+    pub width: f32,
+    /// Padding.
+    pub pad0: u32,
+    /// Padding.
+    pub pad1: u32,
+    /// Padding.
+    pub pad2: u32,
+}
+
+/// hadou's inverted-hull outline of a mesh (a `[[material]]`'s `outline`, `outline_color`,
+/// `outline_width`): put it with the same mesh as the shaded entity (whose `NORMAL`s may be
+/// replaced by outline normals, averaged per position, so the hull stays closed at hard edges:
+/// [`crate::outline_mesh`]). Writes its colour into the HDR target, depth-tested like any opaque
+/// mesh; no shadows or prepass.
+#[derive(Asset, TypePath, AsBindGroup, Clone, Debug, PartialEq)]
+pub struct HadouOutline {
+    /// The uniform.
+    #[uniform(0)]
+    pub outline: HadouOutlineUniform,
+}
+
+impl HadouOutline {
+    /// The outline of `outline` (colour, width).
+    pub fn new(outline: &hadou_scene::Outline) -> Self {
+        let [r, g, b] = outline.color;
+        HadouOutline {
+            outline: HadouOutlineUniform {
+                color: Vec4::new(r, g, b, 1.0),
+                width: outline.width,
+                pad0: 0,
+                pad1: 0,
+                pad2: 0,
+            },
+        }
+    }
+}
+
+impl Material for HadouOutline {
+    fn vertex_shader() -> ShaderRef {
+        ShaderRef::Handle(SHADER)
+    }
+
+    fn fragment_shader() -> ShaderRef {
+        ShaderRef::Handle(SHADER)
+    }
+
+    fn enable_prepass() -> bool {
+        false
+    }
+
+    fn enable_shadows() -> bool {
+        false
+    }
+
+    fn specialize(
+        _pipeline: &MaterialPipeline,
+        descriptor: &mut RenderPipelineDescriptor,
+        layout: &MeshVertexBufferLayoutRef,
+        _key: MaterialPipelineKey<Self>,
+    ) -> Result<(), SpecializedMeshPipelineError> {
+        let buffer = layout.0.get_layout(&[
+            Mesh::ATTRIBUTE_POSITION.at_shader_location(0),
+            Mesh::ATTRIBUTE_NORMAL.at_shader_location(1),
+        ])?;
+        descriptor.vertex.buffers = vec![buffer];
+        descriptor.primitive.cull_mode = Some(Face::Front);
+        Ok(())
+    }
+}
+
+/// The hull mesh of `mesh`'s material slot `slot`: its positions, its outline normals (or its
+/// normals when it has none) as `NORMAL`, and the triangles of that slot.
+pub fn outline_mesh(mesh: &hadou_scene::Mesh, slot: u32) -> Mesh {
+    let normals = if mesh.outline_normals.len() == mesh.positions.len() {
+        mesh.outline_normals.clone()
+    } else {
+        mesh.normals.clone()
+    };
+    let mut out =
+        Mesh::new(bevy::mesh::PrimitiveTopology::TriangleList, bevy::asset::RenderAssetUsages::default());
+    out.insert_attribute(Mesh::ATTRIBUTE_POSITION, mesh.positions.clone());
+    out.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
+    out.insert_indices(bevy::mesh::Indices::U32(crate::spawn::slot_indices(mesh, slot)));
+    out
+}
