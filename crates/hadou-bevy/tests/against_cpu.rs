@@ -264,3 +264,36 @@ fn toon_materials_in_bevy_are_the_picture_of_hadou_render() {
     eprintln!("against the same scene shaded as diffuse: mean {diffuse_mean:.3}");
     assert!(diffuse_mean > MAX_MEAN, "the toon picture is the diffuse one ({diffuse_mean:.3})");
 }
+
+/// The wave as a light (000 Fig. 4.3–4.4): a textured, outlined glTF character of several
+/// material slots whose `wave_blend` a track takes to 1 as a beam fires behind it. Against
+/// hadou-cpu's render of the same frame; and not the picture without the wave's light.
+#[test]
+fn the_wave_as_a_light_in_bevy_is_the_picture_of_hadou_render() {
+    let test = "the_wave_as_a_light_in_bevy_is_the_picture_of_hadou_render";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let mut frame = hadou_scene::Scene::load(scenes().join("light-normal-vs-wave.toml")).unwrap().at(0.75);
+    let materials = || frame.objects.iter().flat_map(|o| &o.materials);
+    assert!(materials().any(|m| m.wave_blend > 0.0), "the frame blends towards the wave");
+    assert!(materials().any(|m| m.feature_texture.is_some() || m.base_texture.is_some()));
+    assert!(materials().any(|m| m.outline.is_some()));
+    assert!(frame.objects.iter().any(|o| o.materials.len() > 1));
+    let reference = hadou_cpu::render(&frame);
+    let (bevy, _) = bevy_picture("light-normal-vs-wave.toml", 0.75, (frame.width, frame.height), None);
+    let (mean, max) = difference(&bevy, &reference);
+    eprintln!(
+        "light-normal-vs-wave.toml at t = 0.75, {}×{}: mean {mean:.3}, largest {max}",
+        frame.width, frame.height
+    );
+    assert!(mean <= MAX_MEAN, "mean absolute 8-bit difference {mean:.3} > {MAX_MEAN} (largest {max})");
+    for object in &mut frame.objects {
+        for material in &mut object.materials {
+            material.wave_blend = 0.0;
+        }
+    }
+    let (unlit_mean, _) = difference(&bevy, &hadou_cpu::render(&frame));
+    eprintln!("against the same frame without the wave's light: mean {unlit_mean:.3}");
+    assert!(unlit_mean > MAX_MEAN, "the wave's light is not on the character ({unlit_mean:.3})");
+}
