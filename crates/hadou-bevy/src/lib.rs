@@ -43,7 +43,7 @@ pub use material::{
 };
 pub use outline::{outline_mesh, HadouOutline, HadouOutlineUniform};
 pub use spawn::{
-    bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, unsupported, HadouSceneRoot, SceneClock,
+    bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, spawn_object, unsupported, ObjectAssets, HadouSceneRoot, SceneClock,
     SpawnedScene,
 };
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};

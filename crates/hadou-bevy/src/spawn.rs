@@ -160,6 +160,61 @@ pub fn scene_time(clock: SceneClock, elapsed: f32, duration: f32) -> f32 {
     }
 }
 
+/// The asset collections [`spawn_object`] adds to.
+pub struct ObjectAssets<'a> {
+    /// Meshes.
+    pub meshes: &'a mut Assets<Mesh>,
+    /// Shaded materials.
+    pub materials: &'a mut Assets<HadouMaterial>,
+    /// Outline materials.
+    pub outlines: &'a mut Assets<HadouOutline>,
+    /// Texture buffers.
+    pub buffers: &'a mut Assets<ShaderBuffer>,
+}
+
+/// Spawns a hadou `[[object]]` under `light`: an entity with its name and transform, with a child
+/// per material slot that has triangles (`Mesh3d`, a [`HadouMaterial`] with the slot's textures)
+/// and one per outlined slot ([`HadouOutline`] over [`crate::outline_mesh`]). Returns the entity
+/// and the material of every slot (the object's materials in order), e.g. to change `wave_blend`.
+pub fn spawn_object(
+    commands: &mut Commands,
+    assets: &mut ObjectAssets,
+    object: &hadou_scene::Object,
+    light: &hadou_scene::Light,
+) -> (Entity, Vec<Handle<HadouMaterial>>) {
+    let entity = commands
+        .spawn((Name::new(object.name.clone()), object_transform(object), Visibility::default()))
+        .id();
+    let slots = object.materials.len().max(1);
+    let mut handles = Vec::with_capacity(slots);
+    for slot in 0..slots as u32 {
+        let material = object.material(slot);
+        let handle = assets.materials.add(HadouMaterial::with_textures(material, light, assets.buffers));
+        handles.push(handle.clone());
+        let indices = slot_indices_of(&object.mesh, slot, slots);
+        if indices.is_empty() {
+            continue;
+        }
+        let mut mesh = bevy_mesh(&object.mesh);
+        mesh.insert_indices(Indices::U32(indices));
+        commands.spawn((
+            Name::new(format!("{} slot {slot}", object.name)),
+            Mesh3d(assets.meshes.add(mesh)),
+            MeshMaterial3d(handle),
+            ChildOf(entity),
+        ));
+        if let Some(outline) = material.outline.filter(|o| o.width > 0.0) {
+            commands.spawn((
+                Name::new(format!("{} slot {slot} outline", object.name)),
+                Mesh3d(assets.meshes.add(outline_mesh(&object.mesh, slot))),
+                MeshMaterial3d(assets.outlines.add(HadouOutline::new(&outline))),
+                ChildOf(entity),
+            ));
+        }
+    }
+    (entity, handles)
+}
+
 pub(crate) fn spawn_scenes(
     mut commands: Commands,
     roots: Query<(Entity, &HadouSceneRoot), Without<SpawnedScene>>,
@@ -214,43 +269,15 @@ pub(crate) fn spawn_scenes(
             .id();
         let mut objects = Vec::with_capacity(frame.objects.len());
         let mut object_materials = Vec::with_capacity(frame.objects.len());
+        let mut assets = ObjectAssets {
+            meshes: &mut meshes,
+            materials: &mut materials,
+            outlines: &mut outlines,
+            buffers: &mut buffers,
+        };
         for object in &frame.objects {
-            let entity = commands
-                .spawn((
-                    Name::new(object.name.clone()),
-                    object_transform(object),
-                    Visibility::default(),
-                    ChildOf(root),
-                ))
-                .id();
-            let slots = object.materials.len().max(1);
-            let mut handles = Vec::with_capacity(slots);
-            for slot in 0..slots as u32 {
-                let material = object.material(slot);
-                let handle =
-                    materials.add(HadouMaterial::with_textures(material, &frame.light, &mut buffers));
-                handles.push(handle.clone());
-                let indices = slot_indices_of(&object.mesh, slot, slots);
-                if indices.is_empty() {
-                    continue;
-                }
-                let mut mesh = bevy_mesh(&object.mesh);
-                mesh.insert_indices(Indices::U32(indices));
-                commands.spawn((
-                    Name::new(format!("{} slot {slot}", object.name)),
-                    Mesh3d(meshes.add(mesh)),
-                    MeshMaterial3d(handle),
-                    ChildOf(entity),
-                ));
-                if let Some(outline) = material.outline.filter(|o| o.width > 0.0) {
-                    commands.spawn((
-                        Name::new(format!("{} slot {slot} outline", object.name)),
-                        Mesh3d(meshes.add(outline_mesh(&object.mesh, slot))),
-                        MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
-                        ChildOf(entity),
-                    ));
-                }
-            }
+            let (entity, handles) = spawn_object(&mut commands, &mut assets, object, &frame.light);
+            commands.entity(entity).insert(ChildOf(root));
             objects.push(entity);
             object_materials.push(handles);
         }
