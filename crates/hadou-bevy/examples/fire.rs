@@ -239,7 +239,8 @@ fn orbit(
         o.pitch = o.pitch.clamp(-0.2, 1.4);
         o.distance = o.distance.clamp(1.5, 30.0);
         let offset = Vec3::new(o.yaw.sin() * o.pitch.cos(), o.pitch.sin(), o.yaw.cos() * o.pitch.cos());
-        *transform = Transform::from_translation(o.target + offset * o.distance).looking_at(o.target, Vec3::Y);
+        *transform =
+            Transform::from_translation(o.target + offset * o.distance).looking_at(o.target, Vec3::Y);
     }
 }
 

@@ -43,8 +43,8 @@ pub use material::{
 };
 pub use outline::{outline_mesh, HadouOutline, HadouOutlineUniform};
 pub use spawn::{
-    bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, spawn_object, unsupported, ObjectAssets, HadouSceneRoot, SceneClock,
-    SpawnedScene,
+    bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, spawn_object, unsupported, HadouSceneRoot,
+    ObjectAssets, SceneClock, SpawnedScene,
 };
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 
