@@ -110,7 +110,9 @@ impl Plugin for HadouPlugin {
             if app.world().contains_resource::<Assets<Mesh>>() {
                 app.add_systems(
                     Update,
-                    (spawn::spawn_scenes, spawn::animate_scenes).chain().in_set(HadouSystems::Scenes),
+                    (spawn::reload_scenes, spawn::spawn_scenes, spawn::animate_scenes)
+                        .chain()
+                        .in_set(HadouSystems::Scenes),
                 );
             }
         }

@@ -301,6 +301,36 @@ pub(crate) fn spawn_scenes(
     }
 }
 
+/// Hot reload: a root whose scene asset changed (Bevy's asset server reloads a watched file, or a
+/// system replaced the asset) loses what it spawned and spawns the new scene; its clock starts
+/// again. A reload that fails leaves the last good scene in place (the asset server logs the
+/// loader's `file:line:col` message).
+pub(crate) fn reload_scenes(
+    mut commands: Commands,
+    mut events: MessageReader<AssetEvent<HadouScene>>,
+    roots: Query<(Entity, &HadouSceneRoot), With<SpawnedScene>>,
+    scenes: Res<Assets<HadouScene>>,
+) {
+    let modified: Vec<AssetId<HadouScene>> = events
+        .read()
+        .filter_map(|e| match e {
+            AssetEvent::Modified { id } => Some(*id),
+            _ => None,
+        })
+        .collect();
+    if modified.is_empty() {
+        return;
+    }
+    for (root, spawn) in &roots {
+        if modified.contains(&spawn.scene.id()) {
+            if let Some(HadouScene(scene)) = scenes.get(&spawn.scene) {
+                info!("{}: changed; spawning it again", scene.path().display());
+            }
+            commands.entity(root).despawn_related::<Children>().remove::<SpawnedScene>();
+        }
+    }
+}
+
 pub(crate) fn animate_scenes(
     time: Res<Time>,
     mut roots: Query<(&HadouSceneRoot, &mut SpawnedScene)>,

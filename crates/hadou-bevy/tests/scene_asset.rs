@@ -98,9 +98,11 @@ fn a_loaded_scene_spawns_its_entities_at_the_frozen_time() {
     let camera = app.world().get::<HadouCamera>(spawned.camera).expect("the camera gets the wave pass");
     assert_eq!(camera.far, reference.camera.far);
     assert_eq!(camera.mapping, ViewMapping::Hadou(reference.color_mapping.mode), "the scene's [color] mode");
-    assert!(app.world().get::<Mesh3d>(spawned.objects[0]).is_some());
-    let material =
-        app.world().get::<MeshMaterial3d<HadouMaterial>>(spawned.objects[0]).expect("hadou's shading");
+    let children = app.world().get::<Children>(spawned.objects[0]).expect("the object's slots");
+    let slot = children[0];
+    assert!(app.world().get::<Mesh3d>(slot).is_some());
+    let material = app.world().get::<MeshMaterial3d<HadouMaterial>>(slot).expect("hadou's shading");
+    assert_eq!(material.0, spawned.materials[0][0]);
     let surface = app.world().resource::<Assets<HadouMaterial>>().get(&material.0).unwrap().surface;
     let ground = reference.objects[0].material(0).base_color;
     assert_eq!(surface.base_color.truncate().to_array(), ground);
@@ -125,8 +127,56 @@ fn what_is_not_drawn_yet_is_named() {
     let missing = unsupported(&frame).join("; ");
     assert!(missing.contains("[[shadow]]"), "{missing}");
     let frame = hadou_scene::Scene::load(scenes.join("light-normal-vs-wave.toml")).unwrap().at(0.75);
-    let missing = unsupported(&frame).join("; ");
-    assert!(missing.contains("wave_blend") && !missing.contains("toon"), "toon ramps are drawn: {missing}");
+    assert_eq!(
+        unsupported(&frame),
+        Vec::<String>::new(),
+        "the wave as a light, textures, material slots and outlines are drawn"
+    );
     let frame = hadou_scene::Scene::load(scenes.join("kamehameha.toml")).unwrap().at(1.5);
     assert_eq!(unsupported(&frame), Vec::<String>::new(), "kamehameha (filmic) uses nothing unsupported");
+}
+
+const ONE_WAVE: &str = "[image]\nwidth = 64\nheight = 32\n\n[[wave]]\nname = \"a\"\nkind = \"sphere\"\nM = [0.0, 0.0, 0.0]\nalpha_s = 0.1\n";
+
+#[test]
+fn a_changed_scene_file_is_spawned_again_and_a_broken_one_keeps_the_last() {
+    let dir = asset_dir("reload", &[("live.toml", ONE_WAVE)]);
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin {
+            file_path: dir.display().to_string(),
+            watch_for_changes_override: Some(true),
+            ..default()
+        },
+        bevy::mesh::MeshPlugin,
+    ));
+    app.add_plugins(HadouPlugin { asset_root: dir.clone() });
+    let handle: Handle<HadouScene> = app.world().resource::<AssetServer>().load("live.toml");
+    let root =
+        app.world_mut().spawn(HadouSceneRoot { scene: handle.clone(), clock: SceneClock::Frozen(0.0) }).id();
+    update_until(&mut app, |app| app.world().get::<SpawnedScene>(root).is_some());
+    let first = app.world().get::<SpawnedScene>(root).unwrap().waves.clone();
+    assert_eq!(first.len(), 1);
+
+    let two = format!(
+        "{ONE_WAVE}\n[[wave]]\nname = \"b\"\nkind = \"sphere\"\nM = [1.0, 0.0, 0.0]\nalpha_s = 0.1\n"
+    );
+    std::fs::write(dir.join("live.toml"), two).unwrap();
+    update_until(&mut app, |app| app.world().get::<SpawnedScene>(root).is_some_and(|s| s.waves.len() == 2));
+    app.update();
+    assert!(app.world().get_entity(first[0]).is_err(), "what the old scene spawned is gone");
+    let waves = app.world_mut().query::<&HadouWave>().iter(app.world()).count();
+    assert_eq!(waves, 2, "no wave of the old scene is left");
+
+    std::fs::write(dir.join("live.toml"), BAD).unwrap();
+    update_until(&mut app, |app| {
+        matches!(app.world().resource::<AssetServer>().load_state(&handle), LoadState::Failed(_))
+    });
+    for _ in 0..5 {
+        app.update();
+    }
+    let spawned = app.world().get::<SpawnedScene>(root).expect("the last good scene stays");
+    assert_eq!(spawned.waves.len(), 2);
+    std::fs::remove_dir_all(&dir).ok();
 }
