@@ -1,5 +1,7 @@
 //! A small game: a toon character on a ground; Space fires a Kamehameha past it whose light sweeps
-//! the character (its materials blend towards the wave's look, 000 §2.1), bloomed by Bevy.
+//! the character (its materials blend towards the wave's look, 000 §2.1) and whose shadow leans
+//! away from the beam along the ground (the wave's stylized shadow, 000 §2.4, θ = 60°), bloomed
+//! by Bevy.
 //! Drag with the left mouse button (or the arrow keys) to orbit the camera, the wheel (or +/−)
 //! to move in and out. The window's title and the log report the frame time.
 //!
@@ -21,9 +23,10 @@ use bevy::render::view::screenshot::{save_to_disk, Screenshot, ScreenshotCapture
 use bevy::render::RenderPlugin;
 use bevy::window::{PrimaryWindow, WindowResolution};
 use hadou_bevy::{
-    spawn_object, HadouCamera, HadouMaterial, HadouOutline, HadouPlugin, HadouWave, ObjectAssets, ViewMapping,
+    shadow_mask, spawn_object, HadouCamera, HadouMaterial, HadouOutline, HadouPlugin, HadouShadows,
+    HadouWave, ObjectAssets, ViewMapping,
 };
-use hadou_scene::{Frame, WaveShape};
+use hadou_scene::{Frame, Shadow, ShadowLight, ShadowMethod, WaveShape};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -35,6 +38,10 @@ const HOLD_SECONDS: f32 = 1.5;
 const FADE_SECONDS: f32 = 0.6;
 /// The beam's full length.
 const FULL_LENGTH: f32 = 6.5;
+/// The longest-shadow angle θ of the beam's shadow, degrees from straight down.
+const SHADOW_THETA_DEG: f32 = 60.0;
+/// The shadow's opacity while the beam is at full strength.
+const SHADOW_OPACITY: f32 = 0.75;
 
 #[derive(Resource, Clone)]
 struct Options {
@@ -136,7 +143,20 @@ fn setup(
     mut outlines: ResMut<Assets<HadouOutline>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
 ) {
-    let frame = start.0.clone();
+    let mut frame = start.0.clone();
+    let index =
+        |name: &str| frame.objects.iter().position(|o| o.name == name).expect("the scene's objects") as u32;
+    let (hero, ground) = (index("hero"), index("ground"));
+    frame.shadows.push(Shadow {
+        name: "beam".into(),
+        light: ShadowLight::Wave { wave: 0, theta: SHADOW_THETA_DEG.to_radians() },
+        method: ShadowMethod::Map { size: 2048 },
+        up: hadou_math::Vec3f::new(0.0, 1.0, 0.0),
+        casters: vec![hero],
+        receivers: vec![ground],
+        color: [0.02, 0.02, 0.08],
+        opacity: 0.0,
+    });
     let target = Vec3::new(0.0, 0.95, 0.0);
     let c = frame.background;
     commands.spawn((
@@ -157,7 +177,8 @@ fn setup(
     };
     let mut handles = Vec::new();
     for (o, object) in frame.objects.iter().enumerate() {
-        let (_, slots) = spawn_object(&mut commands, &mut assets, object, &frame.light);
+        let mask = shadow_mask(&frame, o as u32);
+        let (_, slots) = spawn_object(&mut commands, &mut assets, object, &frame.light, mask);
         let full = |s: usize| start.1.objects[o].material(s as u32).wave_blend;
         handles.extend(slots.into_iter().enumerate().map(|(s, h)| (o, s as u32, full(s), h)));
     }
@@ -189,6 +210,7 @@ fn fire(
     mut game: ResMut<Game>,
     mut waves: Query<&mut HadouWave>,
     mut materials: ResMut<Assets<HadouMaterial>>,
+    mut shadows: ResMut<HadouShadows>,
 ) {
     if options.time.is_none() {
         if keys.just_pressed(KeyCode::Space) {
@@ -204,6 +226,11 @@ fn fire(
             b.capsule.length = length;
         }
         wave.wave.color[3] = strength;
+        // The shadow follows the beam: its light line and strength.
+        let mut frame = game.frame.clone();
+        frame.waves[0] = wave.wave.clone();
+        frame.shadows[0].opacity = SHADOW_OPACITY * strength;
+        shadows.frame = Some(frame);
     }
     let Game { frame, materials: handles, .. } = &*game;
     for (o, s, full, handle) in handles {

@@ -31,6 +31,7 @@ mod camera;
 mod material;
 mod outline;
 mod render;
+mod shadows;
 mod spawn;
 mod tone;
 mod wave;
@@ -42,6 +43,9 @@ pub use material::{
     WAVE_LIGHT_DATA,
 };
 pub use outline::{outline_mesh, HadouOutline, HadouOutlineUniform};
+pub use shadows::{
+    shadow_frame, shadow_mask, shadow_records, HadouShadows, PLANE_MAP_SIZE, SHADOW_DATA, SHADOW_MAPS,
+};
 pub use spawn::{
     bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, spawn_object, unsupported, HadouSceneRoot,
     ObjectAssets, SceneClock, SpawnedScene,
@@ -55,7 +59,7 @@ use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use bevy::render::storage::ShaderBuffer;
-use bevy::render::{ExtractSchedule, RenderApp, RenderStartup};
+use bevy::render::{ExtractSchedule, Render, RenderApp, RenderStartup, RenderSystems};
 use std::path::PathBuf;
 
 /// Bevy plugin: hadou's waves in every [`HadouCamera`]'s view, hadou scene files as assets.
@@ -103,6 +107,14 @@ impl Plugin for HadouPlugin {
                 app.init_asset::<ShaderBuffer>();
             }
             material::insert_buffers(&mut app.world_mut().resource_mut::<Assets<ShaderBuffer>>());
+            if !app.world().contains_resource::<Assets<Image>>() {
+                app.init_asset::<Image>();
+            }
+            app.init_resource::<HadouShadows>();
+            app.world_mut().resource_scope(|world, mut images: Mut<Assets<Image>>| {
+                shadows::insert_assets(&mut images, &mut world.resource_mut::<Assets<ShaderBuffer>>());
+            });
+            app.add_systems(PostUpdate, shadows::update_shadows.in_set(HadouSystems::Lights));
             app.add_systems(
                 PostUpdate,
                 material::update_wave_lights.in_set(HadouSystems::Lights).after(HadouSystems::CheckWaves),
@@ -144,6 +156,9 @@ impl Plugin for HadouPlugin {
         render_app
             .init_resource::<render::ExtractedWaves>()
             .init_resource::<render::Warned>()
+            .init_resource::<shadows::ExtractedShadows>()
+            .add_systems(ExtractSchedule, shadows::extract_shadows)
+            .add_systems(Render, shadows::draw_shadow_maps.in_set(RenderSystems::PrepareResources))
             .add_systems(RenderStartup, render::init_renderer)
             .add_systems(ExtractSchedule, render::extract_waves)
             .add_systems(

@@ -52,7 +52,7 @@ struct HadouSurface {
     outline: vec4<f32>,
     model: u32,
     wave_blend: f32,
-    pad0: u32,
+    shadow_mask: u32,
     pad1: u32,
     base_texture: vec4<u32>,
     feature_texture: vec4<u32>,
@@ -62,6 +62,17 @@ struct HadouSurface {
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<storage, read> lights: array<GpuLight>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> light_data: array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> shading_data: array<u32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(4) var shadow_maps: texture_2d_array<f32>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(5) var<storage, read> shadow_data: array<u32>;
+
+fn shadow_word(o: u32) -> u32 {
+    return shadow_data[o];
+}
+
+// No plane-shadow target in Bevy: plane shadows are drawn as maps (shadows.rs).
+fn plane_cast_at(pixel: vec2<u32>) -> u32 {
+    return 0u;
+}
 
 fn polyline_point(offset: u32, i: u32) -> vec3<f32> {
     let o = offset + 3u * i;
@@ -76,6 +87,11 @@ struct HadouShadeFrame {
     any_glow: u32,
     area_position: vec3<f32>,
     area_color: vec3<f32>,
+    shadow_casts: u32,
+    map_casts: u32,
+    cast_count: u32,
+    map_count: u32,
+    plane_count: u32,
 }
 var<private> frame: HadouShadeFrame;
 
@@ -90,9 +106,14 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     frame.ambient = surface.ambient.xyz;
     frame.wave_count = light_data[0];
     frame.any_glow = light_data[1];
+    frame.cast_count = shadow_data[0];
+    frame.map_count = shadow_data[1];
+    frame.shadow_casts = shadow_data[2];
+    frame.map_casts = shadow_data[3];
+    frame.plane_count = 0u;
     let m = GpuMaterial(
         surface.base_color.xyz, surface.model, surface.outline.xyz, surface.wave_blend,
-        surface.outline.w, 0u, 0u, 0u,
+        surface.outline.w, surface.shadow_mask, 0u, 0u,
         texture_record(surface.base_texture), texture_record(surface.feature_texture), surface.ramp);
     var uv = vec2<f32>(0.0);
 #ifdef VERTEX_UVS_A
@@ -102,8 +123,9 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
 #ifdef VERTEX_COLORS
     color = unpack4x8unorm(pack4x8unorm(in.color));
 #endif
-    let c = shade_surface(m, in.world_position.xyz, in.world_normal, uv, color);
-    return vec4<f32>(c, 1.0);
+    let world = in.world_position.xyz;
+    let c = shade_surface(m, world, in.world_normal, uv, color);
+    return vec4<f32>(apply_shadows(c, m.shadow_mask, world, vec2<u32>(0u)), 1.0);
 }
 ";
 
@@ -113,11 +135,14 @@ fn constants(wgsl: &str) -> String {
 }
 
 /// The WGSL of [`HadouMaterial`]: Bevy's mesh vertex output, hadou-gpu's `common.wgsl`,
-/// `energy.wgsl` and `shading.wgsl` (its switches as constants), then [`FRAGMENT`].
+/// `energy.wgsl`, `shading.wgsl` and `shadow_lookup.wgsl` (their switches as constants), then
+/// [`FRAGMENT`].
 pub(crate) fn shader_source() -> String {
-    use hadou_gpu::shaders::{COMMON, ENERGY, SHADING};
-    let (energy, shading) = (constants(ENERGY), constants(SHADING));
-    format!("#import bevy_pbr::forward_io::VertexOutput\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}")
+    use hadou_gpu::shaders::{COMMON, ENERGY, SHADING, SHADOW_LOOKUP};
+    let (energy, shading, shadows) = (constants(ENERGY), constants(SHADING), constants(SHADOW_LOOKUP));
+    format!(
+        "#import bevy_pbr::forward_io::VertexOutput\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}\n{shadows}"
+    )
 }
 
 /// What [`HadouMaterial`]'s shader reads (its uniform): a hadou `[[material]]`'s record (hadou-gpu's
@@ -138,8 +163,8 @@ pub struct HadouSurface {
     pub model: u32,
     /// `wave_blend` β: 0 keeps the own look, 1 takes the waves' (000 §2.1).
     pub wave_blend: f32,
-    /// Padding.
-    pub pad0: u32,
+    /// Bit `s` set when the surface receives shadow `s` of [`crate::HadouShadows`]' frame.
+    pub shadow_mask: u32,
     /// Padding.
     pub pad1: u32,
     /// The base-colour texture (`GpuTexture`: word offset in the material's texture buffer, width,
@@ -205,7 +230,7 @@ impl HadouSurface {
             outline: v(g.outline_color, g.outline_width),
             model: g.model,
             wave_blend: g.wave_blend,
-            pad0: 0,
+            shadow_mask: 0,
             pad1: 0,
             base_texture: textures[0],
             feature_texture: textures[1],
@@ -238,6 +263,12 @@ pub struct HadouMaterial {
     /// The sRGB table and this material's texels ([`NO_TEXTURES`] without textures).
     #[storage(3, read_only)]
     pub textures: Handle<ShaderBuffer>,
+    /// The shadow maps ([`crate::SHADOW_MAPS`], kept by the plugin).
+    #[texture(4, dimension = "2d_array", sample_type = "float", filterable = false)]
+    pub shadow_maps: Handle<Image>,
+    /// The shadow records ([`crate::SHADOW_DATA`], kept by the plugin).
+    #[storage(5, read_only)]
+    pub shadow_data: Handle<ShaderBuffer>,
 }
 
 impl HadouMaterial {
@@ -249,7 +280,16 @@ impl HadouMaterial {
             lights: WAVE_LIGHTS,
             light_data: WAVE_LIGHT_DATA,
             textures: NO_TEXTURES,
+            shadow_maps: crate::shadows::SHADOW_MAPS,
+            shadow_data: crate::shadows::SHADOW_DATA,
         }
+    }
+
+    /// The same material receiving the shadows whose bits are set in `mask` (bit `s`: shadow `s`
+    /// of [`crate::HadouShadows`]' frame; [`crate::shadow_mask`] gives an object's).
+    pub fn with_shadow_mask(mut self, mask: u32) -> Self {
+        self.surface.shadow_mask = mask;
+        self
     }
 
     /// As [`HadouMaterial::new`], with `material`'s base and feature textures (sampled as hadou
@@ -273,14 +313,17 @@ impl HadouMaterial {
             lights: WAVE_LIGHTS,
             light_data: WAVE_LIGHT_DATA,
             textures,
+            shadow_maps: crate::shadows::SHADOW_MAPS,
+            shadow_data: crate::shadows::SHADOW_DATA,
         }
     }
 
-    /// Sets the uniform from `material` and `light`, keeping the textures (e.g. when a track
+    /// Sets the uniform from `material` and `light`, keeping the textures and the shadow mask (e.g. when a track
     /// changes `wave_blend`); false when nothing changed.
     pub fn update(&mut self, material: &hadou_scene::Material, light: &Light) -> bool {
         let textures = [self.surface.base_texture, self.surface.feature_texture];
-        let surface = HadouSurface::new(material, light, textures);
+        let mut surface = HadouSurface::new(material, light, textures);
+        surface.shadow_mask = self.surface.shadow_mask;
         let changed = surface != self.surface;
         self.surface = surface;
         changed

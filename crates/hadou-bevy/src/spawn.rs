@@ -6,6 +6,7 @@ use crate::asset::HadouScene;
 use crate::camera::{HadouCamera, ViewMapping};
 use crate::material::HadouMaterial;
 use crate::outline::{outline_mesh, HadouOutline};
+use crate::shadows::{shadow_mask, HadouShadows};
 use crate::wave::HadouWave;
 use bevy::asset::RenderAssetUsages;
 use bevy::mesh::{Indices, PrimitiveTopology};
@@ -142,9 +143,6 @@ fn object_transform(object: &hadou_scene::Object) -> Transform {
 /// logged as one warning when a scene is spawned.
 pub fn unsupported(frame: &Frame) -> Vec<String> {
     let mut out = Vec::new();
-    if !frame.shadows.is_empty() {
-        out.push(format!("{} [[shadow]] (wave and sun shadows)", frame.shadows.len()));
-    }
     if frame.area_light.is_some() {
         out.push("the [area_light] (soft shadows)".into());
     }
@@ -172,7 +170,8 @@ pub struct ObjectAssets<'a> {
     pub buffers: &'a mut Assets<ShaderBuffer>,
 }
 
-/// Spawns a hadou `[[object]]` under `light`: an entity with its name and transform, with a child
+/// Spawns a hadou `[[object]]` under `light`, receiving the shadows of `shadow_mask` (see
+/// [`HadouMaterial::with_shadow_mask`]): an entity with its name and transform, with a child
 /// per material slot that has triangles (`Mesh3d`, a [`HadouMaterial`] with the slot's textures)
 /// and one per outlined slot ([`HadouOutline`] over [`crate::outline_mesh`]). Returns the entity
 /// and the material of every slot (the object's materials in order), e.g. to change `wave_blend`.
@@ -181,6 +180,7 @@ pub fn spawn_object(
     assets: &mut ObjectAssets,
     object: &hadou_scene::Object,
     light: &hadou_scene::Light,
+    shadow_mask: u32,
 ) -> (Entity, Vec<Handle<HadouMaterial>>) {
     let entity = commands
         .spawn((Name::new(object.name.clone()), object_transform(object), Visibility::default()))
@@ -189,7 +189,9 @@ pub fn spawn_object(
     let mut handles = Vec::with_capacity(slots);
     for slot in 0..slots as u32 {
         let material = object.material(slot);
-        let handle = assets.materials.add(HadouMaterial::with_textures(material, light, assets.buffers));
+        let shaded =
+            HadouMaterial::with_textures(material, light, assets.buffers).with_shadow_mask(shadow_mask);
+        let handle = assets.materials.add(shaded);
         handles.push(handle.clone());
         let indices = slot_indices_of(&object.mesh, slot, slots);
         if indices.is_empty() {
@@ -275,8 +277,9 @@ pub(crate) fn spawn_scenes(
             outlines: &mut outlines,
             buffers: &mut buffers,
         };
-        for object in &frame.objects {
-            let (entity, handles) = spawn_object(&mut commands, &mut assets, object, &frame.light);
+        for (i, object) in frame.objects.iter().enumerate() {
+            let mask = shadow_mask(&frame, i as u32);
+            let (entity, handles) = spawn_object(&mut commands, &mut assets, object, &frame.light, mask);
             commands.entity(entity).insert(ChildOf(root));
             objects.push(entity);
             object_materials.push(handles);
@@ -339,6 +342,7 @@ pub(crate) fn animate_scenes(
     mut cameras: Query<(&mut Projection, &mut HadouCamera)>,
     mut waves: Query<&mut HadouWave>,
     mut materials: ResMut<Assets<HadouMaterial>>,
+    mut shadows: ResMut<HadouShadows>,
 ) {
     for (root, mut spawned) in &mut roots {
         let Some(HadouScene(scene)) = scenes.get(&root.scene) else { continue };
@@ -378,6 +382,9 @@ pub(crate) fn animate_scenes(
             if let Ok(mut w) = waves.get_mut(entity) {
                 w.wave = wave.clone();
             }
+        }
+        if !frame.shadows.is_empty() {
+            shadows.frame = Some(frame);
         }
     }
 }

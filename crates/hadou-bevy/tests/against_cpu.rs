@@ -297,3 +297,28 @@ fn the_wave_as_a_light_in_bevy_is_the_picture_of_hadou_render() {
     eprintln!("against the same frame without the wave's light: mean {unlit_mean:.3}");
     assert!(unlit_mean > MAX_MEAN, "the wave's light is not on the character ({unlit_mean:.3})");
 }
+
+/// The wave's stylized shadows (000 §2.4): five models around a beam, each shadow leaning away
+/// from it along the ground, drawn in Bevy by hadou-gpu's shadow maps. Against hadou-cpu's render
+/// of the same frame; and not the picture without the shadows.
+#[test]
+fn wave_shadows_in_bevy_are_the_picture_of_hadou_render() {
+    let test = "wave_shadows_in_bevy_are_the_picture_of_hadou_render";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let mut frame = hadou_scene::Scene::load(scenes().join("shadow-wave-top.toml")).unwrap().at(1.0);
+    assert!(!frame.shadows.is_empty());
+    let reference = hadou_cpu::render(&frame);
+    let (bevy, _) = bevy_picture("shadow-wave-top.toml", 1.0, (frame.width, frame.height), None);
+    let (mean, max) = difference(&bevy, &reference);
+    eprintln!(
+        "shadow-wave-top.toml at t = 1.0, {}×{}: mean {mean:.3}, largest {max}",
+        frame.width, frame.height
+    );
+    assert!(mean <= MAX_MEAN, "mean absolute 8-bit difference {mean:.3} > {MAX_MEAN} (largest {max})");
+    frame.shadows.clear();
+    let (unshadowed, _) = difference(&bevy, &hadou_cpu::render(&frame));
+    eprintln!("against the same frame without its shadows: mean {unshadowed:.3}");
+    assert!(unshadowed > MAX_MEAN, "the shadows are not drawn ({unshadowed:.3})");
+}

@@ -237,6 +237,24 @@ impl GpuBackend {
         self.renderer.encode_wave_overlay(frame, encoder, target)
     }
 
+    /// Records `frame`'s shadow maps into `encoder`, drawn into the layers of a texture the
+    /// caller owns: every map cast of its `[[shadow]]`s (`ShadowMethod::Map`; 000 §2.4's wave
+    /// shadows and 001's sun shadows found by an orthographic map along each projection
+    /// direction), map cast `i` (`layout::FrameShadows::map_casts`) in layer `i`, in the first
+    /// `map_size²` texels (`layout::FrameShadows`, whose records say how to look them up, as the
+    /// wave pass's `apply_shadows` does). Plane casts draw nothing here. `target` must be
+    /// `Depth32Float` with `RENDER_ATTACHMENT` usage, at least `map_size` texels on each side and
+    /// as many layers as map casts. Nothing is submitted. What an engine calls once a frame
+    /// before the passes that read the maps.
+    pub fn encode_shadow_maps_into(
+        &mut self,
+        frame: &Frame,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::Texture,
+    ) -> Result<(), RenderError> {
+        self.renderer.encode_shadow_maps_into(frame, encoder, target)
+    }
+
     /// The GPU time of the most recent [`GpuBackend::render_to_texture`] frame whose timestamps
     /// have come back, without waiting: `None` until one has, and always `None` on a device
     /// without [`wgpu::Features::TIMESTAMP_QUERY`] (e.g. WebGL, or OpenGL without

@@ -406,7 +406,65 @@ impl Renderer {
         let Some(bind_group) = &prepared.map_bind_group else { return };
         let maps = self.maps.as_ref().expect("shadow maps are created in prepare");
         let passes = &prepared.map_passes;
-        self.passes.shadow_maps.encode(enc, maps, passes, bind_group, &self.meshes, frame, timestamps);
+        let views = &maps.layer_views;
+        self.passes.shadow_maps.encode(enc, views, passes, bind_group, &self.meshes, frame, timestamps);
+    }
+
+    /// Records `frame`'s shadow maps into the layers of the caller's `target` (see
+    /// `GpuBackend::encode_shadow_maps_into`).
+    pub(crate) fn encode_shadow_maps_into(
+        &mut self,
+        frame: &Frame,
+        enc: &mut wgpu::CommandEncoder,
+        target: &wgpu::Texture,
+    ) -> Result<(), RenderError> {
+        self.ctx.check()?;
+        prepare::validate_frame(frame)?;
+        let data = FrameData::new(&self.ctx.limits, frame)?;
+        let shadows = &data.shadows;
+        if shadows.map_casts.is_empty() {
+            return Ok(());
+        }
+        let size = target.size();
+        if target.format() != crate::formats::MAP_FORMAT
+            || size.width < shadows.map_size
+            || size.height < shadows.map_size
+            || size.depth_or_array_layers < shadows.map_casts.len() as u32
+            || !target.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        {
+            return Err(RenderError::Other(format!(
+                "the shadow-map target must be Depth32Float with RENDER_ATTACHMENT, at least {0}×{0} texels and \
+                 {1} layers (it is {2:?}, {3}×{4}×{5})",
+                shadows.map_size,
+                shadows.map_casts.len(),
+                target.format(),
+                size.width,
+                size.height,
+                size.depth_or_array_layers
+            )));
+        }
+        let scopes = self.ctx.open_scopes();
+        {
+            self.meshes.upload(&self.ctx.device, frame);
+            let d = &self.ctx.device;
+            let buffers = FrameBuffers::upload(d, &data);
+            let passes: Vec<MapPass> = data
+                .map_draws
+                .iter()
+                .enumerate()
+                .map(|(layer, draws)| MapPass {
+                    layer: layer as u32,
+                    edge: shadows.casts[shadows.map_casts[layer] as usize].map_size as f32,
+                    draws: draws.clone(),
+                })
+                .collect();
+            let inputs =
+                ShadowMapInputs { objects: &buffers.objects, casts: &buffers.casts, draws: &buffers.shadow_draws };
+            let bind_group = self.passes.shadow_maps.bind_group(d, &inputs);
+            let views = crate::passes::shadow_maps::layer_views(target, shadows.map_casts.len() as u32);
+            self.passes.shadow_maps.encode(enc, &views, &passes, &bind_group, &self.meshes, frame, None);
+        }
+        self.ctx.close_scopes(scopes, "drawing the shadow maps")
     }
 
     /// Submits the frame's shadow maps (see [`Renderer::encode_shadow_maps`]); `None` when it has

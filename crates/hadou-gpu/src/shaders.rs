@@ -3,7 +3,8 @@
 //! WGSL has no `#include`; each module is the concatenation of shared files and one pass file:
 //! - raster module: `common.wgsl` + `raster.wgsl` (opaque geometry);
 //! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
-//!   `shading_bindings.wgsl` + `shading.wgsl` + `shadow_lookup.wgsl` + `wave.wgsl` (surface shading with the waves as
+//!   `shading_bindings.wgsl` + `shading.wgsl` + `shadow_bindings.wgsl` + `shadow_lookup.wgsl` +
+//!   `wave.wgsl` (surface shading with the waves as
 //!   lights, hard shadows, energy integration, colour mapping);
 //! - wave overlay module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
 //!   `wave_overlay.wgsl` (the waves' light into a caller's colour target against its depth);
@@ -38,8 +39,13 @@ pub const WAVE: &str = include_str!("shaders/wave.wgsl");
 pub const WAVE_ENERGY: &str = include_str!("shaders/wave_energy.wgsl");
 /// The wave overlay: the waves' light into a caller's colour target against its depth buffer.
 pub const WAVE_OVERLAY: &str = include_str!("shaders/wave_overlay.wgsl");
-/// The wave pass's hard-shadow lookups.
+/// The wave pass's hard-shadow lookups. They read `shadow_maps`, `shadow_word` and
+/// `plane_cast_at` of [`SHADOW_BINDINGS`] (or a composer's own with the same names) and a `frame`
+/// with the cast counts and offsets.
 pub const SHADOW_LOOKUP: &str = include_str!("shaders/shadow_lookup.wgsl");
+/// The wave pass's bindings of [`SHADOW_LOOKUP`] (the plane-shadow target, the shadow maps) and
+/// how it reads its records.
+pub const SHADOW_BINDINGS: &str = include_str!("shaders/shadow_bindings.wgsl");
 /// The plane-shadow pass and the shadow-map pass.
 pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
 /// The `[area_light]`'s perspective shadow maps (render pass).
@@ -58,6 +64,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("raster.wgsl", RASTER),
     ("shading.wgsl", SHADING),
     ("shading_bindings.wgsl", SHADING_BINDINGS),
+    ("shadow_bindings.wgsl", SHADOW_BINDINGS),
     ("shadow_lookup.wgsl", SHADOW_LOOKUP),
     ("shadow_raster.wgsl", SHADOW_RASTER),
     ("soft.wgsl", SOFT),
@@ -71,7 +78,7 @@ pub const FILES: &[(&str, &str)] = &[
 pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
 pub const WAVE_PARTS: &[&str] =
-    &[COMMON, ENERGY, CURVE, WAVE_ENERGY, SHADING_BINDINGS, SHADING, SHADOW_LOOKUP, WAVE];
+    &[COMMON, ENERGY, CURVE, WAVE_ENERGY, SHADING_BINDINGS, SHADING, SHADOW_BINDINGS, SHADOW_LOOKUP, WAVE];
 /// The parts of the wave overlay module, in order.
 pub const WAVE_OVERLAY_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE_ENERGY, WAVE_OVERLAY];
 /// The parts of the shadow module, in order.

@@ -42,7 +42,7 @@ pub(crate) struct ShadowMaps {
     /// All layers, as the wave pass reads them.
     pub(crate) view: wgpu::TextureView,
     /// One view per layer, as the map passes draw them.
-    layer_views: Vec<wgpu::TextureView>,
+    pub(crate) layer_views: Vec<wgpu::TextureView>,
 }
 
 impl ShadowMaps {
@@ -69,19 +69,24 @@ impl ShadowMaps {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        let layer_views = (0..layers)
-            .map(|layer| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    label: Some("shadow map layer"),
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
+        let layer_views = layer_views(&texture, layers);
         *maps = Some(ShadowMaps { size, layers, view, layer_views });
     }
+}
+
+/// One 2-D view per layer of `texture`'s first `layers` layers, as the map passes draw them.
+pub(crate) fn layer_views(texture: &wgpu::Texture, layers: u32) -> Vec<wgpu::TextureView> {
+    (0..layers)
+        .map(|layer| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("shadow map layer"),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        })
+        .collect()
 }
 
 /// One shadow-map layer's pass: its layer, its edge in texels and its draws (instance = index into
@@ -131,13 +136,13 @@ impl ShadowMapPass {
         setup::bind_group(device, "shadow maps", &self.layout, &BINDINGS, resources)
     }
 
-    /// Records every map cast's casters into its layer of `maps`, one render pass per layer
+    /// Records every map cast's casters into its layer (of `layer_views`), one render pass per layer
     /// (`timestamps`: a group of its own, a query pair per layer).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn encode(
         &self,
         enc: &mut wgpu::CommandEncoder,
-        maps: &ShadowMaps,
+        layer_views: &[wgpu::TextureView],
         passes: &[MapPass],
         bind_group: &wgpu::BindGroup,
         meshes: &MeshCache,
@@ -152,7 +157,7 @@ impl ShadowMapPass {
                 label: Some("shadow map"),
                 color_attachments: &[],
                 depth_stencil_attachment: cleared_depth(
-                    &maps.layer_views[m.layer as usize],
+                    &layer_views[m.layer as usize],
                     wgpu::StoreOp::Store,
                 ),
                 timestamp_writes: timestamps.as_deref_mut().and_then(|q| q.render("shadow maps")),

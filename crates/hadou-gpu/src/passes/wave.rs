@@ -22,7 +22,7 @@ pub(crate) const WAVE_WORKGROUP: u32 = 8;
 const CS: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
 
 /// The bindings of the wave module (wave.wgsl 0–4, curve.wgsl 5–7, shading_bindings.wgsl 8–10,
-/// shadow_lookup.wgsl 11–12).
+/// shadow_bindings.wgsl 11–12).
 pub(crate) const BINDINGS: [Binding; 13] = [
     Binding::new(0, "frame", Kind::Uniform, CS),
     Binding::new(1, "waves", Kind::Storage, CS),

@@ -1,13 +1,10 @@
 // Hard shadows on the visible surface in the wave pass (twin of hadou-cpu's shadows.rs): the plane
 // cast the plane-shadow pass kept (shadow_raster.wgsl), then every map cast looked up in its
 // shadow map; the most opaque wins (the first among equals) and pulls the shaded colour towards
-// its shadow colour. Prepended to wave.wgsl, after shading.wgsl (whose shading_data holds the
-// cast records at frame.shadow_casts and the map casts' indices at frame.map_casts).
-
-// The plane-shadow pass's target: j + 1 of the kept plane cast j, 0 = none.
-@group(0) @binding(11) var plane_shadow_texels: texture_2d<u32>;
-// The frame's shadow maps, one layer per map cast (cleared to 1 = no caster).
-@group(0) @binding(12) var shadow_maps: texture_2d_array<f32>;
+// its shadow colour. Prepended to wave.wgsl, after shading.wgsl and shadow_bindings.wgsl, which
+// declare `shadow_maps` and define `shadow_word` (the word holding the cast records at
+// frame.shadow_casts and the map casts' indices at frame.map_casts) and `plane_cast_at` (the kept
+// plane cast of a pixel); another composer (hadou-bevy's material) defines its own.
 
 // Whether the frame has plane casts, map casts (pipeline-overridable; see USE_SPHERE in
 // wave.wgsl): a kind it lacks is compiled out of apply_shadows.
@@ -15,7 +12,7 @@ override USE_PLANE_SHADOWS: bool = true;
 override USE_MAP_SHADOWS: bool = true;
 
 fn data_f32(o: u32) -> f32 {
-    return bitcast<f32>(shading_data[o]);
+    return bitcast<f32>(shadow_word(o));
 }
 
 fn data_vec3(o: u32) -> vec3<f32> {
@@ -29,15 +26,15 @@ fn load_shadow_cast(j: u32) -> GpuShadowCast {
     c.k = data_vec3(o);
     c.opacity = data_f32(o + 3u);
     c.plane_point = data_vec3(o + 4u);
-    c.shadow = shading_data[o + 7u];
+    c.shadow = shadow_word(o + 7u);
     c.plane_normal = data_vec3(o + 8u);
     c.depth_key = data_f32(o + 11u);
     c.color = data_vec3(o + 12u);
-    c.map_size = shading_data[o + 15u];
+    c.map_size = shadow_word(o + 15u);
     c.map_center = data_vec3(o + 16u);
     c.map_scale = data_f32(o + 19u);
     c.map_u = data_vec3(o + 20u);
-    c.map_layer = shading_data[o + 23u];
+    c.map_layer = shadow_word(o + 23u);
     c.map_v = data_vec3(o + 24u);
     c.map_bias = data_f32(o + 27u);
     return c;
@@ -54,7 +51,7 @@ fn apply_shadows(c: vec3<f32>, mask: u32, p: vec3<f32>, pixel: vec2<u32>) -> vec
     var best_opacity = 0.0;
     var color = vec3<f32>(0.0);
     if (USE_PLANE_SHADOWS && frame.plane_count != 0u) {
-        let v = textureLoad(plane_shadow_texels, vec2<i32>(pixel), 0).x;
+        let v = plane_cast_at(pixel);
         if (v != 0u) {
             let s = load_shadow_cast(v - 1u);
             best_j = v - 1u;
@@ -63,7 +60,7 @@ fn apply_shadows(c: vec3<f32>, mask: u32, p: vec3<f32>, pixel: vec2<u32>) -> vec
         }
     }
     for (var i = 0u; USE_MAP_SHADOWS && i < frame.map_count; i++) {
-        let j = shading_data[frame.map_casts + i];
+        let j = shadow_word(frame.map_casts + i);
         let s = load_shadow_cast(j);
         if ((mask & (1u << s.shadow)) == 0u) {
             continue;
