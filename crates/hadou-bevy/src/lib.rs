@@ -31,6 +31,7 @@ mod camera;
 mod material;
 mod outline;
 mod render;
+mod shaded;
 mod shadows;
 mod spawn;
 mod tone;
@@ -43,6 +44,7 @@ pub use material::{
     WAVE_LIGHT_DATA,
 };
 pub use outline::{outline_mesh, HadouOutline, HadouOutlineUniform};
+pub use shaded::{hadou_texture, HadouShaded};
 pub use shadows::{
     shadow_frame, shadow_mask, shadow_records, HadouShadows, PLANE_MAP_SIZE, SHADOW_DATA, SHADOW_MAPS,
 };
@@ -115,6 +117,9 @@ impl Plugin for HadouPlugin {
                 shadows::insert_assets(&mut images, &mut world.resource_mut::<Assets<ShaderBuffer>>());
             });
             app.add_systems(PostUpdate, shadows::update_shadows.in_set(HadouSystems::Lights));
+            if app.world().contains_resource::<Assets<StandardMaterial>>() {
+                app.add_systems(Update, shaded::shade_models);
+            }
             app.add_systems(
                 PostUpdate,
                 material::update_wave_lights.in_set(HadouSystems::Lights).after(HadouSystems::CheckWaves),

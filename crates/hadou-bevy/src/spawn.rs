@@ -334,6 +334,7 @@ pub(crate) fn reload_scenes(
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn animate_scenes(
     time: Res<Time>,
     mut roots: Query<(&HadouSceneRoot, &mut SpawnedScene)>,

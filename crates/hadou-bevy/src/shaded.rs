@@ -1,0 +1,140 @@
+//! [`HadouShaded`]: one component that switches a model loaded by Bevy's own loaders (a glTF
+//! character's `SceneRoot`, skinned and animated by Bevy) from Bevy's `StandardMaterial` to
+//! hadou's shading ([`HadouMaterial`]: the toon ramp, the wave as a light, glow, shadows) and
+//! outlines ([`HadouOutline`]).
+
+use crate::material::HadouMaterial;
+use crate::outline::HadouOutline;
+use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler};
+use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::storage::ShaderBuffer;
+use hadou_scene::{Filter, Texture, TextureRef, Wrap};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Put on the root of a model spawned by Bevy (e.g. a glTF `SceneRoot`): every mesh below it
+/// drawn with a `StandardMaterial` is given a [`HadouMaterial`] instead: `material`'s model, ramp,
+/// `wave_blend` and outline under `light`, its base colour multiplied by the `StandardMaterial`'s
+/// base colour, and the `StandardMaterial`'s base-colour texture (an 8-bit RGBA image kept in the
+/// main world, as Bevy's glTF loader keeps it) as hadou's base texture. Meshes spawned later
+/// (the scene loads asynchronously) are switched when they appear. An outline is added to each
+/// mesh that is not skinned (the hull is pushed along the mesh's own normals; a skinned mesh
+/// gets none, and a warning says so once).
+#[derive(Component, Clone, Debug)]
+pub struct HadouShaded {
+    /// hadou's look: `model`, `ramp`, `wave_blend`, `outline`, and a base colour that multiplies
+    /// the model's own.
+    pub material: hadou_scene::Material,
+    /// The light of the look (`[light]`).
+    pub light: hadou_scene::Light,
+    /// The shadows the model receives ([`HadouMaterial::with_shadow_mask`]).
+    pub shadow_mask: u32,
+}
+
+fn wrap(mode: ImageAddressMode) -> Wrap {
+    match mode {
+        ImageAddressMode::ClampToEdge | ImageAddressMode::ClampToBorder => Wrap::Clamp,
+        ImageAddressMode::MirrorRepeat => Wrap::Mirror,
+        _ => Wrap::Repeat,
+    }
+}
+
+/// `image` as a hadou texture (its texels, and its sampler's wrap and filter), when its texels are
+/// 8-bit sRGB or linear RGBA held in the main world; `None` otherwise.
+pub fn hadou_texture(name: &str, image: &Image) -> Option<TextureRef> {
+    let format = image.texture_descriptor.format;
+    if !matches!(format, TextureFormat::Rgba8UnormSrgb | TextureFormat::Rgba8Unorm) {
+        return None;
+    }
+    let (width, height) = (image.width(), image.height());
+    let data = image.data.as_ref()?;
+    let texels: Vec<[u8; 4]> = data.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
+    if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
+        return None;
+    }
+    let (wrap_uv, filter) = match &image.sampler {
+        ImageSampler::Descriptor(d) => (
+            [wrap(d.address_mode_u), wrap(d.address_mode_v)],
+            if d.mag_filter == ImageFilterMode::Nearest { Filter::Nearest } else { Filter::Linear },
+        ),
+        ImageSampler::Default => ([Wrap::Repeat; 2], Filter::Linear),
+    };
+    Some(TextureRef {
+        image: Arc::new(Texture { name: name.to_string(), width, height, texels }),
+        wrap: wrap_uv,
+        filter,
+    })
+}
+
+/// Switches the `StandardMaterial` meshes below every [`HadouShaded`] root (see there).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shade_models(
+    mut commands: Commands,
+    standard: Query<(
+        Entity,
+        &MeshMaterial3d<StandardMaterial>,
+        &Mesh3d,
+        Has<bevy::mesh::skinning::SkinnedMesh>,
+    )>,
+    parents: Query<&ChildOf>,
+    roots: Query<&HadouShaded>,
+    standard_materials: Res<Assets<StandardMaterial>>,
+    images: Res<Assets<Image>>,
+    mut materials: ResMut<Assets<HadouMaterial>>,
+    mut outlines: ResMut<Assets<HadouOutline>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+    mut made: Local<HashMap<(Entity, AssetId<StandardMaterial>), Handle<HadouMaterial>>>,
+    mut warned: Local<bool>,
+) {
+    for (entity, standard_material, mesh, skinned) in &standard {
+        let Some((root, shaded)) =
+            parents.iter_ancestors(entity).find_map(|a| roots.get(a).ok().map(|s| (a, s)))
+        else {
+            continue;
+        };
+        let Some(source) = standard_materials.get(&standard_material.0) else { continue };
+        let key = (root, standard_material.0.id());
+        let handle = match made.get(&key) {
+            Some(h) => h.clone(),
+            None => {
+                let mut look = shaded.material.clone();
+                let base = source.base_color.to_linear();
+                look.base_color = [
+                    look.base_color[0] * base.red,
+                    look.base_color[1] * base.green,
+                    look.base_color[2] * base.blue,
+                ];
+                if let Some(texture) = &source.base_color_texture {
+                    let Some(image) = images.get(texture) else { continue }; // still loading
+                    look.base_texture = hadou_texture("base colour", image);
+                    if look.base_texture.is_none() {
+                        warn!("{entity}: its base-colour texture is not 8-bit RGBA in the main world; drawn without it");
+                    }
+                }
+                let material = HadouMaterial::with_textures(&look, &shaded.light, &mut buffers)
+                    .with_shadow_mask(shaded.shadow_mask);
+                let h = materials.add(material);
+                made.insert(key, h.clone());
+                h
+            }
+        };
+        let mut e = commands.entity(entity);
+        e.remove::<MeshMaterial3d<StandardMaterial>>().insert(MeshMaterial3d(handle));
+        if let Some(outline) = shaded.material.outline.filter(|o| o.width > 0.0) {
+            if skinned {
+                if !*warned {
+                    *warned = true;
+                    warn!("{root}: skinned meshes get no hadou outline in Bevy yet");
+                }
+            } else {
+                commands.spawn((
+                    Name::new("outline"),
+                    Mesh3d(mesh.0.clone()),
+                    MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
+                    ChildOf(entity),
+                ));
+            }
+        }
+    }
+}
