@@ -306,17 +306,7 @@ impl Renderer {
                     tiles.push(([x, y], [tile[0].min(frame.width - x), tile[1].min(rows.end - y)]));
                 }
             }
-            let shadows = &data.shadows;
-            let map_passes: Vec<MapPass> = data
-                .map_draws
-                .into_iter()
-                .enumerate()
-                .map(|(layer, draws)| MapPass {
-                    layer: layer as u32,
-                    edge: shadows.casts[shadows.map_casts[layer] as usize].map_size as f32,
-                    draws,
-                })
-                .collect();
+            let map_passes = map_passes(&data);
             let map_bind_group = (!map_passes.is_empty()).then(|| {
                 let inputs = ShadowMapInputs {
                     objects: &buffers.objects,
@@ -448,18 +438,12 @@ impl Renderer {
             self.meshes.upload(&self.ctx.device, frame);
             let d = &self.ctx.device;
             let buffers = FrameBuffers::upload(d, &data);
-            let passes: Vec<MapPass> = data
-                .map_draws
-                .iter()
-                .enumerate()
-                .map(|(layer, draws)| MapPass {
-                    layer: layer as u32,
-                    edge: shadows.casts[shadows.map_casts[layer] as usize].map_size as f32,
-                    draws: draws.clone(),
-                })
-                .collect();
-            let inputs =
-                ShadowMapInputs { objects: &buffers.objects, casts: &buffers.casts, draws: &buffers.shadow_draws };
+            let passes = map_passes(&data);
+            let inputs = ShadowMapInputs {
+                objects: &buffers.objects,
+                casts: &buffers.casts,
+                draws: &buffers.shadow_draws,
+            };
             let bind_group = self.passes.shadow_maps.bind_group(d, &inputs);
             let views = crate::passes::shadow_maps::layer_views(target, shadows.map_casts.len() as u32);
             self.passes.shadow_maps.encode(enc, &views, &passes, &bind_group, &self.meshes, frame, None);
@@ -717,6 +701,20 @@ fn copy_tile(image: &mut Image, raw: &[u8], origin: [u32; 2], size: [u32; 2]) {
         image.energy[dst..dst + w].copy_from_slice(&energy[src..src + w]);
         image.depth[dst..dst + w].copy_from_slice(&depth[src..src + w]);
     }
+}
+
+/// One pass per map layer of `data`: its layer, its map's edge and its draws.
+fn map_passes(data: &FrameData) -> Vec<MapPass> {
+    let shadows = &data.shadows;
+    data.map_draws
+        .iter()
+        .enumerate()
+        .map(|(layer, draws)| MapPass {
+            layer: layer as u32,
+            edge: shadows.casts[shadows.map_casts[layer] as usize].map_size as f32,
+            draws: draws.clone(),
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -156,10 +156,7 @@ impl ShadowMapPass {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow map"),
                 color_attachments: &[],
-                depth_stencil_attachment: cleared_depth(
-                    &layer_views[m.layer as usize],
-                    wgpu::StoreOp::Store,
-                ),
+                depth_stencil_attachment: cleared_depth(&layer_views[m.layer as usize], wgpu::StoreOp::Store),
                 timestamp_writes: timestamps.as_deref_mut().and_then(|q| q.render("shadow maps")),
                 occlusion_query_set: None,
                 multiview_mask: None,
