@@ -96,12 +96,6 @@ pub(crate) fn wave_pass(
     if waves.0.is_empty() {
         return;
     }
-    if *msaa != Msaa::Off {
-        warned.once(entity, "msaa", || {
-            format!("hadou waves are not drawn into view {entity}: it uses MSAA; give the camera `Msaa::Off`")
-        });
-        return;
-    }
     if let Err(why) = settings.check() {
         warned.once(entity, "settings", || format!("hadou waves are not drawn into view {entity}: {why}"));
         return;
@@ -132,6 +126,9 @@ pub(crate) fn wave_pass(
         color_format: target.main_texture_format(),
         depth: depth.view(),
         depth_model: DepthModel::ReverseInfinite,
+        // With MSAA the depth buffer is multisampled (its first sample is read) and the target
+        // is the resolved image the post-processing reads.
+        depth_samples: msaa.samples(),
         blend: OverlayBlend::Add,
     };
     if let Err(e) = renderer.0.encode_wave_overlay(&frame, ctx.command_encoder(), &overlay) {

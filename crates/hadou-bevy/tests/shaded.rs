@@ -26,6 +26,7 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
     let mut look = scene.objects[0].material(0).clone();
     look.base_color = [0.5, 1.0, 1.0];
     look.wave_blend = 0.75;
+    look.model = hadou_scene::ShadingModel::Toon;
     let handle =
         app.world().resource::<AssetServer>().load(GltfAssetLabel::Scene(0).from_asset("assets/hero.glb"));
     let character = app

@@ -47,6 +47,9 @@ pub struct OverlayTarget<'a> {
     pub depth: &'a wgpu::TextureView,
     /// How to read `depth`.
     pub depth_model: DepthModel,
+    /// Samples per pixel of `depth`: 1, or an MSAA engine's count (its first sample is read; the
+    /// colour target is then the resolved, single-sample image).
+    pub depth_samples: u32,
     /// How to meet `color`'s contents.
     pub blend: OverlayBlend,
 }
@@ -74,7 +77,8 @@ impl Renderer {
         }
         let pass = self.overlay.as_mut().expect("made above");
         let additive = target.blend == OverlayBlend::Add;
-        let pipeline = pass.pipeline(&self.ctx, variant, target.color_format, additive)?;
+        let multisampled = target.depth_samples > 1;
+        let pipeline = pass.pipeline(&self.ctx, variant, target.color_format, additive, multisampled)?;
         let pass = self.overlay.as_ref().expect("made above");
         let (ctx, size) = (&self.ctx, [frame.width, frame.height]);
         ctx.scoped("encoding the wave overlay", || {
@@ -105,7 +109,7 @@ impl Renderer {
                 overlay: &overlay,
                 curves: [&curves[0], &curves[1], &curves[2]],
             };
-            let bind_group = pass.bind_group(d, &inputs);
+            let bind_group = pass.bind_group(d, &inputs, multisampled);
             pass.encode(enc, &pipeline, target.color, size, &bind_group);
         })
     }

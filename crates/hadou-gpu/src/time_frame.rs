@@ -177,6 +177,7 @@ pub(crate) fn time_wave_overlay(
         color_format: OVERLAY_COLOR_FORMAT,
         depth: &depth,
         depth_model: DepthModel::Standard,
+        depth_samples: 1,
         blend: OverlayBlend::Add,
     };
     let once = |r: &mut Renderer| -> Result<f64, RenderError> {

@@ -57,32 +57,47 @@ fn overlay(
     blend: OverlayBlend,
     clear: [f64; 4],
 ) -> Vec<[f32; 4]> {
+    overlay_samples(gpu, frame, depth, model, blend, clear, 1)
+}
+
+/// [`overlay`] against a depth buffer of `samples` samples per pixel (an MSAA engine's).
+fn overlay_samples(
+    gpu: &mut GpuBackend,
+    frame: &Frame,
+    depth: f32,
+    model: DepthModel,
+    blend: OverlayBlend,
+    clear: [f64; 4],
+    samples: u32,
+) -> Vec<[f32; 4]> {
     let (w, h) = (frame.width, frame.height);
     let device = gpu.device().clone();
     let queue = gpu.queue().clone();
-    let texture = |format, usage| {
+    let texture = |format, usage, sample_count| {
         device.create_texture(&wgpu::TextureDescriptor {
             label: None,
             size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
             mip_level_count: 1,
-            sample_count: 1,
+            sample_count,
             dimension: wgpu::TextureDimension::D2,
             format,
             usage,
             view_formats: &[],
         })
     };
-    let color = texture(COLOR_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+    let color =
+        texture(COLOR_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC, 1);
     let depth_texture = texture(
         wgpu::TextureFormat::Depth32Float,
         wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        samples,
     );
     let (color_view, depth_view) =
         (color.create_view(&Default::default()), depth_texture.create_view(&Default::default()));
     let mut enc = device.create_command_encoder(&Default::default());
-    // The caller's own frame: its colour and depth, here just cleared.
+    // The caller's own frame: its (resolved) colour and its depth, here just cleared.
     enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("the caller's pass"),
+        label: Some("the caller's colour"),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
             view: &color_view,
             depth_slice: None,
@@ -92,6 +107,14 @@ fn overlay(
                 store: wgpu::StoreOp::Store,
             },
         })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("the caller's depth"),
+        color_attachments: &[],
         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
             view: &depth_view,
             depth_ops: Some(wgpu::Operations {
@@ -109,6 +132,7 @@ fn overlay(
         color_format: COLOR_FORMAT,
         depth: &depth_view,
         depth_model: model,
+        depth_samples: samples,
         blend,
     };
     gpu.encode_wave_overlay(frame, &mut enc, &target).expect("encode_wave_overlay");
@@ -209,6 +233,18 @@ fn the_overlay_is_the_waves_light_clipped_at_the_callers_depth() {
     assert_matches("nothing drawn (standard)", &got, &bare, [0.0; 3], 0.0);
     let got = overlay(&mut gpu, &open, 0.0, DepthModel::ReverseInfinite, OverlayBlend::Replace, clear);
     assert_matches("nothing drawn (reverse)", &got, &bare, [0.0; 3], 0.0);
+
+    // An MSAA engine's depth buffer (4 samples; its first is read): the same light.
+    let got = overlay_samples(
+        &mut gpu,
+        &open,
+        near / z,
+        DepthModel::ReverseInfinite,
+        OverlayBlend::Replace,
+        clear,
+        4,
+    );
+    assert_matches("reverse infinite depth, 4 samples, replaced", &got, &walled, [0.0; 3], 0.0);
 
     // The wall must matter, or the test could not fail on the clipping.
     let mut cpu = CpuBackend::new();

@@ -29,19 +29,26 @@ mod tests {
     /// bindings.
     #[test]
     fn pass_bindings_match_their_shaders() {
-        let passes: [(&str, &[&str], &[Binding], bool); 8] = [
-            ("raster", shaders::RASTER_PARTS, &super::raster::BINDINGS, true),
-            ("wave", shaders::WAVE_PARTS, &super::wave::BINDINGS, true),
-            ("plane shadows", shaders::SHADOW_PARTS, &super::plane_shadows::BINDINGS, true),
+        let c = shaders::compose;
+        let passes: [(&str, String, &[Binding], bool); 9] = [
+            ("raster", c(shaders::RASTER_PARTS), &super::raster::BINDINGS, true),
+            ("wave", c(shaders::WAVE_PARTS), &super::wave::BINDINGS, true),
+            ("plane shadows", c(shaders::SHADOW_PARTS), &super::plane_shadows::BINDINGS, true),
             // vs_map reads only some of shadow_raster.wgsl's bindings.
-            ("shadow maps", shaders::SHADOW_PARTS, &super::shadow_maps::BINDINGS, false),
-            ("soft map", shaders::SOFT_MAP_PARTS, &super::soft::MAP_BINDINGS, true),
-            ("soft", shaders::SOFT_PARTS, &super::soft::BINDINGS, true),
-            ("present", shaders::PRESENT_PARTS, &super::present::BINDINGS, true),
-            ("wave overlay", shaders::WAVE_OVERLAY_PARTS, &super::wave_overlay::BINDINGS, true),
+            ("shadow maps", c(shaders::SHADOW_PARTS), &super::shadow_maps::BINDINGS, false),
+            ("soft map", c(shaders::SOFT_MAP_PARTS), &super::soft::MAP_BINDINGS, true),
+            ("soft", c(shaders::SOFT_PARTS), &super::soft::BINDINGS, true),
+            ("present", c(shaders::PRESENT_PARTS), &super::present::BINDINGS, true),
+            ("wave overlay", super::wave_overlay::source(false), &super::wave_overlay::BINDINGS, true),
+            (
+                "wave overlay, multisampled depth",
+                super::wave_overlay::source(true),
+                &super::wave_overlay::BINDINGS_MULTISAMPLED,
+                true,
+            ),
         ];
-        for (pass, parts, bindings, whole) in passes {
-            let module = naga::front::wgsl::parse_str(&shaders::compose(parts)).expect("the module parses");
+        for (pass, source, bindings, whole) in passes {
+            let module = naga::front::wgsl::parse_str(&source).expect("the module parses");
             let (mut declared, mut found) = (0, 0);
             for (_, var) in module.global_variables.iter() {
                 let Some(rb) = &var.binding else { continue };
@@ -66,14 +73,15 @@ mod tests {
                     (
                         _,
                         &naga::TypeInner::Image {
-                            class: naga::ImageClass::Sampled { kind, .. },
+                            class: naga::ImageClass::Sampled { kind, multi },
                             arrayed,
                             ..
                         },
-                    ) => match (kind, arrayed) {
-                        (naga::ScalarKind::Uint, false) => Kind::UintTexture,
-                        (naga::ScalarKind::Float, false) => Kind::Depth,
-                        (naga::ScalarKind::Float, true) => Kind::DepthArray,
+                    ) => match (kind, arrayed, multi) {
+                        (naga::ScalarKind::Uint, false, false) => Kind::UintTexture,
+                        (naga::ScalarKind::Float, false, false) => Kind::Depth,
+                        (naga::ScalarKind::Float, false, true) => Kind::DepthMultisampled,
+                        (naga::ScalarKind::Float, true, false) => Kind::DepthArray,
                         other => panic!("{pass}: {name}: unexpected texture {other:?}"),
                     },
                     other => panic!("{pass}: {name}: unexpected {other:?}"),

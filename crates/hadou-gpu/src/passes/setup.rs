@@ -46,6 +46,8 @@ pub(crate) enum Kind {
     /// A 2-D depth texture read with `textureLoad` as unfilterable `f32` (a caller's depth
     /// buffer; GL has no `textureLoad` of depth textures, so not `texture_depth_2d`).
     Depth,
+    /// [`Kind::Depth`] with several samples per pixel (a caller's multisampled depth buffer).
+    DepthMultisampled,
 }
 
 /// One binding of a pass's bind group (group 0): its number, the name of the WGSL variable it
@@ -88,6 +90,11 @@ impl Binding {
                 sample_type: wgpu::TextureSampleType::Float { filterable: false },
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
+            },
+            Kind::DepthMultisampled => wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: true,
             },
             Kind::DepthArray => wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Float { filterable: false },

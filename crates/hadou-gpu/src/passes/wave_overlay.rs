@@ -27,6 +27,29 @@ pub(crate) const BINDINGS: [Binding; 7] = [
     Binding::new(7, "curve_f32", Kind::Storage, FS),
 ];
 
+/// [`BINDINGS`] for a multisampled depth buffer ([`source`]`(true)`).
+pub(crate) const BINDINGS_MULTISAMPLED: [Binding; 7] = [
+    Binding::new(0, "frame", Kind::Uniform, FS),
+    Binding::new(1, "waves", Kind::Storage, FS),
+    Binding::new(2, "depth_texels", Kind::DepthMultisampled, FS),
+    Binding::new(3, "overlay", Kind::Uniform, FS),
+    Binding::new(5, "curves", Kind::Storage, FS),
+    Binding::new(6, "curve_vec4", Kind::Storage, FS),
+    Binding::new(7, "curve_f32", Kind::Storage, FS),
+];
+
+/// The overlay module's WGSL, reading a depth buffer of one sample per pixel or, when
+/// `multisampled`, its first sample (`textureLoad(…, 0)` is then sample 0: the depth a
+/// multisampled engine's opaque pass wrote at the pixel's first sample position).
+pub(crate) fn source(multisampled: bool) -> String {
+    let s = shaders::compose(shaders::WAVE_OVERLAY_PARTS);
+    if multisampled {
+        s.replace("var depth_texels: texture_2d<f32>;", "var depth_texels: texture_multisampled_2d<f32>;")
+    } else {
+        s
+    }
+}
+
 /// The overrides of the wave overlay module: the wave variant's wave kinds, falloffs and curve
 /// parts (the rest of [`WaveVariant::NAMES`] belongs to the wave pass's surfaces).
 pub(crate) const OVERRIDES: [&str; 13] = [
@@ -59,34 +82,56 @@ pub(crate) struct OverlayInputs<'a> {
     pub(crate) curves: [&'a wgpu::Buffer; 3],
 }
 
-/// The overlay's module, bind group layout and pipelines.
-pub(crate) struct WaveOverlayPass {
+/// The overlay's module and bind group layout for one kind of depth buffer.
+struct OverlayModule {
     module: wgpu::ShaderModule,
     layout: wgpu::BindGroupLayout,
-    pipelines: HashMap<(WaveVariant, wgpu::TextureFormat, bool), wgpu::RenderPipeline>,
+}
+
+impl OverlayModule {
+    fn new(ctx: &GpuContext, multisampled: bool) -> Result<Self, RenderError> {
+        let module = setup::compile_module(ctx, "wave overlay", &source(multisampled))?;
+        let bindings: &[Binding] = if multisampled { &BINDINGS_MULTISAMPLED } else { &BINDINGS };
+        ctx.scoped("building the wave overlay's layout", || {
+            let layout = setup::bind_group_layout(&ctx.device, "wave overlay", bindings);
+            Self { module, layout }
+        })
+    }
+}
+
+/// The overlay's modules (one sample per depth pixel; several, built on first use), layouts and
+/// pipelines.
+pub(crate) struct WaveOverlayPass {
+    single: OverlayModule,
+    multisampled: Option<OverlayModule>,
+    pipelines: HashMap<(WaveVariant, wgpu::TextureFormat, bool, bool), wgpu::RenderPipeline>,
 }
 
 impl WaveOverlayPass {
     /// Compiles the overlay module; pipelines are built on first use.
     pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
-        let module =
-            setup::compile_module(ctx, "wave overlay", &shaders::compose(shaders::WAVE_OVERLAY_PARTS))?;
-        ctx.scoped("building the wave overlay's layout", || {
-            let layout = setup::bind_group_layout(&ctx.device, "wave overlay", &BINDINGS);
-            Self { module, layout, pipelines: HashMap::new() }
-        })
+        Ok(Self { single: OverlayModule::new(ctx, false)?, multisampled: None, pipelines: HashMap::new() })
+    }
+
+    fn module(&self, multisampled: bool) -> &OverlayModule {
+        match (&self.multisampled, multisampled) {
+            (Some(m), true) => m,
+            _ => &self.single,
+        }
     }
 
     /// The pipeline drawing `variant`'s waves into a `format` target, adding to it when
-    /// `additive`, else replacing it; built on first use and kept.
+    /// `additive`, else replacing it, against a depth buffer of several samples per pixel when
+    /// `multisampled`; built on first use and kept.
     pub(crate) fn pipeline(
         &mut self,
         ctx: &GpuContext,
         variant: WaveVariant,
         format: wgpu::TextureFormat,
         additive: bool,
+        multisampled: bool,
     ) -> Result<wgpu::RenderPipeline, RenderError> {
-        let key = (variant, format, additive);
+        let key = (variant, format, additive, multisampled);
         if let Some(p) = self.pipelines.get(&key) {
             return Ok(p.clone());
         }
@@ -104,24 +149,34 @@ impl WaveOverlayPass {
                 operation: wgpu::BlendOperation::Add,
             },
         });
+        if multisampled && self.multisampled.is_none() {
+            self.multisampled = Some(OverlayModule::new(ctx, true)?);
+        }
+        let m = self.module(multisampled);
         let pipeline = ctx.scoped("building the wave overlay pipeline", || {
             let targets =
                 [Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })];
             let stages = Stages {
-                module: &self.module,
+                module: &m.module,
                 vertex: "vs_overlay",
                 buffers: &[],
                 fragment: Some(("fs_overlay", &targets)),
                 constants: &constants,
             };
-            setup::render_pipeline(&ctx.device, "wave overlay", &self.layout, &stages, triangles(None), None)
+            setup::render_pipeline(&ctx.device, "wave overlay", &m.layout, &stages, triangles(None), None)
         })?;
         self.pipelines.insert(key, pipeline.clone());
         Ok(pipeline)
     }
 
-    /// The bind group of `inputs`.
-    pub(crate) fn bind_group(&self, device: &wgpu::Device, inputs: &OverlayInputs<'_>) -> wgpu::BindGroup {
+    /// The bind group of `inputs` (`multisampled`: for a depth buffer of several samples per
+    /// pixel).
+    pub(crate) fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        inputs: &OverlayInputs<'_>,
+        multisampled: bool,
+    ) -> wgpu::BindGroup {
         let resources = vec![
             inputs.uniforms.as_entire_binding(),
             inputs.waves.as_entire_binding(),
@@ -131,7 +186,8 @@ impl WaveOverlayPass {
             inputs.curves[1].as_entire_binding(),
             inputs.curves[2].as_entire_binding(),
         ];
-        setup::bind_group(device, "wave overlay", &self.layout, &BINDINGS, resources)
+        let bindings: &[Binding] = if multisampled { &BINDINGS_MULTISAMPLED } else { &BINDINGS };
+        setup::bind_group(device, "wave overlay", &self.module(multisampled).layout, bindings, resources)
     }
 
     /// Records the overlay into `target` over a `size` viewport at its origin; the target is
