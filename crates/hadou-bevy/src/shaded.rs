@@ -67,6 +67,9 @@ pub fn hadou_texture(name: &str, image: &Image) -> Option<TextureRef> {
     })
 }
 
+/// The `HadouMaterial` made for each (root, `StandardMaterial`) pair, shared by its meshes.
+type Made = HashMap<(Entity, AssetId<StandardMaterial>), Handle<HadouMaterial>>;
+
 /// Switches the `StandardMaterial` meshes below every [`HadouShaded`] root (see there).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn shade_models(
@@ -84,7 +87,7 @@ pub(crate) fn shade_models(
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut outlines: ResMut<Assets<HadouOutline>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
-    mut made: Local<HashMap<(Entity, AssetId<StandardMaterial>), Handle<HadouMaterial>>>,
+    mut made: Local<Made>,
     mut warned: Local<bool>,
 ) {
     for (entity, standard_material, mesh, skinned) in &standard {

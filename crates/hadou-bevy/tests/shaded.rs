@@ -33,7 +33,7 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
         .world_mut()
         .spawn((
             WorldAssetRoot(handle),
-            HadouShaded { material: look.clone(), light: scene.light.clone(), shadow_mask: 0b10 },
+            HadouShaded { material: look, light: scene.light, shadow_mask: 0b10 },
         ))
         .id();
     app.finish();
