@@ -84,6 +84,7 @@ pub(crate) fn shade_models(
     roots: Query<&HadouShaded>,
     standard_materials: Res<Assets<StandardMaterial>>,
     images: Res<Assets<Image>>,
+    assets: Res<AssetServer>,
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut outlines: ResMut<Assets<HadouOutline>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
@@ -109,10 +110,21 @@ pub(crate) fn shade_models(
                     look.base_color[2] * base.blue,
                 ];
                 if let Some(texture) = &source.base_color_texture {
-                    let Some(image) = images.get(texture) else { continue }; // still loading
-                    look.base_texture = hadou_texture("base colour", image);
-                    if look.base_texture.is_none() {
-                        warn!("{entity}: its base-colour texture is not 8-bit RGBA in the main world; drawn without it");
+                    match images.get(texture) {
+                        Some(image) => {
+                            look.base_texture = hadou_texture("base colour", image);
+                            if look.base_texture.is_none() {
+                                warn!(
+                                    "{entity}: its `base_color_texture` is not 8-bit RGBA kept in the main world; \
+                                     drawn without it"
+                                );
+                            }
+                        }
+                        None if assets.load_state(texture).is_failed() => {
+                            let path = texture.path().map_or_else(|| "?".to_string(), |p| p.to_string());
+                            error!("{entity}: its `base_color_texture` ({path}) failed to load; drawn without it");
+                        }
+                        None => continue, // still loading
                     }
                 }
                 let material = HadouMaterial::with_textures(&look, &shaded.light, &mut buffers)

@@ -76,3 +76,57 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
         shaded.iter().filter(|(_, h)| materials.get(h).unwrap().surface.base_texture.x != 0).count();
     eprintln!("{} meshes shaded by hadou, {textured} with the glTF's base-colour texture", shaded.len());
 }
+
+/// A model whose `StandardMaterial` names a texture that cannot be loaded: the error is logged
+/// (naming the entity and the key), the mesh is switched without the texture, the app keeps
+/// running.
+#[test]
+fn a_missing_texture_is_an_error_and_the_mesh_is_shaded_without_it() {
+    let test = "a_missing_texture_is_an_error_and_the_mesh_is_shaded_without_it";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("hadou-bevy-missing-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut app = App::new();
+    app.add_plugins(
+        common::windowless().set(AssetPlugin { file_path: dir.display().to_string(), ..default() }),
+    )
+    .add_plugins(HadouPlugin { asset_root: dir.clone() });
+    app.finish();
+    app.cleanup();
+    let texture: Handle<Image> = app.world().resource::<AssetServer>().load("missing.png");
+    let standard = app
+        .world_mut()
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(StandardMaterial { base_color_texture: Some(texture), ..default() });
+    let mesh = app.world_mut().resource_mut::<Assets<Mesh>>().add(Cuboid::new(1.0, 1.0, 1.0));
+    let look = hadou_scene::Material { wave_blend: 0.5, ..Default::default() };
+    let light = hadou_scene::Scene::load(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-normal-vs-wave.toml"),
+    )
+    .unwrap()
+    .at(0.0)
+    .light;
+    let root = app
+        .world_mut()
+        .spawn((HadouShaded { material: look, light, shadow_mask: 0 }, Transform::default()))
+        .id();
+    let child = app.world_mut().spawn((Mesh3d(mesh), MeshMaterial3d(standard), ChildOf(root))).id();
+    let mut switched = None;
+    for _ in 0..500 {
+        app.update();
+        if let Some(m) = app.world().get::<MeshMaterial3d<HadouMaterial>>(child) {
+            switched = Some(m.0.clone());
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let handle = switched.expect("the mesh is switched once the texture has failed");
+    let material = app.world().resource::<Assets<HadouMaterial>>().get(&handle).unwrap();
+    assert_eq!(material.surface.base_texture.x, 0, "no texture");
+    assert_eq!(material.surface.wave_blend, 0.5);
+    assert!(app.world().get::<MeshMaterial3d<StandardMaterial>>(child).is_none());
+    app.update();
+    std::fs::remove_dir_all(&dir).ok();
+}
