@@ -29,6 +29,7 @@
 mod asset;
 mod camera;
 mod material;
+mod mesh;
 mod outline;
 mod render;
 mod shaded;
@@ -40,17 +41,15 @@ mod wave;
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
 pub use material::{
-    light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS, NO_TEXTURES, WAVE_LIGHTS,
-    WAVE_LIGHT_DATA,
+    light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS, NO_TEXTURES, SHADOW_DATA,
+    SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
 };
-pub use outline::{outline_mesh, HadouOutline, HadouOutlineUniform};
+pub use mesh::{bevy_mesh, bevy_slot_mesh, outline_mesh, slot_indices_of};
+pub use outline::{HadouOutline, HadouOutlineUniform};
 pub use shaded::{hadou_texture, HadouShaded};
-pub use shadows::{
-    shadow_frame, shadow_mask, shadow_records, HadouShadows, PLANE_MAP_SIZE, SHADOW_DATA, SHADOW_MAPS,
-};
+pub use shadows::{shadow_frame, shadow_mask, shadow_records, HadouShadows, PLANE_MAP_SIZE};
 pub use spawn::{
-    bevy_mesh, bevy_slot_mesh, scene_time, slot_indices_of, spawn_object, unsupported, HadouSceneRoot,
-    ObjectAssets, SceneClock, SpawnedScene,
+    scene_time, spawn_object, unsupported, HadouSceneRoot, ObjectAssets, SceneClock, SpawnedScene,
 };
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 

@@ -28,6 +28,14 @@ pub const WAVE_LIGHT_DATA: Handle<ShaderBuffer> = uuid_handle!("7a2f4c6e-1b3d-4e
 /// The texture words of a material without textures: hadou's sRGB table only.
 pub const NO_TEXTURES: Handle<ShaderBuffer> = uuid_handle!("9e4a6c8e-3d5f-4a7b-8c9d-0f1e3a5c7e17");
 
+/// The shadow maps every [`HadouMaterial`] binds: a `Depth32Float` array texture, one layer per
+/// map cast, kept by the plugin.
+pub const SHADOW_MAPS: Handle<Image> = uuid_handle!("2b4d6f8a-0c1e-4f3a-9b5d-7e9f1a3c5e21");
+/// The shadow records every [`HadouMaterial`] binds: the number of casts, of map casts, the word
+/// offsets of the cast records and of the map casts' indices, then those (hadou-gpu's
+/// `GpuShadowCast` and `FrameShadows::map_casts`).
+pub const SHADOW_DATA: Handle<ShaderBuffer> = uuid_handle!("4d6f8a0c-2e3a-4b5c-8d7e-9f1a3c5e7a23");
+
 /// The most waves that light a surface (hadou-gpu's `MAX_LIGHTS` in shading.wgsl, hadou-scene's
 /// per-scene limit); past it the first by entity are used, and a warning says so once.
 pub const MAX_WAVE_LIGHTS: usize = 256;
@@ -263,10 +271,10 @@ pub struct HadouMaterial {
     /// The sRGB table and this material's texels ([`NO_TEXTURES`] without textures).
     #[storage(3, read_only)]
     pub textures: Handle<ShaderBuffer>,
-    /// The shadow maps ([`crate::SHADOW_MAPS`], kept by the plugin).
+    /// The shadow maps ([`SHADOW_MAPS`], kept by the plugin).
     #[texture(4, dimension = "2d_array", sample_type = "float", filterable = false)]
     pub shadow_maps: Handle<Image>,
-    /// The shadow records ([`crate::SHADOW_DATA`], kept by the plugin).
+    /// The shadow records ([`SHADOW_DATA`], kept by the plugin).
     #[storage(5, read_only)]
     pub shadow_data: Handle<ShaderBuffer>,
 }
@@ -280,8 +288,8 @@ impl HadouMaterial {
             lights: WAVE_LIGHTS,
             light_data: WAVE_LIGHT_DATA,
             textures: NO_TEXTURES,
-            shadow_maps: crate::shadows::SHADOW_MAPS,
-            shadow_data: crate::shadows::SHADOW_DATA,
+            shadow_maps: SHADOW_MAPS,
+            shadow_data: SHADOW_DATA,
         }
     }
 
@@ -313,8 +321,8 @@ impl HadouMaterial {
             lights: WAVE_LIGHTS,
             light_data: WAVE_LIGHT_DATA,
             textures,
-            shadow_maps: crate::shadows::SHADOW_MAPS,
-            shadow_data: crate::shadows::SHADOW_DATA,
+            shadow_maps: SHADOW_MAPS,
+            shadow_data: SHADOW_DATA,
         }
     }
 

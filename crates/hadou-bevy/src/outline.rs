@@ -135,19 +135,3 @@ impl Material for HadouOutline {
         Ok(())
     }
 }
-
-/// The hull mesh of `mesh`'s material slot `slot`: its positions, its outline normals (or its
-/// normals when it has none) as `NORMAL`, and the triangles of that slot.
-pub fn outline_mesh(mesh: &hadou_scene::Mesh, slot: u32) -> Mesh {
-    let normals = if mesh.outline_normals.len() == mesh.positions.len() {
-        mesh.outline_normals.clone()
-    } else {
-        mesh.normals.clone()
-    };
-    let mut out =
-        Mesh::new(bevy::mesh::PrimitiveTopology::TriangleList, bevy::asset::RenderAssetUsages::default());
-    out.insert_attribute(Mesh::ATTRIBUTE_POSITION, mesh.positions.clone());
-    out.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
-    out.insert_indices(bevy::mesh::Indices::U32(crate::spawn::slot_indices(mesh, slot)));
-    out
-}

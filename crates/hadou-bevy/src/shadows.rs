@@ -7,9 +7,9 @@
 //! [`PLANE_MAP_SIZE`]² texels along the same direction (Bevy has no screen-space plane pass):
 //! the same shadow up to a texel at its edge.
 
-use crate::material::HadouMaterial;
+use crate::material::{HadouMaterial, SHADOW_DATA, SHADOW_MAPS};
 use crate::render::HadouRenderer;
-use bevy::asset::{uuid_handle, RenderAssetUsages};
+use bevy::asset::RenderAssetUsages;
 use bevy::image::Image;
 use bevy::prelude::*;
 use bevy::render::render_asset::RenderAssets;
@@ -22,14 +22,6 @@ use bevy::render::texture::GpuImage;
 use bevy::render::Extract;
 use hadou_gpu::layout::FrameShadows;
 use hadou_scene::{Frame, ShadowMethod};
-
-/// The shadow maps every [`HadouMaterial`] binds: a `Depth32Float` array texture, one layer per
-/// map cast, kept by the plugin.
-pub const SHADOW_MAPS: Handle<Image> = uuid_handle!("2b4d6f8a-0c1e-4f3a-9b5d-7e9f1a3c5e21");
-/// The shadow records every [`HadouMaterial`] binds: the number of casts, of map casts, the word
-/// offsets of the cast records and of the map casts' indices, then those (hadou-gpu's
-/// `GpuShadowCast` and `FrameShadows::map_casts`).
-pub const SHADOW_DATA: Handle<ShaderBuffer> = uuid_handle!("4d6f8a0c-2e3a-4b5c-8d7e-9f1a3c5e7a23");
 
 /// The map edge a `method = "plane"` shadow is drawn with in Bevy.
 pub const PLANE_MAP_SIZE: u32 = 2048;
