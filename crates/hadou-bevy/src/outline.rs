@@ -2,7 +2,8 @@
 //! a second mesh entity drawn over the same mesh: each vertex pushed along its world outline
 //! normal by `d·|z|` (its view depth `z`, so the line keeps its width on screen), front faces
 //! culled, so only the hull's back faces show around the silhouette, in the outline colour. The
-//! twin of hadou-gpu's `vs_hull` (raster.wgsl) and hadou-cpu's `opaque::project_all`.
+//! twin of hadou-gpu's `vs_hull` (raster.wgsl) and hadou-cpu's `opaque::project_all`. A skinned
+//! mesh's hull is skinned as Bevy skins the mesh.
 
 use bevy::asset::uuid_handle;
 use bevy::mesh::MeshVertexBufferLayoutRef;
@@ -19,6 +20,7 @@ pub(crate) const SHADER: Handle<Shader> = uuid_handle!("3f6b8d0a-2c4e-4a6f-9b1d-
 /// The WGSL of [`HadouOutline`].
 pub(crate) const SOURCE: &str = r"
 #import bevy_pbr::mesh_functions
+#import bevy_pbr::skinning
 #import bevy_pbr::view_transformations::position_world_to_clip
 #import bevy_pbr::mesh_view_bindings::view
 
@@ -35,15 +37,25 @@ struct Vertex {
     @builtin(instance_index) instance_index: u32,
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
+#ifdef SKINNED
+    @location(6) joint_indices: vec4<u32>,
+    @location(7) joint_weights: vec4<f32>,
+#endif
 }
 
 // The hull vertex (000 §2.3): R' = R + d·|R_z|·U, U the unit world outline normal, R_z the view
 // depth of the vertex (hadou-gpu's vs_hull).
 @vertex
 fn vertex(v: Vertex) -> @builtin(position) vec4<f32> {
+#ifdef SKINNED
+    // A skinned mesh (Bevy's joints, as Bevy's own mesh shader skins it).
+    let world_from_local = skinning::skin_model(v.joint_indices, v.joint_weights, v.instance_index);
+    let n = skinning::skin_normals(world_from_local, v.normal);
+#else
     let world_from_local = mesh_functions::get_world_from_local(v.instance_index);
-    let base = mesh_functions::mesh_position_local_to_world(world_from_local, vec4<f32>(v.position, 1.0)).xyz;
     let n = mesh_functions::mesh_normal_local_to_world(v.normal, v.instance_index);
+#endif
+    let base = mesh_functions::mesh_position_local_to_world(world_from_local, vec4<f32>(v.position, 1.0)).xyz;
     let len = length(n);
     var u = vec3<f32>(0.0);
     if (len > 0.0 && len < 3.0e38) {
@@ -126,10 +138,17 @@ impl Material for HadouOutline {
         layout: &MeshVertexBufferLayoutRef,
         _key: MaterialPipelineKey<Self>,
     ) -> Result<(), SpecializedMeshPipelineError> {
-        let buffer = layout.0.get_layout(&[
+        let mut attributes = vec![
             Mesh::ATTRIBUTE_POSITION.at_shader_location(0),
             Mesh::ATTRIBUTE_NORMAL.at_shader_location(1),
-        ])?;
+        ];
+        // Bevy's mesh pipeline has set `SKINNED` and the joints' bind group for a skinned mesh;
+        // its joints are read where Bevy's own mesh shader reads them.
+        if layout.0.contains(Mesh::ATTRIBUTE_JOINT_INDEX) && layout.0.contains(Mesh::ATTRIBUTE_JOINT_WEIGHT) {
+            attributes.push(Mesh::ATTRIBUTE_JOINT_INDEX.at_shader_location(6));
+            attributes.push(Mesh::ATTRIBUTE_JOINT_WEIGHT.at_shader_location(7));
+        }
+        let buffer = layout.0.get_layout(&attributes)?;
         descriptor.vertex.buffers = vec![buffer];
         descriptor.primitive.cull_mode = Some(Face::Front);
         Ok(())

@@ -18,9 +18,9 @@ use std::sync::Arc;
 /// `wave_blend` and outline under `light`, its base colour multiplied by the `StandardMaterial`'s
 /// base colour, and the `StandardMaterial`'s base-colour texture (an 8-bit RGBA image kept in the
 /// main world, as Bevy's glTF loader keeps it) as hadou's base texture. Meshes spawned later
-/// (the scene loads asynchronously) are switched when they appear. An outline is added to each
-/// mesh that is not skinned (the hull is pushed along the mesh's own normals; a skinned mesh
-/// gets none, and a warning says so once).
+/// (the scene loads asynchronously) are switched when they appear. With an outline in `material`,
+/// each mesh gets a hull (pushed along the mesh's own normals; a skinned mesh's hull is skinned by
+/// the same joints).
 #[derive(Component, Clone, Debug)]
 pub struct HadouShaded {
     /// hadou's look: `model`, `ramp`, `wave_blend`, `outline`, and a base colour that multiplies
@@ -78,9 +78,10 @@ pub(crate) fn shade_models(
         Entity,
         &MeshMaterial3d<StandardMaterial>,
         &Mesh3d,
-        Has<bevy::mesh::skinning::SkinnedMesh>,
+        Option<&bevy::mesh::skinning::SkinnedMesh>,
     )>,
     parents: Query<&ChildOf>,
+    transforms: Query<&Transform>,
     roots: Query<&HadouShaded>,
     standard_materials: Res<Assets<StandardMaterial>>,
     images: Res<Assets<Image>>,
@@ -89,7 +90,6 @@ pub(crate) fn shade_models(
     mut outlines: ResMut<Assets<HadouOutline>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut made: Local<Made>,
-    mut warned: Local<bool>,
 ) {
     for (entity, standard_material, mesh, skinned) in &standard {
         let Some((root, shaded)) =
@@ -137,18 +137,27 @@ pub(crate) fn shade_models(
         let mut e = commands.entity(entity);
         e.remove::<MeshMaterial3d<StandardMaterial>>().insert(MeshMaterial3d(handle));
         if let Some(outline) = shaded.material.outline.filter(|o| o.width > 0.0) {
-            if skinned {
-                if !*warned {
-                    *warned = true;
-                    warn!("{root}: skinned meshes get no hadou outline in Bevy yet");
+            // The hull is drawn from the same mesh (skinned by the same joints: a sibling of the
+            // mesh entity keeps its transform and skin).
+            let mut hull = commands.spawn((
+                Name::new("outline"),
+                Mesh3d(mesh.0.clone()),
+                MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
+            ));
+            match skinned {
+                Some(skin) => {
+                    // Skinned bounds move with the joints; the hull is never culled.
+                    hull.insert((skin.clone(), bevy::camera::visibility::NoFrustumCulling));
+                    if let Ok(parent) = parents.get(entity) {
+                        hull.insert((
+                            ChildOf(parent.parent()),
+                            transforms.get(entity).copied().unwrap_or_default(),
+                        ));
+                    }
                 }
-            } else {
-                commands.spawn((
-                    Name::new("outline"),
-                    Mesh3d(mesh.0.clone()),
-                    MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
-                    ChildOf(entity),
-                ));
+                None => {
+                    hull.insert(ChildOf(entity));
+                }
             }
         }
     }

@@ -3,12 +3,17 @@
 
 mod common;
 
+use bevy::camera::{Hdr, RenderTarget};
+use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::gltf::GltfAssetLabel;
 use bevy::prelude::*;
+use bevy::render::render_resource::TextureFormat;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::world_serialization::WorldAssetRoot;
 use common::adapter_or_skip;
 use hadou_bevy::{HadouMaterial, HadouPlugin, HadouShaded};
 use std::path::Path;
+use std::sync::{Arc, Mutex};
 
 #[test]
 fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
@@ -27,6 +32,18 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
     look.base_color = [0.5, 1.0, 1.0];
     look.wave_blend = 0.75;
     look.model = hadou_scene::ShadingModel::Toon;
+    // A colour nothing else in the picture has: the hulls must show around the character.
+    look.outline = Some(hadou_scene::Outline { width: 0.01, color: [1.0, 0.0, 1.0] });
+    let image = Image::new_target_texture(96, 96, TextureFormat::Rgba8UnormSrgb, None);
+    let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
+    app.world_mut().spawn((
+        Camera3d::default(),
+        Camera { clear_color: ClearColorConfig::Custom(Color::BLACK), ..default() },
+        RenderTarget::Image(image.clone().into()),
+        Hdr,
+        Tonemapping::None,
+        Transform::from_xyz(0.0, 1.0, 4.0).looking_at(Vec3::new(0.0, 0.9, 0.0), Vec3::Y),
+    ));
     let handle =
         app.world().resource::<AssetServer>().load(GltfAssetLabel::Scene(0).from_asset("assets/hero.glb"));
     let character = app
@@ -72,6 +89,33 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
         // The base colour is the look's times the glTF material's.
         assert!(m.surface.base_color.x <= 0.5 + 1e-6, "{:?}", m.surface.base_color);
     }
+    let world = app.world_mut();
+    let hulls: Vec<bool> = world
+        .query_filtered::<Has<bevy::mesh::skinning::SkinnedMesh>, With<MeshMaterial3d<hadou_bevy::HadouOutline>>>()
+        .iter(world)
+        .collect();
+    assert_eq!(hulls.len(), shaded.len(), "every mesh gets its outline hull");
+    assert!(hulls.iter().all(|&skinned| skinned), "the hulls of the skinned hero are skinned by its joints");
+    // The hulls are drawn (skinned, front faces culled): magenta pixels at the silhouette.
+    let shot: Arc<Mutex<Option<Image>>> = Arc::default();
+    let sink = shot.clone();
+    app.world_mut().spawn(Screenshot::image(image)).observe(move |captured: On<ScreenshotCaptured>| {
+        *sink.lock().unwrap() = Some(captured.image.clone());
+    });
+    for _ in 0..200 {
+        app.update();
+        if shot.lock().unwrap().is_some() {
+            break;
+        }
+    }
+    let picture = shot.lock().unwrap().take().expect("the screenshot came back");
+    let data = picture.data.expect("a captured image has its bytes");
+    let magenta = data.chunks_exact(4).filter(|p| p[0] > 200 && p[1] < 60 && p[2] > 200).count();
+    let lit = data.chunks_exact(4).filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count();
+    eprintln!("{magenta} outline pixels of {lit} drawn");
+    assert!(magenta > 20, "the outline hulls show ({magenta} magenta pixels)");
+    assert!(lit > 2 * magenta, "the character is drawn inside its outline");
+    let materials = app.world().resource::<Assets<HadouMaterial>>();
     let textured =
         shaded.iter().filter(|(_, h)| materials.get(h).unwrap().surface.base_texture.x != 0).count();
     eprintln!("{} meshes shaded by hadou, {textured} with the glTF's base-colour texture", shaded.len());
