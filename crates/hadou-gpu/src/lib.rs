@@ -227,7 +227,8 @@ impl GpuBackend {
     /// light [`Backend::render`] adds to the scene before its colour mapping, without hadou's
     /// objects, materials or shadows. Nothing is submitted or waited for; the buffers it uploads
     /// live as long as the encoded commands. Errors: an invalid frame, a device limit, or (on
-    /// the next call, on the web) a target that does not fit the frame's size.
+    /// the next call, on the web) a target that does not fit the frame's size; a multisampled
+    /// depth buffer on OpenGL (which reads it as empty).
     pub fn encode_wave_overlay(
         &mut self,
         frame: &Frame,

@@ -64,6 +64,15 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         self.ctx.check()?;
         prepare::validate_frame(frame)?;
+        if target.depth_samples > 1 && self.ctx.info.backend == wgpu::Backend::Gl {
+            // Mesa's OpenGL (llvmpipe) reads a multisampled depth texture as if nothing were
+            // drawn (tests/overlay.rs): refused rather than drawn through the caller's surfaces.
+            return Err(RenderError::Other(format!(
+                "the wave overlay cannot read a multisampled depth buffer ({} samples) on OpenGL; \
+                 draw the view without MSAA",
+                target.depth_samples
+            )));
+        }
         let (waves, curves, _) = layout::frame_waves(frame).map_err(RenderError::Other)?;
         check_curves(&self.ctx.limits, &curves)?;
         let faithful = frame.color_mapping.mode == hadou_scene::ToneMode::Faithful;
