@@ -164,11 +164,12 @@ const SETTLE_FRAMES: u32 = 5;
 fn screenshot(
     mut commands: Commands,
     options: Res<Options>,
-    spawned: Query<(), With<SpawnedScene>>,
+    spawned: Query<&SpawnedScene>,
     mut frames: Local<u32>,
 ) {
     let Some(out) = &options.screenshot else { return };
-    if spawned.is_empty() {
+    // Every object drawn with hadou's look (a glTF file loads asynchronously).
+    if spawned.is_empty() || !spawned.iter().all(|s| s.ready) {
         return;
     }
     *frames += 1;

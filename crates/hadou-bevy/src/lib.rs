@@ -130,6 +130,10 @@ impl Plugin for HadouPlugin {
                         .chain()
                         .in_set(HadouSystems::Scenes),
                 );
+                #[cfg(feature = "gltf")]
+                if app.world().contains_resource::<Assets<StandardMaterial>>() {
+                    app.add_systems(Update, spawn::mark_ready.after(HadouSystems::Scenes).after(shaded::shade_models));
+                }
             }
         }
         app.add_systems(PostUpdate, wave::check_changed_waves.in_set(HadouSystems::CheckWaves))

@@ -30,6 +30,51 @@ pub struct HadouShaded {
     pub light: hadou_scene::Light,
     /// The shadows the model receives ([`HadouMaterial::with_shadow_mask`]).
     pub shadow_mask: u32,
+    /// hadou's own looks for the glTF file's materials, by slot (the file's materials in order,
+    /// then its default material: a frame object's `materials` when the object is that file).
+    /// When not empty, a mesh whose `StandardMaterial` Bevy's glTF loader made from material `i`
+    /// takes `slots[i]` as it is (its colours and textures already read from the file) instead
+    /// of `material` times the `StandardMaterial`. Empty for a model of the game's own.
+    pub slots: Vec<hadou_scene::Material>,
+}
+
+impl HadouShaded {
+    /// `material` under `light` for every mesh, receiving the shadows of `shadow_mask`.
+    pub fn new(material: hadou_scene::Material, light: hadou_scene::Light, shadow_mask: u32) -> Self {
+        HadouShaded { material, light, shadow_mask, slots: Vec::new() }
+    }
+}
+
+/// The slot of a `StandardMaterial` that Bevy's glTF loader made (its label is `Material{i}/std`,
+/// `Material{i} (inverted)/std` or `DefaultMaterial/std`) among `slots` slots (the file's
+/// materials, then its default one); `None` for a material of any other origin.
+pub fn gltf_slot(handle: &Handle<StandardMaterial>, slots: usize) -> Option<usize> {
+    let path = handle.path()?;
+    let label = path.label()?.strip_suffix("/std")?;
+    if label == "DefaultMaterial" {
+        return slots.checked_sub(1);
+    }
+    let index = label.strip_prefix("Material")?;
+    let index = index.strip_suffix(" (inverted)").unwrap_or(index);
+    index.parse::<usize>().ok().filter(|&i| i < slots)
+}
+
+/// The look of a mesh drawn with `source` (the `StandardMaterial` behind `handle`) under
+/// `shaded`: the glTF slot's own look, or `shaded.material` with its base colour multiplied by
+/// the `StandardMaterial`'s (the texture is added by the caller). The flag is true for a slot's
+/// own look.
+fn look_of(shaded: &HadouShaded, handle: &Handle<StandardMaterial>, source: &StandardMaterial) -> (hadou_scene::Material, bool) {
+    if let Some(slot) = gltf_slot(handle, shaded.slots.len()) {
+        return (shaded.slots[slot].clone(), true);
+    }
+    let mut look = shaded.material.clone();
+    let base = source.base_color.to_linear();
+    look.base_color = [
+        look.base_color[0] * base.red,
+        look.base_color[1] * base.green,
+        look.base_color[2] * base.blue,
+    ];
+    (look, false)
 }
 
 fn wrap(mode: ImageAddressMode) -> Wrap {
@@ -67,8 +112,9 @@ pub fn hadou_texture(name: &str, image: &Image) -> Option<TextureRef> {
     })
 }
 
-/// The `HadouMaterial` made for each (root, `StandardMaterial`) pair, shared by its meshes.
-type Made = HashMap<(Entity, AssetId<StandardMaterial>), Handle<HadouMaterial>>;
+/// The `HadouMaterial` made for each (root, `StandardMaterial`) pair, shared by its meshes, with
+/// the `StandardMaterial` it replaces.
+type Made = HashMap<(Entity, AssetId<StandardMaterial>), (Handle<StandardMaterial>, Handle<HadouMaterial>)>;
 
 /// Switches the `StandardMaterial` meshes below every [`HadouShaded`] root (see there).
 #[allow(clippy::too_many_arguments)]
@@ -83,6 +129,7 @@ pub(crate) fn shade_models(
     parents: Query<&ChildOf>,
     transforms: Query<&Transform>,
     roots: Query<&HadouShaded>,
+    changed: Query<(Entity, &HadouShaded), Changed<HadouShaded>>,
     standard_materials: Res<Assets<StandardMaterial>>,
     images: Res<Assets<Image>>,
     assets: Res<AssetServer>,
@@ -91,6 +138,19 @@ pub(crate) fn shade_models(
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut made: Local<Made>,
 ) {
+    // A root whose look changed (a scene track, a game system) updates the materials made for it.
+    for (root, shaded) in &changed {
+        for ((_, standard_id), (standard_handle, handle)) in made.iter().filter(|((r, _), _)| *r == root) {
+            let Some(source) = standard_materials.get(*standard_id) else { continue };
+            let (look, _) = look_of(shaded, standard_handle, source);
+            let differs = materials.get(handle).is_some_and(|m| m.clone().update(&look, &shaded.light));
+            if differs {
+                if let Some(mut m) = materials.get_mut(handle) {
+                    m.update(&look, &shaded.light);
+                }
+            }
+        }
+    }
     for (entity, standard_material, mesh, skinned) in &standard {
         let Some((root, shaded)) =
             parents.iter_ancestors(entity).find_map(|a| roots.get(a).ok().map(|s| (a, s)))
@@ -100,16 +160,10 @@ pub(crate) fn shade_models(
         let Some(source) = standard_materials.get(&standard_material.0) else { continue };
         let key = (root, standard_material.0.id());
         let handle = match made.get(&key) {
-            Some(h) => h.clone(),
+            Some((_, h)) => h.clone(),
             None => {
-                let mut look = shaded.material.clone();
-                let base = source.base_color.to_linear();
-                look.base_color = [
-                    look.base_color[0] * base.red,
-                    look.base_color[1] * base.green,
-                    look.base_color[2] * base.blue,
-                ];
-                if let Some(texture) = &source.base_color_texture {
+                let (mut look, own) = look_of(shaded, &standard_material.0, source);
+                if let Some(texture) = source.base_color_texture.as_ref().filter(|_| !own) {
                     match images.get(texture) {
                         Some(image) => {
                             look.base_texture = hadou_texture("base colour", image);
@@ -130,13 +184,17 @@ pub(crate) fn shade_models(
                 let material = HadouMaterial::with_textures(&look, &shaded.light, &mut buffers)
                     .with_shadow_mask(shaded.shadow_mask);
                 let h = materials.add(material);
-                made.insert(key, h.clone());
+                made.insert(key, (standard_material.0.clone(), h.clone()));
                 h
             }
         };
         let mut e = commands.entity(entity);
         e.remove::<MeshMaterial3d<StandardMaterial>>().insert(MeshMaterial3d(handle));
-        if let Some(outline) = shaded.material.outline.filter(|o| o.width > 0.0) {
+        let outline = match gltf_slot(&standard_material.0, shaded.slots.len()) {
+            Some(slot) => shaded.slots[slot].outline,
+            None => shaded.material.outline,
+        };
+        if let Some(outline) = outline.filter(|o| o.width > 0.0) {
             // The hull is drawn from the same mesh (skinned by the same joints: a sibling of the
             // mesh entity keeps its transform and skin).
             let mut hull = commands.spawn((

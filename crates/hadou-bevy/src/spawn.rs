@@ -7,6 +7,13 @@ use crate::camera::{HadouCamera, ViewMapping};
 use crate::material::HadouMaterial;
 use crate::mesh::{bevy_mesh, outline_mesh, slot_indices_of};
 use crate::outline::HadouOutline;
+use crate::shaded::HadouShaded;
+#[cfg(feature = "gltf")]
+use bevy::asset::AssetPath;
+#[cfg(feature = "gltf")]
+use bevy::gltf::GltfAssetLabel;
+#[cfg(feature = "gltf")]
+use bevy::world_serialization::WorldAssetRoot;
 use crate::shadows::{shadow_mask, HadouShadows};
 use crate::wave::HadouWave;
 use bevy::mesh::Indices;
@@ -43,14 +50,23 @@ pub struct SpawnedScene {
     pub camera: Entity,
     /// The directional light.
     pub light: Entity,
-    /// One entity per `[[object]]` (its transform), with a child per material slot that has
-    /// triangles (`Mesh3d`, `HadouMaterial`) and one per outlined slot (`HadouOutline`).
+    /// One entity per `[[object]]` (its transform). A primitive has a child per material slot
+    /// that has triangles (`Mesh3d`, `HadouMaterial`) and one per outlined slot
+    /// (`HadouOutline`); a `kind = "gltf"` object is the file's scene loaded by Bevy's glTF
+    /// loader (`WorldAssetRoot`, skinned and animated by Bevy) with [`crate::HadouShaded`]
+    /// giving each of its meshes its slot's look.
     pub objects: Vec<Entity>,
     /// Per object, the material of each slot (the object's materials in order), set from the
-    /// scene every frame (tracks may change `wave_blend`, colours, the light).
+    /// scene every frame (tracks may change `wave_blend`, colours, the light); empty for a glTF
+    /// object, whose [`crate::HadouShaded`] is set instead.
     pub materials: Vec<Vec<Handle<HadouMaterial>>>,
     /// One entity per `[[wave]]`.
     pub waves: Vec<Entity>,
+    /// Every object is drawn with hadou's look: true at once for a scene of primitives; a scene
+    /// with glTF objects is ready once Bevy has loaded each file (or failed to, with its error
+    /// logged) and each of its meshes has been switched to its slot's `HadouMaterial`. Wait for
+    /// it before a screenshot.
+    pub ready: bool,
 }
 
 fn linear(c: [f32; 3]) -> Color {
@@ -89,6 +105,27 @@ fn light_transform(frame: &Frame) -> Transform {
     let d = vec3(frame.light.direction);
     let up = if d.cross(Vec3::Y).length_squared() > 1e-6 { Vec3::Y } else { Vec3::X };
     Transform::default().looking_to(d, up)
+}
+
+#[cfg(feature = "gltf")]
+/// The asset path of the default scene of the glTF file `file` named by the scene asset
+/// `scene` (relative to the scene file's directory; hadou-scene checked that it lies inside it),
+/// or `None` when the scene asset has no path.
+pub fn gltf_scene_path(scene: &Handle<HadouScene>, file: &std::path::Path) -> Option<AssetPath<'static>> {
+    let scene_path = scene.path()?;
+    let mut path = scene_path.path().parent().map(std::path::Path::to_path_buf).unwrap_or_default();
+    for part in file.components() {
+        match part {
+            std::path::Component::ParentDir => {
+                path.pop();
+            }
+            std::path::Component::Normal(p) => path.push(p),
+            _ => {}
+        }
+    }
+    let file = AssetPath::from(path).with_source(scene_path.source().clone_owned());
+    // hadou reads the file's default scene (`scene`, else the first): Bevy's label for it.
+    Some(file.with_label(GltfAssetLabel::Scene(0).to_string()))
 }
 
 fn object_transform(object: &hadou_scene::Object) -> Transform {
@@ -173,6 +210,7 @@ pub fn spawn_object(
     (entity, handles)
 }
 
+#[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
 pub(crate) fn spawn_scenes(
     mut commands: Commands,
     roots: Query<(Entity, &HadouSceneRoot), Without<SpawnedScene>>,
@@ -181,9 +219,12 @@ pub(crate) fn spawn_scenes(
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut outlines: ResMut<Assets<HadouOutline>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
+    asset_server: Res<AssetServer>,
 ) {
     for (root, spawn) in &roots {
         let Some(HadouScene(scene)) = scenes.get(&spawn.scene) else { continue };
+        #[cfg(feature = "gltf")]
+        let files = scene.object_files();
         let frame = scene.at(scene_time(spawn.clock, 0.0, scene.duration()));
         let missing = unsupported(&frame);
         if !missing.is_empty() {
@@ -235,7 +276,29 @@ pub(crate) fn spawn_scenes(
         };
         for (i, object) in frame.objects.iter().enumerate() {
             let mask = shadow_mask(&frame, i as u32);
-            let (entity, handles) = spawn_object(&mut commands, &mut assets, object, &frame.light, mask);
+            #[cfg(feature = "gltf")]
+            let gltf = files.get(i).copied().flatten().and_then(|file| gltf_scene_path(&spawn.scene, file));
+            #[cfg(not(feature = "gltf"))]
+            let gltf: Option<()> = None;
+            let (entity, handles) = match gltf {
+                #[cfg(feature = "gltf")]
+                Some(path) => {
+                    let shaded = HadouShaded {
+                        slots: object.materials.clone(),
+                        ..HadouShaded::new(object.material(0).clone(), frame.light, mask)
+                    };
+                    let entity = commands
+                        .spawn((
+                            Name::new(object.name.clone()),
+                            object_transform(object),
+                            WorldAssetRoot(asset_server.load(path)),
+                            shaded,
+                        ))
+                        .id();
+                    (entity, Vec::new())
+                }
+                _ => spawn_object(&mut commands, &mut assets, object, &frame.light, mask),
+            };
             commands.entity(entity).insert(ChildOf(root));
             objects.push(entity);
             object_materials.push(handles);
@@ -249,7 +312,9 @@ pub(crate) fn spawn_scenes(
                     .id()
             })
             .collect();
+        let ready = object_materials.iter().all(|m| !m.is_empty());
         commands.entity(root).insert(SpawnedScene {
+            ready,
             elapsed: 0.0,
             camera,
             light,
@@ -296,6 +361,7 @@ pub(crate) fn animate_scenes(
     mut roots: Query<(&HadouSceneRoot, &mut SpawnedScene)>,
     scenes: Res<Assets<HadouScene>>,
     mut transforms: Query<&mut Transform, Without<HadouSceneRoot>>,
+    mut shaded: Query<&mut HadouShaded>,
     mut cameras: Query<(&mut Projection, &mut HadouCamera)>,
     mut waves: Query<&mut HadouWave>,
     mut materials: ResMut<Assets<HadouMaterial>>,
@@ -321,6 +387,13 @@ pub(crate) fn animate_scenes(
             if let Ok(mut t) = transforms.get_mut(entity) {
                 *t = object_transform(object);
             }
+            if let Ok(mut s) = shaded.get_mut(entity) {
+                // Only a changed look marks the component changed (its materials are updated).
+                if s.slots != object.materials || s.light != frame.light {
+                    s.slots.clone_from(&object.materials);
+                    s.light = frame.light;
+                }
+            }
             for (slot, handle) in handles.iter().enumerate() {
                 let material = object.material(slot as u32);
                 // Only a material whose uniform changes is marked changed (and uploaded again).
@@ -342,6 +415,36 @@ pub(crate) fn animate_scenes(
         }
         if !frame.shadows.is_empty() {
             shadows.frame = Some(frame);
+        }
+    }
+}
+
+/// Sets [`SpawnedScene::ready`] once every glTF object's file has loaded (or failed to) and each
+/// of its meshes has its slot's [`HadouMaterial`].
+#[cfg(feature = "gltf")]
+pub(crate) fn mark_ready(
+    mut roots: Query<&mut SpawnedScene>,
+    models: Query<&WorldAssetRoot, With<HadouShaded>>,
+    children: Query<&Children>,
+    standard: Query<(), With<MeshMaterial3d<StandardMaterial>>>,
+    shaded: Query<(), With<MeshMaterial3d<HadouMaterial>>>,
+    asset_server: Res<AssetServer>,
+) {
+    for mut spawned in roots.iter_mut().filter(|s| !s.ready) {
+        let ready = spawned.objects.iter().all(|&object| {
+            let Ok(model) = models.get(object) else { return true };
+            if asset_server.load_state(&model.0).is_failed() {
+                return true;
+            }
+            let (mut switched, mut left) = (0, 0);
+            for e in children.iter_descendants(object) {
+                switched += usize::from(shaded.contains(e));
+                left += usize::from(standard.contains(e));
+            }
+            switched > 0 && left == 0
+        });
+        if ready {
+            spawned.ready = true;
         }
     }
 }

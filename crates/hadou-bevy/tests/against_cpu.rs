@@ -86,10 +86,11 @@ fn picture_in(
     let mut drawn = 0;
     for _ in 0..2000 {
         app.update();
-        if app.world().get::<SpawnedScene>(root).is_some() {
+        if app.world().get::<SpawnedScene>(root).is_some_and(|s| s.ready) {
             drawn += 1;
         }
-        // A few frames after spawning, once the meshes and pipelines are ready.
+        // A few frames after every object has hadou's look (glTF files load asynchronously),
+        // once the meshes and pipelines are ready.
         if drawn == 5 {
             let shot = shot.clone();
             app.world_mut().spawn(Screenshot::image(image.clone())).observe(

@@ -11,7 +11,7 @@ use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::world_serialization::WorldAssetRoot;
 use common::adapter_or_skip;
-use hadou_bevy::{HadouMaterial, HadouPlugin, HadouShaded};
+use hadou_bevy::{HadouMaterial, HadouPlugin, HadouSceneRoot, HadouShaded, SceneClock, SpawnedScene};
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
@@ -50,7 +50,7 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
         .world_mut()
         .spawn((
             WorldAssetRoot(handle),
-            HadouShaded { material: look, light: scene.light, shadow_mask: 0b10 },
+            HadouShaded::new(look, scene.light, 0b10),
         ))
         .id();
     app.finish();
@@ -154,7 +154,7 @@ fn a_missing_texture_is_an_error_and_the_mesh_is_shaded_without_it() {
     .light;
     let root = app
         .world_mut()
-        .spawn((HadouShaded { material: look, light, shadow_mask: 0 }, Transform::default()))
+        .spawn((HadouShaded::new(look, light, 0), Transform::default()))
         .id();
     let child = app.world_mut().spawn((Mesh3d(mesh), MeshMaterial3d(standard), ChildOf(root))).id();
     let mut switched = None;
@@ -173,4 +173,95 @@ fn a_missing_texture_is_an_error_and_the_mesh_is_shaded_without_it() {
     assert!(app.world().get::<MeshMaterial3d<StandardMaterial>>(child).is_none());
     app.update();
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A scene file's `kind = "gltf"` object is loaded by Bevy's own glTF loader (skinned by Bevy)
+/// and each of its meshes takes its own slot's look from the scene (the glTF material's colour
+/// and texture as hadou read them, the scene's `wave_blend`, outline and model); a changed look
+/// on the object's `HadouShaded` (what a track or a game system sets) reaches its materials.
+#[test]
+fn a_scenes_gltf_object_is_loaded_by_bevy_with_each_slots_look() {
+    let test = "a_scenes_gltf_object_is_loaded_by_bevy_with_each_slots_look";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").canonicalize().unwrap();
+    let mut app = App::new();
+    app.add_plugins(
+        common::windowless().set(AssetPlugin { file_path: root.display().to_string(), ..default() }),
+    )
+    .add_plugins(HadouPlugin { asset_root: root.clone() });
+    let scene_handle = app.world().resource::<AssetServer>().load("light-normal-vs-wave.toml");
+    let scene_root = app
+        .world_mut()
+        .spawn(HadouSceneRoot { scene: scene_handle, clock: SceneClock::Frozen(0.75) })
+        .id();
+    app.finish();
+    app.cleanup();
+    let ready = |app: &App| app.world().get::<SpawnedScene>(scene_root).is_some_and(|s| s.ready);
+    for _ in 0..1000 {
+        app.update();
+        if ready(&app) {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert!(ready(&app), "the glTF object loads and is switched");
+    let scene = hadou_scene::Scene::load(root.join("light-normal-vs-wave.toml")).unwrap();
+    let frame = scene.at(0.75);
+    let index = scene.object_names().iter().position(|n| *n == "hero").unwrap();
+    let expected = &frame.objects[index];
+    let hero = app.world().get::<SpawnedScene>(scene_root).unwrap().objects[index];
+    assert!(app.world().get::<WorldAssetRoot>(hero).is_some(), "the hero is Bevy's glTF scene");
+    let shaded = app.world().get::<HadouShaded>(hero).expect("switched by HadouShaded");
+    assert_eq!(shaded.slots, expected.materials, "the frame's looks, slot by slot");
+    assert_eq!(shaded.light, frame.light);
+
+    let world = app.world_mut();
+    let mut below = Vec::new();
+    let mut meshes = world.query::<(Entity, &MeshMaterial3d<HadouMaterial>, Has<bevy::mesh::skinning::SkinnedMesh>)>();
+    let mut parents = world.query::<&ChildOf>();
+    for (entity, material, skinned) in meshes.iter(world) {
+        let mut e = entity;
+        while let Ok(p) = parents.get(world, e) {
+            e = p.parent();
+            if e == hero {
+                below.push((material.0.clone(), skinned));
+                break;
+            }
+        }
+    }
+    assert!(!below.is_empty());
+    assert!(below.iter().all(|(_, skinned)| *skinned), "hero.glb's meshes are skinned by Bevy");
+    let materials = app.world().resource::<Assets<HadouMaterial>>();
+    let mut slots_seen = std::collections::BTreeSet::new();
+    for (handle, _) in &below {
+        let surface = materials.get(handle).unwrap().surface;
+        let slot = expected
+            .materials
+            .iter()
+            .position(|m| m.base_color == surface.base_color.truncate().to_array())
+            .unwrap_or_else(|| panic!("{:?} is the base colour of one of the slots", surface.base_color));
+        slots_seen.insert(slot);
+        let look = &expected.materials[slot];
+        assert_eq!(surface.wave_blend, look.wave_blend);
+        assert_eq!(surface.base_texture.x != 0, look.base_texture.is_some(), "slot {slot}'s texture as hadou read it");
+    }
+    assert!(slots_seen.len() > 1, "the meshes take different slots: {slots_seen:?}");
+
+    // A game system changes the hero's look: its materials follow.
+    let mut shaded = app.world_mut().get_mut::<HadouShaded>(hero).unwrap();
+    for slot in &mut shaded.slots {
+        slot.wave_blend = 0.25;
+    }
+    let root_entity = scene_root;
+    // The scene's clock sets the look back every frame: stop it from doing so by removing the
+    // root's scene link (the spawned entities stay).
+    app.world_mut().entity_mut(root_entity).remove::<HadouSceneRoot>();
+    app.update();
+    app.update();
+    let materials = app.world().resource::<Assets<HadouMaterial>>();
+    for (handle, _) in &below {
+        assert_eq!(materials.get(handle).unwrap().surface.wave_blend, 0.25);
+    }
 }

@@ -217,8 +217,8 @@ impl Mesh {
 }
 
 /// An RGBA8 image for texturing: colour channels sRGB-encoded (as PNG and JPEG store them), alpha
-/// linear, rows from the top.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// linear, rows from the top. `Eq`, so comparing two `Arc`s of one image is a pointer test.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Texture {
     /// Where it came from, for messages.
     pub name: String,

@@ -53,6 +53,8 @@ pub(crate) struct ObjectDef {
     pub materials: ObjectMaterials,
     /// A `kind = "plane"` primitive (a shadow may take its plane).
     pub is_plane: bool,
+    /// A `kind = "gltf"` object's `path`, as written (relative to the scene file).
+    pub gltf: Option<PathBuf>,
 }
 
 impl ObjectDef {
@@ -142,6 +144,14 @@ impl Scene {
     /// Object names in file order.
     pub fn object_names(&self) -> Vec<&str> {
         self.objects.iter().map(|o| o.name.as_str()).collect()
+    }
+
+    /// Per object in file order, the glTF file a `kind = "gltf"` object was read from, as its
+    /// `path` key gives it (relative to the scene file's directory, checked to lie inside it);
+    /// `None` for primitives. An engine with its own glTF loader (hadou-bevy) loads the file
+    /// itself to skin and animate it; the frame's mesh is the file at rest.
+    pub fn object_files(&self) -> Vec<Option<&Path>> {
+        self.objects.iter().map(|o| o.gltf.as_deref()).collect()
     }
 
     /// The animated targets (`wave.beam.M2.z`, …) in file order.

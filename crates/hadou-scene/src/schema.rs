@@ -435,6 +435,7 @@ fn parse_object(
     let mut scratch_s = Vec::new();
     let mut scratch = ParamReader { values: &mut scratch_v, spans: &mut scratch_s };
     let mut shape_set = ParamSet::default();
+    let mut gltf = None;
     let mesh = match kind {
         "box" => {
             scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
@@ -461,6 +462,7 @@ fn parse_object(
         }
         _ => {
             let (rel, span) = t.req_str("path", "the .gltf or .glb file, relative to the scene file")?;
+            gltf = Some(PathBuf::from(rel));
             let gltf_err =
                 |message: String, file: PathBuf| SceneError::Gltf { at: t.src.loc(&span), file, message };
             let file = assets.dir.path.join(rel);
@@ -541,7 +543,7 @@ fn parse_object(
     }
     assets.slots_left -= slots;
     let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
-    Ok(ObjectDef { name, mesh, params, materials, is_plane: kind == "plane" })
+    Ok(ObjectDef { name, mesh, params, materials, is_plane: kind == "plane", gltf })
 }
 
 /// Takes a primitive's `tris` triangles and `verts` vertices from the scene's budget, or says

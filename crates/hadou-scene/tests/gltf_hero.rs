@@ -50,3 +50,18 @@ fn hero_loads_with_materials_textures_and_its_skin_applied() {
     assert!(lowest < 0.9, "the arms do not hang: lowest arm vertex at y = {lowest}");
     assert!(arm.iter().all(|p| p[0].abs() < 0.5), "an arm vertex is detached from the body");
 }
+
+#[test]
+fn a_scene_names_the_gltf_file_each_object_was_read_from() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-normal-vs-wave.toml");
+    let scene = hadou_scene::Scene::load(&path).unwrap();
+    let names = scene.object_names();
+    let files = scene.object_files();
+    assert_eq!(files.len(), names.len());
+    for (name, file) in names.iter().zip(&files) {
+        match *name {
+            "hero" => assert_eq!(*file, Some(Path::new("assets/hero.glb"))),
+            _ => assert_eq!(*file, None, "{name} is a primitive"),
+        }
+    }
+}
