@@ -132,7 +132,10 @@ impl Plugin for HadouPlugin {
                 );
                 #[cfg(feature = "gltf")]
                 if app.world().contains_resource::<Assets<StandardMaterial>>() {
-                    app.add_systems(Update, spawn::mark_ready.after(HadouSystems::Scenes).after(shaded::shade_models));
+                    app.add_systems(
+                        Update,
+                        spawn::mark_ready.after(HadouSystems::Scenes).after(shaded::shade_models),
+                    );
                 }
             }
         }

@@ -63,17 +63,18 @@ pub fn gltf_slot(handle: &Handle<StandardMaterial>, slots: usize) -> Option<usiz
 /// `shaded`: the glTF slot's own look, or `shaded.material` with its base colour multiplied by
 /// the `StandardMaterial`'s (the texture is added by the caller). The flag is true for a slot's
 /// own look.
-fn look_of(shaded: &HadouShaded, handle: &Handle<StandardMaterial>, source: &StandardMaterial) -> (hadou_scene::Material, bool) {
+fn look_of(
+    shaded: &HadouShaded,
+    handle: &Handle<StandardMaterial>,
+    source: &StandardMaterial,
+) -> (hadou_scene::Material, bool) {
     if let Some(slot) = gltf_slot(handle, shaded.slots.len()) {
         return (shaded.slots[slot].clone(), true);
     }
     let mut look = shaded.material.clone();
     let base = source.base_color.to_linear();
-    look.base_color = [
-        look.base_color[0] * base.red,
-        look.base_color[1] * base.green,
-        look.base_color[2] * base.blue,
-    ];
+    look.base_color =
+        [look.base_color[0] * base.red, look.base_color[1] * base.green, look.base_color[2] * base.blue];
     (look, false)
 }
 

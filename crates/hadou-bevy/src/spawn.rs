@@ -8,17 +8,17 @@ use crate::material::HadouMaterial;
 use crate::mesh::{bevy_mesh, outline_mesh, slot_indices_of};
 use crate::outline::HadouOutline;
 use crate::shaded::HadouShaded;
+use crate::shadows::{shadow_mask, HadouShadows};
+use crate::wave::HadouWave;
 #[cfg(feature = "gltf")]
 use bevy::asset::AssetPath;
 #[cfg(feature = "gltf")]
 use bevy::gltf::GltfAssetLabel;
-#[cfg(feature = "gltf")]
-use bevy::world_serialization::WorldAssetRoot;
-use crate::shadows::{shadow_mask, HadouShadows};
-use crate::wave::HadouWave;
 use bevy::mesh::Indices;
 use bevy::prelude::*;
 use bevy::render::storage::ShaderBuffer;
+#[cfg(feature = "gltf")]
+use bevy::world_serialization::WorldAssetRoot;
 use hadou_scene::Frame;
 
 /// Spawns the scene `scene` under this entity once it has loaded (nothing, with the loader's
@@ -211,6 +211,7 @@ pub fn spawn_object(
 }
 
 #[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn spawn_scenes(
     mut commands: Commands,
     roots: Query<(Entity, &HadouSceneRoot), Without<SpawnedScene>>,
@@ -220,6 +221,7 @@ pub(crate) fn spawn_scenes(
     mut outlines: ResMut<Assets<HadouOutline>>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     asset_server: Res<AssetServer>,
+    #[cfg(feature = "gltf")] gltf_loader: Option<Res<Assets<bevy::gltf::Gltf>>>,
 ) {
     for (root, spawn) in &roots {
         let Some(HadouScene(scene)) = scenes.get(&spawn.scene) else { continue };
@@ -277,7 +279,13 @@ pub(crate) fn spawn_scenes(
         for (i, object) in frame.objects.iter().enumerate() {
             let mask = shadow_mask(&frame, i as u32);
             #[cfg(feature = "gltf")]
-            let gltf = files.get(i).copied().flatten().and_then(|file| gltf_scene_path(&spawn.scene, file));
+            // Through Bevy's glTF loader when the app has it (its plugin adds `Assets<Gltf>`).
+            let gltf = files
+                .get(i)
+                .copied()
+                .flatten()
+                .filter(|_| gltf_loader.is_some())
+                .and_then(|file| gltf_scene_path(&spawn.scene, file));
             #[cfg(not(feature = "gltf"))]
             let gltf: Option<()> = None;
             let (entity, handles) = match gltf {

@@ -46,13 +46,8 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
     ));
     let handle =
         app.world().resource::<AssetServer>().load(GltfAssetLabel::Scene(0).from_asset("assets/hero.glb"));
-    let character = app
-        .world_mut()
-        .spawn((
-            WorldAssetRoot(handle),
-            HadouShaded::new(look, scene.light, 0b10),
-        ))
-        .id();
+    let character =
+        app.world_mut().spawn((WorldAssetRoot(handle), HadouShaded::new(look, scene.light, 0b10))).id();
     app.finish();
     app.cleanup();
     let mut shaded = Vec::new();
@@ -152,10 +147,7 @@ fn a_missing_texture_is_an_error_and_the_mesh_is_shaded_without_it() {
     .unwrap()
     .at(0.0)
     .light;
-    let root = app
-        .world_mut()
-        .spawn((HadouShaded::new(look, light, 0), Transform::default()))
-        .id();
+    let root = app.world_mut().spawn((HadouShaded::new(look, light, 0), Transform::default())).id();
     let child = app.world_mut().spawn((Mesh3d(mesh), MeshMaterial3d(standard), ChildOf(root))).id();
     let mut switched = None;
     for _ in 0..500 {
@@ -192,10 +184,8 @@ fn a_scenes_gltf_object_is_loaded_by_bevy_with_each_slots_look() {
     )
     .add_plugins(HadouPlugin { asset_root: root.clone() });
     let scene_handle = app.world().resource::<AssetServer>().load("light-normal-vs-wave.toml");
-    let scene_root = app
-        .world_mut()
-        .spawn(HadouSceneRoot { scene: scene_handle, clock: SceneClock::Frozen(0.75) })
-        .id();
+    let scene_root =
+        app.world_mut().spawn(HadouSceneRoot { scene: scene_handle, clock: SceneClock::Frozen(0.75) }).id();
     app.finish();
     app.cleanup();
     let ready = |app: &App| app.world().get::<SpawnedScene>(scene_root).is_some_and(|s| s.ready);
@@ -219,7 +209,8 @@ fn a_scenes_gltf_object_is_loaded_by_bevy_with_each_slots_look() {
 
     let world = app.world_mut();
     let mut below = Vec::new();
-    let mut meshes = world.query::<(Entity, &MeshMaterial3d<HadouMaterial>, Has<bevy::mesh::skinning::SkinnedMesh>)>();
+    let mut meshes =
+        world.query::<(Entity, &MeshMaterial3d<HadouMaterial>, Has<bevy::mesh::skinning::SkinnedMesh>)>();
     let mut parents = world.query::<&ChildOf>();
     for (entity, material, skinned) in meshes.iter(world) {
         let mut e = entity;
@@ -245,7 +236,11 @@ fn a_scenes_gltf_object_is_loaded_by_bevy_with_each_slots_look() {
         slots_seen.insert(slot);
         let look = &expected.materials[slot];
         assert_eq!(surface.wave_blend, look.wave_blend);
-        assert_eq!(surface.base_texture.x != 0, look.base_texture.is_some(), "slot {slot}'s texture as hadou read it");
+        assert_eq!(
+            surface.base_texture.x != 0,
+            look.base_texture.is_some(),
+            "slot {slot}'s texture as hadou read it"
+        );
     }
     assert!(slots_seen.len() > 1, "the meshes take different slots: {slots_seen:?}");
 
