@@ -60,7 +60,7 @@ pub const MAX_CELLS: u32 = 192;
 pub const REST_TOLERANCE: f64 = 1e-5;
 
 /// A peak is graded only where `|t_c|` and `ε` are below this (`s` is not vanishingly small).
-pub const PEAK_RANGE: f64 = 1e30;
+pub const PEAK_RANGE: f64 = 1e20;
 
 /// Half-width of the inner cell around the peak, in units of the peak's half-width `ε = √H/s`.
 pub const INNER_CELL: f64 = 1.0;
