@@ -93,7 +93,8 @@ fn beam(b: &BeamField<f32>) -> Result<(), WaveError> {
 
 /// Checks what the wave pass reads against the ranges the scene reader enforces for the same
 /// keys: `rgba` finite and ≥ 0 with alpha in [0, 1], `core_radius` finite and ≥ 0, positions
-/// finite, directions finite and non-zero, lengths ≥ 0, strengths in `[0, ALPHA_MAX]`, and a
+/// finite, directions finite and non-zero, lengths ≥ 0, strengths in `[0, ALPHA_MAX]`, the
+/// attenuation exponent `j` in `[0, 64]`, and a
 /// curve's own checks (`CurveWave::validate`).
 pub fn check_wave(wave: &Wave) -> Result<(), WaveError> {
     let [r, g, b, a] = wave.color;
@@ -101,6 +102,10 @@ pub fn check_wave(wave: &Wave) -> Result<(), WaveError> {
         return fail("rgba", format!("must be finite and ≥ 0, alpha in [0, 1] (got [{r}, {g}, {b}, {a}])"));
     }
     non_negative("core_radius", wave.core_radius)?;
+    let j = wave.attenuation;
+    if !(0.0..=64.0).contains(&j) {
+        return fail("j", format!("the attenuation exponent must be in [0, 64] (got {j})"));
+    }
     match &wave.shape {
         WaveShape::Sphere(s) => {
             finite_point("M", s.center)?;

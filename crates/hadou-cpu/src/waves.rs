@@ -3,7 +3,7 @@
 
 use hadou_math::curve::{self, PreparedCurve};
 use hadou_math::energy::lanes::{self, Lanes, RayLanes, LANES, V3};
-use hadou_math::energy::{Falloff, FieldParams, Ray};
+use hadou_math::energy::{self, Falloff, FieldParams, Ray};
 use hadou_math::shade;
 use hadou_math::Vec3;
 use hadou_scene::{CameraBasis, Frame, ToneMode, Wave, WaveShape};
@@ -146,6 +146,11 @@ impl<'a> WavePass<'a> {
                 Falloff::Faithful => &rays.faithful,
                 Falloff::InverseSquare => &rays.inverse_square,
             };
+            if wave.attenuation > 0.0 && !matches!(wave.shape, WaveShape::Curve(_)) {
+                let e = self.attenuated_lanes(wave, &p, ray, &rays, valid);
+                sink(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
+                continue;
+            }
             let e = match &wave.shape {
                 WaveShape::Sphere(f) => lanes::sphere_energy(&p, ray, f),
                 WaveShape::Cylinder(f) => lanes::cylinder_energy(&p, ray, f),
@@ -162,6 +167,38 @@ impl<'a> WavePass<'a> {
             sink(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
         }
         rays.depth
+    }
+
+    /// An analytic wave's energy with the distance attenuation `(1 − u)^j`, `j > 0` (002 eq.
+    /// 3.23, SPEC.md §1.4), one pixel at a time: the attenuated integrals
+    /// (`hadou_math::energy::*_attenuated`) grade their cells per ray and have no eight-lane
+    /// form. `t_far` is 1 (faithful) or the far point's distance (inverse square), as for curves.
+    fn attenuated_lanes(
+        &self,
+        wave: &Wave,
+        p: &FieldParams<f32>,
+        ray: &RayLanes,
+        rays: &PixelRays,
+        valid: usize,
+    ) -> Lanes {
+        let (dx, dy, dz) = (ray.dir.x.to_array(), ray.dir.y.to_array(), ray.dir.z.to_array());
+        let (t0, t1, far) = (ray.t0.to_array(), ray.t1.to_array(), rays.far_dist.to_array());
+        let mut e = [0.0f32; LANES];
+        for i in 0..valid {
+            let r = Ray { origin: ray.origin, dir: Vec3::new(dx[i], dy[i], dz[i]) };
+            let att = wave.attenuation_on(match p.falloff {
+                Falloff::Faithful => 1.0,
+                Falloff::InverseSquare => far[i],
+            });
+            e[i] = match &wave.shape {
+                WaveShape::Sphere(f) => energy::sphere_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
+                WaveShape::Cylinder(f) => energy::cylinder_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
+                WaveShape::Capsule(f) => energy::capsule_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
+                WaveShape::Beam(f) => energy::beam_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
+                WaveShape::Curve(_) => 0.0,
+            };
+        }
+        Lanes::from(e)
     }
 
     /// A curved wave's energy, one pixel at a time (its integrator adapts per ray).

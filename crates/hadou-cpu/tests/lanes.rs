@@ -23,11 +23,13 @@ fn scalar_energy(frame: &Frame, x: u32, y: u32) -> f32 {
             basis.wave_ray(w.falloff, frame.camera.far, x as f32, y as f32, frame.width, frame.height, None);
         let p = FieldParams { falloff: w.falloff, core_radius: w.core_radius };
         let (r, t0, t1) = (&wr.ray, wr.t0, wr.t1);
+        // The analytic kinds' attenuation (002 eq. 3.23); j = 0 is the plain closed form.
+        let a = &w.attenuation_on(wr.t_far);
         let e = match &w.shape {
-            WaveShape::Sphere(f) => energy::sphere_energy(&p, r, t0, t1, f),
-            WaveShape::Cylinder(f) => energy::cylinder_energy(&p, r, t0, t1, f),
-            WaveShape::Capsule(f) => energy::capsule_energy(&p, r, t0, t1, f),
-            WaveShape::Beam(f) => energy::beam_energy(&p, r, t0, t1, f),
+            WaveShape::Sphere(f) => energy::sphere_energy_attenuated(&p, r, t0, t1, a, f),
+            WaveShape::Cylinder(f) => energy::cylinder_energy_attenuated(&p, r, t0, t1, a, f),
+            WaveShape::Capsule(f) => energy::capsule_energy_attenuated(&p, r, t0, t1, a, f),
+            WaveShape::Beam(f) => energy::beam_energy_attenuated(&p, r, t0, t1, a, f),
             WaveShape::Curve(c) => curve::curve_energy(&curve::prepare(c), &p, r, t0, t1, wr.t_far).energy,
         };
         total = energy::saturate(total + energy::saturate(e));

@@ -33,6 +33,7 @@ fn beam(falloff: Falloff) -> Wave {
         color: [0.8, 0.8, 0.2, 1.0],
         falloff,
         core_radius: 0.05,
+        attenuation: 0.0,
         shape: WaveShape::Beam(BeamField {
             capsule: CapsuleField {
                 m: Vec3::new(-10.0, 0.0, 0.0),
@@ -89,6 +90,7 @@ fn degenerate_waves_and_cameras_stay_finite() {
             color: [1.0; 4],
             falloff: Falloff::Faithful,
             core_radius: 0.0,
+            attenuation: 0.0,
             shape: WaveShape::Sphere(SphereField { center: Vec3::new(0.0, 0.0, 40.0), alpha: 1.0 }),
         },
         beam(Falloff::Faithful),

@@ -56,6 +56,7 @@ fn main() {
             color: [0.4, 0.7, 1.0, 1.0],
             falloff: Falloff::InverseSquare,
             core_radius: 0.05,
+            attenuation: 0.0,
             shape: WaveShape::Beam(BeamField {
                 capsule: CapsuleField {
                     m: Vec3::new(-4.0, 1.0, 0.0),

@@ -618,8 +618,9 @@ pub struct GpuWave {
     pub falloff: u32,
     /// Core radius `r_c`.
     pub core_radius: f32,
-    /// Padding.
-    pub _pad: u32,
+    /// Exponent `j` of the distance attenuation `(1 − u)^j` of an analytic wave (002 eq. 3.23,
+    /// SPEC.md §1.4; 0: none). A curve's is in its [`GpuCurve`]; here it is 0.
+    pub attenuation: f32,
     /// See the table above.
     pub p0: [f32; 4],
     /// See the table above.
@@ -643,7 +644,7 @@ impl GpuWave {
                 Falloff::InverseSquare => FALLOFF_INVERSE_SQUARE,
             },
             core_radius: wave.core_radius,
-            _pad: 0,
+            attenuation: wave.attenuation,
             p0: [0.0; 4],
             p1: [0.0; 4],
             p2: [0.0; 4],
@@ -687,7 +688,7 @@ impl GpuWave {
                 Falloff::InverseSquare => FALLOFF_INVERSE_SQUARE,
             },
             core_radius: wave.core_radius,
-            _pad: 0,
+            attenuation: 0.0,
             // Indices below 2^24 are exact in f32; `CurveBuffers::push` keeps them there.
             p0: [index as f32, 0.0, 0.0, 0.0],
             p1: [0.0; 4],

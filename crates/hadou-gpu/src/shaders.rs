@@ -299,7 +299,7 @@ mod tests {
             "GpuLight",
             [line_kind, point_offset, point_count, inverse_square, a, b, color, ramp]
         );
-        check!(GpuWave, "GpuWave", [color, kind, falloff, core_radius, _pad, p0, p1, p2]);
+        check!(GpuWave, "GpuWave", [color, kind, falloff, core_radius, attenuation, p0, p1, p2]);
         check!(
             GpuShadowCast,
             "GpuShadowCast",

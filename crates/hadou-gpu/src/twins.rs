@@ -8,12 +8,13 @@ use crate::shaders;
 use crate::twin_kernel::{self, Rng};
 use bytemuck::{Pod, Zeroable};
 use hadou_math::energy::{
-    self, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
+    self, Attenuation, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
 };
 use hadou_math::{Real, Vec3, Vec3f};
 use hadou_scene::RenderError;
 
-/// One test ray for one wave. `span = [t0, t1, open_end, 0]`.
+/// One test ray for one wave. `span = [t0, t1, open_end, t_far]` (`t_far`: the far point's ray
+/// parameter, read where the wave's `attenuation` is not 0).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 struct Case {
@@ -35,12 +36,14 @@ struct Case {
 fn case_energy(c: Case, ray: Ray, t0: f32, t1: f32) -> f32 {
     let w = c.wave;
     let p = FieldParams(w.falloff, w.core_radius);
+    // span.w: the far point's ray parameter for the attenuation (w.attenuation = j).
+    let att = Attenuation(w.attenuation, c.span.w);
     var e = 0.0;
     switch w.kind {
-        case WAVE_SPHERE: { e = sphere_energy(p, ray, t0, t1, w.p0.xyz, w.p0.w); }
-        case WAVE_CYLINDER: { e = cylinder_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p0.w); }
-        case WAVE_CAPSULE: { e = capsule_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w); }
-        default: { e = beam_energy(p, ray, t0, t1, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z); }
+        case WAVE_SPHERE: { e = sphere_energy(p, ray, t0, t1, att, w.p0.xyz, w.p0.w); }
+        case WAVE_CYLINDER: { e = cylinder_energy(p, ray, t0, t1, att, w.p0.xyz, w.p1.xyz, w.p0.w); }
+        case WAVE_CAPSULE: { e = capsule_energy(p, ray, t0, t1, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w); }
+        default: { e = beam_energy(p, ray, t0, t1, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z); }
     }
     return e;
 }
@@ -68,20 +71,23 @@ fn energy_of<R: Real>(c: &Case, shift: [f64; 3]) -> R {
     let ray = Ray { origin: Vec3::new(o[0], o[1], o[2]), dir: v(c.dir) };
     let t0 = r(c.span[0]);
     let t1 = if c.span[2] != 0.0 { R::from_f64(f64::INFINITY) } else { r(c.span[1]) };
+    // j = 0: the attenuated functions are the plain closed forms, bit for bit.
+    let att = Attenuation { j: r(w.attenuation), t_far: r(c.span[3]) };
     let capsule =
         CapsuleField { m: v(w.p0), d: v(w.p1), length: r(w.p2[0]), alpha_s: r(w.p0[3]), alpha_c: r(w.p1[3]) };
     match w.kind {
         WAVE_SPHERE => {
-            energy::sphere_energy(&p, &ray, t0, t1, &SphereField { center: v(w.p0), alpha: r(w.p0[3]) })
+            let f = SphereField { center: v(w.p0), alpha: r(w.p0[3]) };
+            energy::sphere_energy_attenuated(&p, &ray, t0, t1, &att, &f)
         }
         WAVE_CYLINDER => {
             let f = CylinderField { point: v(w.p0), dir: v(w.p1), alpha: r(w.p0[3]) };
-            energy::cylinder_energy(&p, &ray, t0, t1, &f)
+            energy::cylinder_energy_attenuated(&p, &ray, t0, t1, &att, &f)
         }
-        WAVE_CAPSULE => energy::capsule_energy(&p, &ray, t0, t1, &capsule),
+        WAVE_CAPSULE => energy::capsule_energy_attenuated(&p, &ray, t0, t1, &att, &capsule),
         _ => {
             let f = BeamField { capsule, head_alpha: r(w.p2[1]), muzzle_alpha: r(w.p2[2]) };
-            energy::beam_energy(&p, &ray, t0, t1, &f)
+            energy::beam_energy_attenuated(&p, &ray, t0, t1, &att, &f)
         }
     }
 }
@@ -133,11 +139,12 @@ pub(crate) fn conditioned_error(
 pub(crate) const CONDITION_ULPS: f64 = 2.0;
 
 fn wave(kind: u32, falloff: u32, core: f32, p0: [f32; 4], p1: [f32; 4], p2: [f32; 4]) -> GpuWave {
-    GpuWave { color: [1.0; 4], kind, falloff, core_radius: core, _pad: 0, p0, p1, p2 }
+    GpuWave { color: [1.0; 4], kind, falloff, core_radius: core, attenuation: 0.0, p0, p1, p2 }
 }
 
 fn cases() -> Vec<Case> {
     let mut out = Vec::new();
+    let mut attenuated = Vec::new();
     let mut add = |w: GpuWave, o: Vec3f, d: Vec3f, t0: f32, t1: Option<f32>| {
         out.push(Case {
             wave: w,
@@ -223,7 +230,44 @@ fn cases() -> Vec<Case> {
             let end = if rng.unit_f32() < 0.5 { open } else { t1(rng.range_f32(0.05, 0.5)) };
             add(w, o, (target - o).normalize_or(x) * scale, 0.0, end);
         }
+        // Attenuated (002 eq. 3.23, SPEC.md §1.4): random j, the far point before, at and beyond
+        // the shape (t_far = 1 for faithful rays, whose far point is E).
+        for i in 0..240 {
+            let core = if i % 4 == 0 { 0.0 } else { rng.range_f32(0.0, 0.2) };
+            let m = rng.in_cube_f32(5.0);
+            let d = rng.in_cube_f32(1.0).normalize_or(x);
+            let len = rng.range_f32(0.0, 12.0);
+            let kind = [WAVE_SPHERE, WAVE_CYLINDER, WAVE_CAPSULE, WAVE_BEAM][i % 4];
+            let mut w = wave(
+                kind,
+                falloff,
+                core,
+                [m.x, m.y, m.z, rng.range_f32(0.1, 20.0)],
+                [d.x, d.y, d.z, rng.range_f32(0.1, 20.0)],
+                [len, rng.range_f32(0.0, 5.0), rng.range_f32(0.0, 5.0), 0.0],
+            );
+            w.attenuation = [0.3, 1.0, 2.0, 7.3, 64.0, rng.range_f32(0.0, 64.0)][i % 6];
+            let o = eye + rng.in_cube_f32(3.0);
+            let target = m + d * rng.range_f32(-2.0, len + 2.0) + rng.in_cube_f32(1.0);
+            let dist = (target - o).length();
+            let (far, t_far) = if falloff == FALLOFF_FAITHFUL {
+                (dist * rng.range_f32(0.8, 3.0), 1.0)
+            } else {
+                (1.0, dist * rng.range_f32(0.8, 3.0))
+            };
+            let dir = (target - o).normalize_or(x) * far;
+            let t1 = if rng.unit_f32() < 0.5 { 1.0 } else { rng.range_f32(0.3, 1.0) };
+            let t1 = if falloff == FALLOFF_FAITHFUL { t1 } else { t1 * t_far * 1.2 };
+            let open_end = 0.0;
+            attenuated.push(Case {
+                wave: w,
+                origin: [o.x, o.y, o.z, 0.0],
+                dir: [dir.x, dir.y, dir.z, 0.0],
+                span: [0.0, t1, open_end, t_far],
+            });
+        }
     }
+    out.extend(attenuated);
     out
 }
 

@@ -75,6 +75,49 @@ fn curves_over_scenery_match_cpu() {
     check("curves", &f);
 }
 
+/// The distance attenuation `(1 − u)^j` (002 eq. 3.23) on every analytic shape, both falloffs,
+/// over the occlusion scenery (spans ending at visible surfaces and at the far plane), with the
+/// far plane close enough to cut through the shapes.
+#[test]
+fn attenuated_analytic_shapes_match_cpu() {
+    use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
+    use hadou_math::Vec3;
+    use hadou_scene::WaveShape;
+    let mut f = occlusion_frame(128, 96);
+    f.camera.far = 55.0;
+    f.waves.clear();
+    let capsule =
+        CapsuleField { m: Vec3::new(-8.0, 1.0, 5.0), d: Vec3::X, length: 12.0, alpha_s: 0.08, alpha_c: 0.08 };
+    let shapes = [
+        (
+            Falloff::Faithful,
+            1.5,
+            WaveShape::Sphere(SphereField { center: Vec3::new(-6.0, 3.0, 0.0), alpha: 4.0 }),
+        ),
+        (
+            Falloff::Faithful,
+            6.0,
+            WaveShape::Cylinder(CylinderField { point: Vec3::new(6.0, -2.0, 0.0), dir: Vec3::Z, alpha: 3.0 }),
+        ),
+        (Falloff::InverseSquare, 3.0, WaveShape::Capsule(capsule)),
+        (
+            Falloff::InverseSquare,
+            40.0,
+            WaveShape::Beam(BeamField {
+                capsule: CapsuleField { m: Vec3::new(-4.0, -3.0, -30.0), ..capsule },
+                head_alpha: 0.1,
+                muzzle_alpha: 0.05,
+            }),
+        ),
+    ];
+    for (i, (falloff, j, shape)) in shapes.into_iter().enumerate() {
+        let mut w = wave(&format!("w{i}"), [0.8, 0.6, 0.3, 1.0], falloff, 0.05, shape);
+        w.attenuation = j;
+        f.waves.push(w);
+    }
+    check("attenuated shapes", &f);
+}
+
 /// Every example scene (curved waves included), at the start, middle and end of its animation,
 /// at 128×96.
 #[test]

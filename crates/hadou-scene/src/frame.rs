@@ -7,7 +7,7 @@
 use crate::area_light::AreaLight;
 use crate::shadow::Shadow;
 use hadou_math::curve::{CurveWave, PreparedCurve};
-use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
+use hadou_math::energy::{Attenuation, BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
 pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
 use std::sync::Arc;
@@ -400,6 +400,10 @@ pub struct Wave {
     pub falloff: Falloff,
     /// Core radius `r_c ≥ 0` (see [`hadou_math::energy::FieldParams`]).
     pub core_radius: f32,
+    /// Exponent `j ∈ [0, 64]` of the distance attenuation `(1 − u)^j`, `u = t/t_far` (002 eq.
+    /// 3.23, SPEC.md §1.4; 0: none), the scene file's `j`. The analytic shapes read it here
+    /// ([`Wave::attenuation_on`]); a curve reads its own copy, `CurveWave::attenuation`.
+    pub attenuation: f32,
     /// The shape.
     pub shape: WaveShape,
     /// Its light on surfaces.
@@ -450,7 +454,18 @@ impl Wave {
         shape: WaveShape,
     ) -> Self {
         let light = WaveLight { ramp: Ramp::for_wave_color([color[0], color[1], color[2]]), glow: 0.0 };
-        Wave { name: name.into(), color, falloff, core_radius, shape, light }
+        Wave { name: name.into(), color, falloff, core_radius, attenuation: 0.0, shape, light }
+    }
+
+    /// The attenuation of an analytic wave on a ray whose far point is at ray parameter `t_far`
+    /// (1 for the faithful law, the far point's distance for inverse square; see
+    /// [`WaveRay`]) — `j = 0` (none) for curves, which attenuate in their own
+    /// integrator.
+    pub fn attenuation_on(&self, t_far: f32) -> Attenuation<f32> {
+        match self.shape {
+            WaveShape::Curve(_) => Attenuation::none(),
+            _ => Attenuation { j: self.attenuation, t_far },
+        }
     }
 
     /// The wave's centre line as a light (000 §2.1, SPEC.md §2.1): the centre of a sphere, the

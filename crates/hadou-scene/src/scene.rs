@@ -301,6 +301,7 @@ impl Scene {
             color: p.arr(vals, "rgba"),
             falloff: w.falloff,
             core_radius: p.f(vals, "core_radius"),
+            attenuation: p.f(vals, "j"),
             shape,
             light: self.wave_light(w, vals),
         }

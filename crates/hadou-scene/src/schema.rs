@@ -67,6 +67,10 @@ const WAVE_COMMON: &[&str] = &[
     "light_ramp_smoothing",
     "light_glow",
 ];
+/// Keys of the analytic kinds (sphere, cylinder, capsule, beam) beyond their shape's own.
+const ANALYTIC_COMMON: &[&str] = &["j"];
+/// Largest attenuation exponent `j` of an analytic wave (002 eq. 3.23, SPEC.md §1.4).
+pub(crate) const ATTENUATION_MAX: f32 = 64.0;
 const CURVE_COMMON: &[&str] =
     &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
 
@@ -587,8 +591,12 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
         WaveKind::BSpline => &["points", "order", "knots"],
     };
     let is_curve = matches!(kind, WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline);
-    let allowed: Vec<&str> =
-        WAVE_COMMON.iter().chain(if is_curve { CURVE_COMMON } else { &[] }).chain(extra).copied().collect();
+    let allowed: Vec<&str> = WAVE_COMMON
+        .iter()
+        .chain(if is_curve { CURVE_COMMON } else { ANALYTIC_COMMON })
+        .chain(extra)
+        .copied()
+        .collect();
     t.check_keys(&allowed)?;
 
     let falloff = match t.choice("falloff", &["faithful", "inverse-square"], Some("inverse-square"))? {
@@ -599,6 +607,12 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
     rd.add(t, &mut p, "rgba", Shape::Vector(4), Constraint::Rgba, Fallback::Value(&DEFAULT_RGBA), false)?;
     rd.add(t, &mut p, "core_radius", S, NONNEG, Fallback::Value(&[DEFAULT_CORE_RADIUS]), false)?;
     rd.add(t, &mut p, "light_glow", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+    if !is_curve {
+        // The distance attenuation (1 − u)^j of 002 eq. 3.23 (SPEC.md §1.4); curves read theirs
+        // in parse_curve.
+        let j_rule = Constraint::Range { lo: 0.0, hi: ATTENUATION_MAX, lo_open: false, hi_open: false };
+        rd.add(t, &mut p, "j", S, j_rule, Fallback::Value(&[0.0]), false)?;
+    }
     let light_ramp = parse_ramp(t, "light_ramp")?;
     let dir = Constraint::NonZero;
     let mut def = WaveDef {

@@ -238,3 +238,43 @@ fn curve_limits_of_the_maths_are_reported_at_the_key() {
     assert!(e.to_string().contains("`points` in [[wave]] \"z\""), "{e}");
     assert!(e.to_string().contains("64"), "{e}");
 }
+
+/// The attenuation exponent `j` of an analytic wave (002 eq. 3.23): in [0, 64], a number, also in
+/// tracks; each bad value is reported at the value.
+#[test]
+fn analytic_attenuation_exponent_is_checked() {
+    let base = format!("{WAVE}alpha_s = 1\nalpha_c = 1\n");
+    for (bad, col) in [("-0.5", 5), ("nan", 5), ("64.5", 5), ("-inf", 5)] {
+        let e = err(&format!("{base}j = {bad}\n"));
+        assert!(matches!(e, SceneError::Value { .. }), "{bad}: {e:?}");
+        assert_eq!(at(&e), (8, col), "{bad}: {e}");
+        assert!(e.to_string().contains("`j` in [[wave]] \"beam\""), "{bad}: {e}");
+    }
+    let e = err(&format!("{base}j = \"strong\"\n"));
+    assert!(matches!(e, SceneError::Type { .. }), "{e:?}");
+    assert_eq!(at(&e), (8, 5));
+    assert!(e.to_string().contains("must be a number, got a string"), "{e}");
+    // The limits themselves are accepted, on every analytic kind.
+    for kind in ["sphere", "cylinder", "capsule", "beam"] {
+        let text = format!(
+            "[[wave]]\nname = \"w\"\nkind = \"{kind}\"\nM = [0, 0, 0]\nM2 = [1, 0, 0]\nD = [1, 0, 0]\n\
+             length = 1\nalpha_s = 1\nalpha_c = 1\nj = 64\n"
+        );
+        let text = match kind {
+            "sphere" => {
+                text.replace("M2 = [1, 0, 0]\nD = [1, 0, 0]\nlength = 1\n", "").replace("alpha_c = 1\n", "")
+            }
+            "cylinder" => {
+                text.replace("M2 = [1, 0, 0]\n", "").replace("length = 1\n", "").replace("alpha_s = 1\n", "")
+            }
+            _ => text.replace("D = [1, 0, 0]\nlength = 1\n", ""),
+        };
+        let s = Scene::parse(&text, Path::new("scenes/x.toml")).unwrap_or_else(|e| panic!("{kind}: {e}"));
+        assert_eq!(s.at(0.0).waves[0].attenuation, 64.0, "{kind}");
+    }
+    // A track key out of range, at the key's value.
+    let e = err(&format!("{base}j = 1\n[[track]]\ntarget = \"wave.beam.j\"\nkeys = [[0, 1.0], [1, 65]]\n"));
+    assert!(matches!(e, SceneError::Value { .. } | SceneError::Track { .. }), "{e:?}");
+    assert_eq!(at(&e), (11, 23), "{e}");
+    assert!(e.to_string().contains("64"), "{e}");
+}

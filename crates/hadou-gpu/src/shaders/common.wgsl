@@ -135,7 +135,7 @@ struct GpuWave {
     kind: u32,
     falloff: u32,
     core_radius: f32,
-    _pad: u32,
+    attenuation: f32,
     p0: vec4<f32>,
     p1: vec4<f32>,
     p2: vec4<f32>,

@@ -219,19 +219,193 @@ fn rq_integral(q: RayQuadratic, falloff: u32, t0: f32, t1: f32) -> f32 {
     return 0.0;
 }
 
-// Mirrors hadou_math::energy::sphere_energy (002 eq. 3.4, 3.6, 3.8).
-fn sphere_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, center: vec3<f32>, alpha: f32) -> f32 {
-    let axis = ray_axis(ray.dir);
-    let q = ray_quadratic(axis, ray.origin - center, p.core_radius * p.core_radius);
-    return energy_scaled(rq_integral(q, p.falloff, t0, t1), alpha);
+// Mirrors hadou_math::energy::Attenuation<f32>: the factor (1 − t/t_far)^j of 002 eq. 3.23
+// (SPEC.md §1.4); j = 0 is none.
+struct Attenuation {
+    j: f32,
+    t_far: f32,
 }
 
-// Mirrors hadou_math::energy::cylinder_energy (002 eq. 3.5, 3.7, 3.9).
-fn cylinder_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, point: vec3<f32>, dir: vec3<f32>, alpha: f32) -> f32 {
+// Mirrors Attenuation::none.
+fn att_none() -> Attenuation {
+    return Attenuation(0.0, 1.0);
+}
+
+// Mirrors Attenuation::factor: (1 − t/t_far)^j, 0 from the far point on.
+fn att_factor(att: Attenuation, t: f32) -> f32 {
+    let h = 1.0 - t / att.t_far;
+    if (h > 0.0) {
+        return pow(h, att.j);
+    }
+    return 0.0;
+}
+
+// Mirrors hadou_math::energy::MAX_CELLS, REST_TOLERANCE and INNER_CELL.
+const ATT_MAX_CELLS: u32 = 192u;
+const ATT_REST_TOLERANCE: f32 = 1.0e-5;
+const ATT_INNER_CELL: f32 = 1.0;
+// Mirrors hadou_math::energy::PEAK_RANGE.
+const ATT_PEAK_RANGE: f32 = 1.0e20;
+
+// The density (Y² + H)^{-1/2} or (Y² + H)^{-1} (attenuated.rs `density`).
+fn att_density(falloff: u32, y: f32, h: f32) -> f32 {
+    let r2 = y * y + h;
+    if (falloff == FALLOFF_FAITHFUL) {
+        return 1.0 / sqrt(r2);
+    }
+    return 1.0 / r2;
+}
+
+// Mirrors RayQuadratic::mean_g_line: g averaged over [x, y] against w, 4 Gauss–Legendre nodes
+// uniform in t.
+fn att_mean_line(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation) -> f32 {
+    var xs = array<f32, 4>(0.06943184420297371, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263);
+    var ws = array<f32, 4>(0.17392742256872693, 0.32607257743127307, 0.32607257743127307, 0.17392742256872693);
+    let dt = y - x;
+    var num = 0.0;
+    var den = 0.0;
+    var plain = 0.0;
+    for (var i = 0; i < 4; i++) {
+        let t = x + xs[i] * dt;
+        let g = att_factor(att, t);
+        let w = ws[i] * att_density(falloff, q.s * t + q.beta, q.h);
+        num += w * g;
+        den += w;
+        plain += ws[i] * g;
+    }
+    if (den > 0.0) {
+        return num / den;
+    }
+    return plain;
+}
+
+// Mirrors RayQuadratic::mean_g_peak: g averaged over the inner cell [x, y] around the peak (s > 0),
+// 4 Gauss–Legendre nodes uniform in ψ = asinh(Y/√H) (faithful) or θ = atan(Y/√H).
+fn att_mean_peak(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation) -> f32 {
+    var xs = array<f32, 4>(0.06943184420297371, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263);
+    var ws = array<f32, 4>(0.17392742256872693, 0.32607257743127307, 0.32607257743127307, 0.17392742256872693);
+    let sh = sqrt(q.h);
+    let yx = (q.s * x + q.beta) / sh;
+    let yy = (q.s * y + q.beta) / sh;
+    var px = atan(yx);
+    var py = atan(yy);
+    if (falloff == FALLOFF_FAITHFUL) {
+        px = asinh(yx);
+        py = asinh(yy);
+    }
+    var sum = 0.0;
+    for (var i = 0; i < 4; i++) {
+        let p = px + xs[i] * (py - px);
+        var v = tan(p);
+        if (falloff == FALLOFF_FAITHFUL) {
+            let e = exp(p);
+            v = 0.5 * (e - 1.0 / e);
+        }
+        let t = clamp((v * sh - q.beta) / q.s, x, y);
+        sum += ws[i] * att_factor(att, t);
+    }
+    return sum;
+}
+
+// Mirrors RayQuadratic::attenuated: ∫ (1 − t/t_far)^j w(t) dt over [t0, min(t1, t_far)] (002 eq.
+// 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded cells, each weighted by the closed form
+// (see the Rust module docs of hadou_math::energy::attenuated for the grading).
+fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuation) -> f32 {
+    let tf = att.t_far;
+    let a = max(t0, -T_LIMIT);
+    let b = min(t1, tf);
+    if (!(b > a && tf > 0.0)) {
+        return 0.0;
+    }
+    let total = rq_integral(q, falloff, a, b);
+    if (!(total > 0.0)) {
+        return 0.0;
+    }
+    let s = q.s;
+    let sh = sqrt(q.h);
+    // A peak only where t_c = −β/s and ε = √H/s stay far below overflow.
+    let has_peak = s > 0.0 && sh <= s * ATT_PEAK_RANGE && abs(q.beta) <= s * ATT_PEAK_RANGE;
+    var tc = 0.0;
+    var dmin = 0.0;
+    if (has_peak) {
+        tc = -q.beta / s;
+        dmin = ATT_INNER_CELL * (sh / s);
+    }
+    let ratio = max(exp(-1.0 / att.j), 0.5);
+    var x = a;
+    var acc = 0.0;
+    var used = 0.0;
+    var cells = 0u;
+    loop {
+        if (!(x < b)) {
+            break;
+        }
+        let graded = min(b, tf - ratio * (tf - x));
+        var y = graded;
+        var inner = false;
+        if (cells + 1u >= ATT_MAX_CELLS) {
+            y = b;
+        } else if (has_peak) {
+            if (x < tc - dmin) {
+                y = min(y, min(tc - (tc - x) * 0.5, tc - dmin));
+            } else if (x < tc + dmin) {
+                y = min(y, tc + dmin);
+                inner = true;
+            } else {
+                y = min(y, x + max(x - tc, dmin));
+            }
+        }
+        if (!(y > x)) {
+            // A peak narrower than one ulp of t: a step of about two ulps.
+            y = min(x + max(abs(x) * 2.0 * F32_EPSILON, F32_MIN_POSITIVE), b);
+            if (!(y > x)) {
+                y = b;
+            }
+        }
+        let i0 = rq_integral(q, falloff, x, y);
+        var gbar = 0.0;
+        if (inner) {
+            gbar = att_mean_peak(q, falloff, x, y, att);
+        } else {
+            gbar = att_mean_line(q, falloff, x, y, att);
+        }
+        acc += i0 * gbar;
+        used += i0;
+        cells += 1u;
+        x = y;
+        if (x < b) {
+            let rest = max(total - used, 0.0);
+            if (att_factor(att, x) * rest <= ATT_REST_TOLERANCE * acc) {
+                break;
+            }
+        }
+    }
+    return min(max(acc, 0.0), ENERGY_MAX);
+}
+
+// One piece: rq_integral, or rq_attenuated where att.j > 0 (the Rust shapes' `piece`).
+fn rq_piece(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuation) -> f32 {
+    if (att.j > 0.0) {
+        return rq_attenuated(q, falloff, t0, t1, att);
+    }
+    return rq_integral(q, falloff, t0, t1);
+}
+
+// Mirrors hadou_math::energy::sphere_energy, and sphere_energy_attenuated where att.j > 0 (002 eq.
+// 3.4, 3.6, 3.8, 3.23).
+fn sphere_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, center: vec3<f32>, alpha: f32) -> f32 {
+    let axis = ray_axis(ray.dir);
+    let q = ray_quadratic(axis, ray.origin - center, p.core_radius * p.core_radius);
+    return energy_scaled(rq_piece(q, p.falloff, t0, t1, att), alpha);
+}
+
+// Mirrors hadou_math::energy::cylinder_energy, and cylinder_energy_attenuated where att.j > 0 (002
+// eq. 3.5, 3.7, 3.9, 3.23).
+fn cylinder_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, point: vec3<f32>, dir: vec3<f32>, alpha: f32) -> f32 {
     let axis = ray_axis(cross3(ray.dir, dir));
     let v = cross3(ray.origin - point, dir);
     let q = ray_quadratic(axis, v, p.core_radius * p.core_radius);
-    return energy_scaled(rq_integral(q, p.falloff, t0, t1), alpha);
+    return energy_scaled(rq_piece(q, p.falloff, t0, t1, att), alpha);
 }
 
 // Mirrors hadou_math::energy::CapsuleParts (private).
@@ -243,7 +417,7 @@ struct CapsuleParts {
 
 // Mirrors hadou_math::energy::capsule_parts (private; 002 eq. 3.10–3.11): sphere around the first
 // end crossed, cylinder between the planes through M and M₂ with normal D, sphere around the other.
-fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> CapsuleParts {
+fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, att: Attenuation, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> CapsuleParts {
     // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an end).
     var t0 = 0.0;
     var t1 = 0.0;
@@ -289,25 +463,26 @@ fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, m: vec3<f32>,
     lo = clamp(lo, t0, t1);
     hi = clamp(hi, lo, t1);
     let fo = p.falloff;
-    let spheres = rq_integral(first, fo, t0, lo) + rq_integral(last, fo, hi, t1);
-    let energy = energy_add(energy_scaled(spheres, alpha_s), energy_scaled(rq_integral(cyl, fo, lo, hi), alpha_c));
+    let spheres = rq_piece(first, fo, t0, lo, att) + rq_piece(last, fo, hi, t1, att);
+    let energy = energy_add(energy_scaled(spheres, alpha_s), energy_scaled(rq_piece(cyl, fo, lo, hi, att), alpha_c));
     return CapsuleParts(at_m, at_m2, energy);
 }
 
-// Mirrors hadou_math::energy::capsule_energy.
-fn capsule_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> f32 {
-    return capsule_parts(p, ray, t0, t1, m, d, length, alpha_s, alpha_c).energy;
+// Mirrors hadou_math::energy::capsule_energy, and capsule_energy_attenuated where att.j > 0.
+fn capsule_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> f32 {
+    return capsule_parts(p, ray, t0, t1, att, m, d, length, alpha_s, alpha_c).energy;
 }
 
-// Mirrors hadou_math::energy::beam_energy (SPEC.md §1.2, bulged beam): capsule plus bulbs at M₂, M.
-fn beam_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32, head_alpha: f32, muzzle_alpha: f32) -> f32 {
-    let parts = capsule_parts(p, ray, t0, t1, m, d, length, alpha_s, alpha_c);
+// Mirrors hadou_math::energy::beam_energy (SPEC.md §1.2, bulged beam): capsule plus bulbs at M₂, M;
+// beam_energy_attenuated where att.j > 0.
+fn beam_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32, head_alpha: f32, muzzle_alpha: f32) -> f32 {
+    let parts = capsule_parts(p, ray, t0, t1, att, m, d, length, alpha_s, alpha_c);
     var e = parts.energy;
     if (head_alpha != 0.0) {
-        e = energy_add(e, energy_scaled(rq_integral(parts.at_m2, p.falloff, t0, t1), head_alpha));
+        e = energy_add(e, energy_scaled(rq_piece(parts.at_m2, p.falloff, t0, t1, att), head_alpha));
     }
     if (muzzle_alpha != 0.0) {
-        e = energy_add(e, energy_scaled(rq_integral(parts.at_m, p.falloff, t0, t1), muzzle_alpha));
+        e = energy_add(e, energy_scaled(rq_piece(parts.at_m, p.falloff, t0, t1, att), muzzle_alpha));
     }
     return e;
 }

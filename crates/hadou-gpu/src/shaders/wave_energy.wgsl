@@ -38,36 +38,37 @@ fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
     var span = vec2<f32>(0.0, 0.0);
     let ray = wave_ray(w.falloff, dir, surface, &span);
     let p = FieldParams(w.falloff, w.core_radius);
+    // t_far of hadou_scene::WaveRay: 1 (faithful, t ∈ [0, 1] to the far point) or the far point's
+    // distance (inverse square, unit direction); the analytic kinds' attenuation (002 eq. 3.23).
+    var t_far = 1.0;
+    if (w.falloff != FALLOFF_FAITHFUL) {
+        t_far = frame.far * length3(dir);
+    }
+    let att = Attenuation(w.attenuation, t_far);
     // Each kind's case is compiled in only when its USE_* is set (the variant has the frame's kinds).
     switch w.kind {
         case WAVE_SPHERE: {
             if (USE_SPHERE) {
-                return sphere_energy(p, ray, span.x, span.y, w.p0.xyz, w.p0.w);
+                return sphere_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p0.w);
             }
         }
         case WAVE_CYLINDER: {
             if (USE_CYLINDER) {
-                return cylinder_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p0.w);
+                return cylinder_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p1.xyz, w.p0.w);
             }
         }
         case WAVE_CAPSULE: {
             if (USE_CAPSULE) {
-                return capsule_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
+                return capsule_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
             }
         }
         case WAVE_BEAM: {
             if (USE_BEAM) {
-                return beam_energy(p, ray, span.x, span.y, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
+                return beam_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
             }
         }
         case WAVE_CURVE: {
             if (USE_CURVE) {
-                // t_far of hadou_scene::WaveRay: 1 (faithful, t ∈ [0, 1] to the far point) or the
-                // far point's distance (inverse square, unit direction).
-                var t_far = 1.0;
-                if (w.falloff != FALLOFF_FAITHFUL) {
-                    t_far = frame.far * length3(dir);
-                }
                 return curve_energy(curves[u32(w.p0.x)], w.falloff, w.core_radius, ray, span.x, span.y, t_far);
             }
         }

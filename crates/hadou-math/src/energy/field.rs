@@ -93,3 +93,42 @@ pub struct BeamField<R> {
     /// Strength of the bulb at the muzzle `M` (0: none).
     pub muzzle_alpha: R,
 }
+
+/// The distance attenuation `(1 − t/t_far)^j` of 002 eq. 3.23 (SPEC.md §1.4) on one ray: the
+/// density at ray parameter `t` is multiplied by it, and by 0 from the far point `t_far` on.
+///
+/// `t_far` is the far point's ray parameter: 1 for [`Falloff::Faithful`] (`t ∈ [0, 1]` from the
+/// eye to the far point), the far point's distance for [`Falloff::InverseSquare`] (a unit `dir`).
+/// `j = 0` is no attenuation: every `*_attenuated` function then returns exactly what its
+/// unattenuated twin returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Attenuation<R> {
+    /// Exponent `j ≥ 0` (0: none).
+    pub j: R,
+    /// The far point's ray parameter (`> 0`).
+    pub t_far: R,
+}
+
+impl<R: Real> Attenuation<R> {
+    /// No attenuation (`j = 0`).
+    pub fn none() -> Self {
+        Self { j: R::ZERO, t_far: R::ONE }
+    }
+
+    /// Whether it changes anything (`j > 0`).
+    #[inline(always)]
+    pub fn is_active(&self) -> bool {
+        self.j > R::ZERO
+    }
+
+    /// `(1 − t/t_far)^j`, 0 from the far point on (002 eq. 3.23, SPEC.md §1.4).
+    #[inline(always)]
+    pub fn factor(&self, t: R) -> R {
+        let h = R::ONE - t / self.t_far;
+        if h > R::ZERO {
+            h.powf(self.j)
+        } else {
+            R::ZERO
+        }
+    }
+}

@@ -4,16 +4,38 @@
 
 use super::field::{BeamField, CapsuleField, CylinderField, FieldParams, Ray, SphereField};
 use super::kernel::{saturate, scaled, RayAxis, RayQuadratic};
-use crate::Real;
+use crate::{Real, Vec3};
 
 /// `∫_{t0}^{t1}` of the sphere field `α_s/ρ` (faithful) or `α_s/ρ²` (inverse square) along `ray`,
 /// `ρ² = |V(t) − M|² + r_c²` (002 eq. 3.4, 3.6, 3.8–3.9 with SPEC.md §1.2's corrected `asinh`
 /// denominator; see the [module docs](crate::energy) for both laws and the stable forms).
 #[inline]
 pub fn sphere_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &SphereField<R>) -> R {
-    let axis = RayAxis::new(ray.dir);
-    let q = RayQuadratic::new(&axis, ray.origin - f.center, p.core_radius * p.core_radius);
+    let q = sphere_quadratic(p, ray, f.center);
     scaled(q.integral(p.falloff, t0, t1), f.alpha)
+}
+
+/// The sphere's `|V(t) − M|² + r_c²` along `ray` (002 eq. 3.6).
+#[inline(always)]
+pub(super) fn sphere_quadratic<R: Real>(
+    p: &FieldParams<R>,
+    ray: &Ray<R>,
+    center: Vec3<R>,
+) -> RayQuadratic<R> {
+    let axis = RayAxis::new(ray.dir);
+    RayQuadratic::new(&axis, ray.origin - center, p.core_radius * p.core_radius)
+}
+
+/// The cylinder's squared axis distance `+ r_c²` along `ray` (002 eq. 3.7, SPEC.md §1.2).
+#[inline(always)]
+pub(super) fn cylinder_quadratic<R: Real>(
+    p: &FieldParams<R>,
+    ray: &Ray<R>,
+    f: &CylinderField<R>,
+) -> RayQuadratic<R> {
+    let axis = RayAxis::new(ray.dir.cross(f.dir));
+    let v = (ray.origin - f.point).cross(f.dir);
+    RayQuadratic::new(&axis, v, p.core_radius * p.core_radius)
 }
 
 /// `∫_{t0}^{t1}` of the infinite cylinder field `α_c/ρ` (faithful) or `α_c/ρ²` (inverse square)
@@ -23,31 +45,31 @@ pub fn sphere_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f:
 /// and returns [`ENERGY_MAX`](crate::energy::ENERGY_MAX)`·α`.
 #[inline]
 pub fn cylinder_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &CylinderField<R>) -> R {
-    let axis = RayAxis::new(ray.dir.cross(f.dir));
-    let v = (ray.origin - f.point).cross(f.dir);
-    let q = RayQuadratic::new(&axis, v, p.core_radius * p.core_radius);
+    let q = cylinder_quadratic(p, ray, f);
     scaled(q.integral(p.falloff, t0, t1), f.alpha)
 }
 
 /// The capsule's pieces along a ray, kept so the beam can reuse the end spheres' quadratics.
-struct CapsuleParts<R> {
+pub(super) struct CapsuleParts<R> {
     /// Sphere around `M`.
-    at_m: RayQuadratic<R>,
+    pub(super) at_m: RayQuadratic<R>,
     /// Sphere around `M₂`.
-    at_m2: RayQuadratic<R>,
+    pub(super) at_m2: RayQuadratic<R>,
     /// The capsule's energy.
-    energy: R,
+    pub(super) energy: R,
 }
 
-/// The capsule's split and pieces (002 eq. 3.10–3.11); mirrored eight rays at a time by
-/// `lanes::capsule_parts` (keep in sync).
+/// The capsule's split and pieces (002 eq. 3.10–3.11), each piece integrated by `piece(quadratic,
+/// from, to)` ([`RayQuadratic::integral`], or its attenuated form); mirrored eight rays at a time
+/// by `lanes::capsule_parts` (keep in sync).
 #[inline(always)]
-fn capsule_parts<R: Real>(
+pub(super) fn capsule_parts<R: Real>(
     p: &FieldParams<R>,
     ray: &Ray<R>,
     t0: R,
     t1: R,
     f: &CapsuleField<R>,
+    piece: impl Fn(&RayQuadratic<R>, R, R) -> R,
 ) -> CapsuleParts<R> {
     // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an end).
     let nonempty = t1 > t0;
@@ -77,9 +99,8 @@ fn capsule_parts<R: Real>(
     };
     let lo = lo.clamp(t0, t1);
     let hi = hi.clamp(lo, t1);
-    let fo = p.falloff;
-    let spheres = first.integral(fo, t0, lo) + last.integral(fo, hi, t1);
-    let energy = saturate(scaled(spheres, f.alpha_s) + scaled(cyl.integral(fo, lo, hi), f.alpha_c));
+    let spheres = piece(first, t0, lo) + piece(last, hi, t1);
+    let energy = saturate(scaled(spheres, f.alpha_s) + scaled(piece(&cyl, lo, hi), f.alpha_c));
     CapsuleParts { at_m, at_m2, energy }
 }
 
@@ -91,7 +112,7 @@ fn capsule_parts<R: Real>(
 /// `D·Q = 0` keeps the whole ray in one region; `length = 0` is the sphere field around `M`.
 #[inline]
 pub fn capsule_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &CapsuleField<R>) -> R {
-    capsule_parts(p, ray, t0, t1, f).energy
+    capsule_parts(p, ray, t0, t1, f, |q, a, b| q.integral(p.falloff, a, b)).energy
 }
 
 /// `∫_{t0}^{t1}` of the bulged-beam ("端点膨張型") field along `ray`: [`capsule_energy`] plus sphere
@@ -99,7 +120,7 @@ pub fn capsule_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f
 /// (002 §3.3.3, eq. 3.4 and 3.11; SPEC.md §1.2), faithful `α/ρ` or inverse square `α/ρ²`.
 #[inline]
 pub fn beam_energy<R: Real>(p: &FieldParams<R>, ray: &Ray<R>, t0: R, t1: R, f: &BeamField<R>) -> R {
-    let parts = capsule_parts(p, ray, t0, t1, &f.capsule);
+    let parts = capsule_parts(p, ray, t0, t1, &f.capsule, |q, a, b| q.integral(p.falloff, a, b));
     let mut e = parts.energy;
     if f.head_alpha != R::ZERO {
         e = saturate(e + scaled(parts.at_m2.integral(p.falloff, t0, t1), f.head_alpha));

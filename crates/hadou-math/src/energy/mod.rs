@@ -46,6 +46,12 @@
 //! planes the sphere and cylinder distances coincide, so with `α_s = α_c` the field (and hence the
 //! energy) is continuous across them. The bulged beam adds sphere fields at `M₂` and `M`.
 //!
+//! # Distance attenuation
+//! Every shape also has an `*_attenuated` form taking an [`Attenuation`]: the density times
+//! `(1 − t/t_far)^j` (002 eq. 3.23, SPEC.md §1.4, which the thesis gives for curves only), 0 from
+//! the far point on, in both laws. It is integrated by Gauss–Legendre on graded cells weighted by
+//! the closed forms above (see [`RayQuadratic::attenuated`]); `j = 0` is the plain closed form.
+//!
 //! # Saturation
 //! Each closed-form piece is capped at [`ENERGY_MAX`] (`10³⁰`, reached only where the true
 //! integral diverges: a ray through a centre or along an axis with `r_c = 0`), and every energy
@@ -56,11 +62,18 @@
 //! Every function is generic over [`Real`](crate::Real): `f32` renders, `f64` is what tests compare
 //! against. For finite inputs the results are finite, in `[0, f32::MAX]`.
 
+mod attenuated;
 mod field;
 mod integral;
 mod kernel;
 pub mod lanes;
 
-pub use field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField};
+pub use attenuated::{
+    beam_energy_attenuated, capsule_energy_attenuated, cylinder_energy_attenuated, sphere_energy_attenuated,
+    INNER_CELL, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
+};
+pub use field::{
+    Attenuation, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
+};
 pub use integral::{beam_energy, capsule_energy, cylinder_energy, sphere_energy};
 pub use kernel::{saturate, scaled, RayAxis, RayQuadratic, ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};

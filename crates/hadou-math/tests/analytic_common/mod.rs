@@ -150,6 +150,12 @@ impl Case<f64> {
     /// Converged adaptive quadrature of `shape` along the ray, with break points at every closest
     /// approach and plane crossing inside the interval.
     pub fn reference(&self, shape: Shape) -> Quadrature {
+        self.reference_weighted(shape, &[], |_| 1.0)
+    }
+
+    /// [`Self::reference`] of the density times `weight(t)`, with `extra` break points (where
+    /// the weight has a kink or a branch point).
+    pub fn reference_weighted(&self, shape: Shape, extra: &[f64], weight: impl Fn(f64) -> f64) -> Quadrature {
         let c = &self.beam.capsule;
         let (s, q) = (self.ray.origin, self.ray.dir);
         let w = s - c.m;
@@ -171,6 +177,9 @@ impl Case<f64> {
             add(-w.dot(c.d) / dq);
             add((c.length - w.dot(c.d)) / dq);
         }
+        for &t in extra {
+            add(t);
+        }
         breaks.sort_by(f64::total_cmp);
         breaks.dedup();
         // Each piece in two halves, each integrated in the distance from its break point.
@@ -185,10 +194,13 @@ impl Case<f64> {
             let (a, b) = (w[0], w[1]);
             if b.is_finite() {
                 let half = 0.5 * (b - a);
-                add_q(integrate_adaptive_breaks(|x| self.density(shape, a, x), &[0.0, half], 1e-12, 0.0));
-                add_q(integrate_adaptive_breaks(|x| self.density(shape, b, -x), &[0.0, half], 1e-12, 0.0));
+                let fa = |x: f64| self.density(shape, a, x) * weight(a + x);
+                let fb = |x: f64| self.density(shape, b, -x) * weight(b - x);
+                add_q(integrate_adaptive_breaks(fa, &[0.0, half], 1e-12, 0.0));
+                add_q(integrate_adaptive_breaks(fb, &[0.0, half], 1e-12, 0.0));
             } else {
-                add_q(integrate_adaptive_breaks(|x| self.density(shape, a, x), &[0.0, b], 1e-12, 0.0));
+                let fa = |x: f64| self.density(shape, a, x) * weight(a + x);
+                add_q(integrate_adaptive_breaks(fa, &[0.0, b], 1e-12, 0.0));
             }
         }
         total

@@ -6,8 +6,11 @@ use super::timing::{Timer, Timing};
 use hadou_scene::{Frame, RenderError, Scene};
 use std::path::Path;
 
-/// The shapes of the analytic table: the thesis's three rows plus the bulged beam.
-pub const ANALYTIC_SHAPES: [&str; 4] = ["sphere", "capsule", "sphere+capsule", "bulged beam"];
+/// The shapes of the analytic table: the thesis's three rows plus the bulged beam, then the
+/// sphere and the bulged beam with the distance attenuation `(1 − u)^j`, `j = 8` (002 eq. 3.23;
+/// a shape `"<shape>, j = <j>"` gives every wave of `<shape>` that `j`).
+pub const ANALYTIC_SHAPES: [&str; 6] =
+    ["sphere", "capsule", "sphere+capsule", "bulged beam", "sphere, j = 8", "bulged beam, j = 8"];
 
 /// Scene text for one shape of the analytic table, with or without the two occluding cubes of
 /// 002 Fig. 4.14.
@@ -30,10 +33,11 @@ far = 100.0
 mode = "filmic"
 "#
     );
+    let (shape, j) = shape.split_once(", j = ").unwrap_or((shape, "0"));
     let wave = |kind: &str, extra: &str| {
         format!(
             "\n[[wave]]\nname = \"{kind}\"\nkind = \"{kind}\"\nfalloff = \"{falloff}\"\ncore_radius = {core}\n\
-             rgba = [0.8, 0.8, 0.2, 1.0]\n{extra}"
+             rgba = [0.8, 0.8, 0.2, 1.0]\nj = {j}\n{extra}"
         )
     };
     let capsule =
@@ -104,7 +108,7 @@ pub fn analytic_table(
             measured.push((shape, falloff, cells));
         }
     }
-    let mut columns = vec![Column::left("shape", 16), Column::left("falloff", 15)];
+    let mut columns = vec![Column::left("shape", 20), Column::left("falloff", 15)];
     for &(size, occlusion) in &cases {
         let label = if occlusion { format!("occl. {size}²") } else { format!("{size}²") };
         columns.push(Column::right(label, 22));
@@ -180,7 +184,7 @@ fn parts_table(measured: &[(&str, &str, Vec<Measured>)]) -> Option<Table> {
         return None;
     }
     let title = format!("\nwhere the time goes at {}² (median ms, share of the whole render)\n", first.size);
-    let mut columns = vec![Column::left("shape", 16), Column::left("falloff", 15), Column::right("whole", 9)];
+    let mut columns = vec![Column::left("shape", 20), Column::left("falloff", 15), Column::right("whole", 9)];
     columns.extend(first.timing.parts.iter().map(|(name, _)| Column::right(name.as_str(), 16)));
     let rows = measured
         .iter()
