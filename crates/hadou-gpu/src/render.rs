@@ -897,6 +897,7 @@ mod tests {
             color_mapping: hadou_scene::ColorMapping { mode: hadou_scene::ToneMode::Filmic, exposure: 1.0 },
             shadows: Vec::new(),
             area_light: None,
+            bloom: None,
         }
     }
 
