@@ -78,6 +78,7 @@ pub(crate) fn view_frame(
         color_mapping: ColorMapping { mode: ToneMode::Filmic, exposure: settings.exposure },
         shadows: Vec::new(),
         area_light: None,
+        bloom: None,
     }
 }
 

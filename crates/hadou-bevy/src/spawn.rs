@@ -139,6 +139,9 @@ pub fn unsupported(frame: &Frame) -> Vec<String> {
     if frame.area_light.is_some() {
         out.push("the [area_light] (soft shadows)".into());
     }
+    if frame.bloom.is_some() {
+        out.push("the [bloom] (glare)".into());
+    }
     out
 }
 

@@ -9,8 +9,10 @@
 //! (`opaque`, drawn with the triangle rasterizer `raster`), shaded with the materials and the waves
 //! as lights (`shading`) and darkened by the hard shadows (`shadows`), lit by the area light
 //! through its soft shadows (`soft`), then the energy integrals clipped at the visible surface and
-//! the colour mapping (`waves`). `render` runs them for a frame, `probe` for one pixel.
+//! the colour mapping (`waves`), with a `[bloom]` the glare on the linear colour before the mapping
+//! (`bloom`). `render` runs them for a frame, `probe` for one pixel.
 
+mod bloom;
 mod opaque;
 mod probe;
 mod raster;

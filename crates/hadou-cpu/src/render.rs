@@ -3,6 +3,7 @@
 //! colour mapping ([`crate::waves`]), timed pass by pass ([`PassTimes`]); [`CpuBackend`] keeps the
 //! opaque pass's buffers from frame to frame.
 
+use crate::bloom;
 use crate::opaque::{draw_opaque_into, OpaqueBuffers};
 use crate::setup::FrameSetup;
 use crate::soft;
@@ -71,7 +72,7 @@ pub struct PassTimes {
     pub opaque_ms: f64,
     /// The energy integrals of every wave per pixel, clipped at the visible surface.
     pub wave_ms: f64,
-    /// `scene + exposure·Σ rgb·a·I` and the colour mapping.
+    /// `scene + exposure·Σ rgb·a·I` and the colour mapping (with a `[bloom]`, the glare too).
     pub color_ms: f64,
 }
 
@@ -98,9 +99,16 @@ fn render_with(
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
     let setup = FrameSetup::new(frame);
-    let oy0 = opaque_pass(frame, &setup, y0 as usize..y1 as usize, scratch);
+    let band = y0 as usize..y1 as usize;
+    // With a bloom, the band's halo too (every row of it exactly as a whole-image render has it).
+    let glare = frame.bloom.as_ref().filter(|_| y1 > y0);
+    let src = glare.map_or(band.clone(), |b| bloom::source_rows(frame, b, band.clone()));
+    let oy0 = opaque_pass(frame, &setup, src.clone(), scratch);
     let opaque = &*scratch;
     let opaque_done = std::time::Instant::now();
+    if let Some(params) = glare {
+        return glare_rows(frame, params, &setup, opaque, oy0, src, band, img, (start, opaque_done));
+    }
 
     let w = frame.width as usize;
     let n = w * (y1 - y0) as usize;
@@ -137,6 +145,59 @@ fn render_with(
     let (wn, cn) = (wave_ns.into_inner() as f64, color_ns.into_inner() as f64);
     let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };
     let waves_done = opaque_done + (end - opaque_done).mul_f64(wave_share);
+    let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
+    PassTimes {
+        opaque_ms: ms(start, opaque_done),
+        wave_ms: ms(opaque_done, waves_done),
+        color_ms: ms(waves_done, end),
+    }
+}
+
+/// [`render_with`]'s stage after the opaque pass with a `[bloom]`: the wave pass over the rows
+/// `src` (the band `band` and its halo) into the linear colour, then the glare and the colour
+/// mapping of the band. The wave pass's time is `wave_ms`, the glare's and mapping's `color_ms`.
+#[allow(clippy::too_many_arguments)]
+fn glare_rows(
+    frame: &Frame,
+    params: &hadou_math::bloom::BloomParams,
+    setup: &FrameSetup,
+    opaque: &OpaqueBuffers,
+    oy0: usize,
+    src: std::ops::Range<usize>,
+    band: std::ops::Range<usize>,
+    img: &mut Image,
+    (start, opaque_done): (std::time::Instant, std::time::Instant),
+) -> PassTimes {
+    let w = frame.width as usize;
+    let n = w * band.len();
+    (img.width, img.height) = (frame.width, band.len() as u32);
+    img.color.resize(n, [0.0; 4]);
+    img.energy.resize(n, 0.0);
+    img.depth.resize(n, 0.0);
+    let pass = WavePass::new(frame, &setup.basis, &setup.curves);
+    let first = (src.start - oy0) * w;
+    let m = src.len() * w;
+    let surface = &opaque.surface[first..first + m];
+    let scene = &opaque.color[first..first + m];
+    let mut linear = hadou_math::bloom::Plane::new(w, frame.height as usize, src.clone());
+    let (mut energy, mut depth) = (vec![0.0f32; m], vec![0.0f32; m]);
+    linear
+        .data
+        .par_chunks_mut(w)
+        .zip(energy.par_chunks_mut(w))
+        .zip(depth.par_chunks_mut(w))
+        .zip(surface.par_chunks(w).zip(scene.par_chunks(w)))
+        .enumerate()
+        .for_each_init(Vec::new, |buf, (r, (((lin, en), dep), (surf, scene)))| {
+            pass.row_light((src.start + r) as f32, surf, buf);
+            pass.row_linear(buf, scene, lin, en, dep);
+        });
+    let own = (band.start - src.start) * w..(band.end - src.start) * w;
+    img.energy.copy_from_slice(&energy[own.clone()]);
+    img.depth.copy_from_slice(&depth[own]);
+    let waves_done = std::time::Instant::now();
+    bloom::glare_and_map(frame, params, &linear, band, &mut img.color);
+    let end = std::time::Instant::now();
     let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
     PassTimes {
         opaque_ms: ms(start, opaque_done),

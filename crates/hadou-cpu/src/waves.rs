@@ -261,6 +261,34 @@ impl<'a> WavePass<'a> {
         }
     }
 
+    /// The linear colour `scene + exposure·light` of one row (before the colour mapping) into
+    /// `linear`; the energy and depth alongside.
+    pub(crate) fn row_linear(
+        &self,
+        batches: &[BatchLight],
+        scene: &[[f32; 3]],
+        linear: &mut [[f32; 3]],
+        energy: &mut [f32],
+        depth: &mut [f32],
+    ) {
+        let k = Lanes::splat(self.frame.color_mapping.exposure);
+        for (bi, b) in batches.iter().enumerate() {
+            let x0 = bi * LANES;
+            let n = LANES.min(scene.len() - x0);
+            let sc = &scene[x0..x0 + n];
+            let ch = |c: usize| {
+                Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| sc.get(i).map_or(0.0, |p| p[c])))
+            };
+            let c = [0, 1, 2].map(|i| (ch(i) + k * b.light[i]).to_array());
+            let (t, d) = (b.total.to_array(), b.depth.to_array());
+            for i in 0..n {
+                linear[x0 + i] = [c[0][i], c[1][i], c[2][i]];
+                energy[x0 + i] = t[i];
+                depth[x0 + i] = d[i];
+            }
+        }
+    }
+
     /// The colour mapping over one row: `scene + exposure·light`, mapped, into `color`; the
     /// energy and depth alongside.
     pub(crate) fn row_color(

@@ -72,6 +72,7 @@ fn main() {
         color_mapping: ColorMapping { mode: ToneMode::Filmic, exposure: 1.0 },
         shadows: Vec::new(),
         area_light: None,
+        bloom: None,
     };
     let before = peak_rss_mib().unwrap_or(f64::NAN);
     let mut gpu = match GpuBackend::new() {

@@ -45,6 +45,9 @@ pub const FALLOFF_INVERSE_SQUARE: u32 = 1;
 pub const TONE_FAITHFUL: u32 = 0;
 /// `FrameUniforms::tone_mode` of [`ToneMode::Filmic`]. Keep in sync with `TONE_FILMIC`.
 pub const TONE_FILMIC: u32 = 1;
+/// `FrameUniforms::tone_mode` of a frame with a `[bloom]`: the wave pass writes the linear colour,
+/// unmapped (bloom.wgsl maps it after the glare). Keep in sync with `TONE_LINEAR`.
+pub const TONE_LINEAR: u32 = 2;
 
 /// Per-frame, per-tile uniforms: camera basis, light, colour mapping and the tile's place in the
 /// image. Keep in sync with `FrameUniforms` in common.wgsl.
@@ -1041,3 +1044,23 @@ pub const DEPTH_STANDARD: u32 = 0;
 /// Depth `near / z`: 1 at the near plane, 0 at infinity (reverse-Z with an infinite far plane, as
 /// Bevy draws).
 pub const DEPTH_REVERSE_INFINITE: u32 = 1;
+
+/// One step of the glare chain (bloom.wgsl): its planes, each `[level width, level height, first
+/// row held, rows held]`, and the frame's bloom values. Keep in sync with `BloomUniforms` in
+/// bloom.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct BloomUniforms {
+    /// The first input plane.
+    pub a: [u32; 4],
+    /// The second input plane (the upsample's base, the composite's bloom).
+    pub b: [u32; 4],
+    /// The third input plane (the composite's streak).
+    pub c: [u32; 4],
+    /// The output plane.
+    pub o: [u32; 4],
+    /// `threshold`, `soft_knee`, `intensity/N`, `streak/N_s`.
+    pub params: [f32; 4],
+    /// 1 when the upsample adds `b`; the tone mode ([`TONE_FAITHFUL`], [`TONE_FILMIC`]); unused.
+    pub flags: [u32; 4],
+}

@@ -6,8 +6,11 @@
 
 use crate::device::GpuContext;
 use crate::formats::{DEPTH_FORMAT, PLANE_SHADOW_FORMAT, SCENE_FORMAT};
-use crate::layout::FrameUniforms;
+use crate::layout::{FrameUniforms, TONE_LINEAR};
 use crate::meshes::MeshCache;
+use crate::passes::bloom::BloomPass;
+#[cfg(not(target_arch = "wasm32"))]
+use crate::passes::bloom::{self, BloomInputs};
 use crate::passes::plane_shadows::{PlaneShadowInputs, PlaneShadowPass};
 use crate::passes::present::Presenter;
 use crate::passes::raster::{GBuffer, RasterInputs, RasterPass};
@@ -21,7 +24,7 @@ use crate::passes::wave_overlay::WaveOverlayPass;
 use crate::prepare::{self, FrameBuffers, FrameData, ShadowFields};
 use crate::timing::PassQueries;
 #[cfg(not(target_arch = "wasm32"))]
-use hadou_scene::Image;
+use hadou_scene::{BloomParams, Image};
 use hadou_scene::{Frame, RenderError};
 
 /// Largest tile edge in pixels (smaller when the device's limits demand it).
@@ -78,6 +81,9 @@ pub(crate) struct Prepared {
     raster: bool,
     /// The tiles' bind groups, made once per frame (set at the end of `prepare`).
     groups: Option<TileBindGroups>,
+    /// Whether the wave pass writes the linear colour, unmapped, for the glare
+    /// ([`Renderer::render_rows`] of a frame with a `[bloom]`).
+    linear: bool,
 }
 
 /// The bind groups every tile of a frame uses (the tile's uniforms are rewritten before each
@@ -122,6 +128,7 @@ pub(crate) struct Passes {
     shadow_maps: ShadowMapPass,
     soft: SoftPass,
     pub(crate) wave: WavePass,
+    bloom: BloomPass,
 }
 
 /// The renderer's state between frames.
@@ -188,6 +195,7 @@ impl Renderer {
             plane_shadows: PlaneShadowPass::new(&ctx)?,
             shadow_maps: ShadowMapPass::new(&ctx)?,
             soft: SoftPass::new(&ctx)?,
+            bloom: BloomPass::new(&ctx)?,
         };
         Ok(Self {
             ctx,
@@ -328,6 +336,7 @@ impl Renderer {
                 wave_pipeline,
                 raster,
                 groups: None,
+                linear: false,
             };
             if submit_maps || frame.area_light.is_some() {
                 self.submit_shadow_maps(frame, &prepared, None);
@@ -584,6 +593,9 @@ impl Renderer {
         let (origin, size) = tile;
         let mut uniforms = FrameUniforms::new(frame, &basis, origin, size);
         prepared.shadow_fields.apply(&mut uniforms);
+        if prepared.linear {
+            uniforms.tone_mode = TONE_LINEAR;
+        }
         self.ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&uniforms));
         let groups = prepared.groups.as_ref().expect("bind groups are made in prepare");
         let passes = &self.passes;
@@ -657,6 +669,9 @@ impl Renderer {
     ) -> Result<Image, RenderError> {
         let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
         let rows = y0..y1.max(y0);
+        if let Some(params) = frame.bloom.as_ref().filter(|_| y1 > y0) {
+            return self.render_rows_glare(frame, params, rows);
+        }
         let prepared = self.prepare(frame, rows.clone())?;
         let mut image = alloc_image(frame.width, rows.len() as u32)?;
         for &tile in &prepared.tiles {
@@ -674,6 +689,126 @@ impl Renderer {
             })?;
         }
         Ok(image)
+    }
+}
+
+impl Renderer {
+    /// [`Renderer::render_rows`] of a frame with a `[bloom]` (`rows` non-empty): in bands whose
+    /// rows and halo fit one storage binding, the tiles of the band and its halo drawn with the
+    /// linear colour gathered into one buffer, then the glare pass and the read-back of the band's
+    /// mapped colour.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn render_rows_glare(
+        &mut self,
+        frame: &Frame,
+        params: &BloomParams,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Image, RenderError> {
+        let limit =
+            u64::from(self.ctx.limits.max_storage_buffer_binding_size).min(self.ctx.limits.max_buffer_size);
+        let mut image = alloc_image(frame.width, rows.len() as u32)?;
+        let mut y = rows.start as usize;
+        while y < rows.end as usize {
+            // The longest band from y whose source rows fit.
+            let mut len = rows.end as usize - y;
+            while BloomPass::largest_plane(params, frame.width, frame.height, y..y + len) > limit {
+                if len == 1 {
+                    return Err(RenderError::Other(format!(
+                        "the [bloom] of a {}×{} image needs more than this device's {limit}-byte storage \
+                         binding for one row and its halo; a smaller radius fits",
+                        frame.width, frame.height
+                    )));
+                }
+                len = len.div_ceil(2);
+            }
+            let band = y..y + len;
+            let part = self.glare_band(frame, params, band.clone())?;
+            let w = frame.width as usize;
+            let at = (band.start - rows.start as usize) * w;
+            image.color[at..at + part.color.len()].copy_from_slice(&part.color);
+            image.energy[at..at + part.energy.len()].copy_from_slice(&part.energy);
+            image.depth[at..at + part.depth.len()].copy_from_slice(&part.depth);
+            y += len;
+        }
+        Ok(image)
+    }
+
+    /// One band of [`Renderer::render_rows_glare`].
+    #[cfg(not(target_arch = "wasm32"))]
+    fn glare_band(
+        &mut self,
+        frame: &Frame,
+        params: &BloomParams,
+        band: std::ops::Range<usize>,
+    ) -> Result<Image, RenderError> {
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
+        let mut prepared = self.prepare(frame, src.start as u32..src.end as u32)?;
+        prepared.linear = true;
+        let mut image = alloc_image(frame.width, src.len() as u32)?;
+        let linear = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bloom linear colour"),
+            size: (src.len() * w) as u64 * bloom::TEXEL_BYTES,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        for &tile in &prepared.tiles {
+            let (origin, size) = tile;
+            let submission = self.ctx.scoped("rendering a tile", || {
+                let mut encoders = self.encode_tile(frame, &prepared, tile, true, None);
+                // The tile's colour rows into the band's linear colour.
+                let t = self.targets.as_ref().expect("targets exist");
+                let row_bytes = u64::from(size[0]) * bloom::TEXEL_BYTES;
+                for r in 0..u64::from(size[1]) {
+                    let dst = ((u64::from(origin[1]) + r - src.start as u64) * w as u64
+                        + u64::from(origin[0]))
+                        * bloom::TEXEL_BYTES;
+                    encoders.shading.copy_buffer_to_buffer(&t.output, r * row_bytes, &linear, dst, row_bytes);
+                }
+                self.submit_tile(encoders)
+            })??;
+            let origin = [origin[0], origin[1] - src.start as u32];
+            let bytes = u64::from(size[0]) * u64::from(size[1]) * FLOATS_PER_PIXEL * 4;
+            let staging = &self.targets.as_ref().expect("targets exist").staging;
+            self.ctx.read_buffer(staging, bytes, submission, |raw| {
+                copy_tile(&mut image, raw, origin, size);
+            })?;
+        }
+        let bytes = (band.len() * w) as u64 * bloom::TEXEL_BYTES;
+        let d = &self.ctx.device;
+        let staging = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bloom read-back"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let submission = self.ctx.scoped("drawing the bloom", || {
+            let mut encoder =
+                d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bloom") });
+            let inputs = BloomInputs {
+                params,
+                tone: frame.color_mapping.mode,
+                width: frame.width,
+                height: frame.height,
+                linear: &linear,
+                source: src.clone(),
+                band: band.clone(),
+            };
+            let out = self.passes.bloom.encode(d, &mut encoder, &inputs);
+            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
+            self.ctx.queue.submit([encoder.finish()])
+        })?;
+        let first = (band.start - src.start) * w;
+        self.ctx.read_buffer(&staging, bytes, submission, |raw| {
+            let mut floats = vec![0.0f32; raw.len() / 4];
+            for (f, c) in floats.iter_mut().zip(raw.chunks_exact(4)) {
+                *f = f32::from_ne_bytes([c[0], c[1], c[2], c[3]]);
+            }
+            for (px, c) in image.color[first..first + band.len() * w].iter_mut().zip(floats.chunks_exact(4)) {
+                px.copy_from_slice(c);
+            }
+        })?;
+        Ok(image.crop_rows((band.start - src.start) as u32..(band.end - src.start) as u32))
     }
 }
 
@@ -897,6 +1032,7 @@ mod tests {
             color_mapping: hadou_scene::ColorMapping { mode: hadou_scene::ToneMode::Filmic, exposure: 1.0 },
             shadows: Vec::new(),
             area_light: None,
+            bloom: None,
         }
     }
 

@@ -54,9 +54,12 @@ pub const SOFT_MAP: &str = include_str!("shaders/soft_map.wgsl");
 pub const SOFT: &str = include_str!("shaders/soft.wgsl");
 /// The present pass: a tile's final colour into the full-frame sRGB texture (render pass).
 pub const PRESENT: &str = include_str!("shaders/present.wgsl");
+/// The glare chain: prefilter, downsample, upsample, streak and composite (passes/bloom.rs).
+pub const BLOOM: &str = include_str!("shaders/bloom.wgsl");
 
 /// Every `.wgsl` file in `src/shaders/`, by file name.
 pub const FILES: &[(&str, &str)] = &[
+    ("bloom.wgsl", BLOOM),
     ("common.wgsl", COMMON),
     ("curve.wgsl", CURVE),
     ("energy.wgsl", ENERGY),
@@ -89,6 +92,8 @@ pub const SOFT_MAP_PARTS: &[&str] = &[COMMON, SOFT_MAP];
 pub const SOFT_PARTS: &[&str] = &[COMMON, SOFT];
 /// The parts of the present module, in order.
 pub const PRESENT_PARTS: &[&str] = &[COMMON, PRESENT];
+/// The parts of the glare module, in order.
+pub const BLOOM_PARTS: &[&str] = &[COMMON, BLOOM];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -126,6 +131,7 @@ mod tests {
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
             ("present module", validate("present module", &compose(PRESENT_PARTS))),
             ("wave overlay module", validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS))),
+            ("bloom module", validate("bloom module", &compose(BLOOM_PARTS))),
         ]
     }
 
@@ -157,7 +163,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 7);
+        assert_eq!(modules.len(), 8);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -178,6 +184,7 @@ mod tests {
                 .chain(SOFT_PARTS)
                 .chain(PRESENT_PARTS)
                 .chain(WAVE_OVERLAY_PARTS)
+                .chain(BLOOM_PARTS)
                 .any(|p| std::ptr::eq(*p, *text));
             assert!(used, "{name} is not part of any module");
         }
@@ -226,6 +233,21 @@ mod tests {
         .collect();
         assert_eq!(members, rust, "OverlayUniforms member offsets");
         assert_eq!(span as usize, size_of::<crate::layout::OverlayUniforms>(), "OverlayUniforms size");
+        let bloom = validate("bloom module", &compose(BLOOM_PARTS));
+        let (members, span) = wgsl_layout(&bloom, "BloomUniforms");
+        let rust: Vec<(String, u32)> = [
+            ("a", offset_of!(crate::layout::BloomUniforms, a)),
+            ("b", offset_of!(crate::layout::BloomUniforms, b)),
+            ("c", offset_of!(crate::layout::BloomUniforms, c)),
+            ("o", offset_of!(crate::layout::BloomUniforms, o)),
+            ("params", offset_of!(crate::layout::BloomUniforms, params)),
+            ("flags", offset_of!(crate::layout::BloomUniforms, flags)),
+        ]
+        .iter()
+        .map(|&(n, o)| (n.to_string(), o as u32))
+        .collect();
+        assert_eq!(members, rust, "BloomUniforms member offsets");
+        assert_eq!(span as usize, size_of::<crate::layout::BloomUniforms>(), "BloomUniforms size");
         let module = validate("wave module", &compose(WAVE_PARTS));
         macro_rules! check {
             ($ty:ty, $name:literal, [$($field:ident),* $(,)?]) => {{

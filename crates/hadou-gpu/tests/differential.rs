@@ -395,3 +395,35 @@ fn shadows_match_cpu() {
     assert_eq!(plain.energy, shadowed.energy, "shadows leave the energy alone");
     assert_eq!(plain.depth, shadowed.depth, "shadows leave the depth alone");
 }
+
+/// `[bloom]`: the glare scene two tiles wide, whole and in bands (each band drawing its halo),
+/// with the filmic and the faithful mapping and with a streak only, against the CPU.
+#[test]
+fn glare_matches_cpu_whole_and_in_bands() {
+    use hadou_scene::{BloomParams, ToneMode};
+    let Some(mut gpu) = gpu_or_skip("glare") else { return };
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/glare-kamehameha.toml");
+    let scene = hadou_scene::Scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let mut frame = scene.at(1.5);
+    (frame.width, frame.height) = (hadou_gpu::MAX_TILE + 40, 70);
+    let bloom = frame.bloom.expect("the scene has a [bloom]");
+    let mut faithful = frame.clone();
+    faithful.color_mapping.mode = ToneMode::Faithful;
+    faithful.bloom = Some(BloomParams { intensity: 0.0, streak: 1.5, threshold: 0.5, ..bloom });
+    let mut cpu = CpuBackend::new();
+    for (label, f) in [("glare", &frame), ("glare, faithful streak", &faithful)] {
+        let g = gpu.render(f).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
+        let c = cpu.render(f).expect("cpu");
+        assert_close(label, &compare(&g, &c));
+        let off = cpu.render(&Frame { bloom: None, ..f.clone() }).expect("cpu");
+        assert!(
+            c.color.iter().zip(&off.color).any(|(a, b)| (a[0] - b[0]).abs() > 0.02),
+            "{label}: the glare changes the picture"
+        );
+    }
+    for rows in [0..1, 5..37, 33..70] {
+        let band = gpu.render_rows(&frame, rows.clone()).expect("band");
+        let c = cpu.render_rows(&frame, rows.clone()).expect("cpu band");
+        assert_close(&format!("glare rows {rows:?}"), &compare(&band, &c));
+    }
+}

@@ -10,6 +10,7 @@
 #[cfg(test)]
 extern crate self as hadou_math;
 
+pub mod bloom;
 pub mod curve;
 pub mod energy;
 mod mat4;

@@ -6,6 +6,7 @@
 
 use crate::area_light::AreaLight;
 use crate::shadow::Shadow;
+pub use hadou_math::bloom::BloomParams;
 use hadou_math::curve::{CurveWave, PreparedCurve};
 use hadou_math::energy::{Attenuation, BeamField, CapsuleField, CylinderField, Falloff, Ray, SphereField};
 pub use hadou_math::toon::{Filter, Ramp, RampKind, Wrap};
@@ -37,6 +38,8 @@ pub struct Frame {
     pub shadows: Vec<Shadow>,
     /// The `[area_light]` (003's soft shadows), if any.
     pub area_light: Option<AreaLight>,
+    /// The `[bloom]` (glare on the linear colour before the colour mapping), if any.
+    pub bloom: Option<BloomParams>,
 }
 
 /// A pinhole camera.

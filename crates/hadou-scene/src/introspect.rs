@@ -20,6 +20,8 @@ pub enum Entity {
     Color,
     /// `[area_light]`.
     AreaLight,
+    /// `[bloom]`.
+    Bloom,
     /// `[image]` (no animatable keys; its size is structural).
     Image,
     /// The `[[wave]]` with this name.
@@ -41,6 +43,7 @@ impl Entity {
             Entity::Light => "light",
             Entity::Color => "color",
             Entity::AreaLight => "area_light",
+            Entity::Bloom => "bloom",
             Entity::Image => "image",
             Entity::Wave(_) => "wave",
             Entity::Object(_) => "object",
@@ -203,7 +206,7 @@ pub const WAVE_KINDS: &[&str] =
 
 impl Scene {
     /// Every animatable parameter, grouped by table in the order of `docs/scene-format.md`
-    /// (camera, light, colour, top level, objects, materials, waves, shadows, area light), each
+    /// (camera, light, colour, top level, objects, materials, waves, shadows, area light, bloom), each
     /// table's keys in the order the loader declares them.
     pub fn parameters(&self) -> Vec<ParamInfo> {
         let mut out = Vec::new();
@@ -230,6 +233,9 @@ impl Scene {
         }
         if let Some(a) = &self.area_light {
             push(Entity::AreaLight, &a.params);
+        }
+        if let Some(b) = &self.bloom {
+            push(Entity::Bloom, b);
         }
         out
     }
@@ -313,6 +319,7 @@ impl Scene {
                 "light" => (Entity::Light, rest),
                 "color" => (Entity::Color, rest),
                 "area_light" => (Entity::AreaLight, rest),
+                "bloom" => (Entity::Bloom, rest),
                 _ => {
                     let (name, key) = rest.split_once('.')?;
                     let name = name.to_string();
@@ -333,6 +340,7 @@ impl Scene {
             Entity::Light => &self.light,
             Entity::Color => &self.color,
             Entity::AreaLight => &self.area_light.as_ref()?.params,
+            Entity::Bloom => self.bloom.as_ref()?,
             Entity::Image => return None,
             Entity::Wave(n) => &self.waves.iter().find(|w| &w.name == n)?.params,
             Entity::Object(n) => &self.objects.iter().find(|o| &o.name == n)?.params,

@@ -31,6 +31,7 @@ mod anim;
 mod area_light;
 mod area_light_def;
 mod backend;
+mod bloom_def;
 mod bounds;
 mod error;
 mod files;
@@ -58,6 +59,7 @@ mod track_def;
 pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
 pub use backend::{Backend, RenderError};
+pub use bloom_def::{BLOOM_MAX_STREAK_LENGTH, BLOOM_MAX_THRESHOLD, BLOOM_MAX_WEIGHT};
 pub use bounds::{object_bounds, object_center};
 pub use error::{escape_controls, Location, SceneError};
 pub use files::{

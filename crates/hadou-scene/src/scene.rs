@@ -5,6 +5,7 @@
 
 use crate::anim::Track;
 use crate::area_light_def::{build_area_light, AreaLightDef};
+use crate::bloom_def::build_bloom;
 use crate::frame::{
     Camera, ColorMapping, Frame, Light, Material, Mesh, Object, Ramp, ToneMode, Wave, WaveLight, WaveShape,
 };
@@ -38,6 +39,8 @@ pub struct Scene {
     pub(crate) waves: Vec<WaveDef>,
     pub(crate) shadows: Vec<ShadowDef>,
     pub(crate) area_light: Option<AreaLightDef>,
+    /// `[bloom]`'s parameters.
+    pub(crate) bloom: Option<ParamSet>,
     pub(crate) tracks: Vec<Track>,
     /// Things that were accepted but deserve a note (a downscaled texture, textures on a mesh
     /// without texture coordinates, …).
@@ -185,7 +188,8 @@ impl Scene {
             .chain(self.materials.iter().map(|m| &m.params))
             .chain(self.waves.iter().map(|w| &w.params))
             .chain(self.shadows.iter().map(|s| &s.params))
-            .chain(self.area_light.iter().map(|a| &a.params));
+            .chain(self.area_light.iter().map(|a| &a.params))
+            .chain(self.bloom.iter());
         for set in sets {
             self.clamp_params(set, &mut vals);
         }
@@ -246,6 +250,7 @@ impl Scene {
             shadows,
             area_light: self.area_light.as_ref().map(|a| build_area_light(a, vals, base, &objects)),
             objects,
+            bloom: self.bloom.as_ref().map(|b| build_bloom(b, vals)),
         }
     }
 

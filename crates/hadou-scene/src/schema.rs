@@ -11,6 +11,7 @@
 
 use crate::area_light::SOFT_MAX_PIXELS;
 use crate::area_light_def::{check_area_light, interest_at, parse_area_light, Target};
+use crate::bloom_def::parse_bloom;
 use crate::bounds::mesh_center;
 use crate::error::{show_path, Location, SceneError};
 use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
@@ -48,6 +49,7 @@ const ROOT_KEYS: &[&str] = &[
     "wave",
     "shadow",
     "area_light",
+    "bloom",
     "track",
 ];
 const CAMERA_KEYS: &[&str] = &["position", "target", "up", "fov", "near", "far"];
@@ -314,6 +316,12 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         area_table = Some(t);
     }
 
+    // [bloom]
+    let bloom = match root.sub("bloom", "[bloom]")? {
+        Some(t) => Some(parse_bloom(&t, &mut rd)?),
+        None => None,
+    };
+
     let mut scene = Scene {
         path: path.to_path_buf(),
         width,
@@ -329,6 +337,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         waves,
         shadows,
         area_light,
+        bloom,
         tracks: Vec::new(),
         warnings,
     };
@@ -901,7 +910,7 @@ fn rules_of(scene: &Scene, owner: Owner) -> Option<Rules> {
         }
         Owner::Shadow(i) => Some(Rules::Shadow(i)),
         Owner::Wave(i) => Some(Rules::Wave(i)),
-        Owner::Globals | Owner::Color | Owner::Object(_) | Owner::Material(_) => None,
+        Owner::Globals | Owner::Color | Owner::Bloom | Owner::Object(_) | Owner::Material(_) => None,
     }
 }
 

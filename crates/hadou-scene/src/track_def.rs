@@ -26,6 +26,8 @@ pub(crate) enum Owner {
     Color,
     /// `[area_light]`.
     AreaLight,
+    /// `[bloom]`.
+    Bloom,
     /// `[[object]]` by index.
     Object(usize),
     /// `[[material]]` by index.
@@ -72,7 +74,7 @@ struct Selection {
 }
 
 /// Resolves `target` (`wave.<name>.<key>[i].c`, `object.<name>.<key>`, `camera.<key>`,
-/// `light.<key>`, `area_light.<key>`, `color.exposure`, `background`) against the scene, whose
+/// `light.<key>`, `area_light.<key>`, `bloom.<key>`, `color.exposure`, `background`) against the scene, whose
 /// entities `names` indexes; also says which part of the scene it animates.
 fn resolve_target(scene: &Scene, names: &Names<'_>, target: &str) -> Result<(Selection, Owner), String> {
     let segs: Vec<&str> = target.split('.').collect();
@@ -83,6 +85,10 @@ fn resolve_target(scene: &Scene, names: &Names<'_>, target: &str) -> Result<(Sel
             "area_light" if segs.len() >= 2 => match &scene.area_light {
                 Some(a) => (&a.params, &segs[1..], "[area_light]".into(), Owner::AreaLight),
                 None => return Err(format!("target \"{target}\": the scene has no [area_light]")),
+            },
+            "bloom" if segs.len() >= 2 => match &scene.bloom {
+                Some(b) => (b, &segs[1..], "[bloom]".into(), Owner::Bloom),
+                None => return Err(format!("target \"{target}\": the scene has no [bloom]")),
             },
             "camera" | "light" | "color" if segs.len() >= 2 => {
                 let (set, owner) = match head {
@@ -117,7 +123,7 @@ fn resolve_target(scene: &Scene, names: &Names<'_>, target: &str) -> Result<(Sel
                     }
                 }
             }
-            "camera" | "light" | "color" | "area_light" => {
+            "camera" | "light" | "color" | "area_light" | "bloom" => {
                 return Err(format!("target \"{target}\" needs a key: `{head}.<key>`"));
             }
             "wave" | "object" | "material" | "shadow" => {
@@ -132,12 +138,13 @@ fn resolve_target(scene: &Scene, names: &Names<'_>, target: &str) -> Result<(Sel
                     "camera",
                     "light",
                     "area_light",
+                    "bloom",
                     "color",
                     "background",
                 ];
                 return Err(format!(
                 "target \"{target}\" must start with `wave.`, `object.`, `material.`, `shadow.`, `camera.`, \
-                 `light.`, `area_light.`, `color.` or be `background`{}",
+                 `light.`, `area_light.`, `bloom.`, `color.` or be `background`{}",
                 hint(other, &heads, "targets")
             ));
             }

@@ -255,6 +255,7 @@ fn group_of(e: &Entity) -> &'static str {
         Entity::Wave(_) => "Waves",
         Entity::Shadow(_) => "Shadows",
         Entity::AreaLight => "Area light",
+        Entity::Bloom => "Bloom",
         Entity::Image => "Image",
     }
 }

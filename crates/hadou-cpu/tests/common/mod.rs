@@ -26,5 +26,6 @@ pub fn frame(width: u32, height: u32, camera: Camera, objects: Vec<Object>, wave
         color_mapping: ColorMapping { mode: ToneMode::Filmic, exposure: 1.0 },
         shadows: Vec::new(),
         area_light: None,
+        bloom: None,
     }
 }

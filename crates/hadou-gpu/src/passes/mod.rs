@@ -8,8 +8,11 @@
 //!
 //! Order within a frame: [`shadow_maps`] (once), with an `[area_light]` [`soft`]'s maps and the
 //! whole-image classification and resolve (once), then per tile [`raster`] → [`plane_shadows`] →
-//! [`soft`]'s gather → [`wave`] → read-back, or [`present`] into a window's texture.
+//! [`soft`]'s gather → [`wave`] → read-back, or [`present`] into a window's texture. With a
+//! `[bloom]` the wave pass writes the linear colour, every tile's colour is gathered into one
+//! image, and [`bloom`]'s chain adds the glare and maps the colour before the read-back.
 
+pub(crate) mod bloom;
 pub(crate) mod plane_shadows;
 pub(crate) mod present;
 pub(crate) mod raster;
@@ -30,7 +33,8 @@ mod tests {
     #[test]
     fn pass_bindings_match_their_shaders() {
         let c = shaders::compose;
-        let passes: [(&str, String, &[Binding], bool); 9] = [
+        let passes: [(&str, String, &[Binding], bool); 10] = [
+            ("bloom", c(shaders::BLOOM_PARTS), &super::bloom::BINDINGS, true),
             ("raster", c(shaders::RASTER_PARTS), &super::raster::BINDINGS, true),
             ("wave", c(shaders::WAVE_PARTS), &super::wave::BINDINGS, true),
             ("plane shadows", c(shaders::SHADOW_PARTS), &super::plane_shadows::BINDINGS, true),

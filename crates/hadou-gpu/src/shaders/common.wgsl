@@ -218,6 +218,7 @@ const FALLOFF_FAITHFUL: u32 = 0u;
 const FALLOFF_INVERSE_SQUARE: u32 = 1u;
 const TONE_FAITHFUL: u32 = 0u;
 const TONE_FILMIC: u32 = 1u;
+const TONE_LINEAR: u32 = 2u;
 const RAMP_BANDS: u32 = 0u;
 const RAMP_GRADIENT: u32 = 1u;
 const MODEL_DIFFUSE: u32 = 0u;

@@ -1,7 +1,7 @@
 // Wave pass: per pixel, the visible surface's shading from the raster pass's G-buffer
 // (shading.wgsl: materials, the waves as lights), the waves' light along the pixel's ray clipped
 // at the visible surface (wave_energy.wgsl `waves_light`), the colour scene + exposure·Σ rgb·a·I
-// and the colour mapping (common.wgsl). Prepended by common.wgsl, energy.wgsl, curve.wgsl (curve
+// and the colour mapping (common.wgsl), or with a `[bloom]` the linear colour for bloom.wgsl. Prepended by common.wgsl, energy.wgsl, curve.wgsl (curve
 // buffers: bindings 5–7), wave_energy.wgsl (frame and waves: bindings 0–1), shading.wgsl (bindings
 // 8–10) and shadow_lookup.wgsl (hard shadows: bindings 11–12).
 
@@ -68,7 +68,10 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let lit = vec3<f32>(energy_scaled(light.x, frame.exposure), energy_scaled(light.y, frame.exposure), energy_scaled(light.z, frame.exposure));
     let rgb_in = scene + lit;
     var rgb = vec3<f32>(0.0);
-    if (frame.tone_mode == TONE_FAITHFUL) {
+    if (frame.tone_mode == TONE_LINEAR) {
+        // A `[bloom]` follows (bloom.wgsl), which maps the colour after the glare.
+        rgb = vec3<f32>(energy_saturate(rgb_in.x), energy_saturate(rgb_in.y), energy_saturate(rgb_in.z));
+    } else if (frame.tone_mode == TONE_FAITHFUL) {
         if (USE_TONE_FAITHFUL) {
             rgb = map_faithful(rgb_in);
         }

@@ -155,6 +155,7 @@ pub fn base_frame(width: u32, height: u32, eye: Vec3f, target: Vec3f, mode: Tone
         color_mapping: ColorMapping { mode, exposure: 1.0 },
         shadows: Vec::new(),
         area_light: None,
+        bloom: None,
     }
 }
 

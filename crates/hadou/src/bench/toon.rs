@@ -1,5 +1,6 @@
-//! The toon table: the toon scene full and reduced to plain diffuse, and the shadow scene with
-//! and without its shadows, at each size in one run.
+//! The toon table: the toon scene full and reduced to plain diffuse, the shadow scene with and
+//! without its shadows, and the glare scene with and without its `[bloom]`, at each size in one
+//! run.
 
 use super::table::{Cell, Column, Report, Row, Table};
 use super::timing::Timer;
@@ -13,6 +14,10 @@ pub const TOON_SCENE: (&str, f32) = ("light-from-front.toml", 1.2);
 /// The scene and time whose shadows `hadou bench toon` times on and off: sun shadows by shadow map
 /// (2048²) and by plane projection, and a wave shadow by shadow map, over toon materials.
 pub const SHADOW_SCENE: (&str, f32) = ("shadow-uneven.toml", 1.0);
+
+/// The scene and time whose glare `hadou bench toon` times on and off: the kamehameha with a
+/// bloom and a streak.
+pub const GLARE_SCENE: (&str, f32) = ("glare-kamehameha.toml", 1.5);
 
 /// `frame` with every material reduced to plain diffuse shading of its base colour.
 pub fn plain_materials(frame: &Frame) -> Frame {
@@ -31,7 +36,8 @@ pub fn plain_materials(frame: &Frame) -> Frame {
 /// Measures the toon table: [`TOON_SCENE`] at each size, `full` (the scene as written) and
 /// `plain` (every material diffuse, no wave light, no outlines, no textures: the opaque pass hadou
 /// had before materials), then [`SHADOW_SCENE`] at each size, `shadows` (as written) and
-/// `no-shadows` (its `[[shadow]]`s removed), in one run. Its text pairs the two variants of each
+/// `no-shadows` (its `[[shadow]]`s removed), then [`GLARE_SCENE`] at each size, `bloom` (as
+/// written) and `no-bloom` (its `[bloom]` removed), in one run. Its text pairs the two variants of each
 /// size with their ratio; its JSON `rows` are `{scene, size, variant, ms, fps}`.
 pub fn toon_table(
     time: &mut Timer<'_>,
@@ -85,6 +91,16 @@ pub fn toon_table(
         let bare = Frame { shadows: Vec::new(), ..frame.clone() };
         shadows.push(pair(shadow_file, size, [("shadows", &frame), ("no-shadows", &bare)])?);
     }
+    let (glare_file, gt) = GLARE_SCENE;
+    let glare_scene = Scene::load(scenes.join(glare_file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut glare = Vec::new();
+    for &size in sizes {
+        let mut frame = glare_scene.at(gt);
+        frame.width = size;
+        frame.height = size;
+        let bare = Frame { bloom: None, ..frame.clone() };
+        glare.push(pair(glare_file, size, [("bloom", &frame), ("no-bloom", &bare)])?);
+    }
     let columns = |on: &str, fps: &str, off: &str| {
         vec![
             Column::left("size", 8),
@@ -109,6 +125,14 @@ pub fn toon_table(
             title: format!("\nshadow scene {shadow_file}\n"),
             columns: columns("shadows ms", "fps", "no-shadows ms"),
             rows: shadows,
+        });
+    }
+    if !glare.is_empty() {
+        tables.push(Table {
+            key: None,
+            title: format!("\nglare scene {glare_file}\n"),
+            columns: columns("bloom ms", "fps", "no-bloom ms"),
+            rows: glare,
         });
     }
     Ok(Report {

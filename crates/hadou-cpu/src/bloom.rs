@@ -1,0 +1,45 @@
+//! The `[bloom]` on the CPU: `hadou_math::bloom`'s glare chain over a band of rows, each level's
+//! rows filled in parallel (every texel from the same texels in the same order, so the picture is
+//! the same for any number of threads), and the colour mapping after it.
+
+use hadou_math::bloom::{self, BloomParams, Plane, RowFill};
+use hadou_math::shade;
+use hadou_scene::{Frame, ToneMode};
+use rayon::prelude::*;
+use std::ops::Range;
+
+/// Fills a plane's rows with rayon.
+struct Parallel;
+
+impl RowFill for Parallel {
+    fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync)) {
+        let (w, y0) = (plane.width, plane.rows.start);
+        plane.data.par_chunks_mut(w).enumerate().for_each(|(r, row)| f(y0 + r, row));
+    }
+}
+
+/// The rows of the linear image the band `band` (non-empty) of `frame` needs under `params`: the
+/// band and the bloom's halo ([`bloom::Plan`]).
+pub(crate) fn source_rows(frame: &Frame, params: &BloomParams, band: Range<usize>) -> Range<usize> {
+    bloom::source_rows(params, frame.width as usize, frame.height as usize, band)
+}
+
+/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added and the
+/// frame's colour mapping applied, into `color` (`band.len()` rows).
+pub(crate) fn glare_and_map(
+    frame: &Frame,
+    params: &BloomParams,
+    linear: &Plane,
+    band: Range<usize>,
+    color: &mut [[f32; 4]],
+) {
+    let glared = bloom::glare(params, linear, band, &Parallel);
+    let mode = frame.color_mapping.mode;
+    color.par_iter_mut().zip(glared.data.par_iter()).for_each(|(out, c)| {
+        let m = match mode {
+            ToneMode::Faithful => shade::map_faithful(*c),
+            ToneMode::Filmic => shade::map_filmic(*c),
+        };
+        *out = [m[0], m[1], m[2], 1.0];
+    });
+}

@@ -1,0 +1,405 @@
+//! Glare: a bloom and an anamorphic streak on the linear image, before colour mapping.
+//!
+//! Not from the theses (SPEC.md has no glare); hadou's own, following the bloom chain of
+//! Jimenez, "Next Generation Post Processing in Call of Duty: Advanced Warfare" (SIGGRAPH 2014),
+//! written out texel by texel so that both backends compute the same sums from the same texels:
+//!
+//! 1. **Soft threshold** ([`prefilter`]): with `b = max(r, g, b)`, knee `k = threshold·soft_knee`,
+//!    `q = clamp(b − threshold + k, 0, 2k)² / (4k)` (`q = 0` when `k = 0`) and
+//!    `w = max(q, b − threshold) / b`, the bright part is `T = min(c·w, BLOOM_CLAMP)` per channel
+//!    (`0` where `b ≤ 0`; negative and NaN channels read as 0, infinite ones as `f32::MAX`): zero below `threshold − k`, a quadratic knee up to `threshold + k`, then
+//!    `c − threshold` along `c`'s direction.
+//! 2. **Downsample** ([`down_row`]): level `k+1` (`⌈w/2⌉ × ⌈h/2⌉`) from level `k` by the 13-tap
+//!    filter: thirteen 2×2 box averages `A(dx, dy)` of level `k` around texel `(2i, 2j)` — the box
+//!    whose top-left texel is `(2i+dx, 2j+dy)`, `dx, dy ∈ {−2, −1, 0, 1, 2}` as the pattern uses
+//!    them — weighted `1/8` for the centre `A(0,0)` and the four inner boxes `A(±1,±1)`
+//!    (offsets −1 and +1 in each axis), `1/16` for the edge boxes `A(0,±2)`, `A(±2,0)` and `1/32`
+//!    for the corners `A(±2,±2)`: the four overlapping 2×2-sample boxes weighted `1/8` each and the
+//!    inner box weighted `1/2`, total 1. Texels outside the level clamp to its edge. Levels
+//!    `D₁ … D_N`, `D₁` from `T`.
+//! 3. **Upsample** ([`up_row`]): the 3×3 tent of bilinear taps one low texel apart, written out
+//!    exactly: per axis, an even high texel `2j` reads low texels `j−2 … j+1` weighted
+//!    `(1, 5, 7, 3)/16` and an odd one `2j+1` reads `j−1 … j+2` weighted `(3, 7, 5, 1)/16`; the 2-D
+//!    weights are the products. `U_N = D_N`, `U_k = D_k + up(U_{k+1})`, and the bloom at full
+//!    resolution is `B = up(U₁)/N`, so a uniform bright area blooms to its own `T`.
+//! 4. **Streak** ([`down_row_h`], [`up_row_h`]): the same chain along `x` only (every level keeps
+//!    the image's rows): the 1-D 13-tap `(1, 3, 4, 4, 3, 1)/16` over texels `2i−2 … 2i+3` and the
+//!    1-D tent, `S = up_h(U₁ʰ)/N_s`.
+//! 5. **Composite** ([`composite`]): `c' = c + (intensity/N)·up(U₁) + (streak/N_s)·up_h(U₁ʰ)`
+//!    (`= c + intensity·B + streak·S`), each channel saturated at `f32::MAX` (never infinite), then
+//!    the frame's colour mapping. [`glare`] runs the whole chain over a band of rows.
+//!
+//! `N = clamp(⌈log₂(radius·height)⌉, 1, MAX_LEVELS)` ([`levels`]), `N_s` likewise from
+//! `streak_length·height`. [`Plan`] gives, for a band of output rows, the rows of every level the
+//! band reads, so a band computed with that halo has the whole image's pixels bit for bit.
+
+use std::ops::Range;
+
+/// The most pyramid levels (texels of `2¹⁰ = 1024` pixels at the top).
+pub const MAX_LEVELS: u32 = 10;
+
+/// The largest prefiltered channel value (the largest half float), so that weighted sums of the
+/// pyramid stay finite whatever the linear colour.
+pub const BLOOM_CLAMP: f32 = 65504.0;
+
+/// A bloom's values at one instant (the scene's `[bloom]` table).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BloomParams {
+    /// Weight of the bloom `B` added to the colour, `≥ 0`.
+    pub intensity: f32,
+    /// Brightness (`max(r, g, b)` of the linear colour) where the bloom starts, `≥ 0`.
+    pub threshold: f32,
+    /// Knee half-width as a fraction of `threshold`, in `[0, 1]`.
+    pub soft_knee: f32,
+    /// Bloom reach as a fraction of the image height, in `(0, 1]`.
+    pub radius: f32,
+    /// Weight of the horizontal streak `S`, `≥ 0` (0: no streak).
+    pub streak: f32,
+    /// Streak reach as a fraction of the image height, in `(0, 4]`.
+    pub streak_length: f32,
+}
+
+/// Pyramid levels for a reach of `reach_px` pixels: `clamp(⌈log₂ reach_px⌉, 1, MAX_LEVELS)`.
+pub fn levels(reach_px: f32) -> u32 {
+    if reach_px.is_nan() || reach_px <= 2.0 {
+        return 1;
+    }
+    (reach_px.log2().ceil() as u32).clamp(1, MAX_LEVELS)
+}
+
+/// The next level's size along one axis: `⌈n/2⌉`, at least 1.
+#[inline]
+pub fn half(n: usize) -> usize {
+    n.div_ceil(2).max(1)
+}
+
+/// Step 1: the soft threshold with a quadratic knee (see the module docs).
+#[inline]
+pub fn prefilter(c: [f32; 3], threshold: f32, soft_knee: f32) -> [f32; 3] {
+    // Negative and NaN channels count as 0, infinite ones as `f32::MAX`.
+    let c = c.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, f32::MAX) });
+    let b = c[0].max(c[1]).max(c[2]);
+    if b <= 0.0 {
+        return [0.0; 3];
+    }
+    let k = threshold * soft_knee;
+    let q = if k > 0.0 {
+        let s = (b - threshold + k).clamp(0.0, 2.0 * k);
+        s * s / (4.0 * k)
+    } else {
+        0.0
+    };
+    let w = q.max(b - threshold) / b;
+    c.map(|v| (v * w).min(BLOOM_CLAMP))
+}
+
+/// Step 5: `c + intensity·B + streak·S`, saturated at `f32::MAX`.
+#[inline]
+pub fn composite(c: [f32; 3], bloom: [f32; 3], intensity: f32, streak: [f32; 3], streak_k: f32) -> [f32; 3] {
+    std::array::from_fn(|i| (c[i] + intensity * bloom[i] + streak_k * streak[i]).min(f32::MAX))
+}
+
+/// Rows `rows` of one pyramid level `width × height` (row-major, `rows.len()·width` texels).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Plane {
+    /// The level's width.
+    pub width: usize,
+    /// The level's height.
+    pub height: usize,
+    /// The rows held.
+    pub rows: Range<usize>,
+    /// The texels of those rows.
+    pub data: Vec<[f32; 3]>,
+}
+
+impl Plane {
+    /// A zeroed window `rows` of a `width × height` level.
+    pub fn new(width: usize, height: usize, rows: Range<usize>) -> Self {
+        let n = width * rows.len();
+        Plane { width, height, rows, data: vec![[0.0; 3]; n] }
+    }
+
+    /// Texel `(x, y)` of the level, both clamped to its edge; `y` (after clamping) must be held.
+    #[inline]
+    pub fn at(&self, x: isize, y: isize) -> [f32; 3] {
+        let x = x.clamp(0, self.width as isize - 1) as usize;
+        let y = y.clamp(0, self.height as isize - 1) as usize;
+        debug_assert!(self.rows.contains(&y), "row {y} outside {:?}", self.rows);
+        self.data[(y - self.rows.start) * self.width + x]
+    }
+
+    /// Row `y` of the level (held).
+    pub fn row(&self, y: usize) -> &[[f32; 3]] {
+        let s = (y - self.rows.start) * self.width;
+        &self.data[s..s + self.width]
+    }
+}
+
+#[inline]
+fn madd(acc: &mut [f32; 3], w: f32, v: [f32; 3]) {
+    acc[0] += w * v[0];
+    acc[1] += w * v[1];
+    acc[2] += w * v[2];
+}
+
+/// Step 2: row `y` of the next level from `src` (which holds rows `2y−2 … 2y+3`, clamped), into
+/// `out` (`half(src.width)` texels).
+pub fn down_row(src: &Plane, y: usize, out: &mut [[f32; 3]]) {
+    let y2 = 2 * y as isize;
+    // Each row of texels 2y−2 … 2y+3 once, then the 13 box averages from them.
+    for (i, o) in out.iter_mut().enumerate() {
+        let x2 = 2 * i as isize;
+        let t = |dx: isize, dy: isize| src.at(x2 + dx, y2 + dy);
+        // A(dx, dy): the 2×2 box with top-left texel (2i+dx, 2j+dy).
+        let boxed = |dx: isize, dy: isize| {
+            let (a, b, c, d) = (t(dx, dy), t(dx + 1, dy), t(dx, dy + 1), t(dx + 1, dy + 1));
+            [0, 1, 2].map(|k| 0.25 * (a[k] + b[k] + c[k] + d[k]))
+        };
+        let mut acc = [0.0f32; 3];
+        madd(&mut acc, 0.125, boxed(0, 0));
+        madd(&mut acc, 0.125, boxed(-1, -1));
+        madd(&mut acc, 0.125, boxed(1, -1));
+        madd(&mut acc, 0.125, boxed(-1, 1));
+        madd(&mut acc, 0.125, boxed(1, 1));
+        madd(&mut acc, 0.0625, boxed(0, -2));
+        madd(&mut acc, 0.0625, boxed(-2, 0));
+        madd(&mut acc, 0.0625, boxed(2, 0));
+        madd(&mut acc, 0.0625, boxed(0, 2));
+        madd(&mut acc, 0.03125, boxed(-2, -2));
+        madd(&mut acc, 0.03125, boxed(2, -2));
+        madd(&mut acc, 0.03125, boxed(-2, 2));
+        madd(&mut acc, 0.03125, boxed(2, 2));
+        *o = acc;
+    }
+}
+
+/// The 1-D tent of step 3 for high texel `i`: the first low texel read and the four weights.
+#[inline]
+pub fn tent(i: usize) -> (isize, [f32; 4]) {
+    let j = (i / 2) as isize;
+    if i.is_multiple_of(2) {
+        (j - 2, [1.0 / 16.0, 5.0 / 16.0, 7.0 / 16.0, 3.0 / 16.0])
+    } else {
+        (j - 1, [3.0 / 16.0, 7.0 / 16.0, 5.0 / 16.0, 1.0 / 16.0])
+    }
+}
+
+/// Step 3: row `y` of the level above `low` (`out.len()` texels wide): `base` (the level's own
+/// `D`, if any) plus the tent of `low` (which holds the rows the tent reads).
+pub fn up_row(low: &Plane, y: usize, base: Option<&[[f32; 3]]>, out: &mut [[f32; 3]]) {
+    let (y0, wy) = tent(y);
+    for (i, o) in out.iter_mut().enumerate() {
+        let (x0, wx) = tent(i);
+        let mut acc = [0.0f32; 3];
+        for (dy, &ky) in wy.iter().enumerate() {
+            let mut row = [0.0f32; 3];
+            for (dx, &kx) in wx.iter().enumerate() {
+                madd(&mut row, kx, low.at(x0 + dx as isize, y0 + dy as isize));
+            }
+            madd(&mut acc, ky, row);
+        }
+        if let Some(b) = base {
+            acc = [0, 1, 2].map(|k| b[i][k] + acc[k]);
+        }
+        *o = acc;
+    }
+}
+
+/// Step 4's downsample: one row, `src` (`width`) to `out` (`half(width)`), along `x` only.
+pub fn down_row_h(src: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    const W: [f32; 6] = [1.0 / 16.0, 3.0 / 16.0, 4.0 / 16.0, 4.0 / 16.0, 3.0 / 16.0, 1.0 / 16.0];
+    let last = src.len() as isize - 1;
+    for (i, o) in out.iter_mut().enumerate() {
+        let mut acc = [0.0f32; 3];
+        for (d, &w) in W.iter().enumerate() {
+            let x = (2 * i as isize - 2 + d as isize).clamp(0, last) as usize;
+            madd(&mut acc, w, src[x]);
+        }
+        *o = acc;
+    }
+}
+
+/// Step 4's upsample: one row, `base` (or zero) plus the 1-D tent of `low`, into `out`.
+pub fn up_row_h(low: &[[f32; 3]], base: Option<&[[f32; 3]]>, out: &mut [[f32; 3]]) {
+    let last = low.len() as isize - 1;
+    for (i, o) in out.iter_mut().enumerate() {
+        let (x0, wx) = tent(i);
+        let mut acc = [0.0f32; 3];
+        for (dx, &kx) in wx.iter().enumerate() {
+            madd(&mut acc, kx, low[(x0 + dx as isize).clamp(0, last) as usize]);
+        }
+        if let Some(b) = base {
+            acc = [0, 1, 2].map(|k| b[i][k] + acc[k]);
+        }
+        *o = acc;
+    }
+}
+
+/// One level of a [`Plan`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PlanLevel {
+    /// The level's size.
+    pub width: usize,
+    /// The level's height.
+    pub height: usize,
+    /// Rows of `D_k` the band needs.
+    pub down: Range<usize>,
+    /// Rows of `U_k` the band needs (within `down`).
+    pub up: Range<usize>,
+}
+
+/// Which rows of every level a band of output rows reads (levels `1 … N`), and the rows of the
+/// linear image (`source`) the band needs: the band and its halo.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Rows of the linear image (level 0) read: the band's rows and the prefilter's halo.
+    pub source: Range<usize>,
+    /// The output rows.
+    pub band: Range<usize>,
+    /// Levels `1 … N` (`levels[0]` is level 1).
+    pub levels: Vec<PlanLevel>,
+}
+
+/// Rows `a ..= b` of a low level an upsample of high rows `r` reads (clamped to `h`).
+fn up_source(r: &Range<usize>, h: usize) -> Range<usize> {
+    let a = (r.start / 2).saturating_sub(2);
+    let b = ((r.end - 1) / 2 + 2).min(h - 1);
+    a..b + 1
+}
+
+/// Rows of a high level a downsample into rows `r` reads (clamped to `h`).
+fn down_source(r: &Range<usize>, h: usize) -> Range<usize> {
+    let a = (2 * r.start).saturating_sub(2);
+    let b = (2 * (r.end - 1) + 3).min(h - 1);
+    a..b + 1
+}
+
+fn hull(a: &Range<usize>, b: &Range<usize>) -> Range<usize> {
+    a.start.min(b.start)..a.end.max(b.end)
+}
+
+impl Plan {
+    /// The plan of a `width × height` image with `n` levels for the output rows `band`
+    /// (non-empty, within the image).
+    pub fn new(width: usize, height: usize, n: u32, band: Range<usize>) -> Plan {
+        let n = n.clamp(1, MAX_LEVELS) as usize;
+        let mut sizes = vec![(width.max(1), height.max(1))];
+        for k in 1..=n {
+            let (w, h) = sizes[k - 1];
+            sizes.push((half(w), half(h)));
+        }
+        let mut up = vec![0..0; n + 1];
+        up[0] = band.clone();
+        for k in 1..=n {
+            up[k] = up_source(&up[k - 1], sizes[k].1);
+        }
+        let mut down = vec![0..0; n + 1];
+        down[n] = up[n].clone();
+        for k in (1..n).rev() {
+            down[k] = hull(&up[k], &down_source(&down[k + 1], sizes[k].1));
+        }
+        let source = hull(&band, &down_source(&down[1], sizes[0].1));
+        let levels = (1..=n)
+            .map(|k| PlanLevel {
+                width: sizes[k].0,
+                height: sizes[k].1,
+                down: down[k].clone(),
+                up: up[k].clone(),
+            })
+            .collect();
+        Plan { source, band, levels }
+    }
+}
+
+/// The rows of the linear image a band `band` of a `height`-row image needs for `params`: the
+/// band with the bloom's halo (the streak needs no rows beyond the band).
+pub fn source_rows(params: &BloomParams, width: usize, height: usize, band: Range<usize>) -> Range<usize> {
+    let n = levels(params.radius * height as f32);
+    Plan::new(width, height, n, band).source
+}
+
+/// How the chain fills a plane's rows: one row at a time here ([`Sequential`]), in parallel in a
+/// renderer. `f(y, row)` must be called once for every row `y` of `plane.rows`.
+pub trait RowFill {
+    /// Calls `f(y, row)` for every row of `plane`.
+    fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync));
+}
+
+/// Rows one after the other.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Sequential;
+
+impl RowFill for Sequential {
+    fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync)) {
+        let (w, y0) = (plane.width, plane.rows.start);
+        for (r, row) in plane.data.chunks_mut(w).enumerate() {
+            f(y0 + r, row);
+        }
+    }
+}
+
+/// The streak sum `up_h(U₁ʰ)` of one row `t` (prefiltered) with `n` levels, into `out`.
+pub fn streak_row(t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
+    let n = n.clamp(1, MAX_LEVELS) as usize;
+    let mut down: Vec<Vec<[f32; 3]>> = Vec::with_capacity(n);
+    for k in 0..n {
+        let src: &[[f32; 3]] = if k == 0 { t } else { &down[k - 1] };
+        let mut d = vec![[0.0; 3]; half(src.len())];
+        down_row_h(src, &mut d);
+        down.push(d);
+    }
+    // U_N = D_N; U_k = D_k + up(U_{k+1}).
+    let mut u = down.pop().unwrap_or_default();
+    while let Some(d) = down.pop() {
+        let mut next = vec![[0.0; 3]; d.len()];
+        up_row_h(&u, Some(&d), &mut next);
+        u = next;
+    }
+    up_row_h(&u, None, out);
+}
+
+/// The glare of steps 1–5 over the rows `band` of a `src.width × src.height` linear image: `src`
+/// holds at least the rows `source_rows` names; returns the band's composited colour.
+pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn RowFill) -> Plane {
+    let (w, h) = (src.width, src.height);
+    let n = levels(params.radius * h as f32);
+    let plan = Plan::new(w, h, n, band.clone());
+    let (th, kn) = (params.threshold, params.soft_knee);
+    // T over the source rows (the streak reads the band's rows of it too).
+    let mut t = Plane::new(w, h, plan.source.clone());
+    fill.fill(&mut t, &|y, row| {
+        for (o, c) in row.iter_mut().zip(src.row(y)) {
+            *o = prefilter(*c, th, kn);
+        }
+    });
+    let mut downs: Vec<Plane> = Vec::with_capacity(plan.levels.len());
+    for l in &plan.levels {
+        let mut d = Plane::new(l.width, l.height, l.down.clone());
+        let prev = downs.last().unwrap_or(&t);
+        fill.fill(&mut d, &|y, row| down_row(prev, y, row));
+        downs.push(d);
+    }
+    let mut u = downs.pop().unwrap_or_default();
+    while let Some(d) = downs.pop() {
+        let l = &plan.levels[downs.len()];
+        let mut next = Plane::new(l.width, l.height, l.up.clone());
+        fill.fill(&mut next, &|y, row| up_row(&u, y, Some(d.row(y)), row));
+        u = next;
+    }
+    let kb = params.intensity / n as f32;
+    let ns = levels(params.streak_length * h as f32);
+    let ks = params.streak / ns as f32;
+    let mut out = Plane::new(w, h, band);
+    fill.fill(&mut out, &|y, row| {
+        let mut b = vec![[0.0f32; 3]; w];
+        up_row(&u, y, None, &mut b);
+        let mut s = vec![[0.0f32; 3]; w];
+        if ks > 0.0 {
+            streak_row(t.row(y), ns, &mut s);
+        }
+        for (x, o) in row.iter_mut().enumerate() {
+            *o = composite(src.row(y)[x], b[x], kb, s[x], ks);
+        }
+    });
+    out
+}
