@@ -12,6 +12,7 @@
 //!   maps);
 //! - soft-shadow modules: `common.wgsl` + `soft_map.wgsl` (the `[area_light]`'s maps) and
 //!   `common.wgsl` + `soft.wgsl` (classes, penumbra resolve, gather);
+//! - edge module: `common.wgsl` + `edges.wgsl` (outlines closed where objects meet);
 //! - present module: `common.wgsl` + `present.wgsl` (a tile's colour into the window texture of
 //!   [`crate::GpuBackend::render_to_texture`]).
 //!
@@ -52,6 +53,8 @@ pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
 pub const SOFT_MAP: &str = include_str!("shaders/soft_map.wgsl");
 /// The soft shadows' classification and penumbra resolve (compute passes).
 pub const SOFT: &str = include_str!("shaders/soft.wgsl");
+/// The edge pass: outlines closed where objects meet (render pass over the G-buffer).
+pub const EDGES: &str = include_str!("shaders/edges.wgsl");
 /// The present pass: a tile's final colour into the full-frame sRGB texture (render pass).
 pub const PRESENT: &str = include_str!("shaders/present.wgsl");
 
@@ -59,6 +62,7 @@ pub const PRESENT: &str = include_str!("shaders/present.wgsl");
 pub const FILES: &[(&str, &str)] = &[
     ("common.wgsl", COMMON),
     ("curve.wgsl", CURVE),
+    ("edges.wgsl", EDGES),
     ("energy.wgsl", ENERGY),
     ("present.wgsl", PRESENT),
     ("raster.wgsl", RASTER),
@@ -89,6 +93,8 @@ pub const SOFT_MAP_PARTS: &[&str] = &[COMMON, SOFT_MAP];
 pub const SOFT_PARTS: &[&str] = &[COMMON, SOFT];
 /// The parts of the present module, in order.
 pub const PRESENT_PARTS: &[&str] = &[COMMON, PRESENT];
+/// The parts of the edge module, in order.
+pub const EDGES_PARTS: &[&str] = &[COMMON, EDGES];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -125,6 +131,7 @@ mod tests {
             ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
             ("present module", validate("present module", &compose(PRESENT_PARTS))),
+            ("edge module", validate("edge module", &compose(EDGES_PARTS))),
             ("wave overlay module", validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS))),
         ]
     }
@@ -157,7 +164,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 7);
+        assert_eq!(modules.len(), 8);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -177,6 +184,7 @@ mod tests {
                 .chain(SOFT_MAP_PARTS)
                 .chain(SOFT_PARTS)
                 .chain(PRESENT_PARTS)
+                .chain(EDGES_PARTS)
                 .chain(WAVE_OVERLAY_PARTS)
                 .any(|p| std::ptr::eq(*p, *text));
             assert!(used, "{name} is not part of any module");
@@ -268,7 +276,7 @@ mod tests {
                 plane_count,
                 area,
                 area_position,
-                _pad3,
+                outline_reach,
                 area_color,
                 _pad4,
             ]
@@ -287,7 +295,7 @@ mod tests {
                 wave_blend,
                 outline_width,
                 shadow_mask,
-                _pad1,
+                object,
                 _pad2,
                 base_texture,
                 feature_texture,
@@ -396,6 +404,8 @@ mod tests {
         assert_eq!(value("TONE_FILMIC"), TONE_FILMIC);
         assert_eq!(value("CURVE_MAX_PARTS") as usize, hadou_math::curve::MAX_ATTENUATION_PARTS);
         assert_eq!(value("HULL_BIT"), HULL_BIT);
+        assert_eq!(value("MATERIAL_MASK"), MATERIAL_MASK);
+        assert_eq!(value("REACH_SHIFT"), REACH_SHIFT);
         assert_eq!(value("CAST_PLANE"), CAST_PLANE);
         assert_eq!(value("SHADOW_CAST_WORDS"), SHADOW_CAST_WORDS);
         let overlay = validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS));

@@ -13,6 +13,7 @@ extern crate self as hadou_math;
 pub mod curve;
 pub mod energy;
 mod mat4;
+pub mod outline;
 pub mod quadrature;
 mod real;
 pub mod rng;

@@ -7,9 +7,10 @@
 //! targets.
 //!
 //! Order within a frame: [`shadow_maps`] (once), with an `[area_light]` [`soft`]'s maps and the
-//! whole-image classification and resolve (once), then per tile [`raster`] → [`plane_shadows`] →
+//! whole-image classification and resolve (once), then per tile [`raster`] → [`edges`] → [`plane_shadows`] →
 //! [`soft`]'s gather → [`wave`] → read-back, or [`present`] into a window's texture.
 
+pub(crate) mod edges;
 pub(crate) mod plane_shadows;
 pub(crate) mod present;
 pub(crate) mod raster;
@@ -30,8 +31,9 @@ mod tests {
     #[test]
     fn pass_bindings_match_their_shaders() {
         let c = shaders::compose;
-        let passes: [(&str, String, &[Binding], bool); 9] = [
+        let passes: [(&str, String, &[Binding], bool); 10] = [
             ("raster", c(shaders::RASTER_PARTS), &super::raster::BINDINGS, true),
+            ("edges", c(shaders::EDGES_PARTS), &super::edges::BINDINGS, true),
             ("wave", c(shaders::WAVE_PARTS), &super::wave::BINDINGS, true),
             ("plane shadows", c(shaders::SHADOW_PARTS), &super::plane_shadows::BINDINGS, true),
             // vs_map reads only some of shadow_raster.wgsl's bindings.
