@@ -86,7 +86,7 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 }
                 let px = hull_px(o, material);
                 let rp = reach_pixels(px, code);
-                if !(rp > 0.0) {
+                if rp.is_nan() || rp <= 0.0 {
                     continue;
                 }
                 // Neighbours outside the buffers count as the same object.

@@ -35,7 +35,8 @@ pub(crate) struct TileTargets {
     size: [u32; 2],
     /// G-buffer target 0: normal and eye distance (see raster.wgsl and `formats::SCENE_FORMAT`).
     scene_view: wgpu::TextureView,
-    /// G-buffer target 1: texture coordinates, vertex colour, material word with the hull reach.
+    /// G-buffer target 1: texture coordinates, vertex colour, material word with the hull reach
+    /// (what the later passes read when the frame has no outlines).
     attributes_view: wgpu::TextureView,
     /// Target 1 as the edge pass leaves it (what the plane shadows and the wave pass read).
     edge_attributes_view: wgpu::TextureView,
@@ -227,7 +228,8 @@ impl Renderer {
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let scene_view = texture("normal and distance", SCENE_FORMAT, attach_and_read);
         let attributes_view = texture("uv, colour and material", SCENE_FORMAT, attach_and_read);
-        let edge_attributes_view = texture("uv, colour and material, outlines closed", SCENE_FORMAT, attach_and_read);
+        let edge_attributes_view =
+            texture("uv, colour and material, outlines closed", SCENE_FORMAT, attach_and_read);
         let depth_view = texture("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let plane_shadow_view = texture("plane shadows", PLANE_SHADOW_FORMAT, attach_and_read);
         let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
@@ -508,11 +510,13 @@ impl Renderer {
             attributes: &t.attributes_view,
         };
         let edges = self.passes.edges.bind_group(d, &edges);
+        // Without outlines the edge pass does not run and the raster pass's words carry no reach.
+        let attributes = if prepared.outlines { &t.edge_attributes_view } else { &t.attributes_view };
         let wave = WaveInputs {
             uniforms: &t.uniforms,
             waves: &b.waves,
             surface: &t.scene_view,
-            attributes: &t.edge_attributes_view,
+            attributes,
             output: &t.output,
             curves: [&b.curves[0], &b.curves[1], &b.curves[2]],
             materials: &b.materials,
@@ -530,7 +534,7 @@ impl Renderer {
                 casts: &b.casts,
                 draws: &b.shadow_draws,
                 surface: &t.scene_view,
-                attributes: &t.edge_attributes_view,
+                attributes,
             };
             self.passes.plane_shadows.bind_group(d, &inputs)
         });
@@ -631,7 +635,7 @@ impl Renderer {
             }
             TileWork::Draw { readback } => readback,
         };
-        if let Some(enc) = surfaces.as_mut() {
+        if let Some(enc) = surfaces.as_mut().filter(|_| prepared.outlines) {
             passes.edges.encode(
                 enc,
                 &t.edge_attributes_view,
