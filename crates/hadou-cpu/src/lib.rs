@@ -8,11 +8,13 @@
 //! Passes, in order, after the per-frame set-up (`setup`): opaque geometry and its outline hulls
 //! (`opaque`, drawn with the triangle rasterizer `raster`), shaded with the materials and the waves
 //! as lights (`shading`) and darkened by the hard shadows (`shadows`), lit by the area light
-//! through its soft shadows (`soft`), then the energy integrals clipped at the visible surface and
-//! the colour mapping (`waves`), with a `[bloom]` the glare on the linear colour before the mapping
-//! (`bloom`). `render` runs them for a frame, `probe` for one pixel.
+//! through its soft shadows (`soft`), outlines closed where objects meet (`edges`), then the
+//! energy integrals clipped at the visible surface and the colour mapping (`waves`), with a
+//! `[bloom]` the glare on the linear colour before the mapping (`bloom`). `render` runs them for a
+//! frame, `probe` for one pixel.
 
 mod bloom;
+mod edges;
 mod opaque;
 mod probe;
 mod raster;

@@ -13,7 +13,7 @@ use crate::raster::{cover, edge, perspective, Bands, ScreenProjection, ScreenTri
 use crate::setup::FrameSetup;
 use crate::shading;
 use crate::shadows::NO_SHADOW;
-use hadou_math::{Vec3, Vec3f};
+use hadou_math::{outline, Vec3, Vec3f};
 use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
 
@@ -46,6 +46,22 @@ pub(crate) struct OpaqueBuffers {
     /// The soft-shadow visibility per pixel once resolved (empty before, and without an area
     /// light).
     pub visibility: Vec<f32>,
+    /// What the edge pass ([`crate::edges`]) reads of each drawn pixel.
+    pub edge: Vec<EdgeTexel>,
+}
+
+/// A drawn pixel as the edge pass reads it (the GPU's G-buffer holds the same).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct EdgeTexel {
+    /// The interpolated world normal (not unit; zero where the surface has none).
+    pub normal: Vec3f,
+    /// The material slot of the visible triangle's object.
+    pub material: u32,
+    /// An outline hull fragment.
+    pub hull: bool,
+    /// The hull's reach across the view ray here (`hadou_math::outline::reach_code`; 0 for hulls
+    /// and materials without an outline).
+    pub reach: u32,
 }
 
 /// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
@@ -84,12 +100,13 @@ pub(crate) fn draw_opaque_into(
     let far = frame.camera.far;
     let bands = Bands::new(&tris, frame.height as usize, &rows);
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
-    let OpaqueBuffers { color, surface, object, shadow, soft, visibility } = out;
+    let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge } = out;
     // Every element is written below: the fills only size the buffers.
     refill(color, w * h, [0.0f32; 3]);
     refill(surface, w * h, None);
     refill(object, w * h, None);
     refill(shadow, w * h, None);
+    refill(edge, w * h, EdgeTexel::default());
     visibility.clear();
     let area = frame.area_light.as_ref();
     refill(soft, if area.is_some() { w * h } else { 0 }, None);
@@ -109,8 +126,9 @@ pub(crate) fn draw_opaque_into(
         .chunks_mut(batch_px)
         .zip(surface.chunks_mut(batch_px))
         .zip(object.chunks_mut(batch_px))
-        .zip(shadow.chunks_mut(batch_px));
-    for (k, (((color, surface), object), shadow)) in batches.enumerate() {
+        .zip(shadow.chunks_mut(batch_px))
+        .zip(edge.chunks_mut(batch_px));
+    for (k, ((((color, surface), object), shadow), edge)) in batches.enumerate() {
         let first = k * BATCH;
         let count = color.len().div_ceil(BAND * w);
         let list = bands.batch(first, count);
@@ -121,9 +139,10 @@ pub(crate) fn draw_opaque_into(
             .zip(surface.par_chunks_mut(BAND * w))
             .zip(object.par_chunks_mut(BAND * w))
             .zip(shadow.par_chunks_mut(BAND * w))
+            .zip(edge.par_chunks_mut(BAND * w))
             .zip(soft_batch.into_par_iter())
             .enumerate()
-            .for_each(|(j, ((((col, surf), obj), shad), soft))| {
+            .for_each(|(j, (((((col, surf), obj), shad), edg), soft))| {
                 let b = first + j;
                 let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
                 let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
@@ -148,10 +167,23 @@ pub(crate) fn draw_opaque_into(
                             continue;
                         }
                         let py = (y_start + r) as f32;
-                        let s = interpolate(&tris[tri_id[i] as usize], x as f32 + 0.5, py + 0.5);
+                        let t = &tris[tri_id[i] as usize];
+                        let (s, outline_dir) = interpolate(t, x as f32 + 0.5, py + 0.5);
                         let d = (s.world - basis.eye).length();
                         surf[i] = Some(if d.is_finite() { d } else { 0.0 });
-                        obj[i] = Some(tris[tri_id[i] as usize].object);
+                        obj[i] = Some(t.object);
+                        let outlined = !t.hull
+                            && frame.objects[t.object as usize]
+                                .material(t.material)
+                                .outline
+                                .is_some_and(|o| o.width > 0.0);
+                        let reach = if outlined {
+                            let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
+                            outline::reach_code(outline_dir, dir)
+                        } else {
+                            0
+                        };
+                        edg[i] = EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
                         visible[i] = Some(s);
                     }
                 }
@@ -215,33 +247,39 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Tris {
     for (oi, obj) in frame.objects.iter().enumerate() {
         let nm = obj.transform.normal_matrix();
         let mesh = &obj.mesh;
+        let outlined = obj.materials.iter().any(|m| m.outline.is_some_and(|o| o.width > 0.0));
         let verts: Vec<Vert> = (0..mesh.positions.len())
             .map(|i| {
                 let world = obj.transform.transform_point(Vec3::from_array(mesh.positions[i]));
                 let normal =
                     nm.transform_vector(Vec3::from_array(mesh.normals.get(i).copied().unwrap_or([0.0; 3])));
+                // The unit outline direction `U` of 000 §2.3, which the hull and the edge pass
+                // read.
+                let dir = mesh.outline_normals.get(i).or(mesh.normals.get(i)).copied().unwrap_or([0.0; 3]);
+                let outline = if outlined {
+                    nm.transform_vector(Vec3::from_array(dir)).normalize_or(Vec3f::ZERO)
+                } else {
+                    Vec3f::ZERO
+                };
                 Vert {
                     view: basis.to_view(world),
                     world,
                     normal,
                     uv: mesh.uvs.get(i).copied().unwrap_or([0.0; 2]),
                     color: mesh.colors.get(i).copied().unwrap_or([1.0; 4]),
+                    outline,
                 }
             })
             .collect();
         // The outline hull (000 §2.3): each vertex pushed along its world-space outline normal
         // by `d·|z|` (`z` its view depth), which is `R' = R + d·|R_z|·U` in view space.
-        let outlined = obj.materials.iter().any(|m| m.outline.is_some_and(|o| o.width > 0.0));
         let hull: Vec<Vert> = if outlined {
             verts
                 .iter()
                 .enumerate()
                 .map(|(i, v)| {
                     let width = obj.material(mesh.material_of(i)).outline.map_or(0.0, |o| o.width);
-                    let dir =
-                        mesh.outline_normals.get(i).or(mesh.normals.get(i)).copied().unwrap_or([0.0; 3]);
-                    let u = nm.transform_vector(Vec3::from_array(dir)).normalize_or(Vec3f::ZERO);
-                    let world = v.world + u * (width * v.view.z.abs());
+                    let world = v.world + v.outline * (width * v.view.z.abs());
                     Vert { view: basis.to_view(world), world, ..*v }
                 })
                 .collect()
@@ -296,8 +334,9 @@ fn raster_tri(
     });
 }
 
-/// Perspective-correct surface attributes at screen point `(px, py)`.
-fn interpolate(t: &ScreenTri, px: f32, py: f32) -> shading::Surface {
+/// Perspective-correct surface attributes at screen point `(px, py)`, and the interpolated outline
+/// direction there.
+fn interpolate(t: &ScreenTri, px: f32, py: f32) -> (shading::Surface, Vec3f) {
     let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
     let b = [
         edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) / area,
@@ -312,5 +351,6 @@ fn interpolate(t: &ScreenTri, px: f32, py: f32) -> shading::Surface {
     let uv = std::array::from_fn(|k| t.uv[0][k] * wts[0] + t.uv[1][k] * wts[1] + t.uv[2][k] * wts[2]);
     let color =
         std::array::from_fn(|k| t.color[0][k] * wts[0] + t.color[1][k] * wts[1] + t.color[2][k] * wts[2]);
-    shading::Surface { world, normal, uv, color }
+    let outline = t.outline[0] * wts[0] + t.outline[1] * wts[1] + t.outline[2] * wts[2];
+    (shading::Surface { world, normal, uv, color }, outline)
 }

@@ -91,6 +91,9 @@ pub(crate) struct Vert {
     pub uv: [f32; 2],
     /// Linear RGBA vertex colour.
     pub color: [f32; 4],
+    /// World outline direction: the unit direction the outline hull pushes this vertex along
+    /// (zero where there is none).
+    pub outline: Vec3f,
 }
 
 /// A projected triangle ready to rasterize.
@@ -110,6 +113,8 @@ pub(crate) struct ScreenTri {
     pub uv: [[f32; 2]; 3],
     /// The vertices' colours.
     pub color: [[f32; 4]; 3],
+    /// The vertices' outline directions ([`Vert::outline`]).
+    pub outline: [Vec3f; 3],
     /// Index into `frame.objects` (for a plane cast's triangle, the cast's index).
     pub object: u32,
     /// Material slot of the object.
@@ -137,6 +142,7 @@ impl ScreenTri {
             normal: [Vec3f::ZERO; 3],
             uv: [[0.0; 2]; 3],
             color: [[0.0; 4]; 3],
+            outline: [Vec3f::ZERO; 3],
             object: 0,
             material: 0,
             hull: false,
@@ -235,6 +241,7 @@ impl ScreenProjection {
                 normal: pv.map(|v| v.normal),
                 uv: pv.map(|v| v.uv),
                 color: pv.map(|v| v.color),
+                outline: pv.map(|v| v.outline),
                 object,
                 material,
                 hull,
@@ -281,6 +288,7 @@ fn clip_near(tri: [Vert; 3], near: f32, out: &mut [Vert; 4]) -> usize {
                 normal: lerp(a.normal, b.normal),
                 uv: std::array::from_fn(|k| mix(a.uv[k], b.uv[k])),
                 color: std::array::from_fn(|k| mix(a.color[k], b.color[k])),
+                outline: lerp(a.outline, b.outline),
             };
             v.view.z = near;
             if n < 4 {
@@ -624,7 +632,14 @@ mod tests {
             let (c, s) = (yaw.cos(), yaw.sin());
             let corner = |x: f32, z: f32| {
                 let view = Vec3f::new(c * x - s * z, -height, s * x + c * z);
-                Vert { view, world: view, normal: Vec3f::Y, uv: [0.0; 2], color: [1.0; 4] }
+                Vert {
+                    view,
+                    world: view,
+                    normal: Vec3f::Y,
+                    uv: [0.0; 2],
+                    color: [1.0; 4],
+                    outline: Vec3f::ZERO,
+                }
             };
             let q = [
                 corner(-extent, -extent),

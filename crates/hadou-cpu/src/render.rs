@@ -4,6 +4,7 @@
 //! opaque pass's buffers from frame to frame.
 
 use crate::bloom;
+use crate::edges;
 use crate::opaque::{draw_opaque_into, OpaqueBuffers};
 use crate::setup::FrameSetup;
 use crate::soft;
@@ -207,7 +208,9 @@ fn glare_rows(
 }
 
 /// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which
-/// needs the whole image: then every row is drawn). Returns the buffers and their first row.
+/// needs the whole image: then every row is drawn) and the outlines closed where objects meet
+/// ([`edges::close_outlines`], which needs [`edges::frame_reach`]` + 1` rows beyond `rows`: those
+/// are drawn too). Returns the buffers' first row.
 pub(crate) fn opaque_pass(
     frame: &Frame,
     setup: &FrameSetup,
@@ -215,8 +218,13 @@ pub(crate) fn opaque_pass(
     opaque: &mut OpaqueBuffers,
 ) -> usize {
     let Some(light) = &frame.area_light else {
-        let y0 = rows.start;
-        draw_opaque_into(frame, setup, rows, opaque);
+        let margin = edges::frame_reach(frame) as usize + 1;
+        let h = frame.height as usize;
+        let drawn =
+            rows.start.saturating_sub(margin).min(rows.start)..(rows.end + margin).min(h).max(rows.end);
+        let y0 = drawn.start;
+        draw_opaque_into(frame, setup, drawn, opaque);
+        edges::close_outlines(frame, &setup.basis, y0, opaque);
         return y0;
     };
     draw_opaque_into(frame, setup, 0..frame.height as usize, opaque);
@@ -235,5 +243,6 @@ pub(crate) fn opaque_pass(
     });
     opaque.soft = input.points;
     opaque.visibility = vis;
+    edges::close_outlines(frame, &setup.basis, 0, opaque);
     0
 }

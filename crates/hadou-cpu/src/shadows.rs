@@ -85,6 +85,7 @@ impl ShadowCasts {
                             normal: Vec3f::ZERO,
                             uv: [t, 0.0],
                             color: [0.0; 4],
+                            outline: Vec3f::ZERO,
                         }
                     })
                     .collect();

@@ -100,7 +100,14 @@ fn spot_tris(frame: &Frame, casters: &[u32], map: &SpotMap, size: u32) -> Tris {
             .iter()
             .map(|p| {
                 let world = obj.transform.transform_point(Vec3::from_array(*p));
-                Vert { view: map.to_view(world), world, normal: Vec3f::ZERO, uv: [0.0; 2], color: [0.0; 4] }
+                Vert {
+                    view: map.to_view(world),
+                    world,
+                    normal: Vec3f::ZERO,
+                    uv: [0.0; 2],
+                    color: [0.0; 4],
+                    outline: Vec3f::ZERO,
+                }
             })
             .collect();
         for tri in obj.mesh.indices.chunks_exact(3) {

@@ -7,6 +7,7 @@
 use bytemuck::{Pod, Zeroable};
 use hadou_math::curve::{self, CurveShape, Integrator, PreparedCurve, DEFAULT_SETTINGS};
 use hadou_math::energy::Falloff;
+use hadou_math::outline;
 use hadou_math::shadow::MapFrame;
 use hadou_math::toon::{Filter, Ramp, RampKind, Wrap, MAX_RAMP_BANDS};
 use hadou_math::{Mat4, Vec3f};
@@ -112,12 +113,25 @@ pub struct FrameUniforms {
     pub area: u32,
     /// The area light's centre `L`.
     pub area_position: [f32; 3],
-    /// Padding.
-    pub _pad3: u32,
+    /// How far the edge pass looks for outlines, in pixels (`hadou_math::outline::reach_window`
+    /// of the widest outline; 0: nothing is outlined).
+    pub outline_reach: u32,
     /// The area light's colour times intensity.
     pub area_color: [f32; 3],
     /// Padding.
     pub _pad4: u32,
+}
+
+/// How far the edge pass looks (pixels): the widest outline's hull width on screen, rounded up
+/// and capped (`hadou_math::outline::reach_window`, as hadou-cpu's `edges::frame_reach`).
+fn outline_reach(frame: &Frame, basis: &CameraBasis) -> u32 {
+    let widest = frame
+        .objects
+        .iter()
+        .flat_map(|o| o.materials.iter())
+        .filter_map(|m| m.outline.map(|o| outline::hull_pixels(o.width, basis.tan_half_fov, frame.height)))
+        .fold(0.0f32, f32::max);
+    outline::reach_window(widest)
 }
 
 impl FrameUniforms {
@@ -160,7 +174,7 @@ impl FrameUniforms {
             plane_count: 0,
             area: u32::from(frame.area_light.is_some()),
             area_position: frame.area_light.as_ref().map_or([0.0; 3], |a| a.position.to_array()),
-            _pad3: 0,
+            outline_reach: outline_reach(frame, basis),
             area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
             _pad4: 0,
         }
@@ -220,6 +234,12 @@ pub const LINE_POLYLINE: u32 = 3;
 /// Bit of the raster pass's material word marking an outline-hull fragment. Keep in sync with
 /// `HULL_BIT` in common.wgsl.
 pub const HULL_BIT: u32 = 1 << 31;
+/// The material index's bits in the raster pass's material word (`MAX_MATERIAL_SLOTS` indices).
+/// Keep in sync with `MATERIAL_MASK` in common.wgsl.
+pub const MATERIAL_MASK: u32 = 0xffff;
+/// Shift of the 8-bit hull reach (`hadou_math::outline::reach_code`) in the raster pass's
+/// material word; the edge pass clears it. Keep in sync with `REACH_SHIFT` in common.wgsl.
+pub const REACH_SHIFT: u32 = 16;
 /// Number of 32-bit words at the start of the shading data buffer holding the sRGB → linear
 /// table ([`hadou_math::toon::srgb_table`]).
 pub const SRGB_TABLE_WORDS: u32 = 256;
@@ -293,8 +313,8 @@ pub struct GpuMaterial {
     /// Bit `s` is set when [`Frame::shadows`]`[s]` lists the material's object among its
     /// receivers.
     pub shadow_mask: u32,
-    /// Padding.
-    pub _pad1: u32,
+    /// Index of the material's object in the frame (the edge pass tells objects apart by it).
+    pub object: u32,
     /// Padding.
     pub _pad2: u32,
     /// Base-colour texture.
@@ -386,7 +406,7 @@ pub fn srgb_words() -> impl Iterator<Item = u32> {
 }
 
 /// `m`'s record, its textures stored in `data` through `textures` (whose first 256 words must be
-/// [`srgb_words`]); `shadow_mask` as [`GpuMaterial::shadow_mask`].
+/// [`srgb_words`]); `shadow_mask` as [`GpuMaterial::shadow_mask`]; [`GpuMaterial::object`] 0.
 pub fn material_record(
     m: &hadou_scene::Material,
     shadow_mask: u32,
@@ -404,7 +424,7 @@ pub fn material_record(
         wave_blend: m.wave_blend,
         outline_width: m.outline.map_or(0.0, |o| o.width),
         shadow_mask,
-        _pad1: 0,
+        object: 0,
         _pad2: 0,
         base_texture: textures.texture(data, &m.base_texture),
         feature_texture: textures.texture(data, &m.feature_texture),
@@ -474,7 +494,8 @@ impl ShadingBuffers {
             let mats: &[hadou_scene::Material] =
                 if o.materials.is_empty() { &fallback } else { &o.materials };
             for m in mats {
-                b.materials.push(material_record(m, shadow_mask, &mut b.data, &mut textures));
+                let record = material_record(m, shadow_mask, &mut b.data, &mut textures);
+                b.materials.push(GpuMaterial { object: oi as u32, ..record });
             }
         }
         b.lights = wave_lights(&frame.waves, curves, &mut b.data);

@@ -238,6 +238,14 @@ impl FrameData {
             .map(|(o, &base)| GpuObject::new(o, base))
             .collect();
         check_curves(limits, &curve_data)?;
+        // The raster pass keeps a material index in the low bits of a word (layout::MATERIAL_MASK).
+        if shading.materials.len() > crate::layout::MATERIAL_MASK as usize + 1 {
+            return Err(RenderError::Device(format!(
+                "the frame has {} material slots, more than the {} the GPU backend can tell apart",
+                shading.materials.len(),
+                crate::layout::MATERIAL_MASK as usize + 1
+            )));
+        }
         let max_binding = max_binding(limits);
         let data_bytes = std::mem::size_of_val(shading.data.as_slice()) as u64;
         if data_bytes > max_binding {

@@ -11,6 +11,7 @@ use crate::meshes::MeshCache;
 use crate::passes::bloom::BloomPass;
 #[cfg(not(target_arch = "wasm32"))]
 use crate::passes::bloom::{self, BloomInputs};
+use crate::passes::edges::{EdgeInputs, EdgePass};
 use crate::passes::plane_shadows::{PlaneShadowInputs, PlaneShadowPass};
 use crate::passes::present::Presenter;
 use crate::passes::raster::{GBuffer, RasterInputs, RasterPass};
@@ -37,8 +38,11 @@ pub(crate) struct TileTargets {
     size: [u32; 2],
     /// G-buffer target 0: normal and eye distance (see raster.wgsl and `formats::SCENE_FORMAT`).
     scene_view: wgpu::TextureView,
-    /// G-buffer target 1: texture coordinates, vertex colour, material.
+    /// G-buffer target 1: texture coordinates, vertex colour, material word with the hull reach
+    /// (what the later passes read when the frame has no outlines).
     attributes_view: wgpu::TextureView,
+    /// Target 1 as the edge pass leaves it (what the plane shadows and the wave pass read).
+    edge_attributes_view: wgpu::TextureView,
     /// Depth of the raster pass, then of the plane-shadow pass.
     depth_view: wgpu::TextureView,
     /// The plane-shadow pass's target (`formats::PLANE_SHADOW_FORMAT`).
@@ -90,6 +94,7 @@ pub(crate) struct Prepared {
 /// tile's submission, so one set serves them all).
 struct TileBindGroups {
     raster: wgpu::BindGroup,
+    edges: wgpu::BindGroup,
     wave: wgpu::BindGroup,
     /// Only when the frame has plane casts.
     plane: Option<wgpu::BindGroup>,
@@ -124,6 +129,7 @@ enum TileWork {
 /// The passes, each with its pipelines.
 pub(crate) struct Passes {
     raster: RasterPass,
+    edges: EdgePass,
     plane_shadows: PlaneShadowPass,
     shadow_maps: ShadowMapPass,
     soft: SoftPass,
@@ -191,6 +197,7 @@ impl Renderer {
     pub(crate) fn from_context(ctx: GpuContext) -> Result<Self, RenderError> {
         let passes = Passes {
             raster: RasterPass::new(&ctx)?,
+            edges: EdgePass::new(&ctx)?,
             wave: WavePass::new(&ctx)?,
             plane_shadows: PlaneShadowPass::new(&ctx)?,
             shadow_maps: ShadowMapPass::new(&ctx)?,
@@ -229,6 +236,8 @@ impl Renderer {
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let scene_view = texture("normal and distance", SCENE_FORMAT, attach_and_read);
         let attributes_view = texture("uv, colour and material", SCENE_FORMAT, attach_and_read);
+        let edge_attributes_view =
+            texture("uv, colour and material, outlines closed", SCENE_FORMAT, attach_and_read);
         let depth_view = texture("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let plane_shadow_view = texture("plane shadows", PLANE_SHADOW_FORMAT, attach_and_read);
         let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
@@ -254,6 +263,7 @@ impl Renderer {
             size,
             scene_view,
             attributes_view,
+            edge_attributes_view,
             depth_view,
             plane_shadow_view,
             uniforms,
@@ -502,11 +512,20 @@ impl Renderer {
         let d = &self.ctx.device;
         let raster = RasterInputs { uniforms: &t.uniforms, objects: &b.objects, materials: &b.materials };
         let raster = self.passes.raster.bind_group(d, &raster);
+        let edges = EdgeInputs {
+            uniforms: &t.uniforms,
+            materials: &b.materials,
+            surface: &t.scene_view,
+            attributes: &t.attributes_view,
+        };
+        let edges = self.passes.edges.bind_group(d, &edges);
+        // Without outlines the edge pass does not run and the raster pass's words carry no reach.
+        let attributes = if prepared.outlines { &t.edge_attributes_view } else { &t.attributes_view };
         let wave = WaveInputs {
             uniforms: &t.uniforms,
             waves: &b.waves,
             surface: &t.scene_view,
-            attributes: &t.attributes_view,
+            attributes,
             output: &t.output,
             curves: [&b.curves[0], &b.curves[1], &b.curves[2]],
             materials: &b.materials,
@@ -524,7 +543,7 @@ impl Renderer {
                 casts: &b.casts,
                 draws: &b.shadow_draws,
                 surface: &t.scene_view,
-                attributes: &t.attributes_view,
+                attributes,
             };
             self.passes.plane_shadows.bind_group(d, &inputs)
         });
@@ -537,10 +556,10 @@ impl Renderer {
             };
             self.passes.soft.bind_group(d, soft, &tile)
         });
-        TileBindGroups { raster, wave, plane, soft }
+        TileBindGroups { raster, edges, wave, plane, soft }
     }
 
-    /// Records one tile's passes — raster (unless the frame skips it) and plane shadows into
+    /// Records one tile's passes — raster and edges (unless the frame skips them) and plane shadows into
     /// [`TileEncoders::surfaces`]; the soft shadows' gather, wave and, when `readback`, the copy to
     /// the staging buffer into [`TileEncoders::shading`] — after writing its uniforms. The tiles
     /// share one uniform buffer, so submit each tile ([`Renderer::submit_tile`]) before encoding
@@ -628,6 +647,15 @@ impl Renderer {
             }
             TileWork::Draw { readback } => readback,
         };
+        if let Some(enc) = surfaces.as_mut().filter(|_| prepared.outlines) {
+            passes.edges.encode(
+                enc,
+                &t.edge_attributes_view,
+                size,
+                &groups.edges,
+                timestamps.as_deref_mut().and_then(|q| q.render("edges")),
+            );
+        }
         if let Some(bg) = &groups.plane {
             passes.plane_shadows.encode(
                 surfaces.get_or_insert_with(|| encoder("tile surfaces")),

@@ -12,6 +12,7 @@
 //!   maps);
 //! - soft-shadow modules: `common.wgsl` + `soft_map.wgsl` (the `[area_light]`'s maps) and
 //!   `common.wgsl` + `soft.wgsl` (classes, penumbra resolve, gather);
+//! - edge module: `common.wgsl` + `edges.wgsl` (outlines closed where objects meet);
 //! - present module: `common.wgsl` + `present.wgsl` (a tile's colour into the window texture of
 //!   [`crate::GpuBackend::render_to_texture`]).
 //!
@@ -52,6 +53,8 @@ pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
 pub const SOFT_MAP: &str = include_str!("shaders/soft_map.wgsl");
 /// The soft shadows' classification and penumbra resolve (compute passes).
 pub const SOFT: &str = include_str!("shaders/soft.wgsl");
+/// The edge pass: outlines closed where objects meet (render pass over the G-buffer).
+pub const EDGES: &str = include_str!("shaders/edges.wgsl");
 /// The present pass: a tile's final colour into the full-frame sRGB texture (render pass).
 pub const PRESENT: &str = include_str!("shaders/present.wgsl");
 /// The glare chain: prefilter, downsample, upsample, streak and composite (passes/bloom.rs).
@@ -62,6 +65,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("bloom.wgsl", BLOOM),
     ("common.wgsl", COMMON),
     ("curve.wgsl", CURVE),
+    ("edges.wgsl", EDGES),
     ("energy.wgsl", ENERGY),
     ("present.wgsl", PRESENT),
     ("raster.wgsl", RASTER),
@@ -94,6 +98,8 @@ pub const SOFT_PARTS: &[&str] = &[COMMON, SOFT];
 pub const PRESENT_PARTS: &[&str] = &[COMMON, PRESENT];
 /// The parts of the glare module, in order.
 pub const BLOOM_PARTS: &[&str] = &[COMMON, BLOOM];
+/// The parts of the edge module, in order.
+pub const EDGES_PARTS: &[&str] = &[COMMON, EDGES];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
@@ -130,6 +136,7 @@ mod tests {
             ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
             ("present module", validate("present module", &compose(PRESENT_PARTS))),
+            ("edge module", validate("edge module", &compose(EDGES_PARTS))),
             ("wave overlay module", validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS))),
             ("bloom module", validate("bloom module", &compose(BLOOM_PARTS))),
         ]
@@ -183,6 +190,7 @@ mod tests {
                 .chain(SOFT_MAP_PARTS)
                 .chain(SOFT_PARTS)
                 .chain(PRESENT_PARTS)
+                .chain(EDGES_PARTS)
                 .chain(WAVE_OVERLAY_PARTS)
                 .chain(BLOOM_PARTS)
                 .any(|p| std::ptr::eq(*p, *text));
@@ -290,7 +298,7 @@ mod tests {
                 plane_count,
                 area,
                 area_position,
-                _pad3,
+                outline_reach,
                 area_color,
                 _pad4,
             ]
@@ -309,7 +317,7 @@ mod tests {
                 wave_blend,
                 outline_width,
                 shadow_mask,
-                _pad1,
+                object,
                 _pad2,
                 base_texture,
                 feature_texture,
@@ -418,6 +426,8 @@ mod tests {
         assert_eq!(value("TONE_FILMIC"), TONE_FILMIC);
         assert_eq!(value("CURVE_MAX_PARTS") as usize, hadou_math::curve::MAX_ATTENUATION_PARTS);
         assert_eq!(value("HULL_BIT"), HULL_BIT);
+        assert_eq!(value("MATERIAL_MASK"), MATERIAL_MASK);
+        assert_eq!(value("REACH_SHIFT"), REACH_SHIFT);
         assert_eq!(value("CAST_PLANE"), CAST_PLANE);
         assert_eq!(value("SHADOW_CAST_WORDS"), SHADOW_CAST_WORDS);
         let overlay = validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS));

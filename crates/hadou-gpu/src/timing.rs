@@ -27,7 +27,8 @@ pub enum TimingMethod {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTime {
     /// The pass: `"shadow maps"` (once per frame, every map layer), then per tile `"raster"`
-    /// (opaque geometry and outline hulls into the G-buffer), `"plane shadows"` (only when the
+    /// (opaque geometry and outline hulls into the G-buffer), `"edges"` (outlines closed where
+    /// objects meet), `"plane shadows"` (only when the
     /// frame has plane shadows) and `"wave"` (shading, shadow lookups, the energy integrals and
     /// the colour mapping).
     pub name: String,
@@ -374,8 +375,8 @@ impl FrameTiming {
     }
 }
 
-/// Passes per tile that may take timestamps: raster, plane shadows, soft gather, wave.
-pub(crate) const PASSES_PER_TILE: u32 = 4;
+/// Passes per tile that may take timestamps: raster, edges, plane shadows, soft gather, wave.
+pub(crate) const PASSES_PER_TILE: u32 = 5;
 
 #[cfg(test)]
 mod tests {

@@ -427,3 +427,88 @@ fn glare_matches_cpu_whole_and_in_bands() {
         assert_close(&format!("glare rows {rows:?}"), &compare(&band, &c));
     }
 }
+
+/// Outlines closed where objects meet (the edge pass): a box standing on the ground seen from
+/// above, a little off its axis, has an outline ring on the GPU as on the CPU — every one of 64
+/// directions from the box's screen centre meets an outline pixel within 4 pixels past its last
+/// box pixel (the hull alone, buried in the ground along the base, leaves 26 without) — and the
+/// two backends' images agree; a second, smaller box with its own outline colour stands beside it.
+#[test]
+fn outlines_close_where_objects_meet() {
+    use hadou_math::Vec3;
+    use hadou_scene::mesh::{box_mesh, plane_mesh, with_outline_normals};
+    use hadou_scene::{Image, Material, Outline, ToneMode};
+    use std::sync::Arc;
+    const MAGENTA: [f32; 3] = [1.0, 0.0, 1.0];
+    let Some(mut gpu) = gpu_or_skip("contact outlines") else { return };
+    let mut f = base_frame(128, 128, Vec3::new(1.2, 6.0, 1.6), Vec3::new(0.0, 0.5, 0.0), ToneMode::Faithful);
+    f.camera.fov_y_deg = 40.0;
+    let mut ground = object("ground", Arc::new(plane_mesh([20.0, 20.0])), Vec3::ZERO, Vec3::ZERO, [1.0; 3]);
+    ground.materials = vec![Material::diffuse([0.1, 0.1, 0.8])];
+    let mut cube = object(
+        "box",
+        Arc::new(with_outline_normals(box_mesh([1.0, 1.0, 1.0]))),
+        Vec3::new(0.0, 0.5, 0.0),
+        Vec3::ZERO,
+        [1.0; 3],
+    );
+    cube.materials = vec![Material {
+        outline: Some(Outline { width: 0.02, color: MAGENTA }),
+        ..Material::diffuse([0.8, 0.1, 0.1])
+    }];
+    let mut small = object(
+        "small",
+        Arc::new(with_outline_normals(box_mesh([0.5, 0.5, 0.5]))),
+        Vec3::new(-1.5, 0.25, -1.2),
+        Vec3::new(0.0, 30.0, 0.0),
+        [1.0; 3],
+    );
+    small.materials = vec![Material {
+        outline: Some(Outline { width: 0.015, color: [0.0, 1.0, 0.0] }),
+        ..Material::diffuse([0.7, 0.7, 0.1])
+    }];
+    f.objects = vec![ground, cube, small];
+    let g = gpu.render(&f).expect("GPU render");
+    let c = CpuBackend::new().render(&f).expect("CPU render");
+    assert_close("contact outlines", &compare(&g, &c));
+    let px = |img: &Image, x: i64, y: i64| {
+        let p = img.color[img.index(x as u32, y as u32)];
+        [p[0], p[1], p[2]]
+    };
+    let is_box = |img: &Image, x: i64, y: i64| {
+        let p = px(img, x, y);
+        p != MAGENTA && p[0] > p[2] && p[0] > 2.0 * p[1]
+    };
+    for (name, img) in [("gpu", &g), ("cpu", &c)] {
+        let (mut sx, mut sy, mut n) = (0.0f32, 0.0f32, 0.0f32);
+        for y in 0..128 {
+            for x in 0..128 {
+                if is_box(img, x, y) {
+                    (sx, sy, n) = (sx + x as f32, sy + y as f32, n + 1.0);
+                }
+            }
+        }
+        assert!(n > 100.0, "{name}: the box is not in view");
+        let (cx, cy) = (sx / n, sy / n);
+        let mut missing = Vec::new();
+        for k in 0..64 {
+            let a = k as f32 / 64.0 * std::f32::consts::TAU;
+            let at = |t: f32| ((cx + a.cos() * t).round() as i64, (cy + a.sin() * t).round() as i64);
+            let inside = |(x, y): (i64, i64)| (0..128).contains(&x) && (0..128).contains(&y);
+            let (mut t, mut last) = (0.0, 0.0);
+            while inside(at(t)) && t < 40.0 {
+                if is_box(img, at(t).0, at(t).1) {
+                    last = t;
+                }
+                t += 0.25;
+            }
+            let hit = (0..=16)
+                .map(|s| at(last + s as f32 * 0.25))
+                .any(|p| inside(p) && px(img, p.0, p.1) == MAGENTA);
+            if !hit {
+                missing.push(k);
+            }
+        }
+        assert!(missing.is_empty(), "{name}: no outline in directions {missing:?} of 64");
+    }
+}

@@ -281,7 +281,7 @@ fn present_timing_comes_back_without_waiting() {
     eprintln!("{t2:?}");
     assert_eq!(t2.serial, serial);
     assert!(t2.serial > t.serial);
-    check_timing(&t2, &["shadow maps", "raster", "plane shadows", "wave", "present"]);
+    check_timing(&t2, &["shadow maps", "raster", "edges", "plane shadows", "wave", "present"]);
 
     // An [area_light] frame is not timed: the latest timing stays the previous frame's.
     let soft = scene_frame("soft-gradient.toml", 0.5, 96, 72);

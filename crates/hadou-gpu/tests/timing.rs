@@ -37,7 +37,7 @@ fn time_frame_splits_the_frame_into_its_passes() {
     waves_only.objects.clear();
     let cases = [
         (kamehameha_frame(200, 150), vec!["raster", "wave"]),
-        (shadows, vec!["shadow maps", "raster", "plane shadows", "wave"]),
+        (shadows, vec!["shadow maps", "raster", "edges", "plane shadows", "wave"]),
         (waves_only, vec!["wave"]),
     ];
     for (frame, expected) in cases {

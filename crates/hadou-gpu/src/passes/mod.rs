@@ -7,12 +7,14 @@
 //! targets.
 //!
 //! Order within a frame: [`shadow_maps`] (once), with an `[area_light]` [`soft`]'s maps and the
-//! whole-image classification and resolve (once), then per tile [`raster`] → [`plane_shadows`] →
-//! [`soft`]'s gather → [`wave`] → read-back, or [`present`] into a window's texture. With a
-//! `[bloom]` the wave pass writes the linear colour, every tile's colour is gathered into one
-//! image, and [`bloom`]'s chain adds the glare and maps the colour before the read-back.
+//! whole-image classification and resolve (once), then per tile [`raster`] → [`edges`] →
+//! [`plane_shadows`] → [`soft`]'s gather → [`wave`] → read-back, or [`present`] into a window's
+//! texture. With a `[bloom]` the wave pass writes the linear colour, every tile's colour is
+//! gathered into one image, and [`bloom`]'s chain adds the glare and maps the colour before the
+//! read-back.
 
 pub(crate) mod bloom;
+pub(crate) mod edges;
 pub(crate) mod plane_shadows;
 pub(crate) mod present;
 pub(crate) mod raster;
@@ -36,6 +38,7 @@ mod tests {
         let passes: [(&str, String, &[Binding], bool); 10] = [
             ("bloom", c(shaders::BLOOM_PARTS), &super::bloom::BINDINGS, true),
             ("raster", c(shaders::RASTER_PARTS), &super::raster::BINDINGS, true),
+            ("edges", c(shaders::EDGES_PARTS), &super::edges::BINDINGS, true),
             ("wave", c(shaders::WAVE_PARTS), &super::wave::BINDINGS, true),
             ("plane shadows", c(shaders::SHADOW_PARTS), &super::plane_shadows::BINDINGS, true),
             // vs_map reads only some of shadow_raster.wgsl's bindings.

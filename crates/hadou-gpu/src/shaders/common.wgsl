@@ -53,7 +53,7 @@ struct FrameUniforms {
     plane_count: u32,
     area: u32,
     area_position: vec3<f32>,
-    _pad3: u32,
+    outline_reach: u32,
     area_color: vec3<f32>,
     _pad4: u32,
 }
@@ -110,7 +110,7 @@ struct GpuMaterial {
     wave_blend: f32,
     outline_width: f32,
     shadow_mask: u32,
-    _pad1: u32,
+    object: u32,
     _pad2: u32,
     base_texture: GpuTexture,
     feature_texture: GpuTexture,
@@ -229,6 +229,11 @@ const LINE_SEGMENT: u32 = 1u;
 const LINE_LINE: u32 = 2u;
 const LINE_POLYLINE: u32 = 3u;
 const HULL_BIT: u32 = 0x80000000u;
+// Keep in sync with layout.rs `MATERIAL_MASK` and `REACH_SHIFT`: the raster pass's material word
+// holds the material index in its low 16 bits and the hull reach (8 bits) from bit 16; the edge
+// pass's output holds the index alone (and HULL_BIT).
+const MATERIAL_MASK: u32 = 0xffffu;
+const REACH_SHIFT: u32 = 16u;
 // Keep in sync with layout.rs `CAST_PLANE` and `SHADOW_CAST_WORDS`.
 const CAST_PLANE: u32 = 0u;
 const SHADOW_CAST_WORDS: u32 = 28u;

@@ -5,7 +5,9 @@
 // Rgba32Uint targets (formats.rs SCENE_FORMAT: renderable on every adapter):
 // - target 0: world normal (x, y, z) as f32 bits, Euclidean eye distance as f32 bits (0 = nothing);
 // - target 1: u, v as f32 bits, the vertex colour as pack4x8unorm, the material index in the
-//   frame's material buffer (| HULL_BIT for an outline-hull fragment).
+//   frame's material buffer (| HULL_BIT for an outline-hull fragment; for a surface of an
+//   outlined material | the hull's reach across the view ray, hadou_math::outline::reach_code,
+//   << REACH_SHIFT, which the edge pass (edges.wgsl) reads and clears).
 // Prepended by common.wgsl.
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
@@ -28,6 +30,8 @@ struct VertexOut {
     @location(2) uv: vec2<f32>,
     @location(3) color: vec4<f32>,
     @location(4) @interpolate(flat) material: u32,
+    // The unit outline direction U of 000 §2.3 (zero without an outline), interpolated.
+    @location(5) outline: vec3<f32>,
 }
 
 struct GBuffer {
@@ -43,6 +47,17 @@ fn project(world: vec3<f32>) -> vec4<f32> {
     return clip_position(frame, world);
 }
 
+// The unit world outline direction of a vertex (zero for a zero or non-finite one), as the hull
+// pushes it (hadou-cpu opaque::project_all).
+fn outline_dir(o: GpuObject, outline_normal: vec3<f32>) -> vec3<f32> {
+    let n = (o.normal_matrix * vec4<f32>(outline_normal, 0.0)).xyz;
+    let len = length3(n);
+    if (len > 0.0 && len < 3.0e38) {
+        return n / len;
+    }
+    return vec3<f32>(0.0);
+}
+
 @vertex
 fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     let o = objects[object];
@@ -54,6 +69,10 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     out.uv = v.uv;
     out.color = v.color;
     out.material = material_index(o, v.material);
+    out.outline = vec3<f32>(0.0);
+    if (materials[out.material].outline_width > 0.0) {
+        out.outline = outline_dir(o, v.outline_normal);
+    }
     return out;
 }
 
@@ -69,6 +88,7 @@ fn vs_hull(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     out.material = index | HULL_BIT;
     out.uv = v.uv;
     out.color = v.color;
+    out.outline = vec3<f32>(0.0);
     if (!(width > 0.0)) {
         out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0);
         out.world = frame.eye;
@@ -76,12 +96,7 @@ fn vs_hull(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
         return out;
     }
     let base = (o.model * vec4<f32>(v.position, 1.0)).xyz;
-    let n = (o.normal_matrix * vec4<f32>(v.outline_normal, 0.0)).xyz;
-    let len = length3(n);
-    var u = vec3<f32>(0.0);
-    if (len > 0.0 && len < 3.0e38) {
-        u = n / len;
-    }
+    let u = outline_dir(o, v.outline_normal);
     let z = dot3(base - frame.eye, frame.forward);
     let world = base + u * (width * abs(z));
     out.clip = project(world);
@@ -95,6 +110,18 @@ fn fs_main(in: VertexOut) -> GBuffer {
     var g: GBuffer;
     let distance = length3(in.world - frame.eye);
     g.surface = bitcast<vec4<u32>>(vec4<f32>(in.normal, distance));
-    g.attributes = vec4<u32>(bitcast<u32>(in.uv.x), bitcast<u32>(in.uv.y), pack4x8unorm(in.color), in.material);
+    var word = in.material;
+    if ((word & HULL_BIT) == 0u && materials[word].outline_width > 0.0) {
+        // hadou_math::outline::reach_code at this pixel's ray.
+        let px = frame.tile_origin + vec2<u32>(in.clip.xy);
+        let d = pixel_dir(frame, px.x, px.y);
+        let v = d / length3(d);
+        let across = in.outline - v * dot3(in.outline, v);
+        let s = length3(across);
+        if (s < 3.0e38) {
+            word = word | (u32(floor(min(s, 1.0) * 255.0 + 0.5)) << REACH_SHIFT);
+        }
+    }
+    g.attributes = vec4<u32>(bitcast<u32>(in.uv.x), bitcast<u32>(in.uv.y), pack4x8unorm(in.color), word);
     return g;
 }
