@@ -35,7 +35,7 @@ mod tests {
     #[test]
     fn pass_bindings_match_their_shaders() {
         let c = shaders::compose;
-        let passes: [(&str, String, &[Binding], bool); 10] = [
+        let passes: [(&str, String, &[Binding], bool); 11] = [
             ("bloom", c(shaders::BLOOM_PARTS), &super::bloom::BINDINGS, true),
             ("raster", c(shaders::RASTER_PARTS), &super::raster::BINDINGS, true),
             ("edges", c(shaders::EDGES_PARTS), &super::edges::BINDINGS, true),
