@@ -82,6 +82,8 @@ pub(crate) enum WaveKind {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum IntegratorDef {
     Default,
+    /// `field = "nearest"`.
+    Nearest,
     Simpson { m: u32, n: Option<u32> },
 }
 
@@ -365,6 +367,7 @@ impl Scene {
         };
         let integrator = match w.integrator {
             IntegratorDef::Default => Integrator::Default,
+            IntegratorDef::Nearest => Integrator::Nearest,
             IntegratorDef::Simpson { m, n } => Integrator::Simpson {
                 m,
                 reduction: n.map(|n| Reduction { n, epsilon: p.f(vals, "epsilon") }),
