@@ -12,8 +12,8 @@
 
 use hadou_math::curve::{
     curve_energy, prepare, CurveFrame, CurveShape, CurveWave, Integrator, PreparedCurve, Reduction,
-    MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS, MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE,
-    MAX_TRIG_TERMS, MAX_TURNS,
+    MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS, MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, MAX_ORDER, MAX_SIMPSON_M,
+    MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
 };
 use hadou_math::energy::{Falloff, FieldParams, Ray};
 use hadou_math::rng::Rng;

@@ -84,7 +84,10 @@ pub(crate) enum IntegratorDef {
     Default,
     /// `field = "nearest"`.
     Nearest,
-    Simpson { m: u32, n: Option<u32> },
+    Simpson {
+        m: u32,
+        n: Option<u32>,
+    },
 }
 
 /// A `[[wave]]`.

@@ -67,11 +67,11 @@ pub use dispatch::{curve_energy, curve_energy_f64};
 pub use integrate::{
     attenuation_split, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
 };
+pub use nearest::{MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_STEP, TAIL_RADII};
 pub use prepare::{
     prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS,
     MAX_PIECES, MIN_CORE,
 };
-pub use nearest::{MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_STEP, TAIL_RADII};
 pub use reference::{curve_energy_reference, nearest_energy_reference};
 pub use shape::clamped_uniform_knots;
 pub use validate::CurveError;
