@@ -30,6 +30,8 @@ pub const WAVE_CURVE: u32 = 4;
 pub const INTEGRATOR_DEFAULT: u32 = 0;
 /// `GpuCurve::integrator` of [`Integrator::Simpson`]. Keep in sync with `INTEGRATOR_SIMPSON`.
 pub const INTEGRATOR_SIMPSON: u32 = 1;
+/// `GpuCurve::integrator` of [`Integrator::Nearest`]. Keep in sync with `INTEGRATOR_NEAREST`.
+pub const INTEGRATOR_NEAREST: u32 = 2;
 /// `GpuCurve::shape` of [`CurveShape::Helix`]. Keep in sync with `SHAPE_HELIX`.
 pub const SHAPE_HELIX: u32 = 0;
 /// `GpuCurve::shape` of [`CurveShape::TrigSum`]. Keep in sync with `SHAPE_TRIG`.
@@ -749,7 +751,7 @@ pub struct GpuCurve {
     pub core_floor: f32,
     /// Simpson reduction cylinder radius `R + ε`.
     pub cylinder_radius: f32,
-    /// [`INTEGRATOR_DEFAULT`] or [`INTEGRATOR_SIMPSON`].
+    /// [`INTEGRATOR_DEFAULT`], [`INTEGRATOR_SIMPSON`] or [`INTEGRATOR_NEAREST`].
     pub integrator: u32,
     /// Simpson subintervals `m` (clamped, even).
     pub m: u32,
@@ -799,6 +801,14 @@ pub struct GpuCurve {
     pub att_q: f32,
     /// Attenuation floor `h_floor` of [`curve::attenuation_split`].
     pub att_floor: f32,
+    /// [`PreparedCurve::tail_radius`] (the nearest-point field's open end).
+    pub tail_radius: f32,
+    /// Padding to the struct's 16-byte alignment.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// The storage buffers of a frame's curved waves: one [`GpuCurve`] per curve, the piece-table
@@ -873,7 +883,14 @@ impl CurveBuffers {
             tolerance: settings.tolerance as f32,
             att_q: att_q as f32,
             att_floor: att_floor as f32,
+            tail_radius: prep.tail_radius() as f32,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         };
+        if wave.integrator == Integrator::Nearest {
+            g.integrator = INTEGRATOR_NEAREST;
+        }
         if let Integrator::Simpson { m, reduction } = wave.integrator {
             let m = m.clamp(2, curve::MAX_SIMPSON_M);
             let m = m + (m & 1);

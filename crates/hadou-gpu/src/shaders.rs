@@ -390,6 +390,10 @@ mod tests {
                 tolerance,
                 att_q,
                 att_floor,
+                tail_radius,
+                _pad0,
+                _pad1,
+                _pad2,
             ]
         );
     }
@@ -416,6 +420,7 @@ mod tests {
         assert_eq!(value("WAVE_CURVE"), WAVE_CURVE);
         assert_eq!(value("INTEGRATOR_DEFAULT"), INTEGRATOR_DEFAULT);
         assert_eq!(value("INTEGRATOR_SIMPSON"), INTEGRATOR_SIMPSON);
+        assert_eq!(value("INTEGRATOR_NEAREST"), INTEGRATOR_NEAREST);
         assert_eq!(value("SHAPE_HELIX"), SHAPE_HELIX);
         assert_eq!(value("SHAPE_TRIG"), SHAPE_TRIG);
         assert_eq!(value("SHAPE_BEZIER"), SHAPE_BEZIER);

@@ -12,7 +12,8 @@
 
 use hadou_math::curve::{
     curve_energy, prepare, CurveFrame, CurveShape, CurveWave, Integrator, PreparedCurve, Reduction,
-    MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS, MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
+    MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS, MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, MAX_ORDER, MAX_SIMPSON_M,
+    MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
 };
 use hadou_math::energy::{Falloff, FieldParams, Ray};
 use hadou_math::rng::Rng;
@@ -25,6 +26,9 @@ use std::time::Instant;
 /// 57 474 for a 512-point cubic zigzag B-spline, 17 095 for a helix at 128 turns, 4 212 for a
 /// Bézier curve (denser ray sets, 1 226 rays a corner, found up to 64 489 for the B-spline).
 const DEFAULT_BOUND: u32 = 100_000;
+/// Most evaluations (pieces visited plus exact points) a ray of the nearest-point field takes on
+/// the costliest corners.
+const NEAREST_BOUND: u32 = 1_000_000;
 
 /// Largest value of a scene number (docs/scene-format.md, Limits).
 const COORD_MAX: f32 = 1e6;
@@ -459,9 +463,33 @@ fn simpson_corners_bound_the_work_per_ray() {
             assert!(f64::from(m) * w.point_cost() <= f64::from(MAX_SIMPSON_M));
             (if reduction.is_some() { 3 } else { 1 }) * (m + 1) + DEFAULT_BOUND
         }
-        Integrator::Default => DEFAULT_BOUND,
+        Integrator::Default | Integrator::Nearest => DEFAULT_BOUND,
     });
     println!("simpson: worst {worst:?}");
+}
+
+/// The same four costliest corners as [`simpson_corners`] (128 helix turns, 64 terms at 128
+/// turns, 64 Bézier points, a 512-point B-spline of order 16) with the nearest-point field.
+fn nearest_corners() -> Vec<(String, CurveWave)> {
+    simpson_corners()
+        .into_iter()
+        .filter(|(n, _)| n.contains("n=None"))
+        .map(|(n, mut w)| {
+            w.integrator = Integrator::Nearest;
+            (n.replacen("simpson", "nearest", 1), w)
+        })
+        .collect()
+}
+
+/// The nearest-point field's work is bounded by construction (at most [`MAX_NEAREST_STEPS`]
+/// intervals of two queries, each at most [`MAX_NEAREST_VISITS`] pieces and 7 exact points, plus
+/// the first query and the tail); on the costliest corners it stays far below.
+#[test]
+fn nearest_corners_bound_the_work_per_ray() {
+    let construction = (2 * MAX_NEAREST_STEPS + 1) * (MAX_NEAREST_VISITS + 8) + 1;
+    let worst = check(nearest_corners(), 1, |_| NEAREST_BOUND);
+    println!("nearest: worst {worst:?} (bound by construction {construction})");
+    assert!(NEAREST_BOUND <= construction);
 }
 
 /// Prints evaluations per ray (largest, mean), time per ray (mean, largest) and the preparation

@@ -85,7 +85,12 @@ pub(crate) enum WaveKind {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum IntegratorDef {
     Default,
-    Simpson { m: u32, n: Option<u32> },
+    /// `field = "nearest"`.
+    Nearest,
+    Simpson {
+        m: u32,
+        n: Option<u32>,
+    },
 }
 
 /// A `[[wave]]`.
@@ -371,6 +376,7 @@ impl Scene {
         };
         let integrator = match w.integrator {
             IntegratorDef::Default => Integrator::Default,
+            IntegratorDef::Nearest => Integrator::Nearest,
             IntegratorDef::Simpson { m, n } => Integrator::Simpson {
                 m,
                 reduction: n.map(|n| Reduction { n, epsilon: p.f(vals, "epsilon") }),

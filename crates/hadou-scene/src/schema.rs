@@ -74,7 +74,7 @@ const ANALYTIC_COMMON: &[&str] = &["j"];
 /// Largest attenuation exponent `j` of an analytic wave (002 eq. 3.23, SPEC.md §1.4).
 pub(crate) const ATTENUATION_MAX: f32 = 64.0;
 const CURVE_COMMON: &[&str] =
-    &["O", "D", "up", "alpha", "gamma", "k", "j", "integrator", "m", "n", "epsilon"];
+    &["O", "D", "up", "alpha", "gamma", "k", "j", "field", "integrator", "m", "n", "epsilon"];
 
 /// Default base colour of a wave: the yellow of 002 Fig. 4.1.
 pub(crate) const DEFAULT_RGBA: [f32; 4] = [0.8, 0.8, 0.2, 1.0];
@@ -771,7 +771,17 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
             }
         }
     }
-    // Integrator.
+    // Distance field and integrator.
+    let nearest = t.choice("field", &["section", "nearest"], Some("section"))? == "nearest";
+    if nearest && t.get("integrator").is_some() {
+        return Err(t.src.value_err(
+            &t.key_span("integrator"),
+            format!(
+                "`integrator` in {} applies only with field = \"section\" (the nearest field has its own)",
+                t.what
+            ),
+        ));
+    }
     let simpson = t.choice("integrator", &["default", "simpson"], Some("default"))? == "simpson";
     let m = t.opt_int("m", 2, 100_000)?;
     let n = t.opt_int("n", 1, 100_000)?;
@@ -801,6 +811,8 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
     if simpson {
         def.integrator =
             IntegratorDef::Simpson { m: m.map_or(100, |v| v.0 as u32), n: n.map(|v| v.0 as u32) };
+    } else if nearest {
+        def.integrator = IntegratorDef::Nearest;
     }
     if let Err((key, msg)) = check_curve(def, p, rd.values) {
         return Err(t.src.value_err(&t.key_span(key), format!("{msg} in {}", t.what)));

@@ -156,6 +156,15 @@ fn capsule_forms_are_exclusive_and_curve_rules_hold() {
     let e = err(&format!("{curve}integrator = \"simpson\"\nm = 7\n"));
     assert_eq!(at(&e), (11, 5));
     assert!(e.to_string().contains("must be even"), "{e}");
+    let e = err(&format!("{curve}field = \"exact\"\n"));
+    assert_eq!(at(&e), (10, 9));
+    assert!(e.to_string().contains("`field`"), "{e}");
+    assert!(e.to_string().contains("valid values: `section`, `nearest`"), "{e}");
+    let e = err(&format!("{curve}field = \"nearest\"\nintegrator = \"simpson\"\n"));
+    assert_eq!(at(&e), (11, 1));
+    assert!(e.to_string().contains("only with field = \"section\""), "{e}");
+    let e = err(&format!("{curve}field = \"nearest\"\nm = 8\n"));
+    assert!(e.to_string().contains("only with integrator = \"simpson\""), "{e}");
     let e = err(&format!("{curve}m = 8\n"));
     assert!(e.to_string().contains("only with integrator = \"simpson\""), "{e}");
     let e = err(&format!("{curve}up = [2, 0, 0]\n"));

@@ -77,7 +77,7 @@ pub(crate) struct WaveVariant(u32);
 
 impl WaveVariant {
     /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
-    pub(crate) const NAMES: [&'static str; 26] = [
+    pub(crate) const NAMES: [&'static str; 27] = [
         // wave.wgsl
         "USE_SPHERE",
         "USE_CYLINDER",
@@ -94,6 +94,7 @@ impl WaveVariant {
         // curve.wgsl
         "USE_CHORD",
         "USE_SIMPSON",
+        "USE_NEAREST",
         "USE_HELIX",
         "USE_TRIG",
         "USE_BEZIER",
@@ -160,7 +161,11 @@ impl WaveVariant {
             });
         }
         for c in curves {
-            on.push(if c.integrator == layout::INTEGRATOR_SIMPSON { "USE_SIMPSON" } else { "USE_CHORD" });
+            on.push(match c.integrator {
+                layout::INTEGRATOR_SIMPSON => "USE_SIMPSON",
+                layout::INTEGRATOR_NEAREST => "USE_NEAREST",
+                _ => "USE_CHORD",
+            });
             on.push(match c.shape {
                 layout::SHAPE_HELIX => "USE_HELIX",
                 layout::SHAPE_TRIG => "USE_TRIG",

@@ -52,7 +52,7 @@ pub(crate) fn source(multisampled: bool) -> String {
 
 /// The overrides of the wave overlay module: the wave variant's wave kinds, falloffs and curve
 /// parts (the rest of [`WaveVariant::NAMES`] belongs to the wave pass's surfaces).
-pub(crate) const OVERRIDES: [&str; 13] = [
+pub(crate) const OVERRIDES: [&str; 14] = [
     "USE_SPHERE",
     "USE_CYLINDER",
     "USE_CAPSULE",
@@ -62,6 +62,7 @@ pub(crate) const OVERRIDES: [&str; 13] = [
     "USE_INVERSE_SQUARE",
     "USE_CHORD",
     "USE_SIMPSON",
+    "USE_NEAREST",
     "USE_HELIX",
     "USE_TRIG",
     "USE_BEZIER",

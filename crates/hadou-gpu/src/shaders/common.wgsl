@@ -180,6 +180,10 @@ struct GpuCurve {
     tolerance: f32,
     att_q: f32,
     att_floor: f32,
+    tail_radius: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One shadow cast (hadou_scene::ShadowCast): a plane projection or a shadow map. Keep in sync with
@@ -210,6 +214,7 @@ const WAVE_BEAM: u32 = 3u;
 const WAVE_CURVE: u32 = 4u;
 const INTEGRATOR_DEFAULT: u32 = 0u;
 const INTEGRATOR_SIMPSON: u32 = 1u;
+const INTEGRATOR_NEAREST: u32 = 2u;
 const SHAPE_HELIX: u32 = 0u;
 const SHAPE_TRIG: u32 = 1u;
 const SHAPE_BEZIER: u32 = 2u;

@@ -1,6 +1,7 @@
 // WGSL twins of hadou_math::curve (002 §3.4, SPEC.md §1.4): shape evaluation (shape.rs), the
 // closed-form pieces (closed.rs), the default integrator's chord walk over the PieceTable
-// (integrate.rs) and the faithful Simpson integrator (simpson.rs). Prepended by common.wgsl and
+// (integrate.rs), the faithful Simpson integrator (simpson.rs) and the nearest-point field
+// (nearest.rs). Prepended by common.wgsl and
 // energy.wgsl. The data layout (GpuCurve, curve_vec4, curve_f32) is built by
 // hadou_gpu::layout::CurveBuffers; keep in sync with layout.rs.
 
@@ -17,6 +18,7 @@
 // wave.wgsl): the others are compiled out of curve_energy and curve_eval.
 override USE_CHORD: bool = true;
 override USE_SIMPSON: bool = true;
+override USE_NEAREST: bool = true;
 override USE_HELIX: bool = true;
 override USE_TRIG: bool = true;
 override USE_BEZIER: bool = true;
@@ -885,9 +887,237 @@ fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
     return e;
 }
 
+// ---- nearest.rs ----
+
+// Mirrors nearest.rs NEAREST_STEP, MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE,
+// TAIL_RADII; keep in sync.
+const NEAREST_STEP: f32 = 0.25;
+const MAX_NEAREST_STEPS: u32 = 512u;
+const MAX_NEAREST_VISITS: u32 = 2048u;
+const NEAREST_PRUNE: f32 = 1e-4;
+const TAIL_RADII: f32 = 64.0;
+const NEAREST_STACK: u32 = 32u;
+
+// Mirrors nearest.rs `segment`: (distance from p to the segment a..b, parameter of the nearest point).
+fn curve_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec2<f32> {
+    let d = b - a;
+    let dd = dot3(d, d);
+    var f = 0.0;
+    if (dd > 0.0) {
+        f = clamp(dot3(p - a, d) / dd, 0.0, 1.0);
+    }
+    let e = p - (a + d * f);
+    return vec2<f32>(sqrt(dot3(e, e)), f);
+}
+
+// |p − c(s)|² on the exact curve (the `g` closure of nearest.rs `nearest_point`).
+fn curve_nearest_g(c: GpuCurve, p: vec3<f32>, s: f32) -> f32 {
+    let cs = curve_eval(c, s);
+    let dx = c.gamma * s - p.x;
+    let dy = cs.x - p.y;
+    let dz = cs.y - p.z;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+// Mirrors nearest.rs `nearest_point`: branch and bound over the piece table, the winning leaf
+// refined by two parabolic steps on the exact curve. Returns (squared distance, parameter s).
+fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint_in: f32) -> vec2<f32> {
+    let n = c.node_count - 1u;
+    let hint = clamp(hint_in, 0.0, c.s_head);
+    var out_d2 = curve_nearest_g(c, p, hint);
+    var out_s = hint;
+    var best = sqrt(out_d2);
+    let keep = 1.0 - NEAREST_PRUNE;
+    var found = false;
+    var leaf = 0u;
+    var leaf_f = 0.0;
+    // Entries: level << 24 | piece index.
+    var stack: array<u32, NEAREST_STACK>;
+    stack[0] = (c.levels - 1u) << 24u;
+    var top = 1u;
+    var visits = 0u;
+    while (top > 0u && visits < MAX_NEAREST_VISITS) {
+        top -= 1u;
+        let l = stack[top] >> 24u;
+        let j = stack[top] & 0xffffffu;
+        visits += 1u;
+        let a = j << l;
+        let b = min((j + 1u) << l, n);
+        let na = curve_node(c, a);
+        let nb = curve_node(c, b);
+        if (l == 0u) {
+            let sd = curve_segment(p, na, nb);
+            if (sd.x < best) {
+                best = sd.x;
+                found = true;
+                leaf = a;
+                leaf_f = sd.y;
+            }
+            continue;
+        }
+        let k = curve_level_offset(c, l) + j;
+        let ln = curve_vec4[c.lines + k];
+        let delta = curve_f32[c.errors + k];
+        let xm = 0.5 * (na.x + nb.x);
+        let ea = vec3<f32>(na.x, ln.x + (na.x - xm) * ln.z, ln.y + (na.x - xm) * ln.w);
+        let eb = vec3<f32>(nb.x, ln.x + (nb.x - xm) * ln.z, ln.y + (nb.x - xm) * ln.w);
+        let sd = curve_segment(p, ea, eb);
+        if (!(sd.x - delta < best * keep)) {
+            continue;
+        }
+        let left = ((l - 1u) << 24u) | (2u * j);
+        let right_start = (2u * j + 1u) << (l - 1u);
+        if (right_start >= n) {
+            stack[top] = left;
+            top += 1u;
+            continue;
+        }
+        let right = left + 1u;
+        var first = right;
+        var second = left;
+        if (p.x < curve_node(c, right_start).x) {
+            first = left;
+            second = right;
+        }
+        if (top + 2u <= NEAREST_STACK) {
+            stack[top] = second;
+            stack[top + 1u] = first;
+            top += 2u;
+        }
+    }
+    if (found) {
+        let sa = curve_vec4[c.nodes + leaf].w;
+        let sb = curve_vec4[c.nodes + leaf + 1u].w;
+        let w = sb - sa;
+        let lo = max(sa - w * 0.5, 0.0);
+        let hi = min(sb + w * 0.5, c.s_head);
+        var s0 = sa + w * leaf_f;
+        var h = w * 0.25;
+        for (var it = 0u; it < 2u; it++) {
+            let x1 = max(s0 - h, lo);
+            let x3 = min(s0 + h, hi);
+            let g1 = curve_nearest_g(c, p, x1);
+            let g2 = curve_nearest_g(c, p, s0);
+            let g3 = curve_nearest_g(c, p, x3);
+            if (g1 < out_d2) {
+                out_d2 = g1;
+                out_s = x1;
+            }
+            if (g2 < out_d2) {
+                out_d2 = g2;
+                out_s = s0;
+            }
+            if (g3 < out_d2) {
+                out_d2 = g3;
+                out_s = x3;
+            }
+            if (!(x1 < s0 && s0 < x3)) {
+                break;
+            }
+            // Mirrors nearest.rs `parabola_vertex`.
+            let pa = s0 - x1;
+            let pb = s0 - x3;
+            let num = pa * pa * (g2 - g3) - pb * pb * (g2 - g1);
+            let den = pa * (g2 - g3) - pb * (g2 - g1);
+            let chord = g1 + (g3 - g1) * (s0 - x1) / (x3 - x1);
+            if (!(den < 0.0) && !(den > 0.0)) {
+                break;
+            }
+            let v = s0 - 0.5 * num / den;
+            if (!(curve_finite(v) && g2 <= chord)) {
+                break;
+            }
+            let vc = clamp(v, lo, hi);
+            h = min(max(abs(vc - s0) * 2.0, w * (1.0 / 64.0)), h);
+            s0 = vc;
+        }
+        let gv = curve_nearest_g(c, p, s0);
+        if (gv < out_d2) {
+            out_d2 = gv;
+            out_s = s0;
+        }
+    }
+    return vec2<f32>(out_d2, out_s);
+}
+
+// Mirrors nearest.rs `weight`: w(D) without the attenuation.
+fn curve_nearest_weight(falloff: u32, d2: f32, rc2: f32) -> f32 {
+    let q = d2 + rc2;
+    if (falloff == FALLOFF_FAITHFUL) {
+        return 1.0 / sqrt(q);
+    }
+    return 1.0 / q;
+}
+
+// Mirrors dispatch.rs with Integrator::Nearest: `LocalRay::new`, then nearest.rs
+// `nearest_generic` (the walk whose steps follow the distance, Simpson on each interval, the
+// closed tail of an open span).
+fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
+    var ok = false;
+    let r = curve_local_ray(c, falloff, core_radius, ray, t0, t1, t_far, &ok);
+    if (!ok) {
+        return 0.0;
+    }
+    let qn = sqrt(dot3(r.q, r.q));
+    if (!(qn > 0.0) || !curve_finite(qn)) {
+        return 0.0;
+    }
+    var end = r.t1;
+    let open = !(r.t1 < T_OPEN);
+    if (open) {
+        let centre = vec3<f32>(0.5 * r.x_head, 0.0, 0.0);
+        let rb = c.tail_radius;
+        let big = TAIL_RADII * rb;
+        let tc = dot3(centre - r.o, r.q) / (qn * qn);
+        let e = r.o + r.q * tc - centre;
+        let reach = sqrt(max(big * big - dot3(e, e), 0.0)) / qn;
+        end = max(r.t0, tc + reach);
+    }
+    var a = r.t0;
+    var na = curve_nearest_point(c, r.o + r.q * a, 0.0);
+    var fa = curve_nearest_weight(r.falloff, na.x, r.rc2) * curve_attenuation(r, a);
+    var sum = 0.0;
+    let floor = 1e-3 * r.t_far;
+    var steps = 0u;
+    while (a < end) {
+        steps += 1u;
+        let d = sqrt(na.x + r.rc2);
+        var h = NEAREST_STEP * d / qn;
+        if (r.j > 0.0) {
+            h = min(h, max(NEAREST_STEP * (r.t_far - a), floor));
+        }
+        var b = a + h;
+        if (steps >= MAX_NEAREST_STEPS || !(a + h < end)) {
+            b = end;
+        }
+        let m = 0.5 * (a + b);
+        let nm = curve_nearest_point(c, r.o + r.q * m, na.y);
+        let nb = curve_nearest_point(c, r.o + r.q * b, nm.y);
+        let fm = curve_nearest_weight(r.falloff, nm.x, r.rc2) * curve_attenuation(r, m);
+        let fb = curve_nearest_weight(r.falloff, nb.x, r.rc2) * curve_attenuation(r, b);
+        sum += (b - a) / 6.0 * (fa + 4.0 * fm + fb);
+        a = b;
+        na = nb;
+        fa = fb;
+    }
+    if (open) {
+        let cs = curve_eval(c, na.y);
+        let point = vec3<f32>(c.gamma * na.y, cs.x, cs.y);
+        let quad = quad_new(r.o + r.q * end - point, r.q, r.rc2);
+        sum += segment_new(r.falloff, quad, T_OPEN, r.rc2).value;
+    }
+    return energy_scaled(sum, r.alpha);
+}
+
 // Mirrors hadou_math::curve::curve_energy: dispatch on the wave's integrator.
 fn curve_energy(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
     // Each integrator is compiled in only when the frame's curves use it.
+    if (c.integrator == INTEGRATOR_NEAREST) {
+        if (USE_NEAREST) {
+            return curve_nearest(c, falloff, core_radius, ray, t0, t1, t_far);
+        }
+        return 0.0;
+    }
     if (c.integrator == INTEGRATOR_SIMPSON) {
         if (USE_SIMPSON) {
             return curve_simpson(c, falloff, core_radius, ray, t0, t1, t_far);

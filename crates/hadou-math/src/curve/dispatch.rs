@@ -5,6 +5,7 @@
 
 use super::integrate::{default_generic, CurveSample, DEFAULT_SETTINGS};
 use super::local_ray::{CurveReal, LocalRay};
+use super::nearest::nearest_generic;
 use super::prepare::PreparedCurve;
 use super::simpson::simpson_generic;
 use super::wave::Integrator;
@@ -73,5 +74,6 @@ fn curve_energy_generic<R: CurveReal>(
             (e, n)
         }
         Integrator::Default => default_generic(c, &r, &DEFAULT_SETTINGS),
+        Integrator::Nearest => nearest_generic(c, &r),
     }
 }

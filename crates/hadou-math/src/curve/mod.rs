@@ -23,7 +23,12 @@
 //!   reduction ([`simpson`]); reproduces its banding.
 //! - [`Integrator::Default`]: exact integrals over straight pieces chosen adaptively per ray from
 //!   a precomputed tree of polylines ([`integrate`], [`PieceTable`]).
-//! - [`curve_energy_reference`]: converged `f64` adaptive Gauss–Kronrod on the exact field.
+//! - [`Integrator::Nearest`]: the nearest-point field — the density taken at the ray point's
+//!   true nearest curve point rather than its cross-section partner — by a walk over the ray whose
+//!   steps follow the distance, each distance found by branch and bound over the piece table and
+//!   refined on the exact curve ([`nearest`]).
+//! - [`curve_energy_reference`]: converged `f64` adaptive Gauss–Kronrod on the exact field;
+//!   [`nearest_energy_reference`] the same for the nearest-point field, by dense minimisation.
 //!
 //! # Work per ray
 //! The parameters that multiply a ray's work — turns, terms, control points, steepness and
@@ -50,6 +55,7 @@ mod cost;
 mod dispatch;
 pub mod integrate;
 mod local_ray;
+mod nearest;
 mod prepare;
 mod reference;
 mod shape;
@@ -61,11 +67,12 @@ pub use dispatch::{curve_energy, curve_energy_f64};
 pub use integrate::{
     attenuation_split, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
 };
+pub use nearest::{MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_STEP, TAIL_RADII};
 pub use prepare::{
     prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS,
     MAX_PIECES, MIN_CORE,
 };
-pub use reference::curve_energy_reference;
+pub use reference::{curve_energy_reference, nearest_energy_reference};
 pub use shape::clamped_uniform_knots;
 pub use validate::CurveError;
 pub use wave::{

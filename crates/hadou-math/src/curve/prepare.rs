@@ -145,6 +145,13 @@ impl PreparedCurve {
     pub fn frame_axes(&self) -> (Vec3<f32>, [Vec3<f32>; 3]) {
         (self.origin.as_f32(), [self.axes[0].as_f32(), self.axes[1].as_f32(), self.axes[2].as_f32()])
     }
+    /// Radius of a sphere about the axis's midpoint `(X/2)·D` that holds the whole curve,
+    /// `max(X/2, R, size)` (`R` the bounding-cylinder radius, `size` as in [`LEAF_TOLERANCE`]): an
+    /// inverse-square ray of the nearest-point field closes its open end in one exact piece from
+    /// [`TAIL_RADII`](super::TAIL_RADII) of these radii on (`nearest.rs`).
+    pub fn tail_radius(&self) -> f64 {
+        (0.5 * self.x_head).max(self.bound).max(self.size)
+    }
     /// The polyline tree the default integrator walks (and the GPU uploads).
     pub fn table(&self) -> &PieceTable {
         &self.table

@@ -115,7 +115,9 @@ pub struct Reduction {
     pub epsilon: f32,
 }
 
-/// How a curve's ray integral is computed.
+/// How a curve's ray integral is computed, and by which distance field: the cross-section
+/// pairing (002 §3.4.2; [`Simpson`](Integrator::Simpson), [`Default`](Integrator::Default)) or
+/// the true nearest point ([`Nearest`](Integrator::Nearest)).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum Integrator {
     /// The thesis (002 §3.4.4): composite Simpson over `u ∈ [0, 1]` with `m` (even) subintervals,
@@ -129,6 +131,10 @@ pub enum Integrator {
     /// hadou's default integrator.
     #[default]
     Default,
+    /// The nearest-point field: the density at a ray point is taken at its true nearest point on
+    /// the curve instead of the point its cross-section pairs it with (SPEC.md §1.4), integrated
+    /// by a walk whose steps follow the distance (`nearest.rs`); scene key `field = "nearest"`.
+    Nearest,
 }
 
 /// A curved wave: everything needed to integrate its energy along a ray.

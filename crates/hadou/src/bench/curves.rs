@@ -18,7 +18,8 @@ pub const CURVE_SCENES: [(&str, &str); 4] = [
 ];
 
 /// The integrators of the curve table: the thesis's Simpson at m = 100, 300, 500 without
-/// reduction and with reduction n = 2, 4 (ε = 0.25), then hadou's default.
+/// reduction and with reduction n = 2, 4 (ε = 0.25), then hadou's default, then the nearest-point
+/// field (`field = "nearest"`, whose error is against its own reference).
 pub fn curve_integrators() -> Vec<(String, Integrator)> {
     let mut v = Vec::new();
     for m in [100, 300, 500] {
@@ -29,6 +30,7 @@ pub fn curve_integrators() -> Vec<(String, Integrator)> {
         }
     }
     v.push(("default".into(), Integrator::Default));
+    v.push(("nearest field".into(), Integrator::Nearest));
     v
 }
 
@@ -54,7 +56,14 @@ pub fn curve_table(
         for (label, integrator) in curve_integrators() {
             progress(&format!("{shape}: {label}"));
             let frame = with_integrator(&base, integrator);
-            let (evals_per_pixel, p99_error) = curve_accuracy(&frame, &reference, ACCURACY_GRID);
+            let nearest_reference;
+            let reference = if integrator == Integrator::Nearest {
+                nearest_reference = curve_reference(&frame, ACCURACY_GRID);
+                &nearest_reference
+            } else {
+                &reference
+            };
+            let (evals_per_pixel, p99_error) = curve_accuracy(&frame, reference, ACCURACY_GRID);
             let mut ms = Vec::new();
             for &size in sizes {
                 let mut f = frame.clone();
