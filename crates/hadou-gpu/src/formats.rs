@@ -28,7 +28,9 @@ pub(crate) const SPOT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint
 pub const PRESENT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
 /// The usages of that texture: sampled by the window's renderer, drawn by the present pass,
-/// copied from (screenshots, tests).
+/// copied from (screenshots, tests), written by the queue (a frame with a `[bloom]`, whose glare
+/// is drawn over the whole image before it is uploaded).
 pub const PRESENT_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::TEXTURE_BINDING
     .union(wgpu::TextureUsages::RENDER_ATTACHMENT)
-    .union(wgpu::TextureUsages::COPY_SRC);
+    .union(wgpu::TextureUsages::COPY_SRC)
+    .union(wgpu::TextureUsages::COPY_DST);

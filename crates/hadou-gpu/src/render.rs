@@ -732,8 +732,7 @@ impl Renderer {
         params: &BloomParams,
         rows: std::ops::Range<u32>,
     ) -> Result<Image, RenderError> {
-        let limit =
-            u64::from(self.ctx.limits.max_storage_buffer_binding_size).min(self.ctx.limits.max_buffer_size);
+        let limit = self.ctx.limits.max_storage_buffer_binding_size.min(self.ctx.limits.max_buffer_size);
         let mut image = alloc_image(frame.width, rows.len() as u32)?;
         let mut y = rows.start as usize;
         while y < rows.end as usize {

@@ -3,7 +3,9 @@
 //! (`passes/present.rs`) copies each tile's colour into one full-frame texture. Nothing here waits
 //! for the GPU: the tiles are submitted and the texture's view returned; a window drawing the
 //! texture on the same queue sees the finished frame, as queue order guarantees. With timestamp
-//! queries each such frame's passes are timed without waiting (`timing::PresentTimer`).
+//! queries each such frame's passes are timed without waiting (`timing::PresentTimer`). A frame
+//! with a `[bloom]` is the exception: its glare needs the whole image, so it is rendered as for a
+//! read-back and uploaded (waiting for the GPU; not on wasm32, where it is drawn without glare).
 
 use crate::passes::present::{PresentedFrame, Presenter};
 use crate::render::Renderer;
@@ -28,6 +30,10 @@ impl Renderer {
         }
         if self.present.is_none() {
             self.present = Some(Presenter::new(&self.ctx)?);
+        }
+        #[cfg(not(target_arch = "wasm32"))]
+        if frame.bloom.is_some() {
+            return self.render_glare_to_texture(frame);
         }
         let timed = self.present.as_ref().is_some_and(|p| p.timer.is_some()) && frame.area_light.is_none();
         // When timed, the shadow maps are submitted below, with their timestamps.
@@ -74,6 +80,43 @@ impl Renderer {
             }
         }
         let target = self.present.as_ref().and_then(|p| p.target.as_ref()).expect("made above");
+        Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated, serial })
+    }
+
+    /// [`Renderer::render_to_texture`] of a frame with a `[bloom]`: the glare spreads light across
+    /// tiles, so the tiles' present pass cannot draw it; the frame is rendered as for a read-back
+    /// (the tiles, the glare chain and the colour mapping: `render_rows`) and its colour uploaded
+    /// into the texture in the present pass's encoding (sRGB codes of the colour,
+    /// `hadou_math::shade::linear_to_srgb8`; alpha as unorm). Such frames wait for the GPU and are
+    /// not timed.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn render_glare_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
+        let image = self.render_rows(frame, 0..frame.height)?;
+        let size = [frame.width, frame.height];
+        let mut bytes = vec![0u8; 4 * image.color.len()];
+        hadou_math::shade::rgba_to_srgba8(&image.color, &mut bytes);
+        for (o, c) in bytes.chunks_exact_mut(4).zip(&image.color) {
+            o[3] = (c[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+        }
+        let present = self.present.as_mut().expect("made by the caller");
+        present.serial += 1;
+        let serial = present.serial;
+        let recreated = self
+            .ctx
+            .scoped("creating the window texture", || present.ensure_target(&self.ctx.device, size))?;
+        let target = present.target.as_ref().expect("made above");
+        self.ctx.scoped("uploading the glare frame into the window texture", || {
+            self.ctx.queue.write_texture(
+                target.texture.as_image_copy(),
+                &bytes,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * size[0]),
+                    rows_per_image: Some(size[1]),
+                },
+                wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+            )
+        })?;
         Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated, serial })
     }
 

@@ -184,7 +184,8 @@ fn check(gpu: &mut Gpu, label: &str, frame: &Frame) -> bool {
 #[test]
 fn texture_holds_the_rendered_image_in_srgb() {
     let Some(mut gpu) = gpu_or_skip("present: texture = sRGB of render") else { return };
-    for file in ["kamehameha.toml", "shadow-wave-top.toml", "soft-gradient.toml"] {
+    // The glare scene's texture is the read-back image (with its [bloom]) uploaded.
+    for file in ["kamehameha.toml", "shadow-wave-top.toml", "soft-gradient.toml", "glare-kamehameha.toml"] {
         check(&mut gpu, file, &scene_frame(file, 0.5, 128, 96));
     }
     // The comparison can fail: another frame's texture against this frame's image.
