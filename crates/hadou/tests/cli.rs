@@ -465,16 +465,6 @@ fn probe_names_the_shadow_a_pixel_takes() {
     assert_eq!((lit["object"].as_str(), lit.get("shadow")), (Some("ground"), None));
 }
 
-/// Decodes an 8-bit RGB PNG into its pixel bytes.
-fn decode_png(path: &Path) -> (u32, u32, Vec<u8>) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    buf.truncate(info.buffer_size());
-    (info.width, info.height, buf)
-}
-
 #[test]
 fn a_png_rendered_in_bands_equals_the_whole_frame() {
     use hadou::Backend;
@@ -502,7 +492,7 @@ fn a_png_rendered_in_bands_equals_the_whole_frame() {
     frame.width = w;
     frame.height = h;
     let whole = hadou::CpuBackend::new().render(&frame).unwrap();
-    let (pw, ph, pixels) = decode_png(&out);
+    let (pw, ph, pixels) = common::decode_png(&out);
     assert_eq!((pw, ph), (w, h));
     assert!(pixels == hadou::output::srgb8(&whole), "banded PNG differs from the whole-frame render");
 }

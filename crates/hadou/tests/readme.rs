@@ -22,16 +22,6 @@ fn first_picture(readme: &str) -> String {
     rest[open..open + rest[open..].find(')').unwrap()].to_string()
 }
 
-fn decode_png(path: &Path) -> (u32, u32, Vec<u8>) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    buf.truncate(info.buffer_size());
-    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
-    (info.width, info.height, buf)
-}
-
 #[test]
 fn the_readmes_first_command_renders_its_first_picture() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -53,8 +43,8 @@ fn the_readmes_first_command_renders_its_first_picture() {
         .output()
         .expect("binary runs");
     assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
-    let (w, h, ours) = decode_png(&dir.join(&name));
-    let (pw, ph, theirs) = decode_png(&picture);
+    let (w, h, ours) = common::decode_png(&dir.join(&name));
+    let (pw, ph, theirs) = common::decode_png(&picture);
     assert_eq!((w, h), (pw, ph), "{} has the command's size", picture.display());
     let diff: u64 = ours.iter().zip(&theirs).map(|(a, b)| u64::from(a.abs_diff(*b))).sum();
     let mean = diff as f64 / ours.len() as f64;

@@ -4,6 +4,16 @@
 
 use std::path::{Path, PathBuf};
 
+/// Decodes an 8-bit PNG into its size and pixel bytes (RGB or RGBA, as the file holds them).
+pub fn decode_png(path: &Path) -> (u32, u32, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
+}
+
 /// A fresh empty directory for one test, removed when the test ends — unless it failed, so what
 /// it wrote can be looked at. Some tests write files of a gigabyte and more (an 8192² EXR), which
 /// would otherwise pile up in the temporary directory run after run.
