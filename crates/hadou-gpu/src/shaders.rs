@@ -170,7 +170,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 8);
+        assert_eq!(modules.len(), 9);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
