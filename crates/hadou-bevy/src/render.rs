@@ -79,6 +79,7 @@ pub(crate) fn view_frame(
         shadows: Vec::new(),
         area_light: None,
         bloom: None,
+        samples: 1,
     }
 }
 

@@ -1,11 +1,11 @@
 //! Times the CPU backend's passes on one scene: `cargo run --release -p hadou-cpu --example parts
-//! -- SCENE [SIZE] [TIME]` prints the median whole render and its opaque, wave and colour parts
+//! -- SCENE [SIZE] [TIME] [SAMPLES]` prints the median whole render and its opaque, wave and colour parts
 //! (`CpuBackend::render_into`, reusing its buffers) over nine runs.
 use hadou_scene::Scene;
 
 /// Prints `msg` and exits with status 2 (bad arguments).
 fn usage(msg: &str) -> ! {
-    eprintln!("parts: {msg}\nusage: parts SCENE [SIZE in 1..=16384] [TIME ≥ 0]");
+    eprintln!("parts: {msg}\nusage: parts SCENE [SIZE in 1..=16384] [TIME ≥ 0] [SAMPLES: 1, 4, 9 or 16]");
     std::process::exit(2);
 }
 
@@ -32,6 +32,12 @@ fn main() {
     };
     let mut frame = scene.at(t);
     (frame.width, frame.height) = (size, size);
+    if let Some(a) = args.next() {
+        match a.parse::<u32>() {
+            Ok(s) if hadou_scene::check_samples(s).is_ok() => frame.samples = s,
+            _ => usage(&format!("SAMPLES {a}: expected 1, 4, 9 or 16")),
+        }
+    }
     let mut cpu = hadou_cpu::CpuBackend::new();
     let mut image = hadou_scene::Image::new(0, 0);
     cpu.render_into(&frame, &mut image);
@@ -46,7 +52,7 @@ fn main() {
     let (ms, p) = runs[runs.len() / 2];
     let mpx = (size as f64).powi(2) / (ms * 1e3);
     println!(
-        "{path} {size}²: {ms:.2} ms ({mpx:.1} Mpx/s) = opaque {:.2} + wave {:.2} + colour {:.2}",
-        p.opaque_ms, p.wave_ms, p.color_ms
+        "{path} {size}² × {} samples: {ms:.2} ms ({mpx:.1} Mpx/s) = opaque {:.2} + wave {:.2} + colour {:.2}",
+        frame.samples, p.opaque_ms, p.wave_ms, p.color_ms
     );
 }

@@ -106,42 +106,67 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     if edges.iter().all(|r| r.is_empty()) {
         return;
     }
-    // Each pixel's winning edge pixel, if any.
-    let wins: Vec<Option<usize>> = (0..h * w)
+    // Each pixel's winning edge pixel, if any: row by row, only the pixels within the search
+    // window of some edge pixel searched (a difference array over the window's rows marks them).
+    let (surface_ro, edge_ro, edges_ro) = (&*surface, &*edge, &edges);
+    let owner = &owner;
+    let wins: Vec<Option<usize>> = (0..h)
         .into_par_iter()
-        .map(|i| {
-            let b = owner(i)?;
-            let (x, r) = (i % w, i / w);
-            let y = first_row + r;
-            let p_dir = unit_dir(basis, frame, x, y);
-            let p_dist = surface[i].unwrap_or(0.0);
-            let p_normal = edge[i].normal;
-            let mut best: Option<(f32, usize)> = None;
+        .flat_map_iter(|r| {
+            let (surface, edge, edges) = (surface_ro, edge_ro, edges_ro);
             let lo = r.saturating_sub(reach);
-            for (rr, row) in edges.iter().enumerate().take((r + reach + 1).min(h)).skip(lo) {
-                let dy = rr as f32 - r as f32;
-                let start = row.partition_point(|e| (e.x as usize) + reach < x);
-                for e in &row[start..] {
-                    if e.x as usize > x + reach {
-                        break;
-                    }
-                    if e.object == b {
-                        continue;
-                    }
-                    let dx = e.x as f32 - x as f32;
-                    if dx * dx + dy * dy > e.reach2 {
-                        continue;
-                    }
-                    if best.is_some_and(|(d, _)| e.distance >= d) {
-                        continue;
-                    }
-                    let q_dir = unit_dir(basis, frame, e.x as usize, first_row + rr);
-                    if in_front(p_normal, p_dir, p_dist, q_dir, e.distance) {
-                        best = Some((e.distance, e.index));
-                    }
+            let hi = (r + reach + 1).min(h);
+            let mut near = vec![0i32; w + 1];
+            for row in &edges[lo..hi] {
+                for e in row {
+                    near[(e.x as usize).saturating_sub(reach)] += 1;
+                    near[(e.x as usize + reach + 1).min(w)] -= 1;
                 }
             }
-            best.map(|(_, q)| q)
+            let mut count = 0;
+            let near: Vec<bool> = near[..w]
+                .iter()
+                .map(|d| {
+                    count += d;
+                    count > 0
+                })
+                .collect();
+            (0..w).map(move |x| {
+                let i = r * w + x;
+                if !near[x] {
+                    return None;
+                }
+                let b = owner(i)?;
+                let y = first_row + r;
+                let p_dir = unit_dir(basis, frame, x, y);
+                let p_dist = surface[i].unwrap_or(0.0);
+                let p_normal = edge[i].normal;
+                let mut best: Option<(f32, usize)> = None;
+                for (rr, row) in edges.iter().enumerate().take(hi).skip(lo) {
+                    let dy = rr as f32 - r as f32;
+                    let start = row.partition_point(|e| (e.x as usize) + reach < x);
+                    for e in &row[start..] {
+                        if e.x as usize > x + reach {
+                            break;
+                        }
+                        if e.object == b {
+                            continue;
+                        }
+                        let dx = e.x as f32 - x as f32;
+                        if dx * dx + dy * dy > e.reach2 {
+                            continue;
+                        }
+                        if best.is_some_and(|(d, _)| e.distance >= d) {
+                            continue;
+                        }
+                        let q_dir = unit_dir(basis, frame, e.x as usize, first_row + rr);
+                        if in_front(p_normal, p_dir, p_dist, q_dir, e.distance) {
+                            best = Some((e.distance, e.index));
+                        }
+                    }
+                }
+                best.map(|(_, q)| q)
+            })
         })
         .collect();
     for (i, win) in wins.into_iter().enumerate() {
@@ -150,6 +175,11 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
         if let Some(ol) = frame.objects[o as usize].material(m).outline {
             color[i] = ol.color;
             shadow[i] = None;
+            // The pixel now shows that object's outline, as a hull pixel of it would (the GPU's
+            // edge pass writes its material word | HULL_BIT): what the probe names and what
+            // the anti-aliased resolve compares.
+            object[i] = Some(o);
+            edge[i] = EdgeTexel { material: m, hull: true, reach: 0, ..edge[i] };
         }
     }
 }

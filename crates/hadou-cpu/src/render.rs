@@ -8,7 +8,8 @@ use crate::edges;
 use crate::opaque::{draw_opaque_into, OpaqueBuffers};
 use crate::setup::FrameSetup;
 use crate::soft;
-use crate::waves::WavePass;
+use crate::waves::{BatchLight, WavePass};
+use hadou_math::energy::lanes::LANES;
 use hadou_scene::{Backend, Frame, Image, RenderError};
 use rayon::prelude::*;
 
@@ -89,7 +90,9 @@ pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTi
 }
 
 /// [`render_timed`] with the opaque pass's buffers from `scratch` and into `img`, both resized
-/// and their allocations reused.
+/// and their allocations reused. With more than one sample per pixel ([`Frame::grid`]) the opaque
+/// pass draws the sample frame ([`Frame::sample_frame`]) and each row is resolved by
+/// [`RowSource`].
 fn render_with(
     frame: &Frame,
     rows: std::ops::Range<u32>,
@@ -99,16 +102,30 @@ fn render_with(
     let start = std::time::Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
-    let setup = FrameSetup::new(frame);
+    let k = frame.grid() as usize;
+    let sampled;
+    let surfaces = if k > 1 {
+        sampled = frame.sample_frame();
+        &sampled
+    } else {
+        frame
+    };
+    let setup = FrameSetup::new(surfaces);
     let band = y0 as usize..y1 as usize;
     // With a bloom, the band's halo too (every row of it exactly as a whole-image render has it).
     let glare = frame.bloom.as_ref().filter(|_| y1 > y0);
     let src = glare.map_or(band.clone(), |b| bloom::source_rows(frame, b, band.clone()));
-    let oy0 = opaque_pass(frame, &setup, src.clone(), scratch);
-    let opaque = &*scratch;
+    let oy0 = opaque_pass(surfaces, &setup, k * src.start..k * src.end, scratch);
     let opaque_done = std::time::Instant::now();
+    let source = RowSource {
+        k,
+        opaque: scratch,
+        oy0,
+        pass: WavePass::new(frame, &setup.basis, &setup.curves),
+        samples: WavePass::new(surfaces, &setup.basis, &setup.curves),
+    };
     if let Some(params) = glare {
-        return glare_rows(frame, params, &setup, opaque, oy0, src, band, img, (start, opaque_done));
+        return glare_rows(frame, params, &source, src, band, img, (start, opaque_done));
     }
 
     let w = frame.width as usize;
@@ -118,10 +135,6 @@ fn render_with(
     img.color.resize(n, [0.0; 4]);
     img.energy.resize(n, 0.0);
     img.depth.resize(n, 0.0);
-    let pass = WavePass::new(frame, &setup.basis, &setup.curves);
-    let first = (y0 as usize - oy0) * w;
-    let surface = &opaque.surface[first..first + img.color.len()];
-    let scene = &opaque.color[first..first + img.color.len()];
     // Each row: the wave pass into a row buffer, then the colour mapping from it; the threads'
     // time in each, to split the wall time between them.
     let wave_ns = std::sync::atomic::AtomicU64::new(0);
@@ -130,13 +143,12 @@ fn render_with(
         .par_chunks_mut(w)
         .zip(img.energy.par_chunks_mut(w))
         .zip(img.depth.par_chunks_mut(w))
-        .zip(surface.par_chunks(w).zip(scene.par_chunks(w)))
         .enumerate()
-        .for_each_init(Vec::new, |buf, (r, (((col, en), dep), (surf, scene)))| {
+        .for_each_init(RowBuffers::default, |bufs, (r, ((col, en), dep))| {
             let t0 = std::time::Instant::now();
-            pass.row_light((y0 as usize + r) as f32, surf, buf);
+            let (light, scene) = source.light_row(y0 as usize + r, bufs);
             let t1 = std::time::Instant::now();
-            pass.row_color(buf, scene, col, en, dep);
+            source.pass.row_color(light, scene, col, en, dep);
             let t2 = std::time::Instant::now();
             let ns = |d: std::time::Duration| d.as_nanos() as u64;
             wave_ns.fetch_add(ns(t1 - t0), std::sync::atomic::Ordering::Relaxed);
@@ -154,16 +166,126 @@ fn render_with(
     }
 }
 
+/// A row's scratch buffers for [`RowSource::light_row`], reused from row to row by a thread.
+#[derive(Default)]
+struct RowBuffers {
+    light: Vec<BatchLight>,
+    scene: Vec<[f32; 3]>,
+    surface: Vec<Option<f32>>,
+    edges: Vec<usize>,
+}
+
+/// The opaque pass's buffers and the wave passes a frame's rows are lit from: with `k > 1` the
+/// buffers hold the sample frame's rows (`k` per image row, from sample row `oy0`), and each
+/// pixel is resolved from its `k × k` samples.
+struct RowSource<'a> {
+    k: usize,
+    opaque: &'a OpaqueBuffers,
+    oy0: usize,
+    /// The wave pass through the image's pixel centres.
+    pass: WavePass<'a>,
+    /// The wave pass through the sample frame's pixels (the samples).
+    samples: WavePass<'a>,
+}
+
+impl RowSource<'_> {
+    /// Image row `y`: its waves' light into `bufs.light` (batch by batch, as
+    /// [`WavePass::row_light`]) and its scene colour, both returned. With one sample per pixel, the
+    /// opaque pass's row. With `k × k` samples, each pixel's scene colour is the mean of its
+    /// samples' (the box filter); where all of its samples show the same surface (the same
+    /// object, material and outline state, or all nothing) within
+    /// [`hadou_scene::SAMPLE_DEPTH_SPREAD`] in eye distance, the waves are integrated once along
+    /// the ray through the pixel's centre, clipped at the samples' mean distance; elsewhere (a
+    /// silhouette, an outline's edge) sample by sample, clipped at each sample's surface, and
+    /// averaged. The depth is the centre ray's, or at such an edge the nearest sample's.
+    fn light_row<'b>(&'b self, y: usize, bufs: &'b mut RowBuffers) -> (&'b [BatchLight], &'b [[f32; 3]]) {
+        let o = self.opaque;
+        let k = self.k;
+        if k == 1 {
+            let w = self.pass_width();
+            let first = (y - self.oy0) * w;
+            self.pass.row_light(y as f32, &o.surface[first..first + w], &mut bufs.light);
+            return (&bufs.light, &o.color[first..first + w]);
+        }
+        let w = self.pass_width();
+        let sw = w * k;
+        let RowBuffers { light, scene, surface, edges } = bufs;
+        scene.clear();
+        surface.clear();
+        edges.clear();
+        let inv = 1.0 / (k * k) as f32;
+        for x in 0..w {
+            let mut c = [0.0f32; 3];
+            let (mut lo, mut hi, mut sum) = (f32::INFINITY, 0.0f32, 0.0f32);
+            let first = (k * y - self.oy0) * sw + k * x;
+            let key0 = sample_key(o, first);
+            let mut same = true;
+            for j in 0..k {
+                for i in 0..k {
+                    let idx = first + j * sw + i;
+                    for (ck, v) in c.iter_mut().zip(o.color[idx]) {
+                        *ck += v * inv;
+                    }
+                    same &= sample_key(o, idx) == key0;
+                    if let Some(d) = o.surface[idx] {
+                        (lo, hi, sum) = (lo.min(d), hi.max(d), sum + d);
+                    }
+                }
+            }
+            scene.push(c.map(hadou_math::energy::saturate));
+            let drawn = key0.is_some();
+            let agree = same && (!drawn || hi - lo <= hadou_scene::SAMPLE_DEPTH_SPREAD * lo);
+            surface.push(drawn.then_some(sum * inv));
+            if !agree {
+                edges.push(x);
+            }
+        }
+        self.pass.row_light(y as f32, surface, light);
+        for &x in edges.iter() {
+            let (mut l, mut total, mut depth) = ([0.0f32; 3], 0.0f32, f32::INFINITY);
+            for j in 0..k {
+                let sy = k * y + j;
+                let first = (sy - self.oy0) * sw + k * x;
+                let (lj, tj, dj) = self.samples.samples_light(
+                    k * x,
+                    sy as f32,
+                    &o.surface[first..first + k],
+                    1.0 / (k * k) as f32,
+                );
+                for (a, b) in l.iter_mut().zip(lj) {
+                    *a += b;
+                }
+                total = hadou_math::energy::saturate(total + tj);
+                depth = depth.min(dj);
+            }
+            light[x / LANES].set_lane(x % LANES, l, total, depth);
+        }
+        (light, scene)
+    }
+
+    /// The image's width in pixels.
+    fn pass_width(&self) -> usize {
+        self.pass.width()
+    }
+}
+
+/// What decides whether a pixel's samples show one surface: the visible object, its material
+/// slot and whether it is an outline (a hull, or a pixel the edge pass closed an outline over,
+/// which takes that object and slot); `None` where nothing is drawn. The GPU's wave pass compares
+/// the G-buffer's material word the same way.
+fn sample_key(o: &OpaqueBuffers, i: usize) -> Option<(u32, u32, bool)> {
+    o.surface[i]?;
+    let e = &o.edge[i];
+    Some((o.object[i]?, e.material, e.hull))
+}
+
 /// [`render_with`]'s stage after the opaque pass with a `[bloom]`: the wave pass over the rows
 /// `src` (the band `band` and its halo) into the linear colour, then the glare and the colour
 /// mapping of the band. The wave pass's time is `wave_ms`, the glare's and mapping's `color_ms`.
-#[allow(clippy::too_many_arguments)]
 fn glare_rows(
     frame: &Frame,
     params: &hadou_math::bloom::BloomParams,
-    setup: &FrameSetup,
-    opaque: &OpaqueBuffers,
-    oy0: usize,
+    source: &RowSource<'_>,
     src: std::ops::Range<usize>,
     band: std::ops::Range<usize>,
     img: &mut Image,
@@ -175,11 +297,7 @@ fn glare_rows(
     img.color.resize(n, [0.0; 4]);
     img.energy.resize(n, 0.0);
     img.depth.resize(n, 0.0);
-    let pass = WavePass::new(frame, &setup.basis, &setup.curves);
-    let first = (src.start - oy0) * w;
     let m = src.len() * w;
-    let surface = &opaque.surface[first..first + m];
-    let scene = &opaque.color[first..first + m];
     let mut linear = hadou_math::bloom::Plane::new(w, frame.height as usize, src.clone());
     let (mut energy, mut depth) = (vec![0.0f32; m], vec![0.0f32; m]);
     linear
@@ -187,11 +305,10 @@ fn glare_rows(
         .par_chunks_mut(w)
         .zip(energy.par_chunks_mut(w))
         .zip(depth.par_chunks_mut(w))
-        .zip(surface.par_chunks(w).zip(scene.par_chunks(w)))
         .enumerate()
-        .for_each_init(Vec::new, |buf, (r, (((lin, en), dep), (surf, scene)))| {
-            pass.row_light((src.start + r) as f32, surf, buf);
-            pass.row_linear(buf, scene, lin, en, dep);
+        .for_each_init(RowBuffers::default, |bufs, (r, ((lin, en), dep))| {
+            let (light, scene) = source.light_row(src.start + r, bufs);
+            source.pass.row_linear(light, scene, lin, en, dep);
         });
     let own = (band.start - src.start) * w..(band.end - src.start) * w;
     img.energy.copy_from_slice(&energy[own.clone()]);

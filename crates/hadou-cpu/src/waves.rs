@@ -64,6 +64,23 @@ pub(crate) struct BatchLight {
     depth: Lanes,
 }
 
+impl BatchLight {
+    /// Replaces lane `i`'s light, total energy and depth (an anti-aliased pixel whose samples
+    /// see different surfaces, integrated sample by sample: [`WavePass::samples_light`]).
+    pub(crate) fn set_lane(&mut self, i: usize, light: [f32; 3], total: f32, depth: f32) {
+        let set = |l: &mut Lanes, v: f32| {
+            let mut a = l.to_array();
+            a[i] = v;
+            *l = Lanes::from(a);
+        };
+        for (l, v) in self.light.iter_mut().zip(light) {
+            set(l, v);
+        }
+        set(&mut self.total, total);
+        set(&mut self.depth, depth);
+    }
+}
+
 impl<'a> WavePass<'a> {
     pub(crate) fn new(frame: &'a Frame, basis: &'a CameraBasis, curves: &'a [Option<PreparedCurve>]) -> Self {
         let uses = |f: Falloff| frame.waves.iter().any(|w| w.falloff == f);
@@ -83,6 +100,11 @@ impl<'a> WavePass<'a> {
             inverse_square: uses(Falloff::InverseSquare),
             colors,
         }
+    }
+
+    /// The width in pixels of the frame this pass's rays go through.
+    pub(crate) fn width(&self) -> usize {
+        self.frame.width as usize
     }
 
     /// The rays of pixels `x0 .. x0 + LANES` of row `py`; `surface[i]` is pixel `x0 + i`'s
@@ -259,6 +281,37 @@ impl<'a> WavePass<'a> {
             });
             out.push(BatchLight { light, total, depth });
         }
+    }
+
+    /// The waves' light through `surface.len()` (≤ [`LANES`]) neighbouring pixels of row `py`
+    /// starting at `x0`, clipped at their surfaces, each pixel weighted by `weight`: the weighted
+    /// sums over those pixels of `Σ rgb·a·I` per channel and of the total energy (saturated), and
+    /// their least depth. The anti-aliased pass calls it on the sample frame's pixels (the samples
+    /// of one pixel, a row of them at a time, `weight = 1/samples`).
+    pub(crate) fn samples_light(
+        &self,
+        x0: usize,
+        py: f32,
+        surface: &[Option<f32>],
+        weight: f32,
+    ) -> ([f32; 3], f32, f32) {
+        let n = surface.len().min(LANES);
+        let s = Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| {
+            surface.get(i).filter(|_| i < n).copied().flatten().unwrap_or(f32::INFINITY)
+        }));
+        let mut light = [0.0f32; 3];
+        let mut total = 0.0f32;
+        let depth = self.energies(x0, py, s, n, |wi, e, _| {
+            let e = e.to_array();
+            let c = &self.colors[wi];
+            for (ch, l) in light.iter_mut().enumerate() {
+                let k = c[ch].to_array()[0] * weight;
+                *l += (0..n).map(|i| k * e[i]).sum::<f32>();
+            }
+            total = energy::saturate(total + (0..n).map(|i| weight * e[i]).sum::<f32>());
+        });
+        let depth = depth.to_array()[..n].iter().copied().fold(f32::INFINITY, f32::min);
+        (light, total, depth)
     }
 
     /// The linear colour `scene + exposure·light` of one row (before the colour mapping) into

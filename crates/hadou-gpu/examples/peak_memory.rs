@@ -73,6 +73,7 @@ fn main() {
         shadows: Vec::new(),
         area_light: None,
         bloom: None,
+        samples: 1,
     };
     let before = peak_rss_mib().unwrap_or(f64::NAN);
     let mut gpu = match GpuBackend::new() {

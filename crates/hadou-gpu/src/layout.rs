@@ -120,8 +120,9 @@ pub struct FrameUniforms {
     pub outline_reach: u32,
     /// The area light's colour times intensity.
     pub area_color: [f32; 3],
-    /// Padding.
-    pub _pad4: u32,
+    /// The edge of the sample grid (`Frame::grid`): 1, or with anti-aliasing these are the
+    /// sample frame's uniforms and the wave pass resolves `grid × grid` samples per pixel.
+    pub grid: u32,
 }
 
 /// How far the edge pass looks (pixels): the widest outline's hull width on screen, rounded up
@@ -178,7 +179,7 @@ impl FrameUniforms {
             area_position: frame.area_light.as_ref().map_or([0.0; 3], |a| a.position.to_array()),
             outline_reach: outline_reach(frame, basis),
             area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
-            _pad4: 0,
+            grid: 1,
         }
     }
 }

@@ -88,6 +88,11 @@ pub(crate) struct Prepared {
     /// Whether the wave pass writes the linear colour, unmapped, for the glare
     /// ([`Renderer::render_rows`] of a frame with a `[bloom]`).
     linear: bool,
+    /// The edge of the frame's sample grid (`Frame::grid`); with more than one sample per pixel
+    /// the tiles, the G-buffer, the shadows and the soft shadows are the sample frame's
+    /// (`sampled`), and the wave pass resolves each image pixel from its samples.
+    grid: u32,
+    sampled: Option<Frame>,
 }
 
 /// The bind groups every tile of a frame uses (the tile's uniforms are rewritten before each
@@ -103,6 +108,19 @@ struct TileBindGroups {
 }
 
 impl Prepared {
+    /// The frame whose pixels the tiles' surface passes draw: the sample frame with
+    /// anti-aliasing, else `frame` itself.
+    pub(crate) fn surfaces<'a>(&'a self, frame: &'a Frame) -> &'a Frame {
+        self.sampled.as_ref().unwrap_or(frame)
+    }
+
+    /// A tile of [`Prepared::tiles`] (in samples) in image pixels: what its wave pass writes and
+    /// what is read back.
+    pub(crate) fn output_tile(&self, (origin, size): ([u32; 2], [u32; 2])) -> ([u32; 2], [u32; 2]) {
+        let g = self.grid;
+        ([origin[0] / g, origin[1] / g], [size[0] / g, size[1] / g])
+    }
+
     /// The number of shadow-map passes (map casts) of the frame.
     pub(crate) fn map_pass_count(&self) -> u32 {
         self.map_passes.len() as u32
@@ -296,7 +314,15 @@ impl Renderer {
         debug_assert!(submit_maps || frame.area_light.is_none());
         self.ctx.check()?;
         prepare::validate_frame(frame)?;
-        let tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
+        let grid = frame.grid();
+        let sampled = (grid > 1).then(|| frame.sample_frame());
+        let frame = sampled.as_ref().unwrap_or(frame);
+        let rows = grid * rows.start..grid * rows.end;
+        let mut tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
+        // Whole pixels per tile: tile edges are multiples of the grid (as the frame's are).
+        for t in &mut tile {
+            *t = (*t / grid).max(1) * grid;
+        }
         let data = FrameData::new(&self.ctx.limits, frame)?;
         let (wave_pipeline, variant) = self.passes.wave.pipeline(&self.ctx, data.wave_variant(frame))?;
         let raster =
@@ -347,6 +373,8 @@ impl Renderer {
                 raster,
                 groups: None,
                 linear: false,
+                grid,
+                sampled: None,
             };
             if submit_maps || frame.area_light.is_some() {
                 self.submit_shadow_maps(frame, &prepared, None);
@@ -358,9 +386,10 @@ impl Renderer {
             let soft = if frame.area_light.is_some() { self.draw_soft(frame, &prepared) } else { Ok(()) };
             (prepared, soft)
         };
-        let (prepared, soft) = prepared;
+        let (mut prepared, soft) = prepared;
         self.ctx.close_scopes(scopes, "uploading the frame")?;
         soft?;
+        prepared.sampled = sampled;
         Ok(prepared)
     }
 
@@ -607,10 +636,12 @@ impl Renderer {
         if let Some(q) = timestamps.as_deref_mut() {
             q.next_group();
         }
+        let frame = prepared.surfaces(frame);
         let t = self.targets.as_ref().expect("targets are created in prepare");
         let basis = frame.camera.basis(frame.width, frame.height);
         let (origin, size) = tile;
         let mut uniforms = FrameUniforms::new(frame, &basis, origin, size);
+        uniforms.grid = prepared.grid;
         prepared.shadow_fields.apply(&mut uniforms);
         if prepared.linear {
             uniforms.tone_mode = TONE_LINEAR;
@@ -673,9 +704,10 @@ impl Renderer {
             passes.soft.encode_gather(&mut shading, bg, size, timestamps.as_deref_mut());
         }
         let wave_timestamps = timestamps.and_then(|q| q.compute("wave"));
-        passes.wave.encode(&mut shading, &prepared.wave_pipeline, &groups.wave, size, wave_timestamps);
+        let (_, pixels) = prepared.output_tile(tile);
+        passes.wave.encode(&mut shading, &prepared.wave_pipeline, &groups.wave, pixels, wave_timestamps);
         if readback {
-            let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
+            let bytes = pixels[0] as u64 * pixels[1] as u64 * FLOATS_PER_PIXEL * 4;
             shading.copy_buffer_to_buffer(&t.output, 0, &t.staging, 0, bytes);
         }
         TileEncoders { surfaces, shading }
@@ -707,7 +739,7 @@ impl Renderer {
                 let encoders = self.encode_tile(frame, &prepared, tile, true, None);
                 self.submit_tile(encoders)
             })??;
-            let (origin, size) = tile;
+            let (origin, size) = prepared.output_tile(tile);
             let origin = [origin[0], origin[1] - rows.start];
             let n = size[0] as usize * size[1] as usize;
             let bytes = n as u64 * FLOATS_PER_PIXEL * 4;
@@ -780,7 +812,7 @@ impl Renderer {
             mapped_at_creation: false,
         });
         for &tile in &prepared.tiles {
-            let (origin, size) = tile;
+            let (origin, size) = prepared.output_tile(tile);
             let submission = self.ctx.scoped("rendering a tile", || {
                 let mut encoders = self.encode_tile(frame, &prepared, tile, true, None);
                 // The tile's colour rows into the band's linear colour.
@@ -1060,6 +1092,7 @@ mod tests {
             shadows: Vec::new(),
             area_light: None,
             bloom: None,
+            samples: 1,
         }
     }
 

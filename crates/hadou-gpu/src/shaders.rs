@@ -300,7 +300,7 @@ mod tests {
                 area_position,
                 outline_reach,
                 area_color,
-                _pad4,
+                grid,
             ]
         );
         check!(GpuSpotMap, "GpuSpotMap", [eye, tan_half, forward, near, right, size, up, _pad]);

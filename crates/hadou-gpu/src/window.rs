@@ -66,7 +66,8 @@ impl Renderer {
                 let mut encoders = self.encode_tile(frame, &prepared, tile, false, q.as_mut());
                 // In the tile's group of queries: its span ends with this pass.
                 let timestamps = q.as_mut().and_then(|q| q.render("present"));
-                present.pass.encode(&mut encoders.shading, &target.view, tile, &bind_group, timestamps);
+                let pixels = prepared.output_tile(tile);
+                present.pass.encode(&mut encoders.shading, &target.view, pixels, &bind_group, timestamps);
                 self.submit_tile(encoders)?;
             }
             Ok(q)

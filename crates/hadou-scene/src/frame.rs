@@ -40,6 +40,63 @@ pub struct Frame {
     pub area_light: Option<AreaLight>,
     /// The `[bloom]` (glare on the linear colour before the colour mapping), if any.
     pub bloom: Option<BloomParams>,
+    /// Anti-aliasing samples per pixel (`[image] samples`): 1, 4, 9 or 16, a `k × k` grid
+    /// ([`Frame::grid`]). Every surface is drawn, shaded and shadowed once per sample; the waves'
+    /// integrals once per pixel where its samples see one surface ([`Frame::sample_frame`]).
+    pub samples: u32,
+}
+
+/// Samples per pixel a scene gets without `[image] samples`.
+pub const DEFAULT_SAMPLES: u32 = 4;
+/// How far apart in eye distance (relative to the nearest) the samples of one pixel may be and
+/// still count as one surface, whose waves both backends integrate once, along the ray through the
+/// pixel's centre clipped at the samples' mean distance ([`Frame::sample_frame`]).
+pub const SAMPLE_DEPTH_SPREAD: f32 = 0.01;
+/// Largest `samples` (a 4 × 4 grid).
+pub const MAX_SAMPLES: u32 = 16;
+
+/// Checks an anti-aliasing sample count: 1, 4, 9 or 16 (a `k × k` grid, `k ≤ 4`).
+pub fn check_samples(samples: u32) -> Result<(), String> {
+    if matches!(samples, 1 | 4 | 9 | 16) {
+        Ok(())
+    } else {
+        Err(format!(
+            "samples {samples} is not one of 1, 4, 9, 16 (a k × k grid of samples per pixel, at most {MAX_SAMPLES})"
+        ))
+    }
+}
+
+impl Frame {
+    /// The edge `k` of the frame's `k × k` sample grid: `√samples` (1 for a count that is not
+    /// 4, 9 or 16), made smaller where an `[area_light]` would otherwise shade more than
+    /// [`crate::SOFT_MAX_PIXELS`] samples (its penumbra search works on every sample of the image
+    /// at once).
+    pub fn grid(&self) -> u32 {
+        let mut k = match self.samples {
+            4 => 2,
+            9 => 3,
+            16 => 4,
+            _ => 1,
+        };
+        if self.area_light.is_some() {
+            let px = u64::from(self.width) * u64::from(self.height);
+            while k > 1 && px * u64::from(k * k) > crate::SOFT_MAX_PIXELS {
+                k -= 1;
+            }
+        }
+        k
+    }
+
+    /// The frame whose pixels are this frame's samples: `k` times as wide and as high
+    /// ([`Frame::grid`]), one sample each, without the `[bloom]` (which works on the resolved
+    /// image). Sample `(i, j)` of pixel `(x, y)` is the sample frame's pixel `(k·x + i, k·y + j)`,
+    /// centred at `x + (i + ½)/k`: an ordered grid. Both backends draw the surfaces of this frame
+    /// and resolve each pixel by the box filter over its samples; the camera, and so every ray
+    /// through a pixel's centre, is the same in both frames.
+    pub fn sample_frame(&self) -> Frame {
+        let k = self.grid();
+        Frame { width: self.width * k, height: self.height * k, samples: 1, bloom: None, ..self.clone() }
+    }
 }
 
 /// A pinhole camera.

@@ -25,6 +25,8 @@ use std::sync::Arc;
 pub struct Scene {
     pub(crate) path: PathBuf,
     pub(crate) width: u32,
+    /// `[image] samples` (or [`crate::DEFAULT_SAMPLES`]).
+    pub(crate) samples: u32,
     pub(crate) height: u32,
     /// Every numeric parameter as written in the file (the store tracks write into).
     pub(crate) values: Vec<f32>,
@@ -126,6 +128,11 @@ impl Scene {
     /// Image height in pixels.
     pub fn height(&self) -> u32 {
         self.height
+    }
+
+    /// Anti-aliasing samples per pixel (`[image] samples`, default [`crate::DEFAULT_SAMPLES`]).
+    pub fn samples(&self) -> u32 {
+        self.samples
     }
 
     /// Checks a size for this scene's images (from a flag or the viewer) against the rules its
@@ -256,6 +263,7 @@ impl Scene {
             area_light: self.area_light.as_ref().map(|a| build_area_light(a, vals, base, &objects)),
             objects,
             bloom: self.bloom.as_ref().map(|b| build_bloom(b, vals)),
+            samples: self.samples,
         }
     }
 

@@ -132,11 +132,15 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut rd = ParamReader { values: &mut values, spans: &mut spans };
 
     // [image]
-    let (mut width, mut height) = (512, 512);
+    let (mut width, mut height, mut samples) = (512, 512, crate::DEFAULT_SAMPLES);
     if let Some(t) = root.sub("image", "[image]")? {
-        t.check_keys(&["width", "height"])?;
+        t.check_keys(&["width", "height", "samples"])?;
         width = t.opt_int("width", 1, 16384)?.map_or(width, |v| v.0 as u32);
         height = t.opt_int("height", 1, 16384)?.map_or(height, |v| v.0 as u32);
+        if let Some((v, span)) = t.opt_int("samples", 1, i64::from(crate::MAX_SAMPLES))? {
+            samples = v as u32;
+            crate::check_samples(samples).map_err(|m| src.value_err(&span, m))?;
+        }
     }
 
     // [camera]
@@ -326,6 +330,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         path: path.to_path_buf(),
         width,
         height,
+        samples,
         values,
         camera,
         light,

@@ -5,7 +5,7 @@
 //! use hadou::export::{export_animation, AnimationSpec, Control};
 //! use hadou::{CpuBackend, Scene};
 //! let scene = Scene::load("scenes/kamehameha.toml").expect("valid scene");
-//! let spec = AnimationSpec { frames: 0..48, fps: 24.0, width: Some(320), height: Some(180) };
+//! let spec = AnimationSpec { frames: 0..48, fps: 24.0, width: Some(320), height: Some(180), samples: None };
 //! let outcome = export_animation(&scene, &mut CpuBackend::new(), &spec, "fire.gif".as_ref(), &mut |p| {
 //!     eprintln!("{}/{}", p.done, p.total);
 //!     Control::Continue
@@ -106,6 +106,9 @@ pub struct AnimationSpec {
     pub width: Option<u32>,
     /// Image height overriding the scene's (1..=[`MAX_EDGE`]); `None` keeps the scene's.
     pub height: Option<u32>,
+    /// Anti-aliasing samples per pixel overriding the scene's `[image] samples` (1, 4, 9 or
+    /// 16); `None` keeps the scene's.
+    pub samples: Option<u32>,
 }
 
 impl AnimationSpec {
@@ -130,6 +133,9 @@ impl AnimationSpec {
                 self.fps,
                 f64::from(last) / f64::from(self.fps)
             )));
+        }
+        if let Some(s) = self.samples {
+            hadou_scene::check_samples(s).map_err(ExportError::Spec)?;
         }
         for (name, v) in [("width", self.width), ("height", self.height)] {
             if let Some(v) = v {
@@ -162,6 +168,9 @@ impl AnimationSpec {
         }
         if let Some(h) = self.height {
             frame.height = h;
+        }
+        if let Some(s) = self.samples {
+            frame.samples = s;
         }
         frame
     }

@@ -89,6 +89,10 @@ struct RenderArgs {
     /// Override the image height (the same limits).
     #[arg(long, allow_hyphen_values = true)]
     height: Option<u32>,
+    /// Override the anti-aliasing samples per pixel (`[image] samples`, default 4): 1, 4, 9 or
+    /// 16.
+    #[arg(long, allow_hyphen_values = true)]
+    samples: Option<u32>,
     /// Which backend renders.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
@@ -231,7 +235,8 @@ fn main() -> ExitCode {
 /// `hadou::export` (every path checked before the first frame), with a progress bar.
 fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Result<(), Failure> {
     use hadou::export::{export_animation, AnimationSpec, Control, ExportError, ExportOutcome};
-    let spec = AnimationSpec { frames: range.clone(), fps, width: a.width, height: a.height };
+    let spec =
+        AnimationSpec { frames: range.clone(), fps, width: a.width, height: a.height, samples: a.samples };
     spec.validate().map_err(|e| Failure::input(e.to_string()))?;
     if hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::Gif {
         output::check_directory(&a.output)?;
@@ -377,8 +382,11 @@ fn parse_fps(text: &str, range: &std::ops::Range<u32>) -> Result<f32, Failure> {
     Ok(fps as f32)
 }
 
-fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>) -> Frame {
+fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>, samples: Option<u32>) -> Frame {
     let mut frame = scene.at(t);
+    if let Some(s) = samples {
+        frame.samples = s;
+    }
     if let Some(w) = w {
         frame.width = w;
     }
@@ -481,6 +489,9 @@ fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, Failure> {
 
 fn render(a: RenderArgs) -> Result<(), Failure> {
     size_override(a.width, a.height)?;
+    if let Some(n) = a.samples {
+        hadou_scene::check_samples(n).map_err(|m| Failure::input(format!("--samples {n}: {m}")))?;
+    }
     // Ctrl-C, SIGTERM and SIGHUP remove the temporary file of an output being written.
     output::install_interrupt_cleanup().map_err(Failure::runtime)?;
     let Some(frames) = &a.frames else {
@@ -489,7 +500,7 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         output::check_directory(&a.output)?;
         let scene = load_scene(&a.scene)?;
         check_image_size(&scene, &a.scene, a.width, a.height)?;
-        let frame = frame_at(&scene, time, a.width, a.height);
+        let frame = frame_at(&scene, time, a.width, a.height, a.samples);
         let mut backend = make_backend(a.backend)?;
         // Both formats are rendered and encoded band by band: memory follows the band, not the
         // image.
@@ -548,7 +559,7 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     let time = parse_time("--time", &a.time)?;
     let scene = load_scene(&a.scene)?;
     check_image_size(&scene, &a.scene, a.width, a.height)?;
-    let frame = frame_at(&scene, time, a.width, a.height);
+    let frame = frame_at(&scene, time, a.width, a.height, None);
     let outside = || {
         Failure::input(format!(
             "--pixel {x},{y}: outside the {}×{} image (x < {}, y < {})",

@@ -21,7 +21,7 @@ fn scene() -> Scene {
 }
 
 fn spec(frames: std::ops::Range<u32>, fps: f32) -> AnimationSpec {
-    AnimationSpec { frames, fps, width: Some(W), height: Some(H) }
+    AnimationSpec { frames, fps, width: Some(W), height: Some(H), samples: None }
 }
 
 fn tmpdir(name: &str) -> Scratch {

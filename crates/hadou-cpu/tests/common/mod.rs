@@ -27,5 +27,6 @@ pub fn frame(width: u32, height: u32, camera: Camera, objects: Vec<Object>, wave
         shadows: Vec::new(),
         area_light: None,
         bloom: None,
+        samples: 1,
     }
 }

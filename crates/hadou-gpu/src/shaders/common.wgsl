@@ -55,7 +55,10 @@ struct FrameUniforms {
     area_position: vec3<f32>,
     outline_reach: u32,
     area_color: vec3<f32>,
-    _pad4: u32,
+    // The edge of the sample grid (hadou_scene::Frame::grid): 1, or with anti-aliasing the
+    // uniforms are the sample frame's (image_size, tile_origin and tile_size count samples) and
+    // the wave pass resolves grid × grid samples per image pixel.
+    grid: u32,
 }
 
 // Keep in sync with layout.rs `GpuSpotMap` (hadou_math::soft::SpotMap and its edge in texels).
@@ -249,8 +252,14 @@ const ON_PLANE: f32 = 1.0e-3;
 // Mirrors hadou_scene::CameraBasis::pixel_dir: direction through the centre of the global pixel
 // (px, py) (py = 0 is the top row), with unit component along `forward`.
 fn pixel_dir(u: FrameUniforms, px: u32, py: u32) -> vec3<f32> {
-    let ndc_x = 2.0 * (f32(px) + 0.5) / f32(u.image_size.x) - 1.0;
-    let ndc_y = 1.0 - 2.0 * (f32(py) + 0.5) / f32(u.image_size.y);
+    return pixel_dir_at(u, f32(px) + 0.5, f32(py) + 0.5);
+}
+
+// The direction through the point (x, y) of the image plane, in pixels of `u.image_size` from its
+// top-left corner (pixel_dir is this at a pixel's centre).
+fn pixel_dir_at(u: FrameUniforms, x: f32, y: f32) -> vec3<f32> {
+    let ndc_x = 2.0 * x / f32(u.image_size.x) - 1.0;
+    let ndc_y = 1.0 - 2.0 * y / f32(u.image_size.y);
     return u.forward + u.right * (ndc_x * u.tan_half_fov * u.aspect) + u.up * (ndc_y * u.tan_half_fov);
 }
 

@@ -22,7 +22,9 @@ fn vs_present(@builtin(vertex_index) k: u32) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs_present(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     // Framebuffer coordinates at the pixel centre (x + 0.5, y + 0.5), y down: the image pixel.
-    let p = vec2<u32>(position.xy) - frame.tile_origin;
-    let i = p.y * frame.tile_size.x + p.x;
+    // With anti-aliasing the uniforms count samples: the tile's image pixels are these / grid.
+    let g = max(frame.grid, 1u);
+    let p = vec2<u32>(position.xy) - frame.tile_origin / g;
+    let i = p.y * (frame.tile_size.x / g) + p.x;
     return vec4<f32>(out_buf[4u * i], out_buf[4u * i + 1u], out_buf[4u * i + 2u], out_buf[4u * i + 3u]);
 }

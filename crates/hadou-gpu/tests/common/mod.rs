@@ -156,6 +156,7 @@ pub fn base_frame(width: u32, height: u32, eye: Vec3f, target: Vec3f, mode: Tone
         shadows: Vec::new(),
         area_light: None,
         bloom: None,
+        samples: 1,
     }
 }
 

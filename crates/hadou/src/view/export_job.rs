@@ -28,7 +28,7 @@ impl ExportJob {
         frames: std::ops::Range<u32>,
         fps: f32,
     ) -> Result<ExportJob, String> {
-        let spec = AnimationSpec { frames: frames.clone(), fps, width: None, height: None };
+        let spec = AnimationSpec { frames: frames.clone(), fps, width: None, height: None, samples: None };
         spec.validate().map_err(|e| e.to_string())?;
         let done = Arc::new(AtomicU32::new(0));
         let cancel = Arc::new(AtomicBool::new(false));
