@@ -4,7 +4,8 @@
 //! (what `hadou render` writes on a machine without a GPU); then the same with the camera switched
 //! to hadou's faithful mapping, against the faithful render; and a scene of toon materials (banded
 //! and gradient ramps, no waves) against hadou-cpu's render of it. Skips with a message when there is no
-//! usable adapter; fails instead under `HADOU_REQUIRE_GPU=1`.
+//! usable adapter; fails instead under `HADOU_REQUIRE_GPU=1`. hadou's frames are taken at one
+//! sample per pixel (`samples = 1`): in Bevy anti-aliasing is the camera's own `Msaa`.
 
 mod common;
 
@@ -135,7 +136,8 @@ fn kamehameha_in_bevy_is_the_picture_of_hadou_render() {
     if !adapter_or_skip(test) {
         return;
     }
-    let frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    let mut frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    frame.samples = 1;
     assert_eq!(frame.color_mapping.mode, hadou_scene::ToneMode::Filmic);
     let reference = hadou_cpu::render(&frame);
     let (bevy, mapping) = bevy_picture("kamehameha.toml", 1.5, (frame.width, frame.height), None);
@@ -159,6 +161,7 @@ fn kamehameha_with_the_faithful_mapping_is_the_picture_of_hadou_render() {
         return;
     }
     let mut frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    frame.samples = 1;
     frame.color_mapping.mode = hadou_scene::ToneMode::Faithful;
     let reference = hadou_cpu::render(&frame);
     let faithful = ViewMapping::Hadou(hadou_scene::ToneMode::Faithful);
@@ -246,6 +249,7 @@ fn toon_materials_in_bevy_are_the_picture_of_hadou_render() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("toon.toml"), TOON_SCENE).unwrap();
     let mut frame = hadou_scene::Scene::load(dir.join("toon.toml")).unwrap().at(0.0);
+    frame.samples = 1;
     assert!(frame.waves.is_empty() && frame.shadows.is_empty());
     assert!(frame
         .objects
@@ -280,6 +284,7 @@ fn the_wave_as_a_light_in_bevy_is_the_picture_of_hadou_render() {
         return;
     }
     let mut frame = hadou_scene::Scene::load(scenes().join("light-normal-vs-wave.toml")).unwrap().at(0.75);
+    frame.samples = 1;
     let materials = || frame.objects.iter().flat_map(|o| &o.materials);
     assert!(materials().any(|m| m.wave_blend > 0.0), "the frame blends towards the wave");
     assert!(materials().any(|m| m.feature_texture.is_some() || m.base_texture.is_some()));
@@ -313,6 +318,7 @@ fn wave_shadows_in_bevy_are_the_picture_of_hadou_render() {
         return;
     }
     let mut frame = hadou_scene::Scene::load(scenes().join("shadow-wave-top.toml")).unwrap().at(1.0);
+    frame.samples = 1;
     assert!(!frame.shadows.is_empty());
     let reference = hadou_cpu::render(&frame);
     let (bevy, _) = bevy_picture("shadow-wave-top.toml", 1.0, (frame.width, frame.height), None);
@@ -337,7 +343,8 @@ fn kamehameha_with_msaa_in_bevy_is_the_picture_of_hadou_render() {
     if !adapter_or_skip(test) {
         return;
     }
-    let frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    let mut frame = hadou_scene::Scene::load(scenes().join("kamehameha.toml")).unwrap().at(1.5);
+    frame.samples = 1;
     let reference = hadou_cpu::render(&frame);
     let size = (frame.width, frame.height);
     let (bevy, _) =

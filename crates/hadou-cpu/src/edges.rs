@@ -108,7 +108,16 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     }
     // Each pixel's winning edge pixel, if any: row by row, only the pixels within the search
     // window of some edge pixel searched (a difference array over the window's rows marks them).
-    let (surface_ro, edge_ro, edges_ro) = (&*surface, &*edge, &edges);
+    // Per row of edge pixels, the one object they all belong to (`None`: several, or none): a
+    // pixel of that object skips the row, whose edges can only be its own.
+    let sole: Vec<Option<u32>> = edges
+        .iter()
+        .map(|row| {
+            let first = row.first()?.object;
+            row.iter().all(|e| e.object == first).then_some(first)
+        })
+        .collect();
+    let (surface_ro, edge_ro, edges_ro, sole) = (&*surface, &*edge, &edges, &sole);
     let owner = &owner;
     let wins: Vec<Option<usize>> = (0..h)
         .into_par_iter()
@@ -143,6 +152,9 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 let p_normal = edge[i].normal;
                 let mut best: Option<(f32, usize)> = None;
                 for (rr, row) in edges.iter().enumerate().take(hi).skip(lo) {
+                    if sole[rr] == Some(b) {
+                        continue;
+                    }
                     let dy = rr as f32 - r as f32;
                     let start = row.partition_point(|e| (e.x as usize) + reach < x);
                     for e in &row[start..] {

@@ -41,8 +41,9 @@ pub struct WaveProbe {
     pub evaluations: u32,
 }
 
-/// Probes one pixel: renders the opaque pass and evaluates every wave there. `None` if the pixel
-/// is outside the image.
+/// Probes one pixel: renders the opaque pass and evaluates every wave there, at the pixel's centre
+/// and one sample (`frame.samples` is not used: the pixel of the frame at `samples = 1`). `None`
+/// if the pixel is outside the image.
 pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     if x >= frame.width || y >= frame.height {
         return None;

@@ -45,8 +45,11 @@ fn frame(text: &str) -> Frame {
     parse(&format!("{VIEW}{text}"))
 }
 
+/// The scene's frame at time 0 and one sample per pixel (the tests compare pixels' exact colours).
 fn parse(text: &str) -> Frame {
-    Scene::parse(text, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}")).at(0.0)
+    let mut f = Scene::parse(text, Path::new("x.toml")).unwrap_or_else(|e| panic!("{e}")).at(0.0);
+    f.samples = 1;
+    f
 }
 
 /// The pixel whose centre sees world point `p` (`None` off-screen).

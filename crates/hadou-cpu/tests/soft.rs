@@ -22,6 +22,8 @@ fn example(name: &str, t: f32, size: u32) -> Frame {
     let mut f = s.at(t);
     f.width = size;
     f.height = size;
+    // Pixel by pixel against the soft-shadow stage's own per-pixel results: one sample each.
+    f.samples = 1;
     f
 }
 

@@ -112,6 +112,27 @@ fn image_size_limits() {
 }
 
 #[test]
+fn anti_aliasing_samples_are_one_four_nine_or_sixteen() {
+    for (text, col) in [("0", 11), ("-4", 11), ("17", 11), ("1000000000000", 11), ("2", 11), ("8", 11)] {
+        let e = err(&format!("[image]\nsamples = {text}\n"));
+        assert_eq!(at(&e), (2, col), "samples = {text}: {e}");
+        let msg = e.to_string();
+        assert!(msg.contains("samples") && (msg.contains("1, 4, 9, 16") || msg.contains("1..=16")), "{e}");
+    }
+    let e = err("[image]\nsamples = 4.0\n");
+    assert_eq!(at(&e), (2, 11), "{e}");
+    let e = err("[image]\nsamples = \"many\"\n");
+    assert_eq!(at(&e), (2, 11), "{e}");
+    for n in [1, 4, 9, 16] {
+        let ok = Scene::parse(&format!("[image]\nsamples = {n}\n"), Path::new("x.toml")).unwrap();
+        assert_eq!(ok.samples(), n);
+        assert_eq!(ok.at(0.0).samples, n);
+    }
+    let default = Scene::parse("", Path::new("x.toml")).unwrap();
+    assert_eq!(default.samples(), hadou_scene::DEFAULT_SAMPLES);
+}
+
+#[test]
 fn missing_keys_point_at_the_table() {
     let e = err("[camera]\nfov = 40\n\n[[wave]]\nname = \"s\"\nkind = \"sphere\"\nM = [0, 0, 0]\n");
     assert!(matches!(e, SceneError::Missing { .. }), "{e:?}");

@@ -559,7 +559,8 @@ fn probe(a: ProbeArgs) -> Result<(), Failure> {
     let time = parse_time("--time", &a.time)?;
     let scene = load_scene(&a.scene)?;
     check_image_size(&scene, &a.scene, a.width, a.height)?;
-    let frame = frame_at(&scene, time, a.width, a.height, None);
+    // The pixel's centre, at one sample (docs/scene-format.md, `[image] samples`).
+    let frame = frame_at(&scene, time, a.width, a.height, Some(1));
     let outside = || {
         Failure::input(format!(
             "--pixel {x},{y}: outside the {}×{} image (x < {}, y < {})",

@@ -1,6 +1,7 @@
-//! The toon table: the toon scene full and reduced to plain diffuse, the shadow scene with and
-//! without its shadows, and the glare scene with and without its `[bloom]`, at each size in one
-//! run.
+//! The toon table: the toon scene full and reduced to plain diffuse, the toon scene at 4 samples
+//! per pixel and at 1 (anti-aliasing), the shadow scene with and without its shadows, and the
+//! glare scene with and without its `[bloom]`, at each size in one run (every other row at one
+//! sample per pixel).
 
 use super::table::{Cell, Column, Report, Row, Table};
 use super::timing::Timer;
@@ -35,7 +36,7 @@ pub fn plain_materials(frame: &Frame) -> Frame {
 
 /// Measures the toon table: [`TOON_SCENE`] at each size, `full` (the scene as written) and
 /// `plain` (every material diffuse, no wave light, no outlines, no textures: the opaque pass hadou
-/// had before materials), then [`SHADOW_SCENE`] at each size, `shadows` (as written) and
+/// had before materials) and `4-samples` against `1-sample` (anti-aliasing), then [`SHADOW_SCENE`] at each size, `shadows` (as written) and
 /// `no-shadows` (its `[[shadow]]`s removed), then [`GLARE_SCENE`] at each size, `bloom` (as
 /// written) and `no-bloom` (its `[bloom]` removed), in one run. Its text pairs the two variants of each
 /// size with their ratio; its JSON `rows` are `{scene, size, variant, ms, fps}`.
@@ -73,12 +74,18 @@ pub fn toon_table(
     let (file, t) = TOON_SCENE;
     let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
     let mut toon = Vec::new();
+    let mut samples = Vec::new();
     for &size in sizes {
         let mut frame = scene.at(t);
         frame.width = size;
         frame.height = size;
+        // The toon, shadow and glare rows at one sample per pixel; the anti-aliasing rows set
+        // the scene's 4 samples against 1.
+        frame.samples = 1;
         let plain = plain_materials(&frame);
         toon.push(pair(file, size, [("full", &frame), ("plain", &plain)])?);
+        let aa = Frame { samples: 4, ..frame.clone() };
+        samples.push(pair(file, size, [("4-samples", &aa), ("1-sample", &frame)])?);
     }
     let (shadow_file, st) = SHADOW_SCENE;
     let shadow_scene =
@@ -88,6 +95,7 @@ pub fn toon_table(
         let mut frame = shadow_scene.at(st);
         frame.width = size;
         frame.height = size;
+        frame.samples = 1;
         let bare = Frame { shadows: Vec::new(), ..frame.clone() };
         shadows.push(pair(shadow_file, size, [("shadows", &frame), ("no-shadows", &bare)])?);
     }
@@ -98,6 +106,7 @@ pub fn toon_table(
         let mut frame = glare_scene.at(gt);
         frame.width = size;
         frame.height = size;
+        frame.samples = 1;
         let bare = Frame { bloom: None, ..frame.clone() };
         glare.push(pair(glare_file, size, [("bloom", &frame), ("no-bloom", &bare)])?);
     }
@@ -119,6 +128,14 @@ pub fn toon_table(
             rows: toon,
         },
     ];
+    if !samples.is_empty() {
+        tables.push(Table {
+            key: None,
+            title: format!("\nanti-aliasing, toon scene {file}\n"),
+            columns: columns("4 samples ms", "fps", "1 sample ms"),
+            rows: samples,
+        });
+    }
     if !shadows.is_empty() {
         tables.push(Table {
             key: None,

@@ -1,0 +1,172 @@
+//! Anti-aliasing (`[image] samples`, `Frame::grid`, `Frame::sample_frame`): each pixel is the
+//! box-filtered mean of a `k × k` grid of samples of its surfaces; the waves are integrated once
+//! per pixel wherever its samples show one surface; bands of rows are the whole frame's rows.
+
+use hadou_cpu::{render, render_rows};
+use hadou_math::energy::{CapsuleField, Falloff};
+use hadou_math::toon::{Ramp, RampKind};
+use hadou_math::{Mat4, Vec3, Vec3f};
+use hadou_scene::mesh::{box_mesh, plane_mesh, sphere_mesh, with_outline_normals};
+
+use hadou_scene::{Camera, ColorMapping, Frame, Image, Material, Object, Outline, ToneMode, Wave, WaveShape};
+use std::sync::Arc;
+
+mod common;
+
+fn object(name: &str, mesh: hadou_scene::Mesh, at: Vec3f, m: Material) -> Object {
+    Object { name: name.into(), mesh: Arc::new(mesh), transform: Mat4::translation(at), materials: vec![m] }
+}
+
+/// A box turned 30° on a ground, an outlined sphere with a hard two-band toon ramp beside it, a
+/// capsule wave passing in front, faithful colour mapping at `samples` per pixel.
+fn scene(size: u32, samples: u32) -> Frame {
+    let ground = object("ground", plane_mesh([20.0, 20.0]), Vec3f::ZERO, Material::diffuse([0.1, 0.1, 0.6]));
+    let mut cube = object(
+        "box",
+        box_mesh([1.0, 1.0, 1.0]),
+        Vec3::new(-0.8, 0.5, 0.0),
+        Material::diffuse([0.8, 0.2, 0.1]),
+    );
+    cube.transform =
+        Mat4::translation(Vec3::new(-0.8, 0.5, 0.0)) * Mat4::rotation_xyz_deg(Vec3::new(0.0, 30.0, 0.0));
+    let toon = Material {
+        model: hadou_scene::ShadingModel::Toon,
+        ramp: Ramp {
+            kind: RampKind::Bands { smoothing: 0.0 },
+            stops: vec![(-1.0, [0.3, 0.3, 0.3]), (0.2, [1.0, 1.0, 1.0])],
+        },
+        outline: Some(Outline { width: 0.01, color: [0.0, 0.0, 0.0] }),
+        ..Material::diffuse([0.9, 0.8, 0.3])
+    };
+    let ball = object("ball", with_outline_normals(sphere_mesh(0.6, 48)), Vec3::new(0.9, 0.6, 0.2), toon);
+    let wave = Wave::new(
+        "beam",
+        [0.3, 0.6, 1.0, 1.0],
+        Falloff::InverseSquare,
+        0.0,
+        WaveShape::Capsule(CapsuleField {
+            m: Vec3::new(-3.0, 1.6, 1.0),
+            d: Vec3::new(1.0, -0.05, 0.0).normalize_or(Vec3::X),
+            length: 6.0,
+            alpha_s: 0.3,
+            alpha_c: 1.0,
+        }),
+    );
+    let camera =
+        Camera { target: Vec3::new(0.0, 0.6, 0.0), ..common::camera(Vec3::new(0.5, 2.2, 5.0), 40.0) };
+    Frame {
+        color_mapping: ColorMapping { mode: ToneMode::Faithful, exposure: 0.2 },
+        samples,
+        ..common::frame(size, size * 3 / 4, camera, vec![ground, cube, ball], vec![wave])
+    }
+}
+
+/// Distinct 8-bit colours (by the red, green and blue codes).
+fn codes(img: &Image, i: usize) -> [u8; 3] {
+    let c = img.color[i];
+    [0, 1, 2].map(|k| (c[k].clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+}
+
+/// Pixels whose colour lies strictly between both horizontal neighbours' in every channel that
+/// differs between them by more than 16 codes: the blends a smooth edge has and a stair-stepped
+/// one lacks.
+fn blended_edge_pixels(img: &Image) -> usize {
+    let w = img.width as usize;
+    let mut n = 0;
+    for y in 0..img.height as usize {
+        for x in 1..w - 1 {
+            let (a, b, c) = (codes(img, y * w + x - 1), codes(img, y * w + x), codes(img, y * w + x + 1));
+            let mut edge = false;
+            let mut between = true;
+            for k in 0..3 {
+                let (lo, hi) = (a[k].min(c[k]), a[k].max(c[k]));
+                if hi - lo > 16 {
+                    edge = true;
+                    between &= b[k] > lo + 2 && b[k] + 2 < hi;
+                }
+            }
+            if edge && between {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+#[test]
+fn edges_are_blended_with_samples_and_stepped_without() {
+    let one = render(&scene(160, 1));
+    let sixteen = render(&scene(160, 16));
+    let (a, b) = (blended_edge_pixels(&one), blended_edge_pixels(&sixteen));
+    eprintln!("blended edge pixels: {a} at 1 sample, {b} at 16");
+    // Silhouettes, the outline, the toon band's edge and the box's edges all blend.
+    assert!(b > 4 * a.max(10), "blended edge pixels: {a} at 1 sample, {b} at 16");
+    for img in [&one, &sixteen] {
+        assert!(img.color.iter().flatten().all(|v| v.is_finite()));
+        assert!(img.energy.iter().chain(&img.depth).all(|v| v.is_finite()));
+    }
+}
+
+/// A pixel whose samples all show one surface keeps its 1-sample colour but for the samples'
+/// spread; across the image the 4-sample frame is the 1-sample frame smoothed, not moved.
+#[test]
+fn anti_aliasing_moves_no_interior_pixel_far() {
+    let one = render(&scene(160, 1));
+    let four = render(&scene(160, 4));
+    let mean: f32 = one
+        .color
+        .iter()
+        .zip(&four.color)
+        .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).sum::<f32>() / 3.0)
+        .sum::<f32>()
+        / one.color.len() as f32;
+    assert!(mean < 0.02, "mean colour change {mean}");
+}
+
+/// With nothing drawn every pixel's samples agree, and its waves are integrated once along the
+/// ray through its centre: the energies are those of the 1-sample frame bit for bit (integrated
+/// per sample they would differ).
+#[test]
+fn the_waves_are_integrated_once_per_pixel_where_the_samples_agree() {
+    let bare = |samples| Frame { objects: Vec::new(), ..scene(96, samples) };
+    let one = render(&bare(1));
+    for samples in [4, 9, 16] {
+        let many = render(&bare(samples));
+        assert_eq!(one.energy, many.energy, "samples {samples}");
+        assert_eq!(one.depth, many.depth, "samples {samples}");
+    }
+    // Where the beam passes in front of a surface, too: the interior of the ground.
+    let one = render(&scene(96, 1));
+    let four = render(&scene(96, 4));
+    let (w, h) = (one.width as usize, one.height as usize);
+    let i = (h - 3) * w + w / 2;
+    let rel = (one.energy[i] - four.energy[i]).abs() / one.energy[i].max(1e-12);
+    assert!(rel < 0.02, "ground pixel energy {} vs {}", one.energy[i], four.energy[i]);
+}
+
+#[test]
+fn bands_of_rows_are_the_whole_frames_rows() {
+    for samples in [4, 9] {
+        let frame = scene(120, samples);
+        let whole = render(&frame);
+        for rows in [0..1, 7..40, 39..90, 89..90] {
+            let band = render_rows(&frame, rows.clone());
+            let expect = whole.crop_rows(rows.clone());
+            assert_eq!(band.color, expect.color, "samples {samples} rows {rows:?}");
+            assert_eq!(band.energy, expect.energy, "samples {samples} rows {rows:?}");
+        }
+    }
+}
+
+#[test]
+fn the_grid_follows_the_samples_and_the_soft_shadow_limit() {
+    let f = scene(64, 9);
+    assert_eq!(f.grid(), 3);
+    let s = f.sample_frame();
+    assert_eq!((s.width, s.height, s.samples), (192, 144, 1));
+    assert_eq!(s.camera, f.camera);
+    assert_eq!(Frame { samples: 1, ..f.clone() }.grid(), 1);
+    assert_eq!(Frame { samples: 16, ..f.clone() }.grid(), 4);
+    // A count that is not a square (only code can set one) draws one sample.
+    assert_eq!(Frame { samples: 2, ..f.clone() }.grid(), 1);
+}
