@@ -307,7 +307,8 @@ impl GpuBackend {
     /// Renders `frame` and, when it has an `[area_light]`, reads back every pixel's soft-shadow
     /// class (`hadou_math::soft::Class as u8`) and visibility, row-major: what the differential
     /// tests compare with hadou-cpu's `soft::classify` and `soft::visibility`. `None` without an
-    /// area light.
+    /// area light. With anti-aliasing these are the samples' (the sample frame's pixels,
+    /// `Frame::sample_frame`).
     #[doc(hidden)]
     #[cfg(not(target_arch = "wasm32"))]
     pub fn render_soft(
@@ -315,7 +316,11 @@ impl GpuBackend {
         frame: &Frame,
     ) -> Result<(Image, Option<passes::soft::SoftReadback>), RenderError> {
         let image = self.renderer.render(frame)?;
-        let soft = self.renderer.read_soft(frame)?;
+        let soft = if frame.grid() > 1 {
+            self.renderer.read_soft(&frame.sample_frame())?
+        } else {
+            self.renderer.read_soft(frame)?
+        };
         Ok((image, soft))
     }
 

@@ -77,7 +77,18 @@ impl Renderer {
         check_curves(&self.ctx.limits, &curves)?;
         let faithful = frame.color_mapping.mode == hadou_scene::ToneMode::Faithful;
         let variant = if self.passes.wave.specialise {
-            WaveVariant::of(&waves, &curves.curves, &[], &[], false, false, (false, false), false, faithful)
+            WaveVariant::of(
+                &waves,
+                &curves.curves,
+                &[],
+                &[],
+                false,
+                false,
+                (false, false),
+                false,
+                faithful,
+                false,
+            )
         } else {
             WaveVariant::UBER
         };

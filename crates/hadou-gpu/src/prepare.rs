@@ -268,7 +268,8 @@ impl FrameData {
     }
 
     /// The wave pass's variant for this frame (see [`WaveVariant::of`]).
-    pub(crate) fn wave_variant(&self, frame: &Frame) -> WaveVariant {
+    /// `samples`: whether the wave pass resolves each pixel from several samples.
+    pub(crate) fn wave_variant(&self, frame: &Frame, samples: bool) -> WaveVariant {
         WaveVariant::of(
             &self.waves,
             &self.curves.curves,
@@ -281,6 +282,7 @@ impl FrameData {
             (self.shadow_fields.plane_count > 0, self.shadow_fields.map_count > 0),
             frame.area_light.is_some(),
             frame.color_mapping.mode == hadou_scene::ToneMode::Faithful,
+            samples,
         )
     }
 

@@ -324,7 +324,8 @@ impl Renderer {
             *t = (*t / grid).max(1) * grid;
         }
         let data = FrameData::new(&self.ctx.limits, frame)?;
-        let (wave_pipeline, variant) = self.passes.wave.pipeline(&self.ctx, data.wave_variant(frame))?;
+        let (wave_pipeline, variant) =
+            self.passes.wave.pipeline(&self.ctx, data.wave_variant(frame, grid > 1))?;
         let raster =
             variant.has("USE_SURFACES") || frame.area_light.is_some() || !data.plane_draws.is_empty();
         let outlines = data.outlines();

@@ -359,7 +359,7 @@ fn export_png_sequence(
     }
     for f in range {
         let frame = spec.frame(scene, f);
-        output::write_png_banded(&frame_path(f), frame.width, frame.height, |rows| {
+        output::write_png_banded(&frame_path(f), frame.width, frame.height, frame.grid().pow(2), |rows| {
             let band = backend.render_rows(&frame, rows)?;
             check_finite(&band)?;
             Ok::<_, ExportError>(band)
@@ -376,7 +376,7 @@ fn export_png_sequence(
 fn render_rgba(backend: &mut dyn Backend, frame: &Frame) -> Result<Vec<u8>, ExportError> {
     let (w, h) = (frame.width, frame.height);
     let mut rgba = Vec::with_capacity(w as usize * h as usize * 4);
-    let step = output::band_rows(w);
+    let step = output::band_rows(w, frame.grid().pow(2));
     let mut y = 0;
     while y < h {
         let rows = y..(y + step).min(h);

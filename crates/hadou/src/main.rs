@@ -504,7 +504,7 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         let mut backend = make_backend(a.backend)?;
         // Both formats are rendered and encoded band by band: memory follows the band, not the
         // image.
-        output::write_banded(&a.output, frame.width, frame.height, |rows| {
+        output::write_banded(&a.output, frame.width, frame.height, frame.grid().pow(2), |rows| {
             let band = backend.render_rows(&frame, rows)?;
             check_finite(&band)?;
             Ok::<_, Failure>(band)

@@ -98,15 +98,17 @@ pub fn write(image: &Image, path: &Path) -> Result<(), OutputError> {
 
 /// Writes a `width × height` image to `path` in the format its extension names, band by band
 /// ([`write_png_banded`], [`write_exr_banded`]): memory follows the band, not the image.
+/// `samples` is what the renderer draws per pixel (`Frame::grid()²`), which bands are sized by.
 pub fn write_banded<E: From<OutputError>>(
     path: &Path,
     width: u32,
     height: u32,
+    samples: u32,
     band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     match Format::from_path(path)? {
-        Format::Png => write_png_banded(path, width, height, band),
-        Format::Exr => write_exr_banded(path, width, height, band),
+        Format::Png => write_png_banded(path, width, height, samples, band),
+        Format::Exr => write_exr_banded(path, width, height, samples, band),
     }
 }
 
@@ -158,7 +160,7 @@ pub fn srgb8(image: &Image) -> Vec<u8> {
 /// Writes a float EXR with channels `R, G, B, A` (linear colour after mapping), `energy` and
 /// `depth` ([`write_exr_banded`] over the image's rows).
 pub fn write_exr(image: &Image, path: &Path) -> Result<(), OutputError> {
-    write_exr_banded(path, image.width, image.height, |rows| Ok::<_, OutputError>(image.crop_rows(rows)))
+    write_exr_banded(path, image.width, image.height, 1, |rows| Ok::<_, OutputError>(image.crop_rows(rows)))
 }
 
 fn parent_dir(path: &Path) -> PathBuf {
@@ -209,10 +211,11 @@ fn atomic_write(path: &Path, write: impl FnOnce(File) -> Result<(), String>) -> 
         .map_err(|e| OutputError::Io(format!("{}: write failed: {e}", path.display())))
 }
 
-/// Rows per band of [`write_png_banded`]: about `BAND_PIXELS` pixels (at least one row), so a band
-/// costs a few hundred MB at most on any backend whatever the image size.
-pub fn band_rows(width: u32) -> u32 {
-    (BAND_PIXELS / width.max(1)).max(1)
+/// Rows per band of [`write_png_banded`] for an image `width` pixels wide drawn at `samples` per
+/// pixel (`Frame::grid()²`): about `BAND_PIXELS` samples (at least one row), so a band costs a few
+/// hundred MB at most on any backend whatever the image size and anti-aliasing.
+pub fn band_rows(width: u32, samples: u32) -> u32 {
+    (u64::from(BAND_PIXELS) / (u64::from(width.max(1)) * u64::from(samples.max(1)))).max(1) as u32
 }
 
 /// Pixels per band of a streamed PNG (4 Mi: about 100 MB of float image per band).
@@ -248,7 +251,7 @@ fn next_band<E: From<OutputError>>(
 }
 
 /// Writes a `width × height` 8-bit sRGB PNG to `path`, asking `band` for the image rows
-/// `y0..y1` in turn (each at most [`band_rows`] rows) and streaming them into the encoder, so
+/// `y0..y1` in turn (each at most [`band_rows`] rows, for `samples` per pixel) and streaming them into the encoder, so
 /// memory follows the band, not the image. The file is created (and registered for interrupt
 /// clean-up) before the first band is requested, and renamed into place after the last; on any
 /// error nothing is left behind.
@@ -256,6 +259,7 @@ pub fn write_png_banded<E: From<OutputError>>(
     path: &Path,
     width: u32,
     height: u32,
+    samples: u32,
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     let (tmp, file) = begin_banded(path)?;
@@ -269,7 +273,7 @@ pub fn write_png_banded<E: From<OutputError>>(
     let mut w = enc.write_header().map_err(|e| io(e.to_string()))?;
     {
         let mut stream = w.stream_writer().map_err(|e| io(e.to_string()))?;
-        let step = band_rows(width);
+        let step = band_rows(width, samples);
         let mut y = 0;
         while y < height {
             let rows = y..(y + step).min(height);
@@ -300,7 +304,7 @@ const EXR_CHANNELS: [(&str, ExrSample); 6] = [
 
 /// Writes a `width × height` float EXR (channels `R, G, B, A`: linear colour after mapping,
 /// `energy` and `depth`; RLE-compressed scan lines, layer `hadou`) to `path`, asking `band` for
-/// the image rows `y0..y1` in turn (each at most [`band_rows`] rows) and writing each band's
+/// the image rows `y0..y1` in turn (each at most [`band_rows`] rows, for `samples` per pixel) and writing each band's
 /// lines before asking for the next, so memory follows the band, not the image. The file is
 /// created (and registered for interrupt clean-up) before the first band is requested, and
 /// renamed into place after the last; on any error nothing is left behind.
@@ -308,6 +312,7 @@ pub fn write_exr_banded<E: From<OutputError>>(
     path: &Path,
     width: u32,
     height: u32,
+    samples: u32,
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     use exr::block::writer::ChunksWriter;
@@ -330,7 +335,7 @@ pub fn write_exr_banded<E: From<OutputError>>(
     let mut failure: Option<E> = None;
     let written =
         exr::block::write(BufWriter::new(file), SmallVec::from_vec(vec![header]), true, |meta, chunks| {
-            let step = band_rows(width);
+            let step = band_rows(width, samples);
             let mut y = 0;
             while y < height {
                 let rows = y..(y + step).min(height);

@@ -77,7 +77,7 @@ pub(crate) struct WaveVariant(u32);
 
 impl WaveVariant {
     /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
-    pub(crate) const NAMES: [&'static str; 27] = [
+    pub(crate) const NAMES: [&'static str; 28] = [
         // wave.wgsl
         "USE_SPHERE",
         "USE_CYLINDER",
@@ -88,6 +88,7 @@ impl WaveVariant {
         "USE_AREA",
         "USE_TONE_FAITHFUL",
         "USE_TONE_FILMIC",
+        "USE_SAMPLES",
         // energy.wgsl
         "USE_FAITHFUL",
         "USE_INVERSE_SQUARE",
@@ -132,7 +133,8 @@ impl WaveVariant {
 
     /// The variant a frame needs, from what the wave pass will read: the waves, the curves, the
     /// materials and lights (the lights shading.wgsl reads), whether anything is drawn, whether
-    /// some wave glows, the shadow casts (plane, map), the `[area_light]` and the colour mapping.
+    /// some wave glows, the shadow casts (plane, map), the `[area_light]`, the colour mapping and
+    /// whether pixels are resolved from several samples (anti-aliasing).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn of(
         waves: &[layout::GpuWave],
@@ -144,8 +146,12 @@ impl WaveVariant {
         shadows: (bool, bool),
         area: bool,
         tone_faithful: bool,
+        samples: bool,
     ) -> Self {
         let mut on: Vec<&str> = Vec::new();
+        if samples {
+            on.push("USE_SAMPLES");
+        }
         for w in waves {
             on.push(match w.kind {
                 layout::WAVE_SPHERE => "USE_SPHERE",
@@ -359,8 +365,18 @@ mod tests {
         let names = |v: WaveVariant| -> Vec<&str> {
             WaveVariant::NAMES.iter().copied().filter(|n| v.has(n)).collect()
         };
-        let v =
-            WaveVariant::of(&waves, &[curve], &[toon], &[light], false, true, (false, true), false, false);
+        let v = WaveVariant::of(
+            &waves,
+            &[curve],
+            &[toon],
+            &[light],
+            false,
+            true,
+            (false, true),
+            false,
+            false,
+            false,
+        );
         assert_eq!(
             names(v),
             [
@@ -380,10 +396,21 @@ mod tests {
         );
         // Without surfaces nothing of the shading is compiled in; without blending or glow, no
         // wave lights.
-        let v = WaveVariant::of(&waves[..1], &[], &[toon], &[light], true, false, (true, true), true, true);
+        let v = WaveVariant::of(
+            &waves[..1],
+            &[],
+            &[toon],
+            &[light],
+            true,
+            false,
+            (true, true),
+            true,
+            true,
+            false,
+        );
         assert_eq!(names(v), ["USE_SPHERE", "USE_TONE_FAITHFUL", "USE_FAITHFUL"]);
         toon.wave_blend = 0.0;
-        let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true);
+        let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true, false);
         assert_eq!(
             names(v),
             ["USE_SURFACES", "USE_AREA", "USE_TONE_FAITHFUL", "USE_TOON", "USE_PLANE_SHADOWS"]

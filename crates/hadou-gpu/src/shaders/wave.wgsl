@@ -18,12 +18,15 @@
 // frame. A part set false is compiled out: on a software adapter (llvmpipe runs both sides of
 // every branch under a mask) that is what keeps a frame from paying for what it does not contain.
 // With a part set true the code is exactly the uber-shader's. Here: whether any surface is drawn, the
-// `[area_light]` and the colour mappings; wave_energy.wgsl (the wave kinds), energy.wgsl,
+// `[area_light]`, the colour mappings and the anti-aliasing's samples; wave_energy.wgsl (the wave kinds), energy.wgsl,
 // curve.wgsl, shading.wgsl and shadow_lookup.wgsl have the others.
 override USE_SURFACES: bool = true;
 override USE_AREA: bool = true;
 override USE_TONE_FAITHFUL: bool = true;
 override USE_TONE_FILMIC: bool = true;
+// Whether pixels are resolved from several samples (frame.grid > 1); false compiles the
+// single-sample pixel (loops of one iteration, one ray through the centre).
+override USE_SAMPLES: bool = true;
 
 // Mirrors hadou_scene::SAMPLE_DEPTH_SPREAD: how far apart in eye distance (relative to the
 // nearest) one pixel's samples may be and still count as one surface.
@@ -82,7 +85,10 @@ fn tile_sample(s: vec2<u32>, ns: u32) -> Sample {
 // (the depth then the nearest sample's) — then the colour scene + exposure·light, mapped.
 @compute @workgroup_size(8, 8, 1)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let g = max(frame.grid, 1u);
+    var g = 1u;
+    if (USE_SAMPLES) {
+        g = max(frame.grid, 1u);
+    }
     let size = frame.tile_size / g;
     if (id.x >= size.x || id.y >= size.y) {
         return;
@@ -120,36 +126,40 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     // The ray through the pixel's centre (with g = 1, pixel_dir of the pixel).
     let centre = vec2<f32>(f32(frame.tile_origin.x / g + id.x) + 0.5, f32(frame.tile_origin.y / g + id.y) + 0.5) * f32(g);
     let dir = pixel_dir_at(frame, centre.x, centre.y);
+    // One ray through the centre where the samples agree, else one per sample (a single call
+    // site of waves_light, which every wave kind inlines).
+    let agree = same && (!drawn || hi - lo <= SAMPLE_DEPTH_SPREAD * lo);
+    var rays = g * g;
+    var weight = inv;
+    if (agree) {
+        rays = 1u;
+        weight = 1.0;
+    }
     var total = 0.0;
     var light = vec3<f32>(0.0);
-    var depth = frame.far * length3(dir);
-    if (same && (!drawn || hi - lo <= SAMPLE_DEPTH_SPREAD * lo)) {
+    var depth = 3.0e38;
+    for (var r = 0u; r < rays; r++) {
+        var d = dir;
         var surface = -1.0;
-        if (drawn) {
-            surface = sum * inv;
-            depth = surface;
-        }
-        let lit_by = waves_light(dir, surface);
-        total = lit_by.total;
-        light = lit_by.light;
-    } else {
-        depth = 3.0e38;
-        for (var j = 0u; j < g; j++) {
-            for (var k = 0u; k < g; k++) {
-                let s = id.xy * g + vec2<u32>(k, j);
-                let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(s), 0));
-                let d = pixel_dir(frame, frame.tile_origin.x + s.x, frame.tile_origin.y + s.y);
-                var surface = -1.0;
-                var sample_depth = frame.far * length3(d);
-                if (USE_SURFACES && texel.w > 0.0) {
-                    surface = texel.w;
-                    sample_depth = surface;
-                }
-                let lit_by = waves_light(d, surface);
-                total = energy_saturate(total + inv * lit_by.total);
-                light += inv * lit_by.light;
-                depth = min(depth, sample_depth);
+        if (agree) {
+            if (drawn) {
+                surface = sum * inv;
             }
+        } else {
+            let s = id.xy * g + vec2<u32>(r % g, r / g);
+            d = pixel_dir(frame, frame.tile_origin.x + s.x, frame.tile_origin.y + s.y);
+            let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(s), 0));
+            if (USE_SURFACES && texel.w > 0.0) {
+                surface = texel.w;
+            }
+        }
+        let lit_by = waves_light(d, surface);
+        total = energy_saturate(total + weight * lit_by.total);
+        light += weight * lit_by.light;
+        if (surface >= 0.0) {
+            depth = min(depth, surface);
+        } else {
+            depth = min(depth, frame.far * length3(d));
         }
     }
     // exposure · light without overflowing (energy_scaled); the mappings then take f32::MAX to 1.

@@ -10,7 +10,9 @@ use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 /// Every example scene in `scenes/` whose file name `keep` accepts, as `(label, frame)` at the
 /// start, middle and end of its animation (once for a still scene), at 128×96, in file-name
-/// order. Panics if none is kept or one fails to load.
+/// order: the middle frame (a still scene's only one) with the scene's own anti-aliasing
+/// (`[image] samples`), the start and end at one sample per pixel. Panics if none is kept or one
+/// fails to load.
 pub fn example_frames(keep: impl Fn(&str) -> bool) -> Vec<(String, Frame)> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
     let mut paths: Vec<_> = std::fs::read_dir(dir)
@@ -32,7 +34,10 @@ pub fn example_frames(keep: impl Fn(&str) -> bool) -> Vec<(String, Frame)> {
             let mut frame = scene.at(t);
             frame.width = 128;
             frame.height = 96;
-            out.push((format!("{name} t={t}"), frame));
+            if d > 0.0 && t != 0.5 * d {
+                frame.samples = 1;
+            }
+            out.push((format!("{name} t={t} samples={}", frame.samples), frame));
             if d == 0.0 {
                 break;
             }
