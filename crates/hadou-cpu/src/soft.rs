@@ -17,7 +17,7 @@ use crate::opaque::draw_opaque;
 use crate::raster::{nearest_depths, ScreenProjection, Tris, Vert};
 use crate::setup::FrameSetup;
 use hadou_math::soft::{
-    bilinear, same_surface, segment_brightness, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
+    bilinear, same_surface, segment_brightness, Class, Envelope, FitWindow, SpotMap, FAR, SEARCH_RADIUS,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame, SoftResolve};
@@ -137,7 +137,7 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 /// point is): the two maps, the classes and the resolve `resolve`. What [`crate::render()`]
 /// multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
-    let maps = light.maps.map(|m| (m, light.map_size));
+    let maps = fitted_maps(light, input).map(|m| (m, light.map_size));
     let [a, b] = maps;
     let (m1, m2) = rayon::join(
         || SpotDepth::render(frame, &light.casters, &a.0, a.1),
@@ -150,6 +150,29 @@ pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: 
         SoftResolve::Exact => search.exact(),
         SoftResolve::Faithful { n } => search.faithful(n.max(1) as usize),
     }
+}
+
+/// The light's two maps narrowed to the visible points of `input` that a caster can shadow in
+/// each ([`FitWindow::add_point`], [`SpotMap::fitted`]): a point no caster's box lies in front of
+/// is lit in that map whatever it holds, so the maps spend their texels where shadows can fall
+/// (a wall that casts but stands behind everything does not widen them). soft.wgsl's `cs_points`
+/// gathers the same windows on the GPU.
+pub fn fitted_maps(light: &AreaLight, input: &SoftInput) -> [SpotMap; 2] {
+    let boxes = &light.caster_boxes;
+    let windows = light.maps.map(|m| {
+        input
+            .points
+            .par_iter()
+            .with_min_len(4096)
+            .fold(FitWindow::default, |mut w, p| {
+                if let Some(p) = p {
+                    w.add_point(&m, boxes, p.world);
+                }
+                w
+            })
+            .reduce(FitWindow::default, FitWindow::union)
+    });
+    [0, 1].map(|k| light.maps[k].fitted(&windows[k], light.map_size))
 }
 
 /// The classes of a frame and how its penumbra pixels look for umbra and lit pixels.
