@@ -338,7 +338,7 @@ impl SpotMap {
     #[inline]
     pub fn fit_coords(&self, p: Vec3f) -> Option<[f32; 2]> {
         let v = self.to_view(p);
-        if !(v.z > self.near) {
+        if v.z.is_nan() || v.z <= self.near {
             return None;
         }
         let t = self.tan_half;
@@ -363,7 +363,7 @@ impl SpotMap {
         let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
         let h = (0.5 * (hi[0] - lo[0])).max(0.5 * (hi[1] - lo[1]));
         let half = (1.02 * h / (1.0 - 4.0 / size as f32)).max(SPOT_MIN_TAN);
-        if !(half < self.tan_half) || !c[0].is_finite() || !c[1].is_finite() {
+        if half.is_nan() || half >= self.tan_half || !c[0].is_finite() || !c[1].is_finite() {
             return *self;
         }
         SpotMap {
@@ -403,7 +403,7 @@ impl CasterBox {
     pub fn from_edges(origin: Vec3f, edges: [Vec3f; 3]) -> Option<Self> {
         let [a, b, c] = edges;
         let det = a.dot(b.cross(c));
-        if !(det.abs() > 0.0) || !det.is_finite() {
+        if det == 0.0 || !det.is_finite() {
             return None;
         }
         let dual = [b.cross(c) / det, c.cross(a) / det, a.cross(b) / det];
@@ -494,8 +494,8 @@ impl FitWindow {
     /// Adds the point at `c` (from [`SpotMap::fit_coords`]).
     #[inline]
     pub fn add(&mut self, c: [f32; 2]) {
-        for i in 0..2 {
-            let k = FitWindow::key(c[i]);
+        for (i, &v) in c.iter().enumerate() {
+            let k = FitWindow::key(v);
             self.min[i] = self.min[i].min(k);
             self.max[i] = self.max[i].max(k);
         }
