@@ -17,7 +17,8 @@ use crate::opaque::draw_opaque;
 use crate::raster::{nearest_depths, ScreenProjection, Tris, Vert};
 use crate::setup::FrameSetup;
 use hadou_math::soft::{
-    bilinear, same_surface, segment_brightness, Class, Envelope, FitWindow, SpotMap, FAR, SEARCH_RADIUS,
+    bilinear, same_surface, segment_brightness, Class, Envelope, FitTest, FitWindow, SpotMap, FAR,
+    SEARCH_RADIUS,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame, SoftResolve};
@@ -153,25 +154,27 @@ pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: 
 }
 
 /// The light's two maps narrowed to the visible points of `input` that a caster can shadow in
-/// each ([`FitWindow::add_point`], [`SpotMap::fitted`]): a point no caster's box lies in front of
+/// each ([`FitWindow::add_point`] by way of [`FitTest`], [`SpotMap::fitted`]): a point no caster's box lies in front of
 /// is lit in that map whatever it holds, so the maps spend their texels where shadows can fall
 /// (a wall that casts but stands behind everything does not widen them). soft.wgsl's `cs_points`
 /// gathers the same windows on the GPU.
 pub fn fitted_maps(light: &AreaLight, input: &SoftInput) -> [SpotMap; 2] {
-    let boxes = &light.caster_boxes;
-    let windows = light.maps.map(|m| {
-        input
-            .points
-            .par_iter()
-            .with_min_len(4096)
-            .fold(FitWindow::default, |mut w, p| {
+    let tests = light.maps.map(|m| FitTest::new(&m, &light.caster_boxes));
+    let windows = input
+        .points
+        .par_iter()
+        .with_min_len(4096)
+        .fold(
+            || [FitWindow::EMPTY; 2],
+            |mut w, p| {
                 if let Some(p) = p {
-                    w.add_point(&m, boxes, p.world);
+                    tests[0].add(&mut w[0], p.world);
+                    tests[1].add(&mut w[1], p.world);
                 }
                 w
-            })
-            .reduce(FitWindow::default, FitWindow::union)
-    });
+            },
+        )
+        .reduce(|| [FitWindow::EMPTY; 2], |a, b| [a[0].union(b[0]), a[1].union(b[1])]);
     [0, 1].map(|k| light.maps[k].fitted(&windows[k], light.map_size))
 }
 

@@ -343,6 +343,12 @@ fn a_large_caster_leaves_the_wall_shadow_as_fine_as_the_figure_alone_gives() {
     assert!(rows > size as usize / 5, "the figure's shadow crosses {rows} rows of the wall");
     let step = largest_step(&a, &b);
     assert!(step <= 2.0, "the wall shadow's outline strays {step} px from the figure-only one at {size}²");
+    // The wall's box lies in front of no visible point: it does not widen the maps at all.
+    let (fit_all, fit_alone) = (
+        fitted_maps(all.area_light.as_ref().unwrap(), &input),
+        fitted_maps(alone.area_light.as_ref().unwrap(), &input),
+    );
+    assert_eq!(fit_all.map(|m| m.tan_half), fit_alone.map(|m| m.tan_half));
     // Both maps are fitted far inside the frustum that encloses the wall.
     for (fit, full) in fitted_maps(all.area_light.as_ref().unwrap(), &input)
         .iter()

@@ -393,6 +393,8 @@ pub const SPOT_MIN_TAN: f32 = 1e-3;
 pub struct CasterBox {
     /// The corner at the local bounds' minimum.
     pub origin: Vec3f,
+    /// The edges `e_i` from it.
+    pub edges: [Vec3f; 3],
     /// `(e_j × e_k)/(e_i·(e_j × e_k))` for `(i, j, k)` cyclic.
     pub dual: [Vec3f; 3],
 }
@@ -408,8 +410,11 @@ impl CasterBox {
         }
         let dual = [b.cross(c) / det, c.cross(a) / det, a.cross(b) / det];
         let ok = dual.iter().all(|d| d.x.is_finite() && d.y.is_finite() && d.z.is_finite());
-        (ok && origin.x.is_finite() && origin.y.is_finite() && origin.z.is_finite())
-            .then_some(CasterBox { origin, dual })
+        (ok && origin.x.is_finite() && origin.y.is_finite() && origin.z.is_finite()).then_some(CasterBox {
+            origin,
+            edges,
+            dual,
+        })
     }
 
     /// The box coordinates of `q` (`[0, 1]³` inside).
@@ -426,8 +431,12 @@ impl CasterBox {
     /// widths counts as parallel (met when its coordinate is inside).
     #[inline]
     pub fn blocks(&self, eye: Vec3f, p: Vec3f) -> bool {
-        let a = self.local(eye);
-        let b = self.local(p);
+        CasterBox::blocks_local(self.local(eye), self.local(p))
+    }
+
+    /// [`CasterBox::blocks`] with the box coordinates `a` of the light and `b` of the point.
+    #[inline]
+    pub fn blocks_local(a: [f32; 3], b: [f32; 3]) -> bool {
         let (mut t0, mut t1) = (0.0f32, 1.0 - FIT_MARGIN);
         for i in 0..3 {
             let d = b[i] - a[i];
@@ -442,6 +451,65 @@ impl CasterBox {
             }
         }
         t0 <= t1
+    }
+}
+
+/// [`FitWindow::add_point`] for one map and its casters' boxes, prepared so that most points
+/// cost a projection and a comparison: a point inside the window already gathered changes
+/// nothing, and a box can only lie in front of a point inside its own projection on the map's
+/// plane (the rectangle of its corners' [`SpotMap::fit_coords`], widened by `10⁻⁴·(1 + |c|)`
+/// against rounding; unbounded when a corner lies at or behind the near plane). Gives the same
+/// window as [`FitWindow::add_point`] (tested).
+#[derive(Clone, Debug)]
+pub struct FitTest {
+    map: SpotMap,
+    /// Per box: the box, the light's box coordinates, its rectangle (`None`: unbounded).
+    boxes: Vec<(CasterBox, [f32; 3], Option<([f32; 2], [f32; 2])>)>,
+}
+
+impl FitTest {
+    /// The test of `map` (unfitted) against `boxes`.
+    pub fn new(map: &SpotMap, boxes: &[CasterBox]) -> Self {
+        let boxes = boxes
+            .iter()
+            .map(|b| {
+                let mut rect = Some(([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]));
+                for i in 0..8 {
+                    let u = |k: usize| if i >> k & 1 == 1 { 1.0 } else { 0.0 };
+                    let corner = b.origin + b.edges[0] * u(0) + b.edges[1] * u(1) + b.edges[2] * u(2);
+                    let v = map.to_view(corner);
+                    match (rect.as_mut(), v.z > map.near && v.z.is_finite()) {
+                        (Some((lo, hi)), true) => {
+                            for (k, c) in [v.x / v.z, v.y / v.z].into_iter().enumerate() {
+                                let pad = 1e-4 * (1.0 + c.abs());
+                                lo[k] = lo[k].min(c - pad);
+                                hi[k] = hi[k].max(c + pad);
+                            }
+                        }
+                        _ => rect = None,
+                    }
+                }
+                let rect = rect.filter(|(lo, hi)| lo.iter().chain(hi).all(|v| v.is_finite()));
+                (*b, b.local(map.eye), rect)
+            })
+            .collect();
+        FitTest { map: *map, boxes }
+    }
+
+    /// Adds `p` to `window` as [`FitWindow::add_point`] does.
+    #[inline]
+    pub fn add(&self, window: &mut FitWindow, p: Vec3f) {
+        let Some(c) = self.map.fit_coords(p) else { return };
+        let k = [FitWindow::key(c[0]), FitWindow::key(c[1])];
+        if (0..2).all(|i| window.min[i] <= k[i] && k[i] <= window.max[i]) {
+            return;
+        }
+        let inside = |r: &Option<([f32; 2], [f32; 2])>| {
+            r.is_none_or(|(lo, hi)| lo[0] <= c[0] && c[0] <= hi[0] && lo[1] <= c[1] && c[1] <= hi[1])
+        };
+        if self.boxes.iter().any(|(b, a, r)| inside(r) && CasterBox::blocks_local(*a, b.local(p))) {
+            window.add(c);
+        }
     }
 }
 
@@ -828,5 +896,56 @@ mod tests {
         all.add([map.tan_half, map.tan_half]);
         assert_eq!(map.fitted(&all, 512), map);
         assert_eq!(w.union(FitWindow::EMPTY), w);
+    }
+
+    #[test]
+    fn the_prepared_fit_test_gathers_the_same_window_as_the_rule() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        // A small box near the point of interest, a long wall past the light (reaching behind it:
+        // an unbounded rectangle) and a tilted slab.
+        let boxes = [
+            CasterBox::from_edges(
+                Vec3f::new(-0.3, 0.0, -0.3),
+                [Vec3f::X * 0.6, Vec3f::Y * 1.5, Vec3f::Z * 0.6],
+            ),
+            CasterBox::from_edges(
+                Vec3f::new(-4.0, 0.0, -2.0),
+                [Vec3f::X * 8.0, Vec3f::Y * 4.0, Vec3f::Z * 0.2],
+            ),
+            CasterBox::from_edges(
+                Vec3f::new(1.0, 0.5, 1.0),
+                [Vec3f::new(0.8, 0.3, 0.0), Vec3f::new(0.0, 0.1, 0.9), Vec3f::new(0.05, 0.4, -0.02)],
+            ),
+        ]
+        .map(Option::unwrap);
+        let corners: Vec<Vec3f> = boxes
+            .iter()
+            .flat_map(|b| {
+                (0..8).map(move |i| {
+                    let u = |k: usize| (i >> k & 1) as f32;
+                    b.origin + b.edges[0] * u(0) + b.edges[1] * u(1) + b.edges[2] * u(2)
+                })
+            })
+            .collect();
+        for eye in [Vec3f::new(2.5, 1.8, 1.0), Vec3f::new(0.5, 3.0, 2.0)] {
+            let map = SpotMap::look(eye, Vec3f::new(0.0, 0.7, 0.0), &corners);
+            for set in 0..3 {
+                let test = FitTest::new(&map, &boxes[..=set]);
+                let (mut rule, mut fast) = (FitWindow::EMPTY, FitWindow::EMPTY);
+                for _ in 0..4000 {
+                    let p = Vec3f::new(next() * 10.0 - 5.0, next() * 4.0, next() * 6.0 - 3.0);
+                    rule.add_point(&map, &boxes[..=set], p);
+                    test.add(&mut fast, p);
+                }
+                assert_ne!(rule, FitWindow::EMPTY);
+                assert_eq!(rule, fast, "eye {eye:?}, boxes 0..={set}");
+            }
+        }
     }
 }
