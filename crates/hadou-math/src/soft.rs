@@ -464,8 +464,11 @@ impl CasterBox {
 pub struct FitTest {
     map: SpotMap,
     /// Per box: the box, the light's box coordinates, its rectangle (`None`: unbounded).
-    boxes: Vec<(CasterBox, [f32; 3], Option<([f32; 2], [f32; 2])>)>,
+    boxes: Vec<(CasterBox, [f32; 3], Option<Rect>)>,
 }
+
+/// A rectangle `(lo, hi)` on a map's plane.
+type Rect = ([f32; 2], [f32; 2]);
 
 impl FitTest {
     /// The test of `map` (unfitted) against `boxes`.
@@ -504,7 +507,7 @@ impl FitTest {
         if (0..2).all(|i| window.min[i] <= k[i] && k[i] <= window.max[i]) {
             return;
         }
-        let inside = |r: &Option<([f32; 2], [f32; 2])>| {
+        let inside = |r: &Option<Rect>| {
             r.is_none_or(|(lo, hi)| lo[0] <= c[0] && c[0] <= hi[0] && lo[1] <= c[1] && c[1] <= hi[1])
         };
         if self.boxes.iter().any(|(b, a, r)| inside(r) && CasterBox::blocks_local(*a, b.local(p))) {
