@@ -154,28 +154,47 @@ pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: 
 }
 
 /// The light's two maps narrowed to the visible points of `input` that a caster can shadow in
-/// each ([`FitWindow::add_point`] by way of [`FitTest`], [`SpotMap::fitted`]): a point no caster's box lies in front of
-/// is lit in that map whatever it holds, so the maps spend their texels where shadows can fall
-/// (a wall that casts but stands behind everything does not widen them). soft.wgsl's `cs_points`
-/// gathers the same windows on the GPU.
+/// each ([`FitWindow::add_point`] by way of [`FitTest`], [`SpotMap::fitted`]): a point no
+/// caster's box lies in front of is lit in that map whatever it holds, so the maps spend their
+/// texels where shadows can fall (a wall that casts but stands behind everything does not widen
+/// them). soft.wgsl's `cs_points` gathers the same windows on the GPU.
+///
+/// The window of every 4th pixel in x and y comes first: it is part of the whole image's, and
+/// [`SpotMap::fitted`]'s half-angle only grows with the window, so when even that window would
+/// not narrow a map by [`hadou_math::soft::FIT_GAIN`] the whole one would not either, and that
+/// map keeps its frustum without a pass over every pixel (scenes whose casters all stand in
+/// view). The result is the whole window's in every case.
 pub fn fitted_maps(light: &AreaLight, input: &SoftInput) -> [SpotMap; 2] {
     let tests = light.maps.map(|m| FitTest::new(&m, &light.caster_boxes));
-    let windows = input
-        .points
-        .par_iter()
-        .with_min_len(4096)
-        .fold(
-            || [FitWindow::EMPTY; 2],
-            |mut w, p| {
-                if let Some(p) = p {
-                    tests[0].add(&mut w[0], p.world);
-                    tests[1].add(&mut w[1], p.world);
-                }
-                w
-            },
-        )
-        .reduce(|| [FitWindow::EMPTY; 2], |a, b| [a[0].union(b[0]), a[1].union(b[1])]);
-    [0, 1].map(|k| light.maps[k].fitted(&windows[k], light.map_size))
+    let windows = |step: usize, which: [bool; 2]| {
+        let w = input.width;
+        input
+            .points
+            .par_chunks(w)
+            .step_by(step)
+            .with_min_len(16)
+            .fold(
+                || [FitWindow::EMPTY; 2],
+                |mut acc, row| {
+                    for p in row.iter().step_by(step).flatten() {
+                        for k in 0..2 {
+                            if which[k] {
+                                tests[k].add(&mut acc[k], p.world);
+                            }
+                        }
+                    }
+                    acc
+                },
+            )
+            .reduce(|| [FitWindow::EMPTY; 2], |a, b| [a[0].union(b[0]), a[1].union(b[1])])
+    };
+    let coarse = windows(4, [true; 2]);
+    let need = [0, 1].map(|k| light.maps[k].fitted(&coarse[k], light.map_size) != light.maps[k]);
+    if !need[0] && !need[1] {
+        return light.maps;
+    }
+    let full = windows(1, need);
+    [0, 1].map(|k| if need[k] { light.maps[k].fitted(&full[k], light.map_size) } else { light.maps[k] })
 }
 
 /// The classes of a frame and how its penumbra pixels look for umbra and lit pixels.

@@ -352,7 +352,8 @@ impl SpotMap {
     /// widened to `1.02·h/(1 − 4/size)` so that a point on the window's edge, moved one texel
     /// along its normal by [`SpotMap::lookup`], stays inside. An empty window (nothing in view can
     /// be shadowed) gives the narrowest frustum around the axis, every point outside it lit; a
-    /// window no narrower than this map, or a map of fewer than 16 texels, keeps this map.
+    /// fitted frustum not narrower than [`FIT_GAIN`] times this map's, or a map of fewer than 16
+    /// texels, keeps this map.
     pub fn fitted(&self, window: &FitWindow, size: u32) -> SpotMap {
         if size < 16 {
             return *self;
@@ -363,7 +364,7 @@ impl SpotMap {
         let c = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
         let h = (0.5 * (hi[0] - lo[0])).max(0.5 * (hi[1] - lo[1]));
         let half = (1.02 * h / (1.0 - 4.0 / size as f32)).max(SPOT_MIN_TAN);
-        if half.is_nan() || half >= self.tan_half || !c[0].is_finite() || !c[1].is_finite() {
+        if half.is_nan() || half > FIT_GAIN * self.tan_half || !c[0].is_finite() || !c[1].is_finite() {
             return *self;
         }
         SpotMap {
@@ -374,6 +375,12 @@ impl SpotMap {
         }
     }
 }
+
+/// Largest ratio of a fitted map's half-angle (`tan`) to the unfitted one's for
+/// [`SpotMap::fitted`] to narrow the map: a window that already fills most of 003's frustum
+/// (every caster in view, as in most scenes) would buy little resolution for the extra texels the
+/// casters then cover, and keeping 003's frustum there leaves those scenes' maps as they were.
+pub const FIT_GAIN: f32 = 0.5;
 
 /// How far short of a point a caster's bounding box must begin on the segment from a map's light
 /// to the point, as a fraction of the segment, to count as able to shadow it ([`CasterBox::blocks`]):
@@ -502,6 +509,26 @@ impl FitTest {
     /// Adds `p` to `window` as [`FitWindow::add_point`] does.
     #[inline]
     pub fn add(&self, window: &mut FitWindow, p: Vec3f) {
+        let v = self.map.to_view(p);
+        if v.z.is_nan() || v.z <= self.map.near {
+            return;
+        }
+        // Without a division: well inside the window gathered so far (shrunk by 10⁻⁵·(1 + |b|)
+        // against rounding) changes nothing; outside every box's rectangle, no box blocks.
+        let within = |lo: [f32; 2], hi: [f32; 2]| {
+            lo[0] * v.z <= v.x && v.x <= hi[0] * v.z && lo[1] * v.z <= v.y && v.y <= hi[1] * v.z
+        };
+        if let Some((lo, hi)) = window.bounds() {
+            let shrink = |b: f32| 1e-5 * (1.0 + b.abs());
+            let lo = lo.map(|b| b + shrink(b));
+            let hi = hi.map(|b| b - shrink(b));
+            if within(lo, hi) {
+                return;
+            }
+        }
+        if !self.boxes.iter().any(|(_, _, r)| r.is_none_or(|(lo, hi)| within(lo, hi))) {
+            return;
+        }
         let Some(c) = self.map.fit_coords(p) else { return };
         let k = [FitWindow::key(c[0]), FitWindow::key(c[1])];
         if (0..2).all(|i| window.min[i] <= k[i] && k[i] <= window.max[i]) {
@@ -898,6 +925,16 @@ mod tests {
         all.add([-map.tan_half, -map.tan_half]);
         all.add([map.tan_half, map.tan_half]);
         assert_eq!(map.fitted(&all, 512), map);
+        // Narrowing by less than FIT_GAIN keeps the map; by more, fits it.
+        let window = |f: f32| {
+            let mut w = FitWindow::default();
+            w.add([-f * map.tan_half, -f * map.tan_half]);
+            w.add([f * map.tan_half, f * map.tan_half]);
+            w
+        };
+        assert_eq!(map.fitted(&window(0.6), 512), map);
+        let narrow = map.fitted(&window(0.4), 512);
+        assert!(narrow.tan_half < FIT_GAIN * map.tan_half && narrow.tan_half > 0.4 * map.tan_half);
         assert_eq!(w.union(FitWindow::EMPTY), w);
     }
 
