@@ -51,6 +51,8 @@ struct GpuCasterBox {
 // The maps' fit windows (hadou_math::soft::FitWindow), map k at 4k: keys of min x/z, min y/z,
 // max x/z, max y/z, gathered by cs_points before the maps are fitted and drawn.
 @group(0) @binding(12) var<storage, read_write> fit: array<atomic<u32>, 8>;
+// One workgroup's part of fit (cs_points).
+var<workgroup> wg_fit: array<atomic<u32>, 8>;
 
 // hadou_math::soft::Class.
 const CLASS_NONE: u32 = 0u;
@@ -148,7 +150,8 @@ fn fit_key(v: f32) -> u32 {
     return b | 0x80000000u;
 }
 
-// Twin of hadou_math::soft::FitWindow::add_point for map k (the unfitted map in soft.maps):
+// Twin of hadou_math::soft::FitWindow::add_point for map k (the unfitted map in soft.maps), into
+// the workgroup's part of the window:
 // p widens map k's window when a caster's box lies in front of it and the map sees it
 // (SpotMap::fit_coords).
 fn fit_point(k: u32, p: vec3<f32>) {
@@ -170,20 +173,40 @@ fn fit_point(k: u32, p: vec3<f32>) {
     let c = clamp(v.xy / v.z, vec2<f32>(-s.tan_half), vec2<f32>(s.tan_half));
     let kx = fit_key(c.x);
     let ky = fit_key(c.y);
-    atomicMin(&fit[4u * k], kx);
-    atomicMin(&fit[4u * k + 1u], ky);
-    atomicMax(&fit[4u * k + 2u], kx);
-    atomicMax(&fit[4u * k + 3u], ky);
+    atomicMin(&wg_fit[4u * k], kx);
+    atomicMin(&wg_fit[4u * k + 1u], ky);
+    atomicMax(&wg_fit[4u * k + 2u], kx);
+    atomicMax(&wg_fit[4u * k + 3u], ky);
 }
 
 // Per tile pixel (twin of hadou-cpu's opaque-pass soft points (opaque.rs) and soft::fitted_maps):
 // the visible point and its unit normal, class CLASS_LIT until cs_class (background and outline
 // hulls CLASS_NONE), and the point added to both maps' fit windows.
 @compute @workgroup_size(8, 8, 1)
-fn cs_points(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= frame.tile_size.x || id.y >= frame.tile_size.y) {
-        return;
+fn cs_points(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    // The workgroup's windows first (shared-memory atomics), then one global atomic per slot:
+    // slots 4k and 4k + 1 are minima, 4k + 2 and 4k + 3 maxima (FitWindow::EMPTY to start).
+    let is_min = (li & 2u) == 0u;
+    if (li < 8u) {
+        atomicStore(&wg_fit[li], select(0u, 0xffffffffu, is_min));
     }
+    workgroupBarrier();
+    if (id.x < frame.tile_size.x && id.y < frame.tile_size.y) {
+        gather_point(id);
+    }
+    workgroupBarrier();
+    if (li < 8u) {
+        let v = atomicLoad(&wg_fit[li]);
+        if (is_min && v != 0xffffffffu) {
+            atomicMin(&fit[li], v);
+        } else if (!is_min && v != 0u) {
+            atomicMax(&fit[li], v);
+        }
+    }
+}
+
+// cs_points for one pixel of the tile.
+fn gather_point(id: vec3<u32>) {
     let px = frame.tile_origin.x + id.x;
     let py = frame.tile_origin.y + id.y;
     let gi = py * frame.image_size.x + px;
