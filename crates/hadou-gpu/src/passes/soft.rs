@@ -116,8 +116,10 @@ pub(crate) struct SoftTargets {
     /// The casters' boxes (soft.wgsl binding 11), room for `box_capacity`.
     boxes: wgpu::Buffer,
     box_capacity: usize,
-    /// The maps' fit windows (binding 12, `FitWindow` keys) and their read-back copy.
+    /// The maps' fit windows (binding 12, `FitWindow` keys) and their read-back copy (not read on
+    /// the web, which cannot wait for it).
     fit: wgpu::Buffer,
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     fit_staging: wgpu::Buffer,
 }
 
