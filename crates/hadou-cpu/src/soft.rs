@@ -17,7 +17,8 @@ use crate::opaque::draw_opaque;
 use crate::raster::{nearest_depths, ScreenProjection, Tris, Vert};
 use crate::setup::FrameSetup;
 use hadou_math::soft::{
-    bilinear, same_surface, segment_brightness, Class, Envelope, SpotMap, FAR, SEARCH_RADIUS,
+    bilinear, same_surface, segment_brightness, Class, Envelope, FitTest, FitWindow, SpotMap, FAR,
+    SEARCH_RADIUS,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame, SoftResolve};
@@ -137,7 +138,7 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 /// point is): the two maps, the classes and the resolve `resolve`. What [`crate::render()`]
 /// multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
-    let maps = light.maps.map(|m| (m, light.map_size));
+    let maps = fitted_maps(light, input).map(|m| (m, light.map_size));
     let [a, b] = maps;
     let (m1, m2) = rayon::join(
         || SpotDepth::render(frame, &light.casters, &a.0, a.1),
@@ -150,6 +151,50 @@ pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: 
         SoftResolve::Exact => search.exact(),
         SoftResolve::Faithful { n } => search.faithful(n.max(1) as usize),
     }
+}
+
+/// The light's two maps narrowed to the visible points of `input` that a caster can shadow in
+/// each ([`FitWindow::add_point`] by way of [`FitTest`], [`SpotMap::fitted`]): a point no
+/// caster's box lies in front of is lit in that map whatever it holds, so the maps spend their
+/// texels where shadows can fall (a wall that casts but stands behind everything does not widen
+/// them). soft.wgsl's `cs_points` gathers the same windows on the GPU.
+///
+/// The window of every 4th pixel in x and y comes first: it is part of the whole image's, and
+/// [`SpotMap::fitted`]'s half-angle only grows with the window, so when even that window would
+/// not narrow a map by [`hadou_math::soft::FIT_GAIN`] the whole one would not either, and that
+/// map keeps its frustum without a pass over every pixel (scenes whose casters all stand in
+/// view). The result is the whole window's in every case.
+pub fn fitted_maps(light: &AreaLight, input: &SoftInput) -> [SpotMap; 2] {
+    let tests = light.maps.map(|m| FitTest::new(&m, &light.caster_boxes));
+    let windows = |step: usize, which: [bool; 2]| {
+        let w = input.width;
+        input
+            .points
+            .par_chunks(w)
+            .step_by(step)
+            .with_min_len(16)
+            .fold(
+                || [FitWindow::EMPTY; 2],
+                |mut acc, row| {
+                    for p in row.iter().step_by(step).flatten() {
+                        for k in 0..2 {
+                            if which[k] {
+                                tests[k].add(&mut acc[k], p.world);
+                            }
+                        }
+                    }
+                    acc
+                },
+            )
+            .reduce(|| [FitWindow::EMPTY; 2], |a, b| [a[0].union(b[0]), a[1].union(b[1])])
+    };
+    let coarse = windows(4, [true; 2]);
+    let need = [0, 1].map(|k| light.maps[k].fitted(&coarse[k], light.map_size) != light.maps[k]);
+    if !need[0] && !need[1] {
+        return light.maps;
+    }
+    let full = windows(1, need);
+    [0, 1].map(|k| if need[k] { light.maps[k].fitted(&full[k], light.map_size) } else { light.maps[k] })
 }
 
 /// The classes of a frame and how its penumbra pixels look for umbra and lit pixels.

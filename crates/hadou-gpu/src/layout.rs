@@ -1059,8 +1059,29 @@ pub struct SoftUniforms {
     pub grid_size: [u32; 2],
     /// `k` of `hadou_math::soft::segment_brightness` (1: 003's linear ratio).
     pub ratio: f32,
+    /// How many caster boxes ([`GpuCasterBox`]) the fit tests.
+    pub boxes: u32,
     /// Padding to the uniform's 16-byte alignment.
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 2],
+}
+
+/// A caster's box in the world (`hadou_math::soft::CasterBox`), as soft.wgsl's map fit reads it.
+/// Keep in sync with `GpuCasterBox` in soft.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuCasterBox {
+    /// The corner (w unused).
+    pub origin: [f32; 4],
+    /// The dual vectors of its edges (w unused).
+    pub dual: [[f32; 4]; 3],
+}
+
+impl GpuCasterBox {
+    /// The box `b`.
+    pub fn new(b: &hadou_math::soft::CasterBox) -> Self {
+        let v = |v: hadou_math::Vec3f| [v.x, v.y, v.z, 0.0];
+        GpuCasterBox { origin: v(b.origin), dual: b.dual.map(v) }
+    }
 }
 
 /// How the wave overlay (wave_overlay.wgsl) reads the caller's depth buffer. Keep in sync with

@@ -140,7 +140,7 @@ pub(crate) struct TileEncoders {
 enum TileWork {
     /// Every pass, then (with `readback`) the copy to the staging buffer.
     Draw { readback: bool },
-    /// The raster pass, then the soft shadows' classification of its pixels.
+    /// The raster pass, then the soft shadows' gathering of its visible points.
     Classify,
 }
 
@@ -394,8 +394,9 @@ impl Renderer {
         Ok(prepared)
     }
 
-    /// The `[area_light]`'s soft shadows over the whole image: its two maps, every tile rasterized
-    /// and classified, then the resolve; the wave passes read the visibility.
+    /// The `[area_light]`'s soft shadows over the whole image: every tile rasterized and its points
+    /// gathered, the two maps fitted to them and drawn, the classes, then the resolve; the wave
+    /// passes read the visibility.
     fn draw_soft(&self, frame: &Frame, prepared: &Prepared) -> Result<(), RenderError> {
         let soft = self.soft.as_ref().expect("created in prepare");
         let groups = prepared.groups.as_ref().expect("bind groups are made in prepare");
@@ -405,10 +406,6 @@ impl Renderer {
         let casters = frame.area_light.as_ref().map_or(&[][..], |l| &l.casters[..]);
         let caster_draws: Vec<Draw> =
             prepared.draws.iter().copied().filter(|dr| casters.contains(&(dr.object as u32))).collect();
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
-        let objects = &prepared.buffers.objects;
-        self.passes.soft.encode_maps(&mut enc, d, soft, objects, &self.meshes, frame, &caster_draws);
-        self.ctx.queue.submit([enc.finish()]);
         // Every tile of the image, whatever rows are asked for: the search needs them all.
         let tile = prepared.tile;
         for y in (0..frame.height).step_by(tile[1] as usize) {
@@ -418,8 +415,11 @@ impl Renderer {
                 self.submit_tile(encoders)?;
             }
         }
-        let mut enc =
-            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft resolve") });
+        soft.fit_maps(&self.ctx, frame)?;
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
+        let objects = &prepared.buffers.objects;
+        self.passes.soft.encode_maps(&mut enc, d, soft, objects, &self.meshes, frame, &caster_draws);
+        self.passes.soft.encode_class(&mut enc, bind_group, frame);
         self.passes.soft.encode_resolve(&mut enc, bind_group, frame);
         self.ctx.queue.submit([enc.finish()]);
         Ok(())
@@ -673,7 +673,7 @@ impl Renderer {
         let readback = match work {
             TileWork::Classify => {
                 if let Some(bg) = soft_bg {
-                    passes.soft.encode_classify(&mut shading, bg, size);
+                    passes.soft.encode_points(&mut shading, bg, size);
                 }
                 return TileEncoders { surfaces, shading };
             }

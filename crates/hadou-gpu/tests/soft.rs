@@ -13,7 +13,7 @@
 mod common;
 
 use common::*;
-use hadou_cpu::soft::{classify, soft_input, visibility, SpotDepth};
+use hadou_cpu::soft::{classify, fitted_maps, soft_input, visibility, SpotDepth};
 use hadou_cpu::CpuBackend;
 use hadou_scene::{Backend, Frame, SoftResolve};
 
@@ -30,7 +30,8 @@ fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
     let c = CpuBackend::new().render(frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
     let light = frame.area_light.as_ref().expect("an area light");
     let input = soft_input(frame).expect("an area light");
-    let maps = light.maps.map(|m| SpotDepth::render(frame, &light.casters, &m, light.map_size));
+    let maps =
+        fitted_maps(light, &input).map(|m| SpotDepth::render(frame, &light.casters, &m, light.map_size));
     let c_class = classify(&maps, &input);
     let c_vis = visibility(frame, light, &input, light.resolve);
     let n = g_class.len();
@@ -79,4 +80,29 @@ fn soft_shadows_match_cpu() {
         light.depth_aware = false;
         check(&mut gpu, &format!("{label} exact, not depth-aware"), &plain);
     }
+}
+
+#[test]
+fn the_gpu_fits_the_maps_as_the_cpu_does() {
+    // soft-plaster at t = 1.5, where the wall (a caster too) would stretch unfitted maps to
+    // tan 80°: the GPU's classes match the CPU's fitted ones, which differ from the unfitted
+    // maps' at more than twice the share of pixels the tolerance allows, so the GPU must fit
+    // them alike.
+    let Some(mut gpu) = gpu_or_skip("soft shadows fitted") else { return };
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/soft-plaster.toml");
+    let mut frame = hadou_scene::Scene::load(dir).unwrap_or_else(|e| panic!("{e}")).at(1.5);
+    (frame.width, frame.height) = (192, 192);
+    let light = frame.area_light.as_ref().expect("an area light");
+    let input = soft_input(&frame).expect("an area light");
+    let render = |maps: [hadou_math::soft::SpotMap; 2]| {
+        classify(&maps.map(|m| SpotDepth::render(&frame, &light.casters, &m, light.map_size)), &input)
+    };
+    let (fitted, full) = (render(fitted_maps(light, &input)), render(light.maps));
+    let differ = fitted.iter().zip(&full).filter(|(a, b)| a != b).count();
+    let n = fitted.len();
+    assert!(
+        differ as f64 > 2.0 * CLASS_FLIP_SHARE * n as f64,
+        "{differ} of {n} pixels change class with the fit"
+    );
+    check(&mut gpu, "soft-plaster.toml t=1.5 at 192²", &frame);
 }

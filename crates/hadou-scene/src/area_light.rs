@@ -4,7 +4,7 @@
 //! `L₂ = L − l·P` and their perspective frames, and how the penumbra is resolved
 //! ([`SoftResolve`], [`Penumbra`]). `area_light_def.rs` reads the table and builds this value.
 
-use hadou_math::soft::SpotMap;
+use hadou_math::soft::{CasterBox, SpotMap};
 use hadou_math::Vec3f;
 
 /// Most pixels of an image with an `[area_light]` (4096²): the penumbra search works on the whole
@@ -61,7 +61,12 @@ pub struct AreaLight {
     /// The objects drawn into the maps (indices into `Frame::objects`); every object receives.
     pub casters: Vec<u32>,
     /// The two maps: `[L₁ = L + l·P, L₂ = L − l·P]`, each looking at `G`, every caster inside.
+    /// The renderers narrow each to the visible points that a caster can shadow
+    /// ([`hadou_math::soft::SpotMap::fitted`]) before drawing it.
     pub maps: [SpotMap; 2],
+    /// The casters' boxes in the world ([`crate::caster_box`]), in the order of `casters`
+    /// less the empty meshes: what the maps are fitted with.
+    pub caster_boxes: Vec<CasterBox>,
 }
 
 impl AreaLight {

@@ -3,7 +3,7 @@
 //! of values: `G` from an object or a point, and the two map frames around every caster.
 
 use crate::area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID};
-use crate::bounds::{box_corners, object_bounds, object_center};
+use crate::bounds::{box_corners, caster_box, object_bounds, object_center};
 use crate::frame::Object;
 use crate::limits::fmt_f32;
 use crate::params::{Constraint, ParamSet, Shape};
@@ -245,5 +245,6 @@ pub(crate) fn build_area_light(
         penumbra: def.penumbra,
         casters: def.casters.clone(),
         maps: [SpotMap::look(l1, g, &corners), SpotMap::look(l2, g, &corners)],
+        caster_boxes: def.casters.iter().filter_map(|&c| caster_box(&objects[c as usize])).collect(),
     }
 }

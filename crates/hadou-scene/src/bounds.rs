@@ -3,6 +3,7 @@
 //! them.
 
 use crate::frame::{Mesh, Object};
+use hadou_math::soft::CasterBox;
 use hadou_math::{Vec3, Vec3f};
 
 /// World-space axis-aligned bounds of an object's mesh: the 8 transformed corners of its local
@@ -17,6 +18,33 @@ pub fn object_bounds(o: &Object) -> Option<(Vec3f, Vec3f)> {
         w_hi = w_hi.max(w);
     }
     Some((w_lo, w_hi))
+}
+
+/// The box a caster's mesh lies in, placed in the world (its local bounds under its transform, a
+/// parallelepiped), as the area light's map fit tests it ([`CasterBox::blocks`]). A side of the
+/// local bounds shorter than `10⁻⁶` of the longest (a flat mesh) is widened by that much on both
+/// ends so that the box spans a volume; a transform that flattens it falls back to the
+/// world-space bounds ([`object_bounds`]) so widened. `None` for an empty mesh or bounds that are not finite.
+pub fn caster_box(o: &Object) -> Option<CasterBox> {
+    let widen = |(lo, hi): (Vec3f, Vec3f)| {
+        let e = hi - lo;
+        let m = e.x.max(e.y).max(e.z);
+        let pad = |x: f32| if x > 1e-6 * m { 0.0 } else { 1e-6 * m.max(1e-3) };
+        let pad = Vec3::new(pad(e.x), pad(e.y), pad(e.z));
+        (lo - pad, hi + pad)
+    };
+    let (lo, hi) = widen(local_bounds(o)?);
+    let m = &o.transform;
+    let e = hi - lo;
+    let edges = [Vec3::new(e.x, 0.0, 0.0), Vec3::new(0.0, e.y, 0.0), Vec3::new(0.0, 0.0, e.z)];
+    CasterBox::from_edges(m.transform_point(lo), edges.map(|v| m.transform_vector(v))).or_else(|| {
+        let (lo, hi) = widen(object_bounds(o)?);
+        let e = hi - lo;
+        CasterBox::from_edges(
+            lo,
+            [Vec3::new(e.x, 0.0, 0.0), Vec3::new(0.0, e.y, 0.0), Vec3::new(0.0, 0.0, e.z)],
+        )
+    })
 }
 
 /// The centre `B` of a caster (000 §2.4's "model's centre"): the centre of its mesh's local

@@ -1,7 +1,7 @@
-//! Splits the soft-shadow stage of `scenes/soft-gradient.toml` into its parts: the two maps, the
-//! classes, and each resolve. `cargo run --release -p hadou --example soft_parts [SIZE]`.
+//! Splits the soft-shadow stage of `scenes/soft-gradient.toml` into its parts: the maps' fit, the
+//! two maps, the classes, and each resolve. `cargo run --release -p hadou --example soft_parts [SIZE]`.
 
-use hadou_cpu::soft::{classify, soft_input, visibility, SpotDepth};
+use hadou_cpu::soft::{classify, fitted_maps, soft_input, visibility, SpotDepth};
 use hadou_scene::{Scene, SoftResolve};
 use std::time::Instant;
 
@@ -26,21 +26,25 @@ fn main() {
     frame.height = size;
     let light = frame.area_light.clone().expect("area light");
     let input = soft_input(&frame).expect("area light");
+    let fit_ms = median(|| {
+        let _ = fitted_maps(&light, &input);
+    });
+    let fitted = fitted_maps(&light, &input);
     let maps_ms = median(|| {
         let _ = rayon::join(
-            || SpotDepth::render(&frame, &light.casters, &light.maps[0], light.map_size),
-            || SpotDepth::render(&frame, &light.casters, &light.maps[1], light.map_size),
+            || SpotDepth::render(&frame, &light.casters, &fitted[0], light.map_size),
+            || SpotDepth::render(&frame, &light.casters, &fitted[1], light.map_size),
         );
     });
-    let maps = light.maps.map(|m| SpotDepth::render(&frame, &light.casters, &m, light.map_size));
+    let maps = fitted.map(|m| SpotDepth::render(&frame, &light.casters, &m, light.map_size));
     let class_ms = median(|| {
         let _ = classify(&maps, &input);
     });
-    println!("{size}²: maps {maps_ms:.2} ms, classes {class_ms:.2} ms");
+    println!("{size}²: fit {fit_ms:.2} ms, maps {maps_ms:.2} ms, classes {class_ms:.2} ms");
     for (name, r) in [("exact", SoftResolve::Exact), ("faithful-n3", SoftResolve::Faithful { n: 3 })] {
         let ms = median(|| {
             let _ = visibility(&frame, &light, &input, r);
         });
-        println!("{name}: whole stage {ms:.2} ms, resolve ≈ {:.2} ms", ms - maps_ms - class_ms);
+        println!("{name}: whole stage {ms:.2} ms, resolve ≈ {:.2} ms", ms - fit_ms - maps_ms - class_ms);
     }
 }

@@ -1,8 +1,10 @@
 //! The `[area_light]`'s soft shadows (003; `shaders/soft_map.wgsl`, `shaders/soft.wgsl`; twin of
-//! hadou-cpu's `soft`). They need the whole image at once: the light's two perspective maps are
-//! drawn first ([`SoftPass::encode_maps`]), then every tile of the image is rasterized and its
-//! pixels classed umbra / penumbra / lit into whole-image buffers ([`SoftPass::encode_classify`],
-//! `cs_classify`), the penumbra is resolved over the whole image ([`SoftPass::encode_resolve`]:
+//! hadou-cpu's `soft`). They need the whole image at once: every tile of the image is rasterized
+//! and its visible points gathered into whole-image buffers, with the bounds of those that a
+//! caster's box lies in front of ([`SoftPass::encode_points`], `cs_points`); the light's two
+//! perspective maps are fitted to those bounds ([`SoftTargets::fit_maps`]) and drawn
+//! ([`SoftPass::encode_maps`]), every pixel is classed umbra / penumbra / lit
+//! ([`SoftPass::encode_class`], `cs_class`), the penumbra is resolved over the whole image ([`SoftPass::encode_resolve`]:
 //! `cs_columns` + `cs_exact`, or 003's grid search `cs_grid` + `cs_interp`), and each tile's wave
 //! pass takes its visibility ([`SoftPass::encode_gather`], `cs_gather`, through the output's
 //! eye-distance slot, so the wave pass needs no binding of its own for it). The renderer's tile
@@ -15,10 +17,11 @@ use super::setup::{
 };
 use crate::device::GpuContext;
 use crate::formats::{MAP_FORMAT, SPOT_FORMAT};
-use crate::layout::{GpuSpotMap, SoftUniforms};
+use crate::layout::{GpuCasterBox, GpuSpotMap, SoftUniforms};
 use crate::meshes::MeshCache;
 use crate::shaders;
 use crate::timing::PassQueries;
+use hadou_math::soft::FitWindow;
 use hadou_scene::{Frame, RenderError, SoftResolve};
 
 const VS: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX;
@@ -29,7 +32,7 @@ pub(crate) const MAP_BINDINGS: [Binding; 2] =
     [Binding::new(0, "spot", Kind::Uniform, VS), Binding::new(1, "objects", Kind::Storage, VS)];
 
 /// The bindings of soft.wgsl.
-pub(crate) const BINDINGS: [Binding; 11] = [
+pub(crate) const BINDINGS: [Binding; 13] = [
     Binding::new(0, "frame", Kind::Uniform, CS),
     Binding::new(1, "soft", Kind::Uniform, CS),
     Binding::new(2, "scene_texels", Kind::UintTexture, CS),
@@ -41,9 +44,12 @@ pub(crate) const BINDINGS: [Binding; 11] = [
     Binding::new(8, "visibility", Kind::StorageRw, CS),
     Binding::new(9, "grid", Kind::StorageRw, CS),
     Binding::new(10, "out_buf", Kind::StorageRw, CS),
+    Binding::new(11, "caster_boxes", Kind::Storage, CS),
+    Binding::new(12, "fit", Kind::StorageRw, CS),
 ];
 
-/// What soft.wgsl reads from a tile (the rest, [`BINDINGS`] 1 and 4–9, is [`SoftTargets`]'s).
+/// What soft.wgsl reads from a tile (the rest, [`BINDINGS`] 1, 4–9, 11 and 12, is
+/// [`SoftTargets`]'s).
 pub(crate) struct SoftTileInputs<'a> {
     /// The tile's `layout::FrameUniforms`.
     pub(crate) uniforms: &'a wgpu::Buffer,
@@ -107,7 +113,18 @@ pub(crate) struct SoftTargets {
     normal: wgpu::Buffer,
     visibility: wgpu::Buffer,
     grid: wgpu::Buffer,
+    /// The casters' boxes (soft.wgsl binding 11), room for `box_capacity`.
+    boxes: wgpu::Buffer,
+    box_capacity: usize,
+    /// The maps' fit windows (binding 12, `FitWindow` keys) and their read-back copy (not read on
+    /// the web, which cannot wait for it).
+    fit: wgpu::Buffer,
+    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+    fit_staging: wgpu::Buffer,
 }
+
+/// Bytes of the fit windows: four `u32` keys per map.
+const FIT_BYTES: u64 = 32;
 
 impl SoftTargets {
     /// Makes `soft` fit `frame` (which has an `[area_light]`) and writes its uniforms.
@@ -120,7 +137,8 @@ impl SoftTargets {
         let gs = grid_size(frame.width, frame.height, n.max(1));
         let grid_len = if n == 0 { 1 } else { gs[0] * gs[1] };
         let key = (frame.width, frame.height, light.map_size.max(1), grid_len);
-        if soft.as_ref().is_none_or(|s| s.key != key) {
+        let boxes = light.caster_boxes.len().max(1);
+        if soft.as_ref().is_none_or(|s| s.key != key || s.box_capacity < boxes) {
             *soft = None; // free the old ones first
             let d = &ctx.device;
             let size = key.2;
@@ -148,22 +166,78 @@ impl SoftTargets {
                 normal: buffer("soft normals", pixels * 16, storage),
                 visibility: buffer("soft visibility", pixels * 4, storage),
                 grid: buffer("soft grid", grid_len as u64 * 4, storage),
+                boxes: buffer(
+                    "soft caster boxes",
+                    (boxes * std::mem::size_of::<GpuCasterBox>()) as u64,
+                    wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                ),
+                box_capacity: boxes,
+                fit: buffer("soft fit", FIT_BYTES, storage | wgpu::BufferUsages::COPY_DST),
+                fit_staging: buffer(
+                    "soft fit read-back",
+                    FIT_BYTES,
+                    wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                ),
             });
         }
         let soft = soft.as_ref().expect("created above");
-        let maps = light.maps.map(|m| GpuSpotMap::new(&m, key.2));
+        // The unfitted maps, which cs_points fits the windows in; `fit_maps` narrows them.
+        soft.write_maps(ctx, frame, light.maps);
+        let boxes: Vec<GpuCasterBox> = light.caster_boxes.iter().map(GpuCasterBox::new).collect();
+        if !boxes.is_empty() {
+            ctx.queue.write_buffer(&soft.boxes, 0, bytemuck::cast_slice(&boxes));
+        }
+        let empty = FitWindow::EMPTY;
+        let keys = [empty.min, empty.max, empty.min, empty.max].concat();
+        ctx.queue.write_buffer(&soft.fit, 0, bytemuck::cast_slice(&keys));
+    }
+
+    /// Writes the maps `maps` of the frame's `[area_light]` into soft_map.wgsl's and soft.wgsl's
+    /// uniforms.
+    fn write_maps(&self, ctx: &GpuContext, frame: &Frame, maps: [hadou_math::soft::SpotMap; 2]) {
+        let light = frame.area_light.as_ref().expect("an area light");
+        let n = match light.resolve {
+            SoftResolve::Exact => 0,
+            SoftResolve::Faithful { n } => n.max(1),
+        };
+        let maps = maps.map(|m| GpuSpotMap::new(&m, self.key.2));
         let q = &ctx.queue;
-        q.write_buffer(&soft.spot_uniforms[0], 0, bytemuck::bytes_of(&maps[0]));
-        q.write_buffer(&soft.spot_uniforms[1], 0, bytemuck::bytes_of(&maps[1]));
+        q.write_buffer(&self.spot_uniforms[0], 0, bytemuck::bytes_of(&maps[0]));
+        q.write_buffer(&self.spot_uniforms[1], 0, bytemuck::bytes_of(&maps[1]));
         let u = SoftUniforms {
             maps,
             depth_aware: u32::from(light.depth_aware),
             grid: n,
-            grid_size: gs,
+            grid_size: grid_size(frame.width, frame.height, n.max(1)),
             ratio: light.penumbra_ratio(),
-            _pad: [0; 3],
+            boxes: light.caster_boxes.len() as u32,
+            _pad: [0; 2],
         };
-        q.write_buffer(&soft.uniforms, 0, bytemuck::bytes_of(&u));
+        q.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// Once every tile's `cs_points` has run: reads the maps' fit windows back and writes the
+    /// maps fitted to them (`SpotMap::fitted`, as hadou-cpu's `soft::fitted_maps`) for the map
+    /// and classification passes. On the web, where a frame cannot wait for a read-back, the maps
+    /// stay unfitted.
+    pub(crate) fn fit_maps(&self, ctx: &GpuContext, frame: &Frame) -> Result<(), RenderError> {
+        let light = frame.area_light.as_ref().expect("an area light");
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            enc.copy_buffer_to_buffer(&self.fit, 0, &self.fit_staging, 0, FIT_BYTES);
+            let submission = ctx.queue.submit([enc.finish()]);
+            let keys = ctx.read_buffer(&self.fit_staging, FIT_BYTES, submission, |raw| {
+                let k: Vec<u32> =
+                    raw.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+                [0, 1].map(|m| FitWindow { min: [k[4 * m], k[4 * m + 1]], max: [k[4 * m + 2], k[4 * m + 3]] })
+            })?;
+            let maps = [0, 1].map(|m| light.maps[m].fitted(&keys[m], light.map_size));
+            self.write_maps(ctx, frame, maps);
+        }
+        #[cfg(target_arch = "wasm32")]
+        let _ = (ctx, light);
+        Ok(())
     }
 
     /// After a frame with an `[area_light]` has been drawn: every pixel's soft-shadow class
@@ -196,7 +270,8 @@ impl SoftTargets {
 
 /// The compute pipelines of soft.wgsl.
 struct SoftPipelines {
-    classify: wgpu::ComputePipeline,
+    points: wgpu::ComputePipeline,
+    class: wgpu::ComputePipeline,
     columns: wgpu::ComputePipeline,
     exact: wgpu::ComputePipeline,
     grid: wgpu::ComputePipeline,
@@ -255,7 +330,8 @@ impl SoftPass {
                 })
             };
             let pipelines = SoftPipelines {
-                classify: pipeline("cs_classify"),
+                points: pipeline("cs_points"),
+                class: pipeline("cs_class"),
                 columns: pipeline("cs_columns"),
                 exact: pipeline("cs_exact"),
                 grid: pipeline("cs_grid"),
@@ -286,6 +362,8 @@ impl SoftPass {
             targets.visibility.as_entire_binding(),
             targets.grid.as_entire_binding(),
             tile.output.as_entire_binding(),
+            targets.boxes.as_entire_binding(),
+            targets.fit.as_entire_binding(),
         ];
         setup::bind_group(device, "soft", &self.layout, &BINDINGS, resources)
     }
@@ -343,17 +421,32 @@ impl SoftPass {
         }
     }
 
-    /// Records the classification of a `size` tile's pixels (`cs_classify`), after its raster pass.
-    pub(crate) fn encode_classify(
+    /// Records the gathering of a `size` tile's visible points and the maps' fit windows
+    /// (`cs_points`), after its raster pass.
+    pub(crate) fn encode_points(
         &self,
         enc: &mut wgpu::CommandEncoder,
         bind_group: &wgpu::BindGroup,
         size: [u32; 2],
     ) {
         let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&self.pipelines.classify);
+        pass.set_pipeline(&self.pipelines.points);
         pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(size[0].div_ceil(8), size[1].div_ceil(8), 1);
+    }
+
+    /// Records the classification of the whole image's pixels (`cs_class`), once every tile's
+    /// points are gathered and the fitted maps drawn.
+    pub(crate) fn encode_class(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        bind_group: &wgpu::BindGroup,
+        frame: &Frame,
+    ) {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&self.pipelines.class);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.dispatch_workgroups(frame.width.div_ceil(8), frame.height.div_ceil(8), 1);
     }
 
     /// Records the resolve of the whole image's penumbra, once every tile is classified: 003's grid

@@ -1,5 +1,6 @@
-// Soft shadows of the `[area_light]` (twin of hadou-cpu's soft.rs): every pixel classed umbra /
-// penumbra / lit from the two maps (soft_map.wgsl), then the penumbra resolved over the whole
+// Soft shadows of the `[area_light]` (twin of hadou-cpu's soft.rs): every tile's visible points
+// gathered and the maps' fit windows with them (cs_points), every pixel classed umbra / penumbra /
+// lit from the two fitted maps (soft_map.wgsl, cs_class), then the penumbra resolved over the whole
 // image: exact distances (cs_columns, cs_exact) or 003's grid search with bilinear interpolation
 // (cs_grid, cs_interp); cs_gather hands each tile's visibility to the wave pass. Prepended by
 // common.wgsl.
@@ -17,9 +18,18 @@ struct SoftUniforms {
     grid_size: vec2<u32>,
     // k of hadou_math::soft::segment_brightness (1: 003's linear ratio).
     ratio: f32,
-    _pad0: u32,
+    // How many of caster_boxes are the casters'.
+    boxes: u32,
     _pad1: u32,
     _pad2: u32,
+}
+
+// Keep in sync with layout.rs `GpuCasterBox` (hadou_math::soft::CasterBox).
+struct GpuCasterBox {
+    origin: vec4<f32>,
+    dual0: vec4<f32>,
+    dual1: vec4<f32>,
+    dual2: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: FrameUniforms;
@@ -36,6 +46,13 @@ struct SoftUniforms {
 @group(0) @binding(9) var<storage, read_write> grid: array<f32>;
 // The tile's output buffer (wave.wgsl): cs_gather writes the visibility to its eye-distance slot.
 @group(0) @binding(10) var<storage, read_write> out_buf: array<f32>;
+// The casters' boxes in the world (the first soft.boxes).
+@group(0) @binding(11) var<storage, read> caster_boxes: array<GpuCasterBox>;
+// The maps' fit windows (hadou_math::soft::FitWindow), map k at 4k: keys of min x/z, min y/z,
+// max x/z, max y/z, gathered by cs_points before the maps are fitted and drawn.
+@group(0) @binding(12) var<storage, read_write> fit: array<atomic<u32>, 8>;
+// One workgroup's part of fit (cs_points).
+var<workgroup> wg_fit: array<atomic<u32>, 8>;
 
 // hadou_math::soft::Class.
 const CLASS_NONE: u32 = 0u;
@@ -48,6 +65,8 @@ const R2: u32 = 65536u;
 // hadou_math::soft::DEPTH_SLOPE, BIAS_TEXELS.
 const DEPTH_SLOPE: f32 = 0.3;
 const BIAS_TEXELS: f32 = 1.5;
+// hadou_math::soft::FIT_MARGIN.
+const FIT_MARGIN: f32 = 1e-4;
 // A squared distance standing for "none" (hadou_math::soft::FAR).
 const FAR: u32 = 0xffffffffu;
 const NO_ROW: u32 = 0xffffu;
@@ -93,14 +112,101 @@ fn spot_shadowed(k: u32, p: vec3<f32>, n: vec3<f32>) -> bool {
     return stored < v.z - BIAS_TEXELS * spot_texel(s, v.z);
 }
 
-// Per tile pixel (twin of hadou-cpu's opaque-pass soft points (opaque.rs) and soft::classify): the visible point,
-// its unit normal and its class (hadou_math::soft::Class::of); background and outline hulls are
-// CLASS_NONE.
-@compute @workgroup_size(8, 8, 1)
-fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= frame.tile_size.x || id.y >= frame.tile_size.y) {
+// Twin of hadou_math::soft::CasterBox::local.
+fn box_local(b: GpuCasterBox, q: vec3<f32>) -> vec3<f32> {
+    let d = q - b.origin.xyz;
+    return vec3<f32>(dot3(d, b.dual0.xyz), dot3(d, b.dual1.xyz), dot3(d, b.dual2.xyz));
+}
+
+// Twin of hadou_math::soft::CasterBox::blocks: the segment from eye to p meets the box before
+// 1 − FIT_MARGIN of its length.
+fn box_blocks(b: GpuCasterBox, eye: vec3<f32>, p: vec3<f32>) -> bool {
+    let a = box_local(b, eye);
+    let e = box_local(b, p);
+    var t0 = 0.0;
+    var t1 = 1.0 - FIT_MARGIN;
+    for (var i = 0; i < 3; i++) {
+        let d = e[i] - a[i];
+        if (abs(d) < 1e-7) {
+            if (!(a[i] >= 0.0 && a[i] <= 1.0)) {
+                return false;
+            }
+        } else {
+            let ta = -a[i] / d;
+            let tb = (1.0 - a[i]) / d;
+            t0 = max(t0, min(ta, tb));
+            t1 = min(t1, max(ta, tb));
+        }
+    }
+    return t0 <= t1;
+}
+
+// Twin of hadou_math::soft::FitWindow::key.
+fn fit_key(v: f32) -> u32 {
+    let b = bitcast<u32>(v);
+    if ((b & 0x80000000u) != 0u) {
+        return ~b;
+    }
+    return b | 0x80000000u;
+}
+
+// Twin of hadou_math::soft::FitWindow::add_point for map k (the unfitted map in soft.maps), into
+// the workgroup's part of the window:
+// p widens map k's window when a caster's box lies in front of it and the map sees it
+// (SpotMap::fit_coords).
+fn fit_point(k: u32, p: vec3<f32>) {
+    let s = soft.maps[k];
+    var blocked = false;
+    for (var i = 0u; i < soft.boxes; i++) {
+        if (box_blocks(caster_boxes[i], s.eye, p)) {
+            blocked = true;
+            break;
+        }
+    }
+    if (!blocked) {
         return;
     }
+    let v = spot_to_view(s, p);
+    if (!(v.z > s.near)) {
+        return;
+    }
+    let c = clamp(v.xy / v.z, vec2<f32>(-s.tan_half), vec2<f32>(s.tan_half));
+    let kx = fit_key(c.x);
+    let ky = fit_key(c.y);
+    atomicMin(&wg_fit[4u * k], kx);
+    atomicMin(&wg_fit[4u * k + 1u], ky);
+    atomicMax(&wg_fit[4u * k + 2u], kx);
+    atomicMax(&wg_fit[4u * k + 3u], ky);
+}
+
+// Per tile pixel (twin of hadou-cpu's opaque-pass soft points (opaque.rs) and soft::fitted_maps):
+// the visible point and its unit normal, class CLASS_LIT until cs_class (background and outline
+// hulls CLASS_NONE), and the point added to both maps' fit windows.
+@compute @workgroup_size(8, 8, 1)
+fn cs_points(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    // The workgroup's windows first (shared-memory atomics), then one global atomic per slot:
+    // slots 4k and 4k + 1 are minima, 4k + 2 and 4k + 3 maxima (FitWindow::EMPTY to start).
+    let is_min = (li & 2u) == 0u;
+    if (li < 8u) {
+        atomicStore(&wg_fit[li], select(0u, 0xffffffffu, is_min));
+    }
+    workgroupBarrier();
+    if (id.x < frame.tile_size.x && id.y < frame.tile_size.y) {
+        gather_point(id);
+    }
+    workgroupBarrier();
+    if (li < 8u) {
+        let v = atomicLoad(&wg_fit[li]);
+        if (is_min && v != 0xffffffffu) {
+            atomicMin(&fit[li], v);
+        } else if (!is_min && v != 0u) {
+            atomicMax(&fit[li], v);
+        }
+    }
+}
+
+// cs_points for one pixel of the tile.
+fn gather_point(id: vec3<u32>) {
     let px = frame.tile_origin.x + id.x;
     let py = frame.tile_origin.y + id.y;
     let gi = py * frame.image_size.x + px;
@@ -117,6 +223,26 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
     if (len > 0.0 && len < 3.0e38) {
         n = texel.xyz / len;
     }
+    fit_point(0u, world);
+    fit_point(1u, world);
+    soft_world[gi] = vec4<u32>(bitcast<vec3<u32>>(world), CLASS_LIT);
+    soft_normal[gi] = vec4<u32>(bitcast<vec3<u32>>(n), 0u);
+}
+
+// Per image pixel, once the fitted maps are drawn (twin of hadou-cpu's soft::classify): the class
+// of every visible point from the two maps (hadou_math::soft::Class::of).
+@compute @workgroup_size(8, 8, 1)
+fn cs_class(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= frame.image_size.x || id.y >= frame.image_size.y) {
+        return;
+    }
+    let gi = id.y * frame.image_size.x + id.x;
+    let w = soft_world[gi];
+    if (w.w == CLASS_NONE) {
+        return;
+    }
+    let world = bitcast<vec3<f32>>(w.xyz);
+    let n = bitcast<vec3<f32>>(soft_normal[gi].xyz);
     let s1 = spot_shadowed(0u, world, n);
     let s2 = spot_shadowed(1u, world, n);
     var kind = CLASS_PENUMBRA;
@@ -125,8 +251,7 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
     } else if (!s1 && !s2) {
         kind = CLASS_LIT;
     }
-    soft_world[gi] = vec4<u32>(bitcast<vec3<u32>>(world), kind);
-    soft_normal[gi] = vec4<u32>(bitcast<vec3<u32>>(n), 0u);
+    soft_world[gi].w = kind;
 }
 
 fn class_at(i: u32) -> u32 {
