@@ -62,9 +62,9 @@ fn scene(size: u32, samples: u32) -> Frame {
 }
 
 /// Distinct 8-bit colours (by the red, green and blue codes).
-fn codes(img: &Image, i: usize) -> [u8; 3] {
+fn codes(img: &Image, i: usize) -> [i32; 3] {
     let c = img.color[i];
-    [0, 1, 2].map(|k| (c[k].clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+    [0, 1, 2].map(|k| (c[k].clamp(0.0, 1.0) * 255.0 + 0.5) as i32)
 }
 
 /// Pixels whose colour lies strictly between both horizontal neighbours' in every channel that
