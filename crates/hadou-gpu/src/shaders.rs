@@ -5,7 +5,8 @@
 //! - wave module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
 //!   `shading_bindings.wgsl` + `shading.wgsl` + `shadow_bindings.wgsl` + `shadow_lookup.wgsl` +
 //!   `wave.wgsl` (surface shading with the waves as
-//!   lights, hard shadows, energy integration, colour mapping);
+//!   lights, hard shadows, energy integration, colour mapping); the wave samples module is the
+//!   wave module + `wave_samples.wgsl` (the same pixel resolved from its anti-aliasing samples);
 //! - wave overlay module: `common.wgsl` + `energy.wgsl` + `curve.wgsl` + `wave_energy.wgsl` +
 //!   `wave_overlay.wgsl` (the waves' light into a caller's colour target against its depth);
 //! - shadow module: `common.wgsl` + `shadow_raster.wgsl` (the plane-shadow pass and the shadow
@@ -36,6 +37,8 @@ pub const SHADING_BINDINGS: &str = include_str!("shaders/shading_bindings.wgsl")
 pub const RASTER: &str = include_str!("shaders/raster.wgsl");
 /// The wave pass.
 pub const WAVE: &str = include_str!("shaders/wave.wgsl");
+/// The wave pass of a frame with several samples per pixel (entry point `cs_samples`).
+pub const WAVE_SAMPLES: &str = include_str!("shaders/wave_samples.wgsl");
 /// The waves' light on one pixel (shared by the wave pass and the wave overlay).
 pub const WAVE_ENERGY: &str = include_str!("shaders/wave_energy.wgsl");
 /// The wave overlay: the waves' light into a caller's colour target against its depth buffer.
@@ -78,6 +81,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("soft_map.wgsl", SOFT_MAP),
     ("wave.wgsl", WAVE),
     ("wave_energy.wgsl", WAVE_ENERGY),
+    ("wave_samples.wgsl", WAVE_SAMPLES),
     ("wave_overlay.wgsl", WAVE_OVERLAY),
 ];
 
@@ -86,6 +90,19 @@ pub const RASTER_PARTS: &[&str] = &[COMMON, RASTER];
 /// The parts of the wave module, in order.
 pub const WAVE_PARTS: &[&str] =
     &[COMMON, ENERGY, CURVE, WAVE_ENERGY, SHADING_BINDINGS, SHADING, SHADOW_BINDINGS, SHADOW_LOOKUP, WAVE];
+/// The parts of the wave samples module (anti-aliased frames), in order.
+pub const WAVE_SAMPLES_PARTS: &[&str] = &[
+    COMMON,
+    ENERGY,
+    CURVE,
+    WAVE_ENERGY,
+    SHADING_BINDINGS,
+    SHADING,
+    SHADOW_BINDINGS,
+    SHADOW_LOOKUP,
+    WAVE,
+    WAVE_SAMPLES,
+];
 /// The parts of the wave overlay module, in order.
 pub const WAVE_OVERLAY_PARTS: &[&str] = &[COMMON, ENERGY, CURVE, WAVE_ENERGY, WAVE_OVERLAY];
 /// The parts of the shadow module, in order.
@@ -132,6 +149,7 @@ mod tests {
         vec![
             ("raster module", validate("raster module", &compose(RASTER_PARTS))),
             ("wave module", validate("wave module", &compose(WAVE_PARTS))),
+            ("wave samples module", validate("wave samples module", &compose(WAVE_SAMPLES_PARTS))),
             ("shadow module", validate("shadow module", &compose(SHADOW_PARTS))),
             ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
@@ -170,7 +188,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 9);
+        assert_eq!(modules.len(), 10);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
@@ -186,6 +204,7 @@ mod tests {
             let used = RASTER_PARTS
                 .iter()
                 .chain(WAVE_PARTS)
+                .chain(WAVE_SAMPLES_PARTS)
                 .chain(SHADOW_PARTS)
                 .chain(SOFT_MAP_PARTS)
                 .chain(SOFT_PARTS)

@@ -35,11 +35,12 @@ mod tests {
     #[test]
     fn pass_bindings_match_their_shaders() {
         let c = shaders::compose;
-        let passes: [(&str, String, &[Binding], bool); 11] = [
+        let passes: [(&str, String, &[Binding], bool); 12] = [
             ("bloom", c(shaders::BLOOM_PARTS), &super::bloom::BINDINGS, true),
             ("raster", c(shaders::RASTER_PARTS), &super::raster::BINDINGS, true),
             ("edges", c(shaders::EDGES_PARTS), &super::edges::BINDINGS, true),
             ("wave", c(shaders::WAVE_PARTS), &super::wave::BINDINGS, true),
+            ("wave samples", c(shaders::WAVE_SAMPLES_PARTS), &super::wave::BINDINGS, true),
             ("plane shadows", c(shaders::SHADOW_PARTS), &super::plane_shadows::BINDINGS, true),
             // vs_map reads only some of shadow_raster.wgsl's bindings.
             ("shadow maps", c(shaders::SHADOW_PARTS), &super::shadow_maps::BINDINGS, false),

@@ -77,7 +77,7 @@ pub(crate) struct WaveVariant(u32);
 
 impl WaveVariant {
     /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
-    pub(crate) const NAMES: [&'static str; 28] = [
+    pub(crate) const NAMES: [&'static str; 27] = [
         // wave.wgsl
         "USE_SPHERE",
         "USE_CYLINDER",
@@ -88,7 +88,6 @@ impl WaveVariant {
         "USE_AREA",
         "USE_TONE_FAITHFUL",
         "USE_TONE_FILMIC",
-        "USE_SAMPLES",
         // energy.wgsl
         "USE_FAITHFUL",
         "USE_INVERSE_SQUARE",
@@ -112,8 +111,26 @@ impl WaveVariant {
         "USE_PLANE_SHADOWS",
         "USE_MAP_SHADOWS",
     ];
-    /// Every part: the uber-shader, right for any frame.
+    /// Every part: the uber-shader, right for any frame of one sample per pixel.
     pub(crate) const UBER: WaveVariant = WaveVariant((1 << Self::NAMES.len()) - 1);
+    /// The bit past the overrides: pixels are resolved from several samples, by the wave samples
+    /// module's entry point `cs_samples` instead of the wave module's `cs_main` (a module of its
+    /// own, so a frame of one sample per pixel compiles nothing of the samples' loops).
+    const SAMPLES: u32 = 1 << Self::NAMES.len();
+
+    /// Whether this variant resolves pixels from several samples (`cs_samples`).
+    pub(crate) fn samples(self) -> bool {
+        self.0 & Self::SAMPLES != 0
+    }
+
+    /// This variant, resolving pixels from several samples or not.
+    pub(crate) fn with_samples(self, on: bool) -> Self {
+        if on {
+            WaveVariant(self.0 | Self::SAMPLES)
+        } else {
+            WaveVariant(self.0 & !Self::SAMPLES)
+        }
+    }
 
     /// The bit of override `name`.
     fn bit(name: &str) -> u32 {
@@ -149,9 +166,6 @@ impl WaveVariant {
         samples: bool,
     ) -> Self {
         let mut on: Vec<&str> = Vec::new();
-        if samples {
-            on.push("USE_SAMPLES");
-        }
         for w in waves {
             on.push(match w.kind {
                 layout::WAVE_SPHERE => "USE_SPHERE",
@@ -210,7 +224,7 @@ impl WaveVariant {
             }
         }
         on.push(if tone_faithful { "USE_TONE_FAITHFUL" } else { "USE_TONE_FILMIC" });
-        Self::from_names(on)
+        Self::from_names(on).with_samples(samples)
     }
 
     /// The override values of this variant (`1.0` true, `0.0` false), for the pipeline.
@@ -223,6 +237,8 @@ impl WaveVariant {
 pub(crate) struct WavePass {
     /// The wave module (the uber-shader source; variants set its `USE_*` overrides).
     module: wgpu::ShaderModule,
+    /// The same with `cs_samples`, for frames of several samples per pixel.
+    samples_module: wgpu::ShaderModule,
     pipeline_layout: wgpu::PipelineLayout,
     layout: wgpu::BindGroupLayout,
     /// The wave pipelines built so far, one per variant (see [`WavePass::pipeline`]).
@@ -235,21 +251,32 @@ impl WavePass {
     /// Compiles the wave module; pipelines are built per variant on first use.
     pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
         let module = setup::compile_module(ctx, "wave", &shaders::compose(shaders::WAVE_PARTS))?;
+        let samples_module =
+            setup::compile_module(ctx, "wave samples", &shaders::compose(shaders::WAVE_SAMPLES_PARTS))?;
         ctx.scoped("building the wave pipeline layout", || {
             let layout = setup::bind_group_layout(&ctx.device, "wave", &BINDINGS);
             let pipeline_layout = setup::pipeline_layout(&ctx.device, "wave", &layout);
-            Self { module, pipeline_layout, layout, variants: HashMap::new(), specialise: true }
+            Self {
+                module,
+                samples_module,
+                pipeline_layout,
+                layout,
+                variants: HashMap::new(),
+                specialise: true,
+            }
         })
     }
 
-    /// The wave pipeline of `variant` ([`WaveVariant::UBER`] when not specialising), built on first
-    /// use and kept: the same variant always gets the same pipeline. Also the variant it is.
+    /// The wave pipeline of `variant` ([`WaveVariant::UBER`] when not specialising, resolving
+    /// samples if `variant` does), built on first use and kept: the same variant always gets the
+    /// same pipeline. Also the variant it is.
     pub(crate) fn pipeline(
         &mut self,
         ctx: &GpuContext,
         variant: WaveVariant,
     ) -> Result<(wgpu::ComputePipeline, WaveVariant), RenderError> {
-        let variant = if self.specialise { variant } else { WaveVariant::UBER };
+        let variant =
+            if self.specialise { variant } else { WaveVariant::UBER.with_samples(variant.samples()) };
         if let Some(p) = self.variants.get(&variant) {
             return Ok((p.clone(), variant));
         }
@@ -258,8 +285,8 @@ impl WavePass {
             ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("wave"),
                 layout: Some(&self.pipeline_layout),
-                module: &self.module,
-                entry_point: Some("cs_main"),
+                module: if variant.samples() { &self.samples_module } else { &self.module },
+                entry_point: Some(if variant.samples() { "cs_samples" } else { "cs_main" }),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: &constants,
                     ..Default::default()
@@ -409,6 +436,12 @@ mod tests {
             false,
         );
         assert_eq!(names(v), ["USE_SPHERE", "USE_TONE_FAITHFUL", "USE_FAITHFUL"]);
+        // Samples choose the entry point, not an override: the same parts, another pipeline.
+        let aa = v.with_samples(true);
+        assert!(aa.samples() && !v.samples());
+        assert_eq!(names(aa), names(v));
+        assert_ne!(aa, v);
+        assert!(!WaveVariant::UBER.samples());
         toon.wave_blend = 0.0;
         let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true, false);
         assert_eq!(
