@@ -13,6 +13,7 @@ extern crate self as hadou_math;
 pub mod bloom;
 pub mod curve;
 pub mod energy;
+pub mod keyframes;
 mod mat4;
 pub mod outline;
 pub mod quadrature;

@@ -28,6 +28,7 @@ use crate::files::{
     GLTF_MAX_JSON_VALUES,
 };
 use crate::frame::Mesh;
+use crate::gltf_anim::read_clips;
 use crate::gltf_material::{load_materials, ImageSource, Materials, SUPPORTED_EXTENSIONS};
 use crate::gltf_uri::resolve_uri;
 use crate::guard::guarded;
@@ -35,12 +36,14 @@ use crate::limits::{
     fmt_f32, COORD_MAX, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
 };
 use crate::mesh::{append_mesh, smooth_normals, transform_mesh};
+use crate::rig::{position_groups, MorphTarget, Part, PoseInput, RestLocal, Rig, RigNode, RigSkin};
 use crate::texture::MAX_SCENE_TEXELS;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::buffer::Source;
 use gltf::json;
 use gltf::mesh::{Mode, Semantic};
 use hadou_math::Mat4;
+use std::cell::Cell;
 use std::path::Path;
 
 /// Deepest node hierarchy followed (the recursion that bakes the transforms stays shallow).
@@ -67,6 +70,12 @@ impl Budget {
 /// Loads the glTF/GLB file at `path` into one mesh in the file's scene space. External buffers
 /// must lie inside the file's own directory tree.
 pub fn load_gltf(path: &Path) -> Result<Mesh, String> {
+    load_gltf_rig(path).map(|(mesh, _)| mesh)
+}
+
+/// [`load_gltf`], also returning the file's posable character (skins, morph targets, animation
+/// clips, VRM expressions) when it has one.
+pub fn load_gltf_rig(path: &Path) -> Result<(Mesh, Option<Rig>), String> {
     let mut budget = Budget::FULL;
     load_gltf_in(path, parent_dir(path), &mut budget, &mut Vec::new())
 }
@@ -78,7 +87,7 @@ pub(crate) fn load_gltf_in(
     root: &Path,
     budget: &mut Budget,
     warnings: &mut Vec<String>,
-) -> Result<Mesh, String> {
+) -> Result<(Mesh, Option<Rig>), String> {
     let bytes = read_regular_file(path, GLTF_MAX_BYTES).map_err(|e| format!("cannot read the file: {e}"))?;
     from_bytes_in(std::borrow::Cow::Owned(bytes), parent_dir(path), root, budget, warnings)
 }
@@ -94,7 +103,7 @@ pub fn gltf_from_bytes(bytes: &[u8], dir: &Path) -> Result<Mesh, String> {
 pub fn gltf_from_bytes_with_warnings(bytes: &[u8], dir: &Path) -> Result<(Mesh, Vec<String>), String> {
     let mut budget = Budget::FULL;
     let mut warnings = Vec::new();
-    let mesh = from_bytes_in(std::borrow::Cow::Borrowed(bytes), dir, dir, &mut budget, &mut warnings)?;
+    let (mesh, _) = from_bytes_in(std::borrow::Cow::Borrowed(bytes), dir, dir, &mut budget, &mut warnings)?;
     Ok((mesh, warnings))
 }
 
@@ -183,7 +192,7 @@ fn from_bytes_in(
     root: &Path,
     budget: &mut Budget,
     warnings: &mut Vec<String>,
-) -> Result<Mesh, String> {
+) -> Result<(Mesh, Option<Rig>), String> {
     let file_len = bytes.len() as u64;
     let (mut gltf, raw) = {
         let body = sniff(&bytes)?;
@@ -298,33 +307,137 @@ fn from_bytes_in(
     let texels = &mut budget.texels;
     let materials =
         guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, texels, warnings))??;
-    let out = guarded("glTF", || -> Result<Mesh, String> {
+    let (out, rig) = guarded("glTF", || -> Result<(Mesh, Option<Rig>), String> {
         let nodes: Vec<gltf::Node<'_>> = gltf.nodes().collect();
         let worlds = world_matrices(&nodes, &parent);
-        // Each skin's `J_k · IBM_k` once, for every skin a node of the default scene uses.
+        // Each skin's joints and inverse bind matrices, and `J_k · IBM_k` once, for every skin a
+        // node of the default scene uses.
         let mut skins: Vec<Option<Vec<Mat4>>> = vec![None; doc.skins.len()];
+        let mut rig_skins: Vec<Option<RigSkin>> = vec![None; doc.skins.len()];
         for skin in gltf.skins() {
             if used_skins[skin.index()] {
-                let m = skin_matrices(&skin, &buffers, &worlds)
+                let (rs, m) = skin_matrices(&skin, &buffers, &worlds)
                     .map_err(|e| format!("skin {}: {e}", skin.index()))?;
                 skins[skin.index()] = Some(m);
+                rig_skins[skin.index()] = Some(rs);
             }
         }
-        let ctx = Ctx { buffers: &buffers, materials: &materials, skins };
+        let ctx =
+            Ctx { buffers: &buffers, materials: &materials, skins, morph_left: Cell::new(MAX_MORPH_DELTAS) };
         let mut out = Mesh::default();
+        let mut parts = Vec::new();
         for &r in &roots {
-            add_node(&nodes[r], Mat4::IDENTITY, &ctx, &mut out, 0, warnings)?;
+            add_node(&nodes[r], Mat4::IDENTITY, &ctx, &mut out, &mut parts, 0, warnings)?;
         }
-        Ok(out)
+        let rig = build_rig(&gltf, &raw, &nodes, &parent, rig_skins, parts, &buffers, warnings)?;
+        Ok((out, rig))
     })??;
     if out.indices.is_empty() {
         return Err("the default scene contains no triangles".into());
     }
     let mut out = out;
     out.materials = materials.list;
+    // The rest mesh is the rig's rest pose (default morph weights applied), so a posed frame at
+    // the rest pose equals it exactly.
+    let rig = rig.map(|mut rig| {
+        out = rig.pose(&out, &PoseInput::default());
+        (rig.groups, rig.group_count) = position_groups(&out.positions);
+        rig
+    });
     budget.triangles -= need.triangles;
     budget.vertices -= need.vertices;
-    Ok(out)
+    Ok((out, rig))
+}
+
+/// Most morph-target vertex offsets (targets × vertices, every instance counted) of one glTF
+/// file: 2²² (each holds a position and a normal offset, 24 bytes: 96 MiB at most).
+pub const MAX_MORPH_DELTAS: u64 = 1 << 22;
+
+/// Most morph targets of one mesh.
+pub const MAX_MORPH_TARGETS: usize = 256;
+
+/// The posable character of a file, when it has skins, morph targets or animations (`None`
+/// otherwise).
+#[allow(clippy::too_many_arguments)]
+fn build_rig(
+    gltf: &gltf::Gltf,
+    raw: &serde_json::Value,
+    nodes: &[gltf::Node<'_>],
+    parent: &[Option<usize>],
+    skins: Vec<Option<RigSkin>>,
+    parts: Vec<Part>,
+    buffers: &[Vec<u8>],
+    warnings: &mut Vec<String>,
+) -> Result<Option<Rig>, String> {
+    let skinned = parts.iter().any(|p| p.skin.is_some());
+    let morphs = parts.iter().any(|p| !p.targets.is_empty());
+    let vrm = crate::gltf_vrm::vrm_version(raw);
+    if !skinned && !morphs && gltf.animations().len() == 0 && vrm.is_none() {
+        return Ok(None);
+    }
+    let mut rig_nodes = Vec::with_capacity(nodes.len());
+    for node in nodes {
+        let rest = match node.transform() {
+            gltf::scene::Transform::Matrix { matrix } => RestLocal::Matrix(Mat4 { cols: matrix }),
+            gltf::scene::Transform::Decomposed { translation, rotation, scale } => {
+                RestLocal::Trs { t: translation, r: rotation, s: scale }
+            }
+        };
+        let weights = match node.mesh() {
+            Some(mesh) => {
+                let counts: Vec<usize> = mesh.primitives().map(|p| p.morph_targets().len()).collect();
+                let n = counts.iter().copied().max().unwrap_or(0);
+                if counts.iter().any(|&c| c != n) {
+                    return Err(format!(
+                        "mesh {}: its primitives have different numbers of morph targets ({counts:?}); glTF \
+                         requires the same number",
+                        mesh.index()
+                    ));
+                }
+                let given = node.weights().or(mesh.weights());
+                match given {
+                    Some(w) if n > 0 && w.len() != n => {
+                        return Err(format!(
+                            "node {} (mesh {}): `weights` has {} entries but the mesh has {n} morph targets",
+                            node.index(),
+                            mesh.index(),
+                            w.len()
+                        ))
+                    }
+                    Some(w) if w.iter().any(|x| !x.is_finite()) => {
+                        return Err(format!("node {}: its morph `weights` are not all finite", node.index()))
+                    }
+                    Some(w) if n > 0 => w.to_vec(),
+                    _ => vec![0.0; n],
+                }
+            }
+            None => Vec::new(),
+        };
+        rig_nodes.push(RigNode { parent: parent[node.index()], rest, weights });
+    }
+    // Parents before children.
+    let mut order = Vec::with_capacity(nodes.len());
+    let mut stack: Vec<usize> = (0..nodes.len()).filter(|&i| parent[i].is_none()).collect();
+    while let Some(i) = stack.pop() {
+        order.push(i);
+        stack.extend(nodes[i].children().map(|c| c.index()));
+    }
+    let clips = read_clips(gltf, raw, buffers, &rig_nodes, warnings)?;
+    let mesh_of: Vec<Option<usize>> = nodes.iter().map(|n| n.mesh().map(|m| m.index())).collect();
+    let expressions = crate::gltf_vrm::read_expressions(raw, &rig_nodes, &mesh_of)?;
+    let humanoid = crate::gltf_vrm::read_humanoid(raw, nodes.len())?;
+    Ok(Some(Rig {
+        nodes: rig_nodes,
+        order,
+        skins,
+        parts,
+        clips,
+        expressions,
+        humanoid,
+        vrm,
+        groups: Vec::new(),
+        group_count: 0,
+    }))
 }
 
 /// `Err` naming `from` when `index` is not below `len`.
@@ -553,6 +666,8 @@ struct Ctx<'a> {
     materials: &'a Materials,
     /// Per skin, `J_k · IBM_k` for every joint `k` (computed once, for the skins in use).
     skins: Vec<Option<Vec<Mat4>>>,
+    /// Morph-target offsets still allowed (of [`MAX_MORPH_DELTAS`]).
+    morph_left: Cell<u64>,
 }
 
 /// Every node's world matrix from the node hierarchy (the graph is a forest), without recursion.
@@ -575,6 +690,7 @@ fn add_node(
     parent: Mat4,
     ctx: &Ctx<'_>,
     out: &mut Mesh,
+    parts: &mut Vec<Part>,
     depth: usize,
     warnings: &mut Vec<String>,
 ) -> Result<(), String> {
@@ -599,9 +715,24 @@ fn add_node(
         for prim in mesh.primitives() {
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
             let p = read_primitive(&prim, ctx, &what, warnings).map_err(|e| format!("{what}: {e}"))?;
+            let mut part = Part {
+                node: node.index(),
+                skin: None,
+                first: out.positions.len(),
+                positions: p.mesh.positions.clone(),
+                normals: p.mesh.normals.clone(),
+                influences: Vec::new(),
+                targets: p.targets,
+            };
             let placed = match (&skin, p.joints, p.weights) {
-                (Some(mats), Some(j), Some(w)) => skin_mesh(&p.mesh, &j, &w, mats, &world, &what, warnings)
-                    .map_err(|e| format!("{what}: {e}"))?,
+                (Some(mats), Some(j), Some(w)) => {
+                    let inf = influences(&j, &w, mats.len(), &what, warnings)
+                        .map_err(|e| format!("{what}: {e}"))?;
+                    let placed = skin_mesh(&p.mesh, &inf, mats, &world, &what, warnings);
+                    part.skin = node.skin().map(|s| s.index());
+                    part.influences = inf;
+                    placed
+                }
                 (Some(_), ..) => {
                     warnings.push(format!(
                         "{what} under node {} has a skin but no JOINTS_0 and WEIGHTS_0; it is placed by the \
@@ -623,10 +754,11 @@ fn add_node(
                 ));
             }
             append_mesh(out, &placed);
+            parts.push(part);
         }
     }
     for child in node.children() {
-        add_node(&child, world, ctx, out, depth + 1, warnings)?;
+        add_node(&child, world, ctx, out, parts, depth + 1, warnings)?;
     }
     Ok(())
 }
@@ -637,7 +769,7 @@ fn skin_matrices(
     skin: &gltf::Skin<'_>,
     buffers: &[Vec<u8>],
     worlds: &[Option<Mat4>],
-) -> Result<Vec<Mat4>, String> {
+) -> Result<(RigSkin, Vec<Mat4>), String> {
     let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
     if joints.is_empty() {
         return Err("it has no joints".into());
@@ -667,32 +799,32 @@ fn skin_matrices(
         }
         None => vec![Mat4::IDENTITY; joints.len()],
     };
-    joints
+    let mats = joints
         .iter()
-        .zip(ibms)
+        .zip(&ibms)
         .map(|(&j, ibm)| {
             let w = worlds[j].ok_or_else(|| format!("joint node {j} has a non-finite transform"))?;
-            Ok(w * ibm)
+            Ok(w * *ibm)
         })
-        .collect()
+        .collect::<Result<Vec<Mat4>, String>>()?;
+    Ok((RigSkin { joints, ibms }, mats))
 }
 
-/// `mesh` skinned: each vertex through `Σ w_k · mats[j_k]` (weights normalised), normals through
-/// its inverse transpose; vertices whose weights are all zero keep the node transform `node`
-/// (with one warning).
-fn skin_mesh(
-    mesh: &Mesh,
+/// Allowed difference of a vertex's skin weights' sum from 1 before it is reported.
+const WEIGHT_SUM_TOLERANCE: f32 = 2e-3;
+
+/// Each vertex's `(joint, weight)` pairs from `JOINTS_0`/`WEIGHTS_0`, weights normalised to sum 1
+/// (a sum off by more than [`WEIGHT_SUM_TOLERANCE`] is reported once per primitive) or all zero
+/// (the vertex then keeps its node's transform). Joints must index the skin's `n_joints`.
+fn influences(
     joints: &[[u16; 4]],
     weights: &[[f32; 4]],
-    mats: &[Mat4],
-    node: &Mat4,
+    n_joints: usize,
     what: &str,
     warnings: &mut Vec<String>,
-) -> Result<Mesh, String> {
-    let mut unweighted = 0usize;
-    let mut mirrored = Vec::with_capacity(mesh.positions.len());
-    let mut positions = Vec::with_capacity(mesh.positions.len());
-    let mut normals = Vec::with_capacity(mesh.positions.len());
+) -> Result<Vec<[(u16, f32); 4]>, String> {
+    let mut off = 0usize;
+    let mut out = Vec::with_capacity(joints.len());
     for (v, (j, w)) in joints.iter().zip(weights).enumerate() {
         if w.iter().any(|x| !x.is_finite() || *x < 0.0) {
             return Err(format!("vertex {v} has a negative or non-finite weight in WEIGHTS_0"));
@@ -706,20 +838,54 @@ fn skin_mesh(
             w = w.map(|x| x / max);
             sum = w.iter().sum();
         }
-        let m = if sum > 0.0 {
+        if sum > 0.0 && (sum - 1.0).abs() > WEIGHT_SUM_TOLERANCE {
+            off += 1;
+        }
+        let mut inf = [(0u16, 0.0f32); 4];
+        for k in 0..4 {
+            if w[k] == 0.0 {
+                continue;
+            }
+            if j[k] as usize >= n_joints {
+                return Err(format!(
+                    "vertex {v} is bound to joint {} in JOINTS_0, but the skin has {n_joints} joints (0-based)",
+                    j[k]
+                ));
+            }
+            inf[k] = (j[k], w[k] / sum);
+        }
+        out.push(inf);
+    }
+    if off > 0 {
+        warnings
+            .push(format!("{what}: the skin weights of {off} vertices do not sum to 1; they are normalised"));
+    }
+    Ok(out)
+}
+
+/// `mesh` skinned: each vertex through `Σ w_k · mats[j_k]` of its influences (weights summing to
+/// 1), normals through its inverse transpose; vertices whose weights are all zero keep the node
+/// transform `node` (with one warning).
+fn skin_mesh(
+    mesh: &Mesh,
+    influences: &[[(u16, f32); 4]],
+    mats: &[Mat4],
+    node: &Mat4,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Mesh {
+    let mut unweighted = 0usize;
+    let mut mirrored = Vec::with_capacity(mesh.positions.len());
+    let mut positions = Vec::with_capacity(mesh.positions.len());
+    let mut normals = Vec::with_capacity(mesh.positions.len());
+    for (v, inf) in influences.iter().enumerate() {
+        let m = if inf.iter().any(|&(_, w)| w > 0.0) {
             let mut m = Mat4 { cols: [[0.0; 4]; 4] };
-            for k in 0..4 {
-                if w[k] == 0.0 {
+            for &(j, f) in inf {
+                if f == 0.0 {
                     continue;
                 }
-                let s = mats.get(j[k] as usize).ok_or_else(|| {
-                    format!(
-                        "vertex {v} is bound to joint {} in JOINTS_0, but the skin has {} joints (0-based)",
-                        j[k],
-                        mats.len()
-                    )
-                })?;
-                let f = w[k] / sum;
+                let s = &mats[j as usize];
                 for (c, sc) in m.cols.iter_mut().zip(&s.cols) {
                     for (x, y) in c.iter_mut().zip(sc) {
                         *x += f * y;
@@ -756,7 +922,7 @@ fn skin_mesh(
             t.swap(1, 2);
         }
     }
-    Ok(Mesh { positions, normals, indices, ..mesh.clone() })
+    Mesh { positions, normals, indices, ..mesh.clone() }
 }
 
 /// A primitive read in its mesh's space, with its skin attributes when it has them.
@@ -764,6 +930,7 @@ struct Primitive {
     mesh: Mesh,
     joints: Option<Vec<[u16; 4]>>,
     weights: Option<Vec<[f32; 4]>>,
+    targets: Vec<MorphTarget>,
 }
 
 /// The accessor of attribute `sem` checked for layout, bounds and a count of `n`, if present.
@@ -905,14 +1072,68 @@ fn read_primitive(
         None => None,
     };
 
+    let targets = read_targets(prim, &reader, buffers, n, &ctx.morph_left)?;
     let slot = ctx.materials.slot(mat_index);
     let mesh =
         Mesh { positions, normals, indices, uvs, colors, material_ids: vec![slot; n], ..Mesh::default() };
-    Ok(Primitive { mesh, joints, weights })
+    Ok(Primitive { mesh, joints, weights, targets })
+}
+
+/// The morph targets of a primitive of `n` vertices (position and normal offsets; tangent offsets
+/// are not used), each accessor checked, their offsets taken from `left`.
+fn read_targets<'a, 's, F>(
+    prim: &gltf::Primitive<'a>,
+    reader: &gltf::mesh::Reader<'a, 's, F>,
+    buffers: &[Vec<u8>],
+    n: usize,
+    left: &Cell<u64>,
+) -> Result<Vec<MorphTarget>, String>
+where
+    F: Clone + Fn(gltf::Buffer<'a>) -> Option<&'s [u8]>,
+{
+    let count = prim.morph_targets().len();
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    if count > MAX_MORPH_TARGETS {
+        return Err(format!("it has {count} morph targets, more than the limit of {MAX_MORPH_TARGETS}"));
+    }
+    let need = (count as u64).saturating_mul(n as u64);
+    if need > left.get() {
+        return Err(format!(
+            "its morph targets bring the file past the limit of {MAX_MORPH_DELTAS} morph offsets (targets × \
+             vertices, every instance counted)"
+        ));
+    }
+    left.set(left.get() - need);
+    for (i, t) in prim.morph_targets().enumerate() {
+        for (name, acc) in [("POSITION", t.positions()), ("NORMAL", t.normals())] {
+            if let Some(acc) = acc {
+                check_accessor(&acc, &[Dimensions::Vec3], &[DataType::F32], buffers)
+                    .map_err(|e| format!("morph target {i} {name}: {e}"))?;
+                if acc.count() != n {
+                    return Err(format!(
+                        "morph target {i} {name} has {} entries but POSITION has {n}",
+                        acc.count()
+                    ));
+                }
+            }
+        }
+    }
+    let mut targets = Vec::with_capacity(count);
+    for (i, (pos, nrm, _)) in reader.read_morph_targets().enumerate() {
+        let positions: Vec<[f32; 3]> = pos.map(|p| p.collect()).unwrap_or_default();
+        let normals: Vec<[f32; 3]> = nrm.map(|p| p.collect()).unwrap_or_default();
+        if positions.iter().chain(&normals).flatten().any(|v| !v.is_finite()) {
+            return Err(format!("morph target {i} contains NaN or infinite values"));
+        }
+        targets.push(MorphTarget { positions, normals });
+    }
+    Ok(targets)
 }
 
 /// Checks that reading `acc` stays inside its buffer view and buffer and has the expected layout.
-fn check_accessor(
+pub(crate) fn check_accessor(
     acc: &gltf::Accessor<'_>,
     dims: &[Dimensions],
     types: &[DataType],

@@ -36,9 +36,11 @@ mod bounds;
 mod error;
 mod files;
 mod frame;
+mod gltf_anim;
 mod gltf_load;
 mod gltf_material;
 mod gltf_uri;
+mod gltf_vrm;
 mod guard;
 mod image;
 mod introspect;
@@ -46,6 +48,7 @@ mod limits;
 mod materials;
 pub mod mesh;
 mod params;
+mod rig;
 mod scene;
 mod schema;
 mod shadow;
@@ -67,13 +70,19 @@ pub use files::{
     SCENE_MAX_BYTES,
 };
 pub use frame::*;
-pub use gltf_load::{gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf};
+pub use gltf_anim::MAX_ANIMATION_VALUES;
+pub use gltf_load::{
+    gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf, load_gltf_rig, MAX_MORPH_DELTAS,
+    MAX_MORPH_TARGETS,
+};
+pub use gltf_vrm::VrmVersion;
 pub use image::Image;
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
 pub use limits::{
     check_image_size, ALPHA_MAX, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES,
     MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
 };
+pub use rig::{clip_time, clip_wrap, Clip, Expression, PoseInput, Rig};
 pub use scene::Scene;
 pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,

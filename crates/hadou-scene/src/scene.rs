@@ -11,6 +11,7 @@ use crate::frame::{
 };
 use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
+use crate::rig::{clip_time, clip_wrap, PoseInput, Rig};
 use crate::shadow_def::{build_shadow, ShadowDef};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
@@ -60,6 +61,28 @@ pub(crate) struct ObjectDef {
     pub is_plane: bool,
     /// A `kind = "gltf"` object's `path`, as written (relative to the scene file).
     pub gltf: Option<PathBuf>,
+    /// The posable character of its glTF file, kept when the object is animated (`motion`).
+    pub rig: Option<Arc<Rig>>,
+    /// How it moves: its clip and expressions.
+    pub motion: Option<Motion>,
+    /// The last pose built and its key (clip time and expression weights), shared by clones.
+    pub pose_cache: Arc<std::sync::Mutex<Option<(Vec<u32>, Arc<Mesh>)>>>,
+}
+
+/// An object's animation as its keys give it; the times and speed are its parameters
+/// (`animation_start`, `animation_speed`, `animation_time`).
+#[derive(Clone, Debug)]
+pub(crate) struct Motion {
+    /// The clip played, if any.
+    pub clip: Option<usize>,
+    /// `animation_loop`.
+    pub looping: bool,
+    /// The clip time is `animation_time` (written in the file or animated by a track) rather than
+    /// derived from the scene time.
+    pub pinned: bool,
+    /// It gives `expressions` (the parameter `expressions`, one weight per expression of the
+    /// file, in the file's order).
+    pub expressions: bool,
 }
 
 impl ObjectDef {
@@ -115,6 +138,39 @@ pub(crate) struct WaveDef {
 
 impl Scene {
     /// Notes about things the loader accepted but changed or ignored (downscaled textures,
+    /// Each object's animation clips (name, length in seconds), in the order of its glTF file;
+    /// empty for objects without clips.
+    pub fn object_clips(&self) -> Vec<Vec<(String, f32)>> {
+        self.objects
+            .iter()
+            .map(|o| {
+                o.rig.as_ref().map_or_else(Vec::new, |r| {
+                    r.clips().iter().map(|c| (c.name.clone(), c.duration)).collect()
+                })
+            })
+            .collect()
+    }
+
+    /// Each object's VRM expression names (empty for objects of other files).
+    pub fn object_expressions(&self) -> Vec<Vec<String>> {
+        self.objects
+            .iter()
+            .map(|o| {
+                o.rig
+                    .as_ref()
+                    .map_or_else(Vec::new, |r| r.expressions().iter().map(|e| e.name.clone()).collect())
+            })
+            .collect()
+    }
+
+    /// The clip object `index` plays and its clip time at scene time `time`, if it plays one.
+    pub fn object_clip_at(&self, index: usize, time: f32) -> Option<(String, f32)> {
+        let o = self.objects.get(index)?;
+        let clip = o.rig.as_ref()?.clips().get(o.motion.as_ref()?.clip?)?;
+        let vals = self.values_at(time);
+        Some((clip.name.clone(), self.clip_time_of(o, &vals, time)?))
+    }
+
     /// textures on meshes without texture coordinates, …); the CLI prints them.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
@@ -246,7 +302,7 @@ impl Scene {
             ambient: l.arr(vals, "ambient"),
         };
         let color_mapping = ColorMapping { mode: self.tone, exposure: self.color.f(vals, "exposure") };
-        let objects = self.build_objects(vals);
+        let objects = self.build_objects(vals, time);
         let waves = self.waves.iter().map(|w| self.build_wave(w, vals)).collect();
         let shadows =
             self.shadows.iter().map(|s| build_shadow(s, vals, base, light.direction, &objects)).collect();
@@ -268,16 +324,63 @@ impl Scene {
     }
 
     /// The frame's objects at these values.
-    pub(crate) fn build_objects(&self, vals: &[f32]) -> Vec<Object> {
+    pub(crate) fn build_objects(&self, vals: &[f32], time: f32) -> Vec<Object> {
         self.objects
             .iter()
             .map(|o| Object {
                 name: o.name.clone(),
-                mesh: o.mesh.clone(),
+                mesh: self.posed_mesh(o, vals, time),
                 transform: o.transform(vals),
                 materials: self.object_materials(o, vals),
             })
             .collect()
+    }
+
+    /// The clip time of object `o` at scene time `time` (`None` without a clip).
+    pub(crate) fn clip_time_of(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Option<f32> {
+        let (motion, rig) = (o.motion.as_ref()?, o.rig.as_ref()?);
+        let clip = rig.clips().get(motion.clip?)?;
+        let p = &o.params;
+        let pinned = motion.pinned
+            || p.find("animation_time").is_some_and(|a| self.tracks.iter().any(|t| t.offset == a.offset));
+        Some(if pinned {
+            clip_wrap(p.f(vals, "animation_time"), clip.duration, motion.looping)
+        } else {
+            clip_time(
+                time,
+                p.f(vals, "animation_start"),
+                p.f(vals, "animation_speed"),
+                clip.duration,
+                motion.looping,
+            )
+        })
+    }
+
+    /// Object `o`'s mesh at scene time `time`: its rest mesh, or the pose its clip and expressions
+    /// give (cached for the last pose asked for).
+    fn posed_mesh(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Arc<Mesh> {
+        let (Some(motion), Some(rig)) = (&o.motion, &o.rig) else { return o.mesh.clone() };
+        let clip_t = self.clip_time_of(o, vals, time).unwrap_or(0.0);
+        let expressions: Vec<(usize, f32)> = if motion.expressions {
+            o.params.raw(vals, "expressions").iter().copied().enumerate().filter(|e| e.1 != 0.0).collect()
+        } else {
+            Vec::new()
+        };
+        let key: Vec<u32> =
+            std::iter::once(clip_t.to_bits()).chain(expressions.iter().map(|e| e.1.to_bits())).collect();
+        if let Ok(cache) = o.pose_cache.lock() {
+            if let Some((k, m)) = cache.as_ref() {
+                if *k == key {
+                    return m.clone();
+                }
+            }
+        }
+        let input = PoseInput { clip: motion.clip, time: clip_t, expressions: &expressions };
+        let mesh = Arc::new(rig.pose(&o.mesh, &input));
+        if let Ok(mut cache) = o.pose_cache.lock() {
+            *cache = Some((key, mesh.clone()));
+        }
+        mesh
     }
 
     fn build_wave(&self, w: &WaveDef, vals: &[f32]) -> Wave {

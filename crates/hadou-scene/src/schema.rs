@@ -25,11 +25,13 @@ use crate::materials::{
     parse_material, parse_object_materials, parse_ramp, MaterialDef, TextureCache, OBJECT_MATERIAL_KEYS,
 };
 use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, sphere_size, with_outline_normals};
-use crate::params::{Constraint, ParamSet, Shape};
+use crate::params::{Constraint, Param, ParamSet, Shape};
+use crate::rig::Rig;
+use crate::scene::Motion;
 use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
 use crate::shadow::{MAX_SHADOWS, MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES};
 use crate::shadow_def::{check_map_budget, check_shadow, parse_shadow, ShadowDef};
-use crate::toml_read::{Fallback, ParamReader, Res, Span, Src, Table};
+use crate::toml_read::{echo, read_numbers, Fallback, ParamReader, Res, Span, Src, Table};
 use crate::track_def::{parse_track, Names, Owner};
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
@@ -415,7 +417,7 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
 struct Assets {
     /// The scene file's directory.
     dir: SceneDir,
-    cache: HashMap<PathBuf, Arc<Mesh>>,
+    cache: HashMap<PathBuf, (Arc<Mesh>, Option<Arc<Rig>>)>,
     budget: Budget,
     slots_left: u64,
 }
@@ -433,7 +435,15 @@ fn parse_object(
         "box" => &["size"],
         "sphere" => &["radius", "segments"],
         "plane" => &["size"],
-        _ => &["path"],
+        _ => &[
+            "path",
+            "animation",
+            "animation_start",
+            "animation_speed",
+            "animation_loop",
+            "animation_time",
+            "expressions",
+        ],
     };
     let allowed: Vec<&str> = OBJECT_COMMON.iter().chain(OBJECT_MATERIAL_KEYS).chain(extra).copied().collect();
     t.check_keys(&allowed)?;
@@ -454,6 +464,7 @@ fn parse_object(
     let mut scratch = ParamReader { values: &mut scratch_v, spans: &mut scratch_s };
     let mut shape_set = ParamSet::default();
     let mut gltf = None;
+    let mut rig: Option<Arc<Rig>> = None;
     let mesh = match kind {
         "box" => {
             scratch.add(t, &mut shape_set, "size", V3, POSITIVE, Fallback::Value(&[1.0; 3]), false)?;
@@ -507,7 +518,8 @@ fn parse_object(
                 ));
             }
             match assets.cache.get(&real) {
-                Some(m) => {
+                Some((m, r)) => {
+                    rig = r.clone();
                     let tris = (m.indices.len() / 3) as u64;
                     let verts = m.positions.len() as u64;
                     if tris > assets.budget.triangles || verts > assets.budget.vertices {
@@ -525,11 +537,13 @@ fn parse_object(
                 }
                 None => {
                     let mut notes = Vec::new();
-                    let mesh = crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut notes)
-                        .map_err(|message| gltf_err(message, file.clone()))?;
+                    let (mesh, r) =
+                        crate::gltf_load::load_gltf_in(&real, &root, &mut assets.budget, &mut notes)
+                            .map_err(|message| gltf_err(message, file.clone()))?;
                     warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", show_path(&file))));
                     let mesh = Arc::new(with_outline_normals(mesh));
-                    assets.cache.insert(real, mesh.clone());
+                    rig = r.map(Arc::new);
+                    assets.cache.insert(real, (mesh.clone(), rig.clone()));
                     mesh
                 }
             }
@@ -561,7 +575,137 @@ fn parse_object(
     }
     assets.slots_left -= slots;
     let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
-    Ok(ObjectDef { name, mesh, params, materials, is_plane: kind == "plane", gltf })
+    let motion = parse_motion(t, rig.as_deref(), &mut params, rd)?;
+    Ok(ObjectDef {
+        name,
+        mesh,
+        params,
+        materials,
+        is_plane: kind == "plane",
+        gltf,
+        rig,
+        motion,
+        pose_cache: Default::default(),
+    })
+}
+
+/// A `kind = "gltf"` object's animation keys: `animation` (a clip of the file), `animation_start`,
+/// `animation_speed`, `animation_loop`, `animation_time`, and `expressions` (a table of the VRM
+/// expressions' weights). `None` when it gives none of them (the object is drawn at its rest pose).
+fn parse_motion(
+    t: &Table<'_, '_>,
+    rig: Option<&Rig>,
+    params: &mut ParamSet,
+    rd: &mut ParamReader<'_>,
+) -> Res<Option<Motion>> {
+    let keys = [
+        "animation",
+        "animation_start",
+        "animation_speed",
+        "animation_loop",
+        "animation_time",
+        "expressions",
+    ];
+    if keys.iter().all(|k| t.get(k).is_none()) {
+        return Ok(None);
+    }
+    let no_rig = |key: &str, what: &str| {
+        t.src
+            .value_err(&t.key_span(key), format!("{} gives `{key}`, but its glTF file has no {what}", t.what))
+    };
+    let clip = match t.opt_str("animation")? {
+        None => {
+            for k in ["animation_start", "animation_speed", "animation_loop", "animation_time"] {
+                if t.get(k).is_some() {
+                    return Err(t.src.value_err(
+                        &t.key_span(k),
+                        format!("{} gives `{k}` without `animation` (the clip to play)", t.what),
+                    ));
+                }
+            }
+            None
+        }
+        Some((name, span)) => {
+            let clips = rig.map_or(&[][..], |r| r.clips());
+            if clips.is_empty() {
+                return Err(no_rig("animation", "animation clips"));
+            }
+            let list = clips
+                .iter()
+                .map(|c| {
+                    format!("\"{}\" ({} s)", crate::error::escape_controls(&c.name), fmt_f32(c.duration))
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            match rig.and_then(|r| r.clip(name)) {
+                Some(i) => Some(i),
+                None => {
+                    return Err(t.src.value_err(
+                        &span,
+                        format!(
+                            "{}: the glTF file has no clip \"{}\"; its clips are {list}",
+                            t.what,
+                            crate::error::escape_controls(name)
+                        ),
+                    ))
+                }
+            }
+        }
+    };
+    let time_range = Constraint::Range { lo: -COORD_MAX, hi: COORD_MAX, lo_open: false, hi_open: false };
+    rd.add(t, params, "animation_start", S, time_range, Fallback::Value(&[0.0]), false)?;
+    let speed = Constraint::Range { lo: -1e3, hi: 1e3, lo_open: false, hi_open: false };
+    rd.add(t, params, "animation_speed", S, speed, Fallback::Value(&[1.0]), false)?;
+    rd.add(t, params, "animation_time", S, time_range, Fallback::Value(&[0.0]), false)?;
+    let looping = t.opt_bool("animation_loop")?.unwrap_or(true);
+    let pinned = t.get("animation_time").is_some();
+    let mut expressions = false;
+    if t.get("expressions").is_some() {
+        let Some(rig) = rig.filter(|r| !r.expressions().is_empty()) else {
+            return Err(no_rig("expressions", "VRM expressions"));
+        };
+        let sub = t.sub("expressions", "expressions")?.expect("present");
+        let names: Vec<&str> = rig.expressions().iter().map(|e| e.name.as_str()).collect();
+        let mut weights = vec![(0.0f32, sub.span.clone()); names.len()];
+        let mut keys: Vec<(&str, Span)> =
+            sub.t.iter().map(|(k, _)| (k.get_ref().as_ref(), k.span())).collect();
+        keys.sort_by_key(|(_, s)| s.start);
+        for (key, key_span) in keys {
+            let Some(e) = names.iter().position(|n| *n == key) else {
+                return Err(t.src.unknown(
+                    &key_span,
+                    format!(
+                        "{}: the file has no expression \"{}\"; its expressions are {}",
+                        t.what,
+                        echo(key),
+                        names.join(", ")
+                    ),
+                ));
+            };
+            let what = format!("expression `{}` in {}", echo(key), t.what);
+            let v = read_numbers(&sub.src, sub.get(key).expect("listed"), S, false, &what)?;
+            let unit = Constraint::Range { lo: 0.0, hi: 1.0, lo_open: false, hi_open: false };
+            if let Err((_, msg)) = unit.check(&[v[0].0], 0, true) {
+                return Err(t.src.value_err(&v[0].1, format!("{what} {msg}")));
+            }
+            weights[e] = v[0].clone();
+        }
+        let offset = rd.values.len();
+        for (x, span) in &weights {
+            rd.values.push(*x);
+            rd.spans.push(span.clone());
+        }
+        params.params.push(Param {
+            key: "expressions",
+            offset,
+            len: weights.len(),
+            shape: Shape::Vector(weights.len()),
+            rule: Constraint::Range { lo: 0.0, hi: 1.0, lo_open: false, hi_open: false },
+            broadcast: false,
+        });
+        expressions = true;
+    }
+    Ok(Some(Motion { clip, looping, pinned, expressions }))
 }
 
 /// Takes a primitive's `tris` triangles and `verts` vertices from the scene's budget, or says

@@ -165,6 +165,25 @@ fn resolve_target(scene: &Scene, names: &Names<'_>, target: &str) -> Result<(Sel
             "y" | "g" => 1,
             "z" | "b" => 2,
             "w" | "a" => 3,
+            name if key == "expressions" => {
+                let names: Vec<&str> = match owner {
+                    Owner::Object(o) => scene.objects[o]
+                        .rig
+                        .as_ref()
+                        .map(|r| r.expressions().iter().map(|e| e.name.as_str()).collect())
+                        .unwrap_or_default(),
+                    _ => Vec::new(),
+                };
+                match names.iter().position(|n| *n == name) {
+                    Some(i) => i,
+                    None => {
+                        return Err(format!(
+                            "{ent} has no expression `{name}`{}",
+                            hint(name, &names, "expressions")
+                        ))
+                    }
+                }
+            }
             _ => {
                 return Err(format!(
                     "unknown component `.{comp}` in \"{target}\"; use .x/.y/.z/.w, .r/.g/.b/.a or [i]"

@@ -1,0 +1,360 @@
+//! A glTF character that can be posed: its node hierarchy with the rest transforms, its skins, its
+//! primitives in mesh space with their joint influences and morph targets, and its animation clips
+//! (glTF 2.0 §3.5 nodes, §3.7.2.2 morph targets, §3.7.3 skins, §3.11 animations). The loader
+//! (`gltf_load`) builds one next to the rest-pose [`Mesh`] of a file that has skins, morph targets
+//! or animations; [`Rig::pose`] turns a clip time into a posed mesh with the rest mesh's vertex
+//! order, triangles, texture coordinates and materials, so every backend draws, outlines and
+//! shadows the posed character exactly as it draws a still one.
+//!
+//! Posing a vertex `p` with normal `n` (glTF 2.0 §3.7.2.2, §3.7.3.3):
+//! 1. morph targets: `p' = p + Σ wᵢ·δpᵢ`, `n' = n + Σ wᵢ·δnᵢ` with the weights of the animation
+//!    (else the node's `weights`, else the mesh's, else 0), plus VRM expression binds;
+//! 2. skinning: `M = Σ_k w_k · G(joint_k) · IBM_k` (weights normalised to sum 1; the skinned mesh
+//!    node's own transform is ignored), `p'' = M·p'`, `n'' = cof(M)·n'` normalised; a vertex
+//!    without skin influences takes its node's global transform `G(node)`;
+//! 3. `G(node) = G(parent) · L(node)` with `L = T·R·S` of the sampled channels (a channel that is
+//!    absent keeps the node's rest value).
+
+use crate::frame::Mesh;
+use crate::limits::COORD_MAX;
+use hadou_math::keyframes::{sample, trs_matrix, Sampling};
+use hadou_math::{Mat4, Vec3f};
+
+/// A node's rest transform: a matrix (such a node cannot be animated) or translation, rotation
+/// (unit quaternion `[x, y, z, w]`) and scale.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum RestLocal {
+    Matrix(Mat4),
+    Trs { t: [f32; 3], r: [f32; 4], s: [f32; 3] },
+}
+
+/// A node of the character's hierarchy.
+#[derive(Clone, Debug)]
+pub(crate) struct RigNode {
+    pub parent: Option<usize>,
+    pub rest: RestLocal,
+    /// The default morph weights of the node's mesh (`node.weights`, else `mesh.weights`, else
+    /// zeros); empty when its mesh has no morph targets.
+    pub weights: Vec<f32>,
+}
+
+/// A skin: its joint nodes and their inverse bind matrices.
+#[derive(Clone, Debug)]
+pub(crate) struct RigSkin {
+    pub joints: Vec<usize>,
+    pub ibms: Vec<Mat4>,
+}
+
+/// One morph target of a primitive: position offsets and (possibly empty) normal offsets.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct MorphTarget {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+}
+
+/// One primitive instance of the loaded mesh, in its mesh's own space.
+#[derive(Clone, Debug)]
+pub(crate) struct Part {
+    /// The node that instantiates it.
+    pub node: usize,
+    /// The skin that places it, if it has one and skin attributes.
+    pub skin: Option<usize>,
+    /// Its first vertex in the loaded mesh.
+    pub first: usize,
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Vec<[f32; 3]>,
+    /// Per vertex, up to four (joint, weight) pairs with weights summing to 1, or all weights 0 (the
+    /// vertex follows its node); empty for a rigid part.
+    pub influences: Vec<[(u16, f32); 4]>,
+    pub targets: Vec<MorphTarget>,
+}
+
+/// What an animation channel drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ChannelPath {
+    Translation,
+    Rotation,
+    Scale,
+    Weights,
+}
+
+/// One channel: a node property sampled from keys.
+#[derive(Clone, Debug)]
+pub(crate) struct Channel {
+    pub node: usize,
+    pub path: ChannelPath,
+    pub sampling: Sampling,
+    pub times: Vec<f32>,
+    pub values: Vec<f32>,
+    /// Floats per key value (3, 4, or the node's number of morph targets).
+    pub width: usize,
+}
+
+/// A named animation clip of a glTF file.
+#[derive(Clone, Debug)]
+pub struct Clip {
+    /// The animation's `name` (or `animation N` for an unnamed one).
+    pub name: String,
+    /// Its length in seconds: the latest key time of its channels.
+    pub duration: f32,
+    pub(crate) channels: Vec<Channel>,
+}
+
+/// A VRM expression (blend shape group): morph-target binds `(node, target, weight)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expression {
+    /// The preset or custom name (`happy`, `blink`, `aa`, …).
+    pub name: String,
+    pub(crate) binds: Vec<(usize, usize, f32)>,
+}
+
+/// The posable character of one glTF file.
+#[derive(Clone, Debug)]
+pub struct Rig {
+    pub(crate) nodes: Vec<RigNode>,
+    /// Every node, parents before their children.
+    pub(crate) order: Vec<usize>,
+    pub(crate) skins: Vec<Option<RigSkin>>,
+    pub(crate) parts: Vec<Part>,
+    pub(crate) clips: Vec<Clip>,
+    pub(crate) expressions: Vec<Expression>,
+    /// A VRM's humanoid bones: `(bone name, node)`.
+    pub(crate) humanoid: Vec<(String, usize)>,
+    /// Which VRM the file is, if it is one.
+    pub(crate) vrm: Option<crate::gltf_vrm::VrmVersion>,
+    /// Per vertex of the loaded mesh, the group of vertices at the same rest position (their
+    /// outline normals are the normalised sum of their normals).
+    pub(crate) groups: Vec<u32>,
+    pub(crate) group_count: usize,
+}
+
+/// What to pose: a clip at a time, and expression weights.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PoseInput<'a> {
+    /// The clip (an index into [`Rig::clips`]), or the rest pose.
+    pub clip: Option<usize>,
+    /// Seconds into the clip (held at its ends).
+    pub time: f32,
+    /// `(expression index, weight in [0, 1])`.
+    pub expressions: &'a [(usize, f32)],
+}
+
+impl Rig {
+    /// The file's animation clips.
+    pub fn clips(&self) -> &[Clip] {
+        &self.clips
+    }
+
+    /// The index of the clip called `name`.
+    pub fn clip(&self, name: &str) -> Option<usize> {
+        self.clips.iter().position(|c| c.name == name)
+    }
+
+    /// The file's VRM expressions.
+    pub fn expressions(&self) -> &[Expression] {
+        &self.expressions
+    }
+
+    /// Whether posing can change anything (a clip, a skin, morph targets or expressions).
+    pub fn is_posable(&self) -> bool {
+        !self.clips.is_empty()
+            || !self.expressions.is_empty()
+            || self.parts.iter().any(|p| !p.targets.is_empty())
+    }
+
+    /// Every node's global matrix and morph weights for `input`.
+    fn node_pose(&self, input: &PoseInput<'_>) -> (Vec<Mat4>, Vec<Vec<f32>>) {
+        let n = self.nodes.len();
+        let mut trs: Vec<Option<([f32; 3], [f32; 4], [f32; 3])>> = self
+            .nodes
+            .iter()
+            .map(|node| match node.rest {
+                RestLocal::Trs { t, r, s } => Some((t, r, s)),
+                RestLocal::Matrix(_) => None,
+            })
+            .collect();
+        let mut weights: Vec<Vec<f32>> = self.nodes.iter().map(|node| node.weights.clone()).collect();
+        if let Some(clip) = input.clip.and_then(|c| self.clips.get(c)) {
+            let mut buf = [0.0f32; 4];
+            for ch in &clip.channels {
+                let rotation = ch.path == ChannelPath::Rotation;
+                if ch.path == ChannelPath::Weights {
+                    let w = &mut weights[ch.node];
+                    if w.len() == ch.width {
+                        sample(ch.sampling, &ch.times, &ch.values, ch.width, false, input.time, w);
+                    }
+                    continue;
+                }
+                let Some((t, r, s)) = trs[ch.node].as_mut() else { continue };
+                sample(ch.sampling, &ch.times, &ch.values, ch.width, rotation, input.time, &mut buf);
+                match ch.path {
+                    ChannelPath::Translation => t.copy_from_slice(&buf[..3]),
+                    ChannelPath::Rotation => r.copy_from_slice(&buf),
+                    ChannelPath::Scale => s.copy_from_slice(&buf[..3]),
+                    ChannelPath::Weights => {}
+                }
+            }
+        }
+        for &(e, value) in input.expressions {
+            let Some(ex) = self.expressions.get(e) else { continue };
+            let value = if value.is_finite() { value.clamp(0.0, 1.0) } else { 0.0 };
+            for &(node, target, w) in &ex.binds {
+                if let Some(x) = weights.get_mut(node).and_then(|ws| ws.get_mut(target)) {
+                    *x += value * w;
+                }
+            }
+        }
+        let mut globals = vec![Mat4::IDENTITY; n];
+        for &i in &self.order {
+            let local = match (&self.nodes[i].rest, trs[i]) {
+                (_, Some((t, r, s))) => trs_matrix(t, r, s),
+                (RestLocal::Matrix(m), None) => *m,
+                (RestLocal::Trs { .. }, None) => Mat4::IDENTITY,
+            };
+            globals[i] = match self.nodes[i].parent {
+                Some(p) => globals[p] * local,
+                None => local,
+            };
+        }
+        (globals, weights)
+    }
+
+    /// `base` (this rig's rest mesh) posed by `input`: positions, normals and outline normals
+    /// replaced, everything else shared in value. Non-finite results fall back to the rest
+    /// vertex, and coordinates are clamped to `±COORD_MAX`, so any pose renders.
+    pub fn pose(&self, base: &Mesh, input: &PoseInput<'_>) -> Mesh {
+        let (globals, weights) = self.node_pose(input);
+        let nv = base.positions.len();
+        let mut positions = base.positions.clone();
+        let mut normals = base.normals.clone();
+        for part in &self.parts {
+            let w = &weights[part.node];
+            let skin = part.skin.and_then(|s| self.skins.get(s)).and_then(Option::as_ref);
+            let joints: Vec<Mat4> = match skin {
+                Some(s) => s.joints.iter().zip(&s.ibms).map(|(&j, ibm)| globals[j] * *ibm).collect(),
+                None => Vec::new(),
+            };
+            let node_m = globals[part.node];
+            let node_n = node_m.normal_matrix();
+            let active: Vec<(usize, f32)> =
+                w.iter().copied().enumerate().filter(|&(i, x)| x != 0.0 && i < part.targets.len()).collect();
+            for v in 0..part.positions.len() {
+                let mut p = Vec3f::from_array(part.positions[v]);
+                let mut nrm = Vec3f::from_array(part.normals[v]);
+                for &(i, x) in &active {
+                    let t = &part.targets[i];
+                    if let Some(d) = t.positions.get(v) {
+                        p += Vec3f::from_array(*d) * x;
+                    }
+                    if let Some(d) = t.normals.get(v) {
+                        nrm += Vec3f::from_array(*d) * x;
+                    }
+                }
+                let (m, nm) = match part.influences.get(v) {
+                    Some(inf) if inf.iter().any(|&(_, x)| x > 0.0) && !joints.is_empty() => {
+                        let mut m = Mat4 { cols: [[0.0; 4]; 4] };
+                        for &(j, x) in inf {
+                            if x == 0.0 {
+                                continue;
+                            }
+                            let Some(jm) = joints.get(j as usize) else { continue };
+                            for (c, sc) in m.cols.iter_mut().zip(&jm.cols) {
+                                for (a, b) in c.iter_mut().zip(sc) {
+                                    *a += x * b;
+                                }
+                            }
+                        }
+                        (m, m.normal_matrix())
+                    }
+                    _ => (node_m, node_n),
+                };
+                let out = part.first + v;
+                if out >= nv {
+                    break;
+                }
+                let q = m.transform_point(p);
+                if q.to_array().iter().all(|c| c.is_finite()) {
+                    positions[out] = q.to_array().map(|c| c.clamp(-COORD_MAX, COORD_MAX));
+                }
+                let fallback = Vec3f::from_array(base.normals[out]);
+                normals[out] = nm.transform_vector(nrm).try_normalize().unwrap_or(fallback).to_array();
+            }
+        }
+        let outline_normals = if base.outline_normals.is_empty() || self.groups.len() != nv {
+            Vec::new()
+        } else {
+            let mut sums = vec![Vec3f::ZERO; self.group_count];
+            for (g, n) in self.groups.iter().zip(&normals) {
+                sums[*g as usize] += Vec3f::from_array(*n);
+            }
+            self.groups
+                .iter()
+                .zip(&normals)
+                .map(|(g, n)| sums[*g as usize].try_normalize().unwrap_or(Vec3f::from_array(*n)).to_array())
+                .collect()
+        };
+        Mesh {
+            positions,
+            normals,
+            outline_normals,
+            indices: base.indices.clone(),
+            uvs: base.uvs.clone(),
+            colors: base.colors.clone(),
+            material_ids: base.material_ids.clone(),
+            materials: base.materials.clone(),
+        }
+    }
+}
+
+/// The clip time of a clip of `duration` seconds at scene time `t`: `(t − start)·speed` (0 before
+/// `start`), wrapped into `[0, duration)` when `looping`, else held at `[0, duration]`.
+pub fn clip_time(t: f32, start: f32, speed: f32, duration: f32, looping: bool) -> f32 {
+    let local = ((t - start).max(0.0) * speed) as f64;
+    clip_wrap(local as f32, duration, looping)
+}
+
+/// A clip time wrapped into `[0, duration)` (`looping`) or held within `[0, duration]`.
+pub fn clip_wrap(time: f32, duration: f32, looping: bool) -> f32 {
+    if !time.is_finite() {
+        return 0.0;
+    }
+    if !(duration > 0.0) {
+        return 0.0;
+    }
+    if looping {
+        (time as f64).rem_euclid(duration as f64) as f32
+    } else {
+        time.clamp(0.0, duration)
+    }
+}
+
+/// Per vertex, the group of vertices at exactly the same position, and the number of groups
+/// (what [`crate::mesh::with_outline_normals`] averages over).
+pub(crate) fn position_groups(positions: &[[f32; 3]]) -> (Vec<u32>, usize) {
+    let mut ids: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
+    let key = |p: &[f32; 3]| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+    let groups = positions
+        .iter()
+        .map(|p| {
+            let next = ids.len() as u32;
+            *ids.entry(key(p)).or_insert(next)
+        })
+        .collect();
+    (groups, ids.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clip_time_loops_holds_and_waits_for_its_start() {
+        assert_eq!(clip_time(0.5, 1.0, 1.0, 2.0, true), 0.0);
+        assert!((clip_time(3.5, 1.0, 1.0, 2.0, true) - 0.5).abs() < 1e-6);
+        assert_eq!(clip_time(9.0, 0.0, 1.0, 2.0, false), 2.0);
+        assert!((clip_time(1.25, 0.0, 2.0, 2.0, true) - 0.5).abs() < 1e-6);
+        assert!((clip_wrap(-0.5, 2.0, true) - 1.5).abs() < 1e-6);
+        assert_eq!(clip_wrap(f32::NAN, 2.0, true), 0.0);
+        assert_eq!(clip_wrap(1.0, 0.0, true), 0.0);
+    }
+}
