@@ -42,7 +42,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::buffer::Source;
 use gltf::json;
 use gltf::mesh::{Mode, Semantic};
-use hadou_math::Mat4;
+use hadou_math::{Mat4, Vec3f};
 use std::cell::Cell;
 use std::path::Path;
 
@@ -186,14 +186,18 @@ fn sniff(bytes: &[u8]) -> Result<&[u8], String> {
 
 /// Loads the glTF or GLB `bytes`; the file's own bytes are dropped once parsed (a GLB's binary
 /// chunk lives on in the document), so a large file is not held twice.
-fn from_bytes_in(
-    bytes: std::borrow::Cow<'_, [u8]>,
-    dir: &Path,
-    root: &Path,
-    budget: &mut Budget,
-    warnings: &mut Vec<String>,
-) -> Result<(Mesh, Option<Rig>), String> {
-    let file_len = bytes.len() as u64;
+/// A parsed, checked glTF document: every index in range, the node graph a forest (`parent` of
+/// each node), the glTF crate's validation passed, required extensions supported.
+pub(crate) struct Opened {
+    pub gltf: gltf::Gltf,
+    pub raw: serde_json::Value,
+    pub parent: Vec<Option<usize>>,
+    /// The GLB binary chunk, until the buffers take it.
+    pub blob: Option<Vec<u8>>,
+}
+
+/// Parses and checks the glTF or GLB `bytes` (dropped once parsed).
+pub(crate) fn open(bytes: std::borrow::Cow<'_, [u8]>) -> Result<Opened, String> {
     let (mut gltf, raw) = {
         let body = sniff(&bytes)?;
         let json = json_text(body)?;
@@ -204,7 +208,7 @@ fn from_bytes_in(
     };
     drop(bytes);
     // The binary chunk moves into the buffers below instead of being copied.
-    let mut blob = gltf.blob.take();
+    let blob = gltf.blob.take();
     let doc = gltf.document.as_json();
     for ext in &doc.extensions_required {
         if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
@@ -242,6 +246,51 @@ fn from_bytes_in(
         problems.truncate(3);
         return Err(format!("not a valid glTF 2.0 file: {}{more}", problems.join("; ")));
     }
+    Ok(Opened { gltf, raw, parent, blob })
+}
+
+/// Reads every buffer of `gltf` (the GLB chunk `blob`, or URIs resolved in `dir` and confined to
+/// `root`), taking their bytes from `bytes_left`.
+pub(crate) fn read_buffers(
+    gltf: &gltf::Gltf,
+    mut blob: Option<Vec<u8>>,
+    dir: &Path,
+    root: &Path,
+    bytes_left: &mut u64,
+) -> Result<Vec<Vec<u8>>, String> {
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for buffer in gltf.buffers() {
+        let data = match buffer.source() {
+            Source::Bin => blob.take().ok_or_else(|| {
+                format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index())
+            })?,
+            Source::Uri(uri) => resolve_uri(uri, dir, root, *bytes_left)
+                .map_err(|e| format!("buffer {}: {e}", buffer.index()))?,
+        };
+        *bytes_left = bytes_left.saturating_sub(data.len() as u64);
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "buffer {} has {} bytes but the file declares byteLength {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+fn from_bytes_in(
+    bytes: std::borrow::Cow<'_, [u8]>,
+    dir: &Path,
+    root: &Path,
+    budget: &mut Budget,
+    warnings: &mut Vec<String>,
+) -> Result<(Mesh, Option<Rig>), String> {
+    let file_len = bytes.len() as u64;
+    let Opened { gltf, raw, parent, blob } = open(bytes)?;
+    let doc = gltf.document.as_json();
 
     // The root nodes of the default scene (or the first, or every parentless node).
     let scene = doc.scene.map(|s| s.value()).or(if doc.scenes.is_empty() { None } else { Some(0) });
@@ -282,26 +331,7 @@ fn from_bytes_in(
     }
 
     let mut bytes_left = GLTF_MAX_BYTES.saturating_sub(file_len);
-    let mut buffers: Vec<Vec<u8>> = Vec::new();
-    for buffer in gltf.buffers() {
-        let data = match buffer.source() {
-            Source::Bin => blob.take().ok_or_else(|| {
-                format!("buffer {} refers to a GLB binary chunk, but there is none", buffer.index())
-            })?,
-            Source::Uri(uri) => resolve_uri(uri, dir, root, bytes_left)
-                .map_err(|e| format!("buffer {}: {e}", buffer.index()))?,
-        };
-        bytes_left = bytes_left.saturating_sub(data.len() as u64);
-        if data.len() < buffer.length() {
-            return Err(format!(
-                "buffer {} has {} bytes but the file declares byteLength {}",
-                buffer.index(),
-                data.len(),
-                buffer.length()
-            ));
-        }
-        buffers.push(data);
-    }
+    let buffers = read_buffers(&gltf, blob, dir, root, &mut bytes_left)?;
 
     let src = ImageSource { buffers: &buffers, dir, root };
     let texels = &mut budget.texels;
@@ -309,7 +339,12 @@ fn from_bytes_in(
         guarded("glTF", || load_materials(&gltf, &raw, &src, &mut bytes_left, texels, warnings))??;
     let (out, rig) = guarded("glTF", || -> Result<(Mesh, Option<Rig>), String> {
         let nodes: Vec<gltf::Node<'_>> = gltf.nodes().collect();
-        let worlds = world_matrices(&nodes, &parent);
+        // VRM 0.x models face −z; turned half a turn about y they face +z as every other model.
+        let base = match crate::gltf_vrm::vrm_version(&raw) {
+            Some(crate::gltf_vrm::VrmVersion::V0) => Mat4::rotation_xyz_deg(Vec3f::new(0.0, 180.0, 0.0)),
+            _ => Mat4::IDENTITY,
+        };
+        let worlds = world_matrices(&nodes, &parent, base);
         // Each skin's joints and inverse bind matrices, and `J_k · IBM_k` once, for every skin a
         // node of the default scene uses.
         let mut skins: Vec<Option<Vec<Mat4>>> = vec![None; doc.skins.len()];
@@ -327,9 +362,10 @@ fn from_bytes_in(
         let mut out = Mesh::default();
         let mut parts = Vec::new();
         for &r in &roots {
-            add_node(&nodes[r], Mat4::IDENTITY, &ctx, &mut out, &mut parts, 0, warnings)?;
+            add_node(&nodes[r], base, &ctx, &mut out, &mut parts, 0, warnings)?;
         }
-        let rig = build_rig(&gltf, &raw, &nodes, &parent, rig_skins, parts, &buffers, warnings)?;
+        let rig = build_rig(&gltf, &raw, &nodes, &parent, rig_skins, parts, &buffers, warnings)?
+            .map(|rig| Rig { base, ..rig });
         Ok((out, rig))
     })??;
     if out.indices.is_empty() {
@@ -435,6 +471,7 @@ fn build_rig(
         expressions,
         humanoid,
         vrm,
+        base: Mat4::IDENTITY,
         groups: Vec::new(),
         group_count: 0,
     }))
@@ -671,10 +708,10 @@ struct Ctx<'a> {
 }
 
 /// Every node's world matrix from the node hierarchy (the graph is a forest), without recursion.
-fn world_matrices(nodes: &[gltf::Node<'_>], parent: &[Option<usize>]) -> Vec<Option<Mat4>> {
+fn world_matrices(nodes: &[gltf::Node<'_>], parent: &[Option<usize>], base: Mat4) -> Vec<Option<Mat4>> {
     let mut worlds: Vec<Option<Mat4>> = vec![None; nodes.len()];
     let mut stack: Vec<(usize, Mat4)> =
-        (0..nodes.len()).filter(|&i| parent[i].is_none()).map(|i| (i, Mat4::IDENTITY)).collect();
+        (0..nodes.len()).filter(|&i| parent[i].is_none()).map(|i| (i, base)).collect();
     while let Some((i, up)) = stack.pop() {
         let world = up * Mat4 { cols: nodes[i].transform().matrix() };
         if world.cols.iter().flatten().all(|v| v.is_finite()) {

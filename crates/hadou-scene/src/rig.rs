@@ -122,6 +122,8 @@ pub struct Rig {
     pub(crate) humanoid: Vec<(String, usize)>,
     /// Which VRM the file is, if it is one.
     pub(crate) vrm: Option<crate::gltf_vrm::VrmVersion>,
+    /// The transform above the file's root nodes (a half turn about y for VRM 0.x, which faces −z).
+    pub(crate) base: Mat4,
     /// Per vertex of the loaded mesh, the group of vertices at the same rest position (their
     /// outline normals are the normalised sum of their normals).
     pub(crate) groups: Vec<u32>,
@@ -213,7 +215,7 @@ impl Rig {
             };
             globals[i] = match self.nodes[i].parent {
                 Some(p) => globals[p] * local,
-                None => local,
+                None => self.base * local,
             };
         }
         (globals, weights)
