@@ -6,7 +6,7 @@
 #[path = "common/gltf_reference.rs"]
 mod gltf_reference;
 
-use gltf_reference::{compose, hermite, mul, slerp, transform, Gltf, V3, IDENTITY};
+use gltf_reference::{compose, hermite, mul, slerp, transform, Gltf, IDENTITY, V3};
 use std::path::{Path, PathBuf};
 
 /// Largest allowed distance between a vertex and its reference (the models are about 1.8 tall).
@@ -31,12 +31,20 @@ fn max_dev(got: &[[f32; 3]], want: &[V3]) -> (f64, usize) {
 
 fn assert_close(what: &str, got: &[[f32; 3]], want: &[V3]) {
     let (d, i) = max_dev(got, want);
-    assert!(d <= TOL, "{what}: vertex {i} is {d:.3e} from the reference: got {:?}, want {:?}", got[i], want[i]);
+    assert!(
+        d <= TOL,
+        "{what}: vertex {i} is {d:.3e} from the reference: got {:?}, want {:?}",
+        got[i],
+        want[i]
+    );
 }
 
 /// The largest displacement between two poses (to show a case really moves the mesh).
 fn spread(a: &[V3], b: &[V3]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -150,7 +158,7 @@ fn one_joint_glb() -> Vec<u8> {
         ]
     });
     let mut js = serde_json::to_vec(&json).unwrap();
-    while js.len() % 4 != 0 {
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
     let mut out = Vec::new();
@@ -173,7 +181,8 @@ fn one_joint_glb() -> Vec<u8> {
 fn the_assets_have_the_structure_the_animation_tests_rely_on() {
     let g = Gltf::open(&asset("brace.glb"));
     assert!(g.json["skins"][0]["joints"].as_array().unwrap().len() >= 12);
-    let clips: Vec<&str> = g.json["animations"].as_array().unwrap().iter().map(|a| a["name"].as_str().unwrap()).collect();
+    let clips: Vec<&str> =
+        g.json["animations"].as_array().unwrap().iter().map(|a| a["name"].as_str().unwrap()).collect();
     assert_eq!(clips, ["brace", "step", "cubic", "blink"]);
     assert!((g.duration(g.animation("brace")) - 2.0).abs() < 1e-9);
     // The brace hips rotation holds a key pair with a negative dot product.
@@ -193,7 +202,10 @@ fn the_assets_have_the_structure_the_animation_tests_rely_on() {
         .unwrap()
         .iter()
         .flat_map(|m| m["primitives"].as_array().unwrap())
-        .map(|p| d.json["accessors"][p["indices"].as_u64().unwrap() as usize]["count"].as_u64().unwrap() as usize / 3)
+        .map(|p| {
+            d.json["accessors"][p["indices"].as_u64().unwrap() as usize]["count"].as_u64().unwrap() as usize
+                / 3
+        })
         .sum();
     assert!((48_000..=60_000).contains(&tris), "{tris} triangles");
 }
@@ -281,7 +293,14 @@ fn clip_time(t: f32, start: f64, speed: f64, looped: bool, duration: f64) -> f64
 
 /// Poses `asset_name` by `keys` at each scene time and compares with the reference at the clip
 /// times `want`; returns the reference poses.
-fn check(tag: &str, asset_name: &str, clip: &str, keys: &str, extra: &str, cases: &[(f32, f64)]) -> Vec<Vec<V3>> {
+fn check(
+    tag: &str,
+    asset_name: &str,
+    clip: &str,
+    keys: &str,
+    extra: &str,
+    cases: &[(f32, f64)],
+) -> Vec<Vec<V3>> {
     let (_tmp, scene) = TempScene::new(tag, asset_name, &format!("animation = \"{clip}\"\n{keys}"), extra);
     let g = Gltf::open(&asset(asset_name));
     cases
@@ -289,7 +308,11 @@ fn check(tag: &str, asset_name: &str, clip: &str, keys: &str, extra: &str, cases
         .map(|&(t, c)| {
             let want = g.pose(Some((clip, c)));
             let frame = scene.at(t);
-            assert_close(&format!("{tag}: {clip} at t = {t} (clip time {c})"), &frame.objects[0].mesh.positions, &want);
+            assert_close(
+                &format!("{tag}: {clip} at t = {t} (clip time {c})"),
+                &frame.objects[0].mesh.positions,
+                &want,
+            );
             want
         })
         .collect()
@@ -335,7 +358,8 @@ fn speed_start_loop_and_hold() {
     check("speed", "brace.glb", "brace", "animation_speed = 2.0", "", &t(&[0.3, 0.6], 0.0, 2.0, true));
     check("start", "brace.glb", "brace", "animation_start = 0.5", "", &t(&[0.8, 1.7], 0.5, 1.0, true));
     check("wrap", "brace.glb", "brace", "animation_loop = true", "", &t(&[2.3], 0.0, 1.0, true));
-    let held = check("hold", "brace.glb", "brace", "animation_loop = false", "", &t(&[2.3, 5.0], 0.0, 1.0, false));
+    let held =
+        check("hold", "brace.glb", "brace", "animation_loop = false", "", &t(&[2.3, 5.0], 0.0, 1.0, false));
     let wrapped = Gltf::open(&asset("brace.glb")).pose(Some(("brace", 0.3)));
     assert!(spread(&held[0], &wrapped) > 0.01, "holding differs from wrapping");
 }
@@ -349,6 +373,190 @@ fn animation_time_pins_and_a_track_scrubs_the_clip() {
 
 #[test]
 fn dancer_loops_every_joint_like_the_reference() {
-    let cases: Vec<(f32, f64)> = [0.45f32, 2.7].iter().map(|&t| (t, clip_time(t, 0.0, 1.0, true, 2.0))).collect();
+    let cases: Vec<(f32, f64)> =
+        [0.45f32, 2.7].iter().map(|&t| (t, clip_time(t, 0.0, 1.0, true, 2.0))).collect();
     check("dance", "dancer.glb", "dance", "", "", &cases);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The VRM avatars and the VRM animation (inputs of the humanoid tests).
+
+const HUMAN_BONES: [&str; 15] = [
+    "hips",
+    "spine",
+    "chest",
+    "neck",
+    "head",
+    "leftUpperArm",
+    "leftLowerArm",
+    "leftHand",
+    "rightUpperArm",
+    "rightLowerArm",
+    "rightHand",
+    "leftUpperLeg",
+    "leftLowerLeg",
+    "rightUpperLeg",
+    "rightLowerLeg",
+];
+
+fn node_count(g: &Gltf) -> u64 {
+    g.json["nodes"].as_array().unwrap().len() as u64
+}
+
+#[test]
+fn vrm_1_avatar_has_humanoid_expressions_and_mtoon_materials() {
+    let g = Gltf::open(&asset("brace.vrm"));
+    let used: Vec<&str> =
+        g.json["extensionsUsed"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+    assert!(used.contains(&"VRMC_vrm") && used.contains(&"VRMC_materials_mtoon"), "{used:?}");
+    let vrm = &g.json["extensions"]["VRMC_vrm"];
+    assert_eq!(vrm["specVersion"], "1.0");
+    for k in ["name", "authors", "licenseUrl"] {
+        assert!(!vrm["meta"][k].is_null(), "meta.{k}");
+    }
+    for b in HUMAN_BONES {
+        let n = vrm["humanoid"]["humanBones"][b]["node"].as_u64().unwrap_or_else(|| panic!("{b}"));
+        assert!(n < node_count(&g), "{b}");
+    }
+    for e in ["happy", "blink", "aa"] {
+        for bind in vrm["expressions"]["preset"][e]["morphTargetBinds"].as_array().unwrap() {
+            let node = &g.json["nodes"][bind["node"].as_u64().unwrap() as usize];
+            let mesh = &g.json["meshes"][node["mesh"].as_u64().unwrap() as usize];
+            let n_targets = mesh["primitives"][0]["targets"].as_array().unwrap().len() as u64;
+            assert!(bind["index"].as_u64().unwrap() < n_targets, "{e}");
+        }
+    }
+    let n_tex = g.json["textures"].as_array().unwrap().len() as u64;
+    for m in g.json["materials"].as_array().unwrap() {
+        let t = &m["extensions"]["VRMC_materials_mtoon"];
+        assert_eq!(t["specVersion"], "1.0");
+        assert_eq!(t["outlineWidthMode"], "worldCoordinates");
+        for k in [
+            "shadeColorFactor",
+            "shadingShiftFactor",
+            "shadingToonyFactor",
+            "parametricRimColorFactor",
+            "rimLightingMixFactor",
+            "parametricRimFresnelPowerFactor",
+            "parametricRimLiftFactor",
+            "matcapFactor",
+            "outlineWidthFactor",
+            "outlineColorFactor",
+            "outlineLightingMixFactor",
+            "uvAnimationScrollXSpeedFactor",
+        ] {
+            assert!(!t[k].is_null(), "{}: {k}", m["name"]);
+        }
+        for k in
+            ["shadeMultiplyTexture", "shadingShiftTexture", "matcapTexture", "outlineWidthMultiplyTexture"]
+        {
+            assert!(t[k]["index"].as_u64().unwrap() < n_tex, "{}: {k}", m["name"]);
+        }
+    }
+    // T-pose at rest, facing +z: the hands reach out to ±0.8 at shoulder height, the face
+    // morph (aa) moves vertices on the front of the head.
+    let rest = g.pose(None);
+    let reach = rest.iter().map(|p| p[0].abs()).fold(0.0, f64::max);
+    assert!((0.75..0.85).contains(&reach), "{reach}");
+    let plain = g.pose_with(None, false);
+    let moved: Vec<&V3> =
+        rest.iter().zip(&plain).filter(|(a, b)| spread(&[**a], &[**b]) > 1e-5).map(|(a, _)| a).collect();
+    assert!(!moved.is_empty() && moved.iter().all(|p| p[2] > 0.0), "the morphs move the back of the head");
+    // A valid glTF file for the loader, in the same rest pose.
+    let mesh = hadou_scene::load_gltf(&asset("brace.vrm")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(mesh.positions.len(), rest.len());
+}
+
+#[test]
+fn vrm_0_avatar_is_the_vrm_1_avatar_turned_to_face_minus_z() {
+    let g0 = Gltf::open(&asset("brace0.vrm"));
+    let g1 = Gltf::open(&asset("brace.vrm"));
+    let vrm = &g0.json["extensions"]["VRM"];
+    let bones: Vec<(&str, u64)> = vrm["humanoid"]["humanBones"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| (b["bone"].as_str().unwrap(), b["node"].as_u64().unwrap()))
+        .collect();
+    for b in HUMAN_BONES {
+        let n = bones.iter().find(|x| x.0 == b).unwrap_or_else(|| panic!("{b}")).1;
+        assert!(n < node_count(&g0));
+        // The same bone on the same node as in the VRM 1.0 avatar.
+        assert_eq!(
+            g1.json["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"][b]["node"].as_u64(),
+            Some(n),
+            "{b}"
+        );
+    }
+    let presets: Vec<&str> = vrm["blendShapeMaster"]["blendShapeGroups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| g["presetName"].as_str().unwrap())
+        .collect();
+    assert_eq!(presets, ["joy", "blink", "a"]);
+    for m in vrm["materialProperties"].as_array().unwrap() {
+        assert_eq!(m["shader"], "VRM/MToon");
+        for k in ["_ShadeShift", "_ShadeToony", "_OutlineWidth", "_OutlineWidthMode", "_RimLightingMix"] {
+            assert!(m["floatProperties"][k].is_number(), "{k}");
+        }
+        for k in ["_Color", "_ShadeColor", "_RimColor", "_OutlineColor"] {
+            assert_eq!(m["vectorProperties"][k].as_array().map(Vec::len), Some(4), "{k}");
+        }
+    }
+    // Turned 180° about y: (x, y, z) → (−x, y, −z), morphs included.
+    let (p0, p1) = (g0.pose(None), g1.pose(None));
+    assert_eq!(p0.len(), p1.len());
+    for (a, b) in p0.iter().zip(&p1) {
+        assert!(
+            (a[0] + b[0]).abs() < 1e-5 && (a[1] - b[1]).abs() < 1e-5 && (a[2] + b[2]).abs() < 1e-5,
+            "{a:?} {b:?}"
+        );
+    }
+}
+
+#[test]
+fn vrm_animation_has_its_own_rest_pose_an_extra_bone_and_a_blink_track() {
+    let g = Gltf::open(&asset("brace.vrma"));
+    let ext = &g.json["extensions"]["VRMC_vrm_animation"];
+    assert_eq!(ext["specVersion"], "1.0");
+    let bones = &ext["humanoid"]["humanBones"];
+    for b in HUMAN_BONES {
+        assert!(bones[b]["node"].as_u64().unwrap() < node_count(&g), "{b}");
+    }
+    // A bone the avatars lack.
+    assert!(bones["leftThumbProximal"]["node"].is_u64());
+    let avatar = Gltf::open(&asset("brace.vrm"));
+    assert!(avatar.json["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]
+        .get("leftThumbProximal")
+        .is_none());
+    // The upper arms rest 10° lower than the avatar's T-pose.
+    for (b, sign) in [("leftUpperArm", -1.0), ("rightUpperArm", 1.0)] {
+        let n = bones[b]["node"].as_u64().unwrap() as usize;
+        let q: Vec<f64> =
+            g.json["nodes"][n]["rotation"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let deg = 2.0 * q[2].atan2(q[3]).to_degrees();
+        assert!((deg - sign * 10.0).abs() < 1e-3, "{b}: {deg}");
+        let m = avatar.json["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"][b]["node"].as_u64().unwrap()
+            as usize;
+        assert!(avatar.json["nodes"][m].get("rotation").is_none(), "{b} of the avatar");
+    }
+    // The blink expression: its node's translation x is animated, from 0 up to 1.
+    let blink = ext["expressions"]["preset"]["blink"]["node"].as_u64().unwrap();
+    let a = g.animation("brace");
+    let ch = g.json["animations"][a]["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["target"]["node"].as_u64() == Some(blink))
+        .expect("no blink track");
+    assert_eq!(ch["target"]["path"], "translation");
+    let s = ch["sampler"].as_u64().unwrap() as usize;
+    let xs: Vec<f64> = (0..=20)
+        .map(|k| match g.sample(a, s, "translation", k as f64 * 0.1) {
+            gltf_reference::Sampled::Translation(t) => t[0],
+            _ => unreachable!(),
+        })
+        .collect();
+    assert!(xs.iter().all(|x| (0.0..=1.0).contains(x)) && xs.iter().any(|&x| x > 0.99), "{xs:?}");
 }

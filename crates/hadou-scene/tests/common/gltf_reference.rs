@@ -110,7 +110,8 @@ impl Gltf {
         let Some(view) = a.get("bufferView") else { return vec![vec![0.0; width]; count] };
         let v = &self.arr("bufferViews")[idx(view)];
         assert_eq!(v["buffer"].as_u64(), Some(0), "only the GLB's own buffer");
-        let base = v["byteOffset"].as_u64().unwrap_or(0) as usize + a["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let base =
+            v["byteOffset"].as_u64().unwrap_or(0) as usize + a["byteOffset"].as_u64().unwrap_or(0) as usize;
         let stride = v["byteStride"].as_u64().map(|s| s as usize).unwrap_or(width * size);
         (0..count)
             .map(|e| {
@@ -126,7 +127,9 @@ impl Gltf {
                             5120 => b[0] as i8 as f64,
                             5123 if normalized => u16::from_le_bytes([b[0], b[1]]) as f64 / 65535.0,
                             5123 => u16::from_le_bytes([b[0], b[1]]) as f64,
-                            5122 if normalized => (i16::from_le_bytes([b[0], b[1]]) as f64 / 32767.0).max(-1.0),
+                            5122 if normalized => {
+                                (i16::from_le_bytes([b[0], b[1]]) as f64 / 32767.0).max(-1.0)
+                            }
                             5122 => i16::from_le_bytes([b[0], b[1]]) as f64,
                             _ => u32::from_le_bytes(b.try_into().unwrap()) as f64,
                         }
@@ -182,9 +185,7 @@ impl Gltf {
             let u = (t - times[k]) / td;
             match interp {
                 "STEP" => value(k),
-                "LINEAR" if path == "rotation" => {
-                    slerp(to_q(&value(k)), to_q(&value(k + 1)), u).to_vec()
-                }
+                "LINEAR" if path == "rotation" => slerp(to_q(&value(k)), to_q(&value(k + 1)), u).to_vec(),
                 "LINEAR" => value(k).iter().zip(value(k + 1)).map(|(a, b)| a + (b - a) * u).collect(),
                 "CUBICSPLINE" => {
                     let (p0, m0) = (value(k), elem(k, 2));
@@ -218,7 +219,8 @@ impl Gltf {
             .map(|n| {
                 let m = n.get("matrix").map(|m| nums(m).try_into().unwrap());
                 let t = n.get("translation").map(|v| nums(v).try_into().unwrap()).unwrap_or([0.0; 3]);
-                let r = n.get("rotation").map(|v| nums(v).try_into().unwrap()).unwrap_or([0.0, 0.0, 0.0, 1.0]);
+                let r =
+                    n.get("rotation").map(|v| nums(v).try_into().unwrap()).unwrap_or([0.0, 0.0, 0.0, 1.0]);
                 let s = n.get("scale").map(|v| nums(v).try_into().unwrap()).unwrap_or([1.0; 3]);
                 (t, r, s, m)
             })
@@ -238,7 +240,8 @@ impl Gltf {
                 }
             }
         }
-        let locals: Vec<M4> = trs.iter().map(|(t, r, s, m)| m.unwrap_or_else(|| compose(*t, *r, *s))).collect();
+        let locals: Vec<M4> =
+            trs.iter().map(|(t, r, s, m)| m.unwrap_or_else(|| compose(*t, *r, *s))).collect();
         // Globals through the hierarchy.
         let mut parent = vec![None; nodes.len()];
         for (i, n) in nodes.iter().enumerate() {
