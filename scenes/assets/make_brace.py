@@ -261,29 +261,35 @@ SUIT, SKIN, HAIR, FACE, BAND = range(5)
 MATERIAL_NAMES = ["suit", "skin", "hair", "face", "band"]
 
 
-def build_body(sk, res, fingers=False, braid=0):
+def build_body(sk, res, fingers=False, braid=0, wide=False):
     """Parts SUIT, SKIN, HAIR (the body mesh), FACE (the head mesh, with its morph deltas) and
-    BAND (the rigid headband, in its node's space). `res` scales every tessellation."""
+    BAND (the rigid headband, in its node's space). `res` scales every tessellation; `wide`
+    blends up to four joints along every chain (hats 1.6 bone spacings wide) instead of two."""
     J = sk.index
+
+    def chain(joints, centres):
+        if not wide:
+            return chain2(joints, centres)
+        return chain4(joints, centres, 1.6 * max(b - a for a, b in zip(centres, centres[1:])))
     parts = [Part() for _ in range(5)]
     R = lambda n: max(3, int(round(n * res)))
     # Torso: hips -> spine -> chest -> neck.
     tj = [J("hips"), J("spine"), J("chest"), J("neck")]
     tube(parts[SUIT], (0.0, 0.0, 0.0), "y", 0.17, 0.1, 0.86, 1.47, R(20), R(14),
-         chain2(tj, [0.98, 1.16, 1.35, 1.49]))
+         chain(tj, [0.98, 1.16, 1.35, 1.49]))
     # Neck: chest -> neck -> head.
     tube(parts[SKIN], (0.0, 0.0, 0.0), "y", 0.05, 0.05, 1.43, 1.56, R(12), R(4),
-         chain2([J("chest"), J("neck"), J("head")], [1.42, 1.49, 1.56]))
+         chain([J("chest"), J("neck"), J("head")], [1.42, 1.49, 1.56]))
     for side, tag in ((1.0, "L"), (-1.0, "R")):
         # Legs: along t = -y, hips -> upper leg -> lower leg -> foot.
         lj = [J("hips"), J("upperLeg." + tag), J("lowerLeg." + tag), J("foot." + tag)]
         tube(parts[SUIT], (side * 0.1, 0.0, 0.0), "y", 0.075, 0.08, 0.0, 0.9, R(14), R(22),
-             chain2(lj, [-0.95, -0.7, -0.29, -0.04]), t_sign=-1.0)
+             chain(lj, [-0.95, -0.7, -0.29, -0.04]), t_sign=-1.0)
         # Arms: along t = side * x, shoulder -> upper arm -> lower arm -> hand.
         aj = [J("shoulder." + tag), J("upperArm." + tag), J("lowerArm." + tag), J("hand." + tag)]
         x0, x1 = sorted((side * 0.12, side * 0.72))
         tube(parts[SKIN], (0.0, 1.4, 0.0), "x", 0.045, 0.045, x0, x1, R(12), R(16),
-             chain2(aj, [0.115, 0.315, 0.575, 0.74]), t_sign=side)
+             chain(aj, [0.115, 0.315, 0.575, 0.74]), t_sign=side)
         sphere(parts[SKIN], (side * 0.75, 1.4, 0.0), 0.055, R(12), R(6), const(J("hand." + tag)))
         if fingers:
             for f in range(5):
@@ -292,7 +298,7 @@ def build_body(sk, res, fingers=False, braid=0):
                 centres = [0.74, 0.79, 0.82, 0.85] if f else [0.72, 0.755, 0.785, 0.815]
                 xa, xb = sorted((side * (base[0] * side - 0.01), side * (base[0] * side + 0.095)))
                 tube(parts[SKIN], (0.0, base[1], base[2]), "x", 0.009, 0.009, xa, xb, R(8), R(8),
-                     chain2(fj, centres), t_sign=side)
+                     chain(fj, centres), t_sign=side)
     # Head mesh (the face material, morph targets) and a hair cap, on the head joint.
     head = J("head")
     rows = sphere(parts[FACE], (0.0, 1.64, 0.0), 0.13, R(24), R(14), const(head), scale=(0.95, 1.1, 1.0))
@@ -756,7 +762,7 @@ def write_brace(path, kind):
 def write_dancer(path):
     braid = 16
     sk = body_skeleton(fingers=True, braid=braid)
-    parts = build_body(sk, 2.7, fingers=True, braid=braid)
+    parts = build_body(sk, 2.7, fingers=True, braid=braid, wide=True)
     d = Doc()
     nj = len(sk.names)
     nodes = []
