@@ -146,6 +146,44 @@ pub fn trs_matrix(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
         * Mat4::scale(Vec3f::from_array(s))
 }
 
+/// The rotation of an affine matrix as a unit quaternion: its 3×3 block with each column
+/// normalised (scale removed; a mirroring block loses its reflection first), converted by the
+/// largest-diagonal method (Shepperd). A degenerate block gives the identity.
+pub fn rotation_of(m: &Mat4) -> [f32; 4] {
+    let mut c = [[0.0f64; 3]; 3];
+    for (j, col) in c.iter_mut().enumerate() {
+        let v = [m.cols[j][0] as f64, m.cols[j][1] as f64, m.cols[j][2] as f64];
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if !(l > 1e-30 && l.is_finite()) {
+            return [0.0, 0.0, 0.0, 1.0];
+        }
+        *col = v.map(|x| x / l);
+    }
+    let det = c[0][0] * (c[1][1] * c[2][2] - c[2][1] * c[1][2])
+        - c[1][0] * (c[0][1] * c[2][2] - c[2][1] * c[0][2])
+        + c[2][0] * (c[0][1] * c[1][2] - c[1][1] * c[0][2]);
+    if det < 0.0 {
+        c[0] = c[0].map(|x| -x);
+    }
+    // r(row, col) = c[col][row]
+    let r = |i: usize, j: usize| c[j][i];
+    let tr = r(0, 0) + r(1, 1) + r(2, 2);
+    let q = if tr > 0.0 {
+        let s = (tr + 1.0).sqrt() * 2.0;
+        [(r(2, 1) - r(1, 2)) / s, (r(0, 2) - r(2, 0)) / s, (r(1, 0) - r(0, 1)) / s, 0.25 * s]
+    } else if r(0, 0) > r(1, 1) && r(0, 0) > r(2, 2) {
+        let s = (1.0 + r(0, 0) - r(1, 1) - r(2, 2)).sqrt() * 2.0;
+        [0.25 * s, (r(0, 1) + r(1, 0)) / s, (r(0, 2) + r(2, 0)) / s, (r(2, 1) - r(1, 2)) / s]
+    } else if r(1, 1) > r(2, 2) {
+        let s = (1.0 + r(1, 1) - r(0, 0) - r(2, 2)).sqrt() * 2.0;
+        [(r(0, 1) + r(1, 0)) / s, 0.25 * s, (r(1, 2) + r(2, 1)) / s, (r(0, 2) - r(2, 0)) / s]
+    } else {
+        let s = (1.0 + r(2, 2) - r(0, 0) - r(1, 1)).sqrt() * 2.0;
+        [(r(0, 2) + r(2, 0)) / s, (r(1, 2) + r(2, 1)) / s, 0.25 * s, (r(1, 0) - r(0, 1)) / s]
+    };
+    normalize_quat(q.map(|x| x as f32))
+}
+
 /// The product `a·b` of two quaternions (`[x, y, z, w]`): the rotation `b` followed by `a`.
 pub fn quat_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
     let [ax, ay, az, aw] = a;
@@ -224,6 +262,16 @@ mod tests {
         let q = quat_mul([0.0, 0.0, h.sin(), h.cos()], quat_conjugate([0.0, 0.0, h.sin(), h.cos()]));
         assert!(close(&q, &[0.0, 0.0, 0.0, 1.0], 1e-6));
         assert_eq!(normalize_quat([0.0; 4]), [0.0, 0.0, 0.0, 1.0]);
+        // rotation_of inverts quat_matrix (up to sign), also under a scale, for every branch.
+        for q in
+            [[0.3f32, -0.5, 0.1, 0.8], [0.9, 0.1, 0.2, 0.1], [0.1, 0.9, -0.2, 0.1], [0.1, 0.2, 0.95, 0.05]]
+        {
+            let q = normalize_quat(q);
+            let m = quat_matrix(q) * Mat4::scale(Vec3f::new(2.0, 0.5, 3.0));
+            let r = rotation_of(&m);
+            let d: f32 = (0..4).map(|i| q[i] * r[i]).sum();
+            assert!(d.abs() > 1.0 - 1e-5, "{q:?} vs {r:?}");
+        }
         assert_eq!(normalize_quat([f32::NAN, 0.0, 0.0, 1.0]), [0.0, 0.0, 0.0, 1.0]);
     }
 }

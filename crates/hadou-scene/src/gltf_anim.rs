@@ -84,6 +84,7 @@ fn read_channel(
     let width = match path {
         ChannelPath::Translation | ChannelPath::Scale => 3,
         ChannelPath::Rotation => 4,
+        ChannelPath::Expression => 1,
         ChannelPath::Weights => {
             let n = rig_node.weights.len();
             if n == 0 {
@@ -102,7 +103,7 @@ fn read_channel(
     let (dims, types): (&[Dimensions], &[DataType]) = match path {
         ChannelPath::Translation | ChannelPath::Scale => (&[Dimensions::Vec3], &[DataType::F32]),
         ChannelPath::Rotation => (&[Dimensions::Vec4], &norm),
-        ChannelPath::Weights => (&[Dimensions::Scalar], &norm),
+        ChannelPath::Weights | ChannelPath::Expression => (&[Dimensions::Scalar], &norm),
     };
     check_accessor(&output, dims, types, buffers).map_err(|e| format!("output: {e}"))?;
     let keys = input.count();

@@ -41,6 +41,7 @@ mod gltf_load;
 mod gltf_material;
 mod gltf_uri;
 mod gltf_vrm;
+mod gltf_vrma;
 mod guard;
 mod image;
 mod introspect;
@@ -76,6 +77,7 @@ pub use gltf_load::{
     MAX_MORPH_TARGETS,
 };
 pub use gltf_vrm::VrmVersion;
+pub use gltf_vrma::load_vrma_clip;
 pub use image::Image;
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
 pub use limits::{

@@ -76,6 +76,8 @@ pub(crate) enum ChannelPath {
     Rotation,
     Scale,
     Weights,
+    /// A VRM expression's weight (from a VRM Animation): `node` is the expression's index.
+    Expression,
 }
 
 /// One channel: a node property sampled from keys.
@@ -133,8 +135,8 @@ pub struct Rig {
 /// What to pose: a clip at a time, and expression weights.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PoseInput<'a> {
-    /// The clip (an index into [`Rig::clips`]), or the rest pose.
-    pub clip: Option<usize>,
+    /// The clip (one of [`Rig::clips`] or a retargeted VRM Animation), or the rest pose.
+    pub clip: Option<&'a Clip>,
     /// Seconds into the clip (held at its ends).
     pub time: f32,
     /// `(expression index, weight in [0, 1])`.
@@ -157,6 +159,21 @@ impl Rig {
         &self.expressions
     }
 
+    /// A VRM's humanoid bones: `(bone name, node)` (empty for other files).
+    pub fn humanoid(&self) -> &[(String, usize)] {
+        &self.humanoid
+    }
+
+    /// Which VRM the file is, if it is one.
+    pub fn vrm(&self) -> Option<crate::gltf_vrm::VrmVersion> {
+        self.vrm
+    }
+
+    /// Every node's global matrix under `input` (the scene space of the loaded mesh).
+    pub fn node_globals(&self, input: &PoseInput<'_>) -> Vec<Mat4> {
+        self.node_pose(input).0
+    }
+
     /// Whether posing can change anything (a clip, a skin, morph targets or expressions).
     pub fn is_posable(&self) -> bool {
         !self.clips.is_empty()
@@ -176,9 +193,15 @@ impl Rig {
             })
             .collect();
         let mut weights: Vec<Vec<f32>> = self.nodes.iter().map(|node| node.weights.clone()).collect();
-        if let Some(clip) = input.clip.and_then(|c| self.clips.get(c)) {
+        let mut clip_expressions: Vec<(usize, f32)> = Vec::new();
+        if let Some(clip) = input.clip {
             let mut buf = [0.0f32; 4];
             for ch in &clip.channels {
+                if ch.path == ChannelPath::Expression {
+                    sample(ch.sampling, &ch.times, &ch.values, 1, false, input.time, &mut buf);
+                    clip_expressions.push((ch.node, buf[0]));
+                    continue;
+                }
                 let rotation = ch.path == ChannelPath::Rotation;
                 if ch.path == ChannelPath::Weights {
                     let w = &mut weights[ch.node];
@@ -193,11 +216,11 @@ impl Rig {
                     ChannelPath::Translation => t.copy_from_slice(&buf[..3]),
                     ChannelPath::Rotation => r.copy_from_slice(&buf),
                     ChannelPath::Scale => s.copy_from_slice(&buf[..3]),
-                    ChannelPath::Weights => {}
+                    ChannelPath::Weights | ChannelPath::Expression => {}
                 }
             }
         }
-        for &(e, value) in input.expressions {
+        for &(e, value) in input.expressions.iter().chain(&clip_expressions) {
             let Some(ex) = self.expressions.get(e) else { continue };
             let value = if value.is_finite() { value.clamp(0.0, 1.0) } else { 0.0 };
             for &(node, target, w) in &ex.binds {
@@ -229,13 +252,22 @@ impl Rig {
         let nv = base.positions.len();
         let mut positions = base.positions.clone();
         let mut normals = base.normals.clone();
+        // Each skin's joint matrices `G(joint_k) · IBM_k`, once per pose.
+        let mut skin_mats: Vec<Option<Vec<Mat4>>> = vec![None; self.skins.len()];
+        let empty: Vec<Mat4> = Vec::new();
         for part in &self.parts {
             let w = &weights[part.node];
-            let skin = part.skin.and_then(|s| self.skins.get(s)).and_then(Option::as_ref);
-            let joints: Vec<Mat4> = match skin {
-                Some(s) => s.joints.iter().zip(&s.ibms).map(|(&j, ibm)| globals[j] * *ibm).collect(),
-                None => Vec::new(),
-            };
+            if let Some(s) = part.skin {
+                if let (Some(slot), Some(Some(skin))) = (skin_mats.get_mut(s), self.skins.get(s)) {
+                    if slot.is_none() {
+                        *slot = Some(
+                            skin.joints.iter().zip(&skin.ibms).map(|(&j, ibm)| globals[j] * *ibm).collect(),
+                        );
+                    }
+                }
+            }
+            let joints: &Vec<Mat4> =
+                part.skin.and_then(|s| skin_mats.get(s)).and_then(Option::as_ref).unwrap_or(&empty);
             let node_m = globals[part.node];
             let node_n = node_m.normal_matrix();
             let active: Vec<(usize, f32)> =

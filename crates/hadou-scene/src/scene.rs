@@ -11,7 +11,7 @@ use crate::frame::{
 };
 use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
-use crate::rig::{clip_time, clip_wrap, PoseInput, Rig};
+use crate::rig::{clip_time, clip_wrap, Clip, PoseInput, Rig};
 use crate::shadow_def::{build_shadow, ShadowDef};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
@@ -73,8 +73,8 @@ pub(crate) struct ObjectDef {
 /// (`animation_start`, `animation_speed`, `animation_time`).
 #[derive(Clone, Debug)]
 pub(crate) struct Motion {
-    /// The clip played, if any.
-    pub clip: Option<usize>,
+    /// The clip played, if any: one of the file's, or a VRM Animation retargeted onto it.
+    pub clip: Option<Arc<Clip>>,
     /// `animation_loop`.
     pub looping: bool,
     /// The clip time is `animation_time` (written in the file or animated by a track) rather than
@@ -166,7 +166,7 @@ impl Scene {
     /// The clip object `index` plays and its clip time at scene time `time`, if it plays one.
     pub fn object_clip_at(&self, index: usize, time: f32) -> Option<(String, f32)> {
         let o = self.objects.get(index)?;
-        let clip = o.rig.as_ref()?.clips().get(o.motion.as_ref()?.clip?)?;
+        let clip = o.motion.as_ref()?.clip.as_deref()?;
         let vals = self.values_at(time);
         Some((clip.name.clone(), self.clip_time_of(o, &vals, time)?))
     }
@@ -339,7 +339,8 @@ impl Scene {
     /// The clip time of object `o` at scene time `time` (`None` without a clip).
     pub(crate) fn clip_time_of(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Option<f32> {
         let (motion, rig) = (o.motion.as_ref()?, o.rig.as_ref()?);
-        let clip = rig.clips().get(motion.clip?)?;
+        let _ = rig;
+        let clip = motion.clip.as_deref()?;
         let p = &o.params;
         let pinned = motion.pinned
             || p.find("animation_time").is_some_and(|a| self.tracks.iter().any(|t| t.offset == a.offset));
@@ -375,7 +376,7 @@ impl Scene {
                 }
             }
         }
-        let input = PoseInput { clip: motion.clip, time: clip_t, expressions: &expressions };
+        let input = PoseInput { clip: motion.clip.as_deref(), time: clip_t, expressions: &expressions };
         let mesh = Arc::new(rig.pose(&o.mesh, &input));
         if let Ok(mut cache) = o.pose_cache.lock() {
             *cache = Some((key, mesh.clone()));

@@ -26,7 +26,7 @@ use crate::materials::{
 };
 use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, sphere_size, with_outline_normals};
 use crate::params::{Constraint, Param, ParamSet, Shape};
-use crate::rig::Rig;
+use crate::rig::{Clip, Rig};
 use crate::scene::Motion;
 use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
 use crate::shadow::{MAX_SHADOWS, MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES};
@@ -438,6 +438,7 @@ fn parse_object(
         _ => &[
             "path",
             "animation",
+            "animation_file",
             "animation_start",
             "animation_speed",
             "animation_loop",
@@ -494,29 +495,7 @@ fn parse_object(
             gltf = Some(PathBuf::from(rel));
             let gltf_err =
                 |message: String, file: PathBuf| SceneError::Gltf { at: t.src.loc(&span), file, message };
-            let file = assets.dir.path.join(rel);
-            if Path::new(rel).is_absolute() || Path::new(rel).has_root() {
-                return Err(gltf_err(
-                    "`path` must be relative to the scene file (glTF files must lie inside the scene \
-                         file's directory)"
-                        .into(),
-                    file,
-                ));
-            }
-            let real = std::fs::canonicalize(&file)
-                .map_err(|e| gltf_err(format!("cannot read the file: {e}"), file.clone()))?;
-            let root = assets.dir.root().map_err(|m| gltf_err(m, file.clone()))?;
-            if !real.starts_with(&root) {
-                return Err(gltf_err(
-                    format!(
-                        "it resolves to {}, outside the scene file's directory {}; glTF files must \
-                             lie inside the scene file's directory",
-                        show_path(&real),
-                        show_path(&root)
-                    ),
-                    file,
-                ));
-            }
+            let (file, real, root) = resolve_asset(t, rel, &span, &mut assets.dir)?;
             match assets.cache.get(&real) {
                 Some((m, r)) => {
                     rig = r.clone();
@@ -575,7 +554,7 @@ fn parse_object(
     }
     assets.slots_left -= slots;
     let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
-    let motion = parse_motion(t, rig.as_deref(), &mut params, rd)?;
+    let motion = parse_motion(t, rig.as_deref(), &mut params, rd, &mut assets.dir, warnings)?;
     Ok(ObjectDef {
         name,
         mesh,
@@ -597,9 +576,12 @@ fn parse_motion(
     rig: Option<&Rig>,
     params: &mut ParamSet,
     rd: &mut ParamReader<'_>,
+    dir: &mut SceneDir,
+    warnings: &mut Vec<String>,
 ) -> Res<Option<Motion>> {
     let keys = [
         "animation",
+        "animation_file",
         "animation_start",
         "animation_speed",
         "animation_loop",
@@ -613,19 +595,31 @@ fn parse_motion(
         t.src
             .value_err(&t.key_span(key), format!("{} gives `{key}`, but its glTF file has no {what}", t.what))
     };
-    let clip = match t.opt_str("animation")? {
-        None => {
+    let clip: Option<Arc<Clip>> = match (t.opt_str("animation_file")?, t.opt_str("animation")?) {
+        (Some((rel, span)), name) => {
+            let Some(rig) = rig else { return Err(no_rig("animation_file", "VRM humanoid")) };
+            let (file, real, root) = resolve_asset(t, rel, &span, dir)?;
+            let mut notes = Vec::new();
+            let clip = crate::gltf_vrma::load_vrma(&real, &root, rig, name.map(|n| n.0), &mut notes)
+                .map_err(|message| SceneError::Gltf { at: t.src.loc(&span), file: file.clone(), message })?;
+            warnings.extend(notes.into_iter().map(|n| format!("{}: {n}", show_path(&file))));
+            Some(Arc::new(clip))
+        }
+        (None, None) => {
             for k in ["animation_start", "animation_speed", "animation_loop", "animation_time"] {
                 if t.get(k).is_some() {
                     return Err(t.src.value_err(
                         &t.key_span(k),
-                        format!("{} gives `{k}` without `animation` (the clip to play)", t.what),
+                        format!(
+                            "{} gives `{k}` without `animation` or `animation_file` (the clip to play)",
+                            t.what
+                        ),
                     ));
                 }
             }
             None
         }
-        Some((name, span)) => {
+        (None, Some((name, span))) => {
             let clips = rig.map_or(&[][..], |r| r.clips());
             if clips.is_empty() {
                 return Err(no_rig("animation", "animation clips"));
@@ -637,8 +631,8 @@ fn parse_motion(
                 })
                 .collect::<Vec<_>>()
                 .join(", ");
-            match rig.and_then(|r| r.clip(name)) {
-                Some(i) => Some(i),
+            match clips.iter().find(|c| c.name == name) {
+                Some(c) => Some(Arc::new(c.clone())),
                 None => {
                     return Err(t.src.value_err(
                         &span,
@@ -706,6 +700,41 @@ fn parse_motion(
         expressions = true;
     }
     Ok(Some(Motion { clip, looping, pinned, expressions }))
+}
+
+/// Resolves an asset path `rel` written at `span` of `t`: relative to the scene file and inside
+/// its directory tree. Returns the path as written joined to the scene's directory, its canonical
+/// form and the canonical scene directory.
+fn resolve_asset(
+    t: &Table<'_, '_>,
+    rel: &str,
+    span: &Span,
+    dir: &mut SceneDir,
+) -> Res<(PathBuf, PathBuf, PathBuf)> {
+    let err = |message: String, file: PathBuf| SceneError::Gltf { at: t.src.loc(span), file, message };
+    let file = dir.path.join(rel);
+    if Path::new(rel).is_absolute() || Path::new(rel).has_root() {
+        return Err(err(
+            "the path must be relative to the scene file (glTF files must lie inside the scene file's directory)"
+                .into(),
+            file,
+        ));
+    }
+    let real =
+        std::fs::canonicalize(&file).map_err(|e| err(format!("cannot read the file: {e}"), file.clone()))?;
+    let root = dir.root().map_err(|m| err(m, file.clone()))?;
+    if !real.starts_with(&root) {
+        return Err(err(
+            format!(
+                "it resolves to {}, outside the scene file's directory {}; glTF files must lie inside the scene \
+                 file's directory",
+                show_path(&real),
+                show_path(&root)
+            ),
+            file,
+        ));
+    }
+    Ok((file, real, root))
 }
 
 /// Takes a primitive's `tris` triangles and `verts` vertices from the scene's budget, or says

@@ -213,6 +213,19 @@ impl Gltf {
     /// As [`Gltf::pose`]; `morphs = false` leaves the morph targets out (every weight 0).
     pub fn pose_with(&self, clip: Option<(&str, f64)>, morphs: bool) -> Vec<V3> {
         let nodes = self.arr("nodes");
+        let (globals, weights) = self.posed_nodes(clip);
+        self.place_scene(nodes, &globals, &weights, morphs)
+    }
+
+    /// Every node's global matrix (column-major) under animation `clip` at clip time `t`.
+    pub fn node_globals(&self, clip: Option<(&str, f64)>) -> Vec<M4> {
+        self.posed_nodes(clip).0
+    }
+
+    /// Every node's global matrix and animated morph weights.
+    #[allow(clippy::type_complexity)]
+    fn posed_nodes(&self, clip: Option<(&str, f64)>) -> (Vec<M4>, Vec<Option<Vec<f64>>>) {
+        let nodes = self.arr("nodes");
         // Local TRS of every node, then the animated values.
         let mut trs: Vec<(V3, Q, V3, Option<M4>)> = nodes
             .iter()
@@ -258,7 +271,16 @@ impl Gltf {
             m
         };
         let globals: Vec<M4> = (0..nodes.len()).map(global).collect();
+        (globals, weights)
+    }
 
+    fn place_scene(
+        &self,
+        nodes: &[Value],
+        globals: &[M4],
+        weights: &[Option<Vec<f64>>],
+        morphs: bool,
+    ) -> Vec<V3> {
         let scene = &self.arr("scenes")[self.json["scene"].as_u64().unwrap_or(0) as usize];
         let mut out = Vec::new();
         let mut stack: Vec<usize> = nums(&scene["nodes"]).into_iter().rev().map(|v| v as usize).collect();
@@ -271,7 +293,7 @@ impl Gltf {
                 } else {
                     Vec::new()
                 };
-                let skin = n.get("skin").map(|s| self.joint_matrices(idx(s), &globals));
+                let skin = n.get("skin").map(|s| self.joint_matrices(idx(s), globals));
                 for p in mesh["primitives"].as_array().unwrap() {
                     self.place_primitive(p, &w, skin.as_deref(), &globals[i], &mut out);
                 }
