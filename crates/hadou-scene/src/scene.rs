@@ -197,9 +197,26 @@ impl Scene {
         crate::limits::check_image_size(width, height, self.area_light.is_some())
     }
 
-    /// Time of the last key of any track in seconds (0 for a static scene).
+    /// Time of the last key of any track in seconds, or the end of the longest clip an object
+    /// plays once more (its `animation_start` plus its length over its speed, as the file writes
+    /// them) if that is later; 0 for a static scene.
     pub fn duration(&self) -> f32 {
-        self.tracks.iter().map(Track::end).fold(0.0, f32::max)
+        let tracks = self.tracks.iter().map(Track::end).fold(0.0, f32::max);
+        let clips = self
+            .objects
+            .iter()
+            .filter_map(|o| {
+                let motion = o.motion.as_ref()?;
+                let clip = motion.clip.as_ref()?;
+                if motion.pinned {
+                    return None;
+                }
+                let p = &o.params;
+                let speed = p.f(&self.values, "animation_speed").abs();
+                (speed > 0.0).then(|| p.f(&self.values, "animation_start") + clip.duration / speed)
+            })
+            .fold(0.0, f32::max);
+        tracks.max(clips).min(crate::limits::COORD_MAX)
     }
 
     /// The scene file's path.

@@ -345,3 +345,22 @@ fn a_scene_lists_each_objects_clips() {
     let s = Scene::load(&path).unwrap();
     assert!(s.object_clips().iter().all(|c| c.is_empty()));
 }
+
+#[test]
+fn the_scene_lasts_until_its_clips_have_played_once() {
+    let g = arm(|_, _| {});
+    let s =
+        scene_with("duration", &g, "animation = \"bend\"\nanimation_start = 2\nanimation_speed = 0.5", "")
+            .unwrap();
+    assert_eq!(s.duration(), 4.0);
+    let s = scene_with(
+        "duration-track",
+        &g,
+        "animation = \"bend\"",
+        "[[track]]\ntarget = \"object.arm.position.x\"\nkeys = [[0, 0.0], [9, 1.0]]\n",
+    )
+    .unwrap();
+    assert_eq!(s.duration(), 9.0);
+    let s = scene_with("duration-pinned", &g, "animation = \"bend\"\nanimation_time = 0.5", "").unwrap();
+    assert_eq!(s.duration(), 0.0);
+}

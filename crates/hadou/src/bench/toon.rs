@@ -20,6 +20,52 @@ pub const SHADOW_SCENE: (&str, f32) = ("shadow-uneven.toml", 1.0);
 /// bloom and a streak.
 pub const GLARE_SCENE: (&str, f32) = ("glare-kamehameha.toml", 1.5);
 
+/// The animated character `hadou bench toon` poses and renders: `assets/dancer.glb` (written by
+/// `scenes/assets/make_brace.py`: about 53 000 triangles, 65 joints, up to four weights per
+/// vertex) playing its `dance` clip, outlined, under a firing beam over a toon ground. Read as if it
+/// were `scenes/bench-dance.toml`.
+pub const ANIMATED_SCENE: &str = r#"
+background = [0.05, 0.04, 0.06]
+[camera]
+position = [0.0, 1.3, 4.2]
+target = [0.0, 0.95, 0.0]
+fov = 40.0
+[light]
+direction = [0.4, -1.0, -0.6]
+[[material]]
+name = "ground"
+model = "toon"
+base_color = [0.4, 0.38, 0.34]
+wave_blend = 0.5
+[[object]]
+name = "dancer"
+kind = "gltf"
+path = "assets/dancer.glb"
+animation = "dance"
+wave_blend = 1.0
+outline = true
+outline_width = 0.004
+[[object]]
+name = "ground"
+kind = "plane"
+size = [14.0, 14.0]
+material = "ground"
+[[wave]]
+name = "beam"
+kind = "beam"
+rgba = [0.45, 0.8, 1.0, 1.0]
+M = [1.0, 1.1, 3.0]
+D = [0.0, 0.0, -1.0]
+length = 5.0
+alpha_s = 0.02
+alpha_c = 0.02
+head_alpha = 0.05
+muzzle_alpha = 0.03
+"#;
+
+/// The scene time of the animated row's frame.
+pub const ANIMATED_TIME: f32 = 0.7;
+
 /// `frame` with every material reduced to plain diffuse shading of its base colour.
 pub fn plain_materials(frame: &Frame) -> Frame {
     let mut f = frame.clone();
@@ -110,6 +156,44 @@ pub fn toon_table(
         let bare = Frame { bloom: None, ..frame.clone() };
         glare.push(pair(glare_file, size, [("bloom", &frame), ("no-bloom", &bare)])?);
     }
+    // The animated character: the frame at one sample, and the posing (the whole `Scene::at` of
+    // a new clip time each iteration, so no pose is reused) against it.
+    let dance = Scene::parse(ANIMATED_SCENE, &scenes.join("bench-dance.toml"))
+        .map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut animated = Vec::new();
+    for &size in sizes {
+        let mut frame = dance.at(ANIMATED_TIME);
+        frame.width = size;
+        frame.height = size;
+        frame.samples = 1;
+        let frame_ms = time(&frame, iterations)?.ms;
+        let mut posing = Vec::new();
+        for k in 0..iterations.max(1) + 1 {
+            let t = ANIMATED_TIME + 0.013 * (k + 1) as f32;
+            let start = std::time::Instant::now();
+            std::hint::black_box(dance.at(t));
+            if k > 0 {
+                posing.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        let pose_ms = super::timing::median(posing);
+        for (variant, ms) in [("frame", frame_ms), ("posing", pose_ms)] {
+            rows.push(vec![
+                Cell::json("scene", "bench-dance"),
+                Cell::json("size", size),
+                Cell::json("variant", variant),
+                Cell::json("ms", ms),
+                Cell::json("fps", 1e3 / ms),
+            ]);
+        }
+        animated.push(vec![
+            Cell::text("size", format!("{size}²")),
+            Cell::text("ms", format!("{frame_ms:.2}")),
+            Cell::text("fps", format!("{:.1}", 1e3 / frame_ms)),
+            Cell::text("ms", format!("{pose_ms:.2}")),
+            Cell::text("share", format!("{:.1} %", 100.0 * pose_ms / frame_ms)),
+        ]);
+    }
     let columns = |on: &str, fps: &str, off: &str| {
         vec![
             Column::left("size", 8),
@@ -134,6 +218,17 @@ pub fn toon_table(
             title: format!("\nanti-aliasing, toon scene {file}\n"),
             columns: columns("4 samples ms", "fps", "1 sample ms"),
             rows: samples,
+        });
+    }
+    if !animated.is_empty() {
+        let tris = dance.at(ANIMATED_TIME).objects[0].mesh.indices.len() / 3;
+        let mut cols = columns("frame ms", "fps", "posing ms");
+        cols[4] = Column::right("share", 10);
+        tables.push(Table {
+            key: None,
+            title: format!("\nanimated character assets/dancer.glb ({tris} triangles), clip `dance`\n"),
+            columns: cols,
+            rows: animated,
         });
     }
     if !shadows.is_empty() {
