@@ -253,66 +253,81 @@ impl Rig {
         let mut positions = base.positions.clone();
         let mut normals = base.normals.clone();
         // Each skin's joint matrices `G(joint_k) · IBM_k`, once per pose.
-        let mut skin_mats: Vec<Option<Vec<Mat4>>> = vec![None; self.skins.len()];
+        let skin_mats: Vec<Vec<Mat4>> = self
+            .skins
+            .iter()
+            .enumerate()
+            .map(|(i, skin)| match skin {
+                Some(skin) if self.parts.iter().any(|p| p.skin == Some(i)) => {
+                    skin.joints.iter().zip(&skin.ibms).map(|(&j, ibm)| globals[j] * *ibm).collect()
+                }
+                _ => Vec::new(),
+            })
+            .collect();
+        // What every part shares: its joint matrices, its node's matrices, its active targets.
         let empty: Vec<Mat4> = Vec::new();
-        for part in &self.parts {
-            let w = &weights[part.node];
-            if let Some(s) = part.skin {
-                if let (Some(slot), Some(Some(skin))) = (skin_mats.get_mut(s), self.skins.get(s)) {
-                    if slot.is_none() {
-                        *slot = Some(
-                            skin.joints.iter().zip(&skin.ibms).map(|(&j, ibm)| globals[j] * *ibm).collect(),
-                        );
-                    }
+        let setups: Vec<PartSetup<'_>> = self
+            .parts
+            .iter()
+            .map(|part| {
+                let node = globals[part.node];
+                PartSetup {
+                    joints: part.skin.and_then(|s| skin_mats.get(s)).unwrap_or(&empty),
+                    node,
+                    node_normals: node.normal_matrix(),
+                    active: weights[part.node]
+                        .iter()
+                        .copied()
+                        .enumerate()
+                        .filter(|&(i, x)| x != 0.0 && i < part.targets.len())
+                        .collect(),
                 }
-            }
-            let joints: &Vec<Mat4> =
-                part.skin.and_then(|s| skin_mats.get(s)).and_then(Option::as_ref).unwrap_or(&empty);
-            let node_m = globals[part.node];
-            let node_n = node_m.normal_matrix();
-            let active: Vec<(usize, f32)> =
-                w.iter().copied().enumerate().filter(|&(i, x)| x != 0.0 && i < part.targets.len()).collect();
-            for v in 0..part.positions.len() {
-                let mut p = Vec3f::from_array(part.positions[v]);
-                let mut nrm = Vec3f::from_array(part.normals[v]);
-                for &(i, x) in &active {
-                    let t = &part.targets[i];
-                    if let Some(d) = t.positions.get(v) {
-                        p += Vec3f::from_array(*d) * x;
-                    }
-                    if let Some(d) = t.normals.get(v) {
-                        nrm += Vec3f::from_array(*d) * x;
-                    }
-                }
-                let (m, nm) = match part.influences.get(v) {
-                    Some(inf) if inf.iter().any(|&(_, x)| x > 0.0) && !joints.is_empty() => {
-                        let mut m = Mat4 { cols: [[0.0; 4]; 4] };
-                        for &(j, x) in inf {
-                            if x == 0.0 {
-                                continue;
+            })
+            .collect();
+        // Work in chunks of vertices, spread over the machine's threads for a large mesh.
+        const CHUNK: usize = 4096;
+        let tasks: Vec<(usize, usize, usize)> = self
+            .parts
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.first + p.positions.len() <= nv)
+            .flat_map(|(i, p)| {
+                (0..p.positions.len())
+                    .step_by(CHUNK)
+                    .map(move |v0| (i, v0, (v0 + CHUNK).min(p.positions.len())))
+            })
+            .collect();
+        let run = |&(i, v0, v1): &(usize, usize, usize)| {
+            let part = &self.parts[i];
+            pose_range(part, &setups[i], v0..v1, &base.positions[part.first..], &base.normals[part.first..])
+        };
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(tasks.len());
+        let results: Vec<(usize, PosedRange)> = if threads <= 1 || nv < 2 * CHUNK {
+            tasks.iter().enumerate().map(|(k, t)| (k, run(t))).collect()
+        } else {
+            let next = std::sync::atomic::AtomicUsize::new(0);
+            std::thread::scope(|scope| {
+                let workers: Vec<_> = (0..threads)
+                    .map(|_| {
+                        scope.spawn(|| {
+                            let mut done = Vec::new();
+                            loop {
+                                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                                let Some(t) = tasks.get(k) else { break };
+                                done.push((k, run(t)));
                             }
-                            let Some(jm) = joints.get(j as usize) else { continue };
-                            for (c, sc) in m.cols.iter_mut().zip(&jm.cols) {
-                                for (a, b) in c.iter_mut().zip(sc) {
-                                    *a += x * b;
-                                }
-                            }
-                        }
-                        (m, m.normal_matrix())
-                    }
-                    _ => (node_m, node_n),
-                };
-                let out = part.first + v;
-                if out >= nv {
-                    break;
-                }
-                let q = m.transform_point(p);
-                if q.to_array().iter().all(|c| c.is_finite()) {
-                    positions[out] = q.to_array().map(|c| c.clamp(-COORD_MAX, COORD_MAX));
-                }
-                let fallback = Vec3f::from_array(base.normals[out]);
-                normals[out] = nm.transform_vector(nrm).try_normalize().unwrap_or(fallback).to_array();
-            }
+                            done
+                        })
+                    })
+                    .collect();
+                workers.into_iter().flat_map(|w| w.join().unwrap_or_default()).collect()
+            })
+        };
+        for (k, (pos, nrm)) in results {
+            let (i, v0, _) = tasks[k];
+            let first = self.parts[i].first + v0;
+            positions[first..first + pos.len()].copy_from_slice(&pos);
+            normals[first..first + nrm.len()].copy_from_slice(&nrm);
         }
         let outline_normals = if base.outline_normals.is_empty() || self.groups.len() != nv {
             Vec::new()
@@ -338,6 +353,74 @@ impl Rig {
             materials: base.materials.clone(),
         }
     }
+}
+
+/// What posing every vertex of one part shares.
+struct PartSetup<'a> {
+    /// Its skin's joint matrices (empty for a rigid part).
+    joints: &'a [Mat4],
+    /// Its node's global matrix and that matrix's normal matrix.
+    node: Mat4,
+    node_normals: Mat4,
+    /// The morph targets with a non-zero weight: (target, weight).
+    active: Vec<(usize, f32)>,
+}
+
+/// Posed positions and normals of a range of a part's vertices.
+type PosedRange = (Vec<[f32; 3]>, Vec<[f32; 3]>);
+
+/// Vertices `range` of `part` posed (module docs: morph, then skin or node). `rest_positions` and
+/// `rest_normals` are the rest mesh's from the part's first vertex on: a non-finite position keeps
+/// its rest value, a degenerate normal its rest normal.
+fn pose_range(
+    part: &Part,
+    setup: &PartSetup<'_>,
+    range: std::ops::Range<usize>,
+    rest_positions: &[[f32; 3]],
+    rest_normals: &[[f32; 3]],
+) -> PosedRange {
+    let mut positions = Vec::with_capacity(range.len());
+    let mut normals = Vec::with_capacity(range.len());
+    for v in range {
+        let mut p = Vec3f::from_array(part.positions[v]);
+        let mut nrm = Vec3f::from_array(part.normals[v]);
+        for &(i, x) in &setup.active {
+            let t = &part.targets[i];
+            if let Some(d) = t.positions.get(v) {
+                p += Vec3f::from_array(*d) * x;
+            }
+            if let Some(d) = t.normals.get(v) {
+                nrm += Vec3f::from_array(*d) * x;
+            }
+        }
+        let (m, nm) = match part.influences.get(v) {
+            Some(inf) if inf.iter().any(|&(_, x)| x > 0.0) && !setup.joints.is_empty() => {
+                let mut m = Mat4 { cols: [[0.0; 4]; 4] };
+                for &(j, x) in inf {
+                    if x == 0.0 {
+                        continue;
+                    }
+                    let Some(jm) = setup.joints.get(j as usize) else { continue };
+                    for (c, sc) in m.cols.iter_mut().zip(&jm.cols) {
+                        for (a, b) in c.iter_mut().zip(sc) {
+                            *a += x * b;
+                        }
+                    }
+                }
+                (m, m.normal_matrix())
+            }
+            _ => (setup.node, setup.node_normals),
+        };
+        let q = m.transform_point(p);
+        positions.push(if q.to_array().iter().all(|c| c.is_finite()) {
+            q.to_array().map(|c| c.clamp(-COORD_MAX, COORD_MAX))
+        } else {
+            rest_positions[v]
+        });
+        let fallback = Vec3f::from_array(rest_normals[v]);
+        normals.push(nm.transform_vector(nrm).try_normalize().unwrap_or(fallback).to_array());
+    }
+    (positions, normals)
 }
 
 /// The clip time of a clip of `duration` seconds at scene time `t`: `(t − start)·speed` (0 before
