@@ -1190,14 +1190,45 @@ pub(crate) fn check_accessor(
             acc.data_type()
         ));
     }
-    if acc.sparse().is_some() {
-        return Err(format!("accessor {} is sparse, which is not supported", acc.index()));
-    }
-    let view = acc.view().ok_or_else(|| format!("accessor {} has no bufferView", acc.index()))?;
     if acc.count() == 0 {
         return Err(format!("accessor {} is empty", acc.index()));
     }
-    let size = acc.size();
+    // A sparse accessor: its indices and values must lie inside their views; its base is its
+    // bufferView, or zeros without one.
+    if let Some(sp) = acc.sparse() {
+        let n = sp.count();
+        if n == 0 || n > acc.count() {
+            return Err(format!(
+                "accessor {} has a sparse count of {n}, which must be 1..={} (its count)",
+                acc.index(),
+                acc.count()
+            ));
+        }
+        let indices = sp.indices();
+        check_view_range(&indices.view(), indices.offset(), n, indices.index_type().size(), buffers)
+            .map_err(|e| format!("accessor {} (sparse indices): {e}", acc.index()))?;
+        let values = sp.values();
+        check_view_range(&values.view(), values.offset(), n, acc.size(), buffers)
+            .map_err(|e| format!("accessor {} (sparse values): {e}", acc.index()))?;
+    }
+    let view = match acc.view() {
+        Some(v) => v,
+        None if acc.sparse().is_some() => return Ok(()),
+        None => return Err(format!("accessor {} has no bufferView", acc.index())),
+    };
+    check_view_range(&view, acc.offset(), acc.count(), acc.size(), buffers)
+        .map_err(|e| format!("accessor {}: {e}", acc.index()))
+}
+
+/// `count` elements of `size` bytes from `offset` (with the view's stride) lie inside `view`, and
+/// `view` inside its buffer.
+fn check_view_range(
+    view: &gltf::buffer::View<'_>,
+    offset: usize,
+    count: usize,
+    size: usize,
+    buffers: &[Vec<u8>],
+) -> Result<(), String> {
     let stride = view.stride().unwrap_or(size);
     if stride < size {
         return Err(format!(
@@ -1206,11 +1237,11 @@ pub(crate) fn check_accessor(
         ));
     }
     let end = stride
-        .checked_mul(acc.count() - 1)
+        .checked_mul(count.saturating_sub(1))
         .and_then(|v| v.checked_add(size))
-        .and_then(|v| v.checked_add(acc.offset()));
+        .and_then(|v| v.checked_add(offset));
     if end.is_none_or(|e| e > view.length()) {
-        return Err(format!("accessor {} reads past the end of bufferView {}", acc.index(), view.index()));
+        return Err(format!("it reads past the end of bufferView {}", view.index()));
     }
     let data_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
     if view.offset().checked_add(view.length()).is_none_or(|e| e > data_len) {

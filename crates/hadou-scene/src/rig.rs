@@ -184,7 +184,7 @@ impl Rig {
     /// Every node's global matrix and morph weights for `input`.
     fn node_pose(&self, input: &PoseInput<'_>) -> (Vec<Mat4>, Vec<Vec<f32>>) {
         let n = self.nodes.len();
-        let mut trs: Vec<Option<([f32; 3], [f32; 4], [f32; 3])>> = self
+        let mut trs: Vec<Option<Trs>> = self
             .nodes
             .iter()
             .map(|node| match node.rest {
@@ -355,6 +355,9 @@ impl Rig {
     }
 }
 
+/// A node's translation, rotation (unit quaternion) and scale.
+type Trs = ([f32; 3], [f32; 4], [f32; 3]);
+
 /// What posing every vertex of one part shares.
 struct PartSetup<'a> {
     /// Its skin's joint matrices (empty for a rigid part).
@@ -435,7 +438,7 @@ pub fn clip_wrap(time: f32, duration: f32, looping: bool) -> f32 {
     if !time.is_finite() {
         return 0.0;
     }
-    if !(duration > 0.0) {
+    if duration.is_nan() || duration <= 0.0 {
         return 0.0;
     }
     if looping {

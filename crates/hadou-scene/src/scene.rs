@@ -66,8 +66,11 @@ pub(crate) struct ObjectDef {
     /// How it moves: its clip and expressions.
     pub motion: Option<Motion>,
     /// The last pose built and its key (clip time and expression weights), shared by clones.
-    pub pose_cache: Arc<std::sync::Mutex<Option<(Vec<u32>, Arc<Mesh>)>>>,
+    pub pose_cache: PoseCache,
 }
+
+/// An object's last pose and its key (clip time and expression weights, as bits).
+pub(crate) type PoseCache = Arc<std::sync::Mutex<Option<(Vec<u32>, Arc<Mesh>)>>>;
 
 /// An object's animation as its keys give it; the times and speed are its parameters
 /// (`animation_start`, `animation_speed`, `animation_time`).

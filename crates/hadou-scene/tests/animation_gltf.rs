@@ -364,3 +364,63 @@ fn the_scene_lasts_until_its_clips_have_played_once() {
     let s = scene_with("duration-pinned", &g, "animation = \"bend\"\nanimation_time = 0.5", "").unwrap();
     assert_eq!(s.duration(), 0.0);
 }
+
+/// A morph target stored sparse, without a bufferView (zeros but for the listed vertices), as VRM
+/// exporters write them.
+fn sparse_target(b: &mut Builder, count: usize, indices: &[u16], values: &[f32]) -> usize {
+    let iv = b.view(&indices.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>());
+    let vv = b.view(&values.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>());
+    b.raw_accessor(json!({"componentType": 5126, "count": count, "type": "VEC3",
+        "sparse": {"count": indices.len(), "indices": {"bufferView": iv, "componentType": 5123},
+                   "values": {"bufferView": vv}}}))
+}
+
+#[test]
+fn sparse_morph_targets_are_read_and_checked() {
+    let g = arm(|b, d| {
+        let t = sparse_target(b, 4, &[0, 3], &[0.0, 0.0, 1.0, 0.0, 0.0, 2.0]);
+        d["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] = json!(t);
+        d["meshes"][0]["weights"] = json!([1.0]);
+    });
+    let s = scene_with("sparse", &g, "", "").unwrap();
+    let p = posed(&s, 0.0);
+    assert!(
+        close(p[0], [0.0, 0.0, 1.0]) && close(p[3], [0.1, 2.0, 2.0]) && close(p[1], [0.1, 0.0, 0.0]),
+        "{p:?}"
+    );
+    let e = load_err("sparse-count", |b, d| {
+        let t = sparse_target(b, 4, &[0, 1, 2, 3, 3], &[0.0; 15]);
+        d["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] = json!(t);
+    });
+    assert!(e.contains("sparse count of 5, which must be 1..=4"), "{e}");
+    let e = load_err("sparse-short", |b, d| {
+        let t = sparse_target(b, 4, &[0, 3], &[0.0; 3]);
+        d["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] = json!(t);
+    });
+    assert!(e.contains("(sparse values): it reads past the end of bufferView"), "{e}");
+}
+
+#[test]
+fn morph_targets_and_keyframes_are_bounded() {
+    let e = load_err("many-targets", |_, d| {
+        let t = d["meshes"][0]["primitives"][0]["targets"][0].clone();
+        d["meshes"][0]["primitives"][0]["targets"] = json!(vec![t; hadou_scene::MAX_MORPH_TARGETS + 1]);
+        d["meshes"][0]["weights"] = json!(vec![0.0; hadou_scene::MAX_MORPH_TARGETS + 1]);
+        d["animations"].as_array_mut().unwrap().pop();
+    });
+    assert!(e.contains("257 morph targets, more than the limit of 256"), "{e}");
+    // One accessor of 2²⁰ keys shared by channels: the keyframe numbers past 2²⁴ are refused
+    // before any is copied.
+    let e = load_err("many-keys", |b, d| {
+        let n = 1 << 20;
+        let times: Vec<f32> = (0..n).map(|k| k as f32).collect();
+        let t = b.f32s(&times, n, "SCALAR");
+        let q: Vec<f32> = (0..n).flat_map(|_| [0.0, 0.0, 0.0, 1.0]).collect();
+        let r = b.f32s(&q, n, "VEC4");
+        let channels: Vec<Value> =
+            (0..4).map(|_| json!({"sampler": 0, "target": {"node": 1, "path": "rotation"}})).collect();
+        d["animations"] =
+            json!([{"name": "long", "samplers": [{"input": t, "output": r}], "channels": channels}]);
+    });
+    assert!(e.contains("more than 16777216 keyframe numbers"), "{e}");
+}

@@ -7,7 +7,6 @@
 //! VRMA hips' world position scaled by the ratio of hips heights.
 
 #[path = "common/gltf_reference.rs"]
-#[allow(dead_code)]
 mod gltf_reference;
 
 use gltf_reference::{Gltf, M4};

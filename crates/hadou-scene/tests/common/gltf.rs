@@ -31,6 +31,12 @@ impl Builder {
         self.accessors.len() - 1
     }
 
+    /// An accessor written out by the test (a sparse one, say); its views come from [`Builder::view`].
+    pub fn raw_accessor(&mut self, a: Value) -> usize {
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
     pub fn f32s(&mut self, values: &[f32], count: usize, ty: &str) -> usize {
         let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
         self.acc(&bytes, 5126, count, ty, false)
