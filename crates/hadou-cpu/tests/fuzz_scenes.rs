@@ -3,7 +3,7 @@
 //! scenes past the triangle and image limits, textured materials whose PNG carries ancillary
 //! chunks, a skin whose weights overflow, every shadow kind with an `[area_light]`, tracks with
 //! extreme key times, control bytes in paths), and the files they name (a few glTF files, the
-//! examples' skinned and textured `hero.glb`, a PNG) are mutated at random (byte flips, lines deleted, duplicated, swapped or
+//! examples' skinned and textured `hero.glb` and the animated `brace.glb`, a PNG) are mutated at random (byte flips, lines deleted, duplicated, swapped or
 //! spliced in from another scene, numbers replaced by extreme values, keys swapped, truncation),
 //! written to a temporary directory and loaded with `Scene::load`. Each case must not panic, must
 //! finish in bounded time, and when it loads, its frames at t = 0, 0.5 and 3 rendered by the CPU
@@ -311,7 +311,7 @@ fn mutated_scenes_load_or_fail_cleanly_and_render_finite() {
 
     let dir = std::env::temp_dir().join(format!("hadou-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("assets")).unwrap();
-    for asset in ["crystal.glb", "hero.glb"] {
+    for asset in ["crystal.glb", "hero.glb", "brace.glb"] {
         std::fs::copy(root.join("assets").join(asset), dir.join("assets").join(asset)).unwrap();
     }
     for (name, bytes) in &aux {
