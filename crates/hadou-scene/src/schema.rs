@@ -435,18 +435,11 @@ fn parse_object(
         "box" => &["size"],
         "sphere" => &["radius", "segments"],
         "plane" => &["size"],
-        _ => &[
-            "path",
-            "animation",
-            "animation_file",
-            "animation_start",
-            "animation_speed",
-            "animation_loop",
-            "animation_time",
-            "expressions",
-        ],
+        _ => &["path"],
     };
-    let allowed: Vec<&str> = OBJECT_COMMON.iter().chain(OBJECT_MATERIAL_KEYS).chain(extra).copied().collect();
+    let motion_keys: &[&str] = if kind == "gltf" { MOTION_KEYS } else { &[] };
+    let allowed: Vec<&str> =
+        OBJECT_COMMON.iter().chain(OBJECT_MATERIAL_KEYS).chain(extra).chain(motion_keys).copied().collect();
     t.check_keys(&allowed)?;
     if t.get("color").is_some() && (t.get("material").is_some() || t.get("materials").is_some()) {
         let other = if t.get("material").is_some() { "material" } else { "materials" };
@@ -568,6 +561,17 @@ fn parse_object(
     })
 }
 
+/// The animation keys of a `kind = "gltf"` object.
+const MOTION_KEYS: &[&str] = &[
+    "animation",
+    "animation_file",
+    "animation_start",
+    "animation_speed",
+    "animation_loop",
+    "animation_time",
+    "expressions",
+];
+
 /// A `kind = "gltf"` object's animation keys: `animation` (a clip of the file), `animation_start`,
 /// `animation_speed`, `animation_loop`, `animation_time`, and `expressions` (a table of the VRM
 /// expressions' weights). `None` when it gives none of them (the object is drawn at its rest pose).
@@ -579,16 +583,7 @@ fn parse_motion(
     dir: &mut SceneDir,
     warnings: &mut Vec<String>,
 ) -> Res<Option<Motion>> {
-    let keys = [
-        "animation",
-        "animation_file",
-        "animation_start",
-        "animation_speed",
-        "animation_loop",
-        "animation_time",
-        "expressions",
-    ];
-    if keys.iter().all(|k| t.get(k).is_none()) {
+    if MOTION_KEYS.iter().all(|k| t.get(k).is_none()) {
         return Ok(None);
     }
     let no_rig = |key: &str, what: &str| {
