@@ -205,6 +205,7 @@ fn materials_outlines_and_wave_lights_match_cpu() {
             },
             wave_blend: [1.0, 0.6, 0.0, 0.3][i],
             outline: (i != 2).then_some(Outline { width: 0.006, color: [0.05, 0.0, 0.1] }),
+            mtoon: None,
         };
         let x = -3.0 + 2.0 * i as f32;
         let mut o = object(

@@ -38,6 +38,7 @@ mod files;
 mod frame;
 mod gltf_load;
 mod gltf_material;
+mod gltf_mtoon;
 mod gltf_uri;
 mod guard;
 mod image;
