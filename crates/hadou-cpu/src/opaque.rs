@@ -230,7 +230,7 @@ pub(crate) fn draw_opaque_into(
                                 soft[i] = Some(SoftPoint {
                                     world: s.world,
                                     normal: s.normal.normalize_or(Vec3f::ZERO),
-                                    term: shading::area_term(al, material, s),
+                                    term: shading::area_term(al, material, s, frame.time),
                                 });
                             }
                         }

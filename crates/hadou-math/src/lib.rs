@@ -14,6 +14,7 @@ pub mod bloom;
 pub mod curve;
 pub mod energy;
 mod mat4;
+pub mod mtoon;
 pub mod outline;
 pub mod quadrature;
 mod real;
