@@ -318,8 +318,9 @@ pub struct GpuMaterial {
     pub shadow_mask: u32,
     /// Index of the material's object in the frame (the edge pass tells objects apart by it).
     pub object: u32,
-    /// Padding.
-    pub _pad2: u32,
+    /// Word offset of the material's MToon block in the shading data ([`mtoon_block`]); 0 for
+    /// none (the material's `model` look).
+    pub mtoon: u32,
     /// Base-colour texture.
     pub base_texture: GpuTexture,
     /// Feature texture.
@@ -428,11 +429,67 @@ pub fn material_record(
         outline_width: m.outline.map_or(0.0, |o| o.width),
         shadow_mask,
         object: 0,
-        _pad2: 0,
+        mtoon: 0,
         base_texture: textures.texture(data, &m.base_texture),
         feature_texture: textures.texture(data, &m.feature_texture),
         ramp: GpuRamp::new(&m.ramp),
     }
+}
+
+/// Words of an MToon block ([`mtoon_block`]).
+pub const MTOON_WORDS: usize = 52;
+
+/// Appends `m`'s MToon block to `data` (its textures through `textures`) for a frame at scene
+/// time `time` seen from `eye`, and returns its word offset (0 when `m` has no MToon look).
+/// Read by shading.wgsl's `mtoon_*` functions; the words are, as `f32` bit patterns unless
+/// stated: 0–2 shade colour, 3 toony, 4–6 rim colour, 7 fresnel power, 8–10 matcap factor,
+/// 11 rim lift, 12–14 emissive, 15 rim lighting mix, 16 shading shift, 17 shift texture scale,
+/// 18–19 `scroll · time`, 20 `rotation · time`, 21 the mask channel (`u32`), 22–23 unused,
+/// 24–26 the eye, 27 unused, then six [`GpuTexture`] records (4 words each): shade, shift, rim,
+/// matcap, UV mask, emissive. The time-scaled terms are the products hadou-cpu forms, so both
+/// backends animate alike.
+pub fn mtoon_block(
+    m: &hadou_scene::Material,
+    time: f32,
+    eye: [f32; 3],
+    data: &mut Vec<u32>,
+    textures: &mut TextureStore,
+) -> u32 {
+    let Some(t) = &m.mtoon else { return 0 };
+    let recs = [
+        &t.shade_texture,
+        &t.shift_texture,
+        &t.rim_texture,
+        &t.matcap_texture,
+        &t.uv_mask_texture,
+        &t.emissive_texture,
+    ]
+    .map(|x| textures.texture(data, x));
+    let offset = data.len() as u32;
+    let f = |x: f32| x.to_bits();
+    let c3 = |c: [f32; 3]| c.map(f);
+    data.extend(c3(t.shade_color));
+    data.push(f(t.toony));
+    data.extend(c3(t.rim_color));
+    data.push(f(t.rim_fresnel_power));
+    data.extend(c3(t.matcap_color));
+    data.push(f(t.rim_lift));
+    data.extend(c3(t.emissive));
+    data.push(f(t.rim_lighting_mix));
+    data.extend([
+        f(t.shading_shift),
+        f(t.shift_texture_scale),
+        f(t.uv_scroll[0] * time),
+        f(t.uv_scroll[1] * time),
+    ]);
+    data.extend([f(t.uv_rotation * time), u32::from(t.uv_mask_channel.min(3)), 0, 0]);
+    data.extend(c3(eye));
+    data.push(0);
+    for r in recs {
+        data.extend([r.offset, r.width, r.height, r.flags]);
+    }
+    debug_assert_eq!(data.len() - offset as usize, MTOON_WORDS);
+    offset
 }
 
 /// The waves as lights (000 §2.1): one record per wave, its centre line (`Wave::light_line`),
@@ -496,9 +553,11 @@ impl ShadingBuffers {
             let fallback = [hadou_scene::Material::default()];
             let mats: &[hadou_scene::Material] =
                 if o.materials.is_empty() { &fallback } else { &o.materials };
+            let eye = frame.camera.position;
             for m in mats {
                 let record = material_record(m, shadow_mask, &mut b.data, &mut textures);
-                b.materials.push(GpuMaterial { object: oi as u32, ..record });
+                let mtoon = mtoon_block(m, frame.time, [eye.x, eye.y, eye.z], &mut b.data, &mut textures);
+                b.materials.push(GpuMaterial { object: oi as u32, mtoon, ..record });
             }
         }
         b.lights = wave_lights(&frame.waves, curves, &mut b.data);
