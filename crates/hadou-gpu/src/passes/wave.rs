@@ -203,7 +203,8 @@ impl WaveVariant {
             if mtoon {
                 on.push("USE_MTOON");
             }
-            if mtoon || materials.iter().any(|m| m.base_texture.offset != 0 || m.feature_texture.offset != 0) {
+            if mtoon || materials.iter().any(|m| m.base_texture.offset != 0 || m.feature_texture.offset != 0)
+            {
                 on.push("USE_TEXTURES");
             }
             let lit = !lights.is_empty() && (any_glow || materials.iter().any(|m| m.wave_blend > 0.0));
