@@ -69,13 +69,14 @@ pub fn matcap_uv(n: Vec3f, v: Vec3f) -> [f32; 2] {
 }
 
 /// The animated texture coordinates (MToon "UV Animation"): `uv` rotated about (½, ½) by
-/// `θ = turn·mask` (`turn` = rotation speed × time, radians; `θ` reduced to [0, 2π)) and then
+/// `θ = turn·mask` (`turn` = rotation speed × time, radians; `θ` reduced to [0, 2π), a non-finite
+/// `θ` counting as 0) and then
 /// moved by `scroll·mask` (`scroll` = scroll speeds × time), `mask` the mask texture's channel.
 #[inline]
 pub fn uv_animation(uv: [f32; 2], mask: f32, scroll: [f32; 2], turn: f32) -> [f32; 2] {
     let tau = std::f32::consts::TAU;
     let a = turn * mask;
-    let a = a - tau * (a / tau).floor();
+    let a = if a.is_finite() { a - tau * (a / tau).floor() } else { 0.0 };
     let (s, c) = (a.sin(), a.cos());
     let (u, v) = (uv[0] - 0.5, uv[1] - 0.5);
     [c * u - s * v + 0.5 + scroll[0] * mask, s * u + c * v + 0.5 + scroll[1] * mask]
@@ -141,6 +142,9 @@ mod tests {
         // Half the mask: half the turn and half the scroll.
         let uv = uv_animation([1.0, 0.5], 0.5, [0.2, 0.0], std::f32::consts::PI);
         assert!(close(&uv, &[0.6, 1.0], 1e-6), "{uv:?}");
+        // An overflowing turn is no turn (finite coordinates).
+        let uv = uv_animation([0.25, 0.5], 1.0, [0.0, 0.0], f32::MAX * 4.0);
+        assert!(close(&uv, &[0.25, 0.5], 1e-6), "{uv:?}");
         // No mask: no animation.
         assert!(close(&uv_animation([0.3, 0.7], 0.0, [5.0, 5.0], 100.0), &[0.3, 0.7], 1e-6));
     }

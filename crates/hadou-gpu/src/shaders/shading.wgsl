@@ -238,7 +238,11 @@ fn mtoon_matcap_uv(n: vec3<f32>, v: vec3<f32>) -> vec2<f32> {
 fn mtoon_uv(uv: vec2<f32>, mask: f32, scroll: vec2<f32>, turn: f32) -> vec2<f32> {
     let tau = 6.28318530717958647;
     var a = turn * mask;
-    a = a - tau * floor(a / tau);
+    if (abs(a) <= 3.40282347e38) {
+        a = a - tau * floor(a / tau);
+    } else {
+        a = 0.0;
+    }
     let s = sin(a);
     let c = cos(a);
     let u = uv.x - 0.5;
