@@ -3,9 +3,10 @@
 VRMC_materials_mtoon 1.0 looks, in a VRM 1.0 file (a GLB whose extensionsUsed names VRMC_vrm).
 
 - "soft" (left): a wide step (toony 0.5) from a blue shade to a striped base texture that scrolls
-  (UV animation, 0.25 per second along u), a red parametric rim (lift 0.1, fresnel power 3).
+  (UV animation, 0.25 per second along u), a red parametric rim (lift 0.1, fresnel power 3), an
+  outline 0.006 of the image height (screen coordinates) half lit.
 - "hard" (middle): a hard step (toony 0.95, shift -0.2) to a dark purple shade, a radial matcap
-  texture (factor 0.6), a faint emission.
+  texture (factor 0.8), a faint emission, an outline 0.02 units wide (world coordinates) fully lit.
 - "painted" (right): a checker shade multiply texture, a shading shift texture (a gradient in u,
   scale 0.4), a rim multiply texture, and a rotating UV animation (0.5 rad/s) masked by the blue
   channel of a mask texture (half the sphere turns).
@@ -139,13 +140,15 @@ doc = {
              "specVersion": "1.0", "shadeColorFactor": [0.15, 0.2, 0.45], "shadingToonyFactor": 0.5,
              "parametricRimColorFactor": [0.9, 0.15, 0.1], "parametricRimLiftFactor": 0.1,
              "parametricRimFresnelPowerFactor": 3.0, "rimLightingMixFactor": 0.5,
-             "uvAnimationScrollXSpeedFactor": 0.25}}},
+             "uvAnimationScrollXSpeedFactor": 0.25, "outlineWidthMode": "screenCoordinates",
+             "outlineWidthFactor": 0.006, "outlineColorFactor": [0.1, 0.05, 0.3], "outlineLightingMixFactor": 0.5}}},
         {"name": "hard", "pbrMetallicRoughness": {"baseColorFactor": [0.95, 0.75, 0.55, 1.0]},
          "emissiveFactor": [0.03, 0.01, 0.0],
          "extensions": {"VRMC_materials_mtoon": {
              "specVersion": "1.0", "shadeColorFactor": [0.2, 0.08, 0.25], "shadingToonyFactor": 0.95,
              "shadingShiftFactor": -0.2, "matcapFactor": [0.8, 0.8, 0.8], "matcapTexture": {"index": MATCAP},
-             "rimLightingMixFactor": 1.0}}},
+             "rimLightingMixFactor": 1.0, "outlineWidthMode": "worldCoordinates", "outlineWidthFactor": 0.02,
+             "outlineColorFactor": [0.25, 0.05, 0.1], "outlineLightingMixFactor": 1.0}}},
         {"name": "painted", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.9, 0.85, 1.0]},
          "extensions": {"VRMC_materials_mtoon": {
              "specVersion": "1.0", "shadeColorFactor": [0.45, 0.35, 0.5],

@@ -1,17 +1,19 @@
 //! The MToon look (`VRMC_materials_mtoon` 1.0) on hand-built frames: a pixel's colour follows the
 //! formulas of `hadou_math::mtoon` — the toony step between shade and base colour under the scene
-//! light, ambient, parametric rim, matcap, emission, UV animation — and a wave lights an MToon
-//! surface with the material's own step in the wave's colour (000 §2.1).
+//! light, ambient, parametric rim, matcap, emission, UV animation — a wave lights an MToon
+//! surface with the material's own step in the wave's colour (000 §2.1), and MToon outlines are
+//! as wide as their mode says, in their lit colour.
 
 use hadou_cpu::render;
 use hadou_math::energy::{Falloff, SphereField};
 use hadou_math::toon::{srgb_to_linear, Filter, Wrap};
 use hadou_math::{Mat4, Vec3, Vec3f};
-use hadou_scene::mesh::plane_mesh;
+use hadou_scene::mesh::{plane_mesh, sphere_mesh, with_outline_normals};
 use hadou_scene::{
     ColorMapping, Frame, Image, Light, Material, Mtoon, Object, Texture, TextureRef, ToneMode, Wave,
     WaveShape,
 };
+use hadou_scene::{Outline, OutlineWidthMode};
 use std::sync::Arc;
 
 mod common;
@@ -158,4 +160,56 @@ fn a_wave_lights_mtoon_with_its_own_step() {
         (shade + (base - shade) * s) * [0.5, 0.8, 1.0][k]
     });
     assert!(close(px(&img, 32, 32), want, 2e-3), "{:?} vs {want:?}", px(&img, 32, 32));
+}
+
+/// A sphere of radius 1 at the origin seen from `(0, 0, dist)` on a black background, 128² with a
+/// 40° field of view, its MToon outline in `mode` of width `w`, colour magenta, lighting mix
+/// `mix`; the light (1, 0.9, 0.8), ambient 0.1.
+fn outlined_ball(dist: f32, mode: OutlineWidthMode, w: f32, mix: f32) -> Frame {
+    let look = Mtoon {
+        outline_mode: mode,
+        outline_width: w,
+        outline_color: [1.0, 0.0, 1.0],
+        outline_lighting_mix: mix,
+        ..base_look()
+    };
+    let m = Material { outline: Some(Outline { width: w, color: [1.0, 0.0, 1.0] }), ..mtoon(look) };
+    let ball = Object {
+        name: "ball".into(),
+        mesh: Arc::new(with_outline_normals(sphere_mesh(1.0, 64))),
+        transform: Mat4::IDENTITY,
+        materials: vec![m],
+    };
+    Frame {
+        light: Light { direction: Vec3::new(0.0, -1.0, 0.0), color: [1.0, 0.9, 0.8], ambient: [0.1; 3] },
+        color_mapping: ColorMapping { mode: ToneMode::Faithful, exposure: 1e-9 },
+        ..common::frame(128, 128, common::camera(Vec3::new(0.0, 0.0, dist), 40.0), vec![ball], vec![])
+    }
+}
+
+/// Outline pixels (the outline's colour, up to rounding) in the middle row, left of the centre.
+fn outline_run(img: &Image, want: [f32; 3]) -> usize {
+    (0..64).filter(|&x| close(px(img, x, 64), want, 1e-4)).count()
+}
+
+/// MToon outlines (`VRMC_materials_mtoon` "Outline"): in screen mode `w` of the image height
+/// (0.05 · 128 = 6.4 pixels) at any distance; in world mode `w` world units, so twice as wide on
+/// screen at half the distance (0.2 at a silhouette about `dist` away, `f = 64/tan 20°`: about
+/// 4.4 px at 8, 8.8 px at 4); their colour `outlineColour · mix(1, light + ambient, mix)`.
+#[test]
+fn mtoon_outlines_in_screen_and_world_units() {
+    let magenta = [1.0, 0.0, 1.0];
+    for dist in [4.0, 8.0] {
+        let n = outline_run(&render(&outlined_ball(dist, OutlineWidthMode::Screen, 0.05, 0.0)), magenta);
+        assert!((5..=8).contains(&n), "screen mode at {dist}: {n} px");
+    }
+    let far = outline_run(&render(&outlined_ball(8.0, OutlineWidthMode::World, 0.2, 0.0)), magenta);
+    let near = outline_run(&render(&outlined_ball(4.0, OutlineWidthMode::World, 0.2, 0.0)), magenta);
+    assert!((3..=6).contains(&far), "world mode at 8: {far} px");
+    assert!((7..=11).contains(&near), "world mode at 4: {near} px");
+    // Lighting mix 0.5: magenta · mix(1, (1.1, 1.0, 0.9), 0.5) = (1.05, 0, 0.95), clamped to 1 by
+    // the faithful mapping.
+    let lit = [1.0, 0.0, 0.95];
+    let n = outline_run(&render(&outlined_ball(8.0, OutlineWidthMode::Screen, 0.05, 0.5)), lit);
+    assert!((5..=8).contains(&n), "lit outline: {n} px");
 }

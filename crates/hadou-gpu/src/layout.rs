@@ -127,14 +127,8 @@ pub struct FrameUniforms {
 
 /// How far the edge pass looks (pixels): the widest outline's hull width on screen, rounded up
 /// and capped (`hadou_math::outline::reach_window`, as hadou-cpu's `edges::frame_reach`).
-fn outline_reach(frame: &Frame, basis: &CameraBasis) -> u32 {
-    let widest = frame
-        .objects
-        .iter()
-        .flat_map(|o| o.materials.iter())
-        .filter_map(|m| m.outline.map(|o| outline::hull_pixels(o.width, basis.tan_half_fov, frame.height)))
-        .fold(0.0f32, f32::max);
-    outline::reach_window(widest)
+fn outline_reach(frame: &Frame) -> u32 {
+    outline::reach_window(hadou_scene::widest_outline_pixels(frame))
 }
 
 impl FrameUniforms {
@@ -177,7 +171,7 @@ impl FrameUniforms {
             plane_count: 0,
             area: u32::from(frame.area_light.is_some()),
             area_position: frame.area_light.as_ref().map_or([0.0; 3], |a| a.position.to_array()),
-            outline_reach: outline_reach(frame, basis),
+            outline_reach: outline_reach(frame),
             area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
             grid: 1,
         }
@@ -311,7 +305,9 @@ pub struct GpuMaterial {
     pub outline_color: [f32; 3],
     /// `β`.
     pub wave_blend: f32,
-    /// Outline width `d`; 0 = no outline.
+    /// Outline width: `d` of the hull push `d·|z|` (for an MToon outline in screen mode
+    /// `2·tan(fov/2)·w`), or `−w` for an MToon outline in world units (push `w`;
+    /// [`gpu_outline_width`]); 0 = no outline.
     pub outline_width: f32,
     /// Bit `s` is set when [`Frame::shadows`]`[s]` lists the material's object among its
     /// receivers.
@@ -436,6 +432,17 @@ pub fn material_record(
     }
 }
 
+/// [`GpuMaterial::outline_width`] of `m` for a camera of `tan_half_fov`
+/// (`hadou_scene::Material::hull_push`: `d`, MToon's screen mode `2·tan_half_fov·w`, its world mode
+/// `−w`); 0 without an outline or for a width that is not positive.
+pub fn gpu_outline_width(m: &hadou_scene::Material, tan_half_fov: f32) -> f32 {
+    if m.outline_in_world_units() {
+        -m.hull_push(0.0, tan_half_fov)
+    } else {
+        m.hull_push(1.0, tan_half_fov)
+    }
+}
+
 /// Words of an MToon block ([`mtoon_block`]).
 pub const MTOON_WORDS: usize = 52;
 
@@ -554,10 +561,17 @@ impl ShadingBuffers {
             let mats: &[hadou_scene::Material] =
                 if o.materials.is_empty() { &fallback } else { &o.materials };
             let eye = frame.camera.position;
+            let tan_half_fov = frame.camera.basis(frame.width, frame.height).tan_half_fov;
             for m in mats {
                 let record = material_record(m, shadow_mask, &mut b.data, &mut textures);
                 let mtoon = mtoon_block(m, frame.time, [eye.x, eye.y, eye.z], &mut b.data, &mut textures);
-                b.materials.push(GpuMaterial { object: oi as u32, mtoon, ..record });
+                b.materials.push(GpuMaterial {
+                    object: oi as u32,
+                    mtoon,
+                    outline_width: gpu_outline_width(m, tan_half_fov),
+                    outline_color: m.outline_rgb(&frame.light),
+                    ..record
+                });
             }
         }
         b.lights = wave_lights(&frame.waves, curves, &mut b.data);

@@ -482,6 +482,73 @@ impl Material {
     }
 }
 
+impl Material {
+    /// How the material's outline width is measured: hadou's `d` (view-depth-scaled, constant on
+    /// screen), or an MToon outline's mode ([`Mtoon::outline_mode`]).
+    fn outline_mode(&self) -> OutlineWidthMode {
+        self.mtoon.as_ref().map_or(OutlineWidthMode::None, |t| t.outline_mode)
+    }
+
+    /// How far the outline hull (000 §2.3) moves a vertex at view depth `z` along its unit outline
+    /// normal, for a camera of `tan_half_fov = tan(fov/2)`: hadou's `d·|z|` (`Outline::width` =
+    /// `d`); for an MToon outline (`VRMC_materials_mtoon` "Outline") in screen mode, whose
+    /// `Outline::width` is a fraction `w` of the image height, `2·tan_half_fov·w·|z|` (`w·height`
+    /// pixels on screen, [`hadou_math::outline::hull_pixels`]); in world mode `w` world units. 0
+    /// without an outline or for a width that is not positive.
+    pub fn hull_push(&self, z: f32, tan_half_fov: f32) -> f32 {
+        let Some(o) = self.outline else { return 0.0 };
+        if o.width.is_nan() || o.width <= 0.0 {
+            return 0.0;
+        }
+        match self.outline_mode() {
+            OutlineWidthMode::World => o.width,
+            OutlineWidthMode::Screen => 2.0 * tan_half_fov * o.width * z.abs(),
+            OutlineWidthMode::None => o.width * z.abs(),
+        }
+    }
+
+    /// The hull's width on screen in pixels where the surface is at view depth `z`
+    /// ([`hadou_math::outline::hull_pixels`] of the push over `|z|`; the depth matters only in
+    /// MToon's world mode, whose `|z|` is taken at least [`MIN_OUTLINE_DEPTH`]). The edge pass
+    /// draws contact outlines this wide.
+    pub fn hull_pixels(&self, z: f32, tan_half_fov: f32, height: u32) -> f32 {
+        let d = match (self.outline, self.outline_mode()) {
+            (None, _) => return 0.0,
+            (Some(o), OutlineWidthMode::World) => o.width / z.abs().max(MIN_OUTLINE_DEPTH),
+            (Some(o), OutlineWidthMode::Screen) => 2.0 * tan_half_fov * o.width,
+            (Some(o), OutlineWidthMode::None) => o.width,
+        };
+        hadou_math::outline::hull_pixels(d, tan_half_fov, height)
+    }
+
+    /// Whether the hull's width on screen depends on the depth (an MToon outline in world mode):
+    /// the edge pass then searches its widest window.
+    pub fn outline_in_world_units(&self) -> bool {
+        self.outline.is_some() && self.outline_mode() == OutlineWidthMode::World
+    }
+
+    /// The colour outline pixels of this material take under `light`: `Outline::color`; for an
+    /// MToon outline `outlineColor · mix(1, light + ambient, outlineLightingMix)` per channel
+    /// (`VRMC_materials_mtoon` "Outline", the light reaching the surface as for the rim).
+    pub fn outline_rgb(&self, light: &Light) -> [f32; 3] {
+        let Some(o) = self.outline else { return [0.0; 3] };
+        match &self.mtoon {
+            Some(t) if t.outline_mode != OutlineWidthMode::None => {
+                let mix = hadou_math::mtoon::lighting_mix(
+                    std::array::from_fn(|k| light.color[k] + light.ambient[k]),
+                    t.outline_lighting_mix,
+                );
+                std::array::from_fn(|k| o.color[k] * mix[k])
+            }
+            _ => o.color,
+        }
+    }
+}
+
+/// The nearest view depth at which an MToon world-unit outline's width on screen is taken
+/// ([`Material::hull_pixels`]).
+pub const MIN_OUTLINE_DEPTH: f32 = 1.0e-3;
+
 impl Default for Material {
     fn default() -> Self {
         Material::diffuse([0.8; 3])

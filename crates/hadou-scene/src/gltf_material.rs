@@ -217,10 +217,13 @@ pub(crate) fn load_materials(
             m.uv_mask_texture = mask_t;
             m.emissive_texture = emissive_t;
             if m.outline_mode != crate::frame::OutlineWidthMode::None && m.outline_width > 0.0 {
-                warnings.push(format!(
-                    "material `{name}` ({what}): its MToon outline is not drawn (hadou's outlines are set \
-                     per object in the scene file)"
-                ));
+                mat.outline = Some(crate::frame::Outline { width: m.outline_width, color: m.outline_color });
+                if m.outline_width_texture.is_some() {
+                    warnings.push(format!(
+                        "material `{name}` ({what}): its MToon outlineWidthMultiplyTexture is ignored (the \
+                         outline is outlineWidthFactor wide everywhere)"
+                    ));
+                }
             }
             mat.mtoon = Some(Arc::new(m));
         }

@@ -108,9 +108,30 @@ fn vrm1_mtoon_reads_every_field() {
     // The fallback ramp for renderers without MToon: the threshold at −shift.
     assert_eq!(mat.model, hadou_scene::ShadingModel::Toon);
     assert!((mat.ramp.stops[1].0 - 0.25).abs() < 1e-6, "{:?}", mat.ramp);
-    // The outline is not drawn yet: a warning says so; nothing else warns.
+    // The MToon outline turns the material's outline on, in MToon's units (a fraction of the
+    // image height here); its width texture is not drawn, and a warning says so; nothing else
+    // warns.
+    assert_eq!(mat.outline, Some(hadou_scene::Outline { width: 0.004, color: [0.1, 0.0, 0.2] }));
     assert_eq!(warn.len(), 1, "{warn:?}");
-    assert!(warn[0].contains("`skin`") && warn[0].contains("outline"), "{warn:?}");
+    assert!(warn[0].contains("`skin`") && warn[0].contains("outlineWidthMultiplyTexture"), "{warn:?}");
+    // Screen mode: 0.004 of the height, at any depth (2·tan(fov/2)·w·|z| along the normal).
+    assert!((mat.hull_pixels(7.0, 0.5, 1000) - 4.0).abs() < 1e-4);
+    assert!((mat.hull_push(3.0, 0.5) - 0.012).abs() < 1e-7);
+    // Lit: colour · mix(1, light + ambient, 0.6) = colour · (1 + 1.5 · 0.6).
+    let light = hadou_scene::Light {
+        direction: hadou_math::Vec3::new(0.0, -1.0, 0.0),
+        color: [2.0; 3],
+        ambient: [0.5; 3],
+    };
+    let c = mat.outline_rgb(&light);
+    assert!(close(&c, &[0.1 * 1.9, 0.0, 0.2 * 1.9], 1e-6), "{c:?}");
+    // World mode: w world units, w·f/|z| pixels.
+    let mut world = mat.clone();
+    let mut t = (**mat.mtoon.as_ref().unwrap()).clone();
+    t.outline_mode = OutlineWidthMode::World;
+    world.mtoon = Some(std::sync::Arc::new(t));
+    assert_eq!(world.hull_push(3.0, 0.5), 0.004);
+    assert!((world.hull_pixels(2.0, 0.5, 1000) - 0.004 / 2.0 * 1000.0).abs() < 1e-3);
 }
 
 #[test]
