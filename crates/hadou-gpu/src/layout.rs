@@ -301,7 +301,8 @@ pub struct GpuMaterial {
     pub base_color: [f32; 3],
     /// `MODEL_*`.
     pub model: u32,
-    /// Outline colour.
+    /// Outline colour (in a frame's buffers `hadou_scene::Material::outline_rgb`: an MToon
+    /// outline's colour lit).
     pub outline_color: [f32; 3],
     /// `β`.
     pub wave_blend: f32,

@@ -410,9 +410,12 @@ pub struct Mtoon {
     pub matcap_texture: Option<TextureRef>,
     /// `outlineWidthMode`.
     pub outline_mode: OutlineWidthMode,
-    /// `outlineWidthFactor` (metres, or a fraction of the screen height).
+    /// `outlineWidthFactor` (metres, or a fraction of the screen height). The loader turns the
+    /// material's [`Material::outline`] on with this width and `outline_color`; the backends draw
+    /// it through [`Material::hull_push`], [`Material::hull_pixels`] and [`Material::outline_rgb`].
     pub outline_width: f32,
-    /// `outlineWidthMultiplyTexture`: its green channel multiplies the width.
+    /// `outlineWidthMultiplyTexture` (its green channel multiplies the width in MToon; read, not
+    /// drawn: the outline is `outline_width` wide everywhere).
     pub outline_width_texture: Option<TextureRef>,
     /// `outlineColorFactor`.
     pub outline_color: [f32; 3],
