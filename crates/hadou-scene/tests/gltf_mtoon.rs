@@ -253,3 +253,25 @@ fn wrong_types_give_located_messages() {
         assert!(e.contains(want), "{e}\nwanted: {want}");
     }
 }
+
+/// Through a scene file, a `.vrm` with a wrong MToon type is an error at the object's `path`
+/// (`file:line:col: message`), naming the file, the material and the key.
+#[test]
+fn a_scene_names_the_bad_vrm_material_where_its_path_is() {
+    let d = std::env::temp_dir().join(format!("hadou-gltf-mtoon-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let mats = json!([{"extensions": {"VRMC_materials_mtoon": {"shadingToonyFactor": "soft"}}}]);
+    std::fs::write(d.join("a.vrm"), file(mats, json!({"VRMC_vrm": {}}), &["VRMC_vrm"])).unwrap();
+    std::fs::write(d.join("s.toml"), "[[object]]\nname = \"avatar\"\nkind = \"gltf\"\npath = \"a.vrm\"\n")
+        .unwrap();
+    let msg = match hadou_scene::Scene::load(d.join("s.toml")) {
+        Ok(_) => panic!("a bad MToon material is refused"),
+        Err(e) => e.to_string(),
+    };
+    assert!(msg.contains("s.toml:4:8:"), "{msg}");
+    assert!(
+        msg.contains("a.vrm") && msg.contains("material 0 (VRMC_materials_mtoon).shadingToonyFactor"),
+        "{msg}"
+    );
+    std::fs::remove_dir_all(&d).ok();
+}
