@@ -13,7 +13,7 @@
 //! `shaders/edges.wgsl` is the twin.
 
 use crate::opaque::{EdgeTexel, OpaqueBuffers};
-use hadou_math::outline::{hull_pixels, in_front, reach_pixels, reach_window};
+use hadou_math::outline::{in_front, reach_pixels, reach_window};
 use hadou_math::Vec3f;
 use hadou_scene::{CameraBasis, Frame};
 use rayon::prelude::*;
@@ -22,14 +22,7 @@ use rayon::prelude::*;
 /// material's hull width on screen, rounded up and capped (`reach_window`); 0 when nothing is
 /// outlined.
 pub(crate) fn frame_reach(frame: &Frame) -> u32 {
-    let basis = frame.camera.basis(frame.width, frame.height);
-    let widest = frame
-        .objects
-        .iter()
-        .flat_map(|o| o.materials.iter())
-        .filter_map(|m| m.outline.map(|o| hull_pixels(o.width, basis.tan_half_fov, frame.height)))
-        .fold(0.0f32, f32::max);
-    reach_window(widest)
+    reach_window(hadou_scene::widest_outline_pixels(frame))
 }
 
 /// The unit ray direction of pixel `(x, y)`.
@@ -60,11 +53,9 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
         return;
     }
     let h = out.surface.len() / w;
-    let hull_px = |o: u32, m: u32| {
-        frame.objects[o as usize]
-            .material(m)
-            .outline
-            .map_or(0.0, |ol| hull_pixels(ol.width, basis.tan_half_fov, frame.height))
+    // The hull's width on screen at an edge pixel at view depth `z` (`Material::hull_pixels`).
+    let hull_px = |o: u32, m: u32, z: f32| {
+        frame.objects[o as usize].material(m).hull_pixels(z, basis.tan_half_fov, frame.height)
     };
     let OpaqueBuffers { color, surface, object, shadow, edge, .. } = out;
     // A surface pixel's object (hulls and the background: none).
@@ -84,7 +75,9 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 if code == 0 {
                     continue;
                 }
-                let px = hull_px(o, material);
+                let z =
+                    surface[i].unwrap_or(0.0) * unit_dir(basis, frame, x, r + first_row).dot(basis.forward);
+                let px = hull_px(o, material, z);
                 let rp = reach_pixels(px, code);
                 if rp.is_nan() || rp <= 0.0 {
                     continue;
@@ -184,8 +177,9 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     for (i, win) in wins.into_iter().enumerate() {
         let Some(q) = win else { continue };
         let (Some(o), m) = (object[q], edge[q].material) else { continue };
-        if let Some(ol) = frame.objects[o as usize].material(m).outline {
-            color[i] = ol.color;
+        let mat = frame.objects[o as usize].material(m);
+        if mat.outline.is_some() {
+            color[i] = mat.outline_rgb(&frame.light);
             shadow[i] = None;
             // The pixel now shows that object's outline, as a hull pixel of it would (the GPU's
             // edge pass writes its material word | HULL_BIT): what the probe names and what

@@ -219,7 +219,7 @@ pub(crate) fn draw_opaque_into(
                         let t = &tris[tri_id[i] as usize];
                         let material = frame.objects[t.object as usize].material(t.material);
                         let c = match (t.hull, material.outline) {
-                            (true, Some(o)) => o.color,
+                            (true, Some(_)) => material.outline_rgb(&frame.light),
                             _ => shading::shade(frame, lights, material, s),
                         };
                         if t.hull {
@@ -230,7 +230,7 @@ pub(crate) fn draw_opaque_into(
                                 soft[i] = Some(SoftPoint {
                                     world: s.world,
                                     normal: s.normal.normalize_or(Vec3f::ZERO),
-                                    term: shading::area_term(al, material, s),
+                                    term: shading::area_term(al, material, s, frame.time),
                                 });
                             }
                         }
@@ -272,14 +272,15 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Tris {
             })
             .collect();
         // The outline hull (000 §2.3): each vertex pushed along its world-space outline normal
-        // by `d·|z|` (`z` its view depth), which is `R' = R + d·|R_z|·U` in view space.
+        // by `d·|z|` (`z` its view depth), which is `R' = R + d·|R_z|·U` in view space; an MToon
+        // outline by its own width (`Material::hull_push`).
         let hull: Vec<Vert> = if outlined {
             verts
                 .iter()
                 .enumerate()
                 .map(|(i, v)| {
-                    let width = obj.material(mesh.material_of(i)).outline.map_or(0.0, |o| o.width);
-                    let world = v.world + v.outline * (width * v.view.z.abs());
+                    let push = obj.material(mesh.material_of(i)).hull_push(v.view.z, basis.tan_half_fov);
+                    let world = v.world + v.outline * push;
                     Vert { view: basis.to_view(world), world, ..*v }
                 })
                 .collect()

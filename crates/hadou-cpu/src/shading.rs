@@ -4,9 +4,10 @@
 
 use hadou_math::curve::PreparedCurve;
 use hadou_math::energy::Falloff;
+use hadou_math::mtoon;
 use hadou_math::toon;
 use hadou_math::{shade as tone, Vec3f};
-use hadou_scene::{AreaLight, Frame, LightLine, Material, ShadingModel};
+use hadou_scene::{AreaLight, Frame, LightLine, Material, Mtoon, ShadingModel};
 
 /// The interpolated attributes of a visible surface point.
 #[derive(Clone, Copy, Debug)]
@@ -60,15 +61,89 @@ fn albedo(m: &Material, s: &Surface) -> [f32; 3] {
     std::array::from_fn(|k| m.base_color[k] * tex[k] * vcolor[k])
 }
 
+/// What an MToon material reads at a surface point before any light: the animated texture
+/// coordinates, the albedo there, the shade colour and the shading shift.
+struct MtoonPoint {
+    /// Texture coordinates after the UV animation (every texture but the matcap reads them).
+    uv: [f32; 2],
+    /// `base_color · base_texture · vertex colour`.
+    albedo: [f32; 3],
+    /// `shadeColorFactor · shadeMultiplyTexture`.
+    shade: [f32; 3],
+    /// `shadingShiftFactor + shadingShiftTexture.r · scale`.
+    shift: f32,
+}
+
+fn rgb(c: [f32; 4]) -> [f32; 3] {
+    [c[0], c[1], c[2]]
+}
+
+/// The [`MtoonPoint`] of `s` at scene time `time` (MToon "UV Animation": the mask channel scales
+/// `scroll·time` and `rotation·time`; `hadou_math::mtoon::uv_animation`).
+fn mtoon_point(m: &Material, t: &Mtoon, s: &Surface, time: f32) -> MtoonPoint {
+    let mask =
+        t.uv_mask_texture.as_ref().map_or(1.0, |x| x.sample(s.uv)[usize::from(t.uv_mask_channel.min(3))]);
+    let uv =
+        mtoon::uv_animation(s.uv, mask, [t.uv_scroll[0] * time, t.uv_scroll[1] * time], t.uv_rotation * time);
+    let albedo = albedo(m, &Surface { uv, ..*s });
+    let st = t.shade_texture.as_ref().map_or([1.0; 4], |x| x.sample(uv));
+    let shade = std::array::from_fn(|k| t.shade_color[k] * st[k]);
+    let shift =
+        t.shading_shift + t.shift_texture.as_ref().map_or(0.0, |x| x.sample(uv)[0] * t.shift_texture_scale);
+    MtoonPoint { uv, albedo, shade, shift }
+}
+
+/// The MToon look under the scene light (`VRMC_materials_mtoon` 1.0 "Lighting", "Global
+/// Illumination", "Rim Lighting", "MatCap", "Emission"; `hadou_math::mtoon`):
+/// `mix(shade, A, linearstep(−1 + toony, 1 − toony, N·(−L) + shift)) · light` (hadou's hard
+/// shadows then darken the whole shaded colour, as for every material), plus `A · ambient` (the
+/// ambient light is uniform, so GI equalisation changes nothing), plus the rim
+/// `(matcapFactor · matcap(view-space N) + pow(saturate(1 − N·V + lift), power) · rimColour) ·
+/// rimTexture · mix(1, light + ambient, rimLightingMix)`, plus `emissive · emissiveTexture`.
+fn mtoon_own(frame: &Frame, t: &Mtoon, p: &MtoonPoint, n: Vec3f, world: Vec3f) -> [f32; 3] {
+    let l = &frame.light;
+    let sh = mtoon::shading(n.dot(-l.direction), p.shift, t.toony);
+    let direct = mtoon::lit(p.shade, p.albedo, sh, l.color);
+    let v = (frame.camera.position - world).normalize_or(n);
+    let para = mtoon::parametric_rim(n.dot(v), t.rim_lift, t.rim_fresnel_power, t.rim_color);
+    let cap = t.matcap_texture.as_ref().map_or([0.0; 3], |x| {
+        let c = x.sample(mtoon::matcap_uv(n, v));
+        std::array::from_fn(|k| t.matcap_color[k] * c[k])
+    });
+    let rt = t.rim_texture.as_ref().map_or([1.0; 4], |x| x.sample(p.uv));
+    let lighting: [f32; 3] = std::array::from_fn(|k| l.color[k] + l.ambient[k]);
+    let mix = mtoon::lighting_mix(lighting, t.rim_lighting_mix);
+    let et = t.emissive_texture.as_ref().map_or([1.0; 4], |x| x.sample(p.uv));
+    std::array::from_fn(|k| {
+        let rim = (cap[k] + para[k]) * rt[k] * mix[k];
+        hadou_math::energy::saturate(direct[k] + p.albedo[k] * l.ambient[k] + rim + t.emissive[k] * et[k])
+    })
+}
+
+/// The look a wave of colour `rgb` gives an MToon surface (000 §2.1 with the material's own
+/// step): `mix(shade, A, linearstep(−1 + toony, 1 − toony, m + shift)) · rgb` over the unclamped
+/// `m = N·L` towards the wave's light point.
+fn mtoon_wave(t: &Mtoon, p: &MtoonPoint, m: f32, rgb: [f32; 3]) -> [f32; 3] {
+    mtoon::lit(p.shade, p.albedo, mtoon::shading(m, p.shift, t.toony), rgb)
+}
+
 /// What the `[area_light]` adds to a surface point with material `m` where it is fully visible
 /// (the soft shadow's visibility scales it): with `l̂` the unit vector from the point to the light
 /// centre `L` and `m = N·l̂`, diffuse `A·E·max(0, m)`, toon `A·E·ramp(m)` (unclamped `m`, as the
-/// waves light toon materials, 000 §2.1), unlit nothing; `E` the light's colour times intensity;
-/// then the feature texture, as for [`shade`]. Mirrored by `area_term` in `shading.wgsl`.
-pub(crate) fn area_term(light: &AreaLight, m: &Material, s: &Surface) -> [f32; 3] {
+/// waves light toon materials, 000 §2.1), MToon `mix(shade, A, step(m + shift)) · E` (its own
+/// step, at the animated texture coordinates), unlit nothing; `E` the light's colour times
+/// intensity; then the feature texture, as for [`shade`]. Mirrored by `area_term` in
+/// `shading.wgsl`.
+pub(crate) fn area_term(light: &AreaLight, m: &Material, s: &Surface, time: f32) -> [f32; 3] {
     let n = s.normal.normalize_or(Vec3f::ZERO);
     let dir = (light.position - s.world).normalize_or(Vec3f::ZERO);
     let mdot = n.dot(dir);
+    if let Some(t) = &m.mtoon {
+        let p = mtoon_point(m, t, s, time);
+        let k = mtoon_wave(t, &p, mdot, light.color);
+        let f = m.feature_texture.as_ref().map_or([1.0; 4], |x| x.sample(p.uv));
+        return std::array::from_fn(|i| hadou_math::energy::saturate(k[i] * f[i]));
+    }
     let k: [f32; 3] = match m.model {
         ShadingModel::Diffuse => [mdot.max(0.0); 3],
         ShadingModel::Toon => m.ramp.eval(mdot),
@@ -83,26 +158,31 @@ pub(crate) fn area_term(light: &AreaLight, m: &Material, s: &Surface) -> [f32; 3
 ///
 /// 1. albedo `A = base_color · base_texture(uv) · vertex colour`;
 /// 2. own look: diffuse `A·(ambient + light·max(0, N·(−L)))`, toon `A·ramp(N·(−L))` (unclamped
-///    `N·(−L)`), or unlit `A`;
+///    `N·(−L)`), unlit `A`, or MToon (a material with [`Material::mtoon`], whatever its model;
+///    `mtoon_own`, at the animated texture coordinates, which every texture of the material
+///    reads);
 /// 3. wave look (when the material's `β = wave_blend > 0` and a wave has strength): for each wave
 ///    `i`, the light point `Eᵢ` = nearest point of its centre line, `mᵢ = N·Lᵢ` unclamped
-///    (000 §2.1), look `rampᵢ(mᵢ)`; the looks are weighted by
+///    (000 §2.1), look `rampᵢ(mᵢ)` (MToon: the material's own step over `mᵢ` in the wave's
+///    colour, `mtoon_wave`); the looks are weighted by
 ///    [`toon::dominance_weights`] of the waves' densities at the point; `S = own + β·(wave − own)`;
 /// 4. glow (waves with `light_glow > 0`): `S += glowᵢ · rgbᵢ · ρᵢ`, `ρᵢ` the density of
 ///    [`toon::dominance`];
 /// 5. feature texture: `H = S · T(uv)` (000 §2.2).
 pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surface) -> [f32; 3] {
     let n = s.normal.normalize_or(Vec3f::ZERO);
-    let albedo = albedo(m, s);
     let l = &frame.light;
-    let mut c = match m.model {
-        ShadingModel::Diffuse => tone::diffuse(albedo, n, l.direction, l.color, l.ambient),
-        ShadingModel::Toon => {
-            let r = m.ramp.eval(n.dot(-l.direction));
-            std::array::from_fn(|k| albedo[k] * r[k])
+    let point = m.mtoon.as_ref().map(|t| (t.as_ref(), mtoon_point(m, t, s, frame.time)));
+    let mut c = match (&point, m.model) {
+        (Some((t, p)), _) => mtoon_own(frame, t, p, n, s.world),
+        (None, ShadingModel::Diffuse) => tone::diffuse(albedo(m, s), n, l.direction, l.color, l.ambient),
+        (None, ShadingModel::Toon) => {
+            let (a, r) = (albedo(m, s), m.ramp.eval(n.dot(-l.direction)));
+            std::array::from_fn(|k| a[k] * r[k])
         }
-        ShadingModel::Unlit => albedo,
+        (None, ShadingModel::Unlit) => albedo(m, s),
     };
+    let uv = point.as_ref().map_or(s.uv, |(_, p)| p.uv);
     let waves = &frame.waves;
     if !waves.is_empty() && (m.wave_blend > 0.0 || lights.any_glow) {
         let mut rho_buf = [0.0f32; STACK_WAVES];
@@ -146,7 +226,11 @@ pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surfa
                 let mut look = [0.0f32; 3];
                 for (i, w) in waves.iter().enumerate() {
                     if rho[i] > 0.0 {
-                        let r = w.light.ramp.eval(toon::wave_m(s.world, n, nearest[i]));
+                        let wm = toon::wave_m(s.world, n, nearest[i]);
+                        let r = match &point {
+                            Some((t, p)) => mtoon_wave(t, p, wm, rgb(w.color)),
+                            None => w.light.ramp.eval(wm),
+                        };
                         for k in 0..3 {
                             look[k] += rho[i] * r[k];
                         }
@@ -162,7 +246,7 @@ pub(crate) fn shade(frame: &Frame, lights: &FrameLights, m: &Material, s: &Surfa
         }
     }
     if let Some(t) = &m.feature_texture {
-        let f = t.sample(s.uv);
+        let f = t.sample(uv);
         for k in 0..3 {
             c[k] *= f[k];
         }

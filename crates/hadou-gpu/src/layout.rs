@@ -127,14 +127,8 @@ pub struct FrameUniforms {
 
 /// How far the edge pass looks (pixels): the widest outline's hull width on screen, rounded up
 /// and capped (`hadou_math::outline::reach_window`, as hadou-cpu's `edges::frame_reach`).
-fn outline_reach(frame: &Frame, basis: &CameraBasis) -> u32 {
-    let widest = frame
-        .objects
-        .iter()
-        .flat_map(|o| o.materials.iter())
-        .filter_map(|m| m.outline.map(|o| outline::hull_pixels(o.width, basis.tan_half_fov, frame.height)))
-        .fold(0.0f32, f32::max);
-    outline::reach_window(widest)
+fn outline_reach(frame: &Frame) -> u32 {
+    outline::reach_window(hadou_scene::widest_outline_pixels(frame))
 }
 
 impl FrameUniforms {
@@ -177,7 +171,7 @@ impl FrameUniforms {
             plane_count: 0,
             area: u32::from(frame.area_light.is_some()),
             area_position: frame.area_light.as_ref().map_or([0.0; 3], |a| a.position.to_array()),
-            outline_reach: outline_reach(frame, basis),
+            outline_reach: outline_reach(frame),
             area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
             grid: 1,
         }
@@ -307,19 +301,23 @@ pub struct GpuMaterial {
     pub base_color: [f32; 3],
     /// `MODEL_*`.
     pub model: u32,
-    /// Outline colour.
+    /// Outline colour (in a frame's buffers `hadou_scene::Material::outline_rgb`: an MToon
+    /// outline's colour lit).
     pub outline_color: [f32; 3],
     /// `β`.
     pub wave_blend: f32,
-    /// Outline width `d`; 0 = no outline.
+    /// Outline width: `d` of the hull push `d·|z|` (for an MToon outline in screen mode
+    /// `2·tan(fov/2)·w`), or `−w` for an MToon outline in world units (push `w`;
+    /// [`gpu_outline_width`]); 0 = no outline.
     pub outline_width: f32,
     /// Bit `s` is set when [`Frame::shadows`]`[s]` lists the material's object among its
     /// receivers.
     pub shadow_mask: u32,
     /// Index of the material's object in the frame (the edge pass tells objects apart by it).
     pub object: u32,
-    /// Padding.
-    pub _pad2: u32,
+    /// Word offset of the material's MToon block in the shading data ([`mtoon_block`]); 0 for
+    /// none (the material's `model` look).
+    pub mtoon: u32,
     /// Base-colour texture.
     pub base_texture: GpuTexture,
     /// Feature texture.
@@ -428,11 +426,78 @@ pub fn material_record(
         outline_width: m.outline.map_or(0.0, |o| o.width),
         shadow_mask,
         object: 0,
-        _pad2: 0,
+        mtoon: 0,
         base_texture: textures.texture(data, &m.base_texture),
         feature_texture: textures.texture(data, &m.feature_texture),
         ramp: GpuRamp::new(&m.ramp),
     }
+}
+
+/// [`GpuMaterial::outline_width`] of `m` for a camera of `tan_half_fov`
+/// (`hadou_scene::Material::hull_push`: `d`, MToon's screen mode `2·tan_half_fov·w`, its world mode
+/// `−w`); 0 without an outline or for a width that is not positive.
+pub fn gpu_outline_width(m: &hadou_scene::Material, tan_half_fov: f32) -> f32 {
+    if m.outline_in_world_units() {
+        -m.hull_push(0.0, tan_half_fov)
+    } else {
+        m.hull_push(1.0, tan_half_fov)
+    }
+}
+
+/// Words of an MToon block ([`mtoon_block`]).
+pub const MTOON_WORDS: usize = 52;
+
+/// Appends `m`'s MToon block to `data` (its textures through `textures`) for a frame at scene
+/// time `time` seen from `eye`, and returns its word offset (0 when `m` has no MToon look).
+/// Read by shading.wgsl's `mtoon_*` functions; the words are, as `f32` bit patterns unless
+/// stated: 0–2 shade colour, 3 toony, 4–6 rim colour, 7 fresnel power, 8–10 matcap factor,
+/// 11 rim lift, 12–14 emissive, 15 rim lighting mix, 16 shading shift, 17 shift texture scale,
+/// 18–19 `scroll · time`, 20 `rotation · time`, 21 the mask channel (`u32`), 22–23 unused,
+/// 24–26 the eye, 27 unused, then six [`GpuTexture`] records (4 words each): shade, shift, rim,
+/// matcap, UV mask, emissive. The time-scaled terms are the products hadou-cpu forms, so both
+/// backends animate alike.
+pub fn mtoon_block(
+    m: &hadou_scene::Material,
+    time: f32,
+    eye: [f32; 3],
+    data: &mut Vec<u32>,
+    textures: &mut TextureStore,
+) -> u32 {
+    let Some(t) = &m.mtoon else { return 0 };
+    let recs = [
+        &t.shade_texture,
+        &t.shift_texture,
+        &t.rim_texture,
+        &t.matcap_texture,
+        &t.uv_mask_texture,
+        &t.emissive_texture,
+    ]
+    .map(|x| textures.texture(data, x));
+    let offset = data.len() as u32;
+    let f = |x: f32| x.to_bits();
+    let c3 = |c: [f32; 3]| c.map(f);
+    data.extend(c3(t.shade_color));
+    data.push(f(t.toony));
+    data.extend(c3(t.rim_color));
+    data.push(f(t.rim_fresnel_power));
+    data.extend(c3(t.matcap_color));
+    data.push(f(t.rim_lift));
+    data.extend(c3(t.emissive));
+    data.push(f(t.rim_lighting_mix));
+    data.extend([
+        f(t.shading_shift),
+        f(t.shift_texture_scale),
+        f(t.uv_scroll[0] * time),
+        f(t.uv_scroll[1] * time),
+    ]);
+    data.extend([f(t.uv_rotation * time), u32::from(t.uv_mask_channel.min(3)), 0, 0]);
+    data.extend(c3(eye));
+    data.push(0);
+    for r in recs {
+        data.extend([r.offset, r.width, r.height, r.flags]);
+    }
+    debug_assert_eq!(data.len() - offset as usize, MTOON_WORDS);
+    offset
 }
 
 /// The waves as lights (000 §2.1): one record per wave, its centre line (`Wave::light_line`),
@@ -496,9 +561,18 @@ impl ShadingBuffers {
             let fallback = [hadou_scene::Material::default()];
             let mats: &[hadou_scene::Material] =
                 if o.materials.is_empty() { &fallback } else { &o.materials };
+            let eye = frame.camera.position;
+            let tan_half_fov = frame.camera.basis(frame.width, frame.height).tan_half_fov;
             for m in mats {
                 let record = material_record(m, shadow_mask, &mut b.data, &mut textures);
-                b.materials.push(GpuMaterial { object: oi as u32, ..record });
+                let mtoon = mtoon_block(m, frame.time, [eye.x, eye.y, eye.z], &mut b.data, &mut textures);
+                b.materials.push(GpuMaterial {
+                    object: oi as u32,
+                    mtoon,
+                    outline_width: gpu_outline_width(m, tan_half_fov),
+                    outline_color: m.outline_rgb(&frame.light),
+                    ..record
+                });
             }
         }
         b.lights = wave_lights(&frame.waves, curves, &mut b.data);

@@ -288,7 +288,7 @@ impl FrameData {
 
     /// Whether any object has an outlined material (then the hull pipeline runs).
     pub(crate) fn outlines(&self) -> bool {
-        self.shading.materials.iter().any(|m| m.outline_width > 0.0)
+        self.shading.materials.iter().any(|m| m.outline_width.abs() > 0.0)
     }
 }
 

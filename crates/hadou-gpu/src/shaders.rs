@@ -337,7 +337,7 @@ mod tests {
                 outline_width,
                 shadow_mask,
                 object,
-                _pad2,
+                mtoon,
                 base_texture,
                 feature_texture,
                 ramp

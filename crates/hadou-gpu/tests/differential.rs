@@ -133,6 +133,25 @@ fn every_example_scene_matches_cpu() {
     }
 }
 
+/// The MToon look (scenes/light-mtoon.toml: step, shade, rim, matcap, emission, textures, UV
+/// animation, a wave's light through the materials' own step) at the start, middle and end of its
+/// animation, and at 320×180 at the end (the scrolled and turned textures at more pixels).
+#[test]
+fn light_mtoon_matches_cpu() {
+    let Some(mut gpu) = gpu_or_skip("light-mtoon") else { return };
+    let mut cpu = CpuBackend::new();
+    let mut frames = example_frames(|name| name == "light-mtoon.toml");
+    let (_, mut big) = frames.last().cloned().expect("the scene's frames");
+    big.width = 320;
+    big.height = 180;
+    frames.push(("light-mtoon.toml 320×180".into(), big));
+    for (label, frame) in frames {
+        let g = gpu.render(&frame).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
+        let c = cpu.render(&frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
+        assert_close(&label, &compare(&g, &c));
+    }
+}
+
 /// `render_rows` (how large PNGs are streamed) draws the same pixels as those rows of a whole
 /// frame, for bands that start inside a tile and cross tile seams, and matches the CPU's bands.
 #[test]
@@ -205,6 +224,7 @@ fn materials_outlines_and_wave_lights_match_cpu() {
             },
             wave_blend: [1.0, 0.6, 0.0, 0.3][i],
             outline: (i != 2).then_some(Outline { width: 0.006, color: [0.05, 0.0, 0.1] }),
+            mtoon: None,
         };
         let x = -3.0 + 2.0 * i as f32;
         let mut o = object(

@@ -15,6 +15,7 @@ pub mod curve;
 pub mod energy;
 pub mod keyframes;
 mod mat4;
+pub mod mtoon;
 pub mod outline;
 pub mod quadrature;
 mod real;

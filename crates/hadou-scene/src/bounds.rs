@@ -2,7 +2,7 @@
 //! ([`object_bounds`]) and its centre `B` ([`object_center`]), as shadows and the area light use
 //! them.
 
-use crate::frame::{Mesh, Object};
+use crate::frame::{Frame, Mesh, Object};
 use hadou_math::soft::CasterBox;
 use hadou_math::{Vec3, Vec3f};
 
@@ -81,4 +81,36 @@ fn mesh_bounds(mesh: &Mesh) -> Option<(Vec3f, Vec3f)> {
     let mut it = mesh.positions.iter().map(|p| Vec3f::from_array(*p));
     let first = it.next()?;
     Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
+/// The widest outline hull on screen, in pixels, which the edge pass of both backends searches
+/// around each pixel ([`crate::Material::hull_pixels`] of every outlined material; an MToon outline in
+/// world units at the nearest view depth its object's surface can have, its bounding box's
+/// nearest corner, at least the near plane).
+pub fn widest_outline_pixels(frame: &Frame) -> f32 {
+    let basis = frame.camera.basis(frame.width, frame.height);
+    let mut widest = 0.0f32;
+    for o in &frame.objects {
+        for m in o.materials.iter().filter(|m| m.outline.is_some()) {
+            let z = if m.outline_in_world_units() {
+                let near = object_bounds(o).map_or(frame.camera.near, |(lo, hi)| {
+                    (0..8)
+                        .map(|k| {
+                            let c = Vec3::new(
+                                if k & 1 == 0 { lo.x } else { hi.x },
+                                if k & 2 == 0 { lo.y } else { hi.y },
+                                if k & 4 == 0 { lo.z } else { hi.z },
+                            );
+                            basis.to_view(c).z
+                        })
+                        .fold(f32::INFINITY, f32::min)
+                });
+                near.max(frame.camera.near)
+            } else {
+                1.0
+            };
+            widest = widest.max(m.hull_pixels(z, basis.tan_half_fov, frame.height));
+        }
+    }
+    widest
 }

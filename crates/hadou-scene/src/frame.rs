@@ -354,6 +354,118 @@ pub struct Material {
     pub wave_blend: f32,
     /// Inverted-hull outline, if any.
     pub outline: Option<Outline>,
+    /// The MToon look (VRM's `VRMC_materials_mtoon`, or VRM 0.x's `VRM/MToon` converted), which
+    /// both backends draw in place of [`Material::model`] when present: `model` stays
+    /// [`ShadingModel::Toon`] with `ramp` the two-band approximation of the MToon step, for
+    /// renderers that do not draw MToon (hadou-bevy's material).
+    pub mtoon: Option<Arc<Mtoon>>,
+}
+
+/// How an MToon outline's width is measured (`outlineWidthMode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum OutlineWidthMode {
+    /// No outline.
+    #[default]
+    None,
+    /// `outlineWidthFactor` in world units (metres).
+    World,
+    /// `outlineWidthFactor` as a fraction of the screen height.
+    Screen,
+}
+
+/// The parameters of an MToon material (`VRMC_materials_mtoon` 1.0; VRM 0.x's MToon properties
+/// are converted to these). Colours are linear RGB; textures are sampled at the (UV-animated)
+/// texture coordinates of the material, the matcap at the view-space normal. The formulas are
+/// `hadou_math::mtoon`'s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mtoon {
+    /// `shadeColorFactor`: the colour of the shaded side.
+    pub shade_color: [f32; 3],
+    /// `shadeMultiplyTexture`: multiplies `shade_color`.
+    pub shade_texture: Option<TextureRef>,
+    /// `shadingShiftFactor`: added to `N·L` before the step.
+    pub shading_shift: f32,
+    /// `shadingShiftTexture`: its red channel times `shift_texture_scale` is added to the shift.
+    pub shift_texture: Option<TextureRef>,
+    /// `shadingShiftTexture.scale`.
+    pub shift_texture_scale: f32,
+    /// `shadingToonyFactor` in [0, 1]: the step runs over `[−1 + toony, 1 − toony]`.
+    pub toony: f32,
+    /// `giEqualizationFactor` in [0, 1]. hadou's ambient light is uniform, so the equalised and
+    /// the raw global illumination are the same; kept for completeness.
+    pub gi_equalization: f32,
+    /// `parametricRimColorFactor`.
+    pub rim_color: [f32; 3],
+    /// `parametricRimFresnelPowerFactor` (≥ 0).
+    pub rim_fresnel_power: f32,
+    /// `parametricRimLiftFactor`.
+    pub rim_lift: f32,
+    /// `rimMultiplyTexture`: multiplies the rim (parametric rim and matcap).
+    pub rim_texture: Option<TextureRef>,
+    /// `rimLightingMixFactor` in [0, 1]: how much the light colour tints the rim.
+    pub rim_lighting_mix: f32,
+    /// `matcapFactor`.
+    pub matcap_color: [f32; 3],
+    /// `matcapTexture`, sampled at the view-space normal; absent: no matcap term.
+    pub matcap_texture: Option<TextureRef>,
+    /// `outlineWidthMode`.
+    pub outline_mode: OutlineWidthMode,
+    /// `outlineWidthFactor` (metres, or a fraction of the screen height). The loader turns the
+    /// material's [`Material::outline`] on with this width and `outline_color`; the backends draw
+    /// it through [`Material::hull_push`], [`Material::hull_pixels`] and [`Material::outline_rgb`].
+    pub outline_width: f32,
+    /// `outlineWidthMultiplyTexture` (its green channel multiplies the width in MToon; read, not
+    /// drawn: the outline is `outline_width` wide everywhere).
+    pub outline_width_texture: Option<TextureRef>,
+    /// `outlineColorFactor`.
+    pub outline_color: [f32; 3],
+    /// `outlineLightingMixFactor` in [0, 1].
+    pub outline_lighting_mix: f32,
+    /// `uvAnimationMaskTexture`: channel [`Mtoon::uv_mask_channel`] scales the UV animation.
+    pub uv_mask_texture: Option<TextureRef>,
+    /// The mask's channel: 2 (blue) in VRM 1.0, 0 (red) in VRM 0.x.
+    pub uv_mask_channel: u8,
+    /// `uvAnimationScrollXSpeedFactor`, `uvAnimationScrollYSpeedFactor`: UV units per second.
+    pub uv_scroll: [f32; 2],
+    /// `uvAnimationRotationSpeedFactor`: radians per second about UV (0.5, 0.5).
+    pub uv_rotation: f32,
+    /// glTF `emissiveFactor`.
+    pub emissive: [f32; 3],
+    /// glTF `emissiveTexture`.
+    pub emissive_texture: Option<TextureRef>,
+}
+
+impl Default for Mtoon {
+    /// The specification's defaults.
+    fn default() -> Self {
+        Mtoon {
+            shade_color: [0.0; 3],
+            shade_texture: None,
+            shading_shift: 0.0,
+            shift_texture: None,
+            shift_texture_scale: 1.0,
+            toony: 0.9,
+            gi_equalization: 0.9,
+            rim_color: [0.0; 3],
+            rim_fresnel_power: 5.0,
+            rim_lift: 0.0,
+            rim_texture: None,
+            rim_lighting_mix: 1.0,
+            matcap_color: [1.0; 3],
+            matcap_texture: None,
+            outline_mode: OutlineWidthMode::None,
+            outline_width: 0.0,
+            outline_width_texture: None,
+            outline_color: [0.0; 3],
+            outline_lighting_mix: 1.0,
+            uv_mask_texture: None,
+            uv_mask_channel: 2,
+            uv_scroll: [0.0; 2],
+            uv_rotation: 0.0,
+            emissive: [0.0; 3],
+            emissive_texture: None,
+        }
+    }
 }
 
 impl Material {
@@ -368,9 +480,77 @@ impl Material {
             ramp: Ramp::two_band(0.0, [0.6; 3], 0.0),
             wave_blend: 0.0,
             outline: None,
+            mtoon: None,
         }
     }
 }
+
+impl Material {
+    /// How the material's outline width is measured: hadou's `d` (view-depth-scaled, constant on
+    /// screen), or an MToon outline's mode ([`Mtoon::outline_mode`]).
+    fn outline_mode(&self) -> OutlineWidthMode {
+        self.mtoon.as_ref().map_or(OutlineWidthMode::None, |t| t.outline_mode)
+    }
+
+    /// How far the outline hull (000 §2.3) moves a vertex at view depth `z` along its unit outline
+    /// normal, for a camera of `tan_half_fov = tan(fov/2)`: hadou's `d·|z|` (`Outline::width` =
+    /// `d`); for an MToon outline (`VRMC_materials_mtoon` "Outline") in screen mode, whose
+    /// `Outline::width` is a fraction `w` of the image height, `2·tan_half_fov·w·|z|` (`w·height`
+    /// pixels on screen, [`hadou_math::outline::hull_pixels`]); in world mode `w` world units. 0
+    /// without an outline or for a width that is not positive.
+    pub fn hull_push(&self, z: f32, tan_half_fov: f32) -> f32 {
+        let Some(o) = self.outline else { return 0.0 };
+        if o.width.is_nan() || o.width <= 0.0 {
+            return 0.0;
+        }
+        match self.outline_mode() {
+            OutlineWidthMode::World => o.width,
+            OutlineWidthMode::Screen => 2.0 * tan_half_fov * o.width * z.abs(),
+            OutlineWidthMode::None => o.width * z.abs(),
+        }
+    }
+
+    /// The hull's width on screen in pixels where the surface is at view depth `z`
+    /// ([`hadou_math::outline::hull_pixels`] of the push over `|z|`; the depth matters only in
+    /// MToon's world mode, whose `|z|` is taken at least [`MIN_OUTLINE_DEPTH`]). The edge pass
+    /// draws contact outlines this wide.
+    pub fn hull_pixels(&self, z: f32, tan_half_fov: f32, height: u32) -> f32 {
+        let d = match (self.outline, self.outline_mode()) {
+            (None, _) => return 0.0,
+            (Some(o), OutlineWidthMode::World) => o.width / z.abs().max(MIN_OUTLINE_DEPTH),
+            (Some(o), OutlineWidthMode::Screen) => 2.0 * tan_half_fov * o.width,
+            (Some(o), OutlineWidthMode::None) => o.width,
+        };
+        hadou_math::outline::hull_pixels(d, tan_half_fov, height)
+    }
+
+    /// Whether the hull's width on screen depends on the depth (an MToon outline in world mode):
+    /// the edge pass then searches its widest window.
+    pub fn outline_in_world_units(&self) -> bool {
+        self.outline.is_some() && self.outline_mode() == OutlineWidthMode::World
+    }
+
+    /// The colour outline pixels of this material take under `light`: `Outline::color`; for an
+    /// MToon outline `outlineColor · mix(1, light + ambient, outlineLightingMix)` per channel
+    /// (`VRMC_materials_mtoon` "Outline", the light reaching the surface as for the rim).
+    pub fn outline_rgb(&self, light: &Light) -> [f32; 3] {
+        let Some(o) = self.outline else { return [0.0; 3] };
+        match &self.mtoon {
+            Some(t) if t.outline_mode != OutlineWidthMode::None => {
+                let mix = hadou_math::mtoon::lighting_mix(
+                    std::array::from_fn(|k| light.color[k] + light.ambient[k]),
+                    t.outline_lighting_mix,
+                );
+                std::array::from_fn(|k| o.color[k] * mix[k])
+            }
+            _ => o.color,
+        }
+    }
+}
+
+/// The nearest view depth at which an MToon world-unit outline's width on screen is taken
+/// ([`Material::hull_pixels`]).
+pub const MIN_OUTLINE_DEPTH: f32 = 1.0e-3;
 
 impl Default for Material {
     fn default() -> Self {

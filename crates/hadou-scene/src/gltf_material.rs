@@ -3,7 +3,8 @@
 //! - `pbrMetallicRoughness.baseColorFactor` (rgb) → [`Material::base_color`], `baseColorTexture`
 //!   → [`Material::base_texture`] with the sampler's `wrapS`/`wrapT` and `magFilter`.
 //! - `KHR_materials_unlit` → [`ShadingModel::Unlit`]; `VRMC_materials_mtoon` (VRM 1.0) →
-//!   [`ShadingModel::Toon`] with a two-band ramp (see [`mtoon_ramp`]); otherwise
+//!   [`Material::mtoon`] (see `gltf_mtoon`, also for VRM 0.x), with a two-band
+//!   [`ShadingModel::Toon`] ramp as its approximation (see [`ramp_of`]); otherwise
 //!   [`ShadingModel::Diffuse`].
 //! - hadou's feature texture (000 §2.2) lives in the material's extras:
 //!   `"extras": {"hadou": {"featureTexture": {"index": N, "texCoord": M}}}` (`texCoord` optional,
@@ -16,7 +17,8 @@
 //! against the array it points into first.
 
 use crate::error::escape_controls;
-use crate::frame::{Filter, Material, Ramp, ShadingModel, Texture, TextureRef, Wrap};
+use crate::frame::{Filter, Material, Mtoon, Ramp, ShadingModel, Texture, TextureRef, Wrap};
+use crate::gltf_mtoon::{color3, read_mtoon0, read_mtoon10, tex_info, MtoonTextures, TexInfo};
 use crate::gltf_uri::resolve_uri;
 use crate::texture::decode_texture_within;
 use serde_json::Value;
@@ -24,7 +26,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// The glTF extensions hadou maps (a file may list them in `extensionsRequired`).
-pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_materials_unlit", "VRMC_materials_mtoon"];
+/// `VRMC_vrm` (VRM 1.0) and `VRM` (VRM 0.x) are the avatar extensions of `.vrm` files; of them
+/// hadou reads the MToon materials (`gltf_mtoon`).
+pub(crate) const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_materials_unlit", "VRMC_materials_mtoon", "VRMC_vrm", "VRM"];
 
 /// The materials of a file and the TEXCOORD set each one's textures read.
 pub(crate) struct Materials {
@@ -51,72 +56,30 @@ pub(crate) struct ImageSource<'a> {
     pub root: &'a Path,
 }
 
-/// A texture reference read from raw JSON: texture index and TEXCOORD set.
-#[derive(Clone, Copy)]
-struct TexInfo {
-    index: usize,
-    tex_coord: u32,
-}
-
-/// Reads a `textureInfo` object (`{"index": N, "texCoord": M}`) at `what`.
-fn tex_info(v: &Value, what: &str, n_tex: usize) -> Result<TexInfo, String> {
-    let index = v
-        .get("index")
-        .and_then(Value::as_u64)
-        .ok_or_else(|| format!("{what} must be an object with a non-negative integer `index`"))?;
-    if index >= n_tex as u64 {
-        return Err(format!(
-            "{what} refers to texture {index}, but the file has {n_tex} texture entries (0-based)"
-        ));
-    }
-    let tex_coord = match v.get("texCoord") {
-        None => 0,
-        Some(t) => {
-            t.as_u64()
-                .filter(|&t| t < 16)
-                .ok_or_else(|| format!("{what}.texCoord must be an integer from 0 to 15"))? as u32
-        }
-    };
-    Ok(TexInfo { index: index as usize, tex_coord })
-}
-
-/// A finite number at `v[key]`, `default` when absent.
-fn number(v: &Value, key: &str, default: f32, what: &str) -> Result<f32, String> {
-    match v.get(key) {
-        None => Ok(default),
-        Some(x) => x
-            .as_f64()
-            .map(|x| x as f32)
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("{what}.{key} must be a finite number")),
-    }
-}
-
-/// `v[key]` as `[f32; 3]` (at least three finite numbers), `default` when absent.
-fn color3(v: &Value, key: &str, default: [f32; 3], what: &str) -> Result<[f32; 3], String> {
-    let Some(x) = v.get(key) else { return Ok(default) };
-    let arr = x.as_array().filter(|a| a.len() >= 3);
-    let vals: Option<Vec<f32>> = arr
-        .map(|a| a[..3].iter().map(|c| c.as_f64().map(|c| c as f32).filter(|c| c.is_finite())).collect())
-        .and_then(|v: Option<Vec<f32>>| v);
-    vals.map(|v| [v[0], v[1], v[2]])
-        .ok_or_else(|| format!("{what}.{key} must be an array of 3 or 4 finite numbers"))
-}
-
-/// The two-band toon ramp of a `VRMC_materials_mtoon` object for a material of base colour
-/// `base`: MToon shades with `linearstep(−1 + toony, 1 − toony, N·L + shift)` between the shade
-/// colour and the base colour, so the band threshold is `−shadingShiftFactor` (clamped to
-/// [−1, 1]), the step width `(1 − shadingToonyFactor)·2` (clamped to [0, 2]) and the shade band
-/// the per-channel multiplier `shadeColorFactor / base` (1 where the base channel is 0, clamped to
-/// [0, 4]). Spec defaults: shift 0, toony 0.9, shade colour black.
-pub(crate) fn mtoon_ramp(ext: &Value, base: [f32; 3], what: &str) -> Result<Ramp, String> {
-    let what = format!("{what} (VRMC_materials_mtoon)");
-    let shade = color3(ext, "shadeColorFactor", [0.0; 3], &what)?;
-    let shift = number(ext, "shadingShiftFactor", 0.0, &what)?;
-    let toony = number(ext, "shadingToonyFactor", 0.9, &what)?;
+/// The two-band toon ramp that approximates an MToon material of base colour `base` for
+/// renderers that do not draw MToon (hadou-bevy's material): MToon shades with
+/// `linearstep(−1 + toony, 1 − toony, N·L + shift)` between the shade colour and the base colour,
+/// so the band threshold is `−shift` (clamped to [−1, 1]), the step width `(1 − toony)·2` (clamped
+/// to [0, 2]) and the shade band the per-channel multiplier `shade / base` (1 where the base
+/// channel is 0, clamped to [0, 4]).
+fn ramp_of(shade: [f32; 3], shift: f32, toony: f32, base: [f32; 3]) -> Ramp {
     let mult: [f32; 3] =
         std::array::from_fn(|i| if base[i] > 0.0 { (shade[i] / base[i]).clamp(0.0, 4.0) } else { 1.0 });
-    Ok(Ramp::two_band((-shift).clamp(-1.0, 1.0), mult, ((1.0 - toony) * 2.0).clamp(0.0, 2.0)))
+    Ramp::two_band((-shift).clamp(-1.0, 1.0), mult, ((1.0 - toony) * 2.0).clamp(0.0, 2.0))
+}
+
+/// The glTF material's `emissiveFactor` (black when absent).
+fn m_emissive_factor(rm: &Value, what: &str) -> Result<[f32; 3], String> {
+    color3(rm, "emissiveFactor", [0.0; 3], what)
+}
+
+fn m_emissive(c: [f32; 3]) -> [f32; 3] {
+    c.map(|x| x.max(0.0))
+}
+
+/// VRM 0.x's `extensions.VRM.materialProperties[i]`, if the file has one.
+fn vrm0_properties(raw: &Value, i: usize) -> Option<&Value> {
+    raw.get("extensions")?.get("VRM")?.get("materialProperties")?.as_array()?.get(i)
 }
 
 /// Sampler wrap mode → [`Wrap`] (`None`, and unknown values, are REPEAT, glTF's default).
@@ -174,22 +137,41 @@ pub(crate) fn load_materials(
         if exts.and_then(|e| e.get("KHR_materials_unlit")).is_some() {
             mat.model = ShadingModel::Unlit;
         }
+        let mut base = base;
+        let mut mtoon: Option<(Mtoon, MtoonTextures)> = None;
         if let Some(mt) = exts.and_then(|e| e.get("VRMC_materials_mtoon")) {
             if !mt.is_object() {
                 return Err(format!("{what}: VRMC_materials_mtoon must be an object"));
             }
-            mat.model = ShadingModel::Toon;
-            mat.ramp = mtoon_ramp(mt, base_color, &what)?;
-            if mt.get("shadeMultiplyTexture").is_some() {
-                warnings.push(format!(
-                    "material `{name}` ({what}): its MToon shadeMultiplyTexture is ignored (hadou's toon ramps \
-                     multiply the base colour by one shade colour)"
-                ));
+            let (mut m, mut t) = read_mtoon10(mt, &what, &name, n_tex, warnings)?;
+            m.emissive = m_emissive(m_emissive_factor(rm, &what)?);
+            t.emissive = match rm.get("emissiveTexture") {
+                Some(v) => Some(tex_info(v, &format!("{what}.emissiveTexture"), n_tex)?),
+                None => None,
+            };
+            mtoon = Some((m, t));
+        } else if let Some(props) = vrm0_properties(raw, i) {
+            if let Some((m, t, color)) = read_mtoon0(props, &what, &name, n_tex, warnings)? {
+                if let Some(c) = color {
+                    mat.base_color = c;
+                }
+                if base.is_none() {
+                    base = t.base;
+                }
+                mtoon = Some((m, t));
             }
+        }
+        if let Some((m, _)) = &mtoon {
+            mat.model = ShadingModel::Toon;
+            mat.ramp = ramp_of(m.shade_color, m.shading_shift, m.toony, mat.base_color);
         }
 
         let mut sets: Vec<u32> = Vec::new();
-        for (slot, info) in [(0, base), (1, feature)] {
+        let mt = mtoon.as_ref().map(|m| m.1).unwrap_or_default();
+        let slots =
+            [base, feature, mt.shade, mt.shift, mt.rim, mt.matcap, mt.outline_width, mt.uv_mask, mt.emissive];
+        let mut refs: [Option<TextureRef>; 9] = Default::default();
+        for (slot, info) in slots.into_iter().enumerate() {
             let Some(info) = info else { continue };
             let tex = gltf
                 .textures()
@@ -217,12 +199,33 @@ pub(crate) fn load_materials(
                 _ => Filter::Linear,
             };
             let r = TextureRef { image: texture, wrap: [wrap_of(s.wrap_s()), wrap_of(s.wrap_t())], filter };
-            if slot == 0 {
-                mat.base_texture = Some(r);
-            } else {
-                mat.feature_texture = Some(r);
+            refs[slot] = Some(r);
+            // The matcap is sampled at the view-space normal, not at a TEXCOORD set.
+            if slot != 5 {
+                sets.push(info.tex_coord);
             }
-            sets.push(info.tex_coord);
+        }
+        let [base_t, feature_t, shade_t, shift_t, rim_t, matcap_t, width_t, mask_t, emissive_t] = refs;
+        mat.base_texture = base_t;
+        mat.feature_texture = feature_t;
+        if let Some((mut m, _)) = mtoon {
+            m.shade_texture = shade_t;
+            m.shift_texture = shift_t;
+            m.rim_texture = rim_t;
+            m.matcap_texture = matcap_t;
+            m.outline_width_texture = width_t;
+            m.uv_mask_texture = mask_t;
+            m.emissive_texture = emissive_t;
+            if m.outline_mode != crate::frame::OutlineWidthMode::None && m.outline_width > 0.0 {
+                mat.outline = Some(crate::frame::Outline { width: m.outline_width, color: m.outline_color });
+                if m.outline_width_texture.is_some() {
+                    warnings.push(format!(
+                        "material `{name}` ({what}): its MToon outlineWidthMultiplyTexture is ignored (the \
+                         outline is outlineWidthFactor wide everywhere)"
+                    ));
+                }
+            }
+            mat.mtoon = Some(Arc::new(m));
         }
         let set = match sets.as_slice() {
             [] => None,
@@ -285,12 +288,20 @@ fn load_image(
 }
 
 /// Checks the raw JSON indices this module reads beyond what `check_indices` covers (the feature
-/// texture of the extras), so errors name the material before any image is decoded.
+/// texture of the extras, the MToon properties), so errors name the material before any image is
+/// decoded.
 pub(crate) fn check_raw(raw: &Value, n_tex: usize) -> Result<(), String> {
     let mats = raw.get("materials").and_then(Value::as_array).map_or(&[][..], |v| v.as_slice());
+    let mut scratch = Vec::new();
     for (i, m) in mats.iter().enumerate() {
+        let what = format!("material {i}");
         if let Some(v) = m.get("extras").and_then(|e| e.get("hadou")).and_then(|h| h.get("featureTexture")) {
-            tex_info(v, &format!("material {i} (extras.hadou.featureTexture)"), n_tex)?;
+            tex_info(v, &format!("{what} (extras.hadou.featureTexture)"), n_tex)?;
+        }
+        if let Some(mt) = m.get("extensions").and_then(|e| e.get("VRMC_materials_mtoon")) {
+            read_mtoon10(mt, &what, &what, n_tex, &mut scratch)?;
+        } else if let Some(props) = vrm0_properties(raw, i) {
+            read_mtoon0(props, &what, &what, n_tex, &mut scratch)?;
         }
     }
     Ok(())
@@ -304,12 +315,15 @@ mod tests {
     fn mtoon_ramp_clamps_its_inputs() {
         let ext = serde_json::json!({"shadeColorFactor": [1.0, 0.5, 0.3], "shadingShiftFactor": -3.0,
                                      "shadingToonyFactor": -2.0});
-        let r = mtoon_ramp(&ext, [0.1, 0.0, 0.6], "m").unwrap();
+        let (m, _) = read_mtoon10(&ext, "m", "m", 0, &mut Vec::new()).unwrap();
+        assert_eq!((m.shading_shift, m.toony), (-1.0, 0.0));
+        let r = ramp_of(m.shade_color, m.shading_shift, m.toony, [0.1, 0.0, 0.6]);
         assert_eq!(r.stops[0].1, [4.0, 1.0, 0.5]);
         assert_eq!(r.stops[1].0, 1.0);
         assert_eq!(r.kind, hadou_math::toon::RampKind::Bands { smoothing: 2.0 });
-        let e =
-            mtoon_ramp(&serde_json::json!({"shadingShiftFactor": "up"}), [1.0; 3], "material 2").unwrap_err();
+        let mut w = Vec::new();
+        let e = read_mtoon10(&serde_json::json!({"shadingShiftFactor": "up"}), "material 2", "x", 0, &mut w)
+            .unwrap_err();
         assert!(e.contains("material 2 (VRMC_materials_mtoon).shadingShiftFactor"), "{e}");
     }
 }

@@ -39,6 +39,7 @@ mod frame;
 mod gltf_anim;
 mod gltf_load;
 mod gltf_material;
+mod gltf_mtoon;
 mod gltf_uri;
 mod gltf_vrm;
 mod gltf_vrma;
@@ -64,7 +65,7 @@ pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
 pub use backend::{Backend, RenderError};
 pub use bloom_def::{BLOOM_MAX_STREAK_LENGTH, BLOOM_MAX_THRESHOLD, BLOOM_MAX_WEIGHT};
-pub use bounds::{caster_box, object_bounds, object_center};
+pub use bounds::{caster_box, object_bounds, object_center, widest_outline_pixels};
 pub use error::{escape_controls, Location, SceneError};
 pub use files::{
     read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS, GLTF_MAX_JSON_VALUES,

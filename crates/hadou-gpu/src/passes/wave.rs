@@ -77,7 +77,7 @@ pub(crate) struct WaveVariant(u32);
 
 impl WaveVariant {
     /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
-    pub(crate) const NAMES: [&'static str; 27] = [
+    pub(crate) const NAMES: [&'static str; 28] = [
         // wave.wgsl
         "USE_SPHERE",
         "USE_CYLINDER",
@@ -101,6 +101,7 @@ impl WaveVariant {
         "USE_BSPLINE",
         // shading.wgsl
         "USE_TOON",
+        "USE_MTOON",
         "USE_TEXTURES",
         "USE_WAVE_LIGHTS",
         "USE_LINE_POINT",
@@ -198,7 +199,12 @@ impl WaveVariant {
             if materials.iter().any(|m| m.model == layout::MODEL_TOON) {
                 on.push("USE_TOON");
             }
-            if materials.iter().any(|m| m.base_texture.offset != 0 || m.feature_texture.offset != 0) {
+            let mtoon = materials.iter().any(|m| m.mtoon != 0);
+            if mtoon {
+                on.push("USE_MTOON");
+            }
+            if mtoon || materials.iter().any(|m| m.base_texture.offset != 0 || m.feature_texture.offset != 0)
+            {
                 on.push("USE_TEXTURES");
             }
             let lit = !lights.is_empty() && (any_glow || materials.iter().any(|m| m.wave_blend > 0.0));

@@ -114,7 +114,7 @@ struct GpuMaterial {
     outline_width: f32,
     shadow_mask: u32,
     object: u32,
-    _pad2: u32,
+    mtoon: u32,
     base_texture: GpuTexture,
     feature_texture: GpuTexture,
     ramp: GpuRamp,

@@ -14,6 +14,8 @@
 // G-buffer target 1: u, v, colour, material word (index | reach << REACH_SHIFT | HULL_BIT).
 @group(0) @binding(3) var attribute_texels: texture_2d<u32>;
 
+// Mirrors hadou_scene::MIN_OUTLINE_DEPTH.
+const MIN_OUTLINE_DEPTH: f32 = 1.0e-3;
 // Mirrors hadou_math::outline::IN_FRONT_MARGIN.
 const IN_FRONT_MARGIN: f32 = 1.0e-3;
 // Mirrors hadou_math::outline::REACH_STEPS.
@@ -34,6 +36,17 @@ fn hull_pixels(width: f32, tan_half_fov: f32, height: u32) -> f32 {
         return px;
     }
     return 0.0;
+}
+
+// Twin of hadou_scene::Material::hull_pixels for a material's GPU outline width (layout.rs
+// `GpuMaterial::outline_width`: `d`, or `−w` for an MToon outline in world units) where the
+// surface is at view depth `z`.
+fn material_hull_pixels(width: f32, z: f32) -> f32 {
+    var d = width;
+    if (width < 0.0) {
+        d = -width / max(abs(z), MIN_OUTLINE_DEPTH);
+    }
+    return hull_pixels(d, frame.tan_half_fov, frame.image_size.y);
 }
 
 // Twin of hadou_math::outline::in_front.
@@ -123,7 +136,8 @@ fn fs_edges(@builtin(position) position: vec4<f32>) -> @location(0) vec4<u32> {
                 continue;
             }
             // hadou_math::outline::reach_pixels.
-            let rp = hull_pixels(m.outline_width, frame.tan_half_fov, frame.image_size.y) * (f32(code) / REACH_STEPS);
+            let rp = material_hull_pixels(m.outline_width, q_distance * dot3(unit_dir(q), frame.forward))
+                * (f32(code) / REACH_STEPS);
             if (!(rp > 0.0)) {
                 continue;
             }

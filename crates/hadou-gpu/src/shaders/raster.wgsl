@@ -70,10 +70,16 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     out.color = v.color;
     out.material = material_index(o, v.material);
     out.outline = vec3<f32>(0.0);
-    if (materials[out.material].outline_width > 0.0) {
+    if (has_outline(materials[out.material].outline_width)) {
         out.outline = outline_dir(o, v.outline_normal);
     }
     return out;
+}
+
+// Whether a material's GPU outline width (layout.rs `GpuMaterial::outline_width`: `d > 0`, or
+// `−w < 0` for an MToon outline in world units) draws an outline.
+fn has_outline(width: f32) -> bool {
+    return width > 0.0 || width < 0.0;
 }
 
 // The outline hull (000 §2.3): the vertex pushed along its world outline normal by d·|z|, which is
@@ -89,7 +95,7 @@ fn vs_hull(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     out.uv = v.uv;
     out.color = v.color;
     out.outline = vec3<f32>(0.0);
-    if (!(width > 0.0)) {
+    if (!has_outline(width)) {
         out.clip = vec4<f32>(0.0, 0.0, -2.0, 1.0);
         out.world = frame.eye;
         out.normal = vec3<f32>(0.0);
@@ -98,7 +104,12 @@ fn vs_hull(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     let base = (o.model * vec4<f32>(v.position, 1.0)).xyz;
     let u = outline_dir(o, v.outline_normal);
     let z = dot3(base - frame.eye, frame.forward);
-    let world = base + u * (width * abs(z));
+    var push = width * abs(z);
+    if (width < 0.0) {
+        // An MToon outline in world units (hadou_scene::Material::hull_push).
+        push = -width;
+    }
+    let world = base + u * push;
     out.clip = project(world);
     out.world = world;
     out.normal = (o.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
@@ -111,7 +122,7 @@ fn fs_main(in: VertexOut) -> GBuffer {
     let distance = length3(in.world - frame.eye);
     g.surface = bitcast<vec4<u32>>(vec4<f32>(in.normal, distance));
     var word = in.material;
-    if ((word & HULL_BIT) == 0u && materials[word].outline_width > 0.0) {
+    if ((word & HULL_BIT) == 0u && has_outline(materials[word].outline_width)) {
         // hadou_math::outline::reach_code at this pixel's ray.
         let px = frame.tile_origin + vec2<u32>(in.clip.xy);
         let d = pixel_dir(frame, px.x, px.y);

@@ -9,6 +9,7 @@
 // wave.wgsl): toon-model materials, textures (base or feature), the waves as lights (some material
 // blends towards them or some wave glows) and each kind of light line. The rest is compiled out.
 override USE_TOON: bool = true;
+override USE_MTOON: bool = true;
 override USE_TEXTURES: bool = true;
 override USE_WAVE_LIGHTS: bool = true;
 override USE_LINE_POINT: bool = true;
@@ -165,6 +166,144 @@ fn sample_texture(t: GpuTexture, uv: vec2<f32>) -> vec4<f32> {
     return top + (bottom - top) * fy;
 }
 
+// ---- MToon (VRMC_materials_mtoon 1.0): twins of hadou_math::mtoon and hadou-cpu's
+// shading::mtoon_* functions. A material's MToon block (layout.rs `mtoon_block`) is read from
+// shading_data at word offset `o`.
+
+fn mtoon_f32(o: u32) -> f32 {
+    return bitcast<f32>(shading_data[o]);
+}
+
+fn mtoon_vec3(o: u32) -> vec3<f32> {
+    return vec3<f32>(mtoon_f32(o), mtoon_f32(o + 1u), mtoon_f32(o + 2u));
+}
+
+// The k-th texture record of the block (0 shade, 1 shift, 2 rim, 3 matcap, 4 UV mask, 5 emissive).
+fn mtoon_texture(o: u32, k: u32) -> GpuTexture {
+    let w = o + 28u + 4u * k;
+    return GpuTexture(shading_data[w], shading_data[w + 1u], shading_data[w + 2u], shading_data[w + 3u]);
+}
+
+// Mirrors hadou_math::mtoon::linearstep.
+fn mtoon_linearstep(a: f32, b: f32, t: f32) -> f32 {
+    if (b > a) {
+        return clamp((t - a) / (b - a), 0.0, 1.0);
+    }
+    if (t >= a) {
+        return 1.0;
+    }
+    return 0.0;
+}
+
+// Mirrors hadou_math::mtoon::shading.
+fn mtoon_shading(n_dot_l: f32, shift: f32, toony: f32) -> f32 {
+    return mtoon_linearstep(-1.0 + toony, 1.0 - toony, n_dot_l + shift);
+}
+
+// Mirrors hadou_math::mtoon::lit.
+fn mtoon_lit(shade: vec3<f32>, base: vec3<f32>, s: f32, light: vec3<f32>) -> vec3<f32> {
+    return (shade + (base - shade) * s) * light;
+}
+
+// Mirrors hadou_math::mtoon::parametric_rim.
+fn mtoon_rim(n_dot_v: f32, lift: f32, power: f32, color: vec3<f32>) -> vec3<f32> {
+    let x = clamp(1.0 - n_dot_v + lift, 0.0, 1.0);
+    let p = max(power, 0.0);
+    var f = 0.0;
+    if (x > 0.0) {
+        f = pow(x, p);
+    } else if (p == 0.0) {
+        f = 1.0;
+    }
+    return color * f;
+}
+
+// Unit `v`, or `fallback` for a zero or non-finite vector (hadou_math::Vec3::normalize_or).
+fn normalize_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let l = length3(v);
+    if (l > 0.0 && l <= 3.40282347e38) {
+        return v / l;
+    }
+    return fallback;
+}
+
+// Mirrors hadou_math::mtoon::matcap_uv.
+fn mtoon_matcap_uv(n: vec3<f32>, v: vec3<f32>) -> vec2<f32> {
+    let x = normalize_or(vec3<f32>(v.z, 0.0, -v.x), vec3<f32>(1.0, 0.0, 0.0));
+    let y = cross3(v, x);
+    return vec2<f32>(0.5 + 0.495 * dot3(x, n), 0.5 - 0.495 * dot3(y, n));
+}
+
+// Mirrors hadou_math::mtoon::uv_animation.
+fn mtoon_uv(uv: vec2<f32>, mask: f32, scroll: vec2<f32>, turn: f32) -> vec2<f32> {
+    let tau = 6.28318530717958647;
+    var a = turn * mask;
+    if (abs(a) <= 3.40282347e38) {
+        a = a - tau * floor(a / tau);
+    } else {
+        a = 0.0;
+    }
+    let s = sin(a);
+    let c = cos(a);
+    let u = uv.x - 0.5;
+    let v = uv.y - 0.5;
+    return vec2<f32>(c * u - s * v + 0.5 + scroll.x * mask, s * u + c * v + 0.5 + scroll.y * mask);
+}
+
+// Mirrors hadou-cpu's shading::MtoonPoint.
+struct MtoonPoint {
+    uv: vec2<f32>,
+    albedo: vec3<f32>,
+    shade: vec3<f32>,
+    shift: f32,
+}
+
+// Mirrors hadou-cpu's shading::mtoon_point.
+fn mtoon_point(m: GpuMaterial, uv_in: vec2<f32>, vcolor: vec4<f32>) -> MtoonPoint {
+    let o = m.mtoon;
+    var mask = 1.0;
+    let mask_t = mtoon_texture(o, 4u);
+    if (mask_t.offset != 0u) {
+        mask = sample_texture(mask_t, uv_in)[min(shading_data[o + 21u], 3u)];
+    }
+    let uv = mtoon_uv(uv_in, mask, vec2<f32>(mtoon_f32(o + 18u), mtoon_f32(o + 19u)), mtoon_f32(o + 20u));
+    var p: MtoonPoint;
+    p.uv = uv;
+    p.albedo = m.base_color * sample_texture(m.base_texture, uv).xyz * vcolor.xyz;
+    p.shade = mtoon_vec3(o) * sample_texture(mtoon_texture(o, 0u), uv).xyz;
+    p.shift = mtoon_f32(o + 16u);
+    let shift_t = mtoon_texture(o, 1u);
+    if (shift_t.offset != 0u) {
+        p.shift = p.shift + sample_texture(shift_t, uv).x * mtoon_f32(o + 17u);
+    }
+    return p;
+}
+
+// Mirrors hadou-cpu's shading::mtoon_own: the MToon look under the scene light.
+fn mtoon_own(o: u32, p: MtoonPoint, n: vec3<f32>, world: vec3<f32>) -> vec3<f32> {
+    let sh = mtoon_shading(dot3(n, -frame.light_dir), p.shift, mtoon_f32(o + 3u));
+    let direct = mtoon_lit(p.shade, p.albedo, sh, frame.light_color);
+    let v = normalize_or(mtoon_vec3(o + 24u) - world, n);
+    let para = mtoon_rim(dot3(n, v), mtoon_f32(o + 11u), mtoon_f32(o + 7u), mtoon_vec3(o + 4u));
+    var cap = vec3<f32>(0.0);
+    let cap_t = mtoon_texture(o, 3u);
+    if (cap_t.offset != 0u) {
+        cap = mtoon_vec3(o + 8u) * sample_texture(cap_t, mtoon_matcap_uv(n, v)).xyz;
+    }
+    let rt = sample_texture(mtoon_texture(o, 2u), p.uv).xyz;
+    let lighting = frame.light_color + frame.ambient;
+    let mix_f = vec3<f32>(1.0) + (lighting - vec3<f32>(1.0)) * mtoon_f32(o + 15u);
+    let et = sample_texture(mtoon_texture(o, 5u), p.uv).xyz;
+    let rim = (cap + para) * rt * mix_f;
+    let c = direct + p.albedo * frame.ambient + rim + mtoon_vec3(o + 12u) * et;
+    return vec3<f32>(energy_saturate(c.x), energy_saturate(c.y), energy_saturate(c.z));
+}
+
+// Mirrors hadou-cpu's shading::mtoon_wave: a wave's light through the material's own step.
+fn mtoon_wave(o: u32, p: MtoonPoint, m: f32, rgb: vec3<f32>) -> vec3<f32> {
+    return mtoon_lit(p.shade, p.albedo, mtoon_shading(m, p.shift, mtoon_f32(o + 3u)), rgb);
+}
+
 // Most waves weighed per surface point (hadou_scene's limit is 256 waves per scene).
 const MAX_LIGHTS: u32 = 256u;
 
@@ -176,13 +315,23 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
     if (len > 0.0 && len < 3.0e38) {
         n = normal_in / len;
     }
-    let tex = sample_texture(m.base_texture, uv);
-    let albedo = m.base_color * tex.xyz * vcolor.xyz;
-    var c = albedo;
-    if (m.model == MODEL_DIFFUSE) {
-        c = diffuse(albedo, n, frame.light_dir, frame.light_color, frame.ambient);
-    } else if (USE_TOON && m.model == MODEL_TOON) {
-        c = albedo * ramp_eval(m.ramp, dot3(n, -frame.light_dir));
+    let is_mtoon = USE_MTOON && m.mtoon != 0u;
+    var mp: MtoonPoint;
+    var tuv = uv;
+    var c = vec3<f32>(0.0);
+    if (is_mtoon) {
+        mp = mtoon_point(m, uv, vcolor);
+        tuv = mp.uv;
+        c = mtoon_own(m.mtoon, mp, n, world);
+    } else {
+        let tex = sample_texture(m.base_texture, uv);
+        let albedo = m.base_color * tex.xyz * vcolor.xyz;
+        c = albedo;
+        if (m.model == MODEL_DIFFUSE) {
+            c = diffuse(albedo, n, frame.light_dir, frame.light_color, frame.ambient);
+        } else if (USE_TOON && m.model == MODEL_TOON) {
+            c = albedo * ramp_eval(m.ramp, dot3(n, -frame.light_dir));
+        }
     }
     let count = min(frame.wave_count, MAX_LIGHTS);
     if (USE_WAVE_LIGHTS && count > 0u && (m.wave_blend > 0.0 || frame.any_glow != 0u)) {
@@ -218,7 +367,12 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
                 let x = rho / max_rho;
                 let w = (x * x) / sum;
                 if (w > 0.0) {
-                    look = look + w * ramp_eval(l.ramp, wave_m(world, n, e));
+                    let wm = wave_m(world, n, e);
+                    if (is_mtoon) {
+                        look = look + w * mtoon_wave(m.mtoon, mp, wm, l.color.xyz);
+                    } else {
+                        look = look + w * ramp_eval(l.ramp, wm);
+                    }
                 }
             }
             c = c + m.wave_blend * (look - c);
@@ -226,17 +380,19 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
         c = vec3<f32>(energy_saturate(c.x + glow.x), energy_saturate(c.y + glow.y), energy_saturate(c.z + glow.z));
     }
     if (USE_TEXTURES && m.feature_texture.offset != 0u) {
-        c = c * sample_texture(m.feature_texture, uv).xyz;
+        c = c * sample_texture(m.feature_texture, tuv).xyz;
     }
     return c;
 }
 
 // Twin of hadou_cpu::shading::area_term: what the `[area_light]` adds to a visible point where it
 // is fully visible (the soft shadow's visibility scales it): with l̂ the unit vector from the point
-// to the light centre and m = N·l̂, diffuse A·E·max(0, m), toon A·E·ramp(m), unlit nothing; then
-// the feature texture. E = frame.area_color (colour times intensity).
+// to the light centre and m = N·l̂, diffuse A·E·max(0, m), toon A·E·ramp(m), MToon
+// mix(shade, A, step(m + shift))·E, unlit nothing; then the feature texture. E = frame.area_color
+// (colour times intensity).
 fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f32>, vcolor: vec4<f32>) -> vec3<f32> {
-    if (m.model != MODEL_DIFFUSE && m.model != MODEL_TOON) {
+    let is_mtoon = USE_MTOON && m.mtoon != 0u;
+    if (!is_mtoon && m.model != MODEL_DIFFUSE && m.model != MODEL_TOON) {
         return vec3<f32>(0.0);
     }
     let len = length3(normal_in);
@@ -251,6 +407,16 @@ fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f3
         dir = to_light / dl;
     }
     let mdot = dot3(n, dir);
+    if (is_mtoon) {
+        let p = mtoon_point(m, uv, vcolor);
+        let k = mtoon_wave(m.mtoon, p, mdot, frame.area_color);
+        var f = vec3<f32>(1.0);
+        if (m.feature_texture.offset != 0u) {
+            f = sample_texture(m.feature_texture, p.uv).xyz;
+        }
+        let t = k * f;
+        return vec3<f32>(energy_saturate(t.x), energy_saturate(t.y), energy_saturate(t.z));
+    }
     var k = vec3<f32>(max(mdot, 0.0));
     if (USE_TOON && m.model == MODEL_TOON) {
         k = ramp_eval(m.ramp, mdot);

@@ -24,4 +24,6 @@ pub use soft::{
 };
 pub use table::{rows_json, Align, Cell, Column, Report, Row, Table};
 pub use timing::{median, median_ms, output_ms, time_cpu, Timer, Timing};
-pub use toon::{plain_materials, toon_table, GLARE_SCENE, SHADOW_SCENE, TOON_SCENE};
+pub use toon::{
+    plain_materials, toon_table, without_mtoon, GLARE_SCENE, MTOON_SCENE, SHADOW_SCENE, TOON_SCENE,
+};

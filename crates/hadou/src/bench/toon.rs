@@ -1,6 +1,7 @@
 //! The toon table: the toon scene full and reduced to plain diffuse, the toon scene at 4 samples
-//! per pixel and at 1 (anti-aliasing), the shadow scene with and without its shadows, and the
-//! glare scene with and without its `[bloom]`, at each size in one run (every other row at one
+//! per pixel and at 1 (anti-aliasing), the shadow scene with and without its shadows, the
+//! glare scene with and without its `[bloom]`, and the MToon scene with its MToon look and with the
+//! two-band toon ramps that approximate it, at each size in one run (every other row at one
 //! sample per pixel).
 
 use super::table::{Cell, Column, Report, Row, Table};
@@ -66,6 +67,23 @@ muzzle_alpha = 0.03
 /// The scene time of the animated row's frame.
 pub const ANIMATED_TIME: f32 = 0.7;
 
+/// The scene and time whose MToon materials `hadou bench toon` times against their two-band toon
+/// approximation: three MToon spheres (step, rim, matcap, five textures, UV animation) lit by a
+/// wave, over a diffuse floor.
+pub const MTOON_SCENE: (&str, f32) = ("light-mtoon.toml", 1.5);
+
+/// `frame` with every MToon material drawn by its two-band toon ramp instead (`Material::mtoon`
+/// removed).
+pub fn without_mtoon(frame: &Frame) -> Frame {
+    let mut f = frame.clone();
+    for o in &mut f.objects {
+        for m in &mut o.materials {
+            m.mtoon = None;
+        }
+    }
+    f
+}
+
 /// `frame` with every material reduced to plain diffuse shading of its base colour.
 pub fn plain_materials(frame: &Frame) -> Frame {
     let mut f = frame.clone();
@@ -84,7 +102,8 @@ pub fn plain_materials(frame: &Frame) -> Frame {
 /// `plain` (every material diffuse, no wave light, no outlines, no textures: the opaque pass hadou
 /// had before materials) and `4-samples` against `1-sample` (anti-aliasing), then [`SHADOW_SCENE`] at each size, `shadows` (as written) and
 /// `no-shadows` (its `[[shadow]]`s removed), then [`GLARE_SCENE`] at each size, `bloom` (as
-/// written) and `no-bloom` (its `[bloom]` removed), in one run. Its text pairs the two variants of each
+/// written) and `no-bloom` (its `[bloom]` removed), then [`MTOON_SCENE`] at each size, `mtoon` and
+/// `toon-ramp` ([`without_mtoon`]), in one run. Its text pairs the two variants of each
 /// size with their ratio; its JSON `rows` are `{scene, size, variant, ms, fps}`.
 pub fn toon_table(
     time: &mut Timer<'_>,
@@ -155,6 +174,17 @@ pub fn toon_table(
         frame.samples = 1;
         let bare = Frame { bloom: None, ..frame.clone() };
         glare.push(pair(glare_file, size, [("bloom", &frame), ("no-bloom", &bare)])?);
+    }
+    let (mtoon_file, mt) = MTOON_SCENE;
+    let mtoon_scene = Scene::load(scenes.join(mtoon_file)).map_err(|e| RenderError::Other(e.to_string()))?;
+    let mut mtoon = Vec::new();
+    for &size in sizes {
+        let mut frame = mtoon_scene.at(mt);
+        frame.width = size;
+        frame.height = size;
+        frame.samples = 1;
+        let ramp = without_mtoon(&frame);
+        mtoon.push(pair(mtoon_file, size, [("mtoon", &frame), ("toon-ramp", &ramp)])?);
     }
     // The animated character: the frame at one sample, and the posing (the whole `Scene::at` of
     // a new clip time each iteration, so no pose is reused) against it.
@@ -245,6 +275,14 @@ pub fn toon_table(
             title: format!("\nglare scene {glare_file}\n"),
             columns: columns("bloom ms", "fps", "no-bloom ms"),
             rows: glare,
+        });
+    }
+    if !mtoon.is_empty() {
+        tables.push(Table {
+            key: None,
+            title: format!("\nMToon scene {mtoon_file}\n"),
+            columns: columns("MToon ms", "fps", "toon ramp ms"),
+            rows: mtoon,
         });
     }
     Ok(Report {
