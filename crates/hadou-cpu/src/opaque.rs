@@ -256,8 +256,12 @@ fn project_all(frame: &Frame, basis: &CameraBasis) -> Tris {
                 // The unit outline direction `U` of 000 §2.3, which the hull and the edge pass
                 // read.
                 let dir = mesh.outline_normals.get(i).or(mesh.normals.get(i)).copied().unwrap_or([0.0; 3]);
+                // Its length is the vertex's outline width multiplier (MToon's width texture,
+                // `hadou_scene::mesh::outline_scale`), 1 for most meshes.
                 let outline = if outlined {
-                    nm.transform_vector(Vec3::from_array(dir)).normalize_or(Vec3f::ZERO)
+                    let scale = Vec3::from_array(dir).length();
+                    let scale = if scale.is_finite() { scale.min(1.0) } else { 0.0 };
+                    nm.transform_vector(Vec3::from_array(dir)).normalize_or(Vec3f::ZERO) * scale
                 } else {
                     Vec3f::ZERO
                 };

@@ -81,15 +81,18 @@ fn rgb(c: [f32; 4]) -> [f32; 3] {
 /// The [`MtoonPoint`] of `s` at scene time `time` (MToon "UV Animation": the mask channel scales
 /// `scroll·time` and `rotation·time`; `hadou_math::mtoon::uv_animation`).
 fn mtoon_point(m: &Material, t: &Mtoon, s: &Surface, time: f32) -> MtoonPoint {
+    let channel = usize::from(t.uv_mask_channel.min(3));
     let mask =
-        t.uv_mask_texture.as_ref().map_or(1.0, |x| x.sample(s.uv)[usize::from(t.uv_mask_channel.min(3))]);
+        t.uv_mask_texture.as_ref().map_or(1.0, |x| mtoon::data_texel(x.sample(s.uv)[channel], channel));
     let uv =
         mtoon::uv_animation(s.uv, mask, [t.uv_scroll[0] * time, t.uv_scroll[1] * time], t.uv_rotation * time);
     let albedo = albedo(m, &Surface { uv, ..*s });
     let st = t.shade_texture.as_ref().map_or([1.0; 4], |x| x.sample(uv));
     let shade = std::array::from_fn(|k| t.shade_color[k] * st[k]);
-    let shift =
-        t.shading_shift + t.shift_texture.as_ref().map_or(0.0, |x| x.sample(uv)[0] * t.shift_texture_scale);
+    let shift = t.shading_shift
+        + t.shift_texture
+            .as_ref()
+            .map_or(0.0, |x| mtoon::data_texel(x.sample(uv)[0], 0) * t.shift_texture_scale);
     MtoonPoint { uv, albedo, shade, shift }
 }
 

@@ -82,6 +82,17 @@ pub fn uv_animation(uv: [f32; 2], mask: f32, scroll: [f32; 2], turn: f32) -> [f3
     [c * u - s * v + 0.5 + scroll[0] * mask, s * u + c * v + 0.5 + scroll[1] * mask]
 }
 
+/// A texel of one of MToon's data textures (shading shift, outline width, UV animation mask: linear
+/// values, not colours, in VRMC_materials_mtoon) from the linear colour hadou's texture decoding
+/// gives: the sRGB transfer undone (IEC 61966-2-1), so the texture's stored value comes back. An
+/// alpha channel (`channel` 3) is stored linear already.
+pub fn data_texel(linear: f32, channel: usize) -> f32 {
+    if channel >= 3 {
+        return if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) };
+    }
+    crate::shade::linear_to_srgb(linear)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -414,8 +414,9 @@ pub struct Mtoon {
     /// material's [`Material::outline`] on with this width and `outline_color`; the backends draw
     /// it through [`Material::hull_push`], [`Material::hull_pixels`] and [`Material::outline_rgb`].
     pub outline_width: f32,
-    /// `outlineWidthMultiplyTexture` (its green channel multiplies the width in MToon; read, not
-    /// drawn: the outline is `outline_width` wide everywhere).
+    /// `outlineWidthMultiplyTexture`: its green channel at a vertex multiplies the outline width
+    /// there (baked into the length of the mesh's outline directions by
+    /// [`crate::mesh::with_outline_normals`]; the hull and the edge pass use that length).
     pub outline_width_texture: Option<TextureRef>,
     /// `outlineColorFactor`.
     pub outline_color: [f32; 3],

@@ -218,12 +218,6 @@ pub(crate) fn load_materials(
             m.emissive_texture = emissive_t;
             if m.outline_mode != crate::frame::OutlineWidthMode::None && m.outline_width > 0.0 {
                 mat.outline = Some(crate::frame::Outline { width: m.outline_width, color: m.outline_color });
-                if m.outline_width_texture.is_some() {
-                    warnings.push(format!(
-                        "material `{name}` ({what}): its MToon outlineWidthMultiplyTexture is ignored (the \
-                         outline is outlineWidthFactor wide everywhere)"
-                    ));
-                }
             }
             mat.mtoon = Some(Arc::new(m));
         }

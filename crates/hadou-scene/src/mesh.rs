@@ -177,23 +177,51 @@ pub fn append_mesh(mesh: &mut Mesh, other: &Mesh) {
 /// `mesh` with [`Mesh::outline_normals`] filled: for every group of vertices at exactly the same
 /// position, the normalised sum of their normals (so the hard edges of a box, whose corners carry
 /// three face normals, get one shared direction and the pushed-out hull stays closed). A group
-/// whose normals cancel keeps each vertex's own normal.
+/// whose normals cancel keeps each vertex's own normal. Where a vertex's material is MToon with an
+/// `outlineWidthMultiplyTexture`, the direction is scaled by that texture's green channel at the
+/// vertex's texture coordinates ([`outline_scale`]): backends push the hull by the direction's
+/// length times the outline width.
 pub fn with_outline_normals(mut mesh: Mesh) -> Mesh {
     let mut groups: std::collections::HashMap<[u32; 3], Vec3f> = std::collections::HashMap::new();
     let key = |p: &[f32; 3]| p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
     for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
         *groups.entry(key(p)).or_insert(Vec3f::ZERO) += Vec3f::from_array(*n);
     }
-    mesh.outline_normals = mesh
+    let outline_normals = mesh
         .positions
         .iter()
         .zip(&mesh.normals)
-        .map(|(p, n)| {
+        .enumerate()
+        .map(|(i, (p, n))| {
             let own = Vec3f::from_array(*n);
-            groups[&key(p)].try_normalize().unwrap_or(own).to_array()
+            (groups[&key(p)].try_normalize().unwrap_or(own) * outline_scale(&mesh, i)).to_array()
         })
         .collect();
+    mesh.outline_normals = outline_normals;
     mesh
+}
+
+/// The multiplier of vertex `v`'s outline width: the green channel of its MToon material's
+/// `outlineWidthMultiplyTexture` at its texture coordinates, as stored (a data texture:
+/// `hadou_math::mtoon::data_texel`), clamped to [0, 1]; else 1.
+pub fn outline_scale(mesh: &Mesh, v: usize) -> f32 {
+    let slot = mesh.material_of(v) as usize;
+    let texture = mesh
+        .materials
+        .get(slot)
+        .and_then(|m| m.mtoon.as_ref())
+        .and_then(|m| m.outline_width_texture.as_ref());
+    match (texture, mesh.uvs.get(v)) {
+        (Some(t), Some(uv)) => {
+            let g = hadou_math::mtoon::data_texel(t.sample(*uv)[1], 1);
+            if g.is_finite() {
+                g.clamp(0.0, 1.0)
+            } else {
+                1.0
+            }
+        }
+        _ => 1.0,
+    }
 }
 
 #[cfg(test)]

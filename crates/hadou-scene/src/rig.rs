@@ -336,10 +336,15 @@ impl Rig {
             for (g, n) in self.groups.iter().zip(&normals) {
                 sums[*g as usize] += Vec3f::from_array(*n);
             }
+            // Each rest outline direction's length is its width multiplier (`mesh::outline_scale`).
             self.groups
                 .iter()
                 .zip(&normals)
-                .map(|(g, n)| sums[*g as usize].try_normalize().unwrap_or(Vec3f::from_array(*n)).to_array())
+                .zip(&base.outline_normals)
+                .map(|((g, n), rest)| {
+                    let scale = Vec3f::from_array(*rest).length();
+                    (sums[*g as usize].try_normalize().unwrap_or(Vec3f::from_array(*n)) * scale).to_array()
+                })
                 .collect()
         };
         Mesh {

@@ -109,11 +109,9 @@ fn vrm1_mtoon_reads_every_field() {
     assert_eq!(mat.model, hadou_scene::ShadingModel::Toon);
     assert!((mat.ramp.stops[1].0 - 0.25).abs() < 1e-6, "{:?}", mat.ramp);
     // The MToon outline turns the material's outline on, in MToon's units (a fraction of the
-    // image height here); its width texture is not drawn, and a warning says so; nothing else
-    // warns.
+    // image height here), its width texture scaling it per vertex; nothing warns.
     assert_eq!(mat.outline, Some(hadou_scene::Outline { width: 0.004, color: [0.1, 0.0, 0.2] }));
-    assert_eq!(warn.len(), 1, "{warn:?}");
-    assert!(warn[0].contains("`skin`") && warn[0].contains("outlineWidthMultiplyTexture"), "{warn:?}");
+    assert!(warn.is_empty(), "{warn:?}");
     // Screen mode: 0.004 of the height, at any depth (2·tan(fov/2)·w·|z| along the normal).
     assert!((mat.hull_pixels(7.0, 0.5, 1000) - 4.0).abs() < 1e-4);
     assert!((mat.hull_push(3.0, 0.5) - 0.012).abs() < 1e-7);
@@ -274,4 +272,30 @@ fn a_scene_names_the_bad_vrm_material_where_its_path_is() {
         "{msg}"
     );
     std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn the_outline_width_texture_scales_each_vertex_outline() {
+    // MToon's outlineWidthMultiplyTexture (linear data): green 80/255 everywhere; the outline
+    // directions come out that long (the hull's width multiplier), a plain material's unit long.
+    let mtoon = json!({"specVersion": "1.0", "outlineWidthMode": "worldCoordinates", "outlineWidthFactor": 0.01,
+                       "outlineWidthMultiplyTexture": {"index": 1}});
+    let bytes = file(
+        json!([{"name": "skin", "extensions": {"VRMC_materials_mtoon": mtoon}}]),
+        json!({}),
+        &["VRMC_materials_mtoon"],
+    );
+    let (mesh, warn) = load(&bytes);
+    assert!(warn.is_empty(), "{warn:?}");
+    let mesh = hadou_scene::mesh::with_outline_normals(mesh);
+    for n in &mesh.outline_normals {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!((len - 80.0 / 255.0).abs() < 2e-3, "{len}");
+    }
+    let plain = file(json!([{"name": "plain"}]), json!({}), &[]);
+    let mesh = hadou_scene::mesh::with_outline_normals(load(&plain).0);
+    for n in &mesh.outline_normals {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!((len - 1.0).abs() < 1e-6, "{len}");
+    }
 }

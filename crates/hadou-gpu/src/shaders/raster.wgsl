@@ -47,13 +47,15 @@ fn project(world: vec3<f32>) -> vec4<f32> {
     return clip_position(frame, world);
 }
 
-// The unit world outline direction of a vertex (zero for a zero or non-finite one), as the hull
-// pushes it (hadou-cpu opaque::project_all).
+// The world outline direction of a vertex, as the hull pushes it (hadou-cpu opaque::project_all):
+// unit, times the object-space direction's length (the vertex's outline width multiplier, MToon's
+// width texture, at most 1); zero for a zero or non-finite one.
 fn outline_dir(o: GpuObject, outline_normal: vec3<f32>) -> vec3<f32> {
     let n = (o.normal_matrix * vec4<f32>(outline_normal, 0.0)).xyz;
     let len = length3(n);
-    if (len > 0.0 && len < 3.0e38) {
-        return n / len;
+    let scale = min(length3(outline_normal), 1.0);
+    if (len > 0.0 && len < 3.0e38 && scale < 3.0e38) {
+        return n / len * scale;
     }
     return vec3<f32>(0.0);
 }

@@ -184,6 +184,21 @@ fn mtoon_texture(o: u32, k: u32) -> GpuTexture {
     return GpuTexture(shading_data[w], shading_data[w + 1u], shading_data[w + 2u], shading_data[w + 3u]);
 }
 
+// Mirrors hadou_math::mtoon::data_texel: a data texture's stored value from the decoded colour.
+fn mtoon_data(linear: f32, channel: u32) -> f32 {
+    var v = clamp(linear, 0.0, 1.0);
+    if (linear != linear) {
+        v = 0.0;
+    }
+    if (channel >= 3u) {
+        return v;
+    }
+    if (v <= 0.0031308) {
+        return 12.92 * v;
+    }
+    return 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+}
+
 // Mirrors hadou_math::mtoon::linearstep.
 fn mtoon_linearstep(a: f32, b: f32, t: f32) -> f32 {
     if (b > a) {
@@ -264,7 +279,8 @@ fn mtoon_point(m: GpuMaterial, uv_in: vec2<f32>, vcolor: vec4<f32>) -> MtoonPoin
     var mask = 1.0;
     let mask_t = mtoon_texture(o, 4u);
     if (mask_t.offset != 0u) {
-        mask = sample_texture(mask_t, uv_in)[min(shading_data[o + 21u], 3u)];
+        let channel = min(shading_data[o + 21u], 3u);
+        mask = mtoon_data(sample_texture(mask_t, uv_in)[channel], channel);
     }
     let uv = mtoon_uv(uv_in, mask, vec2<f32>(mtoon_f32(o + 18u), mtoon_f32(o + 19u)), mtoon_f32(o + 20u));
     var p: MtoonPoint;
@@ -274,7 +290,7 @@ fn mtoon_point(m: GpuMaterial, uv_in: vec2<f32>, vcolor: vec4<f32>) -> MtoonPoin
     p.shift = mtoon_f32(o + 16u);
     let shift_t = mtoon_texture(o, 1u);
     if (shift_t.offset != 0u) {
-        p.shift = p.shift + sample_texture(shift_t, uv).x * mtoon_f32(o + 17u);
+        p.shift = p.shift + mtoon_data(sample_texture(shift_t, uv).x, 0u) * mtoon_f32(o + 17u);
     }
     return p;
 }
