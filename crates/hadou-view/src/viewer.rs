@@ -206,15 +206,50 @@ impl Viewer {
         self.doc.scene().at(self.timeline.time)
     }
 
-    /// The scene's duration with a floor of one second, for the scrub bar.
+    /// How long the timeline runs: the scene's tracks, or longer while an object's clip (played
+    /// on the scene's clock) has not run through once ([`Scene::clips_end`]).
+    pub fn duration(&self) -> f32 {
+        self.scene().duration().max(self.scene().clips_end())
+    }
+
+    /// [`Viewer::duration`] with a floor of one second, for the scrub bar.
     pub fn scrub_end(&self) -> f32 {
-        self.scene().duration().max(1.0)
+        self.duration().max(1.0)
     }
 
     /// Advances the clock by `dt` seconds of wall time.
     pub fn tick(&mut self, dt: f32) {
-        let d = self.scene().duration();
+        let d = self.duration();
         self.timeline.advance(dt, d);
+    }
+
+    /// The clip choices of each object whose glTF file has clips: `(object, clips with their
+    /// lengths in seconds, the clip it plays)`, in file order.
+    pub fn clip_objects(&self) -> Vec<(String, Vec<(String, f32)>, Option<String>)> {
+        let scene = self.scene();
+        let names = scene.object_names();
+        scene
+            .object_clips()
+            .into_iter()
+            .enumerate()
+            .filter(|(_, clips)| !clips.is_empty())
+            .map(|(i, clips)| {
+                let playing = scene.object_clip_at(i, self.timeline.time).map(|c| c.0);
+                (names.get(i).map_or_else(String::new, |n| n.to_string()), clips, playing)
+            })
+            .collect()
+    }
+
+    /// The clip object `object` plays and its clip time at the current time, if it plays one.
+    pub fn clip_now(&self, object: &str) -> Option<(String, f32)> {
+        let i = self.scene().object_names().iter().position(|n| *n == object)?;
+        self.scene().object_clip_at(i, self.timeline.time)
+    }
+
+    /// Makes `object` play `clip` (its `animation` key), or rest (`None`: [`Edit::Clip`]); one
+    /// undo step. A clip its file lacks is refused with the loader's list of its clips.
+    pub fn choose_clip(&mut self, object: &str, clip: Option<&str>) -> bool {
+        self.apply(Edit::Clip { object: object.to_string(), clip: clip.map(str::to_string) })
     }
 
     /// Shows `m` in the status line.
