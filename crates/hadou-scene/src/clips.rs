@@ -13,8 +13,8 @@ impl Scene {
         let vals = self.values_at(self.duration());
         let mut end = 0.0f32;
         for o in &self.objects {
-            let (Some(motion), Some(rig)) = (&o.motion, &o.rig) else { continue };
-            let Some(clip) = motion.clip.and_then(|c| rig.clips().get(c)) else { continue };
+            let Some(motion) = &o.motion else { continue };
+            let Some(clip) = motion.clip.as_deref() else { continue };
             let p = &o.params;
             let pinned = motion.pinned
                 || p.find("animation_time").is_some_and(|a| self.tracks.iter().any(|t| t.offset == a.offset));

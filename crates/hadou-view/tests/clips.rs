@@ -16,7 +16,9 @@ fn viewer(name: &str, keys: &str, extra: &str) -> (Viewer, PathBuf) {
     let d = std::env::temp_dir().join(format!("hadou-view-clips-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    std::fs::copy(brace_glb(), d.join("brace.glb")).unwrap();
+    for f in ["brace.glb", "brace.vrm", "brace.vrma"] {
+        std::fs::copy(brace_glb().with_file_name(f), d.join(f)).unwrap();
+    }
     let text = format!(
         "# the character\n[image]\nwidth = 64\nheight = 48\n\n[camera]\nposition = [0.0, 1.0, 5.0]\n\
          target = [0.0, 0.9, 0.0]\n\n[[object]]\nname = \"hero\"\nkind = \"gltf\"\npath = \"brace.glb\" # keep\n\
@@ -147,4 +149,20 @@ fn scripts_choose_clips_and_name_what_they_could_be() {
     let e = script::run(&mut v, &lines[4], &path).unwrap_err();
     assert!(e.contains("s.txt:5:6:") && e.contains("the objects are `hero`"), "{e}");
     assert!(!v.doc.text().contains("animation"));
+}
+
+#[test]
+fn the_rest_pose_also_stops_a_vrm_animation() {
+    let extra = "[[object]]\nname = \"avatar\"\nkind = \"gltf\"\npath = \"brace.vrm\"\n\
+                 animation_file = \"brace.vrma\"\nposition = [2.0, 0.0, 0.0]\n";
+    let (mut v, _d) = viewer("vrma", "", extra);
+    // Its file has no clips of its own: no chooser, but it plays the VRM Animation's clip.
+    assert_eq!(v.clip_objects().len(), 1);
+    assert_eq!(v.clip_now("avatar").map(|c| c.0), Some("brace".to_string()));
+    let at = |v: &Viewer, t: f32| v.scene().at(t).objects[1].mesh.positions.clone();
+    assert!(spread(&at(&v, 0.0), &at(&v, 1.0)) > 0.01);
+    assert!(v.choose_clip("avatar", None), "{:?}", v.message);
+    assert!(!v.doc.text().contains("animation_file"), "{}", v.doc.text());
+    assert_eq!(v.clip_now("avatar"), None);
+    assert_eq!(spread(&at(&v, 0.0), &at(&v, 1.0)), 0.0);
 }

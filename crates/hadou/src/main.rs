@@ -751,26 +751,29 @@ fn load_scene(path: &std::path::Path) -> Result<Scene, Failure> {
     Ok(scene)
 }
 
-/// One line per object whose glTF file has animation clips or VRM expressions, for `validate`:
-/// `object "hero": clips brace (2 s), step (1.5 s); plays "brace"; expressions blink, aa`.
+/// One line per glTF object with animation clips, a clip it plays or VRM expressions, for
+/// `validate`: `object "hero": clips brace (2 s), step (1.5 s); plays "brace"; expressions blink`
+/// (`rests` when its file has clips and it plays none; the clip played may come from its
+/// `animation_file`).
 fn clip_summary(scene: &Scene) -> Vec<String> {
     let esc = hadou::escape_controls;
     let (clips, expressions) = (scene.object_clips(), scene.object_expressions());
     let mut out = Vec::new();
     for (i, name) in scene.object_names().into_iter().enumerate() {
-        let (c, e) =
-            (clips.get(i).map_or(&[][..], Vec::as_slice), expressions.get(i).map_or(&[][..], Vec::as_slice));
+        let c = clips.get(i).map_or(&[][..], Vec::as_slice);
+        let e = expressions.get(i).map_or(&[][..], Vec::as_slice);
         let mut parts = Vec::new();
         if !c.is_empty() {
             let list: Vec<String> = c.iter().map(|(n, d)| format!("{} ({d} s)", esc(n))).collect();
             parts.push(format!("clips {}", list.join(", ")));
-            parts.push(match scene.object_clip_at(i, 0.0) {
-                Some((clip, _)) => format!("plays \"{}\"", esc(&clip)),
-                None => "rests".to_string(),
-            });
+        }
+        match scene.object_clip_at(i, 0.0) {
+            Some((clip, _)) => parts.push(format!("plays \"{}\"", esc(&clip))),
+            None if !c.is_empty() => parts.push("rests".to_string()),
+            None => {}
         }
         if !e.is_empty() {
-            let list: Vec<String> = e.iter().map(|n| esc(n)).collect();
+            let list: Vec<String> = e.iter().map(|n| esc(n).into_owned()).collect();
             parts.push(format!("expressions {}", list.join(", ")));
         }
         if !parts.is_empty() {
