@@ -19,7 +19,7 @@ impl Scene {
             let pinned = motion.pinned
                 || p.find("animation_time").is_some_and(|a| self.tracks.iter().any(|t| t.offset == a.offset));
             let speed = p.f(&vals, "animation_speed").abs();
-            if pinned || !(speed > 0.0) {
+            if pinned || speed.is_nan() || speed == 0.0 {
                 continue;
             }
             let e = p.f(&vals, "animation_start").max(0.0) + clip.duration / speed;
