@@ -33,7 +33,6 @@ mod area_light_def;
 mod backend;
 mod bloom_def;
 mod bounds;
-mod clips;
 mod error;
 mod files;
 mod frame;

@@ -149,7 +149,7 @@ fn top_bar(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
             .on_hover_text("a .gif file, or a directory ending in / for a PNG sequence");
         let fps = v.export_fps;
         if st.export_frames.is_empty() {
-            let n = (v.duration() * fps).ceil().max(1.0) as u32 + 1;
+            let n = (v.scene().duration() * fps).ceil().max(1.0) as u32 + 1;
             st.export_frames = format!("0..{n}");
         }
         ui.add(egui::TextEdit::singleline(&mut st.export_frames).desired_width(60.0))

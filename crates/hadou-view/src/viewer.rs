@@ -206,20 +206,15 @@ impl Viewer {
         self.doc.scene().at(self.timeline.time)
     }
 
-    /// How long the timeline runs: the scene's tracks, or longer while an object's clip (played
-    /// on the scene's clock) has not run through once ([`Scene::clips_end`]).
-    pub fn duration(&self) -> f32 {
-        self.scene().duration().max(self.scene().clips_end())
-    }
-
-    /// [`Viewer::duration`] with a floor of one second, for the scrub bar.
+    /// The scene's duration (its tracks, and the clips its objects play once) with a floor of
+    /// one second, for the scrub bar.
     pub fn scrub_end(&self) -> f32 {
-        self.duration().max(1.0)
+        self.scene().duration().max(1.0)
     }
 
     /// Advances the clock by `dt` seconds of wall time.
     pub fn tick(&mut self, dt: f32) {
-        let d = self.duration();
+        let d = self.scene().duration();
         self.timeline.advance(dt, d);
     }
 

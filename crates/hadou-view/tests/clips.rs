@@ -51,7 +51,7 @@ fn the_chooser_lists_the_files_clips_and_the_rest_pose_until_one_is_chosen() {
     assert_eq!(v.clip_now("hero"), None);
     // At rest the timeline does not move the character.
     assert_eq!(spread(&positions(&v, 0.5), &positions(&v, 1.5)), 0.0);
-    assert_eq!(v.duration(), 0.0);
+    assert_eq!(v.scene().duration(), 0.0);
 }
 
 #[test]
@@ -66,7 +66,7 @@ fn choosing_a_clip_writes_animation_and_the_timeline_plays_it() {
     // The clip follows scene time: the mesh differs between two times, and the scrub bar and
     // playback run for the clip's 2 s although the scene has no tracks.
     assert!(spread(&positions(&v, 0.5), &positions(&v, 1.0)) > 0.01);
-    assert_eq!(v.duration(), 2.0);
+    assert_eq!(v.scene().duration(), 2.0);
     assert_eq!(v.scrub_end(), 2.0);
     v.timeline.playing = true;
     v.tick(0.75);
@@ -101,7 +101,7 @@ fn the_rest_pose_removes_the_clip_and_the_keys_that_time_it() {
                  [[track]]\ntarget = \"object.hero.position\"\nkeys = [[0.0, [0.0, 0.0, 0.0]], [1.0, [1.0, 0.0, 0.0]]]\n";
     let (mut v, _d) = viewer("rest", keys, extra);
     // The clip ends at start + length / speed (speed at the end of the tracks: 1).
-    assert_eq!(v.duration(), 3.0);
+    assert_eq!(v.scene().duration(), 3.0);
     assert!(spread(&positions(&v, 1.0), &positions(&v, 1.5)) > 0.01);
     // Removing only `animation` would leave keys the loader refuses without it.
     assert!(!v.apply(Edit::Raw {
@@ -117,13 +117,13 @@ fn the_rest_pose_removes_the_clip_and_the_keys_that_time_it() {
     assert_eq!(v.clip_objects()[0].2, None);
     // Now only the position track moves it: the same pose at two times once it has arrived.
     assert_eq!(spread(&positions(&v, 1.0), &positions(&v, 1.5)), 0.0);
-    assert_eq!(v.duration(), 1.0);
+    assert_eq!(v.scene().duration(), 1.0);
 }
 
 #[test]
 fn a_pinned_clip_time_does_not_lengthen_the_timeline() {
     let (v, _d) = viewer("pinned", "animation = \"brace\"\nanimation_time = 0.5\n", "");
-    assert_eq!(v.duration(), 0.0);
+    assert_eq!(v.scene().duration(), 0.0);
     assert_eq!(v.clip_now("hero"), Some(("brace".to_string(), 0.5)));
 }
 
