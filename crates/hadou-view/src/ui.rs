@@ -408,7 +408,8 @@ fn entity_actions(ui: &mut egui::Ui, v: &mut Viewer, e: &Entity) {
 /// The clip an object whose glTF file has clips plays: "rest pose" or one of its clips (the
 /// `animation` key, so the clip follows the timeline), with the clip time now.
 fn clip_chooser(ui: &mut egui::Ui, v: &mut Viewer, object: &str) {
-    let Some((_, clips, playing)) = v.clip_objects().into_iter().find(|c| c.0 == object) else { return };
+    let Some(choice) = v.clip_objects().into_iter().find(|c| c.object == object) else { return };
+    let (clips, playing) = (choice.clips, choice.playing);
     ui.horizontal(|ui| {
         ui.label("clip");
         let mut chosen = playing.clone();

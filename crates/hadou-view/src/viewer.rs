@@ -141,6 +141,17 @@ pub enum HandleKind {
     Control(usize),
 }
 
+/// What the clip chooser offers for one glTF object whose file has clips.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipChoice {
+    /// The object's name.
+    pub object: String,
+    /// Its file's clips: name and length in seconds.
+    pub clips: Vec<(String, f32)>,
+    /// The clip it plays, if any.
+    pub playing: Option<String>,
+}
+
 /// The viewer's state.
 pub struct Viewer {
     /// The scene document.
@@ -218,9 +229,8 @@ impl Viewer {
         self.timeline.advance(dt, d);
     }
 
-    /// The clip choices of each object whose glTF file has clips: `(object, clips with their
-    /// lengths in seconds, the clip it plays)`, in file order.
-    pub fn clip_objects(&self) -> Vec<(String, Vec<(String, f32)>, Option<String>)> {
+    /// The clip choices of each object whose glTF file has clips, in file order.
+    pub fn clip_objects(&self) -> Vec<ClipChoice> {
         let scene = self.scene();
         let names = scene.object_names();
         scene
@@ -228,9 +238,10 @@ impl Viewer {
             .into_iter()
             .enumerate()
             .filter(|(_, clips)| !clips.is_empty())
-            .map(|(i, clips)| {
-                let playing = scene.object_clip_at(i, self.timeline.time).map(|c| c.0);
-                (names.get(i).map_or_else(String::new, |n| n.to_string()), clips, playing)
+            .map(|(i, clips)| ClipChoice {
+                object: names.get(i).map_or_else(String::new, |n| n.to_string()),
+                clips,
+                playing: scene.object_clip_at(i, self.timeline.time).map(|c| c.0),
             })
             .collect()
     }

@@ -42,7 +42,7 @@ fn the_chooser_lists_the_files_clips_and_the_rest_pose_until_one_is_chosen() {
     let (v, _d) = viewer("list", "", "");
     let objects = v.clip_objects();
     assert_eq!(objects.len(), 1);
-    let (name, clips, playing) = &objects[0];
+    let (name, clips, playing) = (&objects[0].object, &objects[0].clips, &objects[0].playing);
     assert_eq!(name, "hero");
     let names: Vec<&str> = clips.iter().map(|c| c.0.as_str()).collect();
     assert_eq!(names, ["brace", "step", "cubic", "blink"]);
@@ -62,7 +62,7 @@ fn choosing_a_clip_writes_animation_and_the_timeline_plays_it() {
     let text = v.doc.text().to_string();
     assert!(text.contains("animation = \"brace\"\n"), "{text}");
     assert!(text.contains("# the character") && text.contains("path = \"brace.glb\" # keep"), "{text}");
-    assert_eq!(v.clip_objects()[0].2.as_deref(), Some("brace"));
+    assert_eq!(v.clip_objects()[0].playing.as_deref(), Some("brace"));
     // The clip follows scene time: the mesh differs between two times, and the scrub bar and
     // playback run for the clip's 2 s although the scene has no tracks.
     assert!(spread(&positions(&v, 0.5), &positions(&v, 1.0)) > 0.01);
@@ -114,7 +114,7 @@ fn the_rest_pose_removes_the_clip_and_the_keys_that_time_it() {
     assert!(!text.contains("animation"), "{text}");
     assert!(text.contains("target = \"object.hero.position\""), "other tracks stay: {text}");
     assert_eq!(v.clip_now("hero"), None);
-    assert_eq!(v.clip_objects()[0].2, None);
+    assert_eq!(v.clip_objects()[0].playing, None);
     // Now only the position track moves it: the same pose at two times once it has arrived.
     assert_eq!(spread(&positions(&v, 1.0), &positions(&v, 1.5)), 0.0);
     assert_eq!(v.scene().duration(), 1.0);
