@@ -87,6 +87,17 @@ pub enum Edit {
         /// Its position.
         at: [f32; 3],
     },
+    /// Chooses the clip a `kind = "gltf"` object plays from its own file (its `animation` key):
+    /// `Some(clip)` writes it (and removes `animation_file`, whose clips it would name); `None` is
+    /// the rest pose: it removes `animation`, `animation_file` and the keys that only time a clip
+    /// (`animation_start`, `animation_speed`, `animation_loop`, `animation_time`) with their
+    /// tracks. `expressions` stay.
+    Clip {
+        /// The object's name.
+        object: String,
+        /// A clip of its glTF file, or `None` for the rest pose.
+        clip: Option<String>,
+    },
     /// Removes the named wave, its tracks and the shadows cast by it.
     RemoveWave(String),
     /// Removes the named object and its tracks.
@@ -683,12 +694,43 @@ fn edit_tree(doc: &mut DocumentMut, scene: &Scene, edit: &Edit) -> Result<(), Do
                 }
             }
         }
+        Edit::Clip { object, clip } => {
+            let table = entity_table(doc, &Entity::Object(object.clone()))?;
+            match clip {
+                Some(c) => {
+                    table.remove("animation_file");
+                    set_key(table, "animation", Value::from(c.as_str()));
+                }
+                None => {
+                    for key in CLIP_KEYS {
+                        table.remove(key);
+                    }
+                    let targets: Vec<String> =
+                        CLIP_KEYS[2..].iter().map(|k| format!("object.{object}.{k}")).collect();
+                    if let Some(Item::ArrayOfTables(tr)) = doc.get_mut("track") {
+                        tr.retain(|t| {
+                            !t.get("target")
+                                .and_then(Item::as_str)
+                                .is_some_and(|s| targets.iter().any(|x| x == s))
+                        });
+                        if tr.is_empty() {
+                            doc.remove("track");
+                        }
+                    }
+                }
+            }
+        }
         Edit::RemoveWave(name) => remove_entity(doc, "wave", name)?,
         Edit::RemoveObject(name) => remove_entity(doc, "object", name)?,
         Edit::Fire { wave, start, duration } => fire(doc, scene, wave, *start, *duration)?,
     }
     Ok(())
 }
+
+/// An object's `animation` and `animation_file` keys and the keys that only time its clip (see
+/// [`Edit::Clip`]).
+const CLIP_KEYS: [&str; 6] =
+    ["animation", "animation_file", "animation_start", "animation_speed", "animation_loop", "animation_time"];
 
 /// Moves the `[[name]]` tables to the end of the file (so an added table lands before them in
 /// the order the format documents: objects, waves, shadows, tracks).

@@ -3,7 +3,7 @@
 //! window frame; `wait N` lets `N` frames pass. The viewer exits after the last command (writing
 //! `--screenshot` first, if given). A command that fails stops the run with `file:line:col: …`
 //! ([`run`]); one that names a wave, object or parameter the scene does not have lists the names
-//! it could be.
+//! it could be (a clip the object's file lacks: its clips).
 //!
 //! | command | effect |
 //! |---|---|
@@ -18,6 +18,7 @@
 //! | `undo`, `redo` | |
 //! | `add wave KIND`, `add object KIND`, `remove wave NAME`, `remove object NAME` | |
 //! | `select WAVE`, `select none` | whose handles show |
+//! | `clip OBJECT CLIP`, `clip OBJECT` | the object plays its glTF clip `CLIP` on the scene's clock / rests (the clip chooser) |
 //! | `probe X Y` | probe the pixel `(X, Y)` of the image |
 //! | `backend cpu` / `backend gpu` | switch the renderer |
 //! | `resize W H` | resize the window (0 0 minimises it to nothing) |
@@ -65,6 +66,8 @@ pub enum Command {
     Remove(bool, String),
     /// `select WAVE` / `select none`.
     Select(Option<String>),
+    /// `clip OBJECT [CLIP]`.
+    Clip(String, Option<String>),
     /// `probe X Y`.
     Probe(u32, u32),
     /// `backend cpu|gpu`.
@@ -255,6 +258,10 @@ fn parse_command(name: &str, args: &[(usize, &str)], dir: &Path) -> Result<Comma
             count(1..=1, "a wave name or `none`")?;
             Command::Select((args[0].1 != "none").then(|| args[0].1.to_string()))
         }
+        "clip" => {
+            count(1..=2, "an object name and optionally one of its clips (none: the rest pose)")?;
+            Command::Clip(args[0].1.to_string(), args.get(1).map(|a| a.1.to_string()))
+        }
         "probe" => {
             count(2..=2, "pixel coordinates X Y")?;
             Command::Probe(int(0, 16383)?, int(1, 16383)?)
@@ -299,7 +306,7 @@ fn parse_command(name: &str, args: &[(usize, &str)], dir: &Path) -> Result<Comma
                 None,
                 format!(
                     "unknown command `{other}`; commands: wait, time, play, pause, loop, set, key, unkey, fire, \
-                     orbit, pan, zoom, undo, redo, add, remove, select, probe, backend, resize, save, screenshot, \
+                     orbit, pan, zoom, undo, redo, add, remove, select, clip, probe, backend, resize, save, screenshot, \
                      export, quit"
                 ),
             ))
@@ -323,7 +330,7 @@ pub enum WindowOp {
 /// Carries out one command on the viewer. Failures of edits are errors (a script that does not
 /// do what it says should not pass silently): `Err` has the message, prefixed by
 /// `file:line:col:`. A command naming a wave, object or parameter the scene does not have
-/// (`select`, `fire`, `set`, `key`, `unkey`, `remove`) fails before it does anything, at the
+/// (`select`, `fire`, `set`, `key`, `unkey`, `remove`, `clip`) fails before it does anything, at the
 /// name's column, listing the names it could be.
 pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, String> {
     viewer.message = None;
@@ -340,7 +347,7 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
         Command::Unkey(target) => viewer.check_target(target).and_then(|()| viewer.check_track(target)),
         Command::Fire(wave, _) | Command::Select(Some(wave)) => viewer.check_wave(wave),
         Command::Remove(true, name) => viewer.check_wave(name),
-        Command::Remove(false, name) => viewer.check_object(name),
+        Command::Remove(false, name) | Command::Clip(name, _) => viewer.check_object(name),
         _ => Ok(()),
     };
     if let Err(m) = named {
@@ -396,6 +403,7 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
             viewer.selected_wave = w.clone();
             true
         }
+        Command::Clip(object, clip) => viewer.choose_clip(object, clip.as_deref()),
         Command::Probe(x, y) => {
             viewer.requests.push(Request::Probe([*x, *y]));
             true
@@ -430,6 +438,8 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
         Ok(WindowOp::None)
     } else {
         let why = viewer.message.as_ref().map_or("it did nothing".to_string(), |m| m.0.clone());
-        Err(at(None, &why))
+        // A clip the object's file lacks: at the clip's name.
+        let k = matches!(line.command, Command::Clip(_, Some(_))).then_some(1);
+        Err(at(k, &why))
     }
 }

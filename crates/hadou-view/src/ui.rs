@@ -292,6 +292,9 @@ fn params(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
                         ui,
                         |ui| {
                             entity_actions(ui, v, e);
+                            if let Entity::Object(object) = e {
+                                clip_chooser(ui, v, object);
+                            }
                             param_rows(ui, v, &list);
                             other_keys(ui, v, st, e);
                         },
@@ -401,6 +404,36 @@ fn entity_actions(ui: &mut egui::Ui, v: &mut Viewer, e: &Entity) {
         _ => {}
     });
 }
+
+/// The clip an object whose glTF file has clips plays: "rest pose" or one of its clips (the
+/// `animation` key, so the clip follows the timeline), with the clip time now.
+fn clip_chooser(ui: &mut egui::Ui, v: &mut Viewer, object: &str) {
+    let Some(choice) = v.clip_objects().into_iter().find(|c| c.object == object) else { return };
+    let (clips, playing) = (choice.clips, choice.playing);
+    ui.horizontal(|ui| {
+        ui.label("clip");
+        let mut chosen = playing.clone();
+        egui::ComboBox::from_id_salt(("clip", object))
+            .selected_text(chosen.as_deref().unwrap_or(REST_POSE))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut chosen, None, REST_POSE);
+                for (name, length) in &clips {
+                    ui.selectable_value(&mut chosen, Some(name.clone()), format!("{name} ({length} s)"));
+                }
+            });
+        if chosen != playing {
+            v.choose_clip(object, chosen.as_deref());
+        }
+        if let Some((_, t)) = v.clip_now(object) {
+            let length = clips.iter().find(|c| Some(&c.0) == playing.as_ref()).map_or(0.0, |c| c.1);
+            ui.monospace(format!("{t:.3} s of {length} s"))
+                .on_hover_text("the clip's time at the timeline's time (animation_start, _speed, _loop)");
+        }
+    });
+}
+
+/// The chooser's entry for no clip.
+const REST_POSE: &str = "rest pose";
 
 fn add_menu(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState, wave: bool) {
     ui.horizontal(|ui| {

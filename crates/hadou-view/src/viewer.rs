@@ -141,6 +141,17 @@ pub enum HandleKind {
     Control(usize),
 }
 
+/// What the clip chooser offers for one glTF object whose file has clips.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipChoice {
+    /// The object's name.
+    pub object: String,
+    /// Its file's clips: name and length in seconds.
+    pub clips: Vec<(String, f32)>,
+    /// The clip it plays, if any.
+    pub playing: Option<String>,
+}
+
 /// The viewer's state.
 pub struct Viewer {
     /// The scene document.
@@ -206,7 +217,8 @@ impl Viewer {
         self.doc.scene().at(self.timeline.time)
     }
 
-    /// The scene's duration with a floor of one second, for the scrub bar.
+    /// The scene's duration (its tracks, and the clips its objects play once) with a floor of
+    /// one second, for the scrub bar.
     pub fn scrub_end(&self) -> f32 {
         self.scene().duration().max(1.0)
     }
@@ -215,6 +227,35 @@ impl Viewer {
     pub fn tick(&mut self, dt: f32) {
         let d = self.scene().duration();
         self.timeline.advance(dt, d);
+    }
+
+    /// The clip choices of each object whose glTF file has clips, in file order.
+    pub fn clip_objects(&self) -> Vec<ClipChoice> {
+        let scene = self.scene();
+        let names = scene.object_names();
+        scene
+            .object_clips()
+            .into_iter()
+            .enumerate()
+            .filter(|(_, clips)| !clips.is_empty())
+            .map(|(i, clips)| ClipChoice {
+                object: names.get(i).map_or_else(String::new, |n| n.to_string()),
+                clips,
+                playing: scene.object_clip_at(i, self.timeline.time).map(|c| c.0),
+            })
+            .collect()
+    }
+
+    /// The clip object `object` plays and its clip time at the current time, if it plays one.
+    pub fn clip_now(&self, object: &str) -> Option<(String, f32)> {
+        let i = self.scene().object_names().iter().position(|n| *n == object)?;
+        self.scene().object_clip_at(i, self.timeline.time)
+    }
+
+    /// Makes `object` play `clip` (its `animation` key), or rest (`None`: [`Edit::Clip`]); one
+    /// undo step. A clip its file lacks is refused with the loader's list of its clips.
+    pub fn choose_clip(&mut self, object: &str, clip: Option<&str>) -> bool {
+        self.apply(Edit::Clip { object: object.to_string(), clip: clip.map(str::to_string) })
     }
 
     /// Shows `m` in the status line.

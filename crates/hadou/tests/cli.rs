@@ -826,3 +826,31 @@ fn outputs_are_byte_identical_from_run_to_run() {
         assert!(bytes.windows(2).all(|w| w[0] == w[1]), "{ext}: the files differ between runs");
     }
 }
+
+#[test]
+fn validate_lists_the_clips_and_expressions_of_gltf_objects() {
+    let dir = tmpdir("validate-clips");
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets");
+    for f in ["brace.glb", "brace.vrm", "brace.vrma"] {
+        std::fs::copy(assets.join(f), dir.join(f)).unwrap();
+    }
+    let text = "[camera]\nposition = [0.0, 1.0, 6.0]\ntarget = [0.0, 0.9, 0.0]\n\n\
+                [[object]]\nname = \"hero\"\nkind = \"gltf\"\npath = \"brace.glb\"\nanimation = \"brace\"\n\n\
+                [[object]]\nname = \"idle\"\nkind = \"gltf\"\npath = \"brace.glb\"\nposition = [2.0, 0.0, 0.0]\n\n\
+                [[object]]\nname = \"avatar\"\nkind = \"gltf\"\npath = \"brace.vrm\"\nposition = [-2.0, 0.0, 0.0]\n\n\
+                [[object]]\nname = \"dancer\"\nkind = \"gltf\"\npath = \"brace.vrm\"\nanimation_file = \"brace.vrma\"\n\n\
+                [[object]]\nname = \"floor\"\nkind = \"plane\"\n";
+    let scene = write_scene(&dir, text);
+    let o = hadou(&["validate", scene.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let lines: Vec<&str> = out.lines().collect();
+    let clips = "clips brace (2 s), step (1.5 s), cubic (1.2 s), blink (1 s)";
+    assert_eq!(lines.len(), 4, "one line per glTF object with clips or expressions: {out}");
+    assert_eq!(lines[0], format!("object \"hero\": {clips}; plays \"brace\""));
+    assert_eq!(lines[1], format!("object \"idle\": {clips}; rests"));
+    assert!(lines[2].starts_with("object \"avatar\": expressions ") && lines[2].contains("blink"), "{out}");
+    // A VRM Animation clip is named as played; the avatar's file has no clips of its own.
+    assert!(lines[3].starts_with("object \"dancer\": plays \"brace\"; expressions "), "{out}");
+    assert!(!out.contains("floor"), "{out}");
+}
