@@ -8,7 +8,7 @@
 //! keys need (`keys × 3` for CUBICSPLINE, `× targets` for weights). The floats of all clips
 //! together count against [`MAX_ANIMATION_VALUES`].
 
-use crate::gltf_load::check_accessor;
+use crate::gltf_accessor::check_accessor;
 use crate::rig::{Channel, ChannelPath, Clip, RestLocal, RigNode};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::animation::{util::ReadOutputs, Interpolation, Property};

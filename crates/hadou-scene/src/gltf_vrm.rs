@@ -6,7 +6,7 @@
 //! its bind weights (0–100) to 0–1, and its binds' meshes to every node that instantiates that
 //! mesh. A broken extension (wrong types, indices out of range) is an error naming the JSON path.
 
-use crate::rig::{Expression, RigNode};
+use crate::rig::{Expression, RigNode, VrmVersion};
 use serde_json::Value;
 
 /// VRM 0.x blend-shape preset names and their VRM 1.0 expression names.
@@ -29,15 +29,6 @@ const PRESETS_0X: &[(&str, &str)] = &[
     ("lookright", "lookRight"),
     ("neutral", "neutral"),
 ];
-
-/// Which VRM a file is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum VrmVersion {
-    /// `VRMC_vrm` (VRM 1.0): the model faces +z.
-    V1,
-    /// The `VRM` extension (VRM 0.x): the model faces −z.
-    V0,
-}
 
 /// The file's VRM version, if it is a VRM.
 pub(crate) fn vrm_version(raw: &Value) -> Option<VrmVersion> {

@@ -36,6 +36,7 @@ mod bounds;
 mod error;
 mod files;
 mod frame;
+mod gltf_accessor;
 mod gltf_anim;
 mod gltf_load;
 mod gltf_material;
@@ -77,7 +78,6 @@ pub use gltf_load::{
     gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf, load_gltf_rig, MAX_MORPH_DELTAS,
     MAX_MORPH_TARGETS,
 };
-pub use gltf_vrm::VrmVersion;
 pub use gltf_vrma::load_vrma_clip;
 pub use image::Image;
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
@@ -85,7 +85,7 @@ pub use limits::{
     check_image_size, ALPHA_MAX, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES,
     MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
 };
-pub use rig::{clip_time, clip_wrap, Clip, Expression, PoseInput, Rig};
+pub use rig::{clip_time, clip_wrap, Clip, Expression, PoseInput, Rig, VrmVersion};
 pub use scene::Scene;
 pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,

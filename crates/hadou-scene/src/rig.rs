@@ -102,6 +102,15 @@ pub struct Clip {
     pub(crate) channels: Vec<Channel>,
 }
 
+/// Which VRM a file is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VrmVersion {
+    /// `VRMC_vrm` (VRM 1.0): the model faces +z.
+    V1,
+    /// The `VRM` extension (VRM 0.x): the model faces −z.
+    V0,
+}
+
 /// A VRM expression (blend shape group): morph-target binds `(node, target, weight)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expression {
@@ -123,7 +132,7 @@ pub struct Rig {
     /// A VRM's humanoid bones: `(bone name, node)`.
     pub(crate) humanoid: Vec<(String, usize)>,
     /// Which VRM the file is, if it is one.
-    pub(crate) vrm: Option<crate::gltf_vrm::VrmVersion>,
+    pub(crate) vrm: Option<VrmVersion>,
     /// The transform above the file's root nodes (a half turn about y for VRM 0.x, which faces −z).
     pub(crate) base: Mat4,
     /// Per vertex of the loaded mesh, the group of vertices at the same rest position (their
@@ -165,7 +174,7 @@ impl Rig {
     }
 
     /// Which VRM the file is, if it is one.
-    pub fn vrm(&self) -> Option<crate::gltf_vrm::VrmVersion> {
+    pub fn vrm(&self) -> Option<VrmVersion> {
         self.vrm
     }
 
