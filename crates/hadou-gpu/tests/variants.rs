@@ -96,7 +96,16 @@ fn same_as_uber(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
 #[test]
 fn specialised_variants_render_identically_to_the_uber_shader() {
     let Some(mut gpu) = gpu_or_skip("variants vs uber-shader") else { return };
-    let mixed = every_kind_frame(96, 72);
+    // Known cost (issue 28, speed): on llvmpipe OpenGL the uber-shader's first compile takes over
+    // ten minutes (its WGSL, translated to GLSL, holds every wave kind and the MToon look), so the
+    // comparison runs on the other adapters (lavapipe Vulkan in CI, 12 s); the variants themselves
+    // are held to the CPU on GL by the differential tests.
+    if gpu.adapter_info().backend == wgpu::Backend::Gl {
+        eprintln!("variants vs uber-shader: skipped on OpenGL (issue 28: the uber-shader's compile)");
+        return;
+    }
+    // Small: the uber-shader runs every kind's code per pixel, slowly on a software adapter.
+    let mixed = every_kind_frame(48, 36);
     same_as_uber(&mut gpu, "every kind", &mixed);
     for (i, w) in mixed.waves.iter().enumerate() {
         let mut alone = mixed.clone();
