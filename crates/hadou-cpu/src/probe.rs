@@ -30,6 +30,29 @@ pub struct Probe {
     pub soft: Option<f32>,
 }
 
+impl Probe {
+    /// The probe in one line, as the viewer's status shows it: each wave's energy and
+    /// evaluations, the colour, the depth and the object.
+    pub fn summary(&self) -> String {
+        let waves: Vec<String> = self
+            .waves
+            .iter()
+            .map(|w| format!("{} E={:.4} ({} evals)", w.name, w.energy, w.evaluations))
+            .collect();
+        format!(
+            "pixel ({}, {}): {} · rgb [{:.3}, {:.3}, {:.3}] · depth {:.3}{}",
+            self.x,
+            self.y,
+            if waves.is_empty() { "no waves".to_string() } else { waves.join(", ") },
+            self.color[0],
+            self.color[1],
+            self.color[2],
+            self.depth,
+            self.object.as_ref().map(|o| format!(" · object {o}")).unwrap_or_default()
+        )
+    }
+}
+
 /// One wave's contribution at a probed pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WaveProbe {

@@ -3,6 +3,9 @@
 //! colour mapping ([`crate::waves`]), timed pass by pass ([`PassTimes`]); [`CpuBackend`] keeps the
 //! opaque pass's buffers from frame to frame.
 
+#[cfg(not(target_arch = "wasm32"))]
+use std::time::Instant;
+// wasm32-unknown-unknown has no clock in std (`Instant::now` panics there); the page's clock.
 use crate::bloom;
 use crate::edges;
 use crate::opaque::{draw_opaque_into, OpaqueBuffers};
@@ -12,6 +15,8 @@ use crate::waves::{BatchLight, WavePass};
 use hadou_math::energy::lanes::LANES;
 use hadou_scene::{Backend, Frame, Image, RenderError};
 use rayon::prelude::*;
+#[cfg(target_arch = "wasm32")]
+use web_time::Instant;
 
 /// The CPU reference backend. It keeps the opaque pass's buffers between frames, so a frame
 /// drawn with [`CpuBackend::render_into`] into an image from an earlier frame allocates nothing
@@ -99,7 +104,7 @@ fn render_with(
     scratch: &mut OpaqueBuffers,
     img: &mut Image,
 ) -> PassTimes {
-    let start = std::time::Instant::now();
+    let start = Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
     let k = frame.grid() as usize;
@@ -116,7 +121,7 @@ fn render_with(
     let glare = frame.bloom.as_ref().filter(|_| y1 > y0);
     let src = glare.map_or(band.clone(), |b| bloom::source_rows(frame, b, band.clone()));
     let oy0 = opaque_pass(surfaces, &setup, k * src.start..k * src.end, scratch);
-    let opaque_done = std::time::Instant::now();
+    let opaque_done = Instant::now();
     let source = RowSource {
         k,
         opaque: scratch,
@@ -145,20 +150,20 @@ fn render_with(
         .zip(img.depth.par_chunks_mut(w))
         .enumerate()
         .for_each_init(RowBuffers::default, |bufs, (r, ((col, en), dep))| {
-            let t0 = std::time::Instant::now();
+            let t0 = Instant::now();
             let (light, scene) = source.light_row(y0 as usize + r, bufs);
-            let t1 = std::time::Instant::now();
+            let t1 = Instant::now();
             source.pass.row_color(light, scene, col, en, dep);
-            let t2 = std::time::Instant::now();
+            let t2 = Instant::now();
             let ns = |d: std::time::Duration| d.as_nanos() as u64;
             wave_ns.fetch_add(ns(t1 - t0), std::sync::atomic::Ordering::Relaxed);
             color_ns.fetch_add(ns(t2 - t1), std::sync::atomic::Ordering::Relaxed);
         });
-    let end = std::time::Instant::now();
+    let end = Instant::now();
     let (wn, cn) = (wave_ns.into_inner() as f64, color_ns.into_inner() as f64);
     let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };
     let waves_done = opaque_done + (end - opaque_done).mul_f64(wave_share);
-    let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
+    let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
     PassTimes {
         opaque_ms: ms(start, opaque_done),
         wave_ms: ms(opaque_done, waves_done),
@@ -289,7 +294,7 @@ fn glare_rows(
     src: std::ops::Range<usize>,
     band: std::ops::Range<usize>,
     img: &mut Image,
-    (start, opaque_done): (std::time::Instant, std::time::Instant),
+    (start, opaque_done): (Instant, Instant),
 ) -> PassTimes {
     let w = frame.width as usize;
     let n = w * band.len();
@@ -313,10 +318,10 @@ fn glare_rows(
     let own = (band.start - src.start) * w..(band.end - src.start) * w;
     img.energy.copy_from_slice(&energy[own.clone()]);
     img.depth.copy_from_slice(&depth[own]);
-    let waves_done = std::time::Instant::now();
+    let waves_done = Instant::now();
     bloom::glare_and_map(frame, params, &linear, band, &mut img.color);
-    let end = std::time::Instant::now();
-    let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
+    let end = Instant::now();
+    let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
     PassTimes {
         opaque_ms: ms(start, opaque_done),
         wave_ms: ms(opaque_done, waves_done),

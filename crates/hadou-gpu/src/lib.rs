@@ -92,6 +92,7 @@ mod passes;
 mod prepare;
 mod render;
 pub mod shaders;
+mod texture_read;
 #[cfg(not(target_arch = "wasm32"))]
 mod time_frame;
 mod timing;
@@ -106,6 +107,7 @@ pub use overlay::{DepthModel, OverlayBlend, OverlayTarget};
 pub use passes::present::PresentedFrame;
 pub use passes::soft::SOFT_BYTES_PER_PIXEL;
 pub use render::MAX_TILE;
+pub use texture_read::TextureRead;
 pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
@@ -216,6 +218,14 @@ impl GpuBackend {
     /// the web an error from the GPU surfaces on the next call.
     pub fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
         self.renderer.render_to_texture(frame)
+    }
+
+    /// Starts reading back the texture the last [`GpuBackend::render_to_texture`] drew, without
+    /// waiting: its bytes (`Rgba8UnormSrgb`, as drawn) arrive through [`TextureRead::try_take`]
+    /// on a later frame. What a web page's screenshots, exports and test mode read. `None` before
+    /// the first `render_to_texture`.
+    pub fn read_presented(&self) -> Option<TextureRead> {
+        self.renderer.read_presented()
     }
 
     /// Records `frame`'s waves into `encoder`, drawn into a colour target and against a depth

@@ -9,6 +9,7 @@
 
 use crate::passes::present::{PresentedFrame, Presenter};
 use crate::render::Renderer;
+use crate::texture_read::TextureRead;
 use crate::timing::{PresentTiming, PRESENT_PASSES_PER_TILE};
 use hadou_scene::{Frame, RenderError};
 
@@ -119,6 +120,13 @@ impl Renderer {
             )
         })?;
         Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated, serial })
+    }
+
+    /// See [`crate::GpuBackend::read_presented`].
+    pub(crate) fn read_presented(&self) -> Option<TextureRead> {
+        let target = self.present.as_ref()?.target.as_ref()?;
+        let size = [target.texture.width(), target.texture.height()];
+        Some(TextureRead::start(&self.ctx.device, &self.ctx.queue, &target.texture, size))
     }
 
     /// See [`crate::GpuBackend::last_present_timing`].

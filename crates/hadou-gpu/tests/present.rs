@@ -83,10 +83,11 @@ fn scene_frame(file: &str, t: f32, width: u32, height: u32) -> Frame {
     frame
 }
 
-/// Renders `frame` into the texture, copies the texture into a buffer and waits for it: the
-/// texture's rows of RGBA bytes, and whether the texture was recreated.
+/// Renders `frame` into the texture and reads it back through `GpuBackend::read_presented` (the
+/// web page's non-blocking read-back; the test waits between its polls): the texture's rows of
+/// RGBA bytes, and whether the texture was recreated.
 fn texture_bytes(gpu: &mut Gpu, frame: &Frame) -> (Vec<u8>, bool) {
-    let Gpu { backend, device, queue } = gpu;
+    let Gpu { backend, device, .. } = gpu;
     let presented = backend.render_to_texture(frame).unwrap_or_else(|e| panic!("render_to_texture: {e}"));
     let [w, h] = presented.size;
     assert_eq!([w, h], [frame.width, frame.height]);
@@ -94,42 +95,22 @@ fn texture_bytes(gpu: &mut Gpu, frame: &Frame) -> (Vec<u8>, bool) {
     assert_eq!(texture.format(), PRESENT_FORMAT);
     assert_eq!(texture.usage(), PRESENT_USAGE);
     assert_eq!((texture.width(), texture.height()), (w, h));
-    let row = (4 * w).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("texture read-back"),
-        size: row as u64 * h as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = device.create_command_encoder(&Default::default());
-    enc.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(h),
-            },
-        },
-        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-    );
     let recreated = presented.recreated;
-    queue.submit([enc.finish()]);
-    buffer.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the read-back buffer"));
-    device
-        .poll(wgpu::PollType::Wait {
-            submission_index: None,
-            timeout: Some(std::time::Duration::from_secs(300)),
-        })
-        .expect("waiting for the GPU");
-    let mapped = buffer.slice(..).get_mapped_range();
-    let mut bytes = Vec::with_capacity(4 * w as usize * h as usize);
-    for y in 0..h as usize {
-        bytes.extend_from_slice(&mapped[y * row as usize..][..4 * w as usize]);
-    }
-    drop(mapped);
-    buffer.unmap();
+    let mut read = backend.read_presented().expect("a texture was drawn");
+    assert_eq!(read.size(), [w, h]);
+    let bytes = loop {
+        if let Some(r) = read.try_take(device) {
+            break r.unwrap_or_else(|e| panic!("read_presented: {e}"));
+        }
+        device
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: Some(std::time::Duration::from_secs(300)),
+            })
+            .expect("waiting for the GPU");
+    };
+    assert!(read.try_take(device).is_none(), "the bytes come back once");
+    assert_eq!(bytes.len(), 4 * w as usize * h as usize);
     (bytes, recreated)
 }
 

@@ -3,10 +3,21 @@
 //! opened handle, and the read itself stops one byte past the cap (a file that grows while it is
 //! read is caught too). [`SceneDir`] is the scene file's directory tree, which every file a scene
 //! names (textures, glTF files) must lie in.
+//!
+//! Where there is no file system (a web page) or a program holds the files itself, a
+//! [`MemoryFiles`] set is mounted on the thread ([`mount_memory_files`]): while it is, every
+//! file the loader reads on that thread (scene files, glTF files and their buffers, textures,
+//! VRMA clips) comes from the set, under the same size caps and the same rule that a scene's files
+//! lie inside its directory, and a path the set lacks is "not among the files given"
+//! ([`MemoryFiles::missing_note`]).
 
+use std::cell::RefCell;
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
+use std::rc::Rc;
+use std::sync::Arc;
 
 /// Largest scene file read, in bytes (16 MiB).
 pub const SCENE_MAX_BYTES: u64 = 16 << 20;
@@ -94,6 +105,9 @@ fn open(path: &Path) -> std::io::Result<File> {
 /// Errors are plain-language reasons without the path ("it is a FIFO, not a regular file",
 /// "No such file or directory (os error 2)", …).
 pub fn read_regular_file(path: &Path, cap: u64) -> Result<Vec<u8>, String> {
+    if let Some(set) = mounted() {
+        return set.read(path, cap);
+    }
     let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
     check(&meta, cap)?;
     let file = open(path).map_err(|e| e.to_string())?;
@@ -133,10 +147,177 @@ impl SceneDir {
         if let Some(r) = &self.root {
             return Ok(r.clone());
         }
-        let r = std::fs::canonicalize(&self.path).map_err(|e| {
+        let r = canonicalize(&self.path).map_err(|e| {
             format!("cannot resolve the scene file's directory {}: {e}", crate::error::show_path(&self.path))
         })?;
         self.root = Some(r.clone());
         Ok(r)
+    }
+}
+
+/// Files held in memory under absolute paths (`/scenes/kamehameha.toml`), standing in for the
+/// file system while mounted (see the module documentation). Directories are implied by the
+/// files' paths.
+#[derive(Clone, Debug)]
+pub struct MemoryFiles {
+    files: BTreeMap<PathBuf, Arc<[u8]>>,
+    /// Why a path the set lacks cannot be read (the end of "cannot read PATH: …").
+    pub missing_note: String,
+    /// The paths asked for that the set lacks, in order ([`MemoryFiles::take_missed`]).
+    missed: RefCell<Vec<PathBuf>>,
+}
+
+impl Default for MemoryFiles {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl MemoryFiles {
+    /// An empty set whose missing files are "not among the files given".
+    pub fn new() -> MemoryFiles {
+        MemoryFiles {
+            files: BTreeMap::new(),
+            missing_note: "it is not among the files given".into(),
+            missed: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// Adds (or replaces) the file at `path`, made absolute and normalised (`.` and `..`
+    /// resolved by name).
+    pub fn insert(&mut self, path: impl AsRef<Path>, bytes: impl Into<Arc<[u8]>>) {
+        self.files.insert(normalise(path.as_ref()), bytes.into());
+    }
+
+    /// The file at `path` (normalised as by [`MemoryFiles::insert`]), if the set has it.
+    pub fn get(&self, path: impl AsRef<Path>) -> Option<&Arc<[u8]>> {
+        self.files.get(&normalise(path.as_ref()))
+    }
+
+    /// Every file's path, in order.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.files.keys().map(PathBuf::as_path)
+    }
+
+    /// The paths the loader asked for that the set lacks, since the last call (a page can offer
+    /// a dropped file of the same name there).
+    pub fn take_missed(&self) -> Vec<PathBuf> {
+        std::mem::take(&mut *self.missed.borrow_mut())
+    }
+
+    fn miss(&self, p: PathBuf) {
+        self.missed.borrow_mut().push(p);
+    }
+
+    /// Whether the set has no files.
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty()
+    }
+
+    fn is_dir(&self, p: &Path) -> bool {
+        self.files.range(p.to_path_buf()..).next().is_some_and(|(k, _)| k != p && k.starts_with(p))
+    }
+
+    /// The canonical form of `path` in the set: the normalised path of a file or directory it
+    /// has.
+    fn canonicalize(&self, path: &Path) -> std::io::Result<PathBuf> {
+        let p = normalise(path);
+        if self.files.contains_key(&p) || self.is_dir(&p) {
+            Ok(p)
+        } else {
+            self.miss(p);
+            Err(std::io::Error::new(std::io::ErrorKind::NotFound, self.missing_note.clone()))
+        }
+    }
+
+    fn read(&self, path: &Path, cap: u64) -> Result<Vec<u8>, String> {
+        let p = normalise(path);
+        match self.files.get(&p) {
+            Some(bytes) if bytes.len() as u64 > cap => {
+                Err(format!("it is {} bytes, more than the limit of {}", bytes.len(), describe_bytes(cap)))
+            }
+            Some(bytes) => Ok(bytes.to_vec()),
+            None if self.is_dir(&p) => Err("it is a directory, not a regular file".into()),
+            None => {
+                self.miss(p);
+                Err(self.missing_note.clone())
+            }
+        }
+    }
+}
+
+/// `path` made absolute (under `/`) with `.` and `..` resolved by name (`..` at the top stays
+/// at the top).
+fn normalise(path: &Path) -> PathBuf {
+    let mut out = PathBuf::from("/");
+    for c in path.components() {
+        match c {
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::Normal(n) => out.push(n),
+            Component::CurDir | Component::RootDir | Component::Prefix(_) => {}
+        }
+    }
+    out
+}
+
+thread_local! {
+    static MOUNTED: RefCell<Option<Rc<MemoryFiles>>> = const { RefCell::new(None) };
+}
+
+/// Mounts `files` on this thread in place of the file system (`None` unmounts): every file the
+/// loader reads on this thread from now on comes from the set. Returns the set mounted before.
+pub fn mount_memory_files(files: Option<MemoryFiles>) -> Option<MemoryFiles> {
+    let old = MOUNTED.with(|m| m.replace(files.map(Rc::new)));
+    old.map(|rc| Rc::try_unwrap(rc).unwrap_or_else(|rc| (*rc).clone()))
+}
+
+fn mounted() -> Option<Rc<MemoryFiles>> {
+    MOUNTED.with(|m| m.borrow().clone())
+}
+
+/// `std::fs::canonicalize`, or the mounted [`MemoryFiles`]' canonical path while a set is
+/// mounted on this thread.
+pub(crate) fn canonicalize(path: &Path) -> std::io::Result<PathBuf> {
+    match mounted() {
+        Some(set) => set.canonicalize(path),
+        None => std::fs::canonicalize(path),
+    }
+}
+
+#[cfg(test)]
+mod memory_tests {
+    use super::*;
+
+    #[test]
+    fn a_mounted_set_stands_in_for_the_file_system_with_the_same_caps() {
+        let mut set = MemoryFiles::new();
+        set.insert("/s/scene.toml", b"abc".to_vec());
+        set.insert("s/assets/../assets/hero.glb", vec![0u8; 10]);
+        assert!(set.get("/s/assets/hero.glb").is_some());
+        let old = mount_memory_files(Some(set));
+        assert!(old.is_none());
+        assert_eq!(read_regular_file(Path::new("/s/./scene.toml"), 16).unwrap(), b"abc");
+        let e = read_regular_file(Path::new("/s/assets/hero.glb"), 4).unwrap_err();
+        assert!(e.contains("10 bytes") && e.contains("limit"), "{e}");
+        let e = read_regular_file(Path::new("/s/missing.png"), 4).unwrap_err();
+        assert!(e.contains("not among the files given"), "{e}");
+        assert_eq!(mounted().unwrap().take_missed(), vec![PathBuf::from("/s/missing.png")]);
+        assert!(mounted().unwrap().take_missed().is_empty());
+        let e = read_regular_file(Path::new("/s/assets"), 4).unwrap_err();
+        assert!(e.contains("directory"), "{e}");
+        assert_eq!(
+            canonicalize(Path::new("/s/assets/../scene.toml")).unwrap(),
+            PathBuf::from("/s/scene.toml")
+        );
+        assert_eq!(canonicalize(Path::new("/s/assets")).unwrap(), PathBuf::from("/s/assets"));
+        assert!(canonicalize(Path::new("/s/asset")).is_err());
+        // Climbing out of the top stays at the top.
+        assert_eq!(normalise(Path::new("/../../s/scene.toml")), PathBuf::from("/s/scene.toml"));
+        let back = mount_memory_files(None).expect("the set mounted above");
+        assert_eq!(back.paths().count(), 2);
+        // Unmounted, the real file system answers again.
+        assert!(read_regular_file(Path::new("/s/scene.toml"), 16).is_err());
     }
 }

@@ -26,8 +26,10 @@ pub(crate) fn resolve_uri(uri: &str, dir: &Path, root: &Path, cap: u64) -> Resul
         ));
     }
     let file = dir.join(&rel);
-    let real = std::fs::canonicalize(&file).map_err(|e| format!("cannot read {}: {e}", show_path(&file)))?;
-    let top = std::fs::canonicalize(root).map_err(|e| format!("cannot resolve {}: {e}", show_path(root)))?;
+    let real =
+        crate::files::canonicalize(&file).map_err(|e| format!("cannot read {}: {e}", show_path(&file)))?;
+    let top =
+        crate::files::canonicalize(root).map_err(|e| format!("cannot resolve {}: {e}", show_path(root)))?;
     if !real.starts_with(&top) {
         return Err(format!(
             "`{shown}` resolves to {}, outside {}; buffer and image files must lie inside the scene file's directory",

@@ -34,7 +34,8 @@ use std::path::Path;
 /// `name` (or its first clip) onto `rig`; returns the clip and the load's warnings.
 pub fn load_vrma_clip(path: &Path, rig: &Rig, name: Option<&str>) -> Result<(Clip, Vec<String>), String> {
     let mut warnings = Vec::new();
-    let root = std::fs::canonicalize(parent_dir(path)).map_err(|e| format!("cannot read the file: {e}"))?;
+    let root =
+        crate::files::canonicalize(parent_dir(path)).map_err(|e| format!("cannot read the file: {e}"))?;
     let clip = load_vrma(path, &root, rig, name, &mut warnings)?;
     Ok((clip, warnings))
 }

@@ -18,7 +18,8 @@
 //!    the helpers everything uses (`error.rs`, `limits.rs`, `files.rs`, `guard.rs`, `params.rs`,
 //!    `anim.rs`, `toml_read.rs`) and `temp_file.rs` (how every writer of the workspace writes);
 //! 2. a frame's geometry and assets: `bounds.rs`, `mesh.rs`, `texture.rs`, `gltf_uri.rs`,
-//!    `gltf_material.rs`, `gltf_load.rs`; and `backend.rs`;
+//!    `gltf_material.rs`, `gltf_load.rs`; `backend.rs`; `gif_timing.rs` (what GIF writers share); and `file_kinds.rs` (the files a scene may
+//!    name, by extension, with their size limits);
 //! 3. each feature read from the scene file and built at one set of values (`materials.rs`,
 //!    `shadow_def.rs`, `area_light_def.rs`), and `shadow_casts.rs` (`Frame::shadow_casts`);
 //! 4. `scene.rs`: [`Scene`] and [`Scene::at`];
@@ -34,8 +35,10 @@ mod backend;
 mod bloom_def;
 mod bounds;
 mod error;
+mod file_kinds;
 mod files;
 mod frame;
+mod gif_timing;
 mod gltf_accessor;
 mod gltf_anim;
 mod gltf_load;
@@ -68,11 +71,13 @@ pub use backend::{Backend, RenderError};
 pub use bloom_def::{BLOOM_MAX_STREAK_LENGTH, BLOOM_MAX_THRESHOLD, BLOOM_MAX_WEIGHT};
 pub use bounds::{caster_box, object_bounds, object_center, widest_outline_pixels};
 pub use error::{escape_controls, Location, SceneError};
+pub use file_kinds::file_size_limit;
 pub use files::{
-    read_regular_file, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES, GLTF_MAX_JSON_OBJECTS, GLTF_MAX_JSON_VALUES,
-    SCENE_MAX_BYTES,
+    mount_memory_files, read_regular_file, MemoryFiles, GLTF_MAX_BYTES, GLTF_MAX_JSON_BYTES,
+    GLTF_MAX_JSON_OBJECTS, GLTF_MAX_JSON_VALUES, SCENE_MAX_BYTES,
 };
 pub use frame::*;
+pub use gif_timing::{check_gif_size, gif_delay_cs, GIF_MAX_PIXELS, GIF_QUANT_SPEED};
 pub use gltf_anim::MAX_ANIMATION_VALUES;
 pub use gltf_load::{
     gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf, load_gltf_rig, MAX_MORPH_DELTAS,
@@ -93,6 +98,6 @@ pub use shadow::{
 };
 pub use temp_file::{remove_pending_temp_files, TempFile};
 pub use texture::{
-    decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_EDGE,
-    TEXTURE_MAX_TEXELS,
+    decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_BYTES,
+    TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS,
 };

@@ -194,7 +194,7 @@ pub(crate) fn scene_file(t: &Table<'_, '_>, key: &str, rel: &str, dir: &Path, ro
             ),
         ));
     }
-    let real = std::fs::canonicalize(&file).map_err(|e| {
+    let real = crate::files::canonicalize(&file).map_err(|e| {
         t.src.value_err(
             &span,
             format!("`{key}` in {}: cannot read {}: {e}", t.what, crate::error::show_path(&file)),

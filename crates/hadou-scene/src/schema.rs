@@ -715,8 +715,8 @@ fn resolve_asset(
             file,
         ));
     }
-    let real =
-        std::fs::canonicalize(&file).map_err(|e| err(format!("cannot read the file: {e}"), file.clone()))?;
+    let real = crate::files::canonicalize(&file)
+        .map_err(|e| err(format!("cannot read the file: {e}"), file.clone()))?;
     let root = dir.root().map_err(|m| err(m, file.clone()))?;
     if !real.starts_with(&root) {
         return Err(err(

@@ -335,6 +335,12 @@ impl Document {
         self.write_to(&path)
     }
 
+    /// Takes the current text as saved elsewhere (a web page handed it to the browser as a
+    /// download): the document is no longer dirty; nothing is written.
+    pub fn mark_saved(&mut self) {
+        self.disk_text = self.text.clone();
+    }
+
     /// Writes the document to `path`, which becomes the document's file. Relative asset paths in
     /// the scene resolve next to the new file, so the scene must still load from there.
     pub fn save_as(&mut self, path: &Path) -> Result<(), DocError> {

@@ -86,6 +86,9 @@ pub enum Request {
     },
     /// Stop the running export.
     CancelExport,
+    /// Hand the scene's text to the user as a download named like the scene file (what Save does
+    /// in the web page, [`Viewer::save_downloads`]).
+    DownloadScene,
     /// Probe the pixel (image coordinates of the scene's size).
     Probe([u32; 2]),
     /// Draw with this backend.
@@ -180,6 +183,9 @@ pub struct Viewer {
     pub export_path: String,
     /// Where a screenshot goes (typed in the panel).
     pub screenshot_path: String,
+    /// What Save does: `false` (the native viewer) writes the scene file; `true` (the web page,
+    /// which has no file to write) asks for a download of the text ([`Request::DownloadScene`]).
+    pub save_downloads: bool,
 }
 
 impl Viewer {
@@ -204,6 +210,7 @@ impl Viewer {
             export_fps: 24.0,
             export_path: format!("{stem}.gif"),
             screenshot_path: format!("{stem}.png"),
+            save_downloads: false,
         }
     }
 
@@ -399,6 +406,14 @@ impl Viewer {
 
     /// Saves, reporting the outcome.
     pub fn save(&mut self) {
+        if self.save_downloads {
+            self.requests.push(Request::DownloadScene);
+            self.doc.mark_saved();
+            let name =
+                self.doc.path().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            self.say(format!("downloading {name}"));
+            return;
+        }
         match self.doc.save() {
             Ok(()) => {
                 let m = format!("saved {}", self.doc.path().display());

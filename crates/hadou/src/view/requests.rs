@@ -41,22 +41,7 @@ impl App {
                     let frame = self.viewer.frame();
                     self.viewer.probe_at = (x < frame.width && y < frame.height).then_some([x, y]);
                     self.viewer.probe = Some(match hadou_cpu::probe(&frame, x, y) {
-                        Some(p) => {
-                            let waves: Vec<String> = p
-                                .waves
-                                .iter()
-                                .map(|w| format!("{} E={:.4} ({} evals)", w.name, w.energy, w.evaluations))
-                                .collect();
-                            format!(
-                                "pixel ({x}, {y}): {} · rgb [{:.3}, {:.3}, {:.3}] · depth {:.3}{}",
-                                if waves.is_empty() { "no waves".to_string() } else { waves.join(", ") },
-                                p.color[0],
-                                p.color[1],
-                                p.color[2],
-                                p.depth,
-                                p.object.map(|o| format!(" · object {o}")).unwrap_or_default()
-                            )
-                        }
+                        Some(p) => p.summary(),
                         None => {
                             format!("pixel ({x}, {y}) is outside the {}×{} image", frame.width, frame.height)
                         }
@@ -73,6 +58,8 @@ impl App {
                     }
                 }
                 Request::Quit => self.script_pos = usize::MAX,
+                // The native viewer saves into the file (`save_downloads` is off).
+                Request::DownloadScene => {}
                 Request::MeasureGpu => {
                     let frame = self.viewer.frame();
                     match self.gfx.as_mut().and_then(|g| g.gpu.as_mut()) {
