@@ -132,6 +132,73 @@ mod tests {
     };
     use std::mem::{offset_of, size_of};
 
+    /// Every float literal of every WGSL source fits in an `f32` exactly as written: browsers'
+    /// WGSL compilers (Chrome's Tint) refuse a literal past `f32::MAX` even when it would round
+    /// to it (`3.40282347e38`), where naga rounds; `f32::MAX` is written `3.4028234663852886e38`.
+    #[test]
+    fn float_literals_fit_in_f32_as_browsers_read_them() {
+        let sources = [
+            ("common", COMMON),
+            ("energy", ENERGY),
+            ("curve", CURVE),
+            ("shading", SHADING),
+            ("shading_bindings", SHADING_BINDINGS),
+            ("raster", RASTER),
+            ("wave", WAVE),
+            ("wave_samples", WAVE_SAMPLES),
+            ("wave_energy", WAVE_ENERGY),
+            ("wave_overlay", WAVE_OVERLAY),
+            ("shadow_lookup", SHADOW_LOOKUP),
+            ("shadow_bindings", SHADOW_BINDINGS),
+            ("shadow_raster", SHADOW_RASTER),
+            ("soft_map", SOFT_MAP),
+            ("soft", SOFT),
+            ("edges", EDGES),
+            ("present", PRESENT),
+            ("bloom", BLOOM),
+        ];
+        let mut checked = 0;
+        for (name, src) in sources {
+            for (n, line) in src.lines().enumerate() {
+                let code = line.split("//").next().unwrap_or("");
+                let b = code.as_bytes();
+                let mut i = 0;
+                while i < b.len() {
+                    let starts = b[i].is_ascii_digit()
+                        && (i == 0 || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_'));
+                    if !starts {
+                        i += 1;
+                        continue;
+                    }
+                    let mut j = i;
+                    while j < b.len()
+                        && (b[j].is_ascii_digit()
+                            || b[j] == b'.'
+                            || b[j] == b'e'
+                            || b[j] == b'E'
+                            || ((b[j] == b'-' || b[j] == b'+') && j > i && matches!(b[j - 1], b'e' | b'E')))
+                    {
+                        j += 1;
+                    }
+                    let lit = &code[i..j];
+                    if lit.contains(['.', 'e', 'E']) {
+                        let v: f64 =
+                            lit.parse().unwrap_or_else(|e| panic!("{name}.wgsl:{}: `{lit}`: {e}", n + 1));
+                        assert!(
+                            v.abs() <= f64::from(f32::MAX),
+                            "{name}.wgsl:{}: `{lit}` is past f32::MAX, which browsers refuse; write 3.4028234663852886e38",
+                            n + 1
+                        );
+                        checked += 1;
+                    }
+                    i = j.max(i + 1);
+                }
+            }
+        }
+        assert!(checked > 100, "only {checked} float literals found: the scan is broken");
+        assert!("3.40282347e38".parse::<f64>().unwrap() > f64::from(f32::MAX), "the check can fail");
+    }
+
     fn validate(name: &str, source: &str) -> naga::Module {
         let module = naga::front::wgsl::parse_str(source)
             .unwrap_or_else(|e| panic!("{name}: WGSL parse error:\n{}", e.emit_to_string(source)));

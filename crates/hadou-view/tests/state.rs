@@ -223,6 +223,20 @@ fn save_load_round_trip() {
     assert_eq!(left.len(), 1, "{left:?}");
 }
 
+#[test]
+fn save_in_the_web_page_asks_for_a_download_and_writes_nothing() {
+    let (d, p) = doc("download");
+    let mut v = Viewer::new(d);
+    v.save_downloads = true;
+    assert!(v.edit_value("wave.beam.alpha_s", vec![0.12], None));
+    assert!(v.doc.is_dirty());
+    v.save();
+    assert_eq!(v.requests, vec![Request::DownloadScene]);
+    assert!(!v.doc.is_dirty(), "the downloaded text counts as saved");
+    assert_eq!(std::fs::read_to_string(&p).unwrap(), SCENE, "the file on disk is untouched");
+    assert!(v.message.as_ref().is_some_and(|(m, err)| m.contains("scene.toml") && !err), "{:?}", v.message);
+}
+
 #[cfg(unix)]
 #[test]
 fn save_to_a_read_only_place_keeps_the_edits() {

@@ -49,7 +49,9 @@ pub fn parse_query(query: &str) -> Result<PageParams, Vec<String>> {
             "scene" => p.scene = Some(value.strip_suffix(".toml").unwrap_or(&value).to_string()),
             "time" => match value.parse::<f32>() {
                 Ok(t) if t.is_finite() && t >= 0.0 => p.time = Some(t),
-                _ => errors.push(format!("time=`{shown}`: expected a number of seconds ≥ 0, such as time=1.5")),
+                _ => {
+                    errors.push(format!("time=`{shown}`: expected a number of seconds ≥ 0, such as time=1.5"))
+                }
             },
             "width" | "height" => match value.parse::<u32>() {
                 Ok(n) if (1..=hadou_scene::MAX_IMAGE_EDGE).contains(&n) => {

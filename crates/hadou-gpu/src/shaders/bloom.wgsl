@@ -27,7 +27,7 @@ struct BloomUniforms {
 @group(0) @binding(4) var<storage, read_write> o_buf: array<vec4<f32>>;
 
 const BLOOM_CLAMP: f32 = 65504.0;
-const F32_MAX: f32 = 3.40282347e38;
+const F32_MAX: f32 = 3.4028234663852886e38;
 
 // Texel (x, y) of plane p, both clamped to the level's edge (Plane::at); the index into its buffer.
 fn plane_index(p: vec4<u32>, x: i32, y: i32) -> u32 {

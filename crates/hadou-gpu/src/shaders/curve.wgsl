@@ -26,7 +26,7 @@ override USE_BSPLINE: bool = true;
 
 // `dt` above this is an open (infinite) span: the GPU's stand-in for f32::INFINITY is T_OPEN.
 const CURVE_INF: f32 = 1.0e38;
-const F32_MAX: f32 = 3.4028235e38;
+const F32_MAX: f32 = 3.4028234663852886e38;
 
 // f32::is_finite.
 fn curve_finite(x: f32) -> bool {

@@ -22,7 +22,7 @@ const H_FLOOR: f32 = 1.0e-24;
 // Mirrors hadou_math::energy::ENERGY_MAX.
 const ENERGY_MAX: f32 = 1.0e30;
 // Mirrors hadou_math::energy::ENERGY_SATURATION (f32::MAX).
-const ENERGY_SATURATION: f32 = 3.40282347e38;
+const ENERGY_SATURATION: f32 = 3.4028234663852886e38;
 
 // Mirrors hadou_math::energy::saturate for the values the formulas produce: x ∈ [0, ∞) clamped
 // to [0, f32::MAX]. WGSL may assume no infinity or NaN occurs, so the sums and products below are

@@ -21,7 +21,7 @@ override USE_LINE_POLYLINE: bool = true;
 fn nearest_on_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     let d = b - a;
     let dd = dot3(d, d);
-    if (!(dd > 0.0) || !(dd <= 3.40282347e38)) {
+    if (!(dd > 0.0) || !(dd <= 3.4028234663852886e38)) {
         return a;
     }
     let t = clamp(dot3(p - a, d) / dd, 0.0, 1.0);
@@ -57,7 +57,7 @@ fn light_nearest(l: GpuLight, p: vec3<f32>) -> vec3<f32> {
                 if (l.point_count == 1u) {
                     return best;
                 }
-                var best_d = 3.40282347e38;
+                var best_d = 3.4028234663852886e38;
                 for (var i = 0u; i + 1u < l.point_count; i++) {
                     let q = nearest_on_segment(p, polyline_point(l.point_offset, i), polyline_point(l.point_offset, i + 1u));
                     let e = q - p;
@@ -78,7 +78,7 @@ fn light_nearest(l: GpuLight, p: vec3<f32>) -> vec3<f32> {
 fn wave_m(p: vec3<f32>, n: vec3<f32>, e: vec3<f32>) -> f32 {
     let v = e - p;
     let len = length3(v);
-    if (len > 0.0 && len <= 3.40282347e38) {
+    if (len > 0.0 && len <= 3.4028234663852886e38) {
         return clamp(dot3(n, v / len), -1.0, 1.0);
     }
     return 1.0;
@@ -96,7 +96,7 @@ fn dominance(distance: f32, core_radius: f32, strength: f32, inverse_square: boo
     if (v != v) {
         return 0.0;
     }
-    return min(v, 3.40282347e38);
+    return min(v, 3.4028234663852886e38);
 }
 
 // The density of light `l` at `world`, whose light point is `e` (hadou_math::toon::dominance with
@@ -132,7 +132,7 @@ fn texel(t: GpuTexture, i_in: i32, j_in: i32) -> vec4<f32> {
 }
 
 fn fix_coord(v: f32) -> f32 {
-    if (v != v || abs(v) > 3.40282347e38) {
+    if (v != v || abs(v) > 3.4028234663852886e38) {
         return 0.0;
     }
     return clamp(v, -1.0e6, 1.0e6);
@@ -236,7 +236,7 @@ fn mtoon_rim(n_dot_v: f32, lift: f32, power: f32, color: vec3<f32>) -> vec3<f32>
 // Unit `v`, or `fallback` for a zero or non-finite vector (hadou_math::Vec3::normalize_or).
 fn normalize_or(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     let l = length3(v);
-    if (l > 0.0 && l <= 3.40282347e38) {
+    if (l > 0.0 && l <= 3.4028234663852886e38) {
         return v / l;
     }
     return fallback;
@@ -253,7 +253,7 @@ fn mtoon_matcap_uv(n: vec3<f32>, v: vec3<f32>) -> vec2<f32> {
 fn mtoon_uv(uv: vec2<f32>, mask: f32, scroll: vec2<f32>, turn: f32) -> vec2<f32> {
     let tau = 6.28318530717958647;
     var a = turn * mask;
-    if (abs(a) <= 3.40282347e38) {
+    if (abs(a) <= 3.4028234663852886e38) {
         a = a - tau * floor(a / tau);
     } else {
         a = 0.0;

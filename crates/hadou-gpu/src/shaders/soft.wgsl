@@ -72,7 +72,7 @@ const FAR: u32 = 0xffffffffu;
 const NO_ROW: u32 = 0xffffu;
 
 fn finite(x: f32) -> bool {
-    return x == x && abs(x) <= 3.40282347e38;
+    return x == x && abs(x) <= 3.4028234663852886e38;
 }
 
 // Twin of hadou_math::soft::SpotMap::texel.
