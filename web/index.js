@@ -94,7 +94,9 @@ async function main() {
   }
   select.addEventListener("change", () => hadou.open_preset(select.value));
   installDrop();
-  await hadou.start("hadou-canvas", await webgpuAdapter());
+  // Only test mode names the adapter (its report says what drew the frame): some browsers give
+  // one WebGPU adapter per page, and the viewer's graphics set-up asks for it next.
+  await hadou.start("hadou-canvas", testMode ? await webgpuAdapter() : "");
 }
 
 main().catch((e) => fail("hadou could not start: " + (e && e.message ? e.message : e) + (testMode ? "" : " (see the console)")));

@@ -8,9 +8,8 @@ use crate::device::GpuContext;
 use crate::formats::{DEPTH_FORMAT, PLANE_SHADOW_FORMAT, SCENE_FORMAT};
 use crate::layout::{FrameUniforms, TONE_LINEAR};
 use crate::meshes::MeshCache;
-use crate::passes::bloom::BloomPass;
 #[cfg(not(target_arch = "wasm32"))]
-use crate::passes::bloom::{self, BloomInputs};
+use crate::passes::bloom::{self, BloomInputs, BloomPass};
 use crate::passes::edges::{EdgeInputs, EdgePass};
 use crate::passes::plane_shadows::{PlaneShadowInputs, PlaneShadowPass};
 use crate::passes::present::Presenter;
@@ -152,6 +151,8 @@ pub(crate) struct Passes {
     shadow_maps: ShadowMapPass,
     soft: SoftPass,
     pub(crate) wave: WavePass,
+    /// Not built on the web, where no frame runs it (its pipelines would only cost compile time).
+    #[cfg(not(target_arch = "wasm32"))]
     bloom: BloomPass,
 }
 
@@ -220,6 +221,7 @@ impl Renderer {
             plane_shadows: PlaneShadowPass::new(&ctx)?,
             shadow_maps: ShadowMapPass::new(&ctx)?,
             soft: SoftPass::new(&ctx)?,
+            #[cfg(not(target_arch = "wasm32"))]
             bloom: BloomPass::new(&ctx)?,
         };
         Ok(Self {

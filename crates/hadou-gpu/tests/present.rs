@@ -16,7 +16,6 @@ use std::sync::{Mutex, MutexGuard, OnceLock};
 struct Gpu {
     backend: GpuBackend,
     device: wgpu::Device,
-    queue: wgpu::Queue,
 }
 
 /// The adapter `GpuBackend::new` would choose.
@@ -49,9 +48,9 @@ fn open_with(edit: impl FnOnce(&mut wgpu::DeviceDescriptor<'static>)) -> Result<
     let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))
         .map_err(|e| Some(format!("request_device: {e}")))?;
     let backend =
-        GpuBackend::from_device(&adapter, device.clone(), queue.clone()).map_err(|e| Some(e.to_string()))?;
+        GpuBackend::from_device(&adapter, device.clone(), queue).map_err(|e| Some(e.to_string()))?;
     eprintln!("adapter: {:?}", adapter.get_info());
-    Ok(Gpu { backend, device, queue })
+    Ok(Gpu { backend, device })
 }
 
 /// The one backend of this test binary, shared by its tests in turn (see tests/common), or

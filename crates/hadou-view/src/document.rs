@@ -420,10 +420,13 @@ fn strip_path(m: &str, path: &Path) -> String {
 /// for the interrupt handler's clean-up before its first byte) and renames it over `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     use std::io::Write;
-    let (tmp, mut file) = hadou_scene::TempFile::create(path)?;
-    file.write_all(bytes)?;
-    file.sync_all()?;
-    drop(file);
+    let (tmp, file) = hadou_scene::TempFile::create(path)?;
+    {
+        // Closed at the end of this block, before the rename.
+        let mut file = file;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+    }
     tmp.commit(path)
 }
 

@@ -30,7 +30,7 @@ pub fn refuse_by_size(name: &str, size: f64) -> Option<String> {
             "{shown}: not read: a scene names only .toml scene files, glTF files (.gltf .glb .vrm .vrma .bin) and \
              textures (.png .jpg .jpeg)"
         )),
-        Some((cap, what)) if !(size <= cap as f64) => Some(format!(
+        Some((cap, what)) if size.is_nan() || size > cap as f64 => Some(format!(
             "{shown}: not read: it is {size} bytes, more than the {cap} bytes {what} may have (docs/scene-format.md)"
         )),
         Some(_) => None,

@@ -113,7 +113,11 @@ impl WebApp {
         dom::set_text(dom::STATUS, &status);
         let backend = if gpu.is_some() { BackendKind::Gpu } else { BackendKind::Cpu };
         viewer.stats.backend = Some(backend);
-        viewer.stats.backend_note = status.clone();
+        viewer.stats.backend_note = if info.backend == wgpu::Backend::BrowserWebGpu {
+            "in the browser, on WebGPU".into()
+        } else {
+            "in the browser, WebGL2 fallback".into()
+        };
         viewer.stats.adapter = adapter_name(&info);
         let test = if params.test {
             match &params.scene {
@@ -556,7 +560,10 @@ fn adapter_name(info: &wgpu::AdapterInfo) -> String {
         name = super::WEBGPU_ADAPTER.with(|a| a.borrow().clone());
     }
     if name.is_empty() {
-        format!("{:?}", info.backend)
+        match info.backend {
+            wgpu::Backend::BrowserWebGpu => "the browser's WebGPU adapter".into(),
+            b => format!("{b:?}"),
+        }
     } else {
         name
     }
