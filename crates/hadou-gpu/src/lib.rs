@@ -105,7 +105,7 @@ mod window;
 pub use formats::{PRESENT_FORMAT, PRESENT_USAGE};
 pub use overlay::{DepthModel, OverlayBlend, OverlayTarget};
 pub use passes::present::PresentedFrame;
-pub use passes::soft::SOFT_BYTES_PER_PIXEL;
+pub use passes::soft::{SoftFit, SOFT_BYTES_PER_PIXEL};
 pub use render::MAX_TILE;
 pub use texture_read::TextureRead;
 pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod};
@@ -218,6 +218,16 @@ impl GpuBackend {
     /// the web an error from the GPU surfaces on the next call.
     pub fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
         self.renderer.render_to_texture(frame)
+    }
+
+    /// Whether the soft shadows of the last frame drawn with an `[area_light]` are exact
+    /// ([`SoftFit`]). Natively always [`SoftFit::Settled`]: the frame waits for its maps' fit
+    /// windows. On the web a frame cannot wait, so it is drawn with the windows read back last
+    /// and its own are read back meanwhile: a page draws the frame again while this says
+    /// [`SoftFit::Outdated`], and asks again on a later frame while it says
+    /// [`SoftFit::Pending`]. Never blocks.
+    pub fn soft_fit(&self) -> SoftFit {
+        self.renderer.soft_fit()
     }
 
     /// Starts reading back the texture the last [`GpuBackend::render_to_texture`] drew, without

@@ -427,6 +427,11 @@ impl Renderer {
         Ok(())
     }
 
+    /// See [`crate::GpuBackend::soft_fit`].
+    pub(crate) fn soft_fit(&self) -> crate::passes::soft::SoftFit {
+        self.soft.as_ref().map_or(crate::passes::soft::SoftFit::Settled, SoftTargets::fit_state)
+    }
+
     /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
     /// class (`hadou_math::soft::Class` as `u8`) and visibility, read back (for tests).
     #[cfg(not(target_arch = "wasm32"))]

@@ -119,8 +119,46 @@ pub(crate) struct SoftTargets {
     /// The maps' fit windows (binding 12, `FitWindow` keys) and their read-back copy (not read on
     /// the web, which cannot wait for it).
     fit: wgpu::Buffer,
-    #[cfg_attr(target_arch = "wasm32", allow(dead_code))]
     fit_staging: wgpu::Buffer,
+    /// On the web: the fit windows read back without waiting (see [`SoftTargets::fit_maps`]).
+    #[cfg(target_arch = "wasm32")]
+    web_fit: std::sync::Mutex<WebFit>,
+}
+
+/// How the soft shadows' maps of the last frame drawn stand on the web, where a frame cannot wait
+/// for the read-back of its fit windows ([`crate::GpuBackend::soft_fit`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SoftFit {
+    /// The maps were fitted to the windows the frame's own points give (always so natively): the
+    /// soft shadows are exactly the CPU backend's.
+    Settled,
+    /// The frame's windows are still being read back: ask again on a later frame.
+    Pending,
+    /// The windows that came back differ from those the frame was drawn with (its first frame, or
+    /// the visible points moved): draw the frame again to have it exact.
+    Outdated,
+}
+
+/// The web's asynchronous fit (see [`SoftTargets::fit_maps`]).
+#[cfg(target_arch = "wasm32")]
+#[derive(Default)]
+struct WebFit {
+    /// The windows the last frame's maps were fitted to (`None`: unfitted).
+    used: Option<[FitWindow; 2]>,
+    /// The newest windows read back.
+    latest: Option<[FitWindow; 2]>,
+    /// The read-back in flight: what its map callback reported, once it has.
+    pending: Option<MapSlot>,
+}
+
+/// What a map callback reported: nothing yet, or the outcome.
+#[cfg(target_arch = "wasm32")]
+type MapSlot = std::sync::Arc<std::sync::Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>;
+
+/// The two maps' fit windows from the read-back bytes of the fit buffer.
+fn fit_keys(raw: &[u8]) -> [FitWindow; 2] {
+    let k: Vec<u32> = raw.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
+    [0, 1].map(|m| FitWindow { min: [k[4 * m], k[4 * m + 1]], max: [k[4 * m + 2], k[4 * m + 3]] })
 }
 
 /// Bytes of the fit windows: four `u32` keys per map.
@@ -178,6 +216,8 @@ impl SoftTargets {
                     FIT_BYTES,
                     wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 ),
+                #[cfg(target_arch = "wasm32")]
+                web_fit: Default::default(),
             });
         }
         let soft = soft.as_ref().expect("created above");
@@ -218,8 +258,13 @@ impl SoftTargets {
 
     /// Once every tile's `cs_points` has run: reads the maps' fit windows back and writes the
     /// maps fitted to them (`SpotMap::fitted`, as hadou-cpu's `soft::fitted_maps`) for the map
-    /// and classification passes. On the web, where a frame cannot wait for a read-back, the maps
-    /// stay unfitted.
+    /// and classification passes.
+    ///
+    /// On the web, where a frame cannot wait for a read-back, the maps are fitted to the newest
+    /// windows read back so far (unfitted before the first), and this frame's windows are copied
+    /// and mapped without waiting; [`SoftTargets::fit_state`] says whether the frame was drawn
+    /// with its own windows, so that a page draws a frame again until it is (one more frame for
+    /// a still image).
     pub(crate) fn fit_maps(&self, ctx: &GpuContext, frame: &Frame) -> Result<(), RenderError> {
         let light = frame.area_light.as_ref().expect("an area light");
         #[cfg(not(target_arch = "wasm32"))]
@@ -227,17 +272,61 @@ impl SoftTargets {
             let mut enc = ctx.device.create_command_encoder(&Default::default());
             enc.copy_buffer_to_buffer(&self.fit, 0, &self.fit_staging, 0, FIT_BYTES);
             let submission = ctx.queue.submit([enc.finish()]);
-            let keys = ctx.read_buffer(&self.fit_staging, FIT_BYTES, submission, |raw| {
-                let k: Vec<u32> =
-                    raw.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
-                [0, 1].map(|m| FitWindow { min: [k[4 * m], k[4 * m + 1]], max: [k[4 * m + 2], k[4 * m + 3]] })
-            })?;
+            let keys = ctx.read_buffer(&self.fit_staging, FIT_BYTES, submission, fit_keys)?;
             let maps = [0, 1].map(|m| light.maps[m].fitted(&keys[m], light.map_size));
             self.write_maps(ctx, frame, maps);
         }
         #[cfg(target_arch = "wasm32")]
-        let _ = (ctx, light);
+        {
+            let mut web = self.web_fit.lock().unwrap_or_else(|p| p.into_inner());
+            self.collect_fit(&mut web);
+            web.used = web.latest;
+            if let Some(keys) = web.latest {
+                let maps = [0, 1].map(|m| light.maps[m].fitted(&keys[m], light.map_size));
+                self.write_maps(ctx, frame, maps);
+            }
+            if web.pending.is_none() {
+                let mut enc = ctx.device.create_command_encoder(&Default::default());
+                enc.copy_buffer_to_buffer(&self.fit, 0, &self.fit_staging, 0, FIT_BYTES);
+                ctx.queue.submit([enc.finish()]);
+                let slot: MapSlot = std::sync::Arc::new(std::sync::Mutex::new(None));
+                let s = slot.clone();
+                self.fit_staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                    *s.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
+                });
+                web.pending = Some(slot);
+            }
+        }
         Ok(())
+    }
+
+    /// Takes the windows of a finished read-back into `web.latest` (a failed read-back is
+    /// dropped: the next frame reads again).
+    #[cfg(target_arch = "wasm32")]
+    fn collect_fit(&self, web: &mut WebFit) {
+        let Some(slot) = &web.pending else { return };
+        let Some(outcome) = slot.lock().unwrap_or_else(|p| p.into_inner()).take() else { return };
+        web.pending = None;
+        if outcome.is_ok() {
+            web.latest = Some(fit_keys(&self.fit_staging.slice(..).get_mapped_range()));
+            self.fit_staging.unmap();
+        }
+    }
+
+    /// How the last frame's maps stand ([`SoftFit`]); natively always settled.
+    pub(crate) fn fit_state(&self) -> SoftFit {
+        #[cfg(target_arch = "wasm32")]
+        {
+            let mut web = self.web_fit.lock().unwrap_or_else(|p| p.into_inner());
+            self.collect_fit(&mut web);
+            if web.pending.is_some() {
+                return SoftFit::Pending;
+            }
+            if web.latest != web.used {
+                return SoftFit::Outdated;
+            }
+        }
+        SoftFit::Settled
     }
 
     /// After a frame with an `[area_light]` has been drawn: every pixel's soft-shadow class

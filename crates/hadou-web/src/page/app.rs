@@ -4,20 +4,18 @@
 //! browser frame does at most one frame's rendering, so nothing freezes the tab for longer.
 
 use super::dom;
+use super::frames::{self, cpu_frame_bytes, DEFAULT_PRESET};
 use crate::dropped;
 use crate::export::{png_bytes, GifExport};
 use crate::params::PageParams;
 use crate::presets;
 use hadou_cpu::CpuBackend;
-use hadou_gpu::{GpuBackend, TextureRead};
-use hadou_scene::{Backend, Frame};
+use hadou_gpu::{GpuBackend, SoftFit, TextureRead};
+use hadou_scene::Frame;
 use hadou_view::document::Document;
 use hadou_view::ui::{UiState, ViewportImage};
 use hadou_view::viewer::{BackendKind, Request, Viewer};
 use web_time::Instant;
-
-/// The preset opened when the URL names none.
-pub(super) const DEFAULT_PRESET: &str = "kamehameha";
 
 /// What the viewport shows: the document's text, the time, the backend and the size.
 type DrawKey = (String, f32, BackendKind, [u32; 2]);
@@ -173,14 +171,11 @@ impl WebApp {
         Ok(f)
     }
 
-    /// Whether `frame` is drawn by the GPU backend. A frame with an `[area_light]` or a `[bloom]`
-    /// is drawn by the CPU backend in the page: the GPU backend fits the soft shadows' maps and
-    /// composes the glare after reading results back mid-frame, which a page cannot wait for.
+    /// Whether `frame` is drawn by the GPU backend. A frame with a `[bloom]` is drawn by the CPU
+    /// backend in the page: the GPU backend composes the glare after reading the image back,
+    /// which a page cannot wait for.
     fn on_gpu(&self, frame: &Frame) -> bool {
-        self.backend == BackendKind::Gpu
-            && self.gpu.is_some()
-            && frame.area_light.is_none()
-            && frame.bloom.is_none()
+        self.backend == BackendKind::Gpu && self.gpu.is_some() && frame.bloom.is_none()
     }
 
     /// Renders `frame` on the CPU into sRGB RGBA bytes and the render time (ms).
@@ -263,7 +258,8 @@ impl WebApp {
                     self.image = Some(ViewportImage { texture: id, size: [frame.width, frame.height] });
                     self.viewer.stats.render_ms = ms;
                     self.viewer.stats.render_method = if self.backend == BackendKind::Gpu {
-                        "CPU backend in WebAssembly (a frame with an [area_light] or a [bloom] draws on the CPU in the page)".into()
+                        "CPU backend in WebAssembly (a frame with a [bloom] draws on the CPU in the page)"
+                            .into()
                     } else {
                         "CPU backend in WebAssembly, wall clock".into()
                     };
@@ -275,7 +271,7 @@ impl WebApp {
 
     /// Takes what the page's script handed in: a chosen preset, dropped files.
     fn take_inbox(&mut self) {
-        let (preset, dropped) = super::INBOX.with(|i| {
+        let (preset, dropped) = super::inbox::INBOX.with(|i| {
             let mut i = i.borrow_mut();
             (i.preset.take(), std::mem::take(&mut i.dropped))
         });
@@ -486,12 +482,12 @@ impl WebApp {
             return;
         }
         self.test = TestState::Done;
-        let outcome = super::test_mode::test_frame(self.viewer.scene(), &self.params).and_then(|frame| {
+        let outcome = frames::test_frame(self.viewer.scene(), &self.params).and_then(|frame| {
             let (bytes, ms) = self.cpu_bytes(&frame)?;
             Ok((bytes, ms, frame))
         });
         match outcome {
-            Ok((bytes, ms, frame)) => super::test_mode::finish(
+            Ok((bytes, ms, frame)) => frames::finish(
                 &bytes,
                 frame.width,
                 frame.height,
@@ -509,6 +505,7 @@ impl WebApp {
             || self.export.is_some()
             || self.screenshot.is_some()
             || self.test == TestState::Start
+            || self.gpu.as_ref().is_some_and(|g| g.soft_fit() != SoftFit::Settled)
     }
 }
 
@@ -539,25 +536,11 @@ impl eframe::App for WebApp {
     }
 }
 
-/// Renders `frame` on `cpu` into sRGB RGBA bytes (alpha as unorm, as the GPU's window texture
-/// holds it) and the render time (ms).
-pub(super) fn cpu_frame_bytes(cpu: &mut CpuBackend, frame: &Frame) -> Result<(Vec<u8>, f64), String> {
-    let t0 = Instant::now();
-    let image = cpu.render(frame).map_err(|e| e.to_string())?;
-    let ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut bytes = vec![0u8; 4 * image.color.len()];
-    hadou_math::shade::rgba_to_srgba8(&image.color, &mut bytes);
-    for (o, c) in bytes.chunks_exact_mut(4).zip(&image.color) {
-        o[3] = (c[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-    }
-    Ok((bytes, ms))
-}
-
 /// The adapter's name as the page shows it.
 fn adapter_name(info: &wgpu::AdapterInfo) -> String {
     let mut name = if info.name.is_empty() { info.driver.clone() } else { info.name.clone() };
     if name.is_empty() && info.backend == wgpu::Backend::BrowserWebGpu {
-        name = super::WEBGPU_ADAPTER.with(|a| a.borrow().clone());
+        name = super::inbox::WEBGPU_ADAPTER.with(|a| a.borrow().clone());
     }
     if name.is_empty() {
         match info.backend {

@@ -4,41 +4,16 @@
 
 mod app;
 mod dom;
+mod frames;
+mod inbox;
 mod test_mode;
 
 use crate::dropped::DropBatch;
 use crate::params::{parse_query, ApiChoice, PageParams};
 use crate::presets;
 use app::WebApp;
-use std::cell::RefCell;
+use inbox::{wake, INBOX, WEBGPU_ADAPTER};
 use wasm_bindgen::prelude::*;
-
-/// What the page's script handed in since the viewer's last frame.
-#[derive(Default)]
-struct Inbox {
-    /// The batch being dropped (between `drop_begin` and `drop_end`).
-    dropping: Option<DropBatch>,
-    /// Batches complete.
-    dropped: Vec<DropBatch>,
-    /// A preset chosen in the page's list.
-    preset: Option<String>,
-    /// The viewer's egui context, to wake it.
-    ctx: Option<egui::Context>,
-}
-
-thread_local! {
-    /// The browser's WebGPU adapter in words, from the page's script.
-    static WEBGPU_ADAPTER: RefCell<String> = const { RefCell::new(String::new()) };
-    static INBOX: RefCell<Inbox> = RefCell::new(Inbox::default());
-}
-
-fn wake() {
-    INBOX.with(|i| {
-        if let Some(ctx) = &i.borrow().ctx {
-            ctx.request_repaint();
-        }
-    });
-}
 
 /// The preset scenes' names, for the page's list.
 #[wasm_bindgen]

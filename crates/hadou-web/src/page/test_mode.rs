@@ -4,60 +4,19 @@
 //! cannot present a WebGPU canvas (Chromium's software path loses the device), so the page opens
 //! its own device, draws with `render_to_texture` as the viewport does and reads the texture back
 //! (`read_presented`). On WebGL2 (`backend=webgl`) the viewer runs as usual and renders the frame
-//! on the CPU backend ([`super::app`]).
+//! on the CPU backend (`app.rs`).
 
 use super::dom;
-use crate::export::png_bytes;
+use super::frames::{cpu_frame_bytes, finish, test_frame, DEFAULT_PRESET};
 use crate::params::PageParams;
 use crate::presets;
-use hadou_gpu::GpuBackend;
+use hadou_gpu::{GpuBackend, SoftFit};
 use hadou_scene::{Frame, Scene};
 use wasm_bindgen::JsValue;
 use web_time::Instant;
 
 /// Frames timed after the first (which includes compiling the shaders).
 const TIMED_FRAMES: usize = 5;
-
-/// The test's frame of `scene`: the URL's time and size.
-pub(super) fn test_frame(scene: &Scene, params: &PageParams) -> Result<Frame, String> {
-    let mut f = scene.at(params.time.unwrap_or(0.0));
-    if let Some(w) = params.width {
-        f.width = w;
-    }
-    if let Some(h) = params.height {
-        f.height = h;
-    }
-    scene
-        .check_image_size(f.width, f.height)
-        .map_err(|m| format!("width={} height={}: {m}", f.width, f.height))?;
-    Ok(f)
-}
-
-/// Writes the test's frame (sRGB RGBA bytes) and its times.
-pub(super) fn finish(
-    rgba: &[u8],
-    w: u32,
-    h: u32,
-    backend: &str,
-    adapter: &str,
-    first_ms: f64,
-    frame_ms: Option<f64>,
-) {
-    match png_bytes(rgba, w, h) {
-        Ok(png) => {
-            let frame = frame_ms.map_or("null".to_string(), |m| format!("{m:.2}"));
-            dom::set_text(
-                dom::TEST_TIMING,
-                &format!(
-                    "{{\"backend\": \"{backend}\", \"adapter\": {adapter:?}, \"size\": [{w}, {h}], \
-                     \"first_frame_ms\": {first_ms:.2}, \"frame_ms\": {frame}}}"
-                ),
-            );
-            dom::set_text(dom::TEST_RESULT, &dom::data_url("image/png", &png));
-        }
-        Err(e) => dom::set_text(dom::TEST_ERROR, &e),
-    }
-}
 
 /// Waits a few milliseconds, yielding to the browser.
 async fn tick() {
@@ -98,7 +57,7 @@ pub(super) async fn run_webgpu(params: PageParams, adapter_hint: String) -> Resu
 
 async fn webgpu_frame(params: &PageParams, adapter_hint: &str) -> Result<(), String> {
     hadou_scene::mount_memory_files(Some(presets::files()));
-    let name = params.scene.as_deref().unwrap_or(super::app::DEFAULT_PRESET);
+    let name = params.scene.as_deref().unwrap_or(DEFAULT_PRESET);
     let path = presets::scene_path(name)?;
     let scene = Scene::load(&path).map_err(|e| e.to_string())?;
     let frame = test_frame(&scene, params)?;
@@ -116,10 +75,10 @@ async fn webgpu_frame(params: &PageParams, adapter_hint: &str) -> Result<(), Str
         .map_err(|e| format!("the WebGPU adapter gave no device: {e}"))?;
     let mut gpu = GpuBackend::from_device(&adapter, device.clone(), queue).map_err(|e| e.to_string())?;
     dom::set_text(dom::STATUS, &format!("test mode on WebGPU ({adapter_hint}): the GPU backend draws"));
-    if frame.area_light.is_some() || frame.bloom.is_some() {
-        // As in the viewer: such frames draw on the CPU backend in the page.
+    if frame.bloom.is_some() {
+        // As in the viewer: a frame with glare draws on the CPU backend in the page.
         let t0 = Instant::now();
-        let (bytes, _) = super::app::cpu_frame_bytes(&mut hadou_cpu::CpuBackend::new(), &frame)?;
+        let (bytes, _) = cpu_frame_bytes(&mut hadou_cpu::CpuBackend::new(), &frame)?;
         finish(
             &bytes,
             frame.width,
@@ -131,7 +90,19 @@ async fn webgpu_frame(params: &PageParams, adapter_hint: &str) -> Result<(), Str
         );
         return Ok(());
     }
-    let (bytes, first_ms) = render_and_read(&mut gpu, &device, &frame).await?;
+    let (mut bytes, first_ms) = render_and_read(&mut gpu, &device, &frame).await?;
+    // With an `[area_light]`, the frame again until its soft shadows' maps are fitted to its own
+    // points (the viewer does the same; GpuBackend::soft_fit).
+    for _ in 0..8 {
+        match gpu.soft_fit() {
+            SoftFit::Settled => break,
+            SoftFit::Pending => tick().await,
+            SoftFit::Outdated => bytes = render_and_read(&mut gpu, &device, &frame).await?.0,
+        }
+    }
+    if gpu.soft_fit() != SoftFit::Settled {
+        return Err("the soft shadows' maps did not settle in 8 frames".into());
+    }
     let mut times = Vec::with_capacity(TIMED_FRAMES);
     for _ in 0..TIMED_FRAMES {
         times.push(render_and_read(&mut gpu, &device, &frame).await?.1);
