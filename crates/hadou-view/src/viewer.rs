@@ -122,6 +122,21 @@ pub struct Stats {
     pub ui_ms: f64,
 }
 
+impl Stats {
+    /// Takes the GPU's own time of frame `serial` (timestamps: the whole frame and each pass, in
+    /// ms) as the render time shown.
+    pub fn gpu_timestamps<'a>(
+        &mut self,
+        serial: u64,
+        frame_ms: f64,
+        passes: impl IntoIterator<Item = (&'a str, f64)>,
+    ) {
+        let passes: Vec<String> = passes.into_iter().map(|(name, ms)| format!("{name} {ms:.2} ms")).collect();
+        self.render_ms = frame_ms;
+        self.render_method = format!("GPU timestamps of frame {serial}: {}", passes.join(", "));
+    }
+}
+
 /// A draggable point of a wave in the viewport.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Handle {

@@ -187,11 +187,8 @@ impl WebApp {
     /// texture (no read-back), or the CPU backend's image uploaded.
     fn update_image(&mut self, ctx: &egui::Context) {
         if let Some(t) = self.gpu.as_mut().and_then(|g| g.last_present_timing()) {
-            let passes: Vec<String> =
-                t.passes.iter().map(|p| format!("{} {:.2} ms", p.name, p.median_ms)).collect();
-            self.viewer.stats.render_ms = t.frame_ms;
-            self.viewer.stats.render_method =
-                format!("GPU timestamps of frame {}: {}", t.serial, passes.join(", "));
+            let passes = t.passes.iter().map(|p| (p.name.as_str(), p.median_ms));
+            self.viewer.stats.gpu_timestamps(t.serial, t.frame_ms, passes);
             self.gpu_timed = true;
         }
         let frame = match self.frame() {

@@ -49,11 +49,8 @@ impl App {
         // The GPU's own time of the newest frame whose timestamps have come back (never
         // waits; none on adapters without timestamp queries).
         if let Some(t) = g.gpu.as_mut().and_then(|gpu| gpu.last_present_timing()) {
-            let passes: Vec<String> =
-                t.passes.iter().map(|p| format!("{} {:.2} ms", p.name, p.median_ms)).collect();
-            self.viewer.stats.render_ms = t.frame_ms;
-            self.viewer.stats.render_method =
-                format!("GPU timestamps of frame {}: {}", t.serial, passes.join(", "));
+            let passes = t.passes.iter().map(|p| (p.name.as_str(), p.median_ms));
+            self.viewer.stats.gpu_timestamps(t.serial, t.frame_ms, passes);
             self.gpu_timed = true;
         }
         if changed {
