@@ -175,6 +175,37 @@ class Browser:
         self.log.close()
 
 
+def viewer_checks(browser, base):
+    """Drives the interactive page (backend=webgl) through window.hadou; yields (check, ok, detail)."""
+    target = browser.send("Target.createTarget", {"url": f"{base}?backend=webgl&scene=kamehameha"})["targetId"]
+    session = browser.send("Target.attachToTarget", {"targetId": target, "flatten": True})["sessionId"]
+
+    def js(expr):
+        r = browser.send("Runtime.evaluate", {"expression": expr, "returnByValue": True, "awaitPromise": True}, session)
+        return r.get("result", {}).get("value")
+
+    def wait(expr, seconds=120):
+        started = time.time()
+        while time.time() - started < seconds:
+            v = js(expr)
+            if v:
+                return v
+            time.sleep(0.25)
+        return None
+
+    status = wait("window.hadou && document.getElementById('hadou-status').textContent")
+    yield "starts", bool(status) and "WebGL2" in status, status or "no status line"
+    js("""(() => { const h = window.hadou; h.drop_begin();
+        h.drop_file('bad.toml', new TextEncoder().encode('[camera]\\nfov = \"wide\"\\n')); h.drop_end(); })()""")
+    message = wait("document.getElementById('hadou-message').textContent", 60) or ""
+    yield "a dropped scene with a TOML error", message.startswith("/dropped/bad.toml:2:") and "last good scene" in message, message
+    refusal = js("window.hadou.refuse_file('huge.toml', 2e9)") or ""
+    yield "a file over its size limit", "not read" in refusal and "huge.toml" in refusal, refusal
+    fine = js("window.hadou.refuse_file('hero.glb', 1e6)")
+    yield "a file within its limit", fine is None, repr(fine)
+    browser.send("Target.closeTarget", {"targetId": target})
+
+
 def reference(hadou, scene, t, out):
     subprocess.run([hadou, "render", os.path.join(ROOT, "scenes", scene + ".toml"), "--time", str(t),
                     "--width", str(WIDTH), "--height", str(HEIGHT), "--backend", "cpu", "-o", out], check=True)
@@ -224,6 +255,13 @@ def main():
                   f"first frame {timing.get('first_frame_ms')} ms, then {timing.get('frame_ms')} ms a frame; page run {secs:.1f} s")
             if not ok:
                 failures.append(f"{label}: mean difference {d:.4f} > {MAX_MEAN_DIFF}")
+    # The viewer itself (WebGL2, which headless Chromium can present): it starts, and a dropped
+    # scene with a TOML error is the loader's file:line:col message while the last good scene
+    # stays; a file over its size limit is refused before it is read.
+    for check, ok, detail in viewer_checks(browser, base):
+        print(f"{'ok  ' if ok else 'FAIL'} viewer: {check}: {detail}")
+        if not ok:
+            failures.append(f"viewer: {check}: {detail}")
     # A bad URL is a message in the page, not a blank page.
     for query, want in [("scene=no-such-scene&test=1", "no preset scene"), ("time=soon&test=1", "time=`soon`")]:
         texts, _ = browser.page_texts(f"{base}?{query}", ["hadou-test-error", "hadou-test-result"], 120)

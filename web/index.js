@@ -93,6 +93,8 @@ async function main() {
     select.appendChild(option);
   }
   select.addEventListener("change", () => hadou.open_preset(select.value));
+  // The page's functions for scripts and tests (drop_begin/drop_file/drop_end, open_preset, …).
+  window.hadou = hadou;
   installDrop();
   // Only test mode names the adapter (its report says what drew the frame): some browsers give
   // one WebGPU adapter per page, and the viewer's graphics set-up asks for it next.

@@ -8,7 +8,6 @@ use crate::device::GpuContext;
 use crate::formats::{DEPTH_FORMAT, PLANE_SHADOW_FORMAT, SCENE_FORMAT};
 use crate::layout::{FrameUniforms, TONE_LINEAR};
 use crate::meshes::MeshCache;
-#[cfg(not(target_arch = "wasm32"))]
 use crate::passes::bloom::{self, BloomInputs, BloomPass};
 use crate::passes::edges::{EdgeInputs, EdgePass};
 use crate::passes::plane_shadows::{PlaneShadowInputs, PlaneShadowPass};
@@ -23,8 +22,9 @@ use crate::passes::wave::{WaveInputs, WavePass};
 use crate::passes::wave_overlay::WaveOverlayPass;
 use crate::prepare::{self, FrameBuffers, FrameData, ShadowFields};
 use crate::timing::PassQueries;
+use hadou_scene::BloomParams;
 #[cfg(not(target_arch = "wasm32"))]
-use hadou_scene::{BloomParams, Image};
+use hadou_scene::Image;
 use hadou_scene::{Frame, RenderError};
 
 /// Largest tile edge in pixels (smaller when the device's limits demand it).
@@ -151,8 +151,6 @@ pub(crate) struct Passes {
     shadow_maps: ShadowMapPass,
     soft: SoftPass,
     pub(crate) wave: WavePass,
-    /// Not built on the web, where no frame runs it (its pipelines would only cost compile time).
-    #[cfg(not(target_arch = "wasm32"))]
     bloom: BloomPass,
 }
 
@@ -221,7 +219,6 @@ impl Renderer {
             plane_shadows: PlaneShadowPass::new(&ctx)?,
             shadow_maps: ShadowMapPass::new(&ctx)?,
             soft: SoftPass::new(&ctx)?,
-            #[cfg(not(target_arch = "wasm32"))]
             bloom: BloomPass::new(&ctx)?,
         };
         Ok(Self {
@@ -772,8 +769,27 @@ impl Renderer {
         params: &BloomParams,
         rows: std::ops::Range<u32>,
     ) -> Result<Image, RenderError> {
-        let limit = self.ctx.limits.max_storage_buffer_binding_size.min(self.ctx.limits.max_buffer_size);
         let mut image = alloc_image(frame.width, rows.len() as u32)?;
+        for band in self.glare_bands(frame, params, rows.clone())? {
+            let part = self.glare_band(frame, params, band.clone())?;
+            let w = frame.width as usize;
+            let at = (band.start - rows.start as usize) * w;
+            image.color[at..at + part.color.len()].copy_from_slice(&part.color);
+            image.energy[at..at + part.energy.len()].copy_from_slice(&part.energy);
+            image.depth[at..at + part.depth.len()].copy_from_slice(&part.depth);
+        }
+        Ok(image)
+    }
+
+    /// `rows` cut into the longest bands whose rows and glare halo fit one storage binding.
+    pub(crate) fn glare_bands(
+        &self,
+        frame: &Frame,
+        params: &BloomParams,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Vec<std::ops::Range<usize>>, RenderError> {
+        let limit = self.ctx.limits.max_storage_buffer_binding_size.min(self.ctx.limits.max_buffer_size);
+        let mut bands = Vec::new();
         let mut y = rows.start as usize;
         while y < rows.end as usize {
             // The longest band from y whose source rows fit.
@@ -788,19 +804,13 @@ impl Renderer {
                 }
                 len = len.div_ceil(2);
             }
-            let band = y..y + len;
-            let part = self.glare_band(frame, params, band.clone())?;
-            let w = frame.width as usize;
-            let at = (band.start - rows.start as usize) * w;
-            image.color[at..at + part.color.len()].copy_from_slice(&part.color);
-            image.energy[at..at + part.energy.len()].copy_from_slice(&part.energy);
-            image.depth[at..at + part.depth.len()].copy_from_slice(&part.depth);
+            bands.push(y..y + len);
             y += len;
         }
-        Ok(image)
+        Ok(bands)
     }
 
-    /// One band of [`Renderer::render_rows_glare`].
+    /// One band of [`Renderer::render_rows_glare`], read back.
     #[cfg(not(target_arch = "wasm32"))]
     fn glare_band(
         &mut self,
@@ -810,9 +820,56 @@ impl Renderer {
     ) -> Result<Image, RenderError> {
         let (w, h) = (frame.width as usize, frame.height as usize);
         let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
-        let mut prepared = self.prepare(frame, src.start as u32..src.end as u32)?;
-        prepared.linear = true;
         let mut image = alloc_image(frame.width, src.len() as u32)?;
+        // Each tile read back after its submission (its energy and depth; the colour comes from
+        // the glare).
+        let (out, mut encoder) =
+            self.glare_chain(frame, params, band.clone(), |r, submission, origin, size| {
+                let origin = [origin[0], origin[1] - src.start as u32];
+                let bytes = u64::from(size[0]) * u64::from(size[1]) * FLOATS_PER_PIXEL * 4;
+                let staging = &r.targets.as_ref().expect("targets exist").staging;
+                r.ctx.read_buffer(staging, bytes, submission, |raw| copy_tile(&mut image, raw, origin, size))
+            })?;
+        let bytes = (band.len() * w) as u64 * bloom::TEXEL_BYTES;
+        let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bloom read-back"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let submission = self.ctx.scoped("drawing the bloom", || {
+            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
+            self.ctx.queue.submit([encoder.finish()])
+        })?;
+        let first = (band.start - src.start) * w;
+        self.ctx.read_buffer(&staging, bytes, submission, |raw| {
+            let mut floats = vec![0.0f32; raw.len() / 4];
+            for (f, c) in floats.iter_mut().zip(raw.chunks_exact(4)) {
+                *f = f32::from_ne_bytes([c[0], c[1], c[2], c[3]]);
+            }
+            for (px, c) in image.color[first..first + band.len() * w].iter_mut().zip(floats.chunks_exact(4)) {
+                px.copy_from_slice(c);
+            }
+        })?;
+        Ok(image.crop_rows((band.start - src.start) as u32..(band.end - src.start) as u32))
+    }
+
+    /// The glare of the rows `band`: the tiles of its source rows (the band and its halo) drawn
+    /// with the linear colour, each tile's colour gathered into one buffer (`after_tile` runs after
+    /// each tile's submission, with its origin and size in image pixels), then the glare chain
+    /// recorded into a new encoder, not yet submitted. Returns the band's mapped colour (4
+    /// floats a pixel, row-major over the band) and that encoder.
+    pub(crate) fn glare_chain(
+        &mut self,
+        frame: &Frame,
+        params: &BloomParams,
+        band: std::ops::Range<usize>,
+        mut after_tile: impl FnMut(&Self, wgpu::SubmissionIndex, [u32; 2], [u32; 2]) -> Result<(), RenderError>,
+    ) -> Result<(wgpu::Buffer, wgpu::CommandEncoder), RenderError> {
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
+        let mut prepared = self.prepare_frame(frame, src.start as u32..src.end as u32, true)?;
+        prepared.linear = true;
         let linear = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("bloom linear colour"),
             size: (src.len() * w) as u64 * bloom::TEXEL_BYTES,
@@ -834,48 +891,22 @@ impl Renderer {
                 }
                 self.submit_tile(encoders)
             })??;
-            let origin = [origin[0], origin[1] - src.start as u32];
-            let bytes = u64::from(size[0]) * u64::from(size[1]) * FLOATS_PER_PIXEL * 4;
-            let staging = &self.targets.as_ref().expect("targets exist").staging;
-            self.ctx.read_buffer(staging, bytes, submission, |raw| {
-                copy_tile(&mut image, raw, origin, size);
-            })?;
+            after_tile(self, submission, origin, size)?;
         }
-        let bytes = (band.len() * w) as u64 * bloom::TEXEL_BYTES;
         let d = &self.ctx.device;
-        let staging = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("bloom read-back"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let submission = self.ctx.scoped("drawing the bloom", || {
-            let mut encoder =
-                d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bloom") });
-            let inputs = BloomInputs {
-                params,
-                tone: frame.color_mapping.mode,
-                width: frame.width,
-                height: frame.height,
-                linear: &linear,
-                source: src.clone(),
-                band: band.clone(),
-            };
-            let out = self.passes.bloom.encode(d, &mut encoder, &inputs);
-            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
-            self.ctx.queue.submit([encoder.finish()])
-        })?;
-        let first = (band.start - src.start) * w;
-        self.ctx.read_buffer(&staging, bytes, submission, |raw| {
-            let mut floats = vec![0.0f32; raw.len() / 4];
-            for (f, c) in floats.iter_mut().zip(raw.chunks_exact(4)) {
-                *f = f32::from_ne_bytes([c[0], c[1], c[2], c[3]]);
-            }
-            for (px, c) in image.color[first..first + band.len() * w].iter_mut().zip(floats.chunks_exact(4)) {
-                px.copy_from_slice(c);
-            }
-        })?;
-        Ok(image.crop_rows((band.start - src.start) as u32..(band.end - src.start) as u32))
+        let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bloom") });
+        let inputs = BloomInputs {
+            params,
+            tone: frame.color_mapping.mode,
+            width: frame.width,
+            height: frame.height,
+            linear: &linear,
+            source: src.clone(),
+            band: band.clone(),
+        };
+        let out =
+            self.ctx.scoped("recording the bloom", || self.passes.bloom.encode(d, &mut encoder, &inputs))?;
+        Ok((out, encoder))
     }
 }
 

@@ -4,9 +4,10 @@
 //! for the GPU: the tiles are submitted and the texture's view returned; a window drawing the
 //! texture on the same queue sees the finished frame, as queue order guarantees. With timestamp
 //! queries each such frame's passes are timed without waiting (`timing::PresentTimer`). A frame
-//! with a `[bloom]` is the exception: its glare needs the whole image, so it is rendered as for a
-//! read-back and uploaded (waiting for the GPU; not on wasm32, where it is drawn without glare).
+//! with a `[bloom]` draws its glare after the tiles of each band, then presents the band's
+//! mapped colour: no read-back either, on the web too.
 
+use crate::layout::FrameUniforms;
 use crate::passes::present::{PresentedFrame, Presenter};
 use crate::render::Renderer;
 use crate::texture_read::TextureRead;
@@ -32,7 +33,6 @@ impl Renderer {
         if self.present.is_none() {
             self.present = Some(Presenter::new(&self.ctx)?);
         }
-        #[cfg(not(target_arch = "wasm32"))]
         if frame.bloom.is_some() {
             return self.render_glare_to_texture(frame);
         }
@@ -86,39 +86,45 @@ impl Renderer {
     }
 
     /// [`Renderer::render_to_texture`] of a frame with a `[bloom]`: the glare spreads light across
-    /// tiles, so the tiles' present pass cannot draw it; the frame is rendered as for a read-back
-    /// (the tiles, the glare chain and the colour mapping: `render_rows`) and its colour uploaded
-    /// into the texture in the present pass's encoding (sRGB codes of the colour,
-    /// `hadou_math::shade::linear_to_srgb8`; alpha as unorm). Such frames wait for the GPU and are
-    /// not timed.
-    #[cfg(not(target_arch = "wasm32"))]
+    /// tiles, so it runs once the tiles of a band (and its halo) are drawn. Per band
+    /// ([`Renderer::glare_bands`]) the tiles' linear colour is gathered and the glare chain run
+    /// ([`Renderer::glare_chain`], as `render_rows` does), and the present pass copies the band's
+    /// mapped colour into the texture as it copies a tile's: nothing is read back or waited for,
+    /// so it runs on the web too.
     fn render_glare_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
-        let image = self.render_rows(frame, 0..frame.height)?;
+        let params = frame.bloom.expect("a frame with a [bloom]");
         let size = [frame.width, frame.height];
-        let mut bytes = vec![0u8; 4 * image.color.len()];
-        hadou_math::shade::rgba_to_srgba8(&image.color, &mut bytes);
-        for (o, c) in bytes.chunks_exact_mut(4).zip(&image.color) {
-            o[3] = (c[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-        }
         let present = self.present.as_mut().expect("made by the caller");
         present.serial += 1;
         let serial = present.serial;
         let recreated = self
             .ctx
             .scoped("creating the window texture", || present.ensure_target(&self.ctx.device, size))?;
-        let target = present.target.as_ref().expect("made above");
-        self.ctx.scoped("uploading the glare frame into the window texture", || {
-            self.ctx.queue.write_texture(
-                target.texture.as_image_copy(),
-                &bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * size[0]),
-                    rows_per_image: Some(size[1]),
-                },
-                wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
-            )
-        })?;
+        for band in self.glare_bands(frame, &params, 0..frame.height)? {
+            let (out, mut encoder) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
+            // The present pass reads the tile's place from the uniforms: the band, in image pixels.
+            let mut u: FrameUniforms = bytemuck::Zeroable::zeroed();
+            u.grid = 1;
+            u.tile_origin = [0, band.start as u32];
+            u.tile_size = [frame.width, band.len() as u32];
+            let d = &self.ctx.device;
+            let uniforms = d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("glare present uniforms"),
+                size: std::mem::size_of::<FrameUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.ctx.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&u));
+            let present = self.present.as_ref().expect("made by the caller");
+            let target = present.target.as_ref().expect("made above");
+            self.ctx.scoped("drawing the glare into the window texture", || {
+                let bind_group = present.pass.bind_group(d, &uniforms, &out);
+                let rect = ([0, band.start as u32], [frame.width, band.len() as u32]);
+                present.pass.encode(&mut encoder, &target.view, rect, &bind_group, None);
+                self.ctx.queue.submit([encoder.finish()]);
+            })?;
+        }
+        let target = self.present.as_ref().and_then(|p| p.target.as_ref()).expect("made above");
         Ok(PresentedFrame { texture: &target.texture, view: &target.view, size, recreated, serial })
     }
 

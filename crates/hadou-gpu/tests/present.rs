@@ -188,6 +188,9 @@ fn two_sizes_in_a_row_and_several_tiles() {
     let wide = scene_frame("kamehameha.toml", 0.25, hadou_gpu::MAX_TILE + 20, 24);
     assert!(check(&mut gpu, "1044×24", &wide), "a new size makes a new texture");
     assert!(check(&mut gpu, "96×64 after 1044×24", &small), "and back");
+    // Glare over two tiles: the band's glare presented after both.
+    let glare = scene_frame("glare-kamehameha.toml", 0.5, hadou_gpu::MAX_TILE + 20, 24);
+    assert!(check(&mut gpu, "glare 1044×24", &glare), "a new size makes a new texture");
 }
 
 /// Waits here (test code may) until the backend's latest present timing is of frame `serial` or

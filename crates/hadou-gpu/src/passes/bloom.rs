@@ -4,10 +4,6 @@
 //! 13-tap downsamples and tent upsamples of [`Plan`]'s rows, the horizontal streak over the band's
 //! rows, and the composite with the frame's colour mapping into the band's colour. One dispatch
 //! per step, each with its own small uniform buffer and bind group.
-//!
-//! On the web (`wasm32`) nothing runs the chain yet: it ends in a read-back, which a page cannot
-//! wait for, so the web page draws frames with a `[bloom]` on the CPU backend.
-#![cfg_attr(target_arch = "wasm32", allow(dead_code))]
 
 use super::setup::{self, Binding, Kind};
 use crate::device::GpuContext;

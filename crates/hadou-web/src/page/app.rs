@@ -171,11 +171,9 @@ impl WebApp {
         Ok(f)
     }
 
-    /// Whether `frame` is drawn by the GPU backend. A frame with a `[bloom]` is drawn by the CPU
-    /// backend in the page: the GPU backend composes the glare after reading the image back,
-    /// which a page cannot wait for.
-    fn on_gpu(&self, frame: &Frame) -> bool {
-        self.backend == BackendKind::Gpu && self.gpu.is_some() && frame.bloom.is_none()
+    /// Whether the GPU backend draws: chosen, and the page runs on WebGPU.
+    fn on_gpu(&self) -> bool {
+        self.backend == BackendKind::Gpu && self.gpu.is_some()
     }
 
     /// Renders `frame` on the CPU into sRGB RGBA bytes and the render time (ms).
@@ -210,7 +208,7 @@ impl WebApp {
             return;
         }
         self.drawn = Some(key);
-        if self.on_gpu(&frame) {
+        if self.on_gpu() {
             let t0 = Instant::now();
             let gpu = self.gpu.as_mut().expect("checked");
             match gpu.render_to_texture(&frame) {
@@ -366,7 +364,7 @@ impl WebApp {
             Ok(f) => f,
             Err(m) => return self.viewer.complain(m),
         };
-        if self.on_gpu(&frame) {
+        if self.on_gpu() {
             // The viewport's texture holds the frame once it is current.
             self.drawn = None;
             let gpu = self.gpu.as_mut().expect("checked");
@@ -444,7 +442,7 @@ impl WebApp {
             let (w, h) = (frame.width, frame.height);
             frame = at;
             (frame.width, frame.height) = (w, h);
-            if self.on_gpu(&frame) {
+            if self.on_gpu() {
                 let gpu = self.gpu.as_mut().expect("checked");
                 gpu.render_to_texture(&frame).map_err(|e| e.to_string())?;
                 ex.reading = gpu.read_presented();

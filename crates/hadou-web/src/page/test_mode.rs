@@ -7,7 +7,7 @@
 //! on the CPU backend (`app.rs`).
 
 use super::dom;
-use super::frames::{cpu_frame_bytes, finish, test_frame, DEFAULT_PRESET};
+use super::frames::{finish, test_frame, DEFAULT_PRESET};
 use crate::params::PageParams;
 use crate::presets;
 use hadou_gpu::{GpuBackend, SoftFit};
@@ -75,21 +75,6 @@ async fn webgpu_frame(params: &PageParams, adapter_hint: &str) -> Result<(), Str
         .map_err(|e| format!("the WebGPU adapter gave no device: {e}"))?;
     let mut gpu = GpuBackend::from_device(&adapter, device.clone(), queue).map_err(|e| e.to_string())?;
     dom::set_text(dom::STATUS, &format!("test mode on WebGPU ({adapter_hint}): the GPU backend draws"));
-    if frame.bloom.is_some() {
-        // As in the viewer: a frame with glare draws on the CPU backend in the page.
-        let t0 = Instant::now();
-        let (bytes, _) = cpu_frame_bytes(&mut hadou_cpu::CpuBackend::new(), &frame)?;
-        finish(
-            &bytes,
-            frame.width,
-            frame.height,
-            "CPU",
-            adapter_hint,
-            t0.elapsed().as_secs_f64() * 1e3,
-            None,
-        );
-        return Ok(());
-    }
     let (mut bytes, first_ms) = render_and_read(&mut gpu, &device, &frame).await?;
     // With an `[area_light]`, the frame again until its soft shadows' maps are fitted to its own
     // points (the viewer does the same; GpuBackend::soft_fit).
