@@ -26,12 +26,14 @@ import zlib
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WEB = os.path.join(ROOT, "target", "web")
 WIDTH, HEIGHT = 320, 180
-# (scene, time): the Kamehameha at 1.5 s, and one light-, one shadow- and one soft- scene.
+# (scene, time): the Kamehameha at 1.5 s, one light-, one shadow- and one soft- scene, and the
+# glare (drawn on the GPU in the page too).
 CASES = [
     ("kamehameha", 1.5),
     ("light-from-front", 1.0),
     ("shadow-wave-top", 1.0),
     ("soft-gradient", 0.5),
+    ("glare-kamehameha", 1.5),
 ]
 MAX_MEAN_DIFF = 1.0
 # How long one page may take to show its frame (SwiftShader compiles the wave shader on the CPU).
