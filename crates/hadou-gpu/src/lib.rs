@@ -75,7 +75,9 @@
 //! [`GpuBackend::from_device`] (the page requests the adapter and device asynchronously itself,
 //! with [`device_descriptor`]), [`GpuBackend::render_to_texture`],
 //! [`GpuBackend::encode_wave_overlay`],
-//! [`GpuBackend::last_present_timing`] and the accessors. Everything
+//! [`GpuBackend::last_present_timing`], [`GpuBackend::read_presented`] (the drawn texture read
+//! back without waiting), [`GpuBackend::soft_fit`] (whether an `[area_light]` frame should be
+//! drawn again now that its soft shadows' fit has come back) and the accessors. Everything
 //! that waits for the GPU — [`GpuBackend::new`], [`find_adapter`], the [`Backend`] impl (it reads
 //! the image back), `render_soft` and [`GpuBackend::time_frame`] — exists only off the web. There,
 //! wgpu error scopes are not used (their results arrive asynchronously): errors reach the
