@@ -101,7 +101,7 @@ impl Renderer {
             .ctx
             .scoped("creating the window texture", || present.ensure_target(&self.ctx.device, size))?;
         for band in self.glare_bands(frame, &params, 0..frame.height)? {
-            let (out, mut encoder) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
+            let (out, encoder) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
             // The present pass reads the tile's place from the uniforms: the band, in image pixels.
             let mut u: FrameUniforms = bytemuck::Zeroable::zeroed();
             u.grid = 1;
@@ -117,7 +117,19 @@ impl Renderer {
             self.ctx.queue.write_buffer(&uniforms, 0, bytemuck::bytes_of(&u));
             let present = self.present.as_ref().expect("made by the caller");
             let target = present.target.as_ref().expect("made above");
+            // The glare's compute passes and the present pass that reads their output go in
+            // separate submissions, on OpenGL with a fence wait between them, as a tile's passes
+            // do (`Renderer::submit_tile`).
+            let glare = self.ctx.scoped("drawing the glare", || self.ctx.queue.submit([encoder.finish()]))?;
+            #[cfg(not(target_arch = "wasm32"))]
+            if self.ctx.info.backend == wgpu::Backend::Gl {
+                self.ctx.wait(glare)?;
+            }
+            #[cfg(target_arch = "wasm32")]
+            let _ = glare;
             self.ctx.scoped("drawing the glare into the window texture", || {
+                let mut encoder = d
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("glare present") });
                 let bind_group = present.pass.bind_group(d, &uniforms, &out);
                 let rect = ([0, band.start as u32], [frame.width, band.len() as u32]);
                 present.pass.encode(&mut encoder, &target.view, rect, &bind_group, None);
