@@ -1,6 +1,8 @@
 //! Times the CPU backend's passes on one scene: `cargo run --release -p hadou-cpu --example parts
 //! -- SCENE [SIZE] [TIME] [SAMPLES]` prints the median whole render and its opaque, wave and colour parts
-//! (`CpuBackend::render_into`, reusing its buffers) over nine runs.
+//! over nine runs, on every vector path the CPU supports, into the float image
+//! (`CpuBackend::render_into_on`) and into 8-bit sRGB (`CpuBackend::render_rgb8_into`), reusing
+//! the buffers.
 use hadou_scene::Scene;
 
 /// Prints `msg` and exits with status 2 (bad arguments).
@@ -39,20 +41,35 @@ fn main() {
         }
     }
     let mut cpu = hadou_cpu::CpuBackend::new();
-    let mut image = hadou_scene::Image::new(0, 0);
-    cpu.render_into(&frame, &mut image);
-    let mut runs: Vec<(f64, hadou_cpu::PassTimes)> = (0..9)
-        .map(|_| {
-            let start = std::time::Instant::now();
-            let p = cpu.render_into(&frame, &mut image);
-            (start.elapsed().as_secs_f64() * 1e3, p)
-        })
-        .collect();
-    runs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let (ms, p) = runs[runs.len() / 2];
-    let mpx = (size as f64).powi(2) / (ms * 1e3);
-    println!(
-        "{path} {size}² × {} samples: {ms:.2} ms ({mpx:.1} Mpx/s) = opaque {:.2} + wave {:.2} + colour {:.2}",
-        frame.samples, p.opaque_ms, p.wave_ms, p.color_ms
-    );
+    for simd in hadou_math::simd::SimdPath::supported() {
+        let mut image = hadou_scene::Image::new(0, 0);
+        let mut bytes = hadou_scene::Rgb8Image::default();
+        for (what, mut draw) in [
+            (
+                "float",
+                Box::new(|cpu: &mut hadou_cpu::CpuBackend| cpu.render_into_on(&frame, &mut image, simd))
+                    as Box<dyn FnMut(&mut hadou_cpu::CpuBackend) -> hadou_cpu::PassTimes>,
+            ),
+            (
+                "sRGB8",
+                Box::new(|cpu: &mut hadou_cpu::CpuBackend| cpu.render_rgb8_into(&frame, &mut bytes, simd)),
+            ),
+        ] {
+            draw(&mut cpu);
+            let mut runs: Vec<(f64, hadou_cpu::PassTimes)> = (0..9)
+                .map(|_| {
+                    let start = std::time::Instant::now();
+                    let p = draw(&mut cpu);
+                    (start.elapsed().as_secs_f64() * 1e3, p)
+                })
+                .collect();
+            runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let (ms, p) = runs[runs.len() / 2];
+            let mpx = (size as f64).powi(2) / (ms * 1e3);
+            println!(
+                "{path} {size}² × {} samples, {simd}, {what}: {ms:.2} ms ({mpx:.1} Mpx/s) = opaque {:.2} + wave {:.2} + colour {:.2}",
+                frame.samples, p.opaque_ms, p.wave_ms, p.color_ms
+            );
+        }
+    }
 }

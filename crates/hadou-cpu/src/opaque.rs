@@ -78,13 +78,6 @@ pub(crate) fn draw_opaque(frame: &Frame, setup: &FrameSetup, rows: std::ops::Ran
     out
 }
 
-/// Resizes `v` to `n` copies of `x`, reusing its allocation (every element is rewritten, so a
-/// reused buffer costs a fill, not fresh pages).
-fn refill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
-    v.clear();
-    v.resize(n, x);
-}
-
 /// [`draw_opaque`] into `out`, reusing its buffers' allocations from an earlier frame. Bands of
 /// rows that no triangle or shadow touches are filled with the background without further work.
 pub(crate) fn draw_opaque_into(
@@ -101,15 +94,16 @@ pub(crate) fn draw_opaque_into(
     let bands = Bands::new(&tris, frame.height as usize, &rows);
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
     let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge } = out;
-    // Every element is written below: the fills only size the buffers.
-    refill(color, w * h, [0.0f32; 3]);
-    refill(surface, w * h, None);
-    refill(object, w * h, None);
-    refill(shadow, w * h, None);
-    refill(edge, w * h, EdgeTexel::default());
+    // Sized only: every band clears its own rows below, the bands in parallel (a frame of waves
+    // alone pays for these writes, some 50 bytes a pixel, on every thread rather than one).
+    color.resize(w * h, [0.0f32; 3]);
+    surface.resize(w * h, None);
+    object.resize(w * h, None);
+    shadow.resize(w * h, None);
+    edge.resize(w * h, EdgeTexel::default());
     visibility.clear();
     let area = frame.area_light.as_ref();
-    refill(soft, if area.is_some() { w * h } else { 0 }, None);
+    soft.resize(if area.is_some() { w * h } else { 0 }, None);
     if w * h == 0 {
         return;
     }
@@ -148,8 +142,13 @@ pub(crate) fn draw_opaque_into(
                 let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
                 let y_start = rows.start + b * BAND;
                 let rows = col.len() / w;
+                surf.fill(None);
+                obj.fill(None);
+                shad.fill(None);
+                edg.fill(EdgeTexel::default());
+                soft.fill(None);
                 if mine().next().is_none() && mine_shadows().next().is_none() {
-                    // Nothing drawn here (the refills left surface, object, shadow and soft empty).
+                    // Nothing drawn here.
                     col.fill(frame.background);
                     return;
                 }

@@ -81,19 +81,17 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();
     let pass = WavePass::new(frame, &setup.basis, &setup.curves);
-    let s = hadou_math::energy::lanes::Lanes::splat(surface.unwrap_or(f32::INFINITY));
-    let depth = pass.energies(x as usize, y as f32, s, 1, |wi, e, n| {
-        let wave = &frame.waves[wi];
-        let e = e.to_array()[0];
+    let (energies, depth) = pass.pixel_energies(x as usize, y as f32, surface);
+    for (wave, (e, n)) in frame.waves.iter().zip(energies) {
         waves::accumulate(&mut light, wave, e);
-        out.push(WaveProbe { name: wave.name.clone(), energy: e, evaluations: n[0] });
-    });
+        out.push(WaveProbe { name: wave.name.clone(), energy: e, evaluations: n });
+    }
     Some(Probe {
         x,
         y,
         waves: out,
         color: waves::compose(frame, opaque.color[i], light),
-        depth: depth.to_array()[0],
+        depth,
         object: opaque.object[i].map(|o| frame.objects[o as usize].name.clone()),
         shadow: opaque.shadow[i].map(|s| frame.shadows[s as usize].name.clone()),
         soft: opaque.visibility.get(i).copied().filter(|_| surface.is_some() && opaque.object[i].is_some()),

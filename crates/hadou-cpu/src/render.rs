@@ -11,9 +11,10 @@ use crate::edges;
 use crate::opaque::{draw_opaque_into, OpaqueBuffers};
 use crate::setup::FrameSetup;
 use crate::soft;
-use crate::waves::{BatchLight, WavePass};
+use crate::waves::{BatchLight, RowOut, WavePass};
 use hadou_math::energy::lanes::LANES;
-use hadou_scene::{Backend, Frame, Image, RenderError};
+use hadou_math::simd::SimdPath;
+use hadou_scene::{Backend, Frame, Image, RenderError, Rgb8Image};
 use rayon::prelude::*;
 #[cfg(target_arch = "wasm32")]
 use web_time::Instant;
@@ -42,8 +43,26 @@ impl CpuBackend {
     /// or a benchmark drawing frame after frame wants) and returns the passes' times; the same
     /// pixels as [`render`].
     pub fn render_into(&mut self, frame: &Frame, image: &mut Image) -> PassTimes {
-        render_with(frame, 0..frame.height, &mut self.scratch, image)
+        render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), SimdPath::current())
     }
+
+    /// [`CpuBackend::render_into`] for a PNG: only the 8-bit sRGB bytes, written by the colour
+    /// stage straight from its lanes (no float colour, energy or depth buffer), on the vector path
+    /// `simd`. The same bytes as [`Rgb8Image::from_image`] of [`render`] on that path.
+    pub fn render_rgb8_into(&mut self, frame: &Frame, image: &mut Rgb8Image, simd: SimdPath) -> PassTimes {
+        render_with(frame, 0..frame.height, &mut self.scratch, Target::Srgb8(image), simd)
+    }
+
+    /// [`CpuBackend::render_into`] on the vector path `simd` instead of [`SimdPath::current`].
+    pub fn render_into_on(&mut self, frame: &Frame, image: &mut Image, simd: SimdPath) -> PassTimes {
+        render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), simd)
+    }
+}
+
+/// What a render writes: the float image, or the 8-bit sRGB a PNG needs.
+enum Target<'a> {
+    Float(&'a mut Image),
+    Srgb8(&'a mut Rgb8Image),
 }
 
 impl Backend for CpuBackend {
@@ -57,6 +76,16 @@ impl Backend for CpuBackend {
 
     fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
         Ok(render_rows(frame, rows))
+    }
+
+    fn render_rows_rgb8(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Rgb8Image, RenderError> {
+        let mut out = Rgb8Image::default();
+        render_with(frame, rows, &mut self.scratch, Target::Srgb8(&mut out), SimdPath::current());
+        Ok(out)
     }
 }
 
@@ -90,7 +119,8 @@ pub struct PassTimes {
 pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTimes) {
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let mut img = Image::new(frame.width, y1.max(y0) - y0);
-    let times = render_with(frame, rows, &mut OpaqueBuffers::default(), &mut img);
+    let times =
+        render_with(frame, rows, &mut OpaqueBuffers::default(), Target::Float(&mut img), SimdPath::current());
     (img, times)
 }
 
@@ -102,7 +132,8 @@ fn render_with(
     frame: &Frame,
     rows: std::ops::Range<u32>,
     scratch: &mut OpaqueBuffers,
-    img: &mut Image,
+    target: Target<'_>,
+    simd: SimdPath,
 ) -> PassTimes {
     let start = Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
@@ -126,39 +157,69 @@ fn render_with(
         k,
         opaque: scratch,
         oy0,
-        pass: WavePass::new(frame, &setup.basis, &setup.curves),
-        samples: WavePass::new(surfaces, &setup.basis, &setup.curves),
+        pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
+        samples: WavePass::new(surfaces, &setup.basis, &setup.curves).on_path(simd),
     };
     if let Some(params) = glare {
-        return glare_rows(frame, params, &source, src, band, img, (start, opaque_done));
+        return match target {
+            Target::Float(img) => glare_rows(frame, params, &source, src, band, img, (start, opaque_done)),
+            Target::Srgb8(out) => {
+                // The glare needs the linear colour of the band and its halo: the float image,
+                // then its bytes.
+                let mut img = Image::new(0, 0);
+                let times = glare_rows(frame, params, &source, src, band, &mut img, (start, opaque_done));
+                let srgb = hadou_math::shade::srgb8_encoder();
+                (out.width, out.height) = (img.width, img.height);
+                out.rgb.clear();
+                out.rgb.extend(
+                    img.color.iter().flat_map(|c| [srgb.code(c[0]), srgb.code(c[1]), srgb.code(c[2])]),
+                );
+                times
+            }
+        };
     }
 
     let w = frame.width as usize;
     let n = w * (y1 - y0) as usize;
-    (img.width, img.height) = (frame.width, y1 - y0);
-    // Every pixel is written below: the resizes only size the buffers.
-    img.color.resize(n, [0.0; 4]);
-    img.energy.resize(n, 0.0);
-    img.depth.resize(n, 0.0);
-    // Each row: the wave pass into a row buffer, then the colour mapping from it; the threads'
+    // Each row: the wave pass into a row buffer, then the colour stage from it; the threads'
     // time in each, to split the wall time between them.
     let wave_ns = std::sync::atomic::AtomicU64::new(0);
     let color_ns = std::sync::atomic::AtomicU64::new(0);
-    img.color
-        .par_chunks_mut(w)
-        .zip(img.energy.par_chunks_mut(w))
-        .zip(img.depth.par_chunks_mut(w))
-        .enumerate()
-        .for_each_init(RowBuffers::default, |bufs, (r, ((col, en), dep))| {
-            let t0 = Instant::now();
-            let (light, scene) = source.light_row(y0 as usize + r, bufs);
-            let t1 = Instant::now();
-            source.pass.row_color(light, scene, col, en, dep);
-            let t2 = Instant::now();
-            let ns = |d: std::time::Duration| d.as_nanos() as u64;
-            wave_ns.fetch_add(ns(t1 - t0), std::sync::atomic::Ordering::Relaxed);
-            color_ns.fetch_add(ns(t2 - t1), std::sync::atomic::Ordering::Relaxed);
-        });
+    let row = |bufs: &mut RowBuffers, r: usize, out: RowOut<'_>| {
+        let t0 = Instant::now();
+        let (light, scene) = source.light_row(y0 as usize + r, bufs);
+        let t1 = Instant::now();
+        source.pass.row_color(light, scene, out);
+        let t2 = Instant::now();
+        let ns = |d: std::time::Duration| d.as_nanos() as u64;
+        wave_ns.fetch_add(ns(t1 - t0), std::sync::atomic::Ordering::Relaxed);
+        color_ns.fetch_add(ns(t2 - t1), std::sync::atomic::Ordering::Relaxed);
+    };
+    match target {
+        Target::Float(img) => {
+            (img.width, img.height) = (frame.width, y1 - y0);
+            // Every pixel is written below: the resizes only size the buffers.
+            img.color.resize(n, [0.0; 4]);
+            img.energy.resize(n, 0.0);
+            img.depth.resize(n, 0.0);
+            img.color
+                .par_chunks_mut(w)
+                .zip(img.energy.par_chunks_mut(w))
+                .zip(img.depth.par_chunks_mut(w))
+                .enumerate()
+                .for_each_init(RowBuffers::default, |bufs, (r, ((color, energy), depth))| {
+                    row(bufs, r, RowOut::Float { color, energy, depth })
+                });
+        }
+        Target::Srgb8(out) => {
+            (out.width, out.height) = (frame.width, y1 - y0);
+            out.rgb.resize(3 * n, 0);
+            out.rgb
+                .par_chunks_mut(3 * w.max(1))
+                .enumerate()
+                .for_each_init(RowBuffers::default, |bufs, (r, bytes)| row(bufs, r, RowOut::Srgb8(bytes)));
+        }
+    }
     let end = Instant::now();
     let (wn, cn) = (wave_ns.into_inner() as f64, color_ns.into_inner() as f64);
     let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };

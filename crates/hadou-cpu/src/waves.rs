@@ -2,9 +2,10 @@
 //! the colour mapping.
 
 use hadou_math::curve::{self, PreparedCurve};
-use hadou_math::energy::lanes::{self, Lanes, RayLanes, LANES, V3};
+use hadou_math::energy::lanes::{self, RayLanes, LANES, V3};
 use hadou_math::energy::{self, Falloff, FieldParams, Ray};
 use hadou_math::shade;
+use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
 use hadou_math::Vec3;
 use hadou_scene::{CameraBasis, Frame, ToneMode, Wave, WaveShape};
 
@@ -32,53 +33,58 @@ fn analytic_evaluations(shape: &WaveShape) -> u32 {
 }
 
 /// The wave pass's per-frame set-up: the camera, the curves' piece tables, which ray kinds the
-/// waves need and each wave's `rgb·a`.
+/// waves need, each wave's `rgb·a`, and the vector path its lanes run on.
 pub(crate) struct WavePass<'a> {
     frame: &'a Frame,
     basis: &'a CameraBasis,
     curves: &'a [Option<PreparedCurve>],
     faithful: bool,
     inverse_square: bool,
-    colors: Vec<[Lanes; 3]>,
+    colors: Vec<[f32; 3]>,
+    simd: SimdPath,
 }
 
 /// The rays of [`LANES`] neighbouring pixels of one row, built once per pixel and shared by
 /// every wave, with the arithmetic of [`CameraBasis::pixel_dir`] and [`CameraBasis::wave_ray`]
 /// lane for lane: the faithful ray `Q = E − S` over `[0, g]`, `g = min(d/|E − S|, 1)`, and the
 /// inverse-square unit ray over `[0, d]` (`d = ∞` where nothing is drawn).
-struct PixelRays {
-    faithful: RayLanes,
-    inverse_square: RayLanes,
+struct PixelRays<L> {
+    faithful: RayLanes<L>,
+    inverse_square: RayLanes<L>,
     /// `|E − S|` per pixel (the inverse-square ray's far parameter, for attenuation).
-    far_dist: Lanes,
+    far_dist: L,
     /// The eye distance of the visible surface, or of the far plane.
-    depth: Lanes,
+    depth: L,
 }
 
 /// One batch of [`LANES`] pixels after the wave pass: their light `Σ rgb·a·I` per channel, total
 /// energy and depth.
 #[derive(Clone, Copy)]
 pub(crate) struct BatchLight {
-    light: [Lanes; 3],
-    total: Lanes,
-    depth: Lanes,
+    light: [[f32; LANES]; 3],
+    total: [f32; LANES],
+    depth: [f32; LANES],
 }
 
 impl BatchLight {
     /// Replaces lane `i`'s light, total energy and depth (an anti-aliased pixel whose samples
     /// see different surfaces, integrated sample by sample: [`WavePass::samples_light`]).
     pub(crate) fn set_lane(&mut self, i: usize, light: [f32; 3], total: f32, depth: f32) {
-        let set = |l: &mut Lanes, v: f32| {
-            let mut a = l.to_array();
-            a[i] = v;
-            *l = Lanes::from(a);
-        };
         for (l, v) in self.light.iter_mut().zip(light) {
-            set(l, v);
+            l[i] = v;
         }
-        set(&mut self.total, total);
-        set(&mut self.depth, depth);
+        self.total[i] = total;
+        self.depth[i] = depth;
     }
+}
+
+/// Where the colour stage writes a row: the float colour, energy and depth (EXR, the viewer,
+/// probes), or only the 8-bit sRGB triples a PNG needs.
+pub(crate) enum RowOut<'a> {
+    /// Mapped linear RGBA, total energy, depth.
+    Float { color: &'a mut [[f32; 4]], energy: &'a mut [f32], depth: &'a mut [f32] },
+    /// Packed 8-bit sRGB `R, G, B` of the mapped colour (`3 × width` bytes).
+    Srgb8(&'a mut [u8]),
 }
 
 impl<'a> WavePass<'a> {
@@ -89,7 +95,7 @@ impl<'a> WavePass<'a> {
             .iter()
             .map(|w| {
                 let [r, g, b, a] = w.color;
-                [Lanes::splat(r * a), Lanes::splat(g * a), Lanes::splat(b * a)]
+                [r * a, g * a, b * a]
             })
             .collect();
         Self {
@@ -99,7 +105,13 @@ impl<'a> WavePass<'a> {
             faithful: uses(Falloff::Faithful),
             inverse_square: uses(Falloff::InverseSquare),
             colors,
+            simd: SimdPath::current(),
         }
+    }
+
+    /// The same pass on the vector path `simd` (benchmarks and tests compare the paths).
+    pub(crate) fn on_path(self, simd: SimdPath) -> Self {
+        Self { simd, ..self }
     }
 
     /// The width in pixels of the frame this pass's rays go through.
@@ -110,31 +122,31 @@ impl<'a> WavePass<'a> {
     /// The rays of pixels `x0 .. x0 + LANES` of row `py`; `surface[i]` is pixel `x0 + i`'s
     /// visible-surface distance (`+∞` for none, and for lanes past the row's end).
     #[inline(always)]
-    fn rays(&self, x0: usize, py: f32, surface: Lanes) -> PixelRays {
+    fn rays<L: Lane>(&self, x0: usize, py: f32, surface: L) -> PixelRays<L> {
         let b = self.basis;
+        let k = L::splat;
         let (w, h) = (self.frame.width as f32, self.frame.height as f32);
-        let far = Lanes::splat(self.frame.camera.far);
-        let px = Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| (x0 + i) as f32));
+        let far = k(self.frame.camera.far);
+        let px = L::from_array(std::array::from_fn(|i| (x0 + i) as f32));
         // CameraBasis::pixel_dir, lane for lane.
-        let ndc_x = Lanes::splat(2.0) * (px + Lanes::splat(0.5)) / Lanes::splat(w) - Lanes::ONE;
+        let ndc_x = k(2.0) * (px + k(0.5)) / k(w) - k(1.0);
         let ndc_y = 1.0 - 2.0 * (py + 0.5) / h;
-        let sx = ndc_x * Lanes::splat(b.tan_half_fov) * Lanes::splat(b.aspect);
-        let sy = Lanes::splat(ndc_y * b.tan_half_fov);
-        let axis = |f: f32, r: f32, u: f32| Lanes::splat(f) + Lanes::splat(r) * sx + Lanes::splat(u) * sy;
+        let sx = ndc_x * k(b.tan_half_fov) * k(b.aspect);
+        let sy = k(ndc_y * b.tan_half_fov);
         let dir = V3 {
-            x: axis(b.forward.x, b.right.x, b.up.x),
-            y: axis(b.forward.y, b.right.y, b.up.y),
-            z: axis(b.forward.z, b.right.z, b.up.z),
+            x: k(b.forward.x) + k(b.right.x) * sx + k(b.up.x) * sy,
+            y: k(b.forward.y) + k(b.right.y) * sx + k(b.up.y) * sy,
+            z: k(b.forward.z) + k(b.right.z) * sx + k(b.up.z) * sy,
         };
         let len = (dir.x * dir.x + dir.y * dir.y + dir.z * dir.z).sqrt();
         let far_dist = far * len;
-        let drawn = surface.simd_lt(Lanes::INFINITY);
-        let zero = Lanes::ZERO;
+        let drawn = surface.simd_lt(k(f32::INFINITY));
+        let zero = k(0.0);
         let none = RayLanes { origin: b.eye, dir: V3::splat(Vec3::ZERO), t0: zero, t1: zero };
         let faithful = if self.faithful {
             let dir = V3 { x: dir.x * far, y: dir.y * far, z: dir.z * far };
             // min(d/|E − S|, 1), and 1 where nothing is drawn (∞/|E − S| = ∞).
-            RayLanes { origin: b.eye, dir, t0: zero, t1: (surface / far_dist).min(Lanes::ONE) }
+            RayLanes { origin: b.eye, dir, t0: zero, t1: (surface / far_dist).min(k(1.0)) }
         } else {
             none
         };
@@ -149,18 +161,18 @@ impl<'a> WavePass<'a> {
 
     /// Every wave's energy along the rays of pixels `x0 .. x0 + LANES` of row `py`, clipped at
     /// the visible surfaces `surface` (002 §3.3.5; `+∞` where nothing is drawn), saturated
-    /// ([`lanes::saturate`]); `sink(wave index, energies, evaluations)` is called once per wave
-    /// in scene order. `valid` lanes (from the first) are real pixels; curves skip the others.
+    /// ([`lanes::saturate`]); `sink.wave(wave index, energies, evaluations)` is called once per
+    /// wave in scene order. `valid` lanes (from the first) are real pixels; curves skip the others.
     /// Returns each pixel's depth.
-    #[inline]
-    pub(crate) fn energies(
+    #[inline(always)]
+    pub(crate) fn energies<L: Lane>(
         &self,
         x0: usize,
         py: f32,
-        surface: Lanes,
+        surface: L,
         valid: usize,
-        mut sink: impl FnMut(usize, Lanes, [u32; LANES]),
-    ) -> Lanes {
+        sink: &mut impl WaveSink<L>,
+    ) -> L {
         let rays = self.rays(x0, py, surface);
         for (wi, wave) in self.frame.waves.iter().enumerate() {
             let p = FieldParams { falloff: wave.falloff, core_radius: wave.core_radius };
@@ -169,8 +181,8 @@ impl<'a> WavePass<'a> {
                 Falloff::InverseSquare => &rays.inverse_square,
             };
             if wave.attenuation > 0.0 && !matches!(wave.shape, WaveShape::Curve(_)) {
-                let e = self.attenuated_lanes(wave, &p, ray, &rays, valid);
-                sink(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
+                let e = L::from_array(self.attenuated_lanes(wave, &p, &Rays::of(ray, &rays), valid));
+                sink.wave(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
                 continue;
             }
             let e = match &wave.shape {
@@ -179,14 +191,14 @@ impl<'a> WavePass<'a> {
                 WaveShape::Capsule(f) => lanes::capsule_energy(&p, ray, f),
                 WaveShape::Beam(f) => lanes::beam_energy(&p, ray, f),
                 WaveShape::Curve(c) => {
-                    let (e, n) = self.curve_lanes(wi, c, &p, ray, &rays, valid);
+                    let (e, n) = self.curve_lanes(wi, c, &p, &Rays::of(ray, &rays), valid);
                     // Saturated at f32::MAX (hadou_math::energy::saturate): an overflow is full
                     // brightness, not 0.
-                    sink(wi, lanes::saturate(e), n);
+                    sink.wave(wi, lanes::saturate(L::from_array(e)), n);
                     continue;
                 }
             };
-            sink(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
+            sink.wave(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
         }
         rays.depth
     }
@@ -195,44 +207,37 @@ impl<'a> WavePass<'a> {
     /// 3.23, SPEC.md §1.4), one pixel at a time: the attenuated integrals
     /// (`hadou_math::energy::*_attenuated`) grade their cells per ray and have no eight-lane
     /// form. `t_far` is 1 (faithful) or the far point's distance (inverse square), as for curves.
-    fn attenuated_lanes(
-        &self,
-        wave: &Wave,
-        p: &FieldParams<f32>,
-        ray: &RayLanes,
-        rays: &PixelRays,
-        valid: usize,
-    ) -> Lanes {
-        let (dx, dy, dz) = (ray.dir.x.to_array(), ray.dir.y.to_array(), ray.dir.z.to_array());
-        let (t0, t1, far) = (ray.t0.to_array(), ray.t1.to_array(), rays.far_dist.to_array());
+    #[inline(never)]
+    fn attenuated_lanes(&self, wave: &Wave, p: &FieldParams<f32>, ray: &Rays, valid: usize) -> [f32; LANES] {
         let mut e = [0.0f32; LANES];
-        for i in 0..valid {
-            let r = Ray { origin: ray.origin, dir: Vec3::new(dx[i], dy[i], dz[i]) };
+        for (i, e) in e.iter_mut().enumerate().take(valid) {
+            let r = Ray { origin: ray.origin, dir: Vec3::new(ray.dir[0][i], ray.dir[1][i], ray.dir[2][i]) };
             let att = wave.attenuation_on(match p.falloff {
                 Falloff::Faithful => 1.0,
-                Falloff::InverseSquare => far[i],
+                Falloff::InverseSquare => ray.far[i],
             });
-            e[i] = match &wave.shape {
-                WaveShape::Sphere(f) => energy::sphere_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
-                WaveShape::Cylinder(f) => energy::cylinder_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
-                WaveShape::Capsule(f) => energy::capsule_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
-                WaveShape::Beam(f) => energy::beam_energy_attenuated(p, &r, t0[i], t1[i], &att, f),
+            let (t0, t1) = (ray.t0[i], ray.t1[i]);
+            *e = match &wave.shape {
+                WaveShape::Sphere(f) => energy::sphere_energy_attenuated(p, &r, t0, t1, &att, f),
+                WaveShape::Cylinder(f) => energy::cylinder_energy_attenuated(p, &r, t0, t1, &att, f),
+                WaveShape::Capsule(f) => energy::capsule_energy_attenuated(p, &r, t0, t1, &att, f),
+                WaveShape::Beam(f) => energy::beam_energy_attenuated(p, &r, t0, t1, &att, f),
                 WaveShape::Curve(_) => 0.0,
             };
         }
-        Lanes::from(e)
+        e
     }
 
     /// A curved wave's energy, one pixel at a time (its integrator adapts per ray).
+    #[inline(never)]
     fn curve_lanes(
         &self,
         wi: usize,
         c: &curve::CurveWave,
         p: &FieldParams<f32>,
-        ray: &RayLanes,
-        rays: &PixelRays,
+        ray: &Rays,
         valid: usize,
-    ) -> (Lanes, [u32; LANES]) {
+    ) -> ([f32; LANES], [u32; LANES]) {
         let owned;
         let prep = match &self.curves[wi] {
             Some(p) => p,
@@ -241,45 +246,53 @@ impl<'a> WavePass<'a> {
                 &owned
             }
         };
-        let (dx, dy, dz) = (ray.dir.x.to_array(), ray.dir.y.to_array(), ray.dir.z.to_array());
-        let (t0, t1, far) = (ray.t0.to_array(), ray.t1.to_array(), rays.far_dist.to_array());
         let mut e = [0.0f32; LANES];
         let mut n = [0u32; LANES];
         for i in 0..valid {
-            let r = Ray { origin: ray.origin, dir: Vec3::new(dx[i], dy[i], dz[i]) };
+            let r = Ray { origin: ray.origin, dir: Vec3::new(ray.dir[0][i], ray.dir[1][i], ray.dir[2][i]) };
             let t_far = match p.falloff {
                 Falloff::Faithful => 1.0,
-                Falloff::InverseSquare => far[i],
+                Falloff::InverseSquare => ray.far[i],
             };
-            let s = curve::curve_energy(prep, p, &r, t0[i], t1[i], t_far);
+            let s = curve::curve_energy(prep, p, &r, ray.t0[i], ray.t1[i], t_far);
             e[i] = s.energy;
             n[i] = s.evaluations;
         }
-        (Lanes::from(e), n)
+        (e, n)
+    }
+
+    /// Each wave's energy and evaluation count at pixel `x` of row `py` (in the first lane, as
+    /// the row's batch starting there would give it), clipped at `surface`, and the pixel's depth.
+    pub(crate) fn pixel_energies(&self, x: usize, py: f32, surface: Option<f32>) -> (Vec<(f32, u32)>, f32) {
+        dispatch(self.simd, PixelEnergies { pass: self, x, py, surface: surface.unwrap_or(f32::INFINITY) })
     }
 
     /// The wave pass over one row: `out[k]` gets batch `k`'s light (pixels `8k ..`).
     pub(crate) fn row_light(&self, py: f32, surface: &[Option<f32>], out: &mut Vec<BatchLight>) {
+        dispatch(self.simd, RowLight { pass: self, py, surface, out });
+    }
+
+    /// [`WavePass::row_light`] on lanes `L`.
+    #[inline(always)]
+    fn row_light_lanes<L: Lane>(&self, py: f32, surface: &[Option<f32>], out: &mut Vec<BatchLight>) {
         out.clear();
         for x0 in (0..surface.len()).step_by(LANES) {
             let n = LANES.min(surface.len() - x0);
-            let s = Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| {
+            let s = L::from_array(std::array::from_fn(|i| {
                 if i < n {
                     surface[x0 + i].unwrap_or(f32::INFINITY)
                 } else {
                     f32::INFINITY
                 }
             }));
-            let mut light = [Lanes::ZERO; 3];
-            let mut total = Lanes::ZERO;
-            let depth = self.energies(x0, py, s, n, |wi, e, _| {
-                let c = &self.colors[wi];
-                light[0] += c[0] * e;
-                light[1] += c[1] * e;
-                light[2] += c[2] * e;
-                total = lanes::saturate(total + e);
+            let mut acc = LightSum { colors: &self.colors, light: [L::splat(0.0); 3], total: L::splat(0.0) };
+            let depth = self.energies(x0, py, s, n, &mut acc);
+            let [r, g, b] = acc.light;
+            out.push(BatchLight {
+                light: [r.to_array(), g.to_array(), b.to_array()],
+                total: acc.total.to_array(),
+                depth: depth.to_array(),
             });
-            out.push(BatchLight { light, total, depth });
         }
     }
 
@@ -295,23 +308,26 @@ impl<'a> WavePass<'a> {
         surface: &[Option<f32>],
         weight: f32,
     ) -> ([f32; 3], f32, f32) {
+        dispatch(self.simd, SamplesLight { pass: self, x0, py, surface, weight })
+    }
+
+    /// [`WavePass::samples_light`] on lanes `L`.
+    #[inline(always)]
+    fn samples_light_lanes<L: Lane>(
+        &self,
+        x0: usize,
+        py: f32,
+        surface: &[Option<f32>],
+        weight: f32,
+    ) -> ([f32; 3], f32, f32) {
         let n = surface.len().min(LANES);
-        let s = Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| {
+        let s = L::from_array(std::array::from_fn(|i| {
             surface.get(i).filter(|_| i < n).copied().flatten().unwrap_or(f32::INFINITY)
         }));
-        let mut light = [0.0f32; 3];
-        let mut total = 0.0f32;
-        let depth = self.energies(x0, py, s, n, |wi, e, _| {
-            let e = e.to_array();
-            let c = &self.colors[wi];
-            for (ch, l) in light.iter_mut().enumerate() {
-                let k = c[ch].to_array()[0] * weight;
-                *l += (0..n).map(|i| k * e[i]).sum::<f32>();
-            }
-            total = energy::saturate(total + (0..n).map(|i| weight * e[i]).sum::<f32>());
-        });
+        let mut acc = WeightedSum { colors: &self.colors, n, weight, light: [0.0; 3], total: 0.0 };
+        let depth = self.energies(x0, py, s, n, &mut acc);
         let depth = depth.to_array()[..n].iter().copied().fold(f32::INFINITY, f32::min);
-        (light, total, depth)
+        (acc.light, acc.total, depth)
     }
 
     /// The linear colour `scene + exposure·light` of one row (before the colour mapping) into
@@ -324,56 +340,216 @@ impl<'a> WavePass<'a> {
         energy: &mut [f32],
         depth: &mut [f32],
     ) {
-        let k = Lanes::splat(self.frame.color_mapping.exposure);
+        let k = self.frame.color_mapping.exposure;
         for (bi, b) in batches.iter().enumerate() {
             let x0 = bi * LANES;
             let n = LANES.min(scene.len() - x0);
-            let sc = &scene[x0..x0 + n];
-            let ch = |c: usize| {
-                Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| sc.get(i).map_or(0.0, |p| p[c])))
-            };
-            let c = [0, 1, 2].map(|i| (ch(i) + k * b.light[i]).to_array());
-            let (t, d) = (b.total.to_array(), b.depth.to_array());
             for i in 0..n {
-                linear[x0 + i] = [c[0][i], c[1][i], c[2][i]];
-                energy[x0 + i] = t[i];
-                depth[x0 + i] = d[i];
+                let sc = scene[x0 + i];
+                linear[x0 + i] = [0, 1, 2].map(|c| sc[c] + k * b.light[c][i]);
+                energy[x0 + i] = b.total[i];
+                depth[x0 + i] = b.depth[i];
             }
         }
     }
 
-    /// The colour mapping over one row: `scene + exposure·light`, mapped, into `color`; the
-    /// energy and depth alongside.
-    pub(crate) fn row_color(
-        &self,
-        batches: &[BatchLight],
-        scene: &[[f32; 3]],
-        color: &mut [[f32; 4]],
-        energy: &mut [f32],
-        depth: &mut [f32],
-    ) {
-        let k = Lanes::splat(self.frame.color_mapping.exposure);
+    /// The colour stage over one row: `scene + exposure·light`, mapped, into `out` (the float
+    /// colour with the energy and depth alongside, or 8-bit sRGB only).
+    pub(crate) fn row_color(&self, batches: &[BatchLight], scene: &[[f32; 3]], out: RowOut<'_>) {
+        dispatch(self.simd, RowColor { pass: self, batches, scene, out });
+    }
+
+    /// [`WavePass::row_color`] on lanes `L`.
+    #[inline(always)]
+    fn row_color_lanes<L: Lane>(&self, batches: &[BatchLight], scene: &[[f32; 3]], mut out: RowOut<'_>) {
+        let k = L::splat(self.frame.color_mapping.exposure);
         let mode = self.frame.color_mapping.mode;
+        let srgb = shade::srgb8_encoder();
         for (bi, b) in batches.iter().enumerate() {
             let x0 = bi * LANES;
             let n = LANES.min(scene.len() - x0);
-            let sc = &scene[x0..x0 + n];
-            let ch = |c: usize| {
-                Lanes::from(std::array::from_fn::<f32, LANES, _>(|i| sc.get(i).map_or(0.0, |p| p[c])))
-            };
-            let c = [0, 1, 2].map(|i| ch(i) + k * b.light[i]);
+            // The scene's channels as lanes (zeros past the row's end); no closures over lanes
+            // here (see `hadou_math::simd::Lane`).
+            let mut sc = [[0.0f32; LANES]; 3];
+            for (i, p) in scene[x0..x0 + n].iter().enumerate() {
+                sc[0][i] = p[0];
+                sc[1][i] = p[1];
+                sc[2][i] = p[2];
+            }
+            let c = [
+                L::from_array(sc[0]) + k * L::from_array(b.light[0]),
+                L::from_array(sc[1]) + k * L::from_array(b.light[1]),
+                L::from_array(sc[2]) + k * L::from_array(b.light[2]),
+            ];
             let m = match mode {
                 ToneMode::Faithful => shade::map_faithful_lanes(c),
                 ToneMode::Filmic => shade::map_filmic_lanes(c),
             };
             let (r, g, bl) = (m[0].to_array(), m[1].to_array(), m[2].to_array());
-            let (t, d) = (b.total.to_array(), b.depth.to_array());
-            for i in 0..n {
-                color[x0 + i] = [r[i], g[i], bl[i], 1.0];
-                energy[x0 + i] = t[i];
-                depth[x0 + i] = d[i];
+            match &mut out {
+                RowOut::Float { color, energy, depth } => {
+                    for i in 0..n {
+                        color[x0 + i] = [r[i], g[i], bl[i], 1.0];
+                        energy[x0 + i] = b.total[i];
+                        depth[x0 + i] = b.depth[i];
+                    }
+                }
+                RowOut::Srgb8(bytes) => {
+                    for (i, o) in bytes[3 * x0..3 * (x0 + n)].chunks_exact_mut(3).enumerate() {
+                        o[0] = srgb.code(r[i]);
+                        o[1] = srgb.code(g[i]);
+                        o[2] = srgb.code(bl[i]);
+                    }
+                }
             }
         }
+    }
+}
+
+/// What [`WavePass::energies`] hands each wave's energies to. A trait with `#[inline(always)]`
+/// methods rather than a closure: a closure called from several places may be compiled apart from
+/// the dispatched body, where its lane operations could not inline.
+pub(crate) trait WaveSink<L> {
+    /// Wave `wi`'s saturated energies and evaluation counts for the batch.
+    fn wave(&mut self, wi: usize, e: L, n: [u32; LANES]);
+}
+
+/// `Σ rgb·a·I` per channel and the saturated total energy, per lane.
+struct LightSum<'c, L> {
+    colors: &'c [[f32; 3]],
+    light: [L; 3],
+    total: L,
+}
+
+impl<L: Lane> WaveSink<L> for LightSum<'_, L> {
+    #[inline(always)]
+    fn wave(&mut self, wi: usize, e: L, _: [u32; LANES]) {
+        let c = &self.colors[wi];
+        self.light[0] += L::splat(c[0]) * e;
+        self.light[1] += L::splat(c[1]) * e;
+        self.light[2] += L::splat(c[2]) * e;
+        self.total = lanes::saturate(self.total + e);
+    }
+}
+
+/// The first `n` lanes' light and energy, each weighted by `weight`, summed over the lanes.
+struct WeightedSum<'c> {
+    colors: &'c [[f32; 3]],
+    n: usize,
+    weight: f32,
+    light: [f32; 3],
+    total: f32,
+}
+
+impl<L: Lane> WaveSink<L> for WeightedSum<'_> {
+    #[inline(always)]
+    fn wave(&mut self, wi: usize, e: L, _: [u32; LANES]) {
+        let e = e.to_array();
+        let c = &self.colors[wi];
+        for (ch, l) in self.light.iter_mut().enumerate() {
+            let k = c[ch] * self.weight;
+            *l += e[..self.n].iter().map(|&v| k * v).sum::<f32>();
+        }
+        self.total = energy::saturate(self.total + e[..self.n].iter().map(|&v| self.weight * v).sum::<f32>());
+    }
+}
+
+/// Each wave's first-lane energy and evaluation count.
+struct FirstLane(Vec<(f32, u32)>);
+
+impl<L: Lane> WaveSink<L> for FirstLane {
+    #[inline(always)]
+    fn wave(&mut self, _: usize, e: L, n: [u32; LANES]) {
+        self.0.push((e.to_array()[0], n[0]));
+    }
+}
+
+/// One kind of ray of a batch as plain arrays, for the integrators that work one ray at a time.
+struct Rays {
+    origin: Vec3<f32>,
+    dir: [[f32; LANES]; 3],
+    t0: [f32; LANES],
+    t1: [f32; LANES],
+    far: [f32; LANES],
+}
+
+impl Rays {
+    #[inline(always)]
+    fn of<L: Lane>(ray: &RayLanes<L>, rays: &PixelRays<L>) -> Self {
+        Rays {
+            origin: ray.origin,
+            dir: [ray.dir.x.to_array(), ray.dir.y.to_array(), ray.dir.z.to_array()],
+            t0: ray.t0.to_array(),
+            t1: ray.t1.to_array(),
+            far: rays.far_dist.to_array(),
+        }
+    }
+}
+
+/// [`WavePass::row_light`]'s body for [`dispatch`].
+struct RowLight<'p, 'a> {
+    pass: &'p WavePass<'a>,
+    py: f32,
+    surface: &'p [Option<f32>],
+    out: &'p mut Vec<BatchLight>,
+}
+
+impl WithLanes for RowLight<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        self.pass.row_light_lanes::<L>(self.py, self.surface, self.out)
+    }
+}
+
+/// [`WavePass::pixel_energies`]'s body for [`dispatch`].
+struct PixelEnergies<'p, 'a> {
+    pass: &'p WavePass<'a>,
+    x: usize,
+    py: f32,
+    surface: f32,
+}
+
+impl WithLanes for PixelEnergies<'_, '_> {
+    type Output = (Vec<(f32, u32)>, f32);
+    #[inline(always)]
+    fn run<L: Lane>(self) -> Self::Output {
+        let mut out = FirstLane(Vec::new());
+        let depth = self.pass.energies(self.x, self.py, L::splat(self.surface), 1, &mut out);
+        (out.0, depth.to_array()[0])
+    }
+}
+
+/// [`WavePass::samples_light`]'s body for [`dispatch`].
+struct SamplesLight<'p, 'a> {
+    pass: &'p WavePass<'a>,
+    x0: usize,
+    py: f32,
+    surface: &'p [Option<f32>],
+    weight: f32,
+}
+
+impl WithLanes for SamplesLight<'_, '_> {
+    type Output = ([f32; 3], f32, f32);
+    #[inline(always)]
+    fn run<L: Lane>(self) -> Self::Output {
+        self.pass.samples_light_lanes::<L>(self.x0, self.py, self.surface, self.weight)
+    }
+}
+
+/// [`WavePass::row_color`]'s body for [`dispatch`].
+struct RowColor<'p, 'a> {
+    pass: &'p WavePass<'a>,
+    batches: &'p [BatchLight],
+    scene: &'p [[f32; 3]],
+    out: RowOut<'p>,
+}
+
+impl WithLanes for RowColor<'_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        self.pass.row_color_lanes::<L>(self.batches, self.scene, self.out)
     }
 }
 

@@ -22,6 +22,7 @@ mod real;
 pub mod rng;
 pub mod shade;
 pub mod shadow;
+pub mod simd;
 pub mod soft;
 pub mod toon;
 mod vec3;

@@ -1,7 +1,7 @@
 //! Shading of opaque objects and the mapping from summed wave light to output colour. Mirrored in
 //! WGSL by `hadou-gpu` (keep in sync with `crates/hadou-gpu/src/shaders/common.wgsl`).
 
-use crate::energy::lanes::Lanes;
+use crate::simd::Lane;
 use crate::Vec3f;
 
 /// Simple diffuse shading of the opaque scene: `albedo · (ambient + light · max(0, N·(−L)))`.
@@ -85,31 +85,45 @@ fn one_minus_exp_neg(x: f32) -> f32 {
     }
 }
 
-/// [`map_faithful`] on eight pixels at once (`c[channel]` holds one channel of each), lane for
-/// lane the same values.
-#[inline]
-pub fn map_faithful_lanes(c: [Lanes; 3]) -> [Lanes; 3] {
-    c.map(|v| {
-        let v = v.is_nan().select(Lanes::ZERO, v);
-        v.max(Lanes::ZERO).min(Lanes::ONE)
-    })
+/// [`map_faithful`] on eight pixels at once (`c[channel]` holds one channel of each), on any
+/// [`Lane`] type: lane for lane the same values.
+#[inline(always)]
+pub fn map_faithful_lanes<L: Lane>(c: [L; 3]) -> [L; 3] {
+    // Written out per channel, not with `array::map`: a closure called three times may be
+    // compiled apart from the vector path's `#[target_feature]` body (see `simd::Lane`).
+    #[inline(always)]
+    fn one<L: Lane>(v: L) -> L {
+        let v = v.is_nan().select(L::splat(0.0), v);
+        v.max(L::splat(0.0)).min(L::splat(1.0))
+    }
+    [one(c[0]), one(c[1]), one(c[2])]
 }
 
 /// [`map_filmic`] on eight pixels at once (`c[channel]` holds one channel of each), with the same
 /// arithmetic in the same order, so lane for lane the same values (a zero may lose its sign).
-#[inline]
-pub fn map_filmic_lanes(c: [Lanes; 3]) -> [Lanes; 3] {
-    let c = c.map(|v| v.is_nan().select(Lanes::ZERO, v.max(Lanes::ZERO)));
+#[inline(always)]
+pub fn map_filmic_lanes<L: Lane>(c: [L; 3]) -> [L; 3] {
+    // Per channel by hand, as in `map_faithful_lanes`.
+    #[inline(always)]
+    fn clean<L: Lane>(v: L) -> L {
+        v.is_nan().select(L::splat(0.0), v.max(L::splat(0.0)))
+    }
+    let c = [clean(c[0]), clean(c[1]), clean(c[2])];
     let m = c[0].max(c[1]).max(c[2]);
-    let w = Lanes::splat(0.5) * (m - Lanes::ONE).max(Lanes::ZERO);
-    c.map(|v| one_minus_exp_neg_lanes((v + w).min(Lanes::splat(80.0))))
+    let w = L::splat(0.5) * (m - L::splat(1.0)).max(L::splat(0.0));
+    let top = L::splat(80.0);
+    [
+        one_minus_exp_neg_lanes((c[0] + w).min(top)),
+        one_minus_exp_neg_lanes((c[1] + w).min(top)),
+        one_minus_exp_neg_lanes((c[2] + w).min(top)),
+    ]
 }
 
 /// [`one_minus_exp_neg`] per lane, the same operations in the same order.
 #[inline(always)]
-fn one_minus_exp_neg_lanes(x: Lanes) -> Lanes {
-    let k = Lanes::splat;
-    let one = Lanes::ONE;
+fn one_minus_exp_neg_lanes<L: Lane>(x: L) -> L {
+    let k = L::splat;
+    let one = L::splat(1.0);
     let small = x
         * (one
             - x * (k(1.0 / 2.0)
@@ -128,8 +142,8 @@ fn one_minus_exp_neg_lanes(x: Lanes) -> Lanes {
                 + g * (k(1.0 / 6.0)
                     + g * (k(1.0 / 24.0)
                         + g * (k(1.0 / 120.0) + g * (k(1.0 / 720.0) + g * k(1.0 / 5040.0)))))));
-    let e = (n.round_int() + wide::i32x8::splat(127)).max(wide::i32x8::splat(1)) << 23;
-    let scale = Lanes::from_bits(wide::bytemuck::cast::<wide::i32x8, wide::u32x8>(e));
+    // 2^n from its exponent bits, as the scalar form.
+    let scale = n.exp2_int();
     let large = one - p * scale;
     x.simd_lt(k(0.25)).select(small, large)
 }
@@ -156,8 +170,22 @@ pub fn linear_to_srgb8(v: f32) -> u8 {
     srgb8_code(srgb8_tables(), v)
 }
 
+/// [`linear_to_srgb8`]'s tables, for a loop that encodes many values: [`Srgb8Tables::code`]
+/// without looking the tables up each time.
+pub fn srgb8_encoder() -> &'static Srgb8Tables {
+    srgb8_tables()
+}
+
+impl Srgb8Tables {
+    /// [`linear_to_srgb8`]`(v)`.
+    #[inline(always)]
+    pub fn code(&self, v: f32) -> u8 {
+        srgb8_code(self, v)
+    }
+}
+
 /// [`linear_to_srgb8`] with its tables at hand.
-#[inline]
+#[inline(always)]
 fn srgb8_code(tables: &Srgb8Tables, v: f32) -> u8 {
     if v.is_nan() || v <= 0.0 {
         0
@@ -189,8 +217,8 @@ const SRGB8_SHIFT: u32 = 13;
 /// The number of buckets below 1.0.
 const SRGB8_BUCKETS: usize = (0x3F80_0000u32 >> SRGB8_SHIFT) as usize;
 
-/// The tables of [`linear_to_srgb8`].
-struct Srgb8Tables {
+/// The tables of [`linear_to_srgb8`] ([`srgb8_encoder`]).
+pub struct Srgb8Tables {
     /// Per bucket of floats sharing their top 19 bits, the code of the bucket's first float.
     start: Vec<u8>,
     /// `next[k]`: the smallest `f32` whose code exceeds `k` (`+∞` for 255).
@@ -268,19 +296,32 @@ mod tests {
             f32::NAN,
             1e-30,
         ]);
-        for chunk in vals.chunks_exact(24) {
-            let px: Vec<[f32; 3]> = chunk.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-            let lanes = [0, 1, 2].map(|ch| Lanes::from(std::array::from_fn::<f32, 8, _>(|i| px[i][ch])));
-            for (scalar, vector) in [
-                (map_filmic as fn([f32; 3]) -> [f32; 3], map_filmic_lanes as fn([Lanes; 3]) -> [Lanes; 3]),
-                (map_faithful, map_faithful_lanes),
-            ] {
-                let got = vector(lanes).map(|l| l.to_array());
-                for (i, p) in px.iter().enumerate() {
-                    let want = scalar(*p);
-                    for ch in 0..3 {
-                        // Equal values (a zero's sign may differ: `max(−0, 0)` is either).
-                        assert!(got[ch][i] == want[ch], "{p:?} channel {ch}: {} vs {}", got[ch][i], want[ch]);
+        /// Both mappings of one batch on a path's lanes.
+        struct Batch([[f32; 8]; 3]);
+        impl crate::simd::WithLanes for Batch {
+            type Output = [[[f32; 8]; 3]; 2];
+            #[inline(always)]
+            fn run<L: Lane>(self) -> Self::Output {
+                let c = self.0.map(L::from_array);
+                [map_filmic_lanes(c).map(L::to_array), map_faithful_lanes(c).map(L::to_array)]
+            }
+        }
+        // Every vector path this CPU runs, each held to the scalar mappings.
+        for path in crate::simd::SimdPath::supported() {
+            for chunk in vals.chunks_exact(24) {
+                let px: Vec<[f32; 3]> = chunk.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+                let batch = [0, 1, 2].map(|ch| std::array::from_fn::<f32, 8, _>(|i| px[i][ch]));
+                let got = crate::simd::dispatch(path, Batch(batch));
+                for (m, scalar) in
+                    [map_filmic as fn([f32; 3]) -> [f32; 3], map_faithful].into_iter().enumerate()
+                {
+                    for (i, p) in px.iter().enumerate() {
+                        let want = scalar(*p);
+                        for ch in 0..3 {
+                            // Equal values (a zero's sign may differ: `max(−0, 0)` is either).
+                            let g = got[m][ch][i];
+                            assert!(g == want[ch], "{path}: {p:?} channel {ch}: {g} vs {}", want[ch]);
+                        }
                     }
                 }
             }

@@ -3,6 +3,8 @@
 //! rays the scalar tests cover (through a centre, along and parallel to an axis, `D·Q = 0`,
 //! zero-length capsules, far away, `r_c = 0`, empty, NaN and infinite spans) they are finite,
 //! non-negative and equal to the scalar value — each lane on its own, whatever its neighbours.
+//! Every test runs on each vector path the machine supports (`SimdPath::supported`: the portable
+//! lanes everywhere, AVX2 + FMA and AVX-512 where the CPU has them).
 
 use hadou_math::energy::lanes::{self, RayLanes, LANES, V3};
 use hadou_math::energy::{
@@ -10,6 +12,7 @@ use hadou_math::energy::{
     Falloff, FieldParams, Ray, SphereField,
 };
 use hadou_math::rng::Rng;
+use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
 use hadou_math::{Vec3, Vec3f};
 
 /// One ray of a batch: direction and span (the origin is the batch's).
@@ -88,14 +91,31 @@ impl Shape {
         }
     }
 
-    fn lanes(&self, p: &FieldParams<f32>, origin: Vec3f, rays: &[R; LANES]) -> [f32; LANES] {
+    fn lanes(&self, path: SimdPath, p: &FieldParams<f32>, origin: Vec3f, rays: &[R; LANES]) -> [f32; LANES] {
+        dispatch(path, Kernel { shape: self, p, origin, rays })
+    }
+}
+
+/// One shape's kernel on eight rays, on a path's lanes.
+struct Kernel<'a> {
+    shape: &'a Shape,
+    p: &'a FieldParams<f32>,
+    origin: Vec3f,
+    rays: &'a [R; LANES],
+}
+
+impl WithLanes for Kernel<'_> {
+    type Output = [f32; LANES];
+    #[inline(always)]
+    fn run<L: Lane>(self) -> [f32; LANES] {
         let batch = RayLanes {
-            origin,
-            dir: V3::from_vecs(&rays.map(|r| r.dir)),
-            t0: lanes::Lanes::from(rays.map(|r| r.t0)),
-            t1: lanes::Lanes::from(rays.map(|r| r.t1)),
+            origin: self.origin,
+            dir: V3::<L>::from_vecs(&self.rays.map(|r| r.dir)),
+            t0: L::from_array(self.rays.map(|r| r.t0)),
+            t1: L::from_array(self.rays.map(|r| r.t1)),
         };
-        let e = match self {
+        let p = self.p;
+        let e = match self.shape {
             Shape::Sphere(f) => lanes::sphere_energy(p, &batch, f),
             Shape::Cylinder(f) => lanes::cylinder_energy(p, &batch, f),
             Shape::Capsule(f) => lanes::capsule_energy(p, &batch, f),
@@ -145,19 +165,21 @@ fn random_rays_are_as_accurate_as_the_scalar_kernels() {
                 ray_for(law, target - origin, clip)
             });
             for shape in shapes(&mut rng) {
-                let got = shape.lanes(&p, origin, &rays);
-                for (i, r) in rays.iter().enumerate() {
-                    let s32 = shape.scalar(&p, origin, *r) as f64;
-                    let s64 = shape.reference(&p, origin, *r);
-                    let g = got[i] as f64;
-                    assert!(g.is_finite() && g >= 0.0, "{shape:?} {law:?} lane {i}: {g}");
-                    // As accurate as the scalar f32 kernel, up to a few ulp of the value.
-                    let bound = 4.0 * (s32 - s64).abs() + 2e-6 * s64.abs() + 1e-30;
-                    assert!(
-                        (g - s64).abs() <= bound,
-                        "{shape:?} {law:?} {r:?}: lanes {g}, f32 {s32}, f64 {s64}"
-                    );
-                    worst = worst.max((g - s32).abs() / s64.abs().max(1e-30));
+                for path in SimdPath::supported() {
+                    let got = shape.lanes(path, &p, origin, &rays);
+                    for (i, r) in rays.iter().enumerate() {
+                        let s32 = shape.scalar(&p, origin, *r) as f64;
+                        let s64 = shape.reference(&p, origin, *r);
+                        let g = got[i] as f64;
+                        assert!(g.is_finite() && g >= 0.0, "{path} {shape:?} {law:?} lane {i}: {g}");
+                        // As accurate as the scalar f32 kernel, up to a few ulp of the value.
+                        let bound = 4.0 * (s32 - s64).abs() + 2e-6 * s64.abs() + 1e-30;
+                        assert!(
+                            (g - s64).abs() <= bound,
+                            "{path} {shape:?} {law:?} {r:?}: lanes {g}, f32 {s32}, f64 {s64}"
+                        );
+                        worst = worst.max((g - s32).abs() / s64.abs().max(1e-30));
+                    }
                 }
             }
         }
@@ -168,17 +190,19 @@ fn random_rays_are_as_accurate_as_the_scalar_kernels() {
 /// Every lane equals the scalar kernel on the same ray (relative `tol`, or both saturated), is
 /// finite and non-negative.
 fn assert_matches_scalar(shape: &Shape, p: &FieldParams<f32>, origin: Vec3f, rays: &[R; LANES], tol: f32) {
-    let got = shape.lanes(p, origin, rays);
-    for (i, r) in rays.iter().enumerate() {
-        let s = shape.scalar(p, origin, *r);
-        let g = got[i];
-        assert!(g.is_finite() && g >= 0.0, "{shape:?} {:?} lane {i} {r:?}: {g}", p.falloff);
-        let diff = (g - s).abs();
-        assert!(
-            diff <= tol * s.abs().max(g.abs()) + 1e-30,
-            "{shape:?} {:?} lane {i} {r:?}: lanes {g}, scalar {s}",
-            p.falloff
-        );
+    for path in SimdPath::supported() {
+        let got = shape.lanes(path, p, origin, rays);
+        for (i, r) in rays.iter().enumerate() {
+            let s = shape.scalar(p, origin, *r);
+            let g = got[i];
+            assert!(g.is_finite() && g >= 0.0, "{path} {shape:?} {:?} lane {i} {r:?}: {g}", p.falloff);
+            let diff = (g - s).abs();
+            assert!(
+                diff <= tol * s.abs().max(g.abs()) + 1e-30,
+                "{path} {shape:?} {:?} lane {i} {r:?}: lanes {g}, scalar {s}",
+                p.falloff
+            );
+        }
     }
 }
 
@@ -256,11 +280,13 @@ fn lanes_do_not_depend_on_their_neighbours() {
             ray_for(law, Vec3::new(-10.0, 0.0, 0.0) - eye, None),
             ray_for(law, Vec3::X, None),
         ];
-        let alone = beam.lanes(&p, eye, &[probe; LANES])[0];
-        for lane in 0..LANES {
-            let rays: [R; LANES] =
-                std::array::from_fn(|i| if i == lane { probe } else { odd[i % odd.len()] });
-            assert_eq!(beam.lanes(&p, eye, &rays)[lane], alone, "{law:?} lane {lane}");
+        for path in SimdPath::supported() {
+            let alone = beam.lanes(path, &p, eye, &[probe; LANES])[0];
+            for lane in 0..LANES {
+                let rays: [R; LANES] =
+                    std::array::from_fn(|i| if i == lane { probe } else { odd[i % odd.len()] });
+                assert_eq!(beam.lanes(path, &p, eye, &rays)[lane], alone, "{path} {law:?} lane {lane}");
+            }
         }
     }
 }
@@ -277,6 +303,84 @@ fn saturation_matches_the_scalar_rules() {
         let got = lanes::scaled(lanes::Lanes::from(xs), alpha).to_array();
         for (x, g) in xs.iter().zip(got) {
             assert_eq!(g.to_bits(), scaled(*x, alpha).to_bits(), "scaled({x}, {alpha})");
+        }
+    }
+}
+
+#[test]
+fn every_supported_path_runs_and_names_itself() {
+    let paths = SimdPath::supported();
+    assert_eq!(paths[0], SimdPath::PORTABLE, "the portable path is always there");
+    for path in &paths {
+        assert_eq!(SimdPath::from_name(path.name()), Ok(*path));
+    }
+    assert_eq!(SimdPath::widest(), *paths.last().unwrap());
+    #[cfg(target_arch = "x86_64")]
+    {
+        let avx2 = std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
+        assert_eq!(paths.iter().any(|p| p.name() == "avx2"), avx2, "{paths:?}");
+    }
+    // A path the CPU lacks, or a name that is none, is refused with what the CPU runs.
+    for name in ["avx2", "avx512"] {
+        if !paths.iter().any(|p| p.name() == name) {
+            let e = SimdPath::from_name(name).unwrap_err().to_string();
+            assert!(e.contains("this CPU cannot run") && e.contains("portable"), "{e}");
+        }
+    }
+    let e = SimdPath::from_name("avx9000").unwrap_err().to_string();
+    assert!(e.contains("unknown vector path `avx9000`") && e.contains("avx512"), "{e}");
+}
+
+#[test]
+fn lane_logarithm_and_atan2_follow_the_maths_library() {
+    // The generic polynomials (what the AVX2 lanes use) against `f32::ln` / `f32::atan2`.
+    struct Fns([f32; LANES], [f32; LANES]);
+    impl WithLanes for Fns {
+        type Output = ([f32; LANES], [f32; LANES]);
+        #[inline(always)]
+        fn run<L: Lane>(self) -> Self::Output {
+            let (a, b) = (L::from_array(self.0), L::from_array(self.1));
+            (a.ln().to_array(), a.atan2(b).to_array())
+        }
+    }
+    let mut rng = Rng(7);
+    let specials = [0.0, -0.0, 1.0, -1.0, f32::INFINITY, -f32::INFINITY, 1e-30, 3e30];
+    for path in SimdPath::supported() {
+        for round in 0..4000 {
+            let xs: [f32; LANES] = std::array::from_fn(|_| {
+                let e = rng.range_f32(-30.0, 30.0);
+                rng.range_f32(1.0, 2.0) * 2f32.powf(e)
+            });
+            let ys: [f32; LANES] = std::array::from_fn(|i| {
+                if round % 8 == 0 {
+                    specials[(i + round / 8) % specials.len()]
+                } else {
+                    rng.range_f32(-1.0, 1.0) * 2f32.powf(rng.range_f32(-20.0, 20.0))
+                }
+            });
+            let xs2: [f32; LANES] = std::array::from_fn(|i| {
+                if round % 8 == 0 {
+                    specials[(3 * i + round / 8) % specials.len()]
+                } else {
+                    rng.range_f32(-1.0, 1.0) * 2f32.powf(rng.range_f32(-20.0, 20.0))
+                }
+            });
+            let (ln, _) = dispatch(path, Fns(xs, xs));
+            for (x, g) in xs.iter().zip(ln) {
+                let want = x.ln();
+                assert!(
+                    (g - want).abs() <= 2.0 * f32::EPSILON * want.abs().max(1.0),
+                    "{path} ln({x}) = {g}, not {want}"
+                );
+            }
+            let (_, at) = dispatch(path, Fns(ys, xs2));
+            for i in 0..LANES {
+                let (y, x) = (ys[i], xs2[i]);
+                let want = y.atan2(x);
+                let g = at[i];
+                let close = g == want || (g - want).abs() <= 4.0 * f32::EPSILON * want.abs();
+                assert!(close, "{path} atan2({y}, {x}) = {g}, not {want}");
+            }
         }
     }
 }

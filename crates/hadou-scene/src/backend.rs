@@ -1,7 +1,7 @@
 //! The [`Backend`] trait both renderers implement, and [`RenderError`], why one could not render.
 
 use crate::frame::Frame;
-use crate::image::Image;
+use crate::image::{Image, Rgb8Image};
 
 /// A renderer: turns a [`Frame`] into an [`Image`].
 pub trait Backend {
@@ -16,6 +16,20 @@ pub trait Backend {
     fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
         let full = self.render(frame)?;
         Ok(full.crop_rows(rows))
+    }
+    /// The rows `rows` of `frame` as 8-bit sRGB only (what a PNG holds): the same bytes as
+    /// [`Rgb8Image::from_image`] of [`Backend::render_rows`]'s image. The default converts that
+    /// image (refusing one with a non-finite value); the CPU backend overrides it with a colour
+    /// stage that writes the bytes directly and no float buffers.
+    fn render_rows_rgb8(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Rgb8Image, RenderError> {
+        let image = self.render_rows(frame, rows)?;
+        Rgb8Image::from_image(&image).ok_or_else(|| {
+            RenderError::Other("internal error: the renderer produced a non-finite value".into())
+        })
     }
 }
 

@@ -45,3 +45,33 @@ impl Image {
         y as usize * self.width as usize + x as usize
     }
 }
+
+/// A rendered image as 8-bit sRGB only: what a PNG holds. The CPU backend writes it straight
+/// from its colour stage, without the float colour, energy and depth buffers of [`Image`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Rgb8Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Packed `R, G, B` bytes per pixel, rows top to bottom: the mapped linear colour through
+    /// the sRGB transfer, `⌊255·srgb(v) + ½⌋` ([`hadou_math::shade::linear_to_srgb8`]).
+    pub rgb: Vec<u8>,
+}
+
+impl Rgb8Image {
+    /// The 8-bit sRGB of `image`'s colour; `None` if a colour, energy or depth value is not
+    /// finite (no NaN or infinity may reach an image).
+    pub fn from_image(image: &Image) -> Option<Rgb8Image> {
+        let finite = image.color.iter().all(|c| c.iter().all(|v| v.is_finite()))
+            && image.energy.iter().all(|v| v.is_finite())
+            && image.depth.iter().all(|v| v.is_finite());
+        if !finite {
+            return None;
+        }
+        let srgb = hadou_math::shade::srgb8_encoder();
+        let rgb =
+            image.color.iter().flat_map(|c| [srgb.code(c[0]), srgb.code(c[1]), srgb.code(c[2])]).collect();
+        Some(Rgb8Image { width: image.width, height: image.height, rgb })
+    }
+}

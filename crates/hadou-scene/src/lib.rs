@@ -84,7 +84,7 @@ pub use gltf_load::{
     MAX_MORPH_TARGETS,
 };
 pub use gltf_vrma::load_vrma_clip;
-pub use image::Image;
+pub use image::{Image, Rgb8Image};
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
 pub use limits::{
     check_image_size, ALPHA_MAX, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES,

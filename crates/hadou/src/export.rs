@@ -320,9 +320,7 @@ fn export_png_sequence(
     for f in range {
         let frame = spec.frame(scene, f);
         output::write_png_banded(&frame_path(f), frame.width, frame.height, frame.grid().pow(2), |rows| {
-            let band = backend.render_rows(&frame, rows)?;
-            check_finite(&band)?;
-            Ok::<_, ExportError>(band)
+            Ok::<_, ExportError>(backend.render_rows_rgb8(&frame, rows)?)
         })?;
         done += 1;
         if progress(Progress { done, total }) == Control::Cancel && done < total {

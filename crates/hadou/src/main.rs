@@ -216,6 +216,12 @@ fn main() -> ExitCode {
         std::env::set_var("NODEVICE_SELECT", "1");
     }
     let cli = Cli::parse();
+    // A vector path the CPU lacks is refused here, before anything renders (the library would
+    // fall back to the widest path with a warning; it never runs instructions the CPU lacks).
+    if let Err(e) = hadou_math::simd::SimdPath::from_env() {
+        eprintln!("error: {}: {e}", hadou_math::simd::SIMD_ENV);
+        return ExitCode::from(2);
+    }
     let result = match cli.command {
         Command::Render(a) => render(a),
         Command::Validate { scene } => load_scene(&scene).map(|s| {
@@ -509,11 +515,19 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         let mut backend = make_backend(a.backend)?;
         // Both formats are rendered and encoded band by band: memory follows the band, not the
         // image.
-        output::write_banded(&a.output, frame.width, frame.height, frame.grid().pow(2), |rows| {
-            let band = backend.render_rows(&frame, rows)?;
-            check_finite(&band)?;
-            Ok::<_, Failure>(band)
-        })?;
+        let (w, h, samples) = (frame.width, frame.height, frame.grid().pow(2));
+        match output::Format::from_path(&a.output)? {
+            // A PNG's bands come as 8-bit sRGB straight from the renderer (the CPU backend's colour
+            // stage writes no float buffers for them).
+            output::Format::Png => output::write_png_banded(&a.output, w, h, samples, |rows| {
+                Ok::<_, Failure>(backend.render_rows_rgb8(&frame, rows)?)
+            })?,
+            output::Format::Exr => output::write_banded(&a.output, w, h, samples, |rows| {
+                let band = backend.render_rows(&frame, rows)?;
+                check_finite(&band)?;
+                Ok::<_, Failure>(band)
+            })?,
+        }
         eprintln!(
             "wrote {} ({}×{}, {} backend)",
             a.output.display(),

@@ -5,7 +5,7 @@
 //! ([`write_png_banded`], [`write_exr_banded`]): memory follows the band, not the image.
 
 use hadou_math::shade::linear_to_srgb8;
-use hadou_scene::{Image, TempFile};
+use hadou_scene::{Image, Rgb8Image, TempFile};
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -107,7 +107,18 @@ pub fn write_banded<E: From<OutputError>>(
     band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     match Format::from_path(path)? {
-        Format::Png => write_png_banded(path, width, height, samples, band),
+        Format::Png => {
+            let mut band = band;
+            write_png_banded(path, width, height, samples, |rows| {
+                let image = band(rows)?;
+                Rgb8Image::from_image(&image).ok_or_else(|| {
+                    E::from(OutputError::Io(format!(
+                        "{}: internal error: the renderer produced a non-finite value; nothing was written",
+                        path.display()
+                    )))
+                })
+            })
+        }
         Format::Exr => write_exr_banded(path, width, height, samples, band),
     }
 }
@@ -124,15 +135,26 @@ pub fn encode_png(image: &Image) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
+/// The PNG of 8-bit sRGB rows, in memory.
+pub fn encode_png_rgb8(image: &Rgb8Image) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    encode_rgb8_into(image.width, image.height, &image.rgb, &mut out)?;
+    Ok(out)
+}
+
 fn encode_png_into(image: &Image, sink: impl Write) -> Result<(), String> {
-    let mut enc = png::Encoder::new(sink, image.width, image.height);
+    encode_rgb8_into(image.width, image.height, &srgb8(image), sink)
+}
+
+fn encode_rgb8_into(width: u32, height: u32, rgb: &[u8], sink: impl Write) -> Result<(), String> {
+    let mut enc = png::Encoder::new(sink, width, height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     // fdeflate's PNG-tuned compressor: several times faster than the default level.
     enc.set_compression(png::Compression::Fast);
     let mut w = enc.write_header().map_err(|e| e.to_string())?;
-    w.write_image_data(&srgb8(image)).map_err(|e| e.to_string())?;
+    w.write_image_data(rgb).map_err(|e| e.to_string())?;
     w.finish().map_err(|e| e.to_string())
 }
 
@@ -234,24 +256,41 @@ fn write_failed(path: &Path, e: impl std::fmt::Display) -> OutputError {
     OutputError::Io(format!("{}: write failed: {e}", path.display()))
 }
 
+/// A band of rows as the writers receive it.
+trait BandSize {
+    fn size(&self) -> (u32, u32);
+}
+
+impl BandSize for Image {
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
+impl BandSize for Rgb8Image {
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
 /// The band of rows `rows` from `band`, refused unless it is `width × rows.len()`.
-fn next_band<E: From<OutputError>>(
-    band: &mut impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+fn next_band<E: From<OutputError>, B: BandSize>(
+    band: &mut impl FnMut(std::ops::Range<u32>) -> Result<B, E>,
     rows: std::ops::Range<u32>,
     width: u32,
     path: &Path,
-) -> Result<Image, E> {
+) -> Result<B, E> {
     let image = band(rows.clone())?;
-    if image.width != width || image.height != rows.len() as u32 {
-        let got =
-            format!("a band of rows {}..{} came back {}×{}", rows.start, rows.end, image.width, image.height);
+    let (w, h) = image.size();
+    if w != width || h != rows.len() as u32 {
+        let got = format!("a band of rows {}..{} came back {w}×{h}", rows.start, rows.end);
         return Err(write_failed(path, got).into());
     }
     Ok(image)
 }
 
 /// Writes a `width × height` 8-bit sRGB PNG to `path`, asking `band` for the image rows
-/// `y0..y1` in turn (each at most [`band_rows`] rows, for `samples` per pixel) and streaming them into the encoder, so
+/// `y0..y1` in turn as 8-bit sRGB ([`hadou_scene::Backend::render_rows_rgb8`]) (each at most [`band_rows`] rows, for `samples` per pixel) and streaming them into the encoder, so
 /// memory follows the band, not the image. The file is created (and registered for interrupt
 /// clean-up) before the first band is requested, and renamed into place after the last; on any
 /// error nothing is left behind.
@@ -260,7 +299,7 @@ pub fn write_png_banded<E: From<OutputError>>(
     width: u32,
     height: u32,
     samples: u32,
-    mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+    mut band: impl FnMut(std::ops::Range<u32>) -> Result<Rgb8Image, E>,
 ) -> Result<(), E> {
     let (tmp, file) = begin_banded(path)?;
     let io = |e: String| write_failed(path, e);
@@ -278,7 +317,7 @@ pub fn write_png_banded<E: From<OutputError>>(
         while y < height {
             let rows = y..(y + step).min(height);
             let image = next_band(&mut band, rows.clone(), width, path)?;
-            stream.write_all(&srgb8(&image)).map_err(|e| io(e.to_string()))?;
+            stream.write_all(&image.rgb).map_err(|e| io(e.to_string()))?;
             y = rows.end;
         }
         stream.finish().map_err(|e| io(e.to_string()))?;

@@ -854,3 +854,68 @@ fn validate_lists_the_clips_and_expressions_of_gltf_objects() {
     assert!(lines[3].starts_with("object \"dancer\": plays \"brace\"; expressions "), "{out}");
     assert!(!out.contains("floor"), "{out}");
 }
+
+/// `HADOU_SIMD` picks a vector path by name; an unknown name, or a path this CPU lacks, is exit 2
+/// with what the CPU runs, before anything is written (never an illegal instruction).
+#[test]
+fn a_forced_vector_path_is_checked_against_the_cpu() {
+    let dir = tmpdir("simd");
+    let scene = write_scene(&dir, GOOD);
+    let s = scene.to_str().unwrap();
+    let run = |value: &str, out: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_hadou"))
+            .env("HADOU_SIMD", value)
+            .args(["render", s, "-o", out.to_str().unwrap(), "--width", "24", "--height", "16"])
+            .output()
+            .expect("binary runs")
+    };
+    let supported = hadou_math::simd::SimdPath::supported();
+    let mut pngs = Vec::new();
+    for path in &supported {
+        let png = dir.join(format!("{}.png", path.name()));
+        let o = run(path.name(), &png);
+        assert_eq!(o.status.code(), Some(0), "{path}: {}", stderr(&o));
+        pngs.push(png);
+    }
+    for name in ["avx2", "avx512"] {
+        if !supported.iter().any(|p| p.name() == name) {
+            let png = dir.join("lacking.png");
+            let o = run(name, &png);
+            assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+            let e = stderr(&o);
+            assert!(
+                e.contains("HADOU_SIMD") && e.contains("this CPU cannot run") && e.contains("portable"),
+                "{e}"
+            );
+            assert!(!png.exists());
+        }
+    }
+    let png = dir.join("unknown.png");
+    let o = run("avx9000", &png);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("unknown vector path `avx9000`"), "{}", stderr(&o));
+    assert!(!png.exists());
+}
+
+/// The CPU analytic bench's kernel-limit table has a whole-render, wave-pass and kernel row for
+/// every vector path the CPU supports, then the scalar kernel and the plain loop.
+#[test]
+fn the_kernel_limit_table_has_a_row_per_vector_path() {
+    let o = hadou(&["bench", "analytic", "--backend", "cpu", "--sizes", "24", "--iterations", "1", "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = j["limit"]["rows"].as_array().unwrap_or_else(|| panic!("{j}"));
+    let supported = hadou_math::simd::SimdPath::supported();
+    assert_eq!(rows.len(), 3 * supported.len() + 2, "{rows:?}");
+    for (k, path) in supported.iter().enumerate() {
+        for (i, what) in ["whole render", "wave pass", "kernel only, 8 lanes"].iter().enumerate() {
+            let row = &rows[3 * k + i];
+            assert_eq!(row["path"], path.name(), "{row}");
+            assert_eq!(row["what"], format!("{what} ({path})"), "{row}");
+            assert!(row["ms"].as_f64().unwrap() > 0.0, "{row}");
+        }
+    }
+    assert_eq!(rows[rows.len() - 1]["what"], "plain scalar loop");
+    let names: Vec<&str> = supported.iter().map(|p| p.name()).collect();
+    assert_eq!(j["limit"]["paths"], names.join(","));
+}

@@ -1,10 +1,12 @@
-//! The analytic kernels eight rays at a time: the same closed forms as [`RayQuadratic`], on
-//! `wide::f32x8` lanes, with every branch of the scalar kernel turned into a per-lane select.
+//! The analytic kernels eight rays at a time: the same closed forms as [`RayQuadratic`], on any
+//! [`Lane`] type (the portable `wide::f32x8`, or AVX2 lanes chosen at run time through
+//! [`crate::simd::dispatch`]), with every branch of the scalar kernel turned into a per-lane
+//! select.
 //!
 //! Rays of one batch share their origin (the eye) and carry their own direction and span, as the
 //! CPU backend's pixels do. Each function here agrees with its scalar twin in `f32` within a few
-//! units in the last place (the logarithm and `atan2` are `wide`'s polynomial ones rather than
-//! the maths library's), is finite and non-negative on every ray the scalar tests cover (through
+//! units in the last place (the logarithm and `atan2` are polynomial ones, `wide`'s or
+//! [`Lane`]'s, rather than the maths library's; the AVX2 lanes fuse multiply-adds), is finite and non-negative on every ray the scalar tests cover (through
 //! a centre, along an axis, far away, `r_c = 0`, empty or NaN spans), and saturates the same way
 //! (`tests/analytic_lanes.rs` holds them to the scalar kernels and to the `f64` reference).
 //!
@@ -12,45 +14,45 @@
 
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
+use crate::simd::Lane;
 use crate::Vec3;
-use wide::f32x8;
 
 /// Rays evaluated together.
 pub const LANES: usize = 8;
 
-/// One `f32` per ray of a batch.
-pub type Lanes = f32x8;
+/// One `f32` per ray of a batch, on the portable path ([`crate::simd::Portable`]).
+pub type Lanes = crate::simd::Portable;
 
 /// A 3-vector per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct V3 {
+pub struct V3<L = Lanes> {
     /// x of every lane.
-    pub x: Lanes,
+    pub x: L,
     /// y of every lane.
-    pub y: Lanes,
+    pub y: L,
     /// z of every lane.
-    pub z: Lanes,
+    pub z: L,
 }
 
-impl V3 {
+impl<L: Lane> V3<L> {
     /// The same vector in every lane.
     #[inline(always)]
     pub fn splat(v: Vec3<f32>) -> Self {
-        Self { x: Lanes::splat(v.x), y: Lanes::splat(v.y), z: Lanes::splat(v.z) }
+        Self { x: L::splat(v.x), y: L::splat(v.y), z: L::splat(v.z) }
     }
 
     /// Lane `i` of each component taken from `v[i]`.
     #[inline(always)]
     pub fn from_vecs(v: &[Vec3<f32>; LANES]) -> Self {
         Self {
-            x: Lanes::from(v.map(|p| p.x)),
-            y: Lanes::from(v.map(|p| p.y)),
-            z: Lanes::from(v.map(|p| p.z)),
+            x: L::from_array(v.map(|p| p.x)),
+            y: L::from_array(v.map(|p| p.y)),
+            z: L::from_array(v.map(|p| p.z)),
         }
     }
 
     #[inline(always)]
-    fn dot(self, o: Self) -> Lanes {
+    fn dot(self, o: Self) -> L {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
@@ -64,7 +66,7 @@ impl V3 {
     }
 
     #[inline(always)]
-    fn scale(self, k: Lanes) -> Self {
+    fn scale(self, k: L) -> Self {
         Self { x: self.x * k, y: self.y * k, z: self.z * k }
     }
 
@@ -78,57 +80,57 @@ impl V3 {
 /// Eight rays `origin + t·dir[i]`, `t ∈ [t0[i], t1[i]]`, sharing one origin (see
 /// [`super::Ray`] for what `dir` means per falloff).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RayLanes {
+pub struct RayLanes<L = Lanes> {
     /// The shared origin `S`.
     pub origin: Vec3<f32>,
     /// Each ray's direction.
-    pub dir: V3,
+    pub dir: V3<L>,
     /// Each span's start.
-    pub t0: Lanes,
+    pub t0: L,
     /// Each span's end.
-    pub t1: Lanes,
+    pub t1: L,
 }
 
 /// [`super::RayAxis`] per lane: `s = |u|`, `û = u/s`, or `s = 0`, `û = 0` where `|u|²` is not a
 /// positive normal number.
 #[derive(Clone, Copy)]
-struct Axis {
-    s: Lanes,
-    unit: V3,
+struct Axis<L> {
+    s: L,
+    unit: V3<L>,
 }
 
-impl Axis {
+impl<L: Lane> Axis<L> {
     #[inline(always)]
-    fn new(u: V3) -> Self {
+    fn new(u: V3<L>) -> Self {
         let a = u.dot(u);
-        let ok = a.simd_ge(Lanes::splat(f32::MIN_POSITIVE));
-        let s = ok.select(a.sqrt(), Lanes::ZERO);
-        let inv = ok.select(Lanes::ONE / s, Lanes::ZERO);
+        let ok = a.simd_ge(L::splat(f32::MIN_POSITIVE));
+        let s = ok.select(a.sqrt(), L::splat(0.0));
+        let inv = ok.select(L::splat(1.0) / s, L::splat(0.0));
         Self { s, unit: u.scale(inv) }
     }
 }
 
 /// [`super::RayQuadratic`] per lane: `|v + t·u|² + r_c² = (s·t + β)² + H`.
 #[derive(Clone, Copy)]
-struct Quad {
-    s: Lanes,
-    beta: Lanes,
-    h: Lanes,
+struct Quad<L> {
+    s: L,
+    beta: L,
+    h: L,
 }
 
-impl Quad {
+impl<L: Lane> Quad<L> {
     /// As [`super::RayQuadratic::new`].
     #[inline(always)]
-    fn new(axis: &Axis, v: V3, rc2: f32) -> Self {
+    fn new(axis: &Axis<L>, v: V3<L>, rc2: f32) -> Self {
         let beta = axis.unit.dot(v);
         let c = axis.unit.cross(v);
-        let d2 = axis.s.simd_gt(Lanes::ZERO).select(c.dot(c), v.dot(v));
-        Self { s: axis.s, beta, h: (d2 + Lanes::splat(rc2)).max(Lanes::splat(H_FLOOR as f32)) }
+        let d2 = axis.s.simd_gt(L::splat(0.0)).select(c.dot(c), v.dot(v));
+        Self { s: axis.s, beta, h: (d2 + L::splat(rc2)).max(L::splat(H_FLOOR as f32)) }
     }
 
     /// Lane-wise `if m { a } else { b }`.
     #[inline(always)]
-    fn select(m: Lanes, a: &Self, b: &Self) -> Self {
+    fn select(m: L, a: &Self, b: &Self) -> Self {
         Self { s: a.s, beta: m.select(a.beta, b.beta), h: m.select(a.h, b.h) }
     }
 
@@ -142,8 +144,8 @@ impl Quad {
     /// rounding of `u` cancels between numerator and denominator, so one formula covers every
     /// `z ≥ 0` and needs no division by `s`.
     #[inline(always)]
-    fn faithful(&self, t0: Lanes, t1: Lanes) -> Lanes {
-        let lim = Lanes::splat(T_LIMIT as f32);
+    fn faithful(&self, t0: L, t1: L) -> L {
+        let lim = L::splat(T_LIMIT as f32);
         let t0c = t0.max(-lim);
         let t1c = t1.min(lim);
         // False for NaN ends and empty spans, before and after the clamps (as the scalar kernel).
@@ -156,11 +158,11 @@ impl Quad {
         let r1 = (y1 * y1 + h).sqrt();
         let sum = y0 + y1;
         let rs = r0 + r1;
-        let one = Lanes::ONE;
-        let ahead = sum.simd_ge(Lanes::ZERO);
+        let one = L::splat(1.0);
+        let ahead = sum.simd_ge(L::splat(0.0));
         // sum ≥ 0: P₀ = y₀ + r₀, or H/(r₀ − y₀) for y₀ < 0; else N₁ = r₁ − y₁, or H/(r₁ + y₁).
-        let y0_pos = y0.simd_ge(Lanes::ZERO);
-        let y1_neg = y1.simd_le(Lanes::ZERO);
+        let y0_pos = y0.simd_ge(L::splat(0.0));
+        let y1_neg = y1.simd_le(L::splat(0.0));
         let a_fwd = y0_pos.select(one, r0 - y0);
         let b_fwd = y0_pos.select(y0 + r0, h);
         let a_bwd = y1_neg.select(one, r1 + y1);
@@ -173,7 +175,7 @@ impl Quad {
         let ratio = u.simd_gt(one).select(u.ln() / (u - one), one);
         let v = k * ratio;
         // u = +∞ (k overflowed): ln(u)/(u − 1) is NaN; the integral is then beyond ENERGY_MAX.
-        let v = u.is_inf().select(Lanes::INFINITY, v);
+        let v = u.is_inf().select(L::splat(f32::INFINITY), v);
         clamp_energy(live, v)
     }
 
@@ -181,8 +183,8 @@ impl Quad {
     /// [`super::RayQuadratic::inverse_square`] (one `atan2(√H·s·Δt, H + Y₀Y₁)`, `t ≥ T_LIMIT` as
     /// `±∞`), its branches as selects.
     #[inline(always)]
-    fn inverse_square(&self, t0: Lanes, t1: Lanes) -> Lanes {
-        let lim = Lanes::splat(T_LIMIT as f32);
+    fn inverse_square(&self, t0: L, t1: L) -> L {
+        let lim = L::splat(T_LIMIT as f32);
         let live = t1.simd_gt(t0);
         let (s, h) = (self.s, self.h);
         let sh = h.sqrt();
@@ -195,18 +197,18 @@ impl Quad {
         let num_f = sh * s * dt;
         let den_f = h + y0 * y1;
         // Infinite ends: (√H, Y₀) to +∞, (√H, −Y₁) from −∞, (0, −1) for the whole line.
-        let num_i = (to_inf & from_inf).select(Lanes::ZERO, sh);
-        let den_i = from_inf.select(to_inf.select(-Lanes::ONE, -y1), y0);
+        let num_i = (to_inf & from_inf).select(L::splat(0.0), sh);
+        let den_i = from_inf.select(to_inf.select(-L::splat(1.0), -y1), y0);
         let num = finite.select(num_f, num_i);
         let den = finite.select(den_f, den_i);
         let angle = num.atan2(den) / (s * sh);
-        let tiny = finite & num_f.simd_le(Lanes::splat(f32::EPSILON) * den_f);
+        let tiny = finite & num_f.simd_le(L::splat(f32::EPSILON) * den_f);
         let v = tiny.select(dt / den_f, angle);
         clamp_energy(live, v)
     }
 
     #[inline(always)]
-    fn integral(&self, falloff: Falloff, t0: Lanes, t1: Lanes) -> Lanes {
+    fn integral(&self, falloff: Falloff, t0: L, t1: L) -> L {
         match falloff {
             Falloff::Faithful => self.faithful(t0, t1),
             Falloff::InverseSquare => self.inverse_square(t0, t1),
@@ -217,37 +219,37 @@ impl Quad {
 /// `v` clamped to `[0, ENERGY_MAX]` where `live`, 0 elsewhere; NaN gives 0 (as the scalar
 /// `v.max(0).min(ENERGY_MAX)`).
 #[inline(always)]
-fn clamp_energy(live: Lanes, v: Lanes) -> Lanes {
-    let ok = live & v.simd_ge(Lanes::ZERO);
-    ok.select(v.min(Lanes::splat(ENERGY_MAX as f32)), Lanes::ZERO)
+fn clamp_energy<L: Lane>(live: L, v: L) -> L {
+    let ok = live & v.simd_ge(L::splat(0.0));
+    ok.select(v.min(L::splat(ENERGY_MAX as f32)), L::splat(0.0))
 }
 
 /// [`super::saturate`] per lane: `[0, f32::MAX]`, `+∞` and NaN to `f32::MAX`, negatives to 0.
 #[inline(always)]
-pub fn saturate(x: Lanes) -> Lanes {
-    let max = Lanes::splat(ENERGY_SATURATION as f32);
-    let pos = x.simd_ge(Lanes::ZERO);
-    let neg = x.simd_lt(Lanes::ZERO);
-    pos.select(x.min(max), neg.select(Lanes::ZERO, max))
+pub fn saturate<L: Lane>(x: L) -> L {
+    let max = L::splat(ENERGY_SATURATION as f32);
+    let pos = x.simd_ge(L::splat(0.0));
+    let neg = x.simd_lt(L::splat(0.0));
+    pos.select(x.min(max), neg.select(L::splat(0.0), max))
 }
 
 /// [`super::scaled`] per lane: `α·I` saturated, `α = 0` giving 0.
 #[inline(always)]
-pub fn scaled(integral: Lanes, alpha: f32) -> Lanes {
-    saturate(saturate(integral) * Lanes::splat(alpha))
+pub fn scaled<L: Lane>(integral: L, alpha: f32) -> L {
+    saturate(saturate(integral) * L::splat(alpha))
 }
 
 /// [`super::sphere_energy`] for eight rays (002 eq. 3.4, 3.6, 3.8–3.9, SPEC.md §1.2).
-#[inline]
-pub fn sphere_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &SphereField<f32>) -> Lanes {
+#[inline(always)]
+pub fn sphere_energy<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &SphereField<f32>) -> L {
     let axis = Axis::new(ray.dir);
     let q = Quad::new(&axis, V3::splat(ray.origin - f.center), p.core_radius * p.core_radius);
     scaled(q.integral(p.falloff, ray.t0, ray.t1), f.alpha)
 }
 
 /// [`super::cylinder_energy`] for eight rays (002 eq. 3.5, 3.7–3.9, SPEC.md §1.2).
-#[inline]
-pub fn cylinder_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &CylinderField<f32>) -> Lanes {
+#[inline(always)]
+pub fn cylinder_energy<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &CylinderField<f32>) -> L {
     let axis = Axis::new(ray.dir.cross_splat(f.dir));
     let v = V3::splat((ray.origin - f.point).cross(f.dir));
     let q = Quad::new(&axis, v, p.core_radius * p.core_radius);
@@ -255,20 +257,20 @@ pub fn cylinder_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &CylinderField<f
 }
 
 /// The capsule's energy and its end spheres' quadratics (reused by the beam).
-struct CapsuleParts {
-    at_m: Quad,
-    at_m2: Quad,
-    energy: Lanes,
+struct CapsuleParts<L> {
+    at_m: Quad<L>,
+    at_m2: Quad<L>,
+    energy: L,
 }
 
 /// As the scalar `capsule_parts` (002 eq. 3.10–3.11, SPEC.md §1.2): the ray split at the planes
 /// through `M` and `M₂`, each region its closed form, the region order per lane by the sign of
 /// `D·Q`.
 #[inline(always)]
-fn capsule_parts(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) -> CapsuleParts {
+fn capsule_parts<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &CapsuleField<f32>) -> CapsuleParts<L> {
     let live = ray.t1.simd_gt(ray.t0);
-    let t0 = live.select(ray.t0, Lanes::ZERO);
-    let t1 = live.select(ray.t1, Lanes::ZERO);
+    let t0 = live.select(ray.t0, L::splat(0.0));
+    let t1 = live.select(ray.t1, L::splat(0.0));
     let rc2 = p.core_radius * p.core_radius;
     let q = ray.dir;
     let w = ray.origin - f.m;
@@ -280,12 +282,12 @@ fn capsule_parts(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) ->
     // Axial coordinate along the ray: z(t) = ds + t·dq; planes at z = 0 (M) and z = length (M₂).
     let dq = q.dot(V3::splat(f.d));
     let ds = w.dot(f.d);
-    let len = Lanes::splat(f.length);
+    let len = L::splat(f.length);
     let inf = f32::INFINITY;
-    let fwd = dq.simd_gt(Lanes::ZERO);
-    let bwd = dq.simd_lt(Lanes::ZERO);
-    let at_plane_m = Lanes::splat(-ds) / dq;
-    let at_plane_m2 = (len - Lanes::splat(ds)) / dq;
+    let fwd = dq.simd_gt(L::splat(0.0));
+    let bwd = dq.simd_lt(L::splat(0.0));
+    let at_plane_m = L::splat(-ds) / dq;
+    let at_plane_m2 = (len - L::splat(ds)) / dq;
     // dq = 0: the whole ray in one region, by the offset ds.
     let (flat_lo, flat_hi) = if ds < 0.0 {
         (inf, inf)
@@ -294,8 +296,8 @@ fn capsule_parts(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) ->
     } else {
         (-inf, inf)
     };
-    let lo = fwd.select(at_plane_m, bwd.select(at_plane_m2, Lanes::splat(flat_lo)));
-    let hi = fwd.select(at_plane_m2, bwd.select(at_plane_m, Lanes::splat(flat_hi)));
+    let lo = fwd.select(at_plane_m, bwd.select(at_plane_m2, L::splat(flat_lo)));
+    let hi = fwd.select(at_plane_m2, bwd.select(at_plane_m, L::splat(flat_hi)));
     let lo = lo.max(t0).min(t1);
     let hi = hi.max(lo).min(t1);
     let first = Quad::select(bwd, &at_m2, &at_m);
@@ -307,15 +309,15 @@ fn capsule_parts(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) ->
 }
 
 /// [`super::capsule_energy`] for eight rays (002 eq. 3.10–3.11, SPEC.md §1.2).
-#[inline]
-pub fn capsule_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &CapsuleField<f32>) -> Lanes {
+#[inline(always)]
+pub fn capsule_energy<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &CapsuleField<f32>) -> L {
     capsule_parts(p, ray, f).energy
 }
 
 /// [`super::beam_energy`] for eight rays: the capsule plus the head and muzzle spheres over the
 /// whole span (002 §3.3.3, eq. 3.4 and 3.11; SPEC.md §1.2).
-#[inline]
-pub fn beam_energy(p: &FieldParams<f32>, ray: &RayLanes, f: &BeamField<f32>) -> Lanes {
+#[inline(always)]
+pub fn beam_energy<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &BeamField<f32>) -> L {
     let parts = capsule_parts(p, ray, &f.capsule);
     let mut e = parts.energy;
     if f.head_alpha != 0.0 {

@@ -3,17 +3,19 @@
 
 use super::analytic::analytic_frame;
 use super::table::{Cell, Column, Report, Table};
-use super::timing::{median_ms, time_cpu};
+use super::timing::{median_ms, time_cpu_on};
+use hadou_math::energy::{lanes, FieldParams};
+use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
 use hadou_scene::{Frame, RenderError, WaveShape};
 
-/// The faithful bulged beam of the analytic table at `size`, timed five ways in one run: the
-/// whole render and its wave pass, the eight-lane kernel alone and the scalar kernel alone over
-/// every pixel's ray, and a plain scalar loop of the same maths ([`plain_beam_loop`]), so the
-/// distance from hadou to the machine's limit is a ratio measured on the same machine at the same
-/// moment. Its text gives each line's ratio to the plain loop; its JSON `rows` are `{what, ms,
-/// mpix_per_s}`, beside `size` and `iterations`.
+/// The faithful bulged beam of the analytic table at `size`, timed in one run: on each vector
+/// path the CPU supports ([`SimdPath::supported`]) the whole render (to the 8-bit sRGB a PNG
+/// holds), its wave pass and the eight-lane kernel alone over every pixel's ray; then the scalar
+/// kernel alone and a plain scalar loop of the same maths ([`plain_beam_loop`]), so the distance
+/// from hadou to the machine's limit is a ratio measured on the same machine at the same moment.
+/// Its text gives each line's ratio to the plain loop; its JSON `rows` are `{what, path, ms,
+/// mpix_per_s}` (`path` empty for the scalar lines), beside `size`, `iterations` and `paths`.
 pub fn limit_table(size: u32, iterations: u32) -> Result<Report, RenderError> {
-    use hadou_math::energy::{lanes, FieldParams};
     use rayon::prelude::*;
     let frame = analytic_frame("bulged beam", "faithful", size, false)?;
     let Some(WaveShape::Beam(beam)) = frame.waves.first().map(|w| w.shape.clone()) else {
@@ -23,31 +25,27 @@ pub fn limit_table(size: u32, iterations: u32) -> Result<Report, RenderError> {
     let p = FieldParams { falloff: wave.falloff, core_radius: wave.core_radius };
     let basis = frame.camera.basis(frame.width, frame.height);
     let (w, h, far) = (frame.width, frame.height, frame.camera.far);
-    let whole = time_cpu(&frame, iterations)?;
-    let wave_ms = whole.parts.iter().find(|(n, _)| n == "wave").map_or(0.0, |p| p.1);
     let ray = |x: u32, y: u32| basis.wave_ray(wave.falloff, far, x as f32, y as f32, w, h, None);
-    let mut kernel = |f: &Frame| -> Result<(), RenderError> {
-        let sum: f32 = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let mut acc = lanes::Lanes::ZERO;
-                for x0 in (0..w).step_by(lanes::LANES) {
-                    let rays: [_; lanes::LANES] = std::array::from_fn(|i| ray(x0 + i as u32, y));
-                    let batch = lanes::RayLanes {
-                        origin: f.camera.position,
-                        dir: lanes::V3::from_vecs(&rays.map(|r| r.ray.dir)),
-                        t0: lanes::Lanes::from(rays.map(|r| r.t0)),
-                        t1: lanes::Lanes::from(rays.map(|r| r.t1)),
-                    };
-                    acc += lanes::beam_energy(&p, &batch, &beam);
-                }
-                acc.reduce_add()
-            })
-            .sum();
-        std::hint::black_box(sum);
-        Ok(())
-    };
-    let lanes_ms = median_ms(&mut kernel, &frame, iterations)?;
+    let mut lines: Vec<(String, &'static str, f64)> = Vec::new();
+    for path in SimdPath::supported() {
+        let whole = time_cpu_on(&frame, iterations, path)?;
+        let wave_ms = whole.parts.iter().find(|(n, _)| n == "wave").map_or(0.0, |p| p.1);
+        let mut kernel = |f: &Frame| -> Result<(), RenderError> {
+            let sum: f32 = (0..h)
+                .into_par_iter()
+                .map(|y| {
+                    let rays: Vec<_> = (0..w).map(|x| ray(x, y)).collect();
+                    dispatch(path, KernelRow { p: &p, beam: &beam, origin: f.camera.position, rays: &rays })
+                })
+                .sum();
+            std::hint::black_box(sum);
+            Ok(())
+        };
+        let lanes_ms = median_ms(&mut kernel, &frame, iterations)?;
+        lines.push((format!("whole render ({path})"), path.name(), whole.ms));
+        lines.push((format!("wave pass ({path})"), path.name(), wave_ms));
+        lines.push((format!("kernel only, 8 lanes ({path})"), path.name(), lanes_ms));
+    }
     let mut scalar = |_: &Frame| -> Result<(), RenderError> {
         let sum: f32 = (0..h)
             .into_par_iter()
@@ -69,20 +67,17 @@ pub fn limit_table(size: u32, iterations: u32) -> Result<Report, RenderError> {
         Ok(())
     };
     let plain_ms = median_ms(&mut plain, &frame, iterations)?;
-    let lines = [
-        ("whole render (hadou)", whole.ms),
-        ("wave pass (hadou)", wave_ms),
-        ("kernel only, 8 lanes", lanes_ms),
-        ("kernel only, scalar", scalar_ms),
-        ("plain scalar loop", plain_ms),
-    ];
+    lines.push(("kernel only, scalar".into(), "", scalar_ms));
+    lines.push(("plain scalar loop".into(), "", plain_ms));
     let rows = lines
         .iter()
-        .map(|&(what, ms)| {
+        .map(|(what, path, ms)| {
+            let ms = *ms;
             let mpx = (size as f64).powi(2) / (ms * 1e3);
             let ratio = if ms > 0.0 { plain_ms / ms } else { 0.0 };
             vec![
-                Cell::new("what", what, what),
+                Cell::new("what", what.as_str(), what.as_str()),
+                Cell::json("path", *path),
                 Cell::new("ms", ms, format!("{ms:.2}")),
                 Cell::new("mpix_per_s", mpx, format!("{mpx:.1}")),
                 Cell::text("ratio", format!("{ratio:.2}×")),
@@ -93,15 +88,48 @@ pub fn limit_table(size: u32, iterations: u32) -> Result<Report, RenderError> {
         "\nbulged beam (faithful) at {size}², kernel at its limit ({iterations} runs, median, one run)\n"
     );
     let columns = vec![
-        Column::left("what", 26),
+        Column::left("what", 34),
         Column::right("ms", 10),
         Column::right("Mpx/s", 10),
         Column::right("plain loop ×", 14),
     ];
+    let names: Vec<&str> = SimdPath::supported().iter().map(|p| p.name()).collect();
     Ok(Report {
-        fields: vec![("size", size.into()), ("iterations", iterations.into())],
+        fields: vec![
+            ("size", size.into()),
+            ("iterations", iterations.into()),
+            ("paths", names.join(",").into()),
+        ],
         tables: vec![Table { key: Some("rows"), title, columns, rows }],
     })
+}
+
+/// One row of rays through the beam kernel, eight at a time, on a path's lanes: the sum of the
+/// energies (so nothing is optimised away).
+struct KernelRow<'a> {
+    p: &'a FieldParams<f32>,
+    beam: &'a hadou_math::energy::BeamField<f32>,
+    origin: hadou_math::Vec3f,
+    rays: &'a [hadou_scene::WaveRay],
+}
+
+impl WithLanes for KernelRow<'_> {
+    type Output = f32;
+    #[inline(always)]
+    fn run<L: Lane>(self) -> f32 {
+        let mut acc = L::splat(0.0);
+        for chunk in self.rays.chunks(lanes::LANES) {
+            let at = |i: usize| chunk[i.min(chunk.len() - 1)];
+            let batch = lanes::RayLanes {
+                origin: self.origin,
+                dir: lanes::V3::<L>::from_vecs(&std::array::from_fn(|i| at(i).ray.dir)),
+                t0: L::from_array(std::array::from_fn(|i| at(i).t0)),
+                t1: L::from_array(std::array::from_fn(|i| at(i).t1)),
+            };
+            acc += lanes::beam_energy(self.p, &batch, self.beam);
+        }
+        acc.reduce_add()
+    }
 }
 
 /// A plain, unoptimised scalar `f32` render of a faithful bulged beam, for comparison only: per

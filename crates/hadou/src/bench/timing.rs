@@ -1,12 +1,14 @@
 //! How `hadou bench` times a frame: the [`Timer`] every table measures with, the CPU backend's
 //! ([`time_cpu`]) and the medians.
 
-use hadou_scene::{Frame, RenderError};
+use hadou_math::simd::SimdPath;
+use hadou_scene::{Frame, RenderError, Rgb8Image};
 
 /// What a [`Timer`] measured for one frame.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Timing {
-    /// Median milliseconds per frame: the whole render, without writing the output.
+    /// Median milliseconds per frame: the whole render, without writing the output (on the CPU,
+    /// into the 8-bit sRGB bytes a PNG holds).
     pub ms: f64,
     /// The parts, in order, as (name, median milliseconds): on the CPU the opaque pass, the wave
     /// pass and the colour mapping (which add up to the whole) and the output (8-bit sRGB and
@@ -31,25 +33,32 @@ pub fn median(mut v: Vec<f64>) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
-/// Times the CPU backend: `iterations` frames after a warm-up, drawn as a real-time loop draws
-/// them (one [`hadou_cpu::CpuBackend`] and one image reused from frame to frame), each split into
-/// its passes ([`hadou_cpu::CpuBackend::render_into`]), then the output of the image (sRGB and
-/// PNG encoding into memory) as many times. Medians of each.
+/// Times the CPU backend on the vector path it picks ([`SimdPath::current`]); see
+/// [`time_cpu_on`].
 pub fn time_cpu(frame: &Frame, iterations: u32) -> Result<Timing, RenderError> {
+    time_cpu_on(frame, iterations, SimdPath::current())
+}
+
+/// Times the CPU backend on the vector path `simd`: `iterations` frames after a warm-up, drawn as
+/// `hadou render` draws a PNG's (the 8-bit sRGB bytes straight from the colour stage, one
+/// [`hadou_cpu::CpuBackend`] and one image reused from frame to frame), each split into its passes
+/// ([`hadou_cpu::CpuBackend::render_rgb8_into`]), then the output of the image (PNG encoding
+/// into memory) as many times. Medians of each.
+pub fn time_cpu_on(frame: &Frame, iterations: u32, simd: SimdPath) -> Result<Timing, RenderError> {
     let mut cpu = hadou_cpu::CpuBackend::new();
-    let mut image = hadou_scene::Image::new(0, 0);
-    cpu.render_into(frame, &mut image);
+    let mut image = Rgb8Image::default();
+    cpu.render_rgb8_into(frame, &mut image, simd);
     let (mut whole, mut opaque, mut wave, mut color, mut output) = (vec![], vec![], vec![], vec![], vec![]);
     for _ in 0..iterations.max(1) {
         let t = std::time::Instant::now();
-        let p = cpu.render_into(frame, &mut image);
+        let p = cpu.render_rgb8_into(frame, &mut image, simd);
         whole.push(t.elapsed().as_secs_f64() * 1e3);
         opaque.push(p.opaque_ms);
         wave.push(p.wave_ms);
         color.push(p.color_ms);
     }
     for _ in 0..iterations.max(1) {
-        output.push(output_ms(&image)?);
+        output.push(rgb8_output_ms(&image)?);
     }
     Ok(Timing {
         ms: median(whole),
@@ -66,6 +75,15 @@ pub fn time_cpu(frame: &Frame, iterations: u32) -> Result<Timing, RenderError> {
 pub fn output_ms(image: &hadou_scene::Image) -> Result<f64, RenderError> {
     let t = std::time::Instant::now();
     let bytes = crate::output::encode_png(image).map_err(RenderError::Other)?;
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    std::hint::black_box(bytes);
+    Ok(ms)
+}
+
+/// Milliseconds to turn 8-bit sRGB rows into PNG bytes in memory.
+pub fn rgb8_output_ms(image: &Rgb8Image) -> Result<f64, RenderError> {
+    let t = std::time::Instant::now();
+    let bytes = crate::output::encode_png_rgb8(image).map_err(RenderError::Other)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;
     std::hint::black_box(bytes);
     Ok(ms)

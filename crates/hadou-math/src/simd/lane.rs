@@ -1,0 +1,130 @@
+//! [`Lane`]: what the lane kernels need of eight `f32`s.
+
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// Eight `f32` lanes. Comparisons return masks in the same type (every bit of a lane set where
+/// true), which `&`, `|`, `!` combine and [`Lane::select`] consumes; NaN compares false.
+///
+/// Every method must be `#[inline(always)]` in an implementation: a body generic over `Lane` is
+/// inlined into one function per path ([`super::dispatch`]), and only there do the target's vector
+/// instructions inline. For the same reason a body keeps lane arithmetic out of closures that it
+/// calls more than once (`array::map`, a callback): the compiler may keep such a closure as a
+/// function of its own, compiled without the path's features, whose every lane operation becomes
+/// a call (`hadou-cpu`'s row bodies take a sink trait with `#[inline(always)]` methods instead).
+pub trait Lane:
+    Copy
+    + std::fmt::Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + BitAnd<Output = Self>
+    + BitOr<Output = Self>
+    + Not<Output = Self>
+    + AddAssign
+{
+    /// `v` in every lane.
+    fn splat(v: f32) -> Self;
+    /// Lane `i` from `a[i]`.
+    fn from_array(a: [f32; 8]) -> Self;
+    /// Lane `i` into `[i]`.
+    fn to_array(self) -> [f32; 8];
+    /// `self·a + b`: fused (one rounding) on paths with FMA, a multiply and an add elsewhere.
+    fn mul_add(self, a: Self, b: Self) -> Self;
+    /// Square root per lane.
+    fn sqrt(self) -> Self;
+    /// The lesser lane; where one is NaN, the other (as `f32::min`).
+    fn min(self, rhs: Self) -> Self;
+    /// The greater lane; where one is NaN, the other (as `f32::max`).
+    fn max(self, rhs: Self) -> Self;
+    /// `self ≥ rhs` per lane.
+    fn simd_ge(self, rhs: Self) -> Self;
+    /// `self > rhs` per lane.
+    fn simd_gt(self, rhs: Self) -> Self;
+    /// `self ≤ rhs` per lane.
+    fn simd_le(self, rhs: Self) -> Self;
+    /// `self < rhs` per lane.
+    fn simd_lt(self, rhs: Self) -> Self;
+    /// With `self` a mask: `if_true` where set, `if_false` elsewhere.
+    fn select(self, if_true: Self, if_false: Self) -> Self;
+    /// NaN lanes.
+    fn is_nan(self) -> Self;
+    /// `±∞` lanes.
+    fn is_inf(self) -> Self;
+    /// Lanes whose sign bit is set (`−0` and `−NaN` included).
+    fn is_sign_negative(self) -> Self;
+    /// For positive normal finite lanes, `(f, e)` with `self = f·2^e`, `f ∈ [½, 1)`, `e` an
+    /// integer held as a float.
+    fn frexp(self) -> (Self, Self);
+    /// `2^round(self)` for `round(self) ∈ [−126, 0]` (below, `2^−126`), from exponent bits.
+    fn exp2_int(self) -> Self;
+
+    /// The natural logarithm of positive normal finite lanes (elsewhere unspecified: callers
+    /// select those lanes away). Cephes' `logf` reduction and polynomial (relative error about
+    /// `1e-7`): `x = f·2^e`, `f` taken into `[√½, √2)`, `ln(1 + g)` by a degree-9 polynomial in
+    /// `g = f − 1`, `e·ln 2` added in two parts.
+    #[inline(always)]
+    fn ln(self) -> Self {
+        let k = Self::splat;
+        let (f, e) = self.frexp();
+        let low = f.simd_lt(k(std::f32::consts::FRAC_1_SQRT_2));
+        let g = low.select(f + f, f) - k(1.0);
+        let e = low.select(e - k(1.0), e);
+        let z = g * g;
+        let mut p = k(7.037_683_6e-2);
+        for c in [-1.151_461_e-1, 1.167_699_9e-1, -1.242_014_1e-1, 1.424_932_3e-1, -1.666_805_8e-1] {
+            p = p.mul_add(g, k(c));
+        }
+        for c in [2.000_071_4e-1, -2.499_999_4e-1, 3.333_333e-1] {
+            p = p.mul_add(g, k(c));
+        }
+        let y = p * g * z;
+        let y = e.mul_add(k(-2.121_944_4e-4), y);
+        let y = y - k(0.5) * z;
+        e.mul_add(k(0.693_359_4), g + y)
+    }
+
+    /// `atan2(self, x)` per lane, as `f32::atan2` within a few ulp, for every pair of finite or
+    /// infinite lanes: both zero give `±0` or `±π` by the signs' rule, both infinite `±π/4` or `±3π/4`. The ratio of the lesser to the greater magnitude, in
+    /// `[0, 1]`, goes through cephes' `atanf` (reduced at `tan(π/8)` by `(a − 1)/(a + 1)`, a
+    /// degree-4 polynomial in `z²`), then back to the octant.
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+        let k = Self::splat;
+        let y = self;
+        let (ax, ay) = (x.max(-x), y.max(-y));
+        let (lo, hi) = (ax.min(ay), ax.max(ay));
+        let both_inf = ax.is_inf() & ay.is_inf();
+        let a = hi.simd_gt(k(0.0)).select(lo / hi, k(0.0));
+        let a = both_inf.select(k(1.0), a);
+        let big = a.simd_gt(k(0.414_213_57));
+        let t = big.select((a - k(1.0)) / (a + k(1.0)), a);
+        let z = t * t;
+        let p = k(8.053_744_5e-2).mul_add(z, k(-1.387_768_6e-1));
+        let p = p.mul_add(z, k(1.997_771_1e-1));
+        let p = p.mul_add(z, k(-3.333_295e-1));
+        let r = (p * z).mul_add(t, t);
+        let r = big.select(r + k(FRAC_PI_4), r);
+        let r = ay.simd_gt(ax).select(k(FRAC_PI_2) - r, r);
+        let r = x.is_sign_negative().select(k(PI) - r, r);
+        y.is_sign_negative().select(-r, r)
+    }
+
+    /// The sum of the lanes.
+    #[inline(always)]
+    fn reduce_add(self) -> f32 {
+        self.to_array().iter().sum()
+    }
+}
+
+/// A body generic over the lane type, run by [`super::dispatch`] on a path's lanes. Implementations mark
+/// `run` `#[inline(always)]` (and everything it calls on lanes, down to the [`Lane`] methods), so
+/// that it is compiled inside the path's `#[target_feature]` function.
+pub trait WithLanes {
+    /// What the body returns.
+    type Output;
+    /// The body on lanes `L`.
+    fn run<L: Lane>(self) -> Self::Output;
+}
