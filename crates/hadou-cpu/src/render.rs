@@ -151,10 +151,14 @@ fn render_with(
     // With a bloom, the band's halo too (every row of it exactly as a whole-image render has it).
     let glare = frame.bloom.as_ref().filter(|_| y1 > y0);
     let src = glare.map_or(band.clone(), |b| bloom::source_rows(frame, b, band.clone()));
-    let oy0 = opaque_pass(surfaces, &setup, k * src.start..k * src.end, scratch);
+    // A frame of waves alone draws nothing opaque: every pixel (every sample) shows the
+    // background, so the opaque pass and its per-pixel buffers are skipped.
+    let blank = frame.objects.is_empty() && frame.area_light.is_none();
+    let oy0 = if blank { 0 } else { opaque_pass(surfaces, &setup, k * src.start..k * src.end, scratch) };
     let opaque_done = Instant::now();
     let source = RowSource {
         k,
+        blank: blank.then(|| blank_color(surfaces.background, k)),
         opaque: scratch,
         oy0,
         pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
@@ -246,6 +250,9 @@ struct RowBuffers {
 /// pixel is resolved from its `k × k` samples.
 struct RowSource<'a> {
     k: usize,
+    /// With nothing opaque in the frame, every pixel's scene colour (the background, resolved
+    /// from its samples as a drawn frame's would be); the opaque buffers are then not read.
+    blank: Option<[f32; 3]>,
     opaque: &'a OpaqueBuffers,
     oy0: usize,
     /// The wave pass through the image's pixel centres.
@@ -267,6 +274,20 @@ impl RowSource<'_> {
     fn light_row<'b>(&'b self, y: usize, bufs: &'b mut RowBuffers) -> (&'b [BatchLight], &'b [[f32; 3]]) {
         let o = self.opaque;
         let k = self.k;
+        if let Some(bg) = self.blank {
+            // No surface anywhere: the waves through every pixel's centre, unclipped (the
+            // samples all agree, so an anti-aliased frame integrates once per pixel too).
+            let w = self.pass_width();
+            let RowBuffers { light, scene, surface, .. } = bufs;
+            if surface.len() != w || scene.len() != w || scene.first() != Some(&bg) {
+                surface.clear();
+                surface.resize(w, None);
+                scene.clear();
+                scene.resize(w, bg);
+            }
+            self.pass.row_light(y as f32, surface, light);
+            return (light, scene);
+        }
         if k == 1 {
             let w = self.pass_width();
             let first = (y - self.oy0) * w;
@@ -333,6 +354,23 @@ impl RowSource<'_> {
     fn pass_width(&self) -> usize {
         self.pass.width()
     }
+}
+
+/// The scene colour of a pixel none of whose `k × k` samples shows a surface, summed as
+/// [`RowSource::light_row`] sums a drawn frame's samples (so a blank frame renders bit for bit as
+/// it would through the opaque pass).
+fn blank_color(background: [f32; 3], k: usize) -> [f32; 3] {
+    if k == 1 {
+        return background;
+    }
+    let inv = 1.0 / (k * k) as f32;
+    let mut c = [0.0f32; 3];
+    for _ in 0..k * k {
+        for (ck, v) in c.iter_mut().zip(background) {
+            *ck += v * inv;
+        }
+    }
+    c.map(hadou_math::energy::saturate)
 }
 
 /// What decides whether a pixel's samples show one surface: the visible object, its material
