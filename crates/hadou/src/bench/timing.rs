@@ -11,8 +11,8 @@ pub struct Timing {
     /// into the 8-bit sRGB bytes a PNG holds).
     pub ms: f64,
     /// The parts, in order, as (name, median milliseconds): on the CPU the opaque pass, the wave
-    /// pass and the colour mapping (which add up to the whole) and the output (8-bit sRGB and
-    /// PNG encoding into memory, after the render); on the GPU each pass's GPU timestamps where
+    /// pass and the colour stage (which add up to the whole) and the output (PNG encoding of the
+    /// 8-bit bytes into memory, after the render); on the GPU each pass's GPU timestamps where
     /// the adapter has them, and the output. Empty where nothing finer was measured.
     pub parts: Vec<(String, f64)>,
 }
