@@ -156,19 +156,13 @@ impl Measured {
 
     /// The cell as a JSON row (its parts as rows of `{name, ms}`).
     fn cells(&self) -> Row {
-        let parts: Vec<Row> = self
-            .timing
-            .parts
-            .iter()
-            .map(|(name, ms)| vec![Cell::json("name", name.as_str()), Cell::json("ms", *ms)])
-            .collect();
         vec![
             Cell::json("size", self.size),
             Cell::json("occlusion", self.occlusion),
             Cell::json("ms", self.timing.ms),
             Cell::json("fps", self.fps()),
             Cell::json("mpix_per_s", self.mpix_per_s()),
-            Cell::json("parts", rows_json(&parts)),
+            Cell::json("parts", self.timing.parts_json()),
         ]
     }
 }

@@ -4,6 +4,7 @@
 
 use hadou_math::curve::{self, Integrator};
 use hadou_scene::{Frame, WaveShape};
+use rayon::prelude::*;
 
 /// Replaces the integrator of every curved wave of `frame`.
 pub fn with_integrator(frame: &Frame, integrator: Integrator) -> Frame {
@@ -59,9 +60,13 @@ fn sample_curve_energies(frame: &Frame, reference_tol: Option<f64>, grid: u32) -
             _ => None,
         })
         .collect();
-    let mut out = Vec::with_capacity((grid * grid) as usize);
-    for gy in 0..grid {
-        for gx in 0..grid {
+    // Every pixel is independent and the references are slow (adaptive f64 quadrature; the
+    // nearest-point field's brute force per node): spread them over the machine's threads, in
+    // grid order.
+    (0..grid * grid)
+        .into_par_iter()
+        .map(|i| {
+            let (gx, gy) = (i % grid, i / grid);
             let px = ((gx as f32 + 0.5) * frame.width as f32 / grid as f32).floor();
             let py = ((gy as f32 + 0.5) * frame.height as f32 / grid as f32).floor();
             let (mut e, mut n, mut r) = (0.0f32, 0u32, 0.0f64);
@@ -84,8 +89,7 @@ fn sample_curve_energies(frame: &Frame, reference_tol: Option<f64>, grid: u32) -
                     n += s.evaluations;
                 }
             }
-            out.push((e, n, r));
-        }
-    }
-    out
+            (e, n, r)
+        })
+        .collect()
 }

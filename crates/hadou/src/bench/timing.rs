@@ -22,6 +22,18 @@ impl Timing {
     pub fn whole(ms: f64) -> Self {
         Self { ms, parts: Vec::new() }
     }
+
+    /// The parts as a JSON array of `{name, ms}`.
+    pub fn parts_json(&self) -> serde_json::Value {
+        let parts: Vec<super::table::Row> = self
+            .parts
+            .iter()
+            .map(|(name, ms)| {
+                vec![super::table::Cell::json("name", name.as_str()), super::table::Cell::json("ms", *ms)]
+            })
+            .collect();
+        super::table::rows_json(&parts)
+    }
 }
 
 /// A timer: renders `frame` once untimed, then `iterations` timed times, and returns the medians.

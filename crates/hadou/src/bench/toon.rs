@@ -104,7 +104,8 @@ pub fn plain_materials(frame: &Frame) -> Frame {
 /// `no-shadows` (its `[[shadow]]`s removed), then [`GLARE_SCENE`] at each size, `bloom` (as
 /// written) and `no-bloom` (its `[bloom]` removed), then [`MTOON_SCENE`] at each size, `mtoon` and
 /// `toon-ramp` ([`without_mtoon`]), in one run. Its text pairs the two variants of each
-/// size with their ratio; its JSON `rows` are `{scene, size, variant, ms, fps}`.
+/// size with their ratio; its JSON `rows` are `{scene, size, variant, ms, fps, parts}` (`parts`: `{name, ms}` where the
+/// timer measured them, as in the analytic table).
 pub fn toon_table(
     time: &mut Timer<'_>,
     scenes: &Path,
@@ -118,13 +119,15 @@ pub fn toon_table(
     let mut pair = |scene: &'static str, size: u32, variants: [(&'static str, &Frame); 2]| {
         let mut ms = [0.0; 2];
         for (i, (variant, f)) in variants.into_iter().enumerate() {
-            ms[i] = time(f, iterations)?.ms;
+            let timing = time(f, iterations)?;
+            ms[i] = timing.ms;
             rows.push(vec![
                 Cell::json("scene", scene),
                 Cell::json("size", size),
                 Cell::json("variant", variant),
                 Cell::json("ms", ms[i]),
                 Cell::json("fps", 1e3 / ms[i]),
+                Cell::json("parts", timing.parts_json()),
             ]);
         }
         let [on, off] = ms;
