@@ -134,6 +134,8 @@ const NEEDED_ARRAY_LAYERS: u32 = 2;
 /// Textures the wave pass reads in one compute stage: the two G-buffer targets, the plane-shadow
 /// target and the shadow maps.
 const NEEDED_COMPUTE_TEXTURES: u32 = 4;
+/// Storage textures one compute stage writes: the edge pass's output (`Rgba32Uint`).
+const NEEDED_STORAGE_TEXTURES: u32 = 1;
 /// Invocations per workgroup the kernels use (8×8 wave pass, 64×1 twin-test kernels).
 const NEEDED_WORKGROUP_INVOCATIONS: u32 = 64;
 
@@ -213,6 +215,12 @@ fn check_capabilities(
             limits.max_texture_array_layers
         ));
     }
+    if limits.max_storage_textures_per_shader_stage < NEEDED_STORAGE_TEXTURES {
+        missing.push(format!(
+            "{NEEDED_STORAGE_TEXTURES} storage texture per shader stage (it allows {})",
+            limits.max_storage_textures_per_shader_stage
+        ));
+    }
     if limits.max_sampled_textures_per_shader_stage < NEEDED_COMPUTE_TEXTURES {
         missing.push(format!(
             "{NEEDED_COMPUTE_TEXTURES} sampled textures per shader stage (it allows {})",
@@ -222,6 +230,10 @@ fn check_capabilities(
     let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
     let formats = [
         (crate::formats::SCENE_FORMAT, attach_and_read),
+        (
+            crate::formats::SCENE_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        ),
         (crate::formats::DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
         (crate::formats::PLANE_SHADOW_FORMAT, attach_and_read),
         (crate::formats::MAP_FORMAT, attach_and_read),

@@ -42,6 +42,9 @@ pub(crate) struct TileTargets {
     attributes_view: wgpu::TextureView,
     /// Target 1 as the edge pass leaves it (what the plane shadows and the wave pass read).
     edge_attributes_view: wgpu::TextureView,
+    /// The edge pass's candidate map and block maxima (`passes::edges::scratch_bytes`).
+    edge_candidates: wgpu::Buffer,
+    edge_blocks: wgpu::Buffer,
     /// Depth of the raster pass, then of the plane-shadow pass.
     depth_view: wgpu::TextureView,
     /// The plane-shadow pass's target (`formats::PLANE_SHADOW_FORMAT`).
@@ -253,8 +256,22 @@ impl Renderer {
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let scene_view = texture("normal and distance", SCENE_FORMAT, attach_and_read);
         let attributes_view = texture("uv, colour and material", SCENE_FORMAT, attach_and_read);
-        let edge_attributes_view =
-            texture("uv, colour and material, outlines closed", SCENE_FORMAT, attach_and_read);
+        let edge_attributes_view = texture(
+            "uv, colour and material, outlines closed",
+            SCENE_FORMAT,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let (candidate_bytes, block_bytes) = crate::passes::edges::scratch_bytes(size);
+        let scratch = |label, size| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
+        let edge_candidates = scratch("edge candidates", candidate_bytes);
+        let edge_blocks = scratch("edge blocks", block_bytes);
         let depth_view = texture("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT);
         let plane_shadow_view = texture("plane shadows", PLANE_SHADOW_FORMAT, attach_and_read);
         let bytes = size[0] as u64 * size[1] as u64 * FLOATS_PER_PIXEL * 4;
@@ -281,6 +298,8 @@ impl Renderer {
             scene_view,
             attributes_view,
             edge_attributes_view,
+            edge_candidates,
+            edge_blocks,
             depth_view,
             plane_shadow_view,
             uniforms,
@@ -551,6 +570,9 @@ impl Renderer {
             materials: &b.materials,
             surface: &t.scene_view,
             attributes: &t.attributes_view,
+            output: &t.edge_attributes_view,
+            candidates: &t.edge_candidates,
+            blocks: &t.edge_blocks,
         };
         let edges = self.passes.edges.bind_group(d, &edges);
         // Without outlines the edge pass does not run and the raster pass's words carry no reach.
@@ -686,10 +708,9 @@ impl Renderer {
         if let Some(enc) = surfaces.as_mut().filter(|_| prepared.outlines) {
             passes.edges.encode(
                 enc,
-                &t.edge_attributes_view,
                 size,
                 &groups.edges,
-                timestamps.as_deref_mut().and_then(|q| q.render("edges")),
+                timestamps.as_deref_mut().and_then(|q| q.compute("edges")),
             );
         }
         if let Some(bg) = &groups.plane {

@@ -92,6 +92,15 @@ mod tests {
                         (naga::ScalarKind::Float, true, false) => Kind::DepthArray,
                         other => panic!("{pass}: {name}: unexpected texture {other:?}"),
                     },
+                    (
+                        _,
+                        &naga::TypeInner::Image {
+                            class:
+                                naga::ImageClass::Storage { format: naga::StorageFormat::Rgba32Uint, access },
+                            arrayed: false,
+                            ..
+                        },
+                    ) if access == naga::StorageAccess::STORE => Kind::UintStorageTexture,
                     other => panic!("{pass}: {name}: unexpected {other:?}"),
                 };
                 assert_eq!(b.kind, kind, "{pass}: {name}");

@@ -41,6 +41,8 @@ pub(crate) enum Kind {
     /// A 2-D `u32` texture read with `textureLoad` (the G-buffer, the plane-shadow target, the soft
     /// maps).
     UintTexture,
+    /// A 2-D `rgba32uint` storage texture written with `textureStore` (the edge pass's output).
+    UintStorageTexture,
     /// A 2-D array of depth read with `textureLoad` as unfilterable `f32` (the shadow maps).
     DepthArray,
     /// A 2-D depth texture read with `textureLoad` as unfilterable `f32` (a caller's depth
@@ -85,6 +87,11 @@ impl Binding {
                 sample_type: wgpu::TextureSampleType::Uint,
                 view_dimension: wgpu::TextureViewDimension::D2,
                 multisampled: false,
+            },
+            Kind::UintStorageTexture => wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: crate::formats::SCENE_FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
             },
             Kind::Depth => wgpu::BindingType::Texture {
                 sample_type: wgpu::TextureSampleType::Float { filterable: false },
