@@ -1,11 +1,11 @@
 //! The fixed cost per pixel of the kinds of pass hadou-gpu records, on the adapter at hand, timed
-//! with GPU timestamps (median of 20 after a warm-up): a render pass that only clears the
-//! raster pass's targets (two `Rgba32Uint` and a depth buffer), the same with a full-screen
-//! triangle writing both colour targets (the fragment path the raster and plane-shadow passes
-//! take), a compute pass writing the same 32 bytes a pixel into a storage buffer (the wave
-//! pass's path), and a compute pass writing an `Rgba32Uint` storage texture (the edge pass's
-//! path). On GPUs whose graphics units are a small part of the chip, the fragment rows cost
-//! many times the compute rows; elsewhere they are close.
+//! with GPU timestamps (median of 20 after a warm-up): render passes over the raster pass's
+//! targets (two `Rgba32Uint` and a depth buffer) that clear them or load them, with or without a
+//! full-screen triangle writing the colour targets (the fragment path the raster and
+//! plane-shadow passes take); a compute pass writing the same 32 bytes a pixel into a storage
+//! buffer (the wave pass's path), and a compute pass writing an `Rgba32Uint` storage texture (the
+//! edge pass's path). On GPUs whose graphics units are a small part of the chip, the render rows
+//! cost many times the compute rows; elsewhere they are close.
 //!
 //! `cargo run --release -p hadou-gpu --example fill_cost [SIZE ...]` (default 1024 2048)
 
@@ -25,9 +25,14 @@ fn vs(@builtin(vertex_index) k: u32) -> @builtin(position) vec4<f32> {
 }
 
 @fragment
-fn fs(@builtin(position) p: vec4<f32>) -> Out {
+fn fs2(@builtin(position) p: vec4<f32>) -> Out {
     let q = vec2<u32>(p.xy);
     return Out(vec4<u32>(q, 1u, 2u), vec4<u32>(3u, q, 4u));
+}
+
+@fragment
+fn fs1(@builtin(position) p: vec4<f32>) -> @location(0) vec4<u32> {
+    return vec4<u32>(vec2<u32>(p.xy), 1u, 2u);
 }
 
 struct Size { w: u32, h: u32 }
@@ -78,22 +83,45 @@ fn open() -> Result<Gpu, String> {
     Ok(Gpu { device, queue, name: adapter.get_info().name })
 }
 
-/// How one case records its pass, given the timestamp writes of its one pass.
+/// What one case's pass does.
+#[derive(Clone, Copy)]
 enum Case {
-    Clear,
-    Fragment,
+    /// A render pass over `colour` `Rgba32Uint` targets (cleared, or loaded as they are) and a
+    /// cleared depth buffer, with a full-screen triangle when `draw`.
+    Render { colour: usize, clear: bool, draw: bool },
+    /// A compute pass writing 32 bytes a pixel into a storage buffer.
     ComputeBuffer,
+    /// A compute pass writing an `Rgba32Uint` storage texture.
     ComputeTexture,
 }
 
-impl Case {
-    const ALL: [(Case, &'static str, u64); 4] = [
-        (Case::Clear, "render pass, clears only (2 × Rgba32Uint + depth)", 36),
-        (Case::Fragment, "render pass, full-screen triangle → 2 × Rgba32Uint", 36),
-        (Case::ComputeBuffer, "compute → storage buffer, 32 B a pixel", 32),
-        (Case::ComputeTexture, "compute → Rgba32Uint storage texture", 16),
-    ];
-}
+/// The cases, with their labels and the bytes a pixel each writes.
+const CASES: [(Case, &str, u64); 8] = [
+    (
+        Case::Render { colour: 2, clear: true, draw: false },
+        "render pass, clears only (2 × Rgba32Uint + depth)",
+        36,
+    ),
+    (Case::Render { colour: 0, clear: true, draw: false }, "render pass, depth clear only", 4),
+    (Case::Render { colour: 2, clear: false, draw: false }, "render pass, colour loaded, depth cleared", 4),
+    (
+        Case::Render { colour: 2, clear: true, draw: true },
+        "full-screen triangle → 2 × Rgba32Uint, cleared",
+        36,
+    ),
+    (
+        Case::Render { colour: 2, clear: false, draw: true },
+        "full-screen triangle → 2 × Rgba32Uint, loaded",
+        36,
+    ),
+    (
+        Case::Render { colour: 1, clear: false, draw: true },
+        "full-screen triangle → 1 × Rgba32Uint, loaded",
+        20,
+    ),
+    (Case::ComputeBuffer, "compute → storage buffer, 32 B a pixel", 32),
+    (Case::ComputeTexture, "compute → Rgba32Uint storage texture", 16),
+];
 
 fn main() -> ExitCode {
     let mut sizes = Vec::new();
@@ -119,8 +147,8 @@ fn main() -> ExitCode {
     println!("adapter: {}", gpu.name);
     println!("{:<54} {:>6} {:>10} {:>10} {:>9}", "pass", "size", "µs", "Gpx/s", "GB/s");
     for size in sizes {
-        for (case, label, bytes) in Case::ALL {
-            let us = time_case(&gpu, &case, size);
+        for (case, label, bytes) in CASES {
+            let us = time_case(&gpu, case, size);
             let px = size as f64 * size as f64;
             println!(
                 "{label:<54} {:>6} {us:>10.1} {:>10.2} {:>9.0}",
@@ -134,7 +162,7 @@ fn main() -> ExitCode {
 }
 
 /// Median microseconds of `case`'s pass at `size`², from GPU timestamps.
-fn time_case(gpu: &Gpu, case: &Case, size: u32) -> f64 {
+fn time_case(gpu: &Gpu, case: Case, size: u32) -> f64 {
     let d = &gpu.device;
     let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("fill_cost"),
@@ -174,33 +202,36 @@ fn time_case(gpu: &Gpu, case: &Case, size: u32) -> f64 {
     let color =
         |format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL });
     let color_targets = [color(wgpu::TextureFormat::Rgba32Uint), color(wgpu::TextureFormat::Rgba32Uint)];
-    let render = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("fill"),
-        layout: None,
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: Default::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: wgpu::TextureFormat::Depth32Float,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs"),
-            compilation_options: Default::default(),
-            targets: &color_targets,
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let render = |targets: usize| {
+        d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("fill"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: wgpu::TextureFormat::Depth32Float,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(if targets == 2 { "fs2" } else { "fs1" }),
+                compilation_options: Default::default(),
+                targets: &color_targets[..targets],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    let pipelines = [render(1), render(2)];
     let compute = |entry| {
         d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
@@ -254,21 +285,23 @@ fn time_case(gpu: &Gpu, case: &Case, size: u32) -> f64 {
         let mut enc = d.create_command_encoder(&Default::default());
         let groups = size.div_ceil(8);
         match case {
-            Case::Clear | Case::Fragment => {
-                let cleared = |view| {
-                    Some(wgpu::RenderPassColorAttachment {
-                        view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Store,
-                        },
+            Case::Render { colour, clear, draw } => {
+                let load =
+                    if clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load };
+                let attachments: Vec<_> = targets[..colour]
+                    .iter()
+                    .map(|view| {
+                        Some(wgpu::RenderPassColorAttachment {
+                            view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+                        })
                     })
-                };
+                    .collect();
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: None,
-                    color_attachments: &[cleared(&targets[0]), cleared(&targets[1])],
+                    color_attachments: &attachments,
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                         view: &depth,
                         depth_ops: Some(wgpu::Operations {
@@ -285,8 +318,8 @@ fn time_case(gpu: &Gpu, case: &Case, size: u32) -> f64 {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                if matches!(case, Case::Fragment) {
-                    pass.set_pipeline(&render);
+                if draw && colour > 0 {
+                    pass.set_pipeline(&pipelines[colour - 1]);
                     pass.draw(0..3, 0..1);
                 }
             }
