@@ -110,7 +110,7 @@ pub use passes::present::PresentedFrame;
 pub use passes::soft::{SoftFit, SOFT_BYTES_PER_PIXEL};
 pub use render::MAX_TILE;
 pub use texture_read::TextureRead;
-pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod};
+pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod, SOFT_PREPARATION, SOFT_TILES};
 /// The wgpu version this backend is built on (for [`wgpu::AdapterInfo`] and its types).
 pub use wgpu;
 

@@ -3,7 +3,10 @@
 //! submissions. Not on the web.
 
 use crate::render::Renderer;
-use crate::timing::{median, split_frame, FrameTiming, PassQueries, PassTime, TimingMethod, PASSES_PER_TILE};
+use crate::timing::{
+    median, split_frame, FrameTiming, PassQueries, PassTime, TimingMethod, PASSES_PER_TILE, SOFT_PREPARATION,
+    SOFT_TILES,
+};
 use hadou_scene::{Frame, RenderError};
 use std::time::Instant;
 
@@ -107,17 +110,28 @@ pub(crate) fn time_frame(
         return Ok(timing);
     }
     if soft {
+        let (mut preparation, mut drawing) = (Vec::new(), Vec::new());
         for _ in 0..iterations {
             let start = Instant::now();
-            // `prepare` draws the shadow maps and the soft shadows.
+            // `prepare` draws the shadow maps and the soft shadows; waiting for all it submitted
+            // splits the frame in two.
             let prepared = r.prepare(frame, 0..frame.height)?;
+            r.ctx.wait(r.ctx.queue.submit([]))?;
+            let prepared_at = Instant::now();
             let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))??;
             if let Some(s) = last {
                 r.ctx.wait(s)?;
             }
             samples.push(start.elapsed().as_secs_f64() * 1e3);
+            preparation.push((prepared_at - start).as_secs_f64() * 1e3);
+            drawing.push(prepared_at.elapsed().as_secs_f64() * 1e3);
         }
-        return Ok(FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples));
+        let mut timing = FrameTiming::from_samples(TimingMethod::WallClock, tiles, samples);
+        timing.passes = vec![
+            PassTime { name: SOFT_PREPARATION.into(), median_ms: median(&preparation) },
+            PassTime { name: SOFT_TILES.into(), median_ms: median(&drawing) },
+        ];
+        return Ok(timing);
     }
     for _ in 0..iterations {
         let start = Instant::now();

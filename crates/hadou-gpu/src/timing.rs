@@ -52,13 +52,22 @@ pub struct FrameTiming {
     pub median_ms: f64,
     /// Minimum of `per_iteration_ms`.
     pub min_ms: f64,
-    /// The frame split by pass, in the order the passes first run ([`PassTime`]). Only with
-    /// [`TimingMethod::GpuTimestamps`]; empty when the adapter has no timestamp queries (some
-    /// GL and GLES drivers) or the frame is timed by wall clock. Each pass's median is at most `median_ms`,
-    /// and in any one iteration the passes sum to at most the frame (the frame also holds the
-    /// gaps between passes).
+    /// The frame split by pass, in the order the passes first run ([`PassTime`]). With
+    /// [`TimingMethod::GpuTimestamps`] the passes' GPU times; a frame with an `[area_light]`
+    /// (timed by wall clock) is split in two, [`SOFT_PREPARATION`] and [`SOFT_TILES`]; empty when
+    /// the adapter has no timestamp queries (some GL and GLES drivers) and the frame has no area
+    /// light. Each pass's median is at most `median_ms`, and in any one iteration the passes sum
+    /// to at most the frame (the frame also holds the gaps between passes).
     pub passes: Vec<PassTime>,
 }
+
+/// The first part of a frame with an `[area_light]` in [`FrameTiming::passes`], by wall clock:
+/// uploads, the shadow maps and the soft shadows (every tile rasterized for its points, the fit
+/// windows read back, the two maps, the classes and the resolve), until the GPU has finished them.
+pub const SOFT_PREPARATION: &str = "soft preparation (wall clock)";
+/// The second part: the tiles drawn (raster, edges, plane shadows, the soft gather, the wave
+/// pass), until the GPU has finished them.
+pub const SOFT_TILES: &str = "tiles (wall clock)";
 
 /// The median of `samples` (0 when empty).
 pub(crate) fn median(samples: &[f64]) -> f64 {

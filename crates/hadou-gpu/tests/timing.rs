@@ -61,7 +61,8 @@ fn time_frame_splits_the_frame_into_its_passes() {
 }
 
 /// A frame with an `[area_light]` is timed by the wall clock (its soft shadows are prepared
-/// with it), without a split, on any adapter.
+/// with it), split into the soft preparation and the tiles, on any adapter: each part positive,
+/// and in every iteration together no more than the frame.
 #[test]
 fn time_frame_times_an_area_light_frame_by_the_wall_clock() {
     let Some(mut gpu) = gpu_or_skip("time_frame area light") else { return };
@@ -71,9 +72,15 @@ fn time_frame_times_an_area_light_frame_by_the_wall_clock() {
     frame.height = 72;
     let t = gpu.time_frame(&frame, 2).expect("timing");
     assert_eq!(t.method, TimingMethod::WallClock);
-    assert!(t.passes.is_empty());
+    assert_eq!(names(&t), [hadou_gpu::SOFT_PREPARATION, hadou_gpu::SOFT_TILES]);
+    assert!(t.passes.iter().all(|p| p.median_ms > 0.0 && p.median_ms.is_finite()), "{t:?}");
     assert_eq!(t.per_iteration_ms.len(), 2);
     assert!(t.per_iteration_ms.iter().all(|&ms| ms > 0.0 && ms.is_finite()), "{t:?}");
+    // The parts' medians, each at most the slowest frame; their sum at most the two frames.
+    let slowest = t.per_iteration_ms.iter().copied().fold(0.0, f64::max);
+    assert!(t.passes.iter().all(|p| p.median_ms <= slowest), "{t:?}");
+    let sum: f64 = t.passes.iter().map(|p| p.median_ms).sum();
+    assert!(sum <= t.per_iteration_ms.iter().sum::<f64>(), "{t:?}");
 }
 
 /// `time_wave_overlay` times the overlay pass alone (wall clock): one sample per iteration, each

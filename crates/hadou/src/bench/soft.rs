@@ -39,7 +39,8 @@ pub use hadou_cpu::soft::{disc_radius as soft_disc_radius, edge_errors as soft_e
 /// difference from the ground truth over the shadow-edge pixels; then the rows `frame` (the
 /// whole render with the scene's own resolve, by the bench's backend) and `frame-unlit` (the same
 /// without the area light), without errors. Its JSON `rows` are `{method, size, ms, fps,
-/// mean_error, p99_error}`.
+/// mean_error, p99_error}`, the two frame rows with their `parts` (`{name, ms}`: on the GPU the
+/// soft preparation and the tiles by wall clock, and the output).
 pub fn soft_table(
     time: &mut Timer<'_>,
     scenes: &Path,
@@ -101,7 +102,10 @@ pub fn soft_table(
             ("frame", format!("frame ({backend})"), &frame),
             ("frame-unlit", "  no area light".into(), &unlit),
         ] {
-            rows.push(soft_row(method, label, size, time(f, iterations)?.ms, None, None));
+            let timing = time(f, iterations)?;
+            let mut row = soft_row(method, label, size, timing.ms, None, None);
+            row.push(Cell::json("parts", timing.parts_json()));
+            rows.push(row);
         }
     }
     let title = format!(
