@@ -66,16 +66,7 @@ impl BloomPass {
             let d = &ctx.device;
             let layout = setup::bind_group_layout(d, "bloom", &BINDINGS);
             let pl = setup::pipeline_layout(d, "bloom", &layout);
-            let pipeline = |entry: &str| {
-                d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&pl),
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            };
+            let pipeline = |entry: &str| setup::compute_pipeline(d, &pl, &module, entry);
             Self {
                 prefilter: pipeline("cs_prefilter"),
                 down: pipeline("cs_down"),

@@ -72,16 +72,7 @@ impl EdgePass {
             let d = &ctx.device;
             let layout = setup::bind_group_layout(d, "edges", &BINDINGS);
             let pipeline_layout = setup::pipeline_layout(d, "edges", &layout);
-            let pipeline = |entry: &str| {
-                d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&pipeline_layout),
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            };
+            let pipeline = |entry: &str| setup::compute_pipeline(d, &pipeline_layout, &module, entry);
             Self { candidates: pipeline("cs_candidates"), edges: pipeline("cs_edges"), layout }
         })
     }

@@ -154,6 +154,24 @@ pub(crate) fn pipeline_layout(
     })
 }
 
+/// A compute pipeline of `module`'s entry point `entry` (labelled by it) on `layout`, with the
+/// module's overrides at their defaults.
+pub(crate) fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
 /// The vertex attributes of a cached mesh ([`GpuVertex`]): position, normal, outline normal,
 /// texture coordinates, colour, material.
 pub(crate) const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![

@@ -408,16 +408,7 @@ impl SoftPass {
                 Some(depth),
             );
             let soft_pl = setup::pipeline_layout(d, "soft", &layout);
-            let pipeline = |entry: &str| {
-                d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(entry),
-                    layout: Some(&soft_pl),
-                    module: &soft_module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })
-            };
+            let pipeline = |entry: &str| setup::compute_pipeline(d, &soft_pl, &soft_module, entry);
             let pipelines = SoftPipelines {
                 points: pipeline("cs_points"),
                 class: pipeline("cs_class"),
