@@ -95,6 +95,10 @@ pub(crate) struct Prepared {
     /// (`sampled`), and the wave pass resolves each image pixel from its samples.
     grid: u32,
     sampled: Option<Frame>,
+    /// The tile the G-buffer holds when the last tile encoded was classified for the soft
+    /// shadows (`TileWork::Classify`), and nothing since: the next tile drawn, if it is that
+    /// one, skips the raster pass.
+    classified_tile: std::sync::Mutex<Option<([u32; 2], [u32; 2])>>,
 }
 
 /// The bind groups every tile of a frame uses (the tile's uniforms are rewritten before each
@@ -394,6 +398,7 @@ impl Renderer {
                 linear: false,
                 grid,
                 sampled: None,
+                classified_tile: std::sync::Mutex::new(None),
             };
             if submit_maps || frame.area_light.is_some() {
                 self.submit_shadow_maps(frame, &prepared, None);
@@ -680,7 +685,17 @@ impl Renderer {
             self.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
         };
         let mut surfaces = None;
-        if prepared.raster || work == TileWork::Classify {
+        // With an `[area_light]`, `draw_soft` rasterized every tile of the image for its points:
+        // the first tile drawn after it may be the one the G-buffer still holds as the raster
+        // pass left it (a drawn tile's plane shadows then change its depth, so only a classified
+        // tile is reused).
+        let reuse = {
+            let mut holds = prepared.classified_tile.lock().unwrap_or_else(|e| e.into_inner());
+            let reuse = work != TileWork::Classify && *holds == Some(tile);
+            *holds = (work == TileWork::Classify).then_some(tile);
+            reuse
+        };
+        if (prepared.raster || work == TileWork::Classify) && !reuse {
             let enc = surfaces.get_or_insert_with(|| encoder("tile surfaces"));
             passes.raster.encode(
                 enc,
