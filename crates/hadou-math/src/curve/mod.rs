@@ -54,6 +54,7 @@ mod closed;
 mod cost;
 mod dispatch;
 pub mod integrate;
+mod lanes;
 mod local_ray;
 mod nearest;
 mod prepare;
@@ -67,6 +68,7 @@ pub use dispatch::{curve_energy, curve_energy_f64};
 pub use integrate::{
     attenuation_split, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
 };
+pub use lanes::{curve_energy_lanes, PACKET};
 pub use nearest::{MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_STEP, TAIL_RADII};
 pub use prepare::{
     prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS,
