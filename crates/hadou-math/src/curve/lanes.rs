@@ -27,7 +27,7 @@ use super::dispatch::curve_energy;
 use super::integrate::{
     attenuation_split, default_generic, leaf_walk, Acc, ChordModel, CurveSample, DEFAULT_SETTINGS,
 };
-use super::local_ray::LocalRay;
+use super::local_ray::{LocalFrame, LocalRay};
 use super::prepare::PreparedCurve;
 use super::wave::Integrator;
 use crate::energy::{scaled, Falloff, FieldParams, Ray};
@@ -39,14 +39,7 @@ pub const PACKET: usize = 8;
 /// Per-lane masks as bits.
 #[inline(always)]
 fn bits<L: Lane>(m: L) -> u32 {
-    let a = m.to_array();
-    let mut b = 0u32;
-    for (i, v) in a.iter().enumerate() {
-        if v.to_bits() != 0 {
-            b |= 1 << i;
-        }
-    }
-    b
+    m.bitmask()
 }
 
 /// Bits as a lane mask.
@@ -579,13 +572,14 @@ pub fn curve_energy_lanes<L: Lane>(
     let table = &c.table;
     let nn = table.nodes.len() - 1;
     let xh = c.x_head as f32;
+    let frame = LocalFrame::new(c, p);
     let mut local: [Option<LocalRay<f32>>; PACKET] = [None; PACKET];
     // Lanes the packet integrates; the others are left to the scalar code (or are empty).
     let mut packet = 0u32;
     let mut scalar = 0u32;
     let mut first = None;
     for i in 0..n {
-        let Some(r) = LocalRay::new(c, p, &rays[i], t0[i], t1[i], t_far[i]) else { continue };
+        let Some(r) = frame.ray(&rays[i], t0[i], t1[i], t_far[i]) else { continue };
         local[i] = Some(r);
         let Some((tin, tout, _)) = r.slab() else {
             scalar |= 1 << i;
