@@ -191,7 +191,7 @@ impl<'a> WavePass<'a> {
                 WaveShape::Capsule(f) => lanes::capsule_energy(&p, ray, f),
                 WaveShape::Beam(f) => lanes::beam_energy(&p, ray, f),
                 WaveShape::Curve(c) => {
-                    let (e, n) = self.curve_lanes(wi, c, &p, &Rays::of(ray, &rays), valid);
+                    let (e, n) = self.curve_lanes::<L>(wi, c, &p, &Rays::of(ray, &rays), valid);
                     // Saturated at f32::MAX (hadou_math::energy::saturate): an overflow is full
                     // brightness, not 0.
                     sink.wave(wi, lanes::saturate(L::from_array(e)), n);
@@ -228,9 +228,11 @@ impl<'a> WavePass<'a> {
         e
     }
 
-    /// A curved wave's energy, one pixel at a time (its integrator adapts per ray).
-    #[inline(never)]
-    fn curve_lanes(
+    /// A curved wave's energy through the batch's `valid` pixels: the default integrator walks
+    /// the piece table with the eight rays as one packet (`curve::curve_energy_lanes`), the
+    /// other integrators one pixel at a time (their work adapts per ray).
+    #[inline(always)]
+    fn curve_lanes<L: Lane>(
         &self,
         wi: usize,
         c: &curve::CurveWave,
@@ -246,19 +248,17 @@ impl<'a> WavePass<'a> {
                 &owned
             }
         };
-        let mut e = [0.0f32; LANES];
-        let mut n = [0u32; LANES];
-        for i in 0..valid {
-            let r = Ray { origin: ray.origin, dir: Vec3::new(ray.dir[0][i], ray.dir[1][i], ray.dir[2][i]) };
-            let t_far = match p.falloff {
-                Falloff::Faithful => 1.0,
-                Falloff::InverseSquare => ray.far[i],
-            };
-            let s = curve::curve_energy(prep, p, &r, ray.t0[i], ray.t1[i], t_far);
-            e[i] = s.energy;
-            n[i] = s.evaluations;
-        }
-        (e, n)
+        let n = valid.min(LANES);
+        let rays: [Ray<f32>; LANES] = std::array::from_fn(|i| Ray {
+            origin: ray.origin,
+            dir: Vec3::new(ray.dir[0][i], ray.dir[1][i], ray.dir[2][i]),
+        });
+        let t_far: [f32; LANES] = match p.falloff {
+            Falloff::Faithful => [1.0; LANES],
+            Falloff::InverseSquare => ray.far,
+        };
+        let s = curve::curve_energy_lanes::<L>(prep, p, &rays[..n], &ray.t0[..n], &ray.t1[..n], &t_far[..n]);
+        (s.map(|s| s.energy), s.map(|s| s.evaluations))
     }
 
     /// Each wave's energy and evaluation count at pixel `x` of row `py` (in the first lane, as

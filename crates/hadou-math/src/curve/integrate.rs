@@ -127,13 +127,13 @@ pub fn default_energy(
 }
 
 /// Accumulates pieces: energy and evaluation count.
-struct Acc<R> {
-    sum: R,
-    evals: u32,
+pub(super) struct Acc<R> {
+    pub(super) sum: R,
+    pub(super) evals: u32,
     /// Part ratio `q` of [`attenuation_split`] (`1 − u` shrinks by it per part).
-    q: R,
+    pub(super) q: R,
     /// Attenuation floor `h_floor` of [`attenuation_split`].
-    h_floor: R,
+    pub(super) h_floor: R,
 }
 
 impl<R: Real> Acc<R> {
@@ -206,15 +206,15 @@ pub const MAX_ATTENUATION_PARTS: usize = 64;
 /// walk, [`Acc`] and `line_quad` in `curve_walk`, `curve_piece` and `curve_line_quad` there: keep
 /// them in sync (the GPU twin test compares the two on 1704 rays).
 #[derive(Clone, Copy, Debug)]
-struct ChordModel<R> {
-    first: R,
-    saturation: R,
-    partial: R,
-    second: R,
+pub(super) struct ChordModel<R> {
+    pub(super) first: R,
+    pub(super) saturation: R,
+    pub(super) partial: R,
+    pub(super) second: R,
 }
 
 impl<R: Real> ChordModel<R> {
-    fn new(falloff: Falloff) -> Self {
+    pub(super) fn new(falloff: Falloff) -> Self {
         let (first, partial, second) = match falloff {
             Falloff::Faithful => (3.0 / 16.0, 1.25, 1.0),
             Falloff::InverseSquare => (0.75, 2.5, 3.0),
@@ -581,7 +581,7 @@ struct SubPiece<R> {
 /// ray passing `10⁻⁴` from it. Every sub-piece visited costs one curve evaluation (its
 /// midpoint) and counts one.
 #[allow(clippy::too_many_arguments)]
-fn leaf_walk<R: CurveReal>(
+pub(super) fn leaf_walk<R: CurveReal>(
     c: &PreparedCurve,
     r: &LocalRay<R>,
     i: usize,

@@ -37,6 +37,74 @@ impl CurveReal for f64 {
     }
 }
 
+/// What [`LocalRay::new`] takes from the curve and the field, the same for every ray: the frame's
+/// origin and axes and the wave's constants in the precision `R`. A batch of rays through one
+/// curve forms it once ([`LocalFrame::ray`] per ray).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LocalFrame<R> {
+    origin: Vec3<R>,
+    axes: [Vec3<R>; 3],
+    j: R,
+    rc2: R,
+    falloff: Falloff,
+    alpha: R,
+    x_head: R,
+}
+
+impl<R: Real> LocalFrame<R> {
+    /// The curve's frame and constants in `R`.
+    pub(crate) fn new(c: &PreparedCurve, p: &FieldParams<R>) -> Self {
+        let conv = |v: Vec3<f64>| Vec3::new(R::from_f64(v.x), R::from_f64(v.y), R::from_f64(v.z));
+        LocalFrame {
+            origin: conv(c.origin),
+            axes: c.axes.map(conv),
+            j: R::from_f64(f64::from(c.wave.attenuation)),
+            rc2: {
+                let rc = c.effective_core_radius(p.core_radius);
+                rc * rc
+            },
+            falloff: p.falloff,
+            alpha: R::from_f64(f64::from(c.wave.alpha)),
+            x_head: R::from_f64(c.x_head),
+        }
+    }
+
+    /// [`LocalRay::new`] of one ray in this frame: `None` if the span is empty or the input is
+    /// not finite.
+    #[inline]
+    pub(crate) fn ray(&self, ray: &Ray<R>, t0: R, t1: R, t_far: R) -> Option<LocalRay<R>> {
+        if !(ray.origin.is_finite() && ray.dir.is_finite() && t0.is_finite() && !t1.to_f64().is_nan()) {
+            return None;
+        }
+        let t_far = if t_far.is_finite() && t_far > R::ZERO { t_far } else { R::ONE };
+        let j = self.j;
+        let mut t1 = t1;
+        if self.falloff == Falloff::Faithful && !t1.is_finite() {
+            t1 = t_far;
+        }
+        if j > R::ZERO {
+            t1 = t1.min(t_far);
+        }
+        if !(t1 > t0) {
+            return None;
+        }
+        let [d, y, z] = self.axes;
+        let w = ray.origin - self.origin;
+        Some(LocalRay {
+            o: Vec3::new(w.dot(d), w.dot(y), w.dot(z)),
+            q: Vec3::new(ray.dir.dot(d), ray.dir.dot(y), ray.dir.dot(z)),
+            t0,
+            t1,
+            t_far,
+            j,
+            rc2: self.rc2,
+            falloff: self.falloff,
+            alpha: self.alpha,
+            x_head: self.x_head,
+        })
+    }
+}
+
 /// A ray in the curve's local frame, with the span and the attenuation resolved.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LocalRay<R> {
@@ -66,7 +134,8 @@ impl<R: Real> LocalRay<R> {
     /// Resolves the span: `None` if it is empty or the input is not finite.
     ///
     /// Faithful mode integrates at most to the far point (`t1 = ∞` means `t_far`); with attenuation
-    /// `j > 0` the factor is 0 from the far point on, so the span ends there.
+    /// `j > 0` the factor is 0 from the far point on, so the span ends there. The same as
+    /// [`LocalFrame::new`] followed by [`LocalFrame::ray`].
     pub(crate) fn new(
         c: &PreparedCurve,
         p: &FieldParams<R>,
@@ -75,40 +144,7 @@ impl<R: Real> LocalRay<R> {
         t1: R,
         t_far: R,
     ) -> Option<Self> {
-        if !(ray.origin.is_finite() && ray.dir.is_finite() && t0.is_finite() && !t1.to_f64().is_nan()) {
-            return None;
-        }
-        let t_far = if t_far.is_finite() && t_far > R::ZERO { t_far } else { R::ONE };
-        let j = R::from_f64(f64::from(c.wave.attenuation));
-        let mut t1 = t1;
-        if p.falloff == Falloff::Faithful && !t1.is_finite() {
-            t1 = t_far;
-        }
-        if j > R::ZERO {
-            t1 = t1.min(t_far);
-        }
-        if !(t1 > t0) {
-            return None;
-        }
-        let o64 = c.origin;
-        let conv = |v: Vec3<f64>| Vec3::new(R::from_f64(v.x), R::from_f64(v.y), R::from_f64(v.z));
-        let [d, y, z] = c.axes.map(conv);
-        let w = ray.origin - conv(o64);
-        Some(LocalRay {
-            o: Vec3::new(w.dot(d), w.dot(y), w.dot(z)),
-            q: Vec3::new(ray.dir.dot(d), ray.dir.dot(y), ray.dir.dot(z)),
-            t0,
-            t1,
-            t_far,
-            j,
-            rc2: {
-                let rc = c.effective_core_radius(p.core_radius);
-                rc * rc
-            },
-            falloff: p.falloff,
-            alpha: R::from_f64(f64::from(c.wave.alpha)),
-            x_head: R::from_f64(c.x_head),
-        })
+        LocalFrame::new(c, p).ray(ray, t0, t1, t_far)
     }
 
     /// Local point at `t`.

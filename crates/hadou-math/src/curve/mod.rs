@@ -27,6 +27,9 @@
 //!   true nearest curve point rather than its cross-section partner — by a walk over the ray whose
 //!   steps follow the distance, each distance found by branch and bound over the piece table and
 //!   refined on the exact curve ([`nearest`]).
+//! - [`curve_energy_lanes`]: the default integrator on up to eight neighbouring rays at once,
+//!   walking the piece table as one packet in SIMD lanes (`lanes.rs`; what the CPU backend's
+//!   wave pass runs), each ray evaluating the pieces [`curve_energy`] gives it.
 //! - [`curve_energy_reference`]: converged `f64` adaptive Gauss–Kronrod on the exact field;
 //!   [`nearest_energy_reference`] the same for the nearest-point field, by dense minimisation.
 //!
@@ -54,6 +57,7 @@ mod closed;
 mod cost;
 mod dispatch;
 pub mod integrate;
+mod lanes;
 mod local_ray;
 mod nearest;
 mod prepare;
@@ -67,6 +71,7 @@ pub use dispatch::{curve_energy, curve_energy_f64};
 pub use integrate::{
     attenuation_split, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
 };
+pub use lanes::{curve_energy_lanes, PACKET};
 pub use nearest::{MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_STEP, TAIL_RADII};
 pub use prepare::{
     prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS,

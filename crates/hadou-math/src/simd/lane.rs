@@ -54,6 +54,9 @@ pub trait Lane:
     fn is_inf(self) -> Self;
     /// Lanes whose sign bit is set (`−0` and `−NaN` included).
     fn is_sign_negative(self) -> Self;
+    /// With `self` a mask: bit `i` set where lane `i` is (its sign bit, as `movemask`), so that
+    /// scalar control flow can branch on a lane set without going through memory.
+    fn bitmask(self) -> u32;
     /// For positive normal finite lanes, `(f, e)` with `self = f·2^e`, `f ∈ [½, 1)`, `e` an
     /// integer held as a float.
     fn frexp(self) -> (Self, Self);

@@ -13,6 +13,10 @@ impl Lane for f32x8 {
         f32x8::splat(v)
     }
     #[inline(always)]
+    fn bitmask(self) -> u32 {
+        f32x8::to_bitmask(self)
+    }
+    #[inline(always)]
     fn from_array(a: [f32; 8]) -> Self {
         f32x8::from(a)
     }

@@ -151,6 +151,11 @@ impl Lane for Avx2 {
         abs.cmp::<_CMP_EQ_OQ>(Self::splat(f32::INFINITY))
     }
     #[inline(always)]
+    fn bitmask(self) -> u32 {
+        // The eight sign bits; movemask has no failure mode.
+        unsafe { _mm256_movemask_ps(self.0) as u32 }
+    }
+    #[inline(always)]
     fn is_sign_negative(self) -> Self {
         Self(unsafe { _mm256_castsi256_ps(_mm256_srai_epi32::<31>(_mm256_castps_si256(self.0))) })
     }
