@@ -528,17 +528,27 @@ fn walk<R: CurveReal>(
             continue;
         }
         // Advance to the next piece in x order: the right sibling, or up until there is one.
-        loop {
-            if l + 1 >= levels {
-                return;
-            }
-            if j & 1 == 0 && ((j + 1) << l) < n {
-                j += 1;
-                break;
-            }
-            j >>= 1;
-            l += 1;
+        if !next_piece(&mut j, &mut l, levels, n) {
+            return;
         }
+    }
+}
+
+/// Moves `(j, l)`, piece `j` at level `l` of a table of `levels` levels over `n` leaves, to the
+/// next piece in x order: its right sibling, or the right sibling of the nearest ancestor that has
+/// one. False when there is none (the walk is over). Shared by the scalar walk and the packet walk
+/// (`lanes.rs`), which must visit pieces in the same order.
+pub(super) fn next_piece(j: &mut usize, l: &mut usize, levels: usize, n: usize) -> bool {
+    loop {
+        if *l + 1 >= levels {
+            return false;
+        }
+        if *j & 1 == 0 && ((*j + 1) << *l) < n {
+            *j += 1;
+            return true;
+        }
+        *j >>= 1;
+        *l += 1;
     }
 }
 

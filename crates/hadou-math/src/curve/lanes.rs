@@ -25,7 +25,7 @@
 
 use super::dispatch::curve_energy;
 use super::integrate::{
-    attenuation_split, default_generic, leaf_walk, Acc, ChordModel, CurveSample, DEFAULT_SETTINGS,
+    attenuation_split, default_generic, leaf_walk, next_piece, Acc, ChordModel, CurveSample, DEFAULT_SETTINGS,
 };
 use super::local_ray::{LocalFrame, LocalRay};
 use super::prepare::PreparedCurve;
@@ -813,16 +813,8 @@ fn walk<L: Lane>(
             continue;
         }
         // Advance to the next piece in x order: the right sibling, or up until there is one.
-        loop {
-            if l + 1 >= levels {
-                return;
-            }
-            if j & 1 == 0 && ((j + 1) << l) < n {
-                j += 1;
-                break;
-            }
-            j >>= 1;
-            l += 1;
+        if !next_piece(&mut j, &mut l, levels, n) {
+            return;
         }
         for i in 0..PACKET {
             if gate[i] != FREE && gate[i] <= l {
