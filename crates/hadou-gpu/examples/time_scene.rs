@@ -4,7 +4,8 @@
 //!
 //! `cargo run --release -p hadou-gpu --example time_scene -- SCENE.toml [TIME] [SIZE...]`
 //! (defaults: time 0, sizes 512 1024 2048; 5 timed iterations after one warm-up), then the wall
-//! time of a whole `render` (preparation and read-back included). `HADOU_UBER=1` times the
+//! time of a whole `render` (preparation and read-back included) and of a PNG's rows, by
+//! `render_rows_rgb8` (8-bit words from the wave pass) and by `render` converted on the CPU. `HADOU_UBER=1` times the
 //! uber-shader instead of the frame's wave-pass variant.
 
 use hadou_gpu::GpuBackend;
@@ -61,19 +62,36 @@ fn main() {
             }
             Err(e) => println!("{path} {size}²: {e}"),
         }
-        // The whole render as a caller sees it: preparation, every pass and the read-back.
-        let mut wall: Vec<f64> = (0..5)
-            .map(|_| {
-                let start = std::time::Instant::now();
-                let ok = hadou_scene::Backend::render(&mut gpu, &frame).is_ok();
-                if ok {
-                    start.elapsed().as_secs_f64() * 1e3
-                } else {
-                    f64::NAN
-                }
-            })
-            .collect();
-        wall.sort_by(f64::total_cmp);
-        println!("{path} {size}²: render() with read-back, wall clock: median {:.3} ms", wall[2]);
+        // The whole render as a caller sees it: preparation, every pass and the read-back; then
+        // a PNG's rows, by the wave pass's 8-bit words and by the float image converted here
+        // (the road a PNG took before the words).
+        let wall = |gpu: &mut GpuBackend, draw: &dyn Fn(&mut GpuBackend) -> bool| -> f64 {
+            draw(gpu);
+            let mut v: Vec<f64> = (0..5)
+                .map(|_| {
+                    let start = std::time::Instant::now();
+                    if draw(gpu) {
+                        start.elapsed().as_secs_f64() * 1e3
+                    } else {
+                        f64::NAN
+                    }
+                })
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v[2]
+        };
+        let f = &frame;
+        let floats = wall(&mut gpu, &|g| hadou_scene::Backend::render(g, f).is_ok());
+        let words = wall(&mut gpu, &|g| hadou_scene::Backend::render_rows_rgb8(g, f, 0..f.height).is_ok());
+        let converted = wall(&mut gpu, &|g| {
+            hadou_scene::Backend::render(g, f)
+                .ok()
+                .and_then(|image| hadou_scene::Rgb8Image::from_image(&image))
+                .is_some()
+        });
+        println!(
+            "{path} {size}², wall clock with read-back, median of 5: render() {floats:.3} ms; \
+             PNG rows: render_rows_rgb8() {words:.3} ms, render() + Rgb8Image::from_image {converted:.3} ms"
+        );
     }
 }

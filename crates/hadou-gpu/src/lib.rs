@@ -370,8 +370,10 @@ impl GpuBackend {
         time_frame::time_wave_overlay(&mut self.renderer, frame, iterations)
     }
 
-    /// Measures the GPU time of drawing `frame` (its shadow maps, then every pass of every tile,
-    /// no read-back), `iterations` times after one untimed warm-up; see [`FrameTiming`], whose
+    /// Measures the GPU time of drawing `frame` as a PNG's pixels are drawn (its shadow maps, then
+    /// every pass of every tile, the wave pass writing 8-bit sRGB as
+    /// [`Backend::render_rows_rgb8`] does; no read-back), `iterations` times after one untimed
+    /// warm-up; see [`FrameTiming`], whose
     /// `passes` split the time by pass when the adapter has timestamp queries. Not on the web.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn time_frame(&mut self, frame: &Frame, iterations: u32) -> Result<FrameTiming, RenderError> {
@@ -392,5 +394,16 @@ impl Backend for GpuBackend {
 
     fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
         self.renderer.render_rows(frame, rows)
+    }
+
+    /// The wave pass writes the 8-bit sRGB codes itself (the same thresholds as
+    /// `hadou_math::shade::linear_to_srgb8`), so each tile reads back 4 bytes a pixel instead of
+    /// 24; a frame with a `[bloom]` is converted from its float image.
+    fn render_rows_rgb8(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<hadou_scene::Rgb8Image, RenderError> {
+        self.renderer.render_rows_rgb8(frame, rows)
     }
 }

@@ -32,6 +32,27 @@ pub const MAX_TILE: u32 = 1024;
 /// Floats per pixel in the tile output buffer: colour (4), energy, eye distance.
 const FLOATS_PER_PIXEL: u64 = 6;
 
+/// What a tile's wave pass writes for each image pixel (wave.wgsl `store_pixel`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TileOutput {
+    /// Colour (4), energy and eye distance as `f32`: [`FLOATS_PER_PIXEL`] floats, what an
+    /// [`Image`] holds and the present and glare passes read.
+    Floats,
+    /// One word of 8-bit sRGB (R, G, B and 255, or 0 where a value is not finite): what a PNG
+    /// holds, a sixth of the bytes to write and to read back.
+    Srgb8,
+}
+
+impl TileOutput {
+    /// Bytes per image pixel in the tile output buffer.
+    pub(crate) fn bytes_per_pixel(self) -> u64 {
+        match self {
+            TileOutput::Floats => FLOATS_PER_PIXEL * 4,
+            TileOutput::Srgb8 => 4,
+        }
+    }
+}
+
 /// The per-tile GPU resources, sized for one tile edge pair.
 pub(crate) struct TileTargets {
     size: [u32; 2],
@@ -81,6 +102,8 @@ pub(crate) struct Prepared {
     map_bind_group: Option<wgpu::BindGroup>,
     /// The wave pass's pipeline: the variant this frame needs (`passes::wave::WaveVariant`).
     wave_pipeline: wgpu::ComputePipeline,
+    /// What that pipeline writes per pixel.
+    pub(crate) output: TileOutput,
     /// Whether the tiles need the raster pass: false when nothing is drawn and the wave pass's
     /// variant does not read the G-buffer (no surfaces, no `[area_light]`), so an empty frame
     /// skips clearing 36 bytes per pixel.
@@ -315,13 +338,15 @@ impl Renderer {
     /// Validates the frame, uploads what it needs, plans the tiles covering the rows `rows` and
     /// submits the shadow maps (and, with an `[area_light]`, the soft shadows). Not on the web,
     /// where only `render_to_texture` draws (through [`Renderer::prepare_frame`]).
+    /// The wave pass writes `output` per pixel.
     #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn prepare(
         &mut self,
         frame: &Frame,
         rows: std::ops::Range<u32>,
+        output: TileOutput,
     ) -> Result<Prepared, RenderError> {
-        self.prepare_frame(frame, rows, true)
+        self.prepare_frame(frame, rows, true, output)
     }
 
     /// [`Renderer::prepare`]; with `submit_maps` false the shadow maps are left for the caller to
@@ -332,6 +357,7 @@ impl Renderer {
         frame: &Frame,
         rows: std::ops::Range<u32>,
         submit_maps: bool,
+        output: TileOutput,
     ) -> Result<Prepared, RenderError> {
         debug_assert!(submit_maps || frame.area_light.is_none());
         self.ctx.check()?;
@@ -346,8 +372,8 @@ impl Renderer {
             *t = (*t / grid).max(1) * grid;
         }
         let data = FrameData::new(&self.ctx.limits, frame)?;
-        let (wave_pipeline, variant) =
-            self.passes.wave.pipeline(&self.ctx, data.wave_variant(frame, grid > 1))?;
+        let variant = data.wave_variant(frame, grid > 1).with_srgb8(output == TileOutput::Srgb8);
+        let (wave_pipeline, variant) = self.passes.wave.pipeline(&self.ctx, variant)?;
         let raster =
             variant.has("USE_SURFACES") || frame.area_light.is_some() || !data.plane_draws.is_empty();
         let outlines = data.outlines();
@@ -393,6 +419,7 @@ impl Renderer {
                 map_passes,
                 map_bind_group,
                 wave_pipeline,
+                output,
                 raster,
                 groups: None,
                 linear: false,
@@ -748,7 +775,7 @@ impl Renderer {
         let (_, pixels) = prepared.output_tile(tile);
         passes.wave.encode(&mut shading, &prepared.wave_pipeline, &groups.wave, pixels, wave_timestamps);
         if readback {
-            let bytes = pixels[0] as u64 * pixels[1] as u64 * FLOATS_PER_PIXEL * 4;
+            let bytes = pixels[0] as u64 * pixels[1] as u64 * prepared.output.bytes_per_pixel();
             shading.copy_buffer_to_buffer(&t.output, 0, &t.staging, 0, bytes);
         }
         TileEncoders { surfaces, shading }
@@ -773,7 +800,7 @@ impl Renderer {
         if let Some(params) = frame.bloom.as_ref().filter(|_| y1 > y0) {
             return self.render_rows_glare(frame, params, rows);
         }
-        let prepared = self.prepare(frame, rows.clone())?;
+        let prepared = self.prepare(frame, rows.clone(), TileOutput::Floats)?;
         let mut image = alloc_image(frame.width, rows.len() as u32)?;
         for &tile in &prepared.tiles {
             let submission = self.ctx.scoped("rendering a tile", || {
@@ -794,6 +821,62 @@ impl Renderer {
 }
 
 impl Renderer {
+    /// The rows `rows` of `frame` (clamped to the image) as 8-bit sRGB, what a PNG holds: the
+    /// bytes of `Rgb8Image::from_image` of [`Renderer::render_rows`]'s image, refused the same
+    /// way where a value is not finite. The wave pass writes each pixel's codes
+    /// ([`TileOutput::Srgb8`], wave.wgsl `srgb8_code`: the same thresholds as
+    /// `hadou_math::shade::linear_to_srgb8`), so a tile reads back 4 bytes a pixel instead of
+    /// 24 and nothing is converted here. A frame with a `[bloom]` takes the float road (the
+    /// glare reads the linear colour) and is converted.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub(crate) fn render_rows_rgb8(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<hadou_scene::Rgb8Image, RenderError> {
+        let non_finite =
+            || RenderError::Other("internal error: the renderer produced a non-finite value".into());
+        let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+        let rows = y0..y1.max(y0);
+        if frame.bloom.is_some() && y1 > y0 {
+            let image = self.render_rows(frame, rows)?;
+            return hadou_scene::Rgb8Image::from_image(&image).ok_or_else(non_finite);
+        }
+        let prepared = self.prepare(frame, rows.clone(), TileOutput::Srgb8)?;
+        let width = frame.width as usize;
+        let n = width * rows.len();
+        let mut rgb: Vec<u8> = Vec::new();
+        rgb.try_reserve_exact(3 * n).map_err(|_| {
+            RenderError::Device(format!("out of host memory for a {}×{} image", frame.width, rows.len()))
+        })?;
+        rgb.resize(3 * n, 0);
+        let mut finite = true;
+        for &tile in &prepared.tiles {
+            let submission = self.ctx.scoped("rendering a tile", || {
+                let encoders = self.encode_tile(frame, &prepared, tile, true, None);
+                self.submit_tile(encoders)
+            })??;
+            let (origin, size) = prepared.output_tile(tile);
+            let (x0, y0) = (origin[0] as usize, (origin[1] - rows.start) as usize);
+            let (w, h) = (size[0] as usize, size[1] as usize);
+            let bytes = (w * h) as u64 * TileOutput::Srgb8.bytes_per_pixel();
+            let staging = &self.targets.as_ref().expect("targets exist").staging;
+            self.ctx.read_buffer(staging, bytes, submission, |raw| {
+                for (r, src) in raw.chunks_exact(4 * w).take(h).enumerate() {
+                    let start = 3 * ((y0 + r) * width + x0);
+                    for (o, p) in rgb[start..start + 3 * w].chunks_exact_mut(3).zip(src.chunks_exact(4)) {
+                        o.copy_from_slice(&p[..3]);
+                        finite &= p[3] == 255;
+                    }
+                }
+            })?;
+        }
+        if !finite {
+            return Err(non_finite());
+        }
+        Ok(hadou_scene::Rgb8Image { width: frame.width, height: rows.len() as u32, rgb })
+    }
+
     /// [`Renderer::render_rows`] of a frame with a `[bloom]` (`rows` non-empty): in bands whose
     /// rows and halo fit one storage binding, the tiles of the band and its halo drawn with the
     /// linear colour gathered into one buffer, then the glare pass and the read-back of the band's
@@ -904,7 +987,8 @@ impl Renderer {
     ) -> Result<(wgpu::Buffer, wgpu::CommandEncoder), RenderError> {
         let (w, h) = (frame.width as usize, frame.height as usize);
         let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
-        let mut prepared = self.prepare_frame(frame, src.start as u32..src.end as u32, true)?;
+        let mut prepared =
+            self.prepare_frame(frame, src.start as u32..src.end as u32, true, TileOutput::Floats)?;
         prepared.linear = true;
         let linear = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("bloom linear colour"),
@@ -1192,8 +1276,8 @@ mod tests {
             ));
             f
         };
-        let a = r.prepare(&sphere(0.0), 0..8).unwrap();
-        let b = r.prepare(&sphere(2.0), 0..8).unwrap();
+        let a = r.prepare(&sphere(0.0), 0..8, TileOutput::Floats).unwrap();
+        let b = r.prepare(&sphere(2.0), 0..8, TileOutput::Floats).unwrap();
         assert_eq!(a.wave_pipeline, b.wave_pipeline, "same kinds, same pipeline");
         assert_eq!(r.wave_variants_built(), 1);
         assert!(!a.raster, "nothing to draw: no raster pass");
@@ -1203,19 +1287,24 @@ mod tests {
             dir: hadou_math::Vec3::Y,
             alpha: 1.0,
         });
-        let c = r.prepare(&cylinder, 0..8).unwrap();
+        let c = r.prepare(&cylinder, 0..8, TileOutput::Floats).unwrap();
         assert_ne!(a.wave_pipeline, c.wave_pipeline, "another kind, another pipeline");
         let with_objects = three_triangles(0.0);
-        let d = r.prepare(&with_objects, 0..8).unwrap();
+        let d = r.prepare(&with_objects, 0..8, TileOutput::Floats).unwrap();
         assert!(d.raster, "objects are rasterized");
         assert_eq!(r.wave_variants_built(), 3);
         r.set_specialise(false);
-        let u1 = r.prepare(&sphere(0.0), 0..8).unwrap();
-        let u2 = r.prepare(&cylinder, 0..8).unwrap();
+        let u1 = r.prepare(&sphere(0.0), 0..8, TileOutput::Floats).unwrap();
+        let u2 = r.prepare(&cylinder, 0..8, TileOutput::Floats).unwrap();
         assert_eq!(u1.wave_pipeline, u2.wave_pipeline, "one uber-shader for every frame");
         assert!(u1.raster, "the uber-shader reads the G-buffer");
         assert_ne!(u1.wave_pipeline, a.wave_pipeline);
         assert_eq!(r.wave_variants_built(), 4);
+        // The 8-bit output is another pipeline, even for the uber-shader.
+        let p = r.prepare(&sphere(0.0), 0..8, TileOutput::Srgb8).unwrap();
+        assert_eq!(p.output, TileOutput::Srgb8);
+        assert_ne!(p.wave_pipeline, u1.wave_pipeline);
+        assert_eq!(r.wave_variants_built(), 5);
     }
 
     #[test]

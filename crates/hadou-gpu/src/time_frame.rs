@@ -2,7 +2,7 @@
 //! boundary where the adapter has them (split by pass), else from the wall clock around waited-for
 //! submissions. Not on the web.
 
-use crate::render::Renderer;
+use crate::render::{Renderer, TileOutput};
 use crate::timing::{
     median, split_frame, FrameTiming, PassQueries, PassTime, TimingMethod, PASSES_PER_TILE, SOFT_PREPARATION,
     SOFT_TILES,
@@ -19,7 +19,10 @@ pub(crate) fn time_frame(
     if iterations == 0 {
         return Err(RenderError::Other("time_frame needs at least one iteration".into()));
     }
-    let prepared = r.prepare(frame, 0..frame.height)?;
+    // As `hadou render` draws a PNG's pixels: the wave pass writes their 8-bit sRGB codes (a frame
+    // with a `[bloom]` writes the float colour its glare reads; the glare itself is not timed).
+    let output = if frame.bloom.is_some() { TileOutput::Floats } else { TileOutput::Srgb8 };
+    let prepared = r.prepare(frame, 0..frame.height, output)?;
     let tiles = prepared.tiles.len() as u32;
     // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
     let last = r.ctx.scoped("warming up", || {
@@ -115,7 +118,7 @@ pub(crate) fn time_frame(
             let start = Instant::now();
             // `prepare` draws the shadow maps and the soft shadows; waiting for all it submitted
             // splits the frame in two.
-            let prepared = r.prepare(frame, 0..frame.height)?;
+            let prepared = r.prepare(frame, 0..frame.height, output)?;
             r.ctx.wait(r.ctx.queue.submit([]))?;
             let prepared_at = Instant::now();
             let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))??;

@@ -9,7 +9,7 @@
 
 use crate::layout::FrameUniforms;
 use crate::passes::present::{PresentedFrame, Presenter};
-use crate::render::Renderer;
+use crate::render::{Renderer, TileOutput};
 use crate::texture_read::TextureRead;
 use crate::timing::{PresentTiming, PRESENT_PASSES_PER_TILE};
 use hadou_scene::{Frame, RenderError};
@@ -38,7 +38,7 @@ impl Renderer {
         }
         let timed = self.present.as_ref().is_some_and(|p| p.timer.is_some()) && frame.area_light.is_none();
         // When timed, the shadow maps are submitted below, with their timestamps.
-        let prepared = self.prepare_frame(frame, 0..frame.height, !timed)?;
+        let prepared = self.prepare_frame(frame, 0..frame.height, !timed, TileOutput::Floats)?;
         let present = self.present.as_mut().expect("made above");
         present.serial += 1;
         let serial = present.serial;

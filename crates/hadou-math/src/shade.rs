@@ -182,6 +182,13 @@ impl Srgb8Tables {
     pub fn code(&self, v: f32) -> u8 {
         srgb8_code(self, v)
     }
+
+    /// `next[k]`: the smallest `f32` whose code exceeds `k` (`+∞` for `k = 255`), increasing in
+    /// `k`. For `v ≥ 0` the code is the number of entries `≤ v` (NaN and `v ≤ 0` give 0): the
+    /// table the GPU's 8-bit output bisects to give the same bytes (wave.wgsl `srgb8_code`).
+    pub fn next_thresholds(&self) -> &[f32; 256] {
+        &self.next
+    }
 }
 
 /// [`linear_to_srgb8`] with its tables at hand.
@@ -421,6 +428,36 @@ mod tests {
             assert!(((f64::from(one_minus_exp_neg(x)) - want) / want).abs() < 1e-6, "{x}");
         }
         assert_eq!(one_minus_exp_neg(80.0), 1.0);
+    }
+
+    /// The bisection the GPU's 8-bit output runs over [`Srgb8Tables::next_thresholds`]
+    /// (wave.wgsl `srgb8_code`, written the same way here) gives [`linear_to_srgb8`] on every
+    /// float of `[0, 1]` near each threshold, on a sweep of the whole range, and at the ends.
+    #[test]
+    fn bisecting_the_next_thresholds_is_the_code() {
+        let next = srgb8_encoder().next_thresholds();
+        assert!(next.windows(2).all(|w| w[0] < w[1]) && next[255] == f32::INFINITY);
+        let bisect = |v: f32| {
+            let mut k = 0usize;
+            let mut step = 128;
+            while step > 0 {
+                if v >= next[k + step - 1] {
+                    k += step;
+                }
+                step >>= 1;
+            }
+            k as u8
+        };
+        let mut vals: Vec<f32> = (0..=1_000_000).map(|i| i as f32 * 1e-6).collect();
+        for &t in &next[..255] {
+            for d in -2i32..=2 {
+                vals.push(f32::from_bits((t.to_bits() as i32 + d) as u32));
+            }
+        }
+        vals.extend([-0.0, -1.0, 1.5, f32::MAX, f32::INFINITY, f32::NAN, f32::MIN_POSITIVE, 1e-45]);
+        for v in vals {
+            assert_eq!(bisect(v), linear_to_srgb8(v), "{v:e}");
+        }
     }
 
     #[test]

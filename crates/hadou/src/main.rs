@@ -460,9 +460,18 @@ fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>
             let t = gpu.time_frame(f, n)?;
             let mut parts: Vec<(String, f64)> =
                 t.passes.iter().map(|p| (p.name.clone(), p.median_ms)).collect();
-            let image = gpu.render(f)?;
+            // The PNG's rows as `hadou render` gets them (drawn, read back, 8-bit sRGB), by wall
+            // clock after a warm-up; less the GPU's time, what the read-back adds.
+            let mut image = gpu.render_rows_rgb8(f, 0..f.height)?;
+            let mut wall = Vec::with_capacity(n.max(1) as usize);
+            for _ in 0..n.max(1) {
+                let start = std::time::Instant::now();
+                image = gpu.render_rows_rgb8(f, 0..f.height)?;
+                wall.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+            parts.push(("read-back".into(), (hadou::bench::median(wall) - t.median_ms).max(0.0)));
             let output =
-                (0..n.max(1)).map(|_| hadou::bench::output_ms(&image)).collect::<Result<Vec<_>, _>>()?;
+                (0..n.max(1)).map(|_| hadou::bench::rgb8_output_ms(&image)).collect::<Result<Vec<_>, _>>()?;
             parts.push(("output".into(), hadou::bench::median(output)));
             Ok(hadou::bench::Timing { ms: t.median_ms, parts })
         };

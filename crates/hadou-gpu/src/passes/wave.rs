@@ -21,9 +21,9 @@ pub(crate) const WAVE_WORKGROUP: u32 = 8;
 
 const CS: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
 
-/// The bindings of the wave module (wave.wgsl 0–4, curve.wgsl 5–7, shading_bindings.wgsl 8–10,
-/// shadow_bindings.wgsl 11–12).
-pub(crate) const BINDINGS: [Binding; 13] = [
+/// The bindings of the wave module (wave.wgsl 0–4 and 13, curve.wgsl 5–7, shading_bindings.wgsl
+/// 8–10, shadow_bindings.wgsl 11–12).
+pub(crate) const BINDINGS: [Binding; 14] = [
     Binding::new(0, "frame", Kind::Uniform, CS),
     Binding::new(1, "waves", Kind::Storage, CS),
     Binding::new(2, "scene_texels", Kind::UintTexture, CS),
@@ -37,6 +37,7 @@ pub(crate) const BINDINGS: [Binding; 13] = [
     Binding::new(10, "shading_data", Kind::Storage, CS),
     Binding::new(11, "plane_shadow_texels", Kind::UintTexture, CS),
     Binding::new(12, "shadow_maps", Kind::DepthArray, CS),
+    Binding::new(13, "srgb8_next", Kind::Uniform, CS),
 ];
 
 /// What the wave pass reads and writes, in the order of [`BINDINGS`].
@@ -48,7 +49,8 @@ pub(crate) struct WaveInputs<'a> {
     /// The tile's G-buffer, as the raster pass drew it ([`crate::formats::SCENE_FORMAT`]).
     pub(crate) surface: &'a wgpu::TextureView,
     pub(crate) attributes: &'a wgpu::TextureView,
-    /// The output: per pixel colour (4), energy, eye distance as `f32` (see wave.wgsl binding 4).
+    /// The output: per pixel colour (4), energy, eye distance as `f32`, or one word of 8-bit sRGB
+    /// (see wave.wgsl binding 4).
     pub(crate) output: &'a wgpu::Buffer,
     /// The curve buffers (`layout::CurveBuffers`: curves, vec4s, scalars).
     pub(crate) curves: [&'a wgpu::Buffer; 3],
@@ -118,6 +120,12 @@ impl WaveVariant {
     /// module's entry point `cs_samples` instead of the wave module's `cs_main` (a module of its
     /// own, so a frame of one sample per pixel compiles nothing of the samples' loops).
     const SAMPLES: u32 = 1 << Self::NAMES.len();
+    /// The next bit: the pass writes each pixel's 8-bit sRGB bytes (what a PNG holds) instead of
+    /// its float colour, energy and depth: the override `OUTPUT_SRGB8`, which picks what is
+    /// written, not what is compiled in.
+    const SRGB8: u32 = 1 << (Self::NAMES.len() + 1);
+    /// The override of [`Self::SRGB8`].
+    const SRGB8_OVERRIDE: &'static str = "OUTPUT_SRGB8";
 
     /// Whether this variant resolves pixels from several samples (`cs_samples`).
     pub(crate) fn samples(self) -> bool {
@@ -130,6 +138,20 @@ impl WaveVariant {
             WaveVariant(self.0 | Self::SAMPLES)
         } else {
             WaveVariant(self.0 & !Self::SAMPLES)
+        }
+    }
+
+    /// Whether this variant writes 8-bit sRGB words (see [`Self::SRGB8`]).
+    pub(crate) fn srgb8(self) -> bool {
+        self.0 & Self::SRGB8 != 0
+    }
+
+    /// This variant, writing 8-bit sRGB words or the float outputs.
+    pub(crate) fn with_srgb8(self, on: bool) -> Self {
+        if on {
+            WaveVariant(self.0 | Self::SRGB8)
+        } else {
+            WaveVariant(self.0 & !Self::SRGB8)
         }
     }
 
@@ -235,7 +257,11 @@ impl WaveVariant {
 
     /// The override values of this variant (`1.0` true, `0.0` false), for the pipeline.
     fn constants(self) -> Vec<(&'static str, f64)> {
-        Self::NAMES.iter().map(|&n| (n, if self.has(n) { 1.0 } else { 0.0 })).collect()
+        let bit = |on: bool| if on { 1.0 } else { 0.0 };
+        let mut constants: Vec<(&'static str, f64)> =
+            Self::NAMES.iter().map(|&n| (n, bit(self.has(n)))).collect();
+        constants.push((Self::SRGB8_OVERRIDE, bit(self.srgb8())));
+        constants
     }
 }
 
@@ -247,6 +273,8 @@ pub(crate) struct WavePass {
     samples_module: wgpu::ShaderModule,
     pipeline_layout: wgpu::PipelineLayout,
     layout: wgpu::BindGroupLayout,
+    /// `srgb8_next` (binding 13): the 8-bit sRGB thresholds, written once.
+    srgb8_next: wgpu::Buffer,
     /// The wave pipelines built so far, one per variant (see [`WavePass::pipeline`]).
     variants: HashMap<WaveVariant, wgpu::ComputePipeline>,
     /// Whether [`WavePass::pipeline`] specialises; `false` gives every frame the uber-shader.
@@ -262,11 +290,21 @@ impl WavePass {
         ctx.scoped("building the wave pipeline layout", || {
             let layout = setup::bind_group_layout(&ctx.device, "wave", &BINDINGS);
             let pipeline_layout = setup::pipeline_layout(&ctx.device, "wave", &layout);
+            let next = hadou_math::shade::srgb8_encoder().next_thresholds();
+            let srgb8_next = wgpu::util::DeviceExt::create_buffer_init(
+                &ctx.device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some("sRGB 8-bit thresholds"),
+                    contents: bytemuck::cast_slice(next),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                },
+            );
             Self {
                 module,
                 samples_module,
                 pipeline_layout,
                 layout,
+                srgb8_next,
                 variants: HashMap::new(),
                 specialise: true,
             }
@@ -281,8 +319,11 @@ impl WavePass {
         ctx: &GpuContext,
         variant: WaveVariant,
     ) -> Result<(wgpu::ComputePipeline, WaveVariant), RenderError> {
-        let variant =
-            if self.specialise { variant } else { WaveVariant::UBER.with_samples(variant.samples()) };
+        let variant = if self.specialise {
+            variant
+        } else {
+            WaveVariant::UBER.with_samples(variant.samples()).with_srgb8(variant.srgb8())
+        };
         if let Some(p) = self.variants.get(&variant) {
             return Ok((p.clone(), variant));
         }
@@ -326,6 +367,7 @@ impl WavePass {
             inputs.shading_data.as_entire_binding(),
             view(inputs.plane_shadows),
             view(inputs.shadow_maps),
+            self.srgb8_next.as_entire_binding(),
         ];
         setup::bind_group(device, "wave", &self.layout, &BINDINGS, resources)
     }
@@ -353,8 +395,8 @@ mod tests {
     use super::*;
     use bytemuck::Zeroable;
 
-    /// `WaveVariant::NAMES` are exactly the wave module's overrides, each a `bool` defaulting to
-    /// true (so the module alone is the uber-shader).
+    /// `WaveVariant::NAMES` are exactly the wave module's overrides but `OUTPUT_SRGB8`, each a
+    /// `bool` defaulting to true (so the module alone is the uber-shader, writing floats).
     #[test]
     fn variant_names_are_the_wave_modules_overrides() {
         let source = shaders::compose(shaders::WAVE_PARTS);
@@ -364,21 +406,27 @@ mod tests {
             let name = o.name.as_deref().expect("named override");
             assert_eq!(module.types[o.ty].inner, naga::TypeInner::Scalar(naga::Scalar::BOOL), "{name}");
             let init = o.init.expect("a default");
+            let default_on = name != WaveVariant::SRGB8_OVERRIDE;
             assert!(
                 matches!(
                     module.global_expressions[init],
-                    naga::Expression::Literal(naga::Literal::Bool(true))
+                    naga::Expression::Literal(naga::Literal::Bool(b)) if b == default_on
                 ),
-                "{name} defaults to true"
+                "{name} defaults to {default_on}"
             );
-            overrides.push(name);
+            if default_on {
+                overrides.push(name);
+            }
         }
         overrides.sort_unstable();
         let mut names = WaveVariant::NAMES.to_vec();
         names.sort_unstable();
         assert_eq!(overrides, names);
         assert!(WaveVariant::NAMES.iter().all(|n| WaveVariant::UBER.has(n)));
-        assert!(WaveVariant::UBER.constants().iter().all(|&(_, v)| v == 1.0));
+        let uber = WaveVariant::UBER.constants();
+        assert!(uber.iter().all(|&(n, v)| v == 1.0 || n == WaveVariant::SRGB8_OVERRIDE));
+        assert!(WaveVariant::UBER.with_srgb8(true).constants().iter().all(|&(_, v)| v == 1.0));
+        assert_eq!(uber.len(), WaveVariant::NAMES.len() + 1);
     }
 
     /// `WaveVariant::of` sets a part exactly when the frame's data can reach it.
@@ -448,6 +496,11 @@ mod tests {
         assert_eq!(names(aa), names(v));
         assert_ne!(aa, v);
         assert!(!WaveVariant::UBER.samples());
+        // So does the 8-bit output: another pipeline, independent of the samples bit.
+        let png = aa.with_srgb8(true);
+        assert!(png.srgb8() && png.samples() && !aa.srgb8() && !WaveVariant::UBER.srgb8());
+        assert_eq!(names(png), names(v));
+        assert_eq!(png.with_srgb8(false), aa);
         toon.wave_blend = 0.0;
         let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true, false);
         assert_eq!(

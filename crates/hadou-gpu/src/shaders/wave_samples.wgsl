@@ -44,7 +44,7 @@ fn tile_sample(s: vec2<u32>, ns: u32) -> Sample {
             if (USE_AREA && frame.area != 0u) {
                 // As hadou-cpu's opaque_pass: c + visibility · area term, saturated, after the hard
                 // shadows.
-                let v = out_buf[5u * ns + s.y * frame.tile_size.x + s.x];
+                let v = out_slot5(ns, s.y * frame.tile_size.x + s.x);
                 let t = v * area_term(m, world, texel.xyz, uv, unpack4x8unorm(attributes.z));
                 scene = vec3<f32>(energy_saturate(scene.x + t.x), energy_saturate(scene.y + t.y), energy_saturate(scene.z + t.z));
             }
@@ -69,7 +69,7 @@ fn cs_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= size.x || id.y >= size.y) {
         return;
     }
-    // With g > 1 the outputs (6·n floats) end before the samples' visibility (from 5·ns): no
+    // With g > 1 the outputs (6·n floats, or n words) end before the samples' visibility (from 5·ns): no
     // invocation overwrites what another reads.
     let n = size.x * size.y;
     let i = id.y * size.x + id.x;
@@ -152,10 +152,5 @@ fn cs_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     } else if (USE_TONE_FILMIC) {
         rgb = map_filmic(rgb_in);
     }
-    out_buf[4u * i] = rgb.x;
-    out_buf[4u * i + 1u] = rgb.y;
-    out_buf[4u * i + 2u] = rgb.z;
-    out_buf[4u * i + 3u] = 1.0;
-    out_buf[4u * n + i] = total;
-    out_buf[5u * n + i] = depth;
+    store_pixel(i, n, rgb, total, depth);
 }

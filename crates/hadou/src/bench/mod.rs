@@ -23,7 +23,7 @@ pub use soft::{
     soft_disc_radius, soft_errors, soft_table, truth_map, SOFT_METHODS, SOFT_SCENE, TRUTH_MAP, TRUTH_SAMPLES,
 };
 pub use table::{rows_json, Align, Cell, Column, Report, Row, Table};
-pub use timing::{median, median_ms, output_ms, time_cpu, Timer, Timing};
+pub use timing::{median, median_ms, rgb8_output_ms, time_cpu, Timer, Timing};
 pub use toon::{
     plain_materials, toon_table, without_mtoon, GLARE_SCENE, MTOON_SCENE, SHADOW_SCENE, TOON_SCENE,
 };

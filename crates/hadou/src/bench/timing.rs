@@ -13,7 +13,8 @@ pub struct Timing {
     /// The parts, in order, as (name, median milliseconds): on the CPU the opaque pass, the wave
     /// pass and the colour stage (which add up to the whole) and the output (PNG encoding of the
     /// 8-bit bytes into memory, after the render); on the GPU each pass's GPU timestamps where
-    /// the adapter has them, and the output. Empty where nothing finer was measured.
+    /// the adapter has them, what the read-back adds (the wall clock of the PNG's rows drawn and
+    /// read back, less the GPU time) and the output. Empty where nothing finer was measured.
     pub parts: Vec<(String, f64)>,
 }
 
@@ -81,15 +82,6 @@ pub fn time_cpu_on(frame: &Frame, iterations: u32, simd: SimdPath) -> Result<Tim
             ("output".into(), median(output)),
         ],
     })
-}
-
-/// Milliseconds to turn `image` into PNG bytes in memory, as `hadou render` does before writing.
-pub fn output_ms(image: &hadou_scene::Image) -> Result<f64, RenderError> {
-    let t = std::time::Instant::now();
-    let bytes = crate::output::encode_png(image).map_err(RenderError::Other)?;
-    let ms = t.elapsed().as_secs_f64() * 1e3;
-    std::hint::black_box(bytes);
-    Ok(ms)
 }
 
 /// Milliseconds to turn 8-bit sRGB rows into PNG bytes in memory.
