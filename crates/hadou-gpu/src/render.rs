@@ -781,6 +781,21 @@ impl Renderer {
         TileEncoders { surfaces, shading }
     }
 
+    /// Encodes and submits every pass of `tile` with the copy of its output into the staging
+    /// buffer, for a read-back after the returned submission.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn draw_tile_for_readback(
+        &self,
+        frame: &Frame,
+        prepared: &Prepared,
+        tile: ([u32; 2], [u32; 2]),
+    ) -> Result<wgpu::SubmissionIndex, RenderError> {
+        self.ctx.scoped("rendering a tile", || {
+            let encoders = self.encode_tile(frame, prepared, tile, true, None);
+            self.submit_tile(encoders)
+        })?
+    }
+
     /// Renders `frame` into a new [`Image`].
     #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
@@ -803,10 +818,7 @@ impl Renderer {
         let prepared = self.prepare(frame, rows.clone(), TileOutput::Floats)?;
         let mut image = alloc_image(frame.width, rows.len() as u32)?;
         for &tile in &prepared.tiles {
-            let submission = self.ctx.scoped("rendering a tile", || {
-                let encoders = self.encode_tile(frame, &prepared, tile, true, None);
-                self.submit_tile(encoders)
-            })??;
+            let submission = self.draw_tile_for_readback(frame, &prepared, tile)?;
             let (origin, size) = prepared.output_tile(tile);
             let origin = [origin[0], origin[1] - rows.start];
             let n = size[0] as usize * size[1] as usize;
@@ -852,10 +864,7 @@ impl Renderer {
         rgb.resize(3 * n, 0);
         let mut finite = true;
         for &tile in &prepared.tiles {
-            let submission = self.ctx.scoped("rendering a tile", || {
-                let encoders = self.encode_tile(frame, &prepared, tile, true, None);
-                self.submit_tile(encoders)
-            })??;
+            let submission = self.draw_tile_for_readback(frame, &prepared, tile)?;
             let (origin, size) = prepared.output_tile(tile);
             let (x0, y0) = (origin[0] as usize, (origin[1] - rows.start) as usize);
             let (w, h) = (size[0] as usize, size[1] as usize);
