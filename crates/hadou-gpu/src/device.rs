@@ -37,9 +37,27 @@ pub(crate) fn context_or_skip(test: &str) -> Option<(GpuContext, std::sync::Mute
     }
 }
 
-/// How long one wait for submitted work may take before the device is declared hung.
+/// How long one wait for submitted work may take before a hardware device is declared hung.
 #[cfg(not(target_arch = "wasm32"))]
 pub(crate) const WAIT_TIMEOUT: Duration = Duration::from_secs(120);
+
+/// The same for a software adapter (llvmpipe, SwiftShader, WARP). Such an adapter compiles a
+/// shader to machine code when it first runs it, inside the submission being waited for, and on
+/// its own CPU cores, which a loaded machine shares: the first frame of a large module (the
+/// uber-shader) takes minutes where the shader cache is cold. A hang is still reported, later.
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) const SOFTWARE_WAIT_TIMEOUT: Duration = Duration::from_secs(900);
+
+/// How long one wait for submitted work on the adapter `info` may take (see [`WAIT_TIMEOUT`] and
+/// [`SOFTWARE_WAIT_TIMEOUT`]).
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) fn wait_timeout(info: &wgpu::AdapterInfo) -> Duration {
+    if info.device_type == wgpu::DeviceType::Cpu {
+        SOFTWARE_WAIT_TIMEOUT
+    } else {
+        WAIT_TIMEOUT
+    }
+}
 
 /// Errors the device reported outside any error scope, and the reason it was lost, if it was.
 #[derive(Default)]
@@ -70,13 +88,14 @@ pub(crate) struct GpuContext {
 
 #[cfg(not(target_arch = "wasm32"))]
 impl Drop for GpuContext {
-    /// Waits (up to [`WAIT_TIMEOUT`]) for every submission before the queue goes: wgpu's own
+    /// Waits (up to [`wait_timeout`]) for every submission before the queue goes: wgpu's own
     /// wait when a queue is dropped gives up after about 6 s and panics, and a software adapter
     /// compiling a large shader on a busy machine can take longer than that. (Not on the web,
     /// where nothing may block and the browser keeps the work alive.)
     fn drop(&mut self) {
-        let _ =
-            self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(WAIT_TIMEOUT) });
+        let _ = self
+            .device
+            .poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(wait_timeout(&self.info)) });
     }
 }
 
@@ -416,14 +435,13 @@ impl GpuContext {
         Ok(value)
     }
 
-    /// Waits (with [`WAIT_TIMEOUT`]) until `submission` has finished on the GPU.
+    /// Waits (with [`wait_timeout`]) until `submission` has finished on the GPU.
     #[cfg(not(target_arch = "wasm32"))]
     pub(crate) fn wait(&self, submission: wgpu::SubmissionIndex) -> Result<(), RenderError> {
+        let timeout = wait_timeout(&self.info);
         self.device
-            .poll(wgpu::PollType::Wait { submission_index: Some(submission), timeout: Some(WAIT_TIMEOUT) })
-            .map_err(|e| {
-                RenderError::Device(format!("waiting for the GPU failed after {WAIT_TIMEOUT:?}: {e}"))
-            })?;
+            .poll(wgpu::PollType::Wait { submission_index: Some(submission), timeout: Some(timeout) })
+            .map_err(|e| RenderError::Device(format!("waiting for the GPU failed after {timeout:?}: {e}")))?;
         self.check()
     }
 

@@ -93,12 +93,13 @@ impl Renderer {
             WaveVariant::UBER
         };
         if self.overlay.is_none() {
-            self.overlay = Some(WaveOverlayPass::new(&self.ctx)?);
+            self.overlay = Some(WaveOverlayPass::new());
         }
         let pass = self.overlay.as_mut().expect("made above");
         let additive = target.blend == OverlayBlend::Add;
         let multisampled = target.depth_samples > 1;
-        let pipeline = pass.pipeline(&self.ctx, variant, target.color_format, additive, multisampled)?;
+        let (pipeline, layout) =
+            pass.pipeline(&self.ctx, variant, target.color_format, additive, multisampled)?;
         let pass = self.overlay.as_ref().expect("made above");
         let (ctx, size) = (&self.ctx, [frame.width, frame.height]);
         ctx.scoped("encoding the wave overlay", || {
@@ -129,7 +130,7 @@ impl Renderer {
                 overlay: &overlay,
                 curves: [&curves[0], &curves[1], &curves[2]],
             };
-            let bind_group = pass.bind_group(d, &inputs, multisampled);
+            let bind_group = pass.bind_group(d, &layout, &inputs, multisampled);
             pass.encode(enc, &pipeline, target.color, size, &bind_group);
         })
     }

@@ -17,8 +17,13 @@
 //! - present module: `common.wgsl` + `present.wgsl` (a tile's colour into the window texture of
 //!   [`crate::GpuBackend::render_to_texture`]).
 //!
-//! A unit test parses and validates every composed module with naga (no adapter needed) and
-//! checks that the struct layouts naga computes equal the Rust ones in [`crate::layout`].
+//! A wave, wave samples or wave overlay module is composed per frame with only the source
+//! [`FEATURES`] the frame uses ([`compose_with`]: `// #if NAME` … `// #endif` lines in the WGSL),
+//! so a frame without attenuation or 8-bit output compiles none of that code.
+//!
+//! A unit test parses and validates every composed module (every feature combination) with naga
+//! (no adapter needed) and checks that the struct layouts naga computes equal the Rust ones in
+//! [`crate::layout`].
 
 /// Shared structs, pixel rays, shading and colour mapping.
 pub const COMMON: &str = include_str!("shaders/common.wgsl");
@@ -120,7 +125,84 @@ pub const EDGES_PARTS: &[&str] = &[COMMON, EDGES];
 
 /// Concatenates module parts.
 pub fn compose(parts: &[&str]) -> String {
-    parts.join("\n")
+    compose_with(parts, FEATURES)
+}
+
+/// The source features a composed module may leave out: the lines between `// #if NAME` and
+/// `// #else` (or `// #endif`) are kept only when NAME is on, those between `// #else` and
+/// `// #endif` only when it is off. Unlike a pipeline-overridable constant, whose dead branch
+/// stays in the module for the driver to remove (and a software adapter may still run under an
+/// execution mask), a feature that is off is not in the module at all.
+/// - `ATTENUATION`: the distance attenuation `(1 − u)^j` (002 eq. 3.23): energy.wgsl's graded
+///   march and curve.wgsl's attenuated pieces; without it every wave is integrated as `j = 0`.
+/// - `SRGB8`: wave.wgsl writes each pixel as one word of 8-bit sRGB codes (a PNG's bytes, with
+///   binding 13's thresholds) instead of the float colour, energy and depth.
+pub const FEATURES: &[&str] = &["ATTENUATION", "SRGB8"];
+
+/// [`compose`] with only the [`FEATURES`] in `on` (see there). Removed lines are left empty, so a
+/// line number in a compiler's message is the same as in the full composition.
+pub fn compose_with(parts: &[&str], on: &[&str]) -> String {
+    let source = parts.join("\n");
+    let mut out = String::with_capacity(source.len());
+    // Per open `#if`: whether its enclosing region is kept, and whether its own branch is.
+    let mut open: Vec<(bool, bool)> = Vec::new();
+    let mut keep = true;
+    for line in source.lines() {
+        let directive = line.trim_start();
+        if let Some(name) = directive.strip_prefix("// #if ") {
+            let lit = on.contains(&name.trim());
+            open.push((keep, lit));
+            keep = keep && lit;
+        } else if directive == "// #else" {
+            if let Some(top) = open.last_mut() {
+                top.1 = !top.1;
+                keep = top.0 && top.1;
+            }
+        } else if directive == "// #endif" {
+            if let Some((outer, _)) = open.pop() {
+                keep = outer;
+            }
+        } else if keep {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Every `// #if`, `// #else` and `// #endif` line of `source` balanced, and every `#if` naming one
+/// of [`FEATURES`]: `Err` names the first line that is not.
+pub fn check_directives(source: &str) -> Result<(), String> {
+    let mut open: Vec<(usize, bool)> = Vec::new();
+    for (i, line) in source.lines().enumerate() {
+        let directive = line.trim_start();
+        let at = i + 1;
+        if let Some(name) = directive.strip_prefix("// #if ") {
+            if !FEATURES.contains(&name.trim()) {
+                return Err(format!(
+                    "line {at}: `#if {}` names no feature of shaders::FEATURES",
+                    name.trim()
+                ));
+            }
+            open.push((at, false));
+        } else if directive == "// #else" {
+            match open.last_mut() {
+                Some((_, seen)) if !*seen => *seen = true,
+                Some(_) => return Err(format!("line {at}: a second `#else`")),
+                None => return Err(format!("line {at}: `#else` outside any `#if`")),
+            }
+        } else if directive == "// #endif" {
+            if open.pop().is_none() {
+                return Err(format!("line {at}: `#endif` outside any `#if`"));
+            }
+        } else if directive.starts_with("// #") {
+            return Err(format!("line {at}: unknown directive `{directive}`"));
+        }
+    }
+    match open.last() {
+        Some((at, _)) => Err(format!("line {at}: `#if` without `#endif`")),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -225,6 +307,52 @@ mod tests {
             ("wave overlay module", validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS))),
             ("bloom module", validate("bloom module", &compose(BLOOM_PARTS))),
         ]
+    }
+
+    /// Every file's `// #if` / `// #else` / `// #endif` lines are balanced and name known
+    /// features, and every combination of features composes a valid wave, wave samples and
+    /// overlay module; a feature that is off leaves none of its lines.
+    #[test]
+    fn every_feature_combination_composes_a_valid_module() {
+        for &(name, source) in FILES {
+            check_directives(source).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+        assert!(check_directives("// #if NOPE\n// #endif\n").is_err());
+        assert!(check_directives("// #if SRGB8\n").is_err());
+        assert!(check_directives("// #endif\n").is_err());
+        assert!(check_directives("// #if SRGB8\n// #else\n// #else\n// #endif\n").is_err());
+        let subsets: Vec<Vec<&str>> = (0..1u32 << FEATURES.len())
+            .map(|m| {
+                FEATURES.iter().enumerate().filter(|(i, _)| m & (1 << i) != 0).map(|(_, f)| *f).collect()
+            })
+            .collect();
+        for on in &subsets {
+            for (name, parts) in [
+                ("wave", WAVE_PARTS),
+                ("wave samples", WAVE_SAMPLES_PARTS),
+                ("wave overlay", WAVE_OVERLAY_PARTS),
+            ] {
+                let source = compose_with(parts, on);
+                assert_eq!(
+                    source.lines().count(),
+                    compose(parts).lines().count(),
+                    "{name} {on:?}: line numbers kept"
+                );
+                validate(&format!("{name} module with {on:?}"), &source);
+            }
+        }
+        // What each feature brings, present exactly when it is on.
+        let marks = [
+            ("ATTENUATION", "fn rq_attenuated("),
+            ("ATTENUATION", "fn curve_piece_attenuated("),
+            ("SRGB8", "fn srgb8_code("),
+        ];
+        for on in &subsets {
+            let source = compose_with(WAVE_PARTS, on);
+            for (feature, mark) in marks {
+                assert_eq!(source.contains(mark), on.contains(&feature), "{mark} with {on:?}");
+            }
+        }
     }
 
     /// The builtins `dot`, `cross` and `length` round differently on different drivers (see

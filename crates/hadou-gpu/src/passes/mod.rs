@@ -47,10 +47,10 @@ mod tests {
             ("soft map", c(shaders::SOFT_MAP_PARTS), &super::soft::MAP_BINDINGS, true),
             ("soft", c(shaders::SOFT_PARTS), &super::soft::BINDINGS, true),
             ("present", c(shaders::PRESENT_PARTS), &super::present::BINDINGS, true),
-            ("wave overlay", super::wave_overlay::source(false), &super::wave_overlay::BINDINGS, true),
+            ("wave overlay", super::wave_overlay::source(false, true), &super::wave_overlay::BINDINGS, true),
             (
                 "wave overlay, multisampled depth",
-                super::wave_overlay::source(true),
+                super::wave_overlay::source(true, true),
                 &super::wave_overlay::BINDINGS_MULTISAMPLED,
                 true,
             ),

@@ -5,9 +5,11 @@
 //! surface (002 §3.3.5), `scene + exposure·Σ rgb·a·I` and the colour mapping, written to an output
 //! buffer (colour, energy, eye distance per pixel) that the read-back or the present pass takes.
 //!
-//! The pass is specialised per frame ([`WaveVariant`]): the module declares pipeline-overridable
-//! `bool` constants, one per part, and each frame gets a pipeline with only what its data can
-//! reach compiled in, built on first use and cached.
+//! The pass is specialised per frame ([`WaveVariant`]): the module is composed with only the
+//! source features the frame uses (attenuation, 8-bit output, the samples' entry point:
+//! `shaders::compose_with`), it declares pipeline-overridable `bool` constants, one per part, and
+//! each frame gets a pipeline with only what its data can reach compiled in, modules and pipelines
+//! built on first use and cached.
 
 use super::setup::{self, Binding, Kind};
 use crate::device::GpuContext;
@@ -65,11 +67,14 @@ pub(crate) struct WaveInputs<'a> {
 }
 
 /// Which parts of the wave pass a frame needs: one bit per pipeline-overridable `USE_*` constant of
-/// the wave module (wave.wgsl, energy.wgsl, curve.wgsl, shading.wgsl, shadow_lookup.wgsl). A clear
-/// bit compiles its part out (the constant is `false`, so the branch is dead and the driver drops
-/// it); a set bit leaves the code exactly as the uber-shader's ([`WaveVariant::UBER`], every bit
-/// set). [`WaveVariant::of`] sets a bit for everything the frame's data can reach, so a frame
-/// renders identically with its variant and with the uber-shader.
+/// the wave module (wave.wgsl, energy.wgsl, curve.wgsl, shading.wgsl, shadow_lookup.wgsl), and
+/// three bits that choose the module's source itself: the samples' entry point, the 8-bit output
+/// and the attenuation (`shaders::FEATURES`). A clear `USE_*` bit compiles its part out (the
+/// constant is `false`, so the branch is dead and the driver drops it); a clear source bit leaves
+/// its code out of the module altogether ([`WaveVariant::source`]). A set bit leaves the code
+/// exactly as the uber-shader's ([`WaveVariant::UBER`], every part set). [`WaveVariant::of`] sets
+/// a bit for everything the frame's data can reach, so a frame renders identically with its
+/// variant and with the uber-shader.
 ///
 /// Why: a software adapter such as llvmpipe runs a shader's branches under an execution mask,
 /// both sides of every `if` and every `switch` case, whichever the pixels take; the uber-shader
@@ -114,18 +119,21 @@ impl WaveVariant {
         "USE_PLANE_SHADOWS",
         "USE_MAP_SHADOWS",
     ];
-    /// Every part: the uber-shader, right for any frame of one sample per pixel.
-    pub(crate) const UBER: WaveVariant = WaveVariant((1 << Self::NAMES.len()) - 1);
+    /// Every part, the attenuation included: the uber-shader, right for any frame of one sample
+    /// per pixel (writing floats).
+    pub(crate) const UBER: WaveVariant = WaveVariant(((1 << Self::NAMES.len()) - 1) | Self::ATTENUATION);
     /// The bit past the overrides: pixels are resolved from several samples, by the wave samples
     /// module's entry point `cs_samples` instead of the wave module's `cs_main` (a module of its
     /// own, so a frame of one sample per pixel compiles nothing of the samples' loops).
     const SAMPLES: u32 = 1 << Self::NAMES.len();
     /// The next bit: the pass writes each pixel's 8-bit sRGB bytes (what a PNG holds) instead of
-    /// its float colour, energy and depth: the override `OUTPUT_SRGB8`, which picks what is
-    /// written, not what is compiled in.
+    /// its float colour, energy and depth (the source feature `SRGB8`: a module without it holds
+    /// none of the encoding).
     const SRGB8: u32 = 1 << (Self::NAMES.len() + 1);
-    /// The override of [`Self::SRGB8`].
-    const SRGB8_OVERRIDE: &'static str = "OUTPUT_SRGB8";
+    /// The next bit: some wave of the frame is attenuated, `j > 0` (002 eq. 3.23; the source
+    /// feature `ATTENUATION`: a module without it holds none of the attenuated march, which a
+    /// software adapter would otherwise run under a mask for every piece of every pixel).
+    const ATTENUATION: u32 = 1 << (Self::NAMES.len() + 2);
 
     /// Whether this variant resolves pixels from several samples (`cs_samples`).
     pub(crate) fn samples(self) -> bool {
@@ -153,6 +161,30 @@ impl WaveVariant {
         } else {
             WaveVariant(self.0 & !Self::SRGB8)
         }
+    }
+
+    /// Whether this variant integrates the attenuation `(1 − u)^j` (see [`Self::ATTENUATION`]).
+    pub(crate) fn attenuation(self) -> bool {
+        self.0 & Self::ATTENUATION != 0
+    }
+
+    /// The source features (`shaders::FEATURES`) of this variant's module.
+    pub(crate) fn features(self) -> Vec<&'static str> {
+        let mut on = Vec::new();
+        if self.attenuation() {
+            on.push("ATTENUATION");
+        }
+        if self.srgb8() {
+            on.push("SRGB8");
+        }
+        on
+    }
+
+    /// The WGSL of this variant's module: the wave module (entry point `cs_main`) or, with
+    /// samples, the wave samples module (`cs_samples`), composed with [`Self::features`].
+    pub(crate) fn source(self) -> String {
+        let parts = if self.samples() { shaders::WAVE_SAMPLES_PARTS } else { shaders::WAVE_PARTS };
+        shaders::compose_with(parts, &self.features())
     }
 
     /// The bit of override `name`.
@@ -189,6 +221,9 @@ impl WaveVariant {
         samples: bool,
     ) -> Self {
         let mut on: Vec<&str> = Vec::new();
+        // `!(j == 0)`: the shaders' own test, so a NaN (never validated through) is attenuated too.
+        let attenuated =
+            waves.iter().any(|w| !(w.attenuation == 0.0)) || curves.iter().any(|c| !(c.attenuation == 0.0));
         for w in waves {
             on.push(match w.kind {
                 layout::WAVE_SPHERE => "USE_SPHERE",
@@ -252,25 +287,30 @@ impl WaveVariant {
             }
         }
         on.push(if tone_faithful { "USE_TONE_FAITHFUL" } else { "USE_TONE_FILMIC" });
-        Self::from_names(on).with_samples(samples)
+        let v = Self::from_names(on).with_samples(samples);
+        if attenuated {
+            WaveVariant(v.0 | Self::ATTENUATION)
+        } else {
+            v
+        }
     }
 
     /// The override values of this variant (`1.0` true, `0.0` false), for the pipeline.
     fn constants(self) -> Vec<(&'static str, f64)> {
         let bit = |on: bool| if on { 1.0 } else { 0.0 };
-        let mut constants: Vec<(&'static str, f64)> =
-            Self::NAMES.iter().map(|&n| (n, bit(self.has(n)))).collect();
-        constants.push((Self::SRGB8_OVERRIDE, bit(self.srgb8())));
-        constants
+        Self::NAMES.iter().map(|&n| (n, bit(self.has(n)))).collect()
     }
 }
 
-/// The wave module, its bind group layout and the pipelines built so far.
+/// What picks a wave module's source: samples (the `cs_samples` module), 8-bit output,
+/// attenuation ([`WaveVariant::source`]).
+type ModuleKey = (bool, bool, bool);
+
+/// The wave modules, their bind group layout and the pipelines built so far.
 pub(crate) struct WavePass {
-    /// The wave module (the uber-shader source; variants set its `USE_*` overrides).
-    module: wgpu::ShaderModule,
-    /// The same with `cs_samples`, for frames of several samples per pixel.
-    samples_module: wgpu::ShaderModule,
+    /// The wave modules built so far, one per source ([`WaveVariant::source`]; variants of one
+    /// module set its `USE_*` overrides).
+    modules: HashMap<ModuleKey, wgpu::ShaderModule>,
     pipeline_layout: wgpu::PipelineLayout,
     layout: wgpu::BindGroupLayout,
     /// `srgb8_next` (binding 13): the 8-bit sRGB thresholds, written once.
@@ -282,11 +322,9 @@ pub(crate) struct WavePass {
 }
 
 impl WavePass {
-    /// Compiles the wave module; pipelines are built per variant on first use.
+    /// The bind group layout and thresholds; modules and pipelines are built per variant on
+    /// first use.
     pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
-        let module = setup::compile_module(ctx, "wave", &shaders::compose(shaders::WAVE_PARTS))?;
-        let samples_module =
-            setup::compile_module(ctx, "wave samples", &shaders::compose(shaders::WAVE_SAMPLES_PARTS))?;
         ctx.scoped("building the wave pipeline layout", || {
             let layout = setup::bind_group_layout(&ctx.device, "wave", &BINDINGS);
             let pipeline_layout = setup::pipeline_layout(&ctx.device, "wave", &layout);
@@ -300,8 +338,7 @@ impl WavePass {
                 },
             );
             Self {
-                module,
-                samples_module,
+                modules: HashMap::new(),
                 pipeline_layout,
                 layout,
                 srgb8_next,
@@ -327,12 +364,19 @@ impl WavePass {
         if let Some(p) = self.variants.get(&variant) {
             return Ok((p.clone(), variant));
         }
+        let key = (variant.samples(), variant.srgb8(), variant.attenuation());
+        if !self.modules.contains_key(&key) {
+            let label = if variant.samples() { "wave samples" } else { "wave" };
+            let module = setup::compile_module(ctx, label, &variant.source())?;
+            self.modules.insert(key, module);
+        }
+        let module = &self.modules[&key];
         let constants = variant.constants();
         let pipeline = ctx.scoped("building the wave pipeline", || {
             ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some("wave"),
                 layout: Some(&self.pipeline_layout),
-                module: if variant.samples() { &self.samples_module } else { &self.module },
+                module,
                 entry_point: Some(if variant.samples() { "cs_samples" } else { "cs_main" }),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: &constants,
@@ -395,38 +439,111 @@ mod tests {
     use super::*;
     use bytemuck::Zeroable;
 
-    /// `WaveVariant::NAMES` are exactly the wave module's overrides but `OUTPUT_SRGB8`, each a
-    /// `bool` defaulting to true (so the module alone is the uber-shader, writing floats).
+    /// `WaveVariant::NAMES` are exactly the wave module's overrides, each a `bool` defaulting to
+    /// true (so the module alone is the uber-shader), in every source the variants compose.
     #[test]
     fn variant_names_are_the_wave_modules_overrides() {
-        let source = shaders::compose(shaders::WAVE_PARTS);
-        let module = naga::front::wgsl::parse_str(&source).expect("the wave module parses");
-        let mut overrides: Vec<&str> = Vec::new();
-        for (_, o) in module.overrides.iter() {
-            let name = o.name.as_deref().expect("named override");
-            assert_eq!(module.types[o.ty].inner, naga::TypeInner::Scalar(naga::Scalar::BOOL), "{name}");
-            let init = o.init.expect("a default");
-            let default_on = name != WaveVariant::SRGB8_OVERRIDE;
-            assert!(
-                matches!(
-                    module.global_expressions[init],
-                    naga::Expression::Literal(naga::Literal::Bool(b)) if b == default_on
-                ),
-                "{name} defaults to {default_on}"
-            );
-            if default_on {
+        for variant in
+            [WaveVariant::UBER, WaveVariant(0), WaveVariant::UBER.with_samples(true).with_srgb8(true)]
+        {
+            let source = variant.source();
+            let module = naga::front::wgsl::parse_str(&source).expect("the wave module parses");
+            let mut overrides: Vec<&str> = Vec::new();
+            for (_, o) in module.overrides.iter() {
+                let name = o.name.as_deref().expect("named override");
+                assert_eq!(module.types[o.ty].inner, naga::TypeInner::Scalar(naga::Scalar::BOOL), "{name}");
+                let init = o.init.expect("a default");
+                assert!(
+                    matches!(
+                        module.global_expressions[init],
+                        naga::Expression::Literal(naga::Literal::Bool(true))
+                    ),
+                    "{name} defaults to true"
+                );
                 overrides.push(name);
             }
+            overrides.sort_unstable();
+            let mut names = WaveVariant::NAMES.to_vec();
+            names.sort_unstable();
+            assert_eq!(overrides, names);
         }
-        overrides.sort_unstable();
-        let mut names = WaveVariant::NAMES.to_vec();
-        names.sort_unstable();
-        assert_eq!(overrides, names);
         assert!(WaveVariant::NAMES.iter().all(|n| WaveVariant::UBER.has(n)));
+        assert!(
+            WaveVariant::UBER.attenuation() && !WaveVariant::UBER.srgb8() && !WaveVariant::UBER.samples()
+        );
         let uber = WaveVariant::UBER.constants();
-        assert!(uber.iter().all(|&(n, v)| v == 1.0 || n == WaveVariant::SRGB8_OVERRIDE));
-        assert!(WaveVariant::UBER.with_srgb8(true).constants().iter().all(|&(_, v)| v == 1.0));
-        assert_eq!(uber.len(), WaveVariant::NAMES.len() + 1);
+        assert!(uber.iter().all(|&(_, v)| v == 1.0));
+        assert_eq!(uber.len(), WaveVariant::NAMES.len());
+    }
+
+    /// A frame without attenuation, samples or 8-bit output gets a module that holds none of
+    /// their code: no function, binding or entry point of theirs is in the naga module its
+    /// source parses to (and each is there once the frame uses it).
+    #[test]
+    fn a_frame_compiles_in_only_the_features_it_uses() {
+        let sphere = layout::GpuWave {
+            kind: layout::WAVE_SPHERE,
+            falloff: layout::FALLOFF_FAITHFUL,
+            ..layout::GpuWave::zeroed()
+        };
+        let plain =
+            WaveVariant::of(&[sphere], &[], &[], &[], false, false, (false, false), false, true, false);
+        // The code of each feature: functions, global variables (bindings) and entry points.
+        const ATTENUATION: &[&str] = &[
+            "rq_attenuated",
+            "att_mean_line",
+            "att_mean_peak",
+            "att_density",
+            "att_factor",
+            "curve_piece_attenuated",
+            "segment_attenuated",
+            "segment_moments",
+        ];
+        const SRGB8: &[&str] = &["srgb8_code", "is_finite_f32", "srgb8_next"];
+        const SAMPLES: &[&str] = &["cs_samples", "tile_sample"];
+        let names = |v: WaveVariant| -> Vec<String> {
+            let source = v.source();
+            let module = naga::front::wgsl::parse_str(&source).expect("the variant's module parses");
+            let functions = module.functions.iter().filter_map(|(_, f)| f.name.clone());
+            let globals = module.global_variables.iter().filter_map(|(_, g)| g.name.clone());
+            let entries = module.entry_points.iter().map(|e| e.name.clone());
+            functions.chain(globals).chain(entries).collect()
+        };
+        let has = |v: WaveVariant, item: &str| names(v).iter().any(|n| n == item);
+        for item in ATTENUATION.iter().chain(SRGB8).chain(SAMPLES) {
+            assert!(!has(plain, item), "{item} is in the module of a frame without its feature");
+            assert!(
+                !plain.source().contains(&format!("{item}(")) || *item == "srgb8_next",
+                "{item} in the source"
+            );
+        }
+        assert!(has(plain, "cs_main") && has(plain, "rq_integral") && has(plain, "out_buf"));
+        // Each feature brings its own code, and only its own.
+        let attenuated = WaveVariant::of(
+            &[layout::GpuWave { attenuation: 8.0, ..sphere }],
+            &[],
+            &[],
+            &[],
+            false,
+            false,
+            (false, false),
+            false,
+            true,
+            false,
+        );
+        assert!(attenuated.attenuation() && !plain.attenuation());
+        assert!(ATTENUATION.iter().all(|item| has(attenuated, item)));
+        assert!(!SRGB8.iter().chain(SAMPLES).any(|item| has(attenuated, item)));
+        let png = plain.with_srgb8(true);
+        assert!(SRGB8.iter().all(|item| has(png, item)));
+        assert!(!ATTENUATION.iter().chain(SAMPLES).any(|item| has(png, item)));
+        let aa = plain.with_samples(true);
+        assert!(SAMPLES.iter().all(|item| has(aa, item)));
+        assert!(!ATTENUATION.iter().chain(SRGB8).any(|item| has(aa, item)));
+        // A curve's attenuation counts too.
+        let curve = layout::GpuCurve { attenuation: 1.5, ..Zeroable::zeroed() };
+        let v = WaveVariant::of(&[], &[curve], &[], &[], false, false, (false, false), false, true, false);
+        assert!(v.attenuation());
     }
 
     /// `WaveVariant::of` sets a part exactly when the frame's data can reach it.

@@ -40,9 +40,11 @@ pub(crate) const BINDINGS_MULTISAMPLED: [Binding; 7] = [
 
 /// The overlay module's WGSL, reading a depth buffer of one sample per pixel or, when
 /// `multisampled`, its first sample (`textureLoad(…, 0)` is then sample 0: the depth a
-/// multisampled engine's opaque pass wrote at the pixel's first sample position).
-pub(crate) fn source(multisampled: bool) -> String {
-    let s = shaders::compose(shaders::WAVE_OVERLAY_PARTS);
+/// multisampled engine's opaque pass wrote at the pixel's first sample position); with the
+/// attenuated march only when `attenuation` (`shaders::FEATURES`).
+pub(crate) fn source(multisampled: bool, attenuation: bool) -> String {
+    let features: &[&str] = if attenuation { &["ATTENUATION"] } else { &[] };
+    let s = shaders::compose_with(shaders::WAVE_OVERLAY_PARTS, features);
     if multisampled {
         s.replace("var depth_texels: texture_2d<f32>;", "var depth_texels: texture_multisampled_2d<f32>;")
     } else {
@@ -83,47 +85,49 @@ pub(crate) struct OverlayInputs<'a> {
     pub(crate) curves: [&'a wgpu::Buffer; 3],
 }
 
-/// The overlay's module and bind group layout for one kind of depth buffer.
-struct OverlayModule {
-    module: wgpu::ShaderModule,
-    layout: wgpu::BindGroupLayout,
-}
-
-impl OverlayModule {
-    fn new(ctx: &GpuContext, multisampled: bool) -> Result<Self, RenderError> {
-        let module = setup::compile_module(ctx, "wave overlay", &source(multisampled))?;
-        let bindings: &[Binding] = if multisampled { &BINDINGS_MULTISAMPLED } else { &BINDINGS };
-        ctx.scoped("building the wave overlay's layout", || {
-            let layout = setup::bind_group_layout(&ctx.device, "wave overlay", bindings);
-            Self { module, layout }
-        })
-    }
-}
-
-/// The overlay's modules (one sample per depth pixel; several, built on first use), layouts and
-/// pipelines.
+/// The overlay's modules (by depth samples, one or several, and attenuation; each built on first
+/// use), bind group layouts (by depth samples) and pipelines.
 pub(crate) struct WaveOverlayPass {
-    single: OverlayModule,
-    multisampled: Option<OverlayModule>,
-    pipelines: HashMap<(WaveVariant, wgpu::TextureFormat, bool, bool), wgpu::RenderPipeline>,
+    modules: HashMap<(bool, bool), wgpu::ShaderModule>,
+    layouts: HashMap<bool, wgpu::BindGroupLayout>,
+    pipelines: HashMap<
+        (WaveVariant, wgpu::TextureFormat, bool, bool),
+        (wgpu::RenderPipeline, wgpu::BindGroupLayout),
+    >,
 }
 
 impl WaveOverlayPass {
-    /// Compiles the overlay module; pipelines are built on first use.
-    pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
-        Ok(Self { single: OverlayModule::new(ctx, false)?, multisampled: None, pipelines: HashMap::new() })
+    /// An overlay with nothing built yet: modules, layouts and pipelines are built on first use.
+    pub(crate) fn new() -> Self {
+        Self { modules: HashMap::new(), layouts: HashMap::new(), pipelines: HashMap::new() }
     }
 
-    fn module(&self, multisampled: bool) -> &OverlayModule {
-        match (&self.multisampled, multisampled) {
-            (Some(m), true) => m,
-            _ => &self.single,
+    /// The module for a depth buffer of several samples per pixel or one, with or without the
+    /// attenuation, and the bind group layout of that kind of depth buffer, built on first use.
+    fn module(
+        &mut self,
+        ctx: &GpuContext,
+        multisampled: bool,
+        attenuation: bool,
+    ) -> Result<(&wgpu::ShaderModule, &wgpu::BindGroupLayout), RenderError> {
+        let key = (multisampled, attenuation);
+        if !self.modules.contains_key(&key) {
+            let module = setup::compile_module(ctx, "wave overlay", &source(multisampled, attenuation))?;
+            self.modules.insert(key, module);
         }
+        if !self.layouts.contains_key(&multisampled) {
+            let bindings: &[Binding] = if multisampled { &BINDINGS_MULTISAMPLED } else { &BINDINGS };
+            let layout = ctx.scoped("building the wave overlay's layout", || {
+                setup::bind_group_layout(&ctx.device, "wave overlay", bindings)
+            })?;
+            self.layouts.insert(multisampled, layout);
+        }
+        Ok((&self.modules[&key], &self.layouts[&multisampled]))
     }
 
     /// The pipeline drawing `variant`'s waves into a `format` target, adding to it when
     /// `additive`, else replacing it, against a depth buffer of several samples per pixel when
-    /// `multisampled`; built on first use and kept.
+    /// `multisampled`; built on first use and kept. Also the bind group layout it reads.
     pub(crate) fn pipeline(
         &mut self,
         ctx: &GpuContext,
@@ -131,7 +135,7 @@ impl WaveOverlayPass {
         format: wgpu::TextureFormat,
         additive: bool,
         multisampled: bool,
-    ) -> Result<wgpu::RenderPipeline, RenderError> {
+    ) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout), RenderError> {
         let key = (variant, format, additive, multisampled);
         if let Some(p) = self.pipelines.get(&key) {
             return Ok(p.clone());
@@ -150,31 +154,30 @@ impl WaveOverlayPass {
                 operation: wgpu::BlendOperation::Add,
             },
         });
-        if multisampled && self.multisampled.is_none() {
-            self.multisampled = Some(OverlayModule::new(ctx, true)?);
-        }
-        let m = self.module(multisampled);
+        let (module, layout) = self.module(ctx, multisampled, variant.attenuation())?;
         let pipeline = ctx.scoped("building the wave overlay pipeline", || {
             let targets =
                 [Some(wgpu::ColorTargetState { format, blend, write_mask: wgpu::ColorWrites::ALL })];
             let stages = Stages {
-                module: &m.module,
+                module,
                 vertex: "vs_overlay",
                 buffers: &[],
                 fragment: Some(("fs_overlay", &targets)),
                 constants: &constants,
             };
-            setup::render_pipeline(&ctx.device, "wave overlay", &m.layout, &stages, triangles(None), None)
+            setup::render_pipeline(&ctx.device, "wave overlay", layout, &stages, triangles(None), None)
         })?;
-        self.pipelines.insert(key, pipeline.clone());
-        Ok(pipeline)
+        let built = (pipeline, layout.clone());
+        self.pipelines.insert(key, built.clone());
+        Ok(built)
     }
 
     /// The bind group of `inputs` (`multisampled`: for a depth buffer of several samples per
-    /// pixel).
+    /// pixel) in `layout`, the one [`Self::pipeline`] gave with the pipeline.
     pub(crate) fn bind_group(
         &self,
         device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
         inputs: &OverlayInputs<'_>,
         multisampled: bool,
     ) -> wgpu::BindGroup {
@@ -188,7 +191,7 @@ impl WaveOverlayPass {
             inputs.curves[2].as_entire_binding(),
         ];
         let bindings: &[Binding] = if multisampled { &BINDINGS_MULTISAMPLED } else { &BINDINGS };
-        setup::bind_group(device, "wave overlay", &self.module(multisampled).layout, bindings, resources)
+        setup::bind_group(device, "wave overlay", layout, bindings, resources)
     }
 
     /// Records the overlay into `target` over a `size` viewport at its origin; the target is

@@ -217,6 +217,7 @@ fn curve_local_ray(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f3
 
 // Mirrors `LocalRay::attenuation`: (1 − t/t_far)^j (002 eq. 3.23), 0 beyond the far point.
 fn curve_attenuation(r: LocalRay, t: f32) -> f32 {
+// #if ATTENUATION
     if (r.j == 0.0) {
         return 1.0;
     }
@@ -225,6 +226,9 @@ fn curve_attenuation(r: LocalRay, t: f32) -> f32 {
         return 0.0;
     }
     return pow(u, r.j);
+// #else
+    return 1.0;
+// #endif
 }
 
 // ---- closed.rs: Segment ----
@@ -342,6 +346,7 @@ fn segment_new(falloff: u32, q: vec4<f32>, dt: f32, rc2: f32) -> Segment {
     return seg;
 }
 
+// #if ATTENUATION
 // Mirrors `Segment::fitted_variance`: the variance of the weight's quadratic interpolant.
 fn segment_fitted_variance(seg: Segment, uniform: f32) -> f32 {
     let y0 = seg.y0;
@@ -437,15 +442,26 @@ fn segment_attenuated(seg: Segment, t_start: f32, t_far: f32, j: f32) -> f32 {
     return seg.value * pow(h, j) * factor;
 }
 
+// #endif
+
 // ---- integrate.rs: the default integrator ----
 
 // Mirrors integrate.rs `Acc::piece_quad`: adds the piece d(τ) = p + vτ, τ ∈ [0, dt], from ray
-// parameter ts; with j > 0 cut into parts whose 1 − u shrinks by att_q, down to att_floor.
+// parameter ts; with j > 0 (curve_piece_attenuated) cut into parts whose 1 − u shrinks by att_q,
+// down to att_floor.
 fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, q: vec4<f32>, dt: f32, acc: ptr<function, f32>) {
-    if (r.j == 0.0) {
-        *acc += segment_new(r.falloff, q, dt, r.rc2).value;
+// #if ATTENUATION
+    if (r.j != 0.0) {
+        curve_piece_attenuated(c, r, ts, q, dt, acc);
         return;
     }
+// #endif
+    *acc += segment_new(r.falloff, q, dt, r.rc2).value;
+}
+
+// #if ATTENUATION
+// curve_piece where j > 0.
+fn curve_piece_attenuated(c: GpuCurve, r: LocalRay, ts: f32, q: vec4<f32>, dt: f32, acc: ptr<function, f32>) {
     let te = ts + dt;
     var a = ts;
     for (var i = 0u; i < CURVE_MAX_PARTS; i++) {
@@ -462,6 +478,7 @@ fn curve_piece(c: GpuCurve, r: LocalRay, ts: f32, q: vec4<f32>, dt: f32, acc: pt
         a = b;
     }
 }
+// #endif
 
 // Mirrors hadou_math::curve::MAX_ATTENUATION_PARTS (checked by shaders.rs `constants_match`).
 const CURVE_MAX_PARTS: u32 = 64u;
@@ -1083,9 +1100,11 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
         steps += 1u;
         let d = sqrt(na.x + r.rc2);
         var h = NEAREST_STEP * d / qn;
+// #if ATTENUATION
         if (r.j > 0.0) {
             h = min(h, max(NEAREST_STEP * (r.t_far - a), floor));
         }
+// #endif
         var b = a + h;
         if (steps >= MAX_NEAREST_STEPS || !(a + h < end)) {
             b = end;

@@ -231,6 +231,7 @@ fn att_none() -> Attenuation {
     return Attenuation(0.0, 1.0);
 }
 
+// #if ATTENUATION
 // Mirrors Attenuation::factor: (1 − t/t_far)^j, 0 from the far point on.
 fn att_factor(att: Attenuation, t: f32) -> f32 {
     let h = 1.0 - t / att.t_far;
@@ -383,11 +384,17 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
     return min(max(acc, 0.0), ENERGY_MAX);
 }
 
-// One piece: rq_integral, or rq_attenuated where att.j > 0 (the Rust shapes' `piece`).
+// #endif
+
+// One piece: rq_integral, or rq_attenuated where att.j > 0 (the Rust shapes' `piece`). A module
+// composed without ATTENUATION (no wave of the frame has j > 0; shaders.rs `compose_with`) holds
+// none of the march above.
 fn rq_piece(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuation) -> f32 {
+// #if ATTENUATION
     if (att.j > 0.0) {
         return rq_attenuated(q, falloff, t0, t1, att);
     }
+// #endif
     return rq_integral(q, falloff, t0, t1);
 }
 

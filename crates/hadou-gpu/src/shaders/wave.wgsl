@@ -11,17 +11,16 @@
 @group(0) @binding(3) var attribute_texels: texture_2d<u32>;
 // Tile output, n = (tile_size / grid).x · (tile_size / grid).y image pixels, row-major, as f32
 // bits: colour (4 floats per pixel) in [0, 4n), energy in [4n, 5n), eye distance in [5n, 6n); or,
-// with OUTPUT_SRGB8, one word per pixel in [0, n) (store_pixel). Keep in sync with the read-backs
-// in render.rs.
+// in a module composed with SRGB8, one word per pixel in [0, n) (store_pixel). Keep in sync with
+// the read-backs in render.rs.
 @group(0) @binding(4) var<storage, read_write> out_buf: array<u32>;
+// The 8-bit sRGB output (a PNG's bytes) is composed in only where a frame writes it (SRGB8:
+// passes/wave.rs WaveVariant::with_srgb8, shaders.rs compose_with); every other module writes
+// the float colour, energy and depth and holds none of the code below.
+// #if SRGB8
 // hadou_math::shade::Srgb8Tables::next_thresholds: element k, the smallest f32 whose 8-bit sRGB
 // code exceeds k (+∞ for 255), four to a vector.
 @group(0) @binding(13) var<uniform> srgb8_next: array<vec4<f32>, 64>;
-
-// Whether the pass writes the 8-bit sRGB bytes a PNG holds instead of the float colour, energy
-// and depth (passes/wave.rs WaveVariant::with_srgb8; not one of the USE_* parts below: it picks
-// what is written, not what is compiled in).
-override OUTPUT_SRGB8: bool = false;
 
 // hadou_math::shade::linear_to_srgb8 exactly: the number of thresholds srgb8_next[k] ≤ v, by
 // bisection (the thresholds increase); NaN and v ≤ 0 give 0, v ≥ 1 gives 255.
@@ -41,6 +40,7 @@ fn srgb8_code(v: f32) -> u32 {
 fn is_finite_f32(v: f32) -> bool {
     return (bitcast<u32>(v) & 0x7f800000u) != 0x7f800000u;
 }
+// #endif
 
 // The eye-distance slot of pixel `i` of `n`, as f32 (where soft.wgsl's cs_gather leaves the
 // soft-shadow visibility before this pass).
@@ -49,23 +49,23 @@ fn out_slot5(n: u32, i: u32) -> f32 {
 }
 
 // Writes image pixel `i` of the tile's `n`: the floats (colour with alpha 1, energy, eye
-// distance), or with OUTPUT_SRGB8 the word R | G << 8 | B << 16 | A << 24 of the colour's 8-bit
-// sRGB codes, A = 255, or 0 where the colour, energy or distance is not finite (the read-back
+// distance), or in a module composed with SRGB8 the word R | G << 8 | B << 16 | A << 24 of the
+// colour's 8-bit sRGB codes, A = 255, or 0 where the colour, energy or distance is not finite (the read-back
 // refuses such a pixel as Rgb8Image::from_image does).
 fn store_pixel(i: u32, n: u32, rgb: vec3<f32>, total: f32, depth: f32) {
-    if (OUTPUT_SRGB8) {
-        let finite = is_finite_f32(rgb.x) && is_finite_f32(rgb.y) && is_finite_f32(rgb.z)
-            && is_finite_f32(total) && is_finite_f32(depth);
-        let alpha = select(0u, 255u, finite);
-        out_buf[i] = srgb8_code(rgb.x) | (srgb8_code(rgb.y) << 8u) | (srgb8_code(rgb.z) << 16u) | (alpha << 24u);
-    } else {
-        out_buf[4u * i] = bitcast<u32>(rgb.x);
-        out_buf[4u * i + 1u] = bitcast<u32>(rgb.y);
-        out_buf[4u * i + 2u] = bitcast<u32>(rgb.z);
-        out_buf[4u * i + 3u] = bitcast<u32>(1.0);
-        out_buf[4u * n + i] = bitcast<u32>(total);
-        out_buf[5u * n + i] = bitcast<u32>(depth);
-    }
+// #if SRGB8
+    let finite = is_finite_f32(rgb.x) && is_finite_f32(rgb.y) && is_finite_f32(rgb.z)
+        && is_finite_f32(total) && is_finite_f32(depth);
+    let alpha = select(0u, 255u, finite);
+    out_buf[i] = srgb8_code(rgb.x) | (srgb8_code(rgb.y) << 8u) | (srgb8_code(rgb.z) << 16u) | (alpha << 24u);
+// #else
+    out_buf[4u * i] = bitcast<u32>(rgb.x);
+    out_buf[4u * i + 1u] = bitcast<u32>(rgb.y);
+    out_buf[4u * i + 2u] = bitcast<u32>(rgb.z);
+    out_buf[4u * i + 3u] = bitcast<u32>(1.0);
+    out_buf[4u * n + i] = bitcast<u32>(total);
+    out_buf[5u * n + i] = bitcast<u32>(depth);
+// #endif
 }
 
 // The wave pass's variant (pipeline-overridable constants; see passes/wave.rs WaveVariant, which sets
