@@ -38,14 +38,7 @@ fn case_energy(c: Case, ray: Ray, t0: f32, t1: f32) -> f32 {
     let p = FieldParams(w.falloff, w.core_radius);
     // span.w: the far point's ray parameter for the attenuation (w.attenuation = j).
     let att = Attenuation(w.attenuation, c.span.w);
-    var e = 0.0;
-    switch w.kind {
-        case WAVE_SPHERE: { e = sphere_energy(p, ray, t0, t1, att, w.p0.xyz, w.p0.w); }
-        case WAVE_CYLINDER: { e = cylinder_energy(p, ray, t0, t1, att, w.p0.xyz, w.p1.xyz, w.p0.w); }
-        case WAVE_CAPSULE: { e = capsule_energy(p, ray, t0, t1, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w); }
-        default: { e = beam_energy(p, ray, t0, t1, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z); }
-    }
-    return e;
+    return analytic_energy(p, ray, t0, t1, att, w, KIND_BITS_ALL);
 }
 "#;
 

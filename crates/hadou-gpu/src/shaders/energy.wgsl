@@ -398,98 +398,127 @@ fn rq_piece(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuation) -
     return rq_integral(q, falloff, t0, t1);
 }
 
-// Mirrors hadou_math::energy::sphere_energy, and sphere_energy_attenuated where att.j > 0 (002 eq.
-// 3.4, 3.6, 3.8, 3.23).
-fn sphere_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, center: vec3<f32>, alpha: f32) -> f32 {
-    let axis = ray_axis(ray.dir);
-    let q = ray_quadratic(axis, ray.origin - center, p.core_radius * p.core_radius);
-    return energy_scaled(rq_piece(q, p.falloff, t0, t1, att), alpha);
-}
+// The analytic kinds, bits of analytic_energy's `kinds` (a module passes the kinds its variant has
+// compiled in, which the driver then folds as constants).
+const KIND_BIT_SPHERE: u32 = 1u;
+const KIND_BIT_CYLINDER: u32 = 2u;
+const KIND_BIT_CAPSULE: u32 = 4u;
+const KIND_BIT_BEAM: u32 = 8u;
+const KIND_BITS_ALL: u32 = 15u;
 
-// Mirrors hadou_math::energy::cylinder_energy, and cylinder_energy_attenuated where att.j > 0 (002
-// eq. 3.5, 3.7, 3.9, 3.23).
-fn cylinder_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, point: vec3<f32>, dir: vec3<f32>, alpha: f32) -> f32 {
-    let axis = ray_axis(cross3(ray.dir, dir));
-    let v = cross3(ray.origin - point, dir);
-    let q = ray_quadratic(axis, v, p.core_radius * p.core_radius);
-    return energy_scaled(rq_piece(q, p.falloff, t0, t1, att), alpha);
-}
-
-// Mirrors hadou_math::energy::CapsuleParts (private).
-struct CapsuleParts {
-    at_m: RayQuadratic,
-    at_m2: RayQuadratic,
-    energy: f32,
-}
-
-// Mirrors hadou_math::energy::capsule_parts (private; 002 eq. 3.10–3.11): sphere around the first
-// end crossed, cylinder between the planes through M and M₂ with normal D, sphere around the other.
-fn capsule_parts(p: FieldParams, ray: Ray, t0_in: f32, t1_in: f32, att: Attenuation, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> CapsuleParts {
-    // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an end).
-    var t0 = 0.0;
-    var t1 = 0.0;
-    if (t1_in > t0_in) {
-        t0 = t0_in;
-        t1 = t1_in;
-    }
+// The energy of one analytic wave `w` (sphere, cylinder, capsule or bulged beam) along `ray` over
+// [t0, t1], its kind taken only if its bit is in `kinds` (else 0). Mirrors, by kind:
+// - hadou_math::energy::sphere_energy (002 eq. 3.4, 3.6, 3.8): one piece around the centre M;
+// - cylinder_energy (002 eq. 3.5, 3.7, 3.9): one piece about the axis through M along D;
+// - capsule_energy (capsule_parts, 002 eq. 3.10–3.11): the sphere around the first end crossed,
+//   the cylinder between the planes through M and M₂ with normal D, the sphere around the other;
+// - beam_energy (SPEC.md §1.2, the bulged beam): the capsule plus bulbs at M₂ (head) and M
+//   (muzzle);
+// each piece with the attenuation where att.j > 0 (the *_energy_attenuated twins, 002 eq. 3.23,
+// SPEC.md §1.4). The pieces are gathered first and integrated by ONE call of rq_piece in a loop:
+// a driver inlines every call site, and the attenuated march is the largest code of the wave
+// module, so one call site instead of ten keeps a module with every kind (the uber-shader) small
+// enough to compile in seconds on a software adapter.
+fn analytic_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, w: GpuWave, kinds: u32) -> f32 {
     let rc2 = p.core_radius * p.core_radius;
-    let q = ray.dir;
-    let w = ray.origin - m;
-    let sphere_axis = ray_axis(q);
-    let at_m = ray_quadratic(sphere_axis, w, rc2);
-    let at_m2 = ray_quadratic(sphere_axis, w - d * length, rc2);
-    let cyl = ray_quadratic(ray_axis(cross3(q, d)), cross3(w, d), rc2);
-    let dq = dot3(q, d);
-    let ds = dot3(w, d);
-    var lo = 0.0;
-    var hi = 0.0;
-    var first_is_m = true;
-    if (dq > 0.0) {
-        lo = -ds / dq;
-        hi = (length - ds) / dq;
-    } else if (dq < 0.0) {
-        lo = (length - ds) / dq;
-        hi = -ds / dq;
-        first_is_m = false;
-    } else if (ds < 0.0) {
-        lo = T_OPEN;
-        hi = T_OPEN;
-    } else if (ds > length) {
-        lo = -T_OPEN;
-        hi = -T_OPEN;
-    } else {
-        lo = -T_OPEN;
-        hi = T_OPEN;
+    let sphere = (kinds & KIND_BIT_SPHERE) != 0u && w.kind == WAVE_SPHERE;
+    let cylinder = (kinds & KIND_BIT_CYLINDER) != 0u && w.kind == WAVE_CYLINDER;
+    let beam = (kinds & KIND_BIT_BEAM) != 0u && w.kind == WAVE_BEAM;
+    let capsule = beam || ((kinds & KIND_BIT_CAPSULE) != 0u && w.kind == WAVE_CAPSULE);
+    var qs: array<RayQuadratic, 5>;
+    var a = array<f32, 5>(t0, t0, t0, t0, t0);
+    var b = array<f32, 5>(t1, t1, t1, t1, t1);
+    var n = 0u;
+    if (sphere) {
+        qs[0] = ray_quadratic(ray_axis(ray.dir), ray.origin - w.p0.xyz, rc2);
+        n = 1u;
+    } else if (cylinder) {
+        let d = w.p1.xyz;
+        qs[0] = ray_quadratic(ray_axis(cross3(ray.dir, d)), cross3(ray.origin - w.p0.xyz, d), rc2);
+        n = 1u;
+    } else if (capsule) {
+        let m = w.p0.xyz;
+        let d = w.p1.xyz;
+        let length = w.p2.x;
+        // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an
+        // end).
+        var c0 = 0.0;
+        var c1 = 0.0;
+        if (t1 > t0) {
+            c0 = t0;
+            c1 = t1;
+        }
+        let q = ray.dir;
+        let wm = ray.origin - m;
+        let sphere_axis = ray_axis(q);
+        let at_m = ray_quadratic(sphere_axis, wm, rc2);
+        let at_m2 = ray_quadratic(sphere_axis, wm - d * length, rc2);
+        let cyl = ray_quadratic(ray_axis(cross3(q, d)), cross3(wm, d), rc2);
+        let dq = dot3(q, d);
+        let ds = dot3(wm, d);
+        var lo = 0.0;
+        var hi = 0.0;
+        var first_is_m = true;
+        if (dq > 0.0) {
+            lo = -ds / dq;
+            hi = (length - ds) / dq;
+        } else if (dq < 0.0) {
+            lo = (length - ds) / dq;
+            hi = -ds / dq;
+            first_is_m = false;
+        } else if (ds < 0.0) {
+            lo = T_OPEN;
+            hi = T_OPEN;
+        } else if (ds > length) {
+            lo = -T_OPEN;
+            hi = -T_OPEN;
+        } else {
+            lo = -T_OPEN;
+            hi = T_OPEN;
+        }
+        lo = clamp(lo, c0, c1);
+        hi = clamp(hi, lo, c1);
+        // Pieces 0 and 1: the spheres around the first and the last end crossed; 2: the cylinder.
+        qs[0] = at_m;
+        qs[1] = at_m2;
+        if (!first_is_m) {
+            qs[0] = at_m2;
+            qs[1] = at_m;
+        }
+        a[0] = c0;
+        b[0] = lo;
+        a[1] = hi;
+        b[1] = c1;
+        qs[2] = cyl;
+        a[2] = lo;
+        b[2] = hi;
+        n = 3u;
+        if (beam) {
+            // Pieces 3 and 4: the head's bulb at M₂ and the muzzle's at M, over the whole span.
+            qs[3] = at_m2;
+            qs[4] = at_m;
+            n = 5u;
+        }
     }
-    var first = at_m;
-    var last = at_m2;
-    if (!first_is_m) {
-        first = at_m2;
-        last = at_m;
+    var e = array<f32, 5>(0.0, 0.0, 0.0, 0.0, 0.0);
+    for (var k = 0u; k < n; k++) {
+        e[k] = rq_piece(qs[k], p.falloff, a[k], b[k], att);
     }
-    lo = clamp(lo, t0, t1);
-    hi = clamp(hi, lo, t1);
-    let fo = p.falloff;
-    let spheres = rq_piece(first, fo, t0, lo, att) + rq_piece(last, fo, hi, t1, att);
-    let energy = energy_add(energy_scaled(spheres, alpha_s), energy_scaled(rq_piece(cyl, fo, lo, hi, att), alpha_c));
-    return CapsuleParts(at_m, at_m2, energy);
-}
-
-// Mirrors hadou_math::energy::capsule_energy, and capsule_energy_attenuated where att.j > 0.
-fn capsule_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32) -> f32 {
-    return capsule_parts(p, ray, t0, t1, att, m, d, length, alpha_s, alpha_c).energy;
-}
-
-// Mirrors hadou_math::energy::beam_energy (SPEC.md §1.2, bulged beam): capsule plus bulbs at M₂, M;
-// beam_energy_attenuated where att.j > 0.
-fn beam_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation, m: vec3<f32>, d: vec3<f32>, length: f32, alpha_s: f32, alpha_c: f32, head_alpha: f32, muzzle_alpha: f32) -> f32 {
-    let parts = capsule_parts(p, ray, t0, t1, att, m, d, length, alpha_s, alpha_c);
-    var e = parts.energy;
-    if (head_alpha != 0.0) {
-        e = energy_add(e, energy_scaled(rq_piece(parts.at_m2, p.falloff, t0, t1, att), head_alpha));
+    if (sphere || cylinder) {
+        return energy_scaled(e[0], w.p0.w);
     }
-    if (muzzle_alpha != 0.0) {
-        e = energy_add(e, energy_scaled(rq_piece(parts.at_m, p.falloff, t0, t1, att), muzzle_alpha));
+    if (!capsule) {
+        return 0.0;
     }
-    return e;
+    // α_s = p0.w, α_c = p1.w; the beam's head and muzzle strengths p2.y, p2.z.
+    var energy = energy_add(energy_scaled(e[0] + e[1], w.p0.w), energy_scaled(e[2], w.p1.w));
+    if (beam) {
+        if (w.p2.y != 0.0) {
+            energy = energy_add(energy, energy_scaled(e[3], w.p2.y));
+        }
+        if (w.p2.z != 0.0) {
+            energy = energy_add(energy, energy_scaled(e[4], w.p2.z));
+        }
+    }
+    return energy;
 }

@@ -45,26 +45,14 @@ fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
         t_far = frame.far * length3(dir);
     }
     let att = Attenuation(w.attenuation, t_far);
-    // Each kind's case is compiled in only when its USE_* is set (the variant has the frame's kinds).
+    // Each kind is compiled in only when its USE_* is set (the variant has the frame's kinds); the
+    // analytic kinds share one call (see analytic_energy).
+    let kinds = select(0u, KIND_BIT_SPHERE, USE_SPHERE) | select(0u, KIND_BIT_CYLINDER, USE_CYLINDER)
+        | select(0u, KIND_BIT_CAPSULE, USE_CAPSULE) | select(0u, KIND_BIT_BEAM, USE_BEAM);
     switch w.kind {
-        case WAVE_SPHERE: {
-            if (USE_SPHERE) {
-                return sphere_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p0.w);
-            }
-        }
-        case WAVE_CYLINDER: {
-            if (USE_CYLINDER) {
-                return cylinder_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p1.xyz, w.p0.w);
-            }
-        }
-        case WAVE_CAPSULE: {
-            if (USE_CAPSULE) {
-                return capsule_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w);
-            }
-        }
-        case WAVE_BEAM: {
-            if (USE_BEAM) {
-                return beam_energy(p, ray, span.x, span.y, att, w.p0.xyz, w.p1.xyz, w.p2.x, w.p0.w, w.p1.w, w.p2.y, w.p2.z);
+        case WAVE_SPHERE, WAVE_CYLINDER, WAVE_CAPSULE, WAVE_BEAM: {
+            if (kinds != 0u) {
+                return analytic_energy(p, ray, span.x, span.y, att, w, kinds);
             }
         }
         case WAVE_CURVE: {
