@@ -12,8 +12,8 @@
 use hadou_math::energy::lanes::{self, AttenuationLanes, RayLanes, LANES, V3};
 use hadou_math::energy::{
     beam_energy, beam_energy_attenuated, capsule_energy, capsule_energy_attenuated, cylinder_energy,
-    cylinder_energy_attenuated, sphere_energy, sphere_energy_attenuated, Attenuation, BeamField, CapsuleField,
-    CylinderField, Falloff, FieldParams, Ray, SphereField,
+    cylinder_energy_attenuated, sphere_energy, sphere_energy_attenuated, Attenuation, BeamField,
+    CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
 };
 use hadou_math::rng::Rng;
 use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
@@ -324,7 +324,11 @@ fn zero_exponent_is_the_unattenuated_lane_kernels_bit_for_bit() {
                     let plain = shape.lanes(path, &p, origin, &rays, 0.0, false);
                     for j in [0.0, -0.0, f32::NAN] {
                         let got = shape.lanes(path, &p, origin, &rays, j, true);
-                        assert_eq!(got.map(f32::to_bits), plain.map(f32::to_bits), "{path} {shape:?} {law:?} j {j}");
+                        assert_eq!(
+                            got.map(f32::to_bits),
+                            plain.map(f32::to_bits),
+                            "{path} {shape:?} {law:?} j {j}"
+                        );
                     }
                 }
             }
@@ -337,7 +341,8 @@ fn lanes_do_not_depend_on_their_neighbours() {
     // The same ray gives the same value in every lane, whatever the other lanes hold (a lane
     // that needs many cells, NaN spans, the far point before the span).
     let eye = Vec3::new(0.0, 6.0, 40.0);
-    let c = CapsuleField { m: Vec3::new(-10.0, 0.0, 0.0), d: Vec3::X, length: 20.0, alpha_s: 2.0, alpha_c: 2.0 };
+    let c =
+        CapsuleField { m: Vec3::new(-10.0, 0.0, 0.0), d: Vec3::X, length: 20.0, alpha_s: 2.0, alpha_c: 2.0 };
     let beam = Shape::Beam(BeamField { capsule: c, head_alpha: 4.0, muzzle_alpha: 1.0 });
     for law in LAWS {
         let p = FieldParams { falloff: law, core_radius: 0.0 };
