@@ -29,7 +29,7 @@
 use super::attenuated::{GL_W, GL_X, INNER_CELL, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE};
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
-use crate::simd::Lane;
+use crate::simd::{Lane, Outlined};
 use crate::Vec3;
 
 /// Rays evaluated together.
@@ -222,11 +222,29 @@ impl<L: Lane> Quad<L> {
         clamp_energy(live, v)
     }
 
+    /// The closed form of `falloff` over `[t0, t1]` per lane ([`Lane::outlined_if_unoptimized`]:
+    /// a frame of its own in an unoptimized build).
     #[inline(always)]
     fn integral(&self, falloff: Falloff, t0: L, t1: L) -> L {
-        match falloff {
-            Falloff::Faithful => self.faithful(t0, t1),
-            Falloff::InverseSquare => self.inverse_square(t0, t1),
+        L::outlined_if_unoptimized(Integral { quad: *self, falloff, t0, t1 })
+    }
+}
+
+/// [`Quad::integral`] as a body for [`Lane::outlined_if_unoptimized`].
+struct Integral<L> {
+    quad: Quad<L>,
+    falloff: Falloff,
+    t0: L,
+    t1: L,
+}
+
+impl<L: Lane> Outlined<L> for Integral<L> {
+    type Output = L;
+    #[inline(always)]
+    fn run(self) -> L {
+        match self.falloff {
+            Falloff::Faithful => self.quad.faithful(self.t0, self.t1),
+            Falloff::InverseSquare => self.quad.inverse_square(self.t0, self.t1),
         }
     }
 }
@@ -240,12 +258,22 @@ impl<L: Lane> Quad<L> {
     /// lanes whose span is empty, NaN, beyond `t_far`, or whose `t_far` is not positive and
     /// finite, give 0 and take no pass. `j = 0` (or NaN) is [`Self::integral`].
     ///
+    /// The march runs in a function of its own ([`Lane::outlined`], [`March`]): inlined, each of
+    /// a beam's five pieces would add the march's lane temporaries to the dispatched body's frame,
+    /// which in an unoptimized build (a slot per temporary) outgrows a thread's stack.
+    ///
     /// Mirrors `RayQuadratic::attenuated` (keep in sync).
     #[inline(always)]
     fn attenuated(&self, falloff: Falloff, t0: L, t1: L, att: &AttenuationLanes<L>) -> L {
         if !att.is_active() {
             return self.integral(falloff, t0, t1);
         }
+        L::outlined(March { quad: *self, falloff, t0, t1, att: *att })
+    }
+
+    /// [`Self::attenuated`]'s march (`j > 0`) in place: what [`March`] runs.
+    #[inline(always)]
+    fn march(&self, falloff: Falloff, t0: L, t1: L, att: &AttenuationLanes<L>) -> L {
         let k = L::splat;
         let zero = k(0.0);
         let tf = att.t_far;
@@ -368,6 +396,23 @@ impl<L: Lane> Quad<L> {
             sum += k(wi as f32) * att.factor(t);
         }
         sum
+    }
+}
+
+/// [`Quad::attenuated`]'s march as a body for [`Lane::outlined`].
+struct March<L> {
+    quad: Quad<L>,
+    falloff: Falloff,
+    t0: L,
+    t1: L,
+    att: AttenuationLanes<L>,
+}
+
+impl<L: Lane> Outlined<L> for March<L> {
+    type Output = L;
+    #[inline(always)]
+    fn run(self) -> L {
+        self.quad.march(self.falloff, self.t0, self.t1, &self.att)
     }
 }
 
@@ -495,8 +540,37 @@ struct CapsuleParts<L> {
 /// As the scalar `capsule_parts` (002 eq. 3.10–3.11, SPEC.md §1.2): the ray split at the planes
 /// through `M` and `M₂`, each region its closed form (or attenuated march: `piece`), the region
 /// order per lane by the sign of `D·Q`.
+///
+/// A frame of its own in an unoptimized build ([`Lane::outlined_if_unoptimized`]).
 #[inline(always)]
-fn capsule_parts<L: Lane>(
+fn capsule_parts<L: Lane, P: Piece<L>>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    f: &CapsuleField<f32>,
+    piece: &P,
+) -> CapsuleParts<L> {
+    L::outlined_if_unoptimized(Capsule { p, ray, f, piece })
+}
+
+/// [`capsule_parts`]' arguments, a body for [`Lane::outlined_if_unoptimized`].
+struct Capsule<'a, L, P> {
+    p: &'a FieldParams<f32>,
+    ray: &'a RayLanes<L>,
+    f: &'a CapsuleField<f32>,
+    piece: &'a P,
+}
+
+impl<L: Lane, P: Piece<L>> Outlined<L> for Capsule<'_, L, P> {
+    type Output = CapsuleParts<L>;
+    #[inline(always)]
+    fn run(self) -> CapsuleParts<L> {
+        capsule_parts_here(self.p, self.ray, self.f, self.piece)
+    }
+}
+
+/// [`capsule_parts`] in place.
+#[inline(always)]
+fn capsule_parts_here<L: Lane>(
     p: &FieldParams<f32>,
     ray: &RayLanes<L>,
     f: &CapsuleField<f32>,

@@ -62,6 +62,32 @@ pub trait Lane:
     fn frexp(self) -> (Self, Self);
     /// `2^round(self)` for `round(self) ∈ [−126, 127]` (below, `2^−126`), from exponent bits.
     fn exp2_int(self) -> Self;
+    /// Runs `body` in a function of its own: never inlined, compiled for this lane type's path
+    /// (with its `#[target_feature]`s on x86-64), so that its lane operations inline there.
+    ///
+    /// For a large piece of lane code called from a dispatched body: inlined (as everything in
+    /// such a body is), it would add its temporaries to the body's own frame once per call site,
+    /// and an unoptimized build gives every temporary a stack slot of its own. Outlined, it is
+    /// one frame, live only while it runs.
+    fn outlined<B: Outlined<Self>>(body: B) -> B::Output;
+
+    /// Runs `body` in place (inlined) in an optimized build, and as [`Lane::outlined`] in one
+    /// compiled at opt-level 0 (`cfg(hadou_unoptimized)`, from the crate's build script). There
+    /// nothing but `#[inline(always)]` inlines, and every temporary of an inlined function keeps
+    /// a stack slot of its own for the whole frame: a dispatched body with every kernel inlined
+    /// would need megabytes of stack. The lane kernels run through this, so that each takes a
+    /// frame of its own only while it runs.
+    #[inline(always)]
+    fn outlined_if_unoptimized<B: Outlined<Self>>(body: B) -> B::Output {
+        #[cfg(hadou_unoptimized)]
+        {
+            Self::outlined(body)
+        }
+        #[cfg(not(hadou_unoptimized))]
+        {
+            body.run()
+        }
+    }
 
     /// The natural logarithm of positive normal finite lanes (elsewhere unspecified: callers
     /// select those lanes away). Cephes' `logf` reduction and polynomial (relative error about
@@ -206,4 +232,13 @@ pub trait WithLanes {
     type Output;
     /// The body on lanes `L`.
     fn run<L: Lane>(self) -> Self::Output;
+}
+
+/// A body run on lanes `L` in a function of its own ([`Lane::outlined`]). Implementations mark
+/// `run` `#[inline(always)]`, so that it is compiled inside that function.
+pub trait Outlined<L> {
+    /// What the body returns.
+    type Output;
+    /// The body.
+    fn run(self) -> Self::Output;
 }
