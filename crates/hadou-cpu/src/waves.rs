@@ -181,7 +181,7 @@ impl<'a> WavePass<'a> {
                 Falloff::InverseSquare => &rays.inverse_square,
             };
             if wave.attenuation > 0.0 && !matches!(wave.shape, WaveShape::Curve(_)) {
-                let e = L::from_array(self.attenuated_lanes(wave, &p, &Rays::of(ray, &rays), valid));
+                let e = attenuated_lanes(wave, &p, ray, &rays, valid);
                 sink.wave(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
                 continue;
             }
@@ -201,31 +201,6 @@ impl<'a> WavePass<'a> {
             sink.wave(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
         }
         rays.depth
-    }
-
-    /// An analytic wave's energy with the distance attenuation `(1 − u)^j`, `j > 0` (002 eq.
-    /// 3.23, SPEC.md §1.4), one pixel at a time: the attenuated integrals
-    /// (`hadou_math::energy::*_attenuated`) grade their cells per ray and have no eight-lane
-    /// form. `t_far` is 1 (faithful) or the far point's distance (inverse square), as for curves.
-    #[inline(never)]
-    fn attenuated_lanes(&self, wave: &Wave, p: &FieldParams<f32>, ray: &Rays, valid: usize) -> [f32; LANES] {
-        let mut e = [0.0f32; LANES];
-        for (i, e) in e.iter_mut().enumerate().take(valid) {
-            let r = Ray { origin: ray.origin, dir: Vec3::new(ray.dir[0][i], ray.dir[1][i], ray.dir[2][i]) };
-            let att = wave.attenuation_on(match p.falloff {
-                Falloff::Faithful => 1.0,
-                Falloff::InverseSquare => ray.far[i],
-            });
-            let (t0, t1) = (ray.t0[i], ray.t1[i]);
-            *e = match &wave.shape {
-                WaveShape::Sphere(f) => energy::sphere_energy_attenuated(p, &r, t0, t1, &att, f),
-                WaveShape::Cylinder(f) => energy::cylinder_energy_attenuated(p, &r, t0, t1, &att, f),
-                WaveShape::Capsule(f) => energy::capsule_energy_attenuated(p, &r, t0, t1, &att, f),
-                WaveShape::Beam(f) => energy::beam_energy_attenuated(p, &r, t0, t1, &att, f),
-                WaveShape::Curve(_) => 0.0,
-            };
-        }
-        e
     }
 
     /// A curved wave's energy through the batch's `valid` pixels: the default integrator walks
@@ -403,6 +378,39 @@ impl<'a> WavePass<'a> {
                 }
             }
         }
+    }
+}
+
+/// An analytic wave's energy with the distance attenuation `(1 − u)^j`, `j > 0` (002 eq. 3.23,
+/// SPEC.md §1.4), eight pixels at a time (`hadou_math::energy::lanes::*_attenuated`, the graded
+/// march with each lane's own cells). `t_far` is 1 (faithful) or each pixel's far-point distance
+/// (inverse square), as for curves. Lanes past `valid` get an empty span: 0, and no cells.
+#[inline(always)]
+fn attenuated_lanes<L: Lane>(
+    wave: &Wave,
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    rays: &PixelRays<L>,
+    valid: usize,
+) -> L {
+    let att = lanes::AttenuationLanes {
+        j: wave.attenuation,
+        t_far: match p.falloff {
+            Falloff::Faithful => L::splat(1.0),
+            Falloff::InverseSquare => rays.far_dist,
+        },
+    };
+    let mut ray = *ray;
+    if valid < LANES {
+        let lane = L::from_array(std::array::from_fn(|i| i as f32));
+        ray.t1 = lane.simd_lt(L::splat(valid as f32)).select(ray.t1, ray.t0);
+    }
+    match &wave.shape {
+        WaveShape::Sphere(f) => lanes::sphere_energy_attenuated(p, &ray, &att, f),
+        WaveShape::Cylinder(f) => lanes::cylinder_energy_attenuated(p, &ray, &att, f),
+        WaveShape::Capsule(f) => lanes::capsule_energy_attenuated(p, &ray, &att, f),
+        WaveShape::Beam(f) => lanes::beam_energy_attenuated(p, &ray, &att, f),
+        WaveShape::Curve(_) => L::splat(0.0),
     }
 }
 

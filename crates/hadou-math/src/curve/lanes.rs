@@ -31,7 +31,7 @@ use super::local_ray::{LocalFrame, LocalRay};
 use super::prepare::PreparedCurve;
 use super::wave::Integrator;
 use crate::energy::{scaled, Falloff, FieldParams, Ray};
-use crate::simd::Lane;
+use crate::simd::{Lane, Outlined};
 
 /// Rays per packet (the lane count of [`Lane`]).
 pub const PACKET: usize = 8;
@@ -402,9 +402,16 @@ impl<L: Lane> Packet<L> {
     }
 
     /// `Acc::piece_quad` on the lanes of `m`: the piece from `ts` on over `τ ∈ [0, dt]`, cut into
-    /// attenuation parts as the scalar rule cuts it (each part counts 1).
+    /// attenuation parts as the scalar rule cuts it (each part counts 1). A frame of its own in an
+    /// unoptimized build ([`Lane::outlined_if_unoptimized`]).
     #[inline(always)]
     fn piece(&self, m: u32, ts: L, q: &QuadL<L>, dt: L, acc: &mut Sums<L>) {
+        L::outlined_if_unoptimized(Piece { pk: self, m, ts, q, dt, acc })
+    }
+
+    /// [`Packet::piece`] in place.
+    #[inline(always)]
+    fn piece_here(&self, m: u32, ts: L, q: &QuadL<L>, dt: L, acc: &mut Sums<L>) {
         let zero = L::splat(0.0);
         if self.j == 0.0 {
             let seg = SegL::from_quad(self.falloff, q, dt, self.rc2);
@@ -473,6 +480,24 @@ impl<L: Lane> Packet<L> {
             cr = near.select(ay * vz - az * vy, cr);
         }
         QuadL { pp: py * py + pz * pz, vv, pv, big_e: cr * cr + self.rc2 * vv }
+    }
+}
+
+/// [`Packet::piece`]'s arguments, a body for [`Lane::outlined_if_unoptimized`].
+struct Piece<'a, L> {
+    pk: &'a Packet<L>,
+    m: u32,
+    ts: L,
+    q: &'a QuadL<L>,
+    dt: L,
+    acc: &'a mut Sums<L>,
+}
+
+impl<L: Lane> Outlined<L> for Piece<'_, L> {
+    type Output = ();
+    #[inline(always)]
+    fn run(self) {
+        self.pk.piece_here(self.m, self.ts, self.q, self.dt, self.acc)
     }
 }
 
@@ -553,6 +578,38 @@ impl<L: Lane> RangeL<L> {
 /// inlined into that body, as every lane function must be).
 #[inline(always)]
 pub fn curve_energy_lanes<L: Lane>(
+    c: &PreparedCurve,
+    p: &FieldParams<f32>,
+    rays: &[Ray<f32>],
+    t0: &[f32],
+    t1: &[f32],
+    t_far: &[f32],
+) -> [CurveSample; PACKET] {
+    L::outlined_if_unoptimized(CurvePacket { c, p, rays, t0, t1, t_far })
+}
+
+/// [`curve_energy_lanes`]'s arguments, a body for [`Lane::outlined_if_unoptimized`] (in an
+/// unoptimized build the packet walk takes a frame of its own).
+struct CurvePacket<'a> {
+    c: &'a PreparedCurve,
+    p: &'a FieldParams<f32>,
+    rays: &'a [Ray<f32>],
+    t0: &'a [f32],
+    t1: &'a [f32],
+    t_far: &'a [f32],
+}
+
+impl<L: Lane> Outlined<L> for CurvePacket<'_> {
+    type Output = [CurveSample; PACKET];
+    #[inline(always)]
+    fn run(self) -> Self::Output {
+        packet_energy::<L>(self.c, self.p, self.rays, self.t0, self.t1, self.t_far)
+    }
+}
+
+/// [`curve_energy_lanes`] in place.
+#[inline(always)]
+fn packet_energy<L: Lane>(
     c: &PreparedCurve,
     p: &FieldParams<f32>,
     rays: &[Ray<f32>],

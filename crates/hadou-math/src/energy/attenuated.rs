@@ -36,8 +36,9 @@
 //! [`MAX_CELLS`] (the rest is then one last cell).
 //!
 //! `j = 0` calls the unattenuated kernels themselves, so it is bit-identical to them and as fast.
-//! The eight-lane kernels (`lanes.rs`) have no attenuated form: the CPU backend evaluates a wave
-//! with `j > 0` one pixel at a time through these functions.
+//! The eight-lane kernels (`lanes.rs`) have the same march in lanes (`lanes::*_attenuated`, a
+//! masked loop in which each lane grades, stops and caps its own cells by the rules here), which
+//! the CPU backend uses; these functions are what they are tested against.
 
 use super::field::{
     Attenuation, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
@@ -47,10 +48,10 @@ use super::kernel::{saturate, scaled, RayQuadratic, ENERGY_MAX, T_LIMIT};
 use crate::Real;
 
 /// Gauss–Legendre nodes on `[0, 1]` (4 points).
-const GL_X: [f64; 4] =
+pub(super) const GL_X: [f64; 4] =
     [0.069_431_844_202_973_71, 0.330_009_478_207_571_9, 0.669_990_521_792_428_1, 0.930_568_155_797_026_3];
 /// Gauss–Legendre weights on `[0, 1]` (sum 1).
-const GL_W: [f64; 4] =
+pub(super) const GL_W: [f64; 4] =
     [0.173_927_422_568_726_93, 0.326_072_577_431_273_07, 0.326_072_577_431_273_07, 0.173_927_422_568_726_93];
 
 /// Most cells one piece is cut into; the rest of the span is then one last cell.
@@ -83,7 +84,8 @@ impl<R: Real> RayQuadratic<R> {
     /// [`Self::integral`] itself. Finite and in `[0, ENERGY_MAX]` for finite inputs; empty or
     /// NaN spans give 0.
     ///
-    /// Mirrored by `rq_attenuated` in the GPU crate's `energy.wgsl` (keep in sync).
+    /// Mirrored by `rq_attenuated` in the GPU crate's `energy.wgsl` and eight rays at a time by
+    /// `lanes::Quad::attenuated` (keep all three in sync).
     pub fn attenuated(&self, falloff: Falloff, t0: R, t1: R, att: &Attenuation<R>) -> R {
         if !att.is_active() {
             return self.integral(falloff, t0, t1);

@@ -10,11 +10,26 @@
 //! a centre, along an axis, far away, `r_c = 0`, empty or NaN spans), and saturates the same way
 //! (`tests/analytic_lanes.rs` holds them to the scalar kernels and to the `f64` reference).
 //!
+//! # Distance attenuation
+//! The `*_attenuated` kernels add the attenuation `(1 − t/t_far)^j` of 002 eq. 3.23 (SPEC.md
+//! §1.4) with a per-lane `t_far` ([`AttenuationLanes`]), by the march of
+//! [`RayQuadratic::attenuated`] run on all eight rays at once: one loop whose every pass cuts one
+//! cell per lane, each lane keeping its own position, sums, cell count and active mask, with the
+//! scalar march's grading (geometric towards `t_far` and away from the peak, the inner cell in
+//! `ψ = asinh(Y/√H)` or `θ = atan(Y/√H)`, the ulp step), early stop and cell cap applied per
+//! lane by selects; the loop ends when no lane is active ([`Lane::bitmask`]), so a batch costs
+//! its slowest lane's cells (at most [`MAX_CELLS`](super::MAX_CELLS)). The powers, `sinh`, `tan`,
+//! `asinh` and `atan` are the lane polynomials of [`Lane`] (`exp(j·ln h)` for `h^j`), so each lane
+//! cuts the scalar march's cells up to rounding and agrees with it to about `10⁻⁵` relative
+//! (`tests/analytic_attenuation_lanes.rs`). `j = 0` (or NaN) runs the unattenuated kernels.
+//!
 //! [`RayQuadratic`]: super::RayQuadratic
+//! [`RayQuadratic::attenuated`]: super::RayQuadratic::attenuated
 
+use super::attenuated::{GL_W, GL_X, INNER_CELL, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE};
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
-use crate::simd::Lane;
+use crate::simd::{Lane, Outlined};
 use crate::Vec3;
 
 /// Rays evaluated together.
@@ -207,13 +222,272 @@ impl<L: Lane> Quad<L> {
         clamp_energy(live, v)
     }
 
+    /// The closed form of `falloff` over `[t0, t1]` per lane ([`Lane::outlined_if_unoptimized`]:
+    /// a frame of its own in an unoptimized build).
     #[inline(always)]
     fn integral(&self, falloff: Falloff, t0: L, t1: L) -> L {
-        match falloff {
-            Falloff::Faithful => self.faithful(t0, t1),
-            Falloff::InverseSquare => self.inverse_square(t0, t1),
+        L::outlined_if_unoptimized(Integral { quad: *self, falloff, t0, t1 })
+    }
+}
+
+/// [`Quad::integral`] as a body for [`Lane::outlined_if_unoptimized`].
+struct Integral<L> {
+    quad: Quad<L>,
+    falloff: Falloff,
+    t0: L,
+    t1: L,
+}
+
+impl<L: Lane> Outlined<L> for Integral<L> {
+    type Output = L;
+    #[inline(always)]
+    fn run(self) -> L {
+        match self.falloff {
+            Falloff::Faithful => self.quad.faithful(self.t0, self.t1),
+            Falloff::InverseSquare => self.quad.inverse_square(self.t0, self.t1),
         }
     }
+}
+
+impl<L: Lane> Quad<L> {
+    /// The scalar [`super::RayQuadratic::attenuated`] on eight rays: `∫_{t0}^{min(t1, t_far)}
+    /// (1 − t/t_far)^j w(t) dt` (002 eq. 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded
+    /// cells weighted by the closed form, as one masked loop (see the [module docs](self)). Each
+    /// lane cuts the scalar march's cells: the same grading, ulp step, early stop
+    /// ([`REST_TOLERANCE`](super::REST_TOLERANCE)) and cap ([`MAX_CELLS`](super::MAX_CELLS));
+    /// lanes whose span is empty, NaN, beyond `t_far`, or whose `t_far` is not positive and
+    /// finite, give 0 and take no pass. `j = 0` (or NaN) is [`Self::integral`].
+    ///
+    /// The march runs in a function of its own ([`Lane::outlined`], [`March`]): inlined, each of
+    /// a beam's five pieces would add the march's lane temporaries to the dispatched body's frame,
+    /// which in an unoptimized build (a slot per temporary) outgrows a thread's stack.
+    ///
+    /// Mirrors `RayQuadratic::attenuated` (keep in sync).
+    #[inline(always)]
+    fn attenuated(&self, falloff: Falloff, t0: L, t1: L, att: &AttenuationLanes<L>) -> L {
+        if !att.is_active() {
+            return self.integral(falloff, t0, t1);
+        }
+        L::outlined(March { quad: *self, falloff, t0, t1, att: *att })
+    }
+
+    /// [`Self::attenuated`]'s march (`j > 0`) in place: what [`March`] runs.
+    #[inline(always)]
+    fn march(&self, falloff: Falloff, t0: L, t1: L, att: &AttenuationLanes<L>) -> L {
+        let k = L::splat;
+        let zero = k(0.0);
+        let tf = att.t_far;
+        let a = t0.max(k(-T_LIMIT as f32));
+        let b = t1.min(tf);
+        // False for NaN ends, empty spans and spans beyond the far point.
+        let live = b.simd_gt(a) & tf.simd_gt(zero) & tf.simd_lt(k(f32::INFINITY));
+        let (a, b) = (live.select(a, zero), live.select(b, zero));
+        let total = self.integral(falloff, a, b);
+        let mut active = live & total.simd_gt(zero);
+        if active.bitmask() == 0 {
+            return zero;
+        }
+        let (s, h) = (self.s, self.h);
+        let sh = h.sqrt();
+        // A peak only where t_c = −β/s and ε = √H/s stay far below overflow.
+        let range = s * k(PEAK_RANGE as f32);
+        let has_peak = s.simd_gt(zero) & sh.simd_le(range) & self.beta.max(-self.beta).simd_le(range);
+        let tc = has_peak.select(-self.beta / s, zero);
+        let dmin = has_peak.select(k(INNER_CELL as f32) * (sh / s), zero);
+        // The same ratio as the scalar march (the maths library's exp, once per wave).
+        let q = k((-1.0f32 / att.j).exp().max(0.5));
+        let half = k(0.5);
+        let last_cell = k((MAX_CELLS - 1) as f32);
+        let tolerance = k(REST_TOLERANCE as f32);
+        let mut x = a;
+        let mut acc = zero;
+        let mut used = zero;
+        let mut cells = zero;
+        while active.bitmask() != 0 {
+            let graded = b.min(tf - q * (tf - x));
+            let capped = cells.simd_ge(last_cell);
+            // Approaching the peak: halve the distance, down to the inner cell; inside it: to its
+            // end; leaving it: double the distance.
+            let before = x.simd_lt(tc - dmin);
+            let within = x.simd_lt(tc + dmin);
+            let y_before = graded.min((tc - (tc - x) * half).min(tc - dmin));
+            let y_within = graded.min(tc + dmin);
+            let y_after = graded.min(x + (x - tc).max(dmin));
+            let y_peak = before.select(y_before, within.select(y_within, y_after));
+            let y = capped.select(b, has_peak.select(y_peak, graded));
+            let inner = has_peak & !capped & !before & within;
+            // The grading rounded away (a peak narrower than one ulp of t): about two ulps.
+            let step = (x.max(-x) * k(2.0 * f32::EPSILON)).max(k(f32::MIN_POSITIVE));
+            let nudged = (x + step).min(b);
+            let nudged = nudged.simd_gt(x).select(nudged, b);
+            let y = y.simd_gt(x).select(y, nudged);
+            let i0 = self.integral(falloff, x, y);
+            let g_line =
+                if (active & !inner).bitmask() != 0 { self.mean_g_line(falloff, x, y, att) } else { zero };
+            let gbar = if (active & inner).bitmask() != 0 {
+                inner.select(self.mean_g_peak(falloff, x, y, att), g_line)
+            } else {
+                g_line
+            };
+            acc += active.select(i0 * gbar, zero);
+            used += active.select(i0, zero);
+            cells += active.select(k(1.0), zero);
+            x = active.select(y, x);
+            let rest = (total - used).max(zero);
+            let done = (att.factor(x) * rest).simd_le(tolerance * acc);
+            active = active & x.simd_lt(b) & !done;
+        }
+        clamp_energy(live, acc)
+    }
+
+    /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
+    /// plain mean of `g` where the weights underflow (the scalar `mean_g_line`).
+    #[inline(always)]
+    fn mean_g_line(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> L {
+        let k = L::splat;
+        let dt = y - x;
+        let mut num = k(0.0);
+        let mut den = k(0.0);
+        let mut plain = k(0.0);
+        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
+            let wi = k(wi as f32);
+            let t = x + k(xi as f32) * dt;
+            let g = att.factor(t);
+            let yv = self.s * t + self.beta;
+            let r2 = yv * yv + self.h;
+            let density = match falloff {
+                Falloff::Faithful => k(1.0) / r2.sqrt(),
+                Falloff::InverseSquare => k(1.0) / r2,
+            };
+            let w = wi * density;
+            num += w * g;
+            den += w;
+            plain += wi * g;
+        }
+        let ok = den.simd_gt(k(0.0)) & finite(den) & finite(num);
+        ok.select(num / den, plain)
+    }
+
+    /// `g` averaged over `[x, y]` against `w` on the inner cell around the peak, with 4
+    /// Gauss–Legendre nodes uniform in `ψ = asinh(Y/√H)` (faithful; `Y/√H = sinh ψ` from
+    /// [`Lane::exp`]) or `θ = atan(Y/√H)` (inverse square; `Y/√H = tan θ`, [`Lane::tan`]): the
+    /// scalar `mean_g_peak`. Lanes without a peak (`s = 0`) give garbage, which the caller
+    /// selects away; node positions are clamped to `[x, y]` (a NaN one to `x`).
+    #[inline(always)]
+    fn mean_g_peak(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> L {
+        let k = L::splat;
+        let sh = self.h.sqrt();
+        let (yx, yy) = ((self.s * x + self.beta) / sh, (self.s * y + self.beta) / sh);
+        let (px, py) = match falloff {
+            Falloff::Faithful => (yx.asinh(), yy.asinh()),
+            Falloff::InverseSquare => (yx.atan(), yy.atan()),
+        };
+        let mut sum = k(0.0);
+        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
+            let p = px + k(xi as f32) * (py - px);
+            let v = match falloff {
+                Falloff::Faithful => {
+                    let e = p.exp();
+                    k(0.5) * (e - k(1.0) / e)
+                }
+                Falloff::InverseSquare => p.tan(),
+            };
+            let t = ((v * sh - self.beta) / self.s).max(x).min(y);
+            sum += k(wi as f32) * att.factor(t);
+        }
+        sum
+    }
+}
+
+/// [`Quad::attenuated`]'s march as a body for [`Lane::outlined`].
+struct March<L> {
+    quad: Quad<L>,
+    falloff: Falloff,
+    t0: L,
+    t1: L,
+    att: AttenuationLanes<L>,
+}
+
+impl<L: Lane> Outlined<L> for March<L> {
+    type Output = L;
+    #[inline(always)]
+    fn run(self) -> L {
+        self.quad.march(self.falloff, self.t0, self.t1, &self.att)
+    }
+}
+
+/// The distance attenuation `(1 − t/t_far)^j` of 002 eq. 3.23 (SPEC.md §1.4) on eight rays:
+/// [`super::Attenuation`] with one exponent for the batch (a wave's) and each ray's own far point
+/// (`t_far` is 1 for every faithful ray, the far point's distance along each inverse-square ray).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttenuationLanes<L = Lanes> {
+    /// Exponent `j ≥ 0` (0: none), shared by the lanes.
+    pub j: f32,
+    /// Each ray's far-point parameter (`> 0`).
+    pub t_far: L,
+}
+
+impl<L: Lane> AttenuationLanes<L> {
+    /// No attenuation (`j = 0`).
+    pub fn none() -> Self {
+        Self { j: 0.0, t_far: L::splat(1.0) }
+    }
+
+    /// Whether it changes anything (`j > 0`; false for NaN).
+    #[inline(always)]
+    pub fn is_active(&self) -> bool {
+        self.j > 0.0
+    }
+
+    /// `(1 − t/t_far)^j` per lane, 0 from the far point on (002 eq. 3.23, SPEC.md §1.4), as
+    /// `exp(j·ln h)` with [`Lane::ln`] and [`Lane::exp`], `h = 1 − t/t_far` formed as the scalar
+    /// [`super::Attenuation::factor`] forms it: relative error about `10⁻⁷·(1 + j·|ln h|)`
+    /// against `powf` (`h^j` below `10⁻³⁸` gives 0).
+    #[inline(always)]
+    pub fn factor(&self, t: L) -> L {
+        let k = L::splat;
+        let h = k(1.0) - t / self.t_far;
+        let pos = h.simd_gt(k(0.0));
+        let g = (k(self.j) * pos.select(h, k(1.0)).ln()).exp();
+        pos.select(g, k(0.0))
+    }
+}
+
+/// How [`capsule_parts`] integrates one piece: the closed form, or the attenuated march. A trait
+/// with an `#[inline(always)]` method rather than a closure, so that the lane arithmetic inlines
+/// into the dispatched body (see [`Lane`]).
+trait Piece<L> {
+    /// `∫_{t0}^{t1}` of `q`'s density (attenuated or not).
+    fn piece(&self, q: &Quad<L>, t0: L, t1: L) -> L;
+}
+
+/// The unattenuated closed form ([`Quad::integral`]).
+struct Plain(Falloff);
+
+impl<L: Lane> Piece<L> for Plain {
+    #[inline(always)]
+    fn piece(&self, q: &Quad<L>, t0: L, t1: L) -> L {
+        q.integral(self.0, t0, t1)
+    }
+}
+
+/// The attenuated march ([`Quad::attenuated`]).
+struct Attenuated<'a, L> {
+    falloff: Falloff,
+    att: &'a AttenuationLanes<L>,
+}
+
+impl<L: Lane> Piece<L> for Attenuated<'_, L> {
+    #[inline(always)]
+    fn piece(&self, q: &Quad<L>, t0: L, t1: L) -> L {
+        q.attenuated(self.falloff, t0, t1, self.att)
+    }
+}
+
+/// The lanes that are neither NaN nor infinite.
+#[inline(always)]
+fn finite<L: Lane>(v: L) -> L {
+    !(v.is_nan() | v.is_inf())
 }
 
 /// `v` clamped to `[0, ENERGY_MAX]` where `live`, 0 elsewhere; NaN gives 0 (as the scalar
@@ -264,10 +538,44 @@ struct CapsuleParts<L> {
 }
 
 /// As the scalar `capsule_parts` (002 eq. 3.10–3.11, SPEC.md §1.2): the ray split at the planes
-/// through `M` and `M₂`, each region its closed form, the region order per lane by the sign of
-/// `D·Q`.
+/// through `M` and `M₂`, each region its closed form (or attenuated march: `piece`), the region
+/// order per lane by the sign of `D·Q`.
+///
+/// A frame of its own in an unoptimized build ([`Lane::outlined_if_unoptimized`]).
 #[inline(always)]
-fn capsule_parts<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &CapsuleField<f32>) -> CapsuleParts<L> {
+fn capsule_parts<L: Lane, P: Piece<L>>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    f: &CapsuleField<f32>,
+    piece: &P,
+) -> CapsuleParts<L> {
+    L::outlined_if_unoptimized(Capsule { p, ray, f, piece })
+}
+
+/// [`capsule_parts`]' arguments, a body for [`Lane::outlined_if_unoptimized`].
+struct Capsule<'a, L, P> {
+    p: &'a FieldParams<f32>,
+    ray: &'a RayLanes<L>,
+    f: &'a CapsuleField<f32>,
+    piece: &'a P,
+}
+
+impl<L: Lane, P: Piece<L>> Outlined<L> for Capsule<'_, L, P> {
+    type Output = CapsuleParts<L>;
+    #[inline(always)]
+    fn run(self) -> CapsuleParts<L> {
+        capsule_parts_here(self.p, self.ray, self.f, self.piece)
+    }
+}
+
+/// [`capsule_parts`] in place.
+#[inline(always)]
+fn capsule_parts_here<L: Lane>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    f: &CapsuleField<f32>,
+    piece: &impl Piece<L>,
+) -> CapsuleParts<L> {
     let live = ray.t1.simd_gt(ray.t0);
     let t0 = live.select(ray.t0, L::splat(0.0));
     let t1 = live.select(ray.t1, L::splat(0.0));
@@ -302,29 +610,106 @@ fn capsule_parts<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &CapsuleFi
     let hi = hi.max(lo).min(t1);
     let first = Quad::select(bwd, &at_m2, &at_m);
     let last = Quad::select(bwd, &at_m, &at_m2);
-    let fo = p.falloff;
-    let spheres = first.integral(fo, t0, lo) + last.integral(fo, hi, t1);
-    let energy = saturate(scaled(spheres, f.alpha_s) + scaled(cyl.integral(fo, lo, hi), f.alpha_c));
+    let spheres = piece.piece(&first, t0, lo) + piece.piece(&last, hi, t1);
+    let energy = saturate(scaled(spheres, f.alpha_s) + scaled(piece.piece(&cyl, lo, hi), f.alpha_c));
     CapsuleParts { at_m, at_m2, energy }
 }
 
 /// [`super::capsule_energy`] for eight rays (002 eq. 3.10–3.11, SPEC.md §1.2).
 #[inline(always)]
 pub fn capsule_energy<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &CapsuleField<f32>) -> L {
-    capsule_parts(p, ray, f).energy
+    capsule_parts(p, ray, f, &Plain(p.falloff)).energy
 }
 
 /// [`super::beam_energy`] for eight rays: the capsule plus the head and muzzle spheres over the
 /// whole span (002 §3.3.3, eq. 3.4 and 3.11; SPEC.md §1.2).
 #[inline(always)]
 pub fn beam_energy<L: Lane>(p: &FieldParams<f32>, ray: &RayLanes<L>, f: &BeamField<f32>) -> L {
-    let parts = capsule_parts(p, ray, &f.capsule);
+    let parts = capsule_parts(p, ray, &f.capsule, &Plain(p.falloff));
     let mut e = parts.energy;
     if f.head_alpha != 0.0 {
         e = saturate(e + scaled(parts.at_m2.integral(p.falloff, ray.t0, ray.t1), f.head_alpha));
     }
     if f.muzzle_alpha != 0.0 {
         e = saturate(e + scaled(parts.at_m.integral(p.falloff, ray.t0, ray.t1), f.muzzle_alpha));
+    }
+    e
+}
+
+/// [`super::sphere_energy_attenuated`] for eight rays: `α_s ∫ g(t)/ρ` (faithful) or
+/// `α_s ∫ g(t)/ρ²` (inverse square) over `[t0, min(t1, t_far)]`, `g = (1 − t/t_far)^j` with each
+/// lane's `t_far` (002 eq. 3.4, 3.6, 3.23; SPEC.md §1.2, §1.4). `j = 0` is [`sphere_energy`]
+/// exactly.
+#[inline(always)]
+pub fn sphere_energy_attenuated<L: Lane>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    att: &AttenuationLanes<L>,
+    f: &SphereField<f32>,
+) -> L {
+    if !att.is_active() {
+        return sphere_energy(p, ray, f);
+    }
+    let axis = Axis::new(ray.dir);
+    let q = Quad::new(&axis, V3::splat(ray.origin - f.center), p.core_radius * p.core_radius);
+    scaled(q.attenuated(p.falloff, ray.t0, ray.t1, att), f.alpha)
+}
+
+/// [`super::cylinder_energy_attenuated`] for eight rays (002 eq. 3.5, 3.7, 3.23; SPEC.md §1.2,
+/// §1.4). `j = 0` is [`cylinder_energy`] exactly.
+#[inline(always)]
+pub fn cylinder_energy_attenuated<L: Lane>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    att: &AttenuationLanes<L>,
+    f: &CylinderField<f32>,
+) -> L {
+    if !att.is_active() {
+        return cylinder_energy(p, ray, f);
+    }
+    let axis = Axis::new(ray.dir.cross_splat(f.dir));
+    let v = V3::splat((ray.origin - f.point).cross(f.dir));
+    let q = Quad::new(&axis, v, p.core_radius * p.core_radius);
+    scaled(q.attenuated(p.falloff, ray.t0, ray.t1, att), f.alpha)
+}
+
+/// [`super::capsule_energy_attenuated`] for eight rays (002 eq. 3.10–3.11, 3.23; SPEC.md §1.2,
+/// §1.4): the same split at the planes through `M` and `M₂`, each piece attenuated in the ray's
+/// own parameter. `j = 0` is [`capsule_energy`] exactly.
+#[inline(always)]
+pub fn capsule_energy_attenuated<L: Lane>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    att: &AttenuationLanes<L>,
+    f: &CapsuleField<f32>,
+) -> L {
+    if !att.is_active() {
+        return capsule_energy(p, ray, f);
+    }
+    capsule_parts(p, ray, f, &Attenuated { falloff: p.falloff, att }).energy
+}
+
+/// [`super::beam_energy_attenuated`] for eight rays (002 §3.3.3, eq. 3.4, 3.11, 3.23; SPEC.md
+/// §1.2, §1.4): the attenuated capsule plus the attenuated bulbs at `M₂` and `M` over the whole
+/// span. `j = 0` is [`beam_energy`] exactly.
+#[inline(always)]
+pub fn beam_energy_attenuated<L: Lane>(
+    p: &FieldParams<f32>,
+    ray: &RayLanes<L>,
+    att: &AttenuationLanes<L>,
+    f: &BeamField<f32>,
+) -> L {
+    if !att.is_active() {
+        return beam_energy(p, ray, f);
+    }
+    let piece = Attenuated { falloff: p.falloff, att };
+    let parts = capsule_parts(p, ray, &f.capsule, &piece);
+    let mut e = parts.energy;
+    if f.head_alpha != 0.0 {
+        e = saturate(e + scaled(piece.piece(&parts.at_m2, ray.t0, ray.t1), f.head_alpha));
+    }
+    if f.muzzle_alpha != 0.0 {
+        e = saturate(e + scaled(piece.piece(&parts.at_m, ray.t0, ray.t1), f.muzzle_alpha));
     }
     e
 }

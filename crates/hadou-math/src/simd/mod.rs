@@ -15,6 +15,13 @@
 //! x86-64 ones inside functions carrying `#[target_feature]`, so a single binary uses AVX2 + FMA
 //! (and AVX-512's extra registers and encodings, `avx512` path) where the CPU has them and SSE2
 //! elsewhere. `tests/simd_paths.rs` holds every path the machine supports to the scalar kernels.
+//!
+//! A large kernel called from such a body can run in a function of its own compiled for the same
+//! path ([`Lane::outlined`], through the [`Outlined`] trait): the attenuated march always does,
+//! and in a build at opt-level 0 the closed forms, the capsule's split and the curve packet and
+//! its pieces do too ([`Lane::outlined_if_unoptimized`]). Unoptimized, every temporary of an
+//! inlined function keeps a stack slot of its own, so a body inlining every kernel would need
+//! megabytes of stack; outlined, each kernel's frame is live only while it runs.
 
 mod dispatch;
 mod lane;
@@ -24,6 +31,6 @@ mod portable;
 mod x86;
 
 pub use dispatch::dispatch;
-pub use lane::{Lane, WithLanes};
+pub use lane::{Lane, Outlined, WithLanes};
 pub use path::{SimdPath, SimdPathError, SIMD_ENV};
 pub use portable::Portable;

@@ -1,6 +1,6 @@
 //! [`Portable`]: `wide::f32x8`, at the vector width the build targets.
 
-use super::Lane;
+use super::{Lane, Outlined};
 use wide::{f32x8, i32x8, u32x8};
 
 /// The lanes every build has: `wide::f32x8` (two SSE2 halves on baseline x86-64, two NEON halves
@@ -85,6 +85,10 @@ impl Lane for f32x8 {
         f32x8::from_bits(wide::bytemuck::cast::<i32x8, u32x8>(e))
     }
     #[inline(always)]
+    fn outlined<B: Outlined<Self>>(body: B) -> B::Output {
+        outlined(body)
+    }
+    #[inline(always)]
     fn ln(self) -> Self {
         f32x8::ln(self)
     }
@@ -96,4 +100,10 @@ impl Lane for f32x8 {
     fn reduce_add(self) -> f32 {
         f32x8::reduce_add(self)
     }
+}
+
+/// [`Lane::outlined`] for [`Portable`]: the build's own target features are the path's.
+#[inline(never)]
+fn outlined<B: Outlined<f32x8>>(body: B) -> B::Output {
+    body.run()
 }
