@@ -365,12 +365,13 @@ impl WavePass {
             return Ok((p.clone(), variant));
         }
         let key = (variant.samples(), variant.srgb8(), variant.attenuation());
-        if !self.modules.contains_key(&key) {
-            let label = if variant.samples() { "wave samples" } else { "wave" };
-            let module = setup::compile_module(ctx, label, &variant.source())?;
-            self.modules.insert(key, module);
-        }
-        let module = &self.modules[&key];
+        let module = match self.modules.entry(key) {
+            std::collections::hash_map::Entry::Occupied(m) => m.into_mut(),
+            std::collections::hash_map::Entry::Vacant(slot) => {
+                let label = if variant.samples() { "wave samples" } else { "wave" };
+                slot.insert(setup::compile_module(ctx, label, &variant.source())?)
+            }
+        };
         let constants = variant.constants();
         let pipeline = ctx.scoped("building the wave pipeline", || {
             ctx.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

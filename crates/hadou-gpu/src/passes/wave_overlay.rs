@@ -110,19 +110,17 @@ impl WaveOverlayPass {
         multisampled: bool,
         attenuation: bool,
     ) -> Result<(&wgpu::ShaderModule, &wgpu::BindGroupLayout), RenderError> {
-        let key = (multisampled, attenuation);
-        if !self.modules.contains_key(&key) {
-            let module = setup::compile_module(ctx, "wave overlay", &source(multisampled, attenuation))?;
-            self.modules.insert(key, module);
+        use std::collections::hash_map::Entry;
+        if let Entry::Vacant(slot) = self.modules.entry((multisampled, attenuation)) {
+            slot.insert(setup::compile_module(ctx, "wave overlay", &source(multisampled, attenuation))?);
         }
-        if !self.layouts.contains_key(&multisampled) {
+        if let Entry::Vacant(slot) = self.layouts.entry(multisampled) {
             let bindings: &[Binding] = if multisampled { &BINDINGS_MULTISAMPLED } else { &BINDINGS };
-            let layout = ctx.scoped("building the wave overlay's layout", || {
+            slot.insert(ctx.scoped("building the wave overlay's layout", || {
                 setup::bind_group_layout(&ctx.device, "wave overlay", bindings)
-            })?;
-            self.layouts.insert(multisampled, layout);
+            })?);
         }
-        Ok((&self.modules[&key], &self.layouts[&multisampled]))
+        Ok((&self.modules[&(multisampled, attenuation)], &self.layouts[&multisampled]))
     }
 
     /// The pipeline drawing `variant`'s waves into a `format` target, adding to it when
