@@ -150,7 +150,7 @@ struct BenchArgs {
     sizes: Vec<u32>,
     /// Timed repetitions per cell (after one warm-up) [default: 5 for analytic and toon, 1 for
     /// curves].
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     iterations: Option<u32>,
     /// Which backend to measure.
     #[arg(long, value_enum, default_value_t = BackendChoice::Cpu)]
@@ -215,7 +215,10 @@ fn main() -> ExitCode {
     if std::env::var_os("NODEVICE_SELECT").is_none() {
         std::env::set_var("NODEVICE_SELECT", "1");
     }
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return flag_error(e),
+    };
     // A vector path the CPU lacks is refused here, before anything renders (the library would
     // fall back to the widest path with a warning; it never runs instructions the CPU lacks).
     if let Err(e) = hadou_math::simd::SimdPath::from_env() {
@@ -358,6 +361,57 @@ fn size_origin(scene: &Scene, path: &std::path::Path, w: Option<u32>, h: Option<
     }
 }
 
+/// What each numeric flag that the argument parser reads accepts, for its one-line message.
+fn flag_accepts(flag: &str) -> Option<&'static str> {
+    Some(match flag {
+        "--width" | "--height" => "must be a whole number of pixels, 1 to 16384",
+        "--samples" => "must be one of 1, 4, 9, 16 (a k × k grid of samples per pixel)",
+        "--sizes" => "must be whole numbers of pixels separated by commas, e.g. 512,1024",
+        "--iterations" => "must be a whole number of repetitions, 1 or more",
+        _ => return None,
+    })
+}
+
+/// A command line the argument parser refused: help and version are printed as asked (exit 0);
+/// anything else is one line on stderr naming the flag, the value as typed and what the flag
+/// accepts, exit 2 (the parser's own message is three lines, with a usage hint).
+fn flag_error(e: clap::Error) -> ExitCode {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    if matches!(e.kind(), ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+        let _ = e.print();
+        return ExitCode::from(2);
+    }
+    let text = |kind| match e.get(kind) {
+        Some(ContextValue::String(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let line = match (e.kind(), text(ContextKind::InvalidArg), text(ContextKind::InvalidValue)) {
+        (ErrorKind::InvalidValue | ErrorKind::ValueValidation, Some(arg), Some(value)) => {
+            // The argument as clap names it: `--samples <SAMPLES>`; the flag is its first word.
+            let flag = arg.split_whitespace().next().unwrap_or(&arg).to_string();
+            let value = hadou_scene::escape_controls(&value).into_owned();
+            match flag_accepts(&flag) {
+                Some(accepts) => format!("{flag} {value}: {accepts}"),
+                None => {
+                    let first = e.to_string();
+                    let first = first.lines().next().unwrap_or("").trim_start_matches("error: ").to_string();
+                    format!("{flag} {value}: {first}")
+                }
+            }
+        }
+        _ => {
+            let first = e.to_string();
+            first.lines().next().unwrap_or("").trim_start_matches("error: ").to_string()
+        }
+    };
+    eprintln!("error: {} (see hadou --help)", hadou_scene::escape_controls(&line));
+    ExitCode::from(2)
+}
+
 /// Parses a time in seconds as typed after `flag`: a finite number ≥ 0. Messages echo the text
 /// as typed, never a reformatted value.
 fn parse_time(flag: &str, text: &str) -> Result<f32, Failure> {
@@ -365,8 +419,14 @@ fn parse_time(flag: &str, text: &str) -> Result<f32, Failure> {
         .trim()
         .parse()
         .map_err(|_| Failure::input(format!("{flag} {text}: must be a number of seconds, e.g. 1.5")))?;
-    if !t.is_finite() || t.abs() > f64::from(f32::MAX) {
+    if !t.is_finite() {
         return Err(Failure::input(format!("{flag} {text}: must be a finite number of seconds")));
+    }
+    if t.abs() > f64::from(f32::MAX) {
+        return Err(Failure::input(format!(
+            "{flag} {text}: is past the largest time a frame can hold ({:e} s, a 32-bit float)",
+            f32::MAX
+        )));
     }
     if t < 0.0 {
         return Err(Failure::input(format!("{flag} {text}: times are ≥ 0 seconds")));

@@ -257,6 +257,42 @@ fn bad_flags_are_exit_2() {
     assert!(!out.exists());
 }
 
+/// Every flag's bad value, whether the argument parser or hadou refuses it, is one line naming the
+/// flag, the value as typed and what the flag accepts (issue 41: the parser's own error was three
+/// lines), exit 2; a time past f32 says so rather than "not finite".
+#[test]
+fn issue_41_every_bad_flag_value_is_one_line_naming_the_flag() {
+    let dir = tmpdir("flag-lines");
+    let scene = write_scene(&dir, GOOD);
+    let s = scene.to_str().unwrap();
+    let out = dir.join("o.png");
+    let o = out.to_str().unwrap();
+    for (args, needles) in [
+        (vec!["render", s, "-o", o, "--samples", "-1"], vec!["--samples -1", "1, 4, 9, 16"]),
+        (vec!["render", s, "-o", o, "--samples", "4.0"], vec!["--samples 4.0", "1, 4, 9, 16"]),
+        (vec!["render", s, "-o", o, "--samples", "nan"], vec!["--samples nan", "1, 4, 9, 16"]),
+        (vec!["render", s, "-o", o, "--samples", "1e30"], vec!["--samples 1e30", "1, 4, 9, 16"]),
+        (vec!["render", s, "-o", o, "--samples", "2"], vec!["--samples 2", "1, 4, 9, 16"]),
+        (vec!["render", s, "-o", o, "--width", "wide"], vec!["--width wide", "pixels"]),
+        (vec!["render", s, "-o", o, "--height", "-3"], vec!["--height -3", "pixels"]),
+        (vec!["bench", "--sizes", "a,b"], vec!["--sizes a", "commas"]),
+        (vec!["bench", "--iterations", "-2"], vec!["--iterations -2", "1 or more"]),
+        (vec!["render", s, "-o", o, "--backend", "tpu"], vec!["--backend tpu"]),
+        (vec!["render", s, "-o", o, "--samples", "4\x1b[2J"], vec!["--samples 4\\u{1b}[2J"]),
+        (vec!["render", s, "-o", o, "--time", "3.5e38"], vec!["--time 3.5e38", "32-bit float"]),
+    ] {
+        let r = hadou(&args);
+        let e = stderr(&r);
+        assert_eq!(r.status.code(), Some(2), "{args:?}: {e}");
+        assert_eq!(e.trim_end().lines().count(), 1, "{args:?}: not one line: {e}");
+        for n in needles {
+            assert!(e.contains(n), "{args:?}: {e:?} lacks {n:?}");
+        }
+        assert!(!e.contains('\x1b'), "{args:?}: a raw escape reached the terminal");
+    }
+    assert!(!out.exists());
+}
+
 #[test]
 fn every_example_scene_validates() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
