@@ -25,6 +25,13 @@ ci_close() {
     ci_states+=("$1")
     ci_current=""
   fi
+  local i
+  for ((i = 0; i < ${#ci_pending[@]}; i += 3)); do
+    ci_names+=("${ci_pending[$i]}")
+    ci_secs+=("${ci_pending[$((i + 1))]}")
+    ci_states+=("${ci_pending[$((i + 2))]}")
+  done
+  ci_pending=()
 }
 
 step() {
@@ -36,6 +43,11 @@ step() {
 }
 
 steps_done() { ci_close ok; }
+
+# Adds a row for work that ran in the background beside the current step (its own wall time,
+# measured by whoever ran it), shown after that step's row: `step_row NAME SECONDS STATE`.
+ci_pending=()
+step_row() { ci_pending+=("$1" "$2" "$3"); }
 
 # JSON string escaping for the step names (quotes and backslashes; names hold nothing else).
 ci_json_str() { local s=${1//\\/\\\\}; printf '"%s"' "${s//\"/\\\"}"; }

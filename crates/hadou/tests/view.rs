@@ -30,10 +30,25 @@ fn tmp(name: &str) -> Scratch {
 }
 
 /// One Xvfb at a time: `xvfb-run -a` picks a free display number by looking for lock files, and
-/// two started at once can pick the same one.
-fn xvfb_lock() -> std::sync::MutexGuard<'static, ()> {
+/// two started at once can pick the same one. The lock holds across processes too (an advisory
+/// lock on a file in the temporary folder), since CI runs this binary on Vulkan and on OpenGL at
+/// the same time.
+struct XvfbLock {
+    _file: Option<std::fs::File>,
+    _guard: std::sync::MutexGuard<'static, ()>,
+}
+
+fn xvfb_lock() -> XvfbLock {
     static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    LOCK.lock().unwrap_or_else(|p| p.into_inner())
+    let guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(std::env::temp_dir().join("hadou-view-tests-xvfb.lock"))
+        .ok()
+        .filter(|f| f.lock().is_ok());
+    XvfbLock { _file: file, _guard: guard }
 }
 
 /// `xvfb-run` when present; `None` (skip) otherwise, a failure in CI.

@@ -782,36 +782,64 @@ fn curve_end_piece(c: GpuCurve, r: LocalRay, head: bool, a: f32, b: f32, acc: pt
     }
 }
 
-// Mirrors integrate.rs `integrate_span`.
+// Mirrors integrate.rs `integrate_span`: the tail's end piece, the walk over the slab, the head's
+// end piece, in ray order. Written as one pass over the three parts with one call of each (the
+// parts a ray parallel to the slab (q.x = 0) does not meet are empty), because a software adapter
+// inlines every call site: each extra call of the walk would be compiled again.
 fn curve_integrate_span(c: GpuCurve, r: LocalRay, ta: f32, tb: f32, acc: ptr<function, f32>) {
     let qx = r.q.x;
+    // The three parts' ranges: [ta, first_end) beside the first end point, [a, b) in the slab,
+    // [second_start, tb) beside the second end point.
+    var head_first = false;
+    var first_end = ta;
+    var a = ta;
+    var b = ta;
+    var second_start = tb;
+    var walk = false;
     if (qx == 0.0) {
         if (r.o.x < 0.0) {
-            curve_end_piece(c, r, false, ta, tb, acc);
+            first_end = tb;
         } else if (r.o.x > r.x_head) {
-            curve_end_piece(c, r, true, ta, tb, acc);
+            head_first = true;
+            first_end = tb;
         } else {
-            curve_walk(c, r, ta, tb, acc);
+            // As integrate.rs: the walk runs even on an empty range here.
+            b = tb;
+            walk = true;
         }
-        return;
+    } else {
+        let t_a = -r.o.x / qx;
+        let t_b = (r.x_head - r.o.x) / qx;
+        var tin = t_a;
+        var tout = t_b;
+        if (!(qx > 0.0)) {
+            tin = t_b;
+            tout = t_a;
+            head_first = true;
+        }
+        first_end = min(tb, tin);
+        a = max(ta, tin);
+        b = min(tb, tout);
+        second_start = max(ta, tout);
+        walk = b > a;
     }
-    let t_a = -r.o.x / qx;
-    let t_b = (r.x_head - r.o.x) / qx;
-    var tin = t_a;
-    var tout = t_b;
-    var head_first = false;
-    if (!(qx > 0.0)) {
-        tin = t_b;
-        tout = t_a;
-        head_first = true;
+    for (var part = 0u; part < 3u; part++) {
+        if (part == 1u) {
+            if (walk) {
+                curve_walk(c, r, a, b, acc);
+            }
+            continue;
+        }
+        var head = head_first;
+        var lo = ta;
+        var hi = first_end;
+        if (part == 2u) {
+            head = !head_first;
+            lo = second_start;
+            hi = tb;
+        }
+        curve_end_piece(c, r, head, lo, hi, acc);
     }
-    curve_end_piece(c, r, head_first, ta, min(tb, tin), acc);
-    let a = max(ta, tin);
-    let b = min(tb, tout);
-    if (b > a) {
-        curve_walk(c, r, a, b, acc);
-    }
-    curve_end_piece(c, r, !head_first, max(ta, tout), tb, acc);
 }
 
 // Mirrors integrate.rs `default_energy` (f32) at DEFAULT_SETTINGS: `LocalRay::new`, then
@@ -846,7 +874,9 @@ fn curve_density(c: GpuCurve, r: LocalRay, t: f32) -> f32 {
     return w * curve_attenuation(r, t);
 }
 
-// Mirrors simpson.rs `composite`: composite Simpson with m (even) subintervals over [a, b].
+// Mirrors simpson.rs `composite`: composite Simpson with m (even) subintervals over [a, b]. The
+// end points are evaluated in the loop (one call site of the density: a software adapter inlines
+// every call), and summed as simpson.rs sums them.
 fn curve_composite(c: GpuCurve, r: LocalRay, a: f32, b: f32, m: u32) -> f32 {
     if (!(b > a)) {
         return 0.0;
@@ -854,32 +884,56 @@ fn curve_composite(c: GpuCurve, r: LocalRay, a: f32, b: f32, m: u32) -> f32 {
     let h = (b - a) / f32(m);
     var odd = 0.0;
     var even = 0.0;
-    for (var i = 1u; i < m; i++) {
-        let v = curve_density(c, r, a + h * f32(i));
-        if ((i & 1u) == 1u) {
+    var fa = 0.0;
+    var fb = 0.0;
+    for (var i = 0u; i <= m; i++) {
+        var t = a + h * f32(i);
+        if (i == 0u) {
+            t = a;
+        } else if (i == m) {
+            t = b;
+        }
+        let v = curve_density(c, r, t);
+        if (i == 0u) {
+            fa = v;
+        } else if (i == m) {
+            fb = v;
+        } else if ((i & 1u) == 1u) {
             odd += v;
         } else {
             even += v;
         }
     }
-    return (curve_density(c, r, a) + 4.0 * odd + 2.0 * even + curve_density(c, r, b)) * h / 3.0;
+    return (fa + 4.0 * odd + 2.0 * even + fb) * h / 3.0;
+}
+
+// What curve_simpson leaves to the default integrator: the tail [t0, t1] past the far point
+// (none when t1 ≤ t0), after the Simpson part's energy.
+struct SimpsonPart {
+    energy: f32,
+    tail_t0: f32,
+    tail_t1: f32,
 }
 
 // Mirrors the Simpson arm of dispatch.rs `curve_energy_generic` (f32): simpson.rs `simpson_generic`
-// (m subintervals, m/n outside the bounding cylinder of radius R + ε, 002 §3.4.4, eq. 3.22), then
-// the default integrator for any tail past the far point.
-fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
+// (m subintervals, m/n outside the bounding cylinder of radius R + ε, 002 §3.4.4, eq. 3.22); the
+// default integrator for any tail past the far point is curve_energy's (one call site for both
+// integrators). The one, two or three composite rules run from one call site too: a software
+// adapter inlines every call.
+fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> SimpsonPart {
+    var out = SimpsonPart(0.0, 0.0, 0.0);
     var ok = false;
     let r = curve_local_ray(c, falloff, core_radius, ray, t0, t1, t_far, &ok);
     if (!ok) {
-        return 0.0;
+        return out;
     }
     let m = c.m;
     let te = min(r.t1, r.t_far);
-    var sum = 0.0;
-    if (c.reduce == 0u) {
-        sum += curve_composite(c, r, r.t0, te, m);
-    } else {
+    // The spans [bounds[k], bounds[k + 1]] with ms[k] subintervals, k < spans.
+    var bounds = array<f32, 4>(r.t0, te, te, te);
+    var ms = array<u32, 3>(m, m, m);
+    var spans = 1u;
+    if (c.reduce != 0u) {
         let mo = c.m_reduced;
         let rad = c.cylinder_radius;
         let a = r.q.y * r.q.y + r.q.z * r.q.z;
@@ -888,20 +942,24 @@ fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
         let disc = b * b - a * k;
         if (a > 0.0 && disc > 0.0) {
             let sq = sqrt(disc);
-            let u1 = clamp((-b - sq) / a, r.t0, te);
-            let u2 = clamp((-b + sq) / a, r.t0, te);
-            sum += curve_composite(c, r, r.t0, u1, mo);
-            sum += curve_composite(c, r, u1, u2, m);
-            sum += curve_composite(c, r, u2, te, mo);
+            bounds[1] = clamp((-b - sq) / a, r.t0, te);
+            bounds[2] = clamp((-b + sq) / a, r.t0, te);
+            ms = array<u32, 3>(mo, m, mo);
+            spans = 3u;
         } else {
-            sum += curve_composite(c, r, r.t0, te, mo);
+            ms[0] = mo;
         }
     }
-    var e = energy_scaled(sum, r.alpha);
-    if (r.t1 > r.t_far) {
-        e = energy_add(e, curve_default(c, falloff, core_radius, ray, r.t_far, r.t1, r.t_far));
+    var sum = 0.0;
+    for (var k = 0u; k < spans; k++) {
+        sum += curve_composite(c, r, bounds[k], bounds[k + 1u], ms[k]);
     }
-    return e;
+    out.energy = energy_scaled(sum, r.alpha);
+    if (r.t1 > r.t_far) {
+        out.tail_t0 = r.t_far;
+        out.tail_t1 = r.t1;
+    }
+    return out;
 }
 
 // ---- nearest.rs ----
@@ -1090,13 +1148,39 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
         let reach = sqrt(max(big * big - dot3(e, e), 0.0)) / qn;
         end = max(r.t0, tc + reach);
     }
+    // Simpson's rule on steps [a, b] with midpoint m, the nearest point found at a, m, b in turn
+    // from the one before (the hint). Each point is evaluated by the one call below (phase 0: the
+    // start; 1: a step's midpoint; 2: its end), because a software adapter inlines every call.
     var a = r.t0;
-    var na = curve_nearest_point(c, r.o + r.q * a, 0.0);
-    var fa = curve_nearest_weight(r.falloff, na.x, r.rc2) * curve_attenuation(r, a);
+    var b = a;
+    var na = vec2<f32>(0.0);
+    var fa = 0.0;
+    var fm = 0.0;
     var sum = 0.0;
     let floor = 1e-3 * r.t_far;
     var steps = 0u;
-    while (a < end) {
+    var phase = 0u;
+    var x = a;
+    var hint = 0.0;
+    loop {
+        let n = curve_nearest_point(c, r.o + r.q * x, hint);
+        let f = curve_nearest_weight(r.falloff, n.x, r.rc2) * curve_attenuation(r, x);
+        if (phase == 1u) {
+            fm = f;
+            phase = 2u;
+            x = b;
+            hint = n.y;
+            continue;
+        }
+        if (phase == 2u) {
+            sum += (b - a) / 6.0 * (fa + 4.0 * fm + f);
+            a = b;
+        }
+        na = n;
+        fa = f;
+        if (!(a < end)) {
+            break;
+        }
         steps += 1u;
         let d = sqrt(na.x + r.rc2);
         var h = NEAREST_STEP * d / qn;
@@ -1105,19 +1189,13 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
             h = min(h, max(NEAREST_STEP * (r.t_far - a), floor));
         }
 // #endif
-        var b = a + h;
+        b = a + h;
         if (steps >= MAX_NEAREST_STEPS || !(a + h < end)) {
             b = end;
         }
-        let m = 0.5 * (a + b);
-        let nm = curve_nearest_point(c, r.o + r.q * m, na.y);
-        let nb = curve_nearest_point(c, r.o + r.q * b, nm.y);
-        let fm = curve_nearest_weight(r.falloff, nm.x, r.rc2) * curve_attenuation(r, m);
-        let fb = curve_nearest_weight(r.falloff, nb.x, r.rc2) * curve_attenuation(r, b);
-        sum += (b - a) / 6.0 * (fa + 4.0 * fm + fb);
-        a = b;
-        na = nb;
-        fa = fb;
+        phase = 1u;
+        x = 0.5 * (a + b);
+        hint = na.y;
     }
     if (open) {
         let cs = curve_eval(c, na.y);
@@ -1128,7 +1206,9 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
     return energy_scaled(sum, r.alpha);
 }
 
-// Mirrors hadou_math::curve::curve_energy: dispatch on the wave's integrator.
+// Mirrors hadou_math::curve::curve_energy: dispatch on the wave's integrator. The default
+// integrator, which the Simpson rule also calls for the tail past the far point, has one call
+// site (a software adapter inlines every call).
 fn curve_energy(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, t1: f32, t_far: f32) -> f32 {
     // Each integrator is compiled in only when the frame's curves use it.
     if (c.integrator == INTEGRATOR_NEAREST) {
@@ -1137,14 +1217,30 @@ fn curve_energy(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32, 
         }
         return 0.0;
     }
+    var simpson = false;
+    var head = 0.0;
+    var ta = t0;
+    var tb = t1;
+    var tf = t_far;
     if (c.integrator == INTEGRATOR_SIMPSON) {
-        if (USE_SIMPSON) {
-            return curve_simpson(c, falloff, core_radius, ray, t0, t1, t_far);
+        if (!USE_SIMPSON) {
+            return 0.0;
         }
+        let part = curve_simpson(c, falloff, core_radius, ray, t0, t1, t_far);
+        if (!(part.tail_t1 > part.tail_t0)) {
+            return part.energy;
+        }
+        simpson = true;
+        head = part.energy;
+        ta = part.tail_t0;
+        tb = part.tail_t1;
+        tf = part.tail_t0;
+    } else if (!USE_CHORD) {
         return 0.0;
     }
-    if (USE_CHORD) {
-        return curve_default(c, falloff, core_radius, ray, t0, t1, t_far);
+    let e = curve_default(c, falloff, core_radius, ray, ta, tb, tf);
+    if (simpson) {
+        return energy_add(head, e);
     }
-    return 0.0;
+    return e;
 }
