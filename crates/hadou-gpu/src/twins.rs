@@ -38,13 +38,19 @@ fn case_energy(c: Case, ray: Ray, t0: f32, t1: f32) -> f32 {
     let p = FieldParams(w.falloff, w.core_radius);
     // span.w: the far point's ray parameter for the attenuation (w.attenuation = j).
     let att = Attenuation(w.attenuation, c.span.w);
+    if (DIRECT && w.attenuation == 0.0) {
+        return analytic_energy_direct(p, ray, t0, t1, w, KIND_BITS_ALL);
+    }
     return analytic_energy(p, ray, t0, t1, att, w, KIND_BITS_ALL);
 }
 "#;
 
-/// Runs the WGSL energy functions on `cases`.
-fn run_gpu(ctx: &GpuContext, cases: &[Case]) -> Result<Vec<f32>, RenderError> {
-    let source = twin_kernel::source(&[shaders::COMMON, shaders::ENERGY], KERNEL);
+/// Runs the WGSL energy functions on `cases`: `analytic_energy` (what a module with attenuation
+/// runs), or with `direct` its twin without arrays `analytic_energy_direct` where j = 0 (what the
+/// wave pass runs for a frame without attenuation).
+fn run_gpu(ctx: &GpuContext, cases: &[Case], direct: bool) -> Result<Vec<f32>, RenderError> {
+    let kernel = format!("const DIRECT: bool = {direct};\n{KERNEL}");
+    let source = twin_kernel::source(&[shaders::COMMON, shaders::ENERGY], &kernel);
     twin_kernel::run(ctx, "energy twins", &source, &[(0, bytemuck::cast_slice(cases))], cases.len())
 }
 
@@ -268,39 +274,44 @@ fn cases() -> Vec<Case> {
 fn wgsl_energy_functions_match_their_rust_twins() {
     let Some((ctx, _gpu)) = crate::device::context_or_skip("energy twins") else { return };
     let cases = cases();
-    let gpu = run_gpu(&ctx, &cases).expect("GPU twin run");
-    let mut worst = 0.0f32;
-    let mut lit = 0;
-    for (i, (c, g)) in cases.iter().zip(&gpu).enumerate() {
-        let r = run_cpu(c);
-        assert!(g.is_finite() && r.is_finite(), "case {i}: gpu {g} cpu {r} ({c:?})");
-        // 1e-3 relative (the backends' energy tolerance), absolute below 1e-6; on an
-        // ill-conditioned ray, no worse than the Rust twin against the exact energy.
-        let err = conditioned_error(
-            *g,
-            r,
-            c.origin,
-            |shift| energy_of::<f64>(c, shift),
-            |shift| energy_of::<f32>(c, shift),
-        );
-        assert!(err <= 1e-3, "case {i}: gpu {g} cpu {r}, rel {err:.2e} beyond its conditioning ({c:?})");
-        worst = worst.max(err);
-        lit += usize::from(r > 1e-3);
-    }
-    assert!(lit * 2 > cases.len(), "most cases must carry real energy ({lit} of {})", cases.len());
-    let saturated = cases.iter().zip(&gpu).filter(|(c, _)| run_cpu(c) == f32::MAX).count();
-    // Saturation agrees up to rounding: where one side saturates, the other is at the ceiling
-    // too (≥ 2¹²⁷; a log-divergent energy crosses f32::MAX on one side's rounding only).
-    let ceiling = 2f32.powi(127);
-    assert!(
-        cases.iter().zip(&gpu).all(|(c, g)| {
+    for direct in [false, true] {
+        let gpu = run_gpu(&ctx, &cases, direct).expect("GPU twin run");
+        let mut worst = 0.0f32;
+        let mut lit = 0;
+        for (i, (c, g)) in cases.iter().zip(&gpu).enumerate() {
             let r = run_cpu(c);
-            (r == f32::MAX) == (*g == f32::MAX) || (r >= ceiling && *g >= ceiling)
-        }),
-        "saturated on one side only"
-    );
-    assert!(saturated >= 12, "only {saturated} saturated cases");
-    eprintln!("{} cases, worst relative difference {worst:.2e}", cases.len());
+            assert!(g.is_finite() && r.is_finite(), "direct {direct}, case {i}: gpu {g} cpu {r} ({c:?})");
+            // 1e-3 relative (the backends' energy tolerance), absolute below 1e-6; on an
+            // ill-conditioned ray, no worse than the Rust twin against the exact energy.
+            let err = conditioned_error(
+                *g,
+                r,
+                c.origin,
+                |shift| energy_of::<f64>(c, shift),
+                |shift| energy_of::<f32>(c, shift),
+            );
+            assert!(
+                err <= 1e-3,
+                "direct {direct}, case {i}: gpu {g} cpu {r}, rel {err:.2e} beyond its conditioning ({c:?})"
+            );
+            worst = worst.max(err);
+            lit += usize::from(r > 1e-3);
+        }
+        assert!(lit * 2 > cases.len(), "most cases must carry real energy ({lit} of {})", cases.len());
+        let saturated = cases.iter().zip(&gpu).filter(|(c, _)| run_cpu(c) == f32::MAX).count();
+        // Saturation agrees up to rounding: where one side saturates, the other is at the ceiling
+        // too (≥ 2¹²⁷; a log-divergent energy crosses f32::MAX on one side's rounding only).
+        let ceiling = 2f32.powi(127);
+        assert!(
+            cases.iter().zip(&gpu).all(|(c, g)| {
+                let r = run_cpu(c);
+                (r == f32::MAX) == (*g == f32::MAX) || (r >= ceiling && *g >= ceiling)
+            }),
+            "saturated on one side only"
+        );
+        assert!(saturated >= 12, "only {saturated} saturated cases");
+        eprintln!("direct {direct}: {} cases, worst relative difference {worst:.2e}", cases.len());
+    }
 }
 
 /// `dot3`, `cross3` and `length3` (common.wgsl) round exactly as `hadou_math::Vec3`'s `dot`,

@@ -406,6 +406,81 @@ const KIND_BIT_CAPSULE: u32 = 4u;
 const KIND_BIT_BEAM: u32 = 8u;
 const KIND_BITS_ALL: u32 = 15u;
 
+// The pieces of a capsule (and a bulged beam) along `ray` over [t0, t1] (capsule_parts, 002 eq.
+// 3.10–3.11): the sphere around the first end crossed over [c0, lo], the cylinder between the
+// planes through M and M₂ with normal D over [lo, hi], the sphere around the other end over
+// [hi, c1]; and the two end spheres (the beam's bulbs at M₂ and M, over the whole span).
+struct CapsulePieces {
+    first: RayQuadratic,
+    last: RayQuadratic,
+    cylinder: RayQuadratic,
+    at_m: RayQuadratic,
+    at_m2: RayQuadratic,
+    c0: f32,
+    lo: f32,
+    hi: f32,
+    c1: f32,
+}
+
+fn capsule_pieces(ray: Ray, t0: f32, t1: f32, w: GpuWave, rc2: f32) -> CapsulePieces {
+    let m = w.p0.xyz;
+    let d = w.p1.xyz;
+    let length = w.p2.x;
+    // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an
+    // end).
+    var c0 = 0.0;
+    var c1 = 0.0;
+    if (t1 > t0) {
+        c0 = t0;
+        c1 = t1;
+    }
+    let q = ray.dir;
+    let wm = ray.origin - m;
+    let sphere_axis = ray_axis(q);
+    let at_m = ray_quadratic(sphere_axis, wm, rc2);
+    let at_m2 = ray_quadratic(sphere_axis, wm - d * length, rc2);
+    let cyl = ray_quadratic(ray_axis(cross3(q, d)), cross3(wm, d), rc2);
+    let dq = dot3(q, d);
+    let ds = dot3(wm, d);
+    var lo = 0.0;
+    var hi = 0.0;
+    var first_is_m = true;
+    if (dq > 0.0) {
+        lo = -ds / dq;
+        hi = (length - ds) / dq;
+    } else if (dq < 0.0) {
+        lo = (length - ds) / dq;
+        hi = -ds / dq;
+        first_is_m = false;
+    } else if (ds < 0.0) {
+        lo = T_OPEN;
+        hi = T_OPEN;
+    } else if (ds > length) {
+        lo = -T_OPEN;
+        hi = -T_OPEN;
+    } else {
+        lo = -T_OPEN;
+        hi = T_OPEN;
+    }
+    lo = clamp(lo, c0, c1);
+    hi = clamp(hi, lo, c1);
+    var out: CapsulePieces;
+    out.first = at_m;
+    out.last = at_m2;
+    if (!first_is_m) {
+        out.first = at_m2;
+        out.last = at_m;
+    }
+    out.cylinder = cyl;
+    out.at_m = at_m;
+    out.at_m2 = at_m2;
+    out.c0 = c0;
+    out.lo = lo;
+    out.hi = hi;
+    out.c1 = c1;
+    return out;
+}
+
 // The energy of one analytic wave `w` (sphere, cylinder, capsule or bulged beam) along `ray` over
 // [t0, t1], its kind taken only if its bit is in `kinds` (else 0). Mirrors, by kind:
 // - hadou_math::energy::sphere_energy (002 eq. 3.4, 3.6, 3.8): one piece around the centre M;
@@ -437,66 +512,21 @@ fn analytic_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation,
         qs[0] = ray_quadratic(ray_axis(cross3(ray.dir, d)), cross3(ray.origin - w.p0.xyz, d), rc2);
         n = 1u;
     } else if (capsule) {
-        let m = w.p0.xyz;
-        let d = w.p1.xyz;
-        let length = w.p2.x;
-        // An empty or NaN interval: every piece empty (the clamps below would turn a NaN into an
-        // end).
-        var c0 = 0.0;
-        var c1 = 0.0;
-        if (t1 > t0) {
-            c0 = t0;
-            c1 = t1;
-        }
-        let q = ray.dir;
-        let wm = ray.origin - m;
-        let sphere_axis = ray_axis(q);
-        let at_m = ray_quadratic(sphere_axis, wm, rc2);
-        let at_m2 = ray_quadratic(sphere_axis, wm - d * length, rc2);
-        let cyl = ray_quadratic(ray_axis(cross3(q, d)), cross3(wm, d), rc2);
-        let dq = dot3(q, d);
-        let ds = dot3(wm, d);
-        var lo = 0.0;
-        var hi = 0.0;
-        var first_is_m = true;
-        if (dq > 0.0) {
-            lo = -ds / dq;
-            hi = (length - ds) / dq;
-        } else if (dq < 0.0) {
-            lo = (length - ds) / dq;
-            hi = -ds / dq;
-            first_is_m = false;
-        } else if (ds < 0.0) {
-            lo = T_OPEN;
-            hi = T_OPEN;
-        } else if (ds > length) {
-            lo = -T_OPEN;
-            hi = -T_OPEN;
-        } else {
-            lo = -T_OPEN;
-            hi = T_OPEN;
-        }
-        lo = clamp(lo, c0, c1);
-        hi = clamp(hi, lo, c1);
-        // Pieces 0 and 1: the spheres around the first and the last end crossed; 2: the cylinder.
-        qs[0] = at_m;
-        qs[1] = at_m2;
-        if (!first_is_m) {
-            qs[0] = at_m2;
-            qs[1] = at_m;
-        }
-        a[0] = c0;
-        b[0] = lo;
-        a[1] = hi;
-        b[1] = c1;
-        qs[2] = cyl;
-        a[2] = lo;
-        b[2] = hi;
+        let c = capsule_pieces(ray, t0, t1, w, rc2);
+        qs[0] = c.first;
+        qs[1] = c.last;
+        a[0] = c.c0;
+        b[0] = c.lo;
+        a[1] = c.hi;
+        b[1] = c.c1;
+        qs[2] = c.cylinder;
+        a[2] = c.lo;
+        b[2] = c.hi;
         n = 3u;
         if (beam) {
             // Pieces 3 and 4: the head's bulb at M₂ and the muzzle's at M, over the whole span.
-            qs[3] = at_m2;
-            qs[4] = at_m;
+            qs[3] = c.at_m2;
+            qs[4] = c.at_m;
             n = 5u;
         }
     }
@@ -518,6 +548,39 @@ fn analytic_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation,
         }
         if (w.p2.z != 0.0) {
             energy = energy_add(energy, energy_scaled(e[4], w.p2.z));
+        }
+    }
+    return energy;
+}
+
+// analytic_energy in a module without ATTENUATION: the same pieces, each integrated where it is
+// made (rq_integral is small), with no arrays indexed in a loop, which a software adapter keeps
+// in memory and reads lane by lane (the faithful sphere at 512² on lavapipe took 2.8× longer
+// through the arrays).
+fn analytic_energy_direct(p: FieldParams, ray: Ray, t0: f32, t1: f32, w: GpuWave, kinds: u32) -> f32 {
+    let rc2 = p.core_radius * p.core_radius;
+    let beam = (kinds & KIND_BIT_BEAM) != 0u && w.kind == WAVE_BEAM;
+    if ((kinds & KIND_BIT_SPHERE) != 0u && w.kind == WAVE_SPHERE) {
+        let q = ray_quadratic(ray_axis(ray.dir), ray.origin - w.p0.xyz, rc2);
+        return energy_scaled(rq_integral(q, p.falloff, t0, t1), w.p0.w);
+    }
+    if ((kinds & KIND_BIT_CYLINDER) != 0u && w.kind == WAVE_CYLINDER) {
+        let d = w.p1.xyz;
+        let q = ray_quadratic(ray_axis(cross3(ray.dir, d)), cross3(ray.origin - w.p0.xyz, d), rc2);
+        return energy_scaled(rq_integral(q, p.falloff, t0, t1), w.p0.w);
+    }
+    if (!(beam || ((kinds & KIND_BIT_CAPSULE) != 0u && w.kind == WAVE_CAPSULE))) {
+        return 0.0;
+    }
+    let c = capsule_pieces(ray, t0, t1, w, rc2);
+    let ends = rq_integral(c.first, p.falloff, c.c0, c.lo) + rq_integral(c.last, p.falloff, c.hi, c.c1);
+    var energy = energy_add(energy_scaled(ends, w.p0.w), energy_scaled(rq_integral(c.cylinder, p.falloff, c.lo, c.hi), w.p1.w));
+    if (beam) {
+        if (w.p2.y != 0.0) {
+            energy = energy_add(energy, energy_scaled(rq_integral(c.at_m2, p.falloff, t0, t1), w.p2.y));
+        }
+        if (w.p2.z != 0.0) {
+            energy = energy_add(energy, energy_scaled(rq_integral(c.at_m, p.falloff, t0, t1), w.p2.z));
         }
     }
     return energy;

@@ -45,14 +45,19 @@ fn wave_energy(w: GpuWave, dir: vec3<f32>, surface: f32) -> f32 {
         t_far = frame.far * length3(dir);
     }
     let att = Attenuation(w.attenuation, t_far);
-    // Each kind is compiled in only when its USE_* is set (the variant has the frame's kinds); the
-    // analytic kinds share one call (see analytic_energy).
+    // Each kind is compiled in only when its USE_* is set (the variant has the frame's kinds). With
+    // attenuation compiled in, the analytic kinds share one call of its march (analytic_energy);
+    // without, each piece's closed form is called where it is made (analytic_energy_direct).
     let kinds = select(0u, KIND_BIT_SPHERE, USE_SPHERE) | select(0u, KIND_BIT_CYLINDER, USE_CYLINDER)
         | select(0u, KIND_BIT_CAPSULE, USE_CAPSULE) | select(0u, KIND_BIT_BEAM, USE_BEAM);
     switch w.kind {
         case WAVE_SPHERE, WAVE_CYLINDER, WAVE_CAPSULE, WAVE_BEAM: {
             if (kinds != 0u) {
+// #if ATTENUATION
                 return analytic_energy(p, ray, span.x, span.y, att, w, kinds);
+// #else
+                return analytic_energy_direct(p, ray, span.x, span.y, w, kinds);
+// #endif
             }
         }
         case WAVE_CURVE: {
