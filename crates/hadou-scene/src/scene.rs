@@ -174,7 +174,10 @@ impl Scene {
         Some((clip.name.clone(), self.clip_time_of(o, &vals, time)?))
     }
 
-    /// textures on meshes without texture coordinates, …); the CLI prints them.
+    /// What loading found and worked around (textures downscaled to fit, textures on meshes
+    /// without texture coordinates, animation keys for bones a character lacks, …), one line each,
+    /// every control character of a file's text escaped ([`crate::escape_controls`]); the CLI
+    /// prints them.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }

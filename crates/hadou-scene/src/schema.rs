@@ -346,7 +346,10 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         area_light,
         bloom,
         tracks: Vec::new(),
-        warnings,
+        // A warning may quote any file's text (a bone's, a material's or an extension's name):
+        // its control characters are escaped here, once for every loader, as errors are when
+        // shown.
+        warnings: warnings.iter().map(|w| crate::error::escape_controls(w).into_owned()).collect(),
     };
 
     // The curve maths' own rules (limits on control points, order, terms, …), on the file's values.

@@ -160,3 +160,56 @@ fn a_scene_plays_a_vrma_file_and_reports_its_problems() {
     let e = scene("animation_file = \"missing.vrma\"").unwrap_err().to_string();
     assert!(e.contains("cannot read the file"), "{e}");
 }
+
+/// `data` (a binary glTF) with its JSON chunk replaced by `json` (padded with spaces, as the
+/// format pads it).
+fn with_json(data: &[u8], json: &str) -> Vec<u8> {
+    let le = |b: &[u8]| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize;
+    let json_len = le(&data[12..16]);
+    let rest = &data[20 + json_len..];
+    let mut j = json.as_bytes().to_vec();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let mut out = data[..12].to_vec();
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&j);
+    out.extend(rest);
+    let total = out.len() as u32;
+    out[8..12].copy_from_slice(&total.to_le_bytes());
+    out
+}
+
+/// Issue 41, point 3: a VRMA whose bone name holds an escape sequence (`a\x1b[2Jb`) reached the
+/// terminal raw in the "names bones … the character lacks" warning. Every warning a scene keeps
+/// has its control characters escaped, whichever loader wrote it.
+#[test]
+fn issue_41_a_warning_never_carries_a_files_control_characters() {
+    let d = std::env::temp_dir().join(format!("hadou-vrma-escape-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::copy(asset("brace.vrm"), d.join("brace.vrm")).unwrap();
+    let data = std::fs::read(asset("brace.vrma")).unwrap();
+    let json_len = u32::from_le_bytes([data[12], data[13], data[14], data[15]]) as usize;
+    let json = std::str::from_utf8(&data[20..20 + json_len]).unwrap();
+    assert!(json.contains("\"leftThumbProximal\""), "the fixture names a bone the avatar lacks");
+    let hostile = json.replace("\"leftThumbProximal\"", "\"a\\u001b[2Jb\\u0007\\u202e\"");
+    std::fs::write(d.join("hostile.vrma"), with_json(&data, &hostile)).unwrap();
+    let p = d.join("scene.toml");
+    std::fs::write(
+        &p,
+        "[camera]\nposition = [0, 1, 6]\ntarget = [0, 1, 0]\n\n[[object]]\nname = \"who\"\nkind = \"gltf\"\n\
+         path = \"brace.vrm\"\nanimation_file = \"hostile.vrma\"\n",
+    )
+    .unwrap();
+    let s = Scene::load(&p).unwrap();
+    let w = s.warnings().iter().find(|w| w.contains("lacks")).unwrap_or_else(|| panic!("{:?}", s.warnings()));
+    assert!(w.contains("a\\u{1b}[2Jb\\u{7}\\u{202e}"), "{w}");
+    for w in s.warnings() {
+        assert!(
+            !w.chars().any(|c| c.is_control() || ('\u{202a}'..='\u{202e}').contains(&c)),
+            "a warning carries a control character: {w:?}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}

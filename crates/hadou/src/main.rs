@@ -239,7 +239,9 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            eprintln!("error: {}", f.message);
+            // One line whatever a message quotes (a path, a file's text): control characters
+            // escaped here, for every error.
+            eprintln!("error: {}", hadou_scene::escape_controls(&f.message));
             ExitCode::from(f.code)
         }
     }
@@ -829,7 +831,7 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
 fn load_scene(path: &std::path::Path) -> Result<Scene, Failure> {
     let scene = Scene::load(path)?;
     for w in scene.warnings() {
-        eprintln!("{}: warning: {w}", path.display());
+        eprintln!("{}: warning: {w}", hadou_scene::escape_controls(&path.display().to_string()));
     }
     Ok(scene)
 }

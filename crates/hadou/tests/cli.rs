@@ -257,6 +257,33 @@ fn bad_flags_are_exit_2() {
     assert!(!out.exists());
 }
 
+/// Issue 41, point 3: whatever an error or warning quotes (a path given, a file's text) reaches
+/// the terminal as one line with its control characters escaped: a scene path holding an escape
+/// sequence, and a scene whose texture path holds one, exit 2 with no control byte on stderr.
+#[test]
+fn issue_41_messages_escape_the_control_characters_they_quote() {
+    let dir = tmpdir("escape");
+    let clean = |o: &Output| {
+        let e = stderr(o);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(!e.trim_end().contains('\n'), "one line: {e:?}");
+        assert!(!e.trim_end().chars().any(|c| c.is_control()), "a control character reached stderr: {e:?}");
+        e
+    };
+    let missing = dir.join("a\u{1b}[2Jb.toml");
+    let e = clean(&hadou(&["validate", missing.to_str().unwrap()]));
+    assert!(e.contains("\\u{1b}[2Jb"), "{e}");
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nposition = [0, 0, 5]\ntarget = [0, 0, 0]\n\n[[material]]\nname = \"m\"\nmodel = \"toon\"\n\
+         base_texture = \"t\\u001b]0;x\\u0007.png\"\n\n[[object]]\nname = \"b\"\nkind = \"box\"\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    let e = clean(&hadou(&["validate", scene.to_str().unwrap()]));
+    assert!(e.contains("\\u{1b}]0;x\\u{7}"), "{e}");
+}
+
 /// Every flag's bad value, whether the argument parser or hadou refuses it, is one line naming the
 /// flag, the value as typed and what the flag accepts (issue 41: the parser's own error was three
 /// lines), exit 2; a time past f32 says so rather than "not finite".

@@ -93,7 +93,11 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = frame.tile_size.x * frame.tile_size.y;
     let i = id.y * frame.tile_size.x + id.x;
 
-    let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(id.xy), 0));
+    // Without surfaces (a frame of waves alone) the G-buffer is not read at all.
+    var texel = vec4<f32>(0.0);
+    if (USE_SURFACES) {
+        texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(id.xy), 0));
+    }
     let drawn = texel.w > 0.0;
     var surface = -1.0;
     var scene = frame.background;

@@ -27,7 +27,11 @@ fn tile_sample(s: vec2<u32>, ns: u32) -> Sample {
     out.scene = frame.background;
     out.surface = -1.0;
     out.key = NO_SURFACE;
-    let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(s), 0));
+    // Without surfaces (a frame of waves alone) the G-buffer is not read at all.
+    var texel = vec4<f32>(0.0);
+    if (USE_SURFACES) {
+        texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(s), 0));
+    }
     if (USE_SURFACES && texel.w > 0.0) {
         let dir = pixel_dir(frame, frame.tile_origin.x + s.x, frame.tile_origin.y + s.y);
         out.surface = texel.w;
@@ -124,9 +128,11 @@ fn cs_samples(@builtin(global_invocation_id) id: vec3<u32>) {
         } else {
             let s = id.xy * g + vec2<u32>(r % g, r / g);
             d = pixel_dir(frame, frame.tile_origin.x + s.x, frame.tile_origin.y + s.y);
-            let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(s), 0));
-            if (USE_SURFACES && texel.w > 0.0) {
-                surface = texel.w;
+            if (USE_SURFACES) {
+                let texel = bitcast<vec4<f32>>(textureLoad(scene_texels, vec2<i32>(s), 0));
+                if (texel.w > 0.0) {
+                    surface = texel.w;
+                }
             }
         }
         let lit_by = waves_light(d, surface);
