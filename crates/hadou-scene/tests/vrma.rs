@@ -168,7 +168,7 @@ fn with_json(data: &[u8], json: &str) -> Vec<u8> {
     let json_len = le(&data[12..16]);
     let rest = &data[20 + json_len..];
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut out = data[..12].to_vec();
