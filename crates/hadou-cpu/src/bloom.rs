@@ -32,8 +32,13 @@ pub(crate) fn glare_and_map(
     linear: &Plane,
     band: Range<usize>,
     color: &mut [[f32; 4]],
-) {
-    let glared = bloom::glare(params, linear, band, &Parallel);
+) -> Result<(), hadou_scene::RenderError> {
+    let glared = bloom::try_glare(params, linear, band, &Parallel).map_err(|bytes| {
+        hadou_scene::RenderError::Memory(format!(
+            "the glare's planes need {:.2} GB that could not be allocated",
+            bytes as f64 / 1e9
+        ))
+    })?;
     let mode = frame.color_mapping.mode;
     color.par_iter_mut().zip(glared.data.par_iter()).for_each(|(out, c)| {
         let m = match mode {
@@ -42,4 +47,5 @@ pub(crate) fn glare_and_map(
         };
         *out = [m[0], m[1], m[2], 1.0];
     });
+    Ok(())
 }

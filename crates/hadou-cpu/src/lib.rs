@@ -26,4 +26,4 @@ pub mod soft;
 mod waves;
 
 pub use probe::{probe, Probe, WaveProbe};
-pub use render::{render, render_rows, render_timed, CpuBackend, PassTimes};
+pub use render::{render, render_rows, render_rows_glare_chunked, render_timed, CpuBackend, PassTimes};

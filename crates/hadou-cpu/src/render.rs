@@ -43,19 +43,19 @@ impl CpuBackend {
     /// or a benchmark drawing frame after frame wants) and returns the passes' times; the same
     /// pixels as [`render`].
     pub fn render_into(&mut self, frame: &Frame, image: &mut Image) -> PassTimes {
-        render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), SimdPath::current())
+        expect_memory(render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), SimdPath::current()))
     }
 
     /// [`CpuBackend::render_into`] for a PNG: only the 8-bit sRGB bytes, written by the colour
     /// stage straight from its lanes (no float colour, energy or depth buffer), on the vector path
     /// `simd`. The same bytes as [`Rgb8Image::from_image`] of [`render`] on that path.
     pub fn render_rgb8_into(&mut self, frame: &Frame, image: &mut Rgb8Image, simd: SimdPath) -> PassTimes {
-        render_with(frame, 0..frame.height, &mut self.scratch, Target::Srgb8(image), simd)
+        expect_memory(render_with(frame, 0..frame.height, &mut self.scratch, Target::Srgb8(image), simd))
     }
 
     /// [`CpuBackend::render_into`] on the vector path `simd` instead of [`SimdPath::current`].
     pub fn render_into_on(&mut self, frame: &Frame, image: &mut Image, simd: SimdPath) -> PassTimes {
-        render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), simd)
+        expect_memory(render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), simd))
     }
 }
 
@@ -71,11 +71,14 @@ impl Backend for CpuBackend {
     }
 
     fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
-        Ok(render(frame))
+        self.render_rows(frame, 0..frame.height)
     }
 
     fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
-        Ok(render_rows(frame, rows))
+        let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+        let mut img = Image::new(frame.width, y1.max(y0) - y0);
+        render_with(frame, rows, &mut OpaqueBuffers::default(), Target::Float(&mut img), SimdPath::current())?;
+        Ok(img)
     }
 
     fn render_rows_rgb8(
@@ -84,7 +87,7 @@ impl Backend for CpuBackend {
         rows: std::ops::Range<u32>,
     ) -> Result<Rgb8Image, RenderError> {
         let mut out = Rgb8Image::default();
-        render_with(frame, rows, &mut self.scratch, Target::Srgb8(&mut out), SimdPath::current());
+        render_with(frame, rows, &mut self.scratch, Target::Srgb8(&mut out), SimdPath::current())?;
         Ok(out)
     }
 }
@@ -119,9 +122,21 @@ pub struct PassTimes {
 pub fn render_timed(frame: &Frame, rows: std::ops::Range<u32>) -> (Image, PassTimes) {
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let mut img = Image::new(frame.width, y1.max(y0) - y0);
-    let times =
-        render_with(frame, rows, &mut OpaqueBuffers::default(), Target::Float(&mut img), SimdPath::current());
+    let times = expect_memory(render_with(
+        frame,
+        rows,
+        &mut OpaqueBuffers::default(),
+        Target::Float(&mut img),
+        SimdPath::current(),
+    ));
     (img, times)
+}
+
+/// The times of a render that cannot fail but for memory, which only a frame with a `[bloom]`
+/// reserves fallibly: the functions that return an image or times, not a `Result`, panic with its
+/// message there (the [`Backend`] methods return it as a [`RenderError`]).
+fn expect_memory(r: Result<PassTimes, RenderError>) -> PassTimes {
+    r.unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// [`render_timed`] with the opaque pass's buffers from `scratch` and into `img`, both resized
@@ -134,7 +149,32 @@ fn render_with(
     scratch: &mut OpaqueBuffers,
     target: Target<'_>,
     simd: SimdPath,
-) -> PassTimes {
+) -> Result<PassTimes, RenderError> {
+    render_chunked(frame, rows, scratch, target, simd, GLARE_CHUNK_SAMPLES)
+}
+
+/// Renders a frame with a `[bloom]` with its opaque pass in chunks of `chunk_samples` samples
+/// (at least a row), for tests of the chunking: the same pixels as [`render_rows`] whatever the
+/// chunk.
+#[doc(hidden)]
+pub fn render_rows_glare_chunked(frame: &Frame, rows: std::ops::Range<u32>, chunk_samples: usize) -> Image {
+    let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
+    let mut img = Image::new(frame.width, y1.max(y0) - y0);
+    let target = Target::Float(&mut img);
+    let scratch = &mut OpaqueBuffers::default();
+    expect_memory(render_chunked(frame, rows, scratch, target, SimdPath::current(), chunk_samples));
+    img
+}
+
+/// [`render_with`], a `[bloom]`'s opaque pass in chunks of `chunk_samples` samples.
+fn render_chunked(
+    frame: &Frame,
+    rows: std::ops::Range<u32>,
+    scratch: &mut OpaqueBuffers,
+    target: Target<'_>,
+    simd: SimdPath,
+    chunk_samples: usize,
+) -> Result<PassTimes, RenderError> {
     let start = Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
@@ -154,6 +194,26 @@ fn render_with(
     // A frame of waves alone draws nothing opaque: every pixel (every sample) shows the
     // background, so the opaque pass and its per-pixel buffers are skipped.
     let blank = frame.objects.is_empty() && frame.area_light.is_none();
+    if let Some(params) = glare {
+        let parts = GlareParts { frame, surfaces, setup: &setup, params, k, blank, simd, chunk_samples };
+        return match target {
+            Target::Float(img) => glare_rows(&parts, scratch, src, band, img, start),
+            Target::Srgb8(out) => {
+                // The glare needs the linear colour of the band and its halo: the float image,
+                // then its bytes.
+                let mut img = Image::new(0, 0);
+                let times = glare_rows(&parts, scratch, src, band, &mut img, start)?;
+                let srgb = hadou_math::shade::srgb8_encoder();
+                (out.width, out.height) = (img.width, img.height);
+                out.rgb.clear();
+                try_grow(&mut out.rgb, 3 * img.color.len(), "the band's 8-bit colour")?;
+                out.rgb.extend(
+                    img.color.iter().flat_map(|c| [srgb.code(c[0]), srgb.code(c[1]), srgb.code(c[2])]),
+                );
+                Ok(times)
+            }
+        };
+    }
     let oy0 = if blank { 0 } else { opaque_pass(surfaces, &setup, k * src.start..k * src.end, scratch) };
     let opaque_done = Instant::now();
     let source = RowSource {
@@ -164,24 +224,6 @@ fn render_with(
         pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
         samples: WavePass::new(surfaces, &setup.basis, &setup.curves).on_path(simd),
     };
-    if let Some(params) = glare {
-        return match target {
-            Target::Float(img) => glare_rows(frame, params, &source, src, band, img, (start, opaque_done)),
-            Target::Srgb8(out) => {
-                // The glare needs the linear colour of the band and its halo: the float image,
-                // then its bytes.
-                let mut img = Image::new(0, 0);
-                let times = glare_rows(frame, params, &source, src, band, &mut img, (start, opaque_done));
-                let srgb = hadou_math::shade::srgb8_encoder();
-                (out.width, out.height) = (img.width, img.height);
-                out.rgb.clear();
-                out.rgb.extend(
-                    img.color.iter().flat_map(|c| [srgb.code(c[0]), srgb.code(c[1]), srgb.code(c[2])]),
-                );
-                times
-            }
-        };
-    }
 
     let w = frame.width as usize;
     let n = w * (y1 - y0) as usize;
@@ -229,11 +271,11 @@ fn render_with(
     let wave_share = if wn + cn > 0.0 { wn / (wn + cn) } else { 1.0 };
     let waves_done = opaque_done + (end - opaque_done).mul_f64(wave_share);
     let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
-    PassTimes {
+    Ok(PassTimes {
         opaque_ms: ms(start, opaque_done),
         wave_ms: ms(opaque_done, waves_done),
         color_ms: ms(waves_done, end),
-    }
+    })
 }
 
 /// A row's scratch buffers for [`RowSource::light_row`], reused from row to row by a thread.
@@ -383,49 +425,117 @@ fn sample_key(o: &OpaqueBuffers, i: usize) -> Option<(u32, u32, bool)> {
     Some((o.object[i]?, e.material, e.hull))
 }
 
-/// [`render_with`]'s stage after the opaque pass with a `[bloom]`: the wave pass over the rows
-/// `src` (the band `band` and its halo) into the linear colour, then the glare and the colour
-/// mapping of the band. The wave pass's time is `wave_ms`, the glare's and mapping's `color_ms`.
+/// What [`glare_rows`] draws a frame with a `[bloom]` from.
+struct GlareParts<'a> {
+    frame: &'a Frame,
+    /// The frame the opaque pass draws (the sample frame with `k > 1`).
+    surfaces: &'a Frame,
+    setup: &'a FrameSetup,
+    params: &'a hadou_math::bloom::BloomParams,
+    k: usize,
+    blank: bool,
+    simd: SimdPath,
+    /// Samples of the opaque pass drawn at once ([`GLARE_CHUNK_SAMPLES`]).
+    chunk_samples: usize,
+}
+
+/// Samples of the opaque pass drawn at once for a frame with a `[bloom]` (4 Mi, about 200 MB of
+/// per-sample buffers): the glare needs the linear colour of (nearly) every row, but not every
+/// sample of it at once.
+const GLARE_CHUNK_SAMPLES: usize = 1 << 22;
+
+/// `v` grown by `n` elements' room, or a message naming `what` where memory ran out (never an
+/// abort).
+fn try_grow<T>(v: &mut Vec<T>, n: usize, what: &str) -> Result<(), RenderError> {
+    v.try_reserve_exact(n).map_err(|_| out_of_memory(n * std::mem::size_of::<T>(), what))
+}
+
+fn out_of_memory(bytes: usize, what: &str) -> RenderError {
+    RenderError::Memory(format!("{what} needs {:.2} GB that could not be allocated", bytes as f64 / 1e9))
+}
+
+/// [`render_with`] for a frame with a `[bloom]`: the opaque pass and the wave pass over the rows
+/// `src` (the band `band` and its halo) into the linear colour, in chunks of about
+/// `chunk_samples` samples (every row as a whole-image render has it: the opaque pass of
+/// a chunk draws its own outline margin), then the glare and the colour mapping of the band. The
+/// opaque passes' time is `opaque_ms`, the wave passes' `wave_ms`, the glare's and mapping's
+/// `color_ms`. Every buffer that grows with the image is reserved fallibly: memory that is not
+/// there is a [`RenderError`], not an abort.
 fn glare_rows(
-    frame: &Frame,
-    params: &hadou_math::bloom::BloomParams,
-    source: &RowSource<'_>,
+    parts: &GlareParts<'_>,
+    scratch: &mut OpaqueBuffers,
     src: std::ops::Range<usize>,
     band: std::ops::Range<usize>,
     img: &mut Image,
-    (start, opaque_done): (Instant, Instant),
-) -> PassTimes {
+    start: Instant,
+) -> Result<PassTimes, RenderError> {
+    let GlareParts { frame, surfaces, setup, params, k, blank, simd, chunk_samples } = *parts;
     let w = frame.width as usize;
     let n = w * band.len();
     (img.width, img.height) = (frame.width, band.len() as u32);
-    img.color.resize(n, [0.0; 4]);
-    img.energy.resize(n, 0.0);
-    img.depth.resize(n, 0.0);
-    let m = src.len() * w;
-    let mut linear = hadou_math::bloom::Plane::new(w, frame.height as usize, src.clone());
-    let (mut energy, mut depth) = (vec![0.0f32; m], vec![0.0f32; m]);
-    linear
-        .data
-        .par_chunks_mut(w)
-        .zip(energy.par_chunks_mut(w))
-        .zip(depth.par_chunks_mut(w))
-        .enumerate()
-        .for_each_init(RowBuffers::default, |bufs, (r, ((lin, en), dep))| {
-            let (light, scene) = source.light_row(src.start + r, bufs);
-            source.pass.row_linear(light, scene, lin, en, dep);
-        });
-    let own = (band.start - src.start) * w..(band.end - src.start) * w;
-    img.energy.copy_from_slice(&energy[own.clone()]);
-    img.depth.copy_from_slice(&depth[own]);
-    let waves_done = Instant::now();
-    bloom::glare_and_map(frame, params, &linear, band, &mut img.color);
-    let end = Instant::now();
-    let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
-    PassTimes {
-        opaque_ms: ms(start, opaque_done),
-        wave_ms: ms(opaque_done, waves_done),
-        color_ms: ms(waves_done, end),
+    for (v, what) in [(&mut img.energy, "the band's energy"), (&mut img.depth, "the band's depth")] {
+        v.clear();
+        try_grow(v, n, what)?;
+        v.resize(n, 0.0);
     }
+    img.color.clear();
+    try_grow(&mut img.color, n, "the band's colour")?;
+    img.color.resize(n, [0.0; 4]);
+    let mut linear = hadou_math::bloom::Plane::try_new(w, frame.height as usize, src.clone())
+        .map_err(|bytes| out_of_memory(bytes, "the glare's linear colour"))?;
+    // With an area light the opaque pass draws every row whatever it is asked: one chunk.
+    let chunk = if frame.area_light.is_some() { src.len() } else { (chunk_samples / (w * k * k).max(1)).max(1) };
+    let (mut opaque_ms, mut wave_ms) = (0.0, 0.0);
+    let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
+    let mut t = start;
+    for (c, lin) in linear.data.chunks_mut(chunk * w).enumerate() {
+        let rows = src.start + c * chunk..(src.start + (c + 1) * chunk).min(src.end);
+        let oy0 = if blank { 0 } else { opaque_pass(surfaces, setup, k * rows.start..k * rows.end, scratch) };
+        let opaque_done = Instant::now();
+        let source = RowSource {
+            k,
+            blank: blank.then(|| blank_color(surfaces.background, k)),
+            opaque: scratch,
+            oy0,
+            pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
+            samples: WavePass::new(surfaces, &setup.basis, &setup.curves).on_path(simd),
+        };
+        // The band's rows of this chunk keep their energy and depth; the halo's go to scratch.
+        let own = rows.start.max(band.start)..rows.end.min(band.end).max(rows.start.max(band.start));
+        let (energy, depth) = if own.is_empty() {
+            (&mut [][..], &mut [][..])
+        } else {
+            let at = (own.start - band.start) * w..(own.end - band.start) * w;
+            (&mut img.energy[at.clone()], &mut img.depth[at])
+        };
+        let (skip, own_rows) = (own.start.saturating_sub(rows.start), own.len());
+        let (mut energy_rows, mut depth_rows) = (energy.chunks_mut(w.max(1)), depth.chunks_mut(w.max(1)));
+        let mut outs: Vec<Option<(&mut [f32], &mut [f32])>> = (0..rows.len())
+            .map(|r| {
+                if r >= skip && r < skip + own_rows {
+                    Some((energy_rows.next().expect("a row"), depth_rows.next().expect("a row")))
+                } else {
+                    None
+                }
+            })
+            .collect();
+        lin.par_chunks_mut(w).zip(outs.par_iter_mut()).enumerate().for_each_init(
+            || (RowBuffers::default(), vec![0.0f32; w], vec![0.0f32; w]),
+            |(bufs, en_scratch, dep_scratch), (r, (lin, out))| {
+                let (light, scene) = source.light_row(rows.start + r, bufs);
+                match out {
+                    Some((en, dep)) => source.pass.row_linear(light, scene, lin, en, dep),
+                    None => source.pass.row_linear(light, scene, lin, en_scratch, dep_scratch),
+                }
+            },
+        );
+        let waves_done = Instant::now();
+        opaque_ms += ms(t, opaque_done);
+        wave_ms += ms(opaque_done, waves_done);
+        t = waves_done;
+    }
+    bloom::glare_and_map(frame, params, &linear, band, &mut img.color)?;
+    Ok(PassTimes { opaque_ms, wave_ms, color_ms: ms(t, Instant::now()) })
 }
 
 /// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which

@@ -105,3 +105,24 @@ fn strong_glare_on_a_saturated_wave_stays_finite() {
     let img = hadou_cpu::render(&f);
     assert!(img.color.iter().flatten().all(|v| v.is_finite() && (0.0..=1.0).contains(v)));
 }
+
+/// Issue 41 (glare within the memory promise): a frame with a `[bloom]` draws its opaque pass in
+/// chunks of rows (so its memory does not grow with the samples), and every chunking gives the
+/// pixels of one chunk over the whole image, bit for bit, outlines (which read rows beyond a
+/// chunk) and anti-aliasing included.
+#[test]
+fn issue_41_the_glare_drawn_in_chunks_equals_one_chunk() {
+    let mut f = scene_frame("repainted.toml", 1.5, 96, 64);
+    f.samples = 4;
+    f.bloom = glare_frame().bloom;
+    assert!(f.grid() == 2, "the frame is anti-aliased");
+    let one = hadou_cpu::render_rows_glare_chunked(&f, 0..64, usize::MAX);
+    assert_eq!(one, hadou_cpu::render(&f), "one chunk is the renderer's own frame here");
+    // 1, 3 and 7 rows of samples a chunk (the chunk's size is in samples: width × 4 a row).
+    for rows_per_chunk in [1usize, 3, 7] {
+        let chunked = hadou_cpu::render_rows_glare_chunked(&f, 0..64, rows_per_chunk * 96 * 4);
+        assert_eq!(chunked, one, "{rows_per_chunk} rows a chunk");
+        let band = hadou_cpu::render_rows_glare_chunked(&f, 20..33, rows_per_chunk * 96 * 4);
+        assert_eq!(band, one.crop_rows(20..33), "rows 20..33, {rows_per_chunk} rows a chunk");
+    }
+}

@@ -203,7 +203,7 @@ pub(crate) struct Renderer {
 #[cfg(not(target_arch = "wasm32"))]
 fn alloc_image(width: u32, height: u32) -> Result<Image, RenderError> {
     let n = width as usize * height as usize;
-    let oom = |_| RenderError::Device(format!("out of host memory for a {width}×{height} image"));
+    let oom = |_| RenderError::Memory(format!("the host's copy of a {width}×{height} image could not be allocated"));
     let mut color: Vec<[f32; 4]> = Vec::new();
     color.try_reserve_exact(n).map_err(oom)?;
     let mut energy: Vec<f32> = Vec::new();
@@ -859,7 +859,7 @@ impl Renderer {
         let n = width * rows.len();
         let mut rgb: Vec<u8> = Vec::new();
         rgb.try_reserve_exact(3 * n).map_err(|_| {
-            RenderError::Device(format!("out of host memory for a {}×{} image", frame.width, rows.len()))
+            RenderError::Memory(format!("the host's copy of a {}×{} image could not be allocated", frame.width, rows.len()))
         })?;
         rgb.resize(3 * n, 0);
         let mut finite = true;

@@ -119,6 +119,16 @@ impl Plane {
         Plane { width, height, rows, data: vec![[0.0; 3]; n] }
     }
 
+    /// [`Plane::new`], its texels reserved fallibly: `Err(bytes)` where that much memory could
+    /// not be allocated.
+    pub fn try_new(width: usize, height: usize, rows: Range<usize>) -> Result<Self, usize> {
+        let n = width.saturating_mul(rows.len());
+        let mut data = Vec::new();
+        data.try_reserve_exact(n).map_err(|_| n.saturating_mul(12))?;
+        data.resize(n, [0.0; 3]);
+        Ok(Plane { width, height, rows, data })
+    }
+
     /// Texel `(x, y)` of the level, both clamped to its edge; `y` (after clamping) must be held.
     #[inline]
     pub fn at(&self, x: isize, y: isize) -> [f32; 3] {
@@ -361,12 +371,18 @@ pub fn streak_row(t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
 /// The glare of steps 1–5 over the rows `band` of a `src.width × src.height` linear image: `src`
 /// holds at least the rows `source_rows` names; returns the band's composited colour.
 pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn RowFill) -> Plane {
+    try_glare(params, src, band, fill).unwrap_or_else(|bytes| panic!("the glare's planes need {bytes} bytes"))
+}
+
+/// [`glare`], each plane reserved fallibly: `Err(bytes)`, the size of the plane that could not
+/// be allocated, where memory ran out (never an abort).
+pub fn try_glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn RowFill) -> Result<Plane, usize> {
     let (w, h) = (src.width, src.height);
     let n = levels(params.radius * h as f32);
     let plan = Plan::new(w, h, n, band.clone());
     let (th, kn) = (params.threshold, params.soft_knee);
     // T over the source rows (the streak reads the band's rows of it too).
-    let mut t = Plane::new(w, h, plan.source.clone());
+    let mut t = Plane::try_new(w, h, plan.source.clone())?;
     fill.fill(&mut t, &|y, row| {
         for (o, c) in row.iter_mut().zip(src.row(y)) {
             *o = prefilter(*c, th, kn);
@@ -374,7 +390,7 @@ pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn R
     });
     let mut downs: Vec<Plane> = Vec::with_capacity(plan.levels.len());
     for l in &plan.levels {
-        let mut d = Plane::new(l.width, l.height, l.down.clone());
+        let mut d = Plane::try_new(l.width, l.height, l.down.clone())?;
         let prev = downs.last().unwrap_or(&t);
         fill.fill(&mut d, &|y, row| down_row(prev, y, row));
         downs.push(d);
@@ -382,14 +398,14 @@ pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn R
     let mut u = downs.pop().unwrap_or_default();
     while let Some(d) = downs.pop() {
         let l = &plan.levels[downs.len()];
-        let mut next = Plane::new(l.width, l.height, l.up.clone());
+        let mut next = Plane::try_new(l.width, l.height, l.up.clone())?;
         fill.fill(&mut next, &|y, row| up_row(&u, y, Some(d.row(y)), row));
         u = next;
     }
     let kb = params.intensity / n as f32;
     let ns = levels(params.streak_length * h as f32);
     let ks = params.streak / ns as f32;
-    let mut out = Plane::new(w, h, band);
+    let mut out = Plane::try_new(w, h, band)?;
     fill.fill(&mut out, &|y, row| {
         let mut b = vec![[0.0f32; 3]; w];
         up_row(&u, y, None, &mut b);
@@ -401,5 +417,5 @@ pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn R
             *o = composite(src.row(y)[x], b[x], kb, s[x], ks);
         }
     });
-    out
+    Ok(out)
 }

@@ -40,6 +40,11 @@ pub enum RenderError {
     NoDevice(String),
     /// The device was lost or ran out of memory.
     Device(String),
+    /// Host memory for a buffer that grows with the image could not be reserved (what did not
+    /// fit, and how much): the render stops cleanly instead of aborting. A frame too large for
+    /// the documented limits is refused before it starts ([`crate::check_image_size_with`]); this
+    /// is a machine with less memory than they assume.
+    Memory(String),
     /// Anything else, with a message for the user.
     Other(String),
 }
@@ -49,6 +54,7 @@ impl std::fmt::Display for RenderError {
         match self {
             RenderError::NoDevice(m) => write!(f, "no usable device: {m}"),
             RenderError::Device(m) => write!(f, "device error: {m}"),
+            RenderError::Memory(m) => write!(f, "out of memory: {m}"),
             RenderError::Other(m) => write!(f, "{m}"),
         }
     }

@@ -41,6 +41,67 @@ pub const MAX_IMAGE_EDGE: u32 = 16384;
 /// script, the viewer's window) calls this, so one limit holds everywhere. The message names the
 /// size; callers prefix where it came from (a flag, a script line, a file position).
 pub fn check_image_size(width: u32, height: u32, area_light: bool) -> Result<(), String> {
+    check_image_size_with(width, height, area_light, None)
+}
+
+/// Bytes a renderer holds per pixel of the whole image while it draws a frame with a `[bloom]`,
+/// whatever the band: the glare reads every row of the linear colour (its deepest level is as
+/// tall as the image), so the linear colour (12), its prefiltered copy (12), the pyramid's levels
+/// (≤ 8) and the energy and depth of the rows drawn (8) are kept for the whole image at once.
+/// The opaque pass's per-sample buffers are not: they are drawn in bands of about 4 Mi samples
+/// whatever the anti-aliasing.
+pub const GLARE_BYTES_PER_PIXEL: u64 = 40;
+
+/// Bytes per pixel of a band of output rows of a frame with a `[bloom]`: the glared colour (12),
+/// the band's float image (24) and its 8-bit bytes (3), rounded up.
+pub const GLARE_BAND_BYTES_PER_PIXEL: u64 = 40;
+
+/// The most memory a frame with a `[bloom]` may need (3 GiB): the whole image's glare planes
+/// ([`GLARE_BYTES_PER_PIXEL`]) and at least one row of output band. With it, no scene within the
+/// limits needs more than about 3.5 GB (docs/scene-format.md, "Memory").
+pub const GLARE_MAX_BYTES: u64 = 3 << 30;
+
+/// The most pixels an image with a `[bloom]` may have: 8192² = 2²⁶, whose glare planes
+/// ([`GLARE_BYTES_PER_PIXEL`]) take 2.7 GB of [`GLARE_MAX_BYTES`], leaving room for bands of
+/// 1 638 rows.
+pub const GLARE_MAX_PIXELS: u64 = 1 << 26;
+
+/// Rows per band of output for a `width × height` frame with a `[bloom]`: the most rows whose
+/// band ([`GLARE_BAND_BYTES_PER_PIXEL`]) fits in [`GLARE_MAX_BYTES`] beside the whole image's
+/// glare planes, at least 1 and at most `height`. Every band draws the whole linear image again
+/// (the glare of a row depends on every row), so the fewer bands, the less work: an image up to
+/// about 6 340² is one band, 8192² six.
+pub fn glare_band_rows(width: u32, height: u32) -> u32 {
+    let (w, h) = (u64::from(width.max(1)), u64::from(height.max(1)));
+    let fixed = w * h * GLARE_BYTES_PER_PIXEL;
+    let rows = GLARE_MAX_BYTES.saturating_sub(fixed) / (w * GLARE_BAND_BYTES_PER_PIXEL);
+    rows.clamp(1, h) as u32
+}
+
+/// [`check_image_size`], and with `bloom` (where the scene's `[bloom]` is, for the message) at
+/// most [`GLARE_MAX_PIXELS`] pixels.
+pub fn check_image_size_with(
+    width: u32,
+    height: u32,
+    area_light: bool,
+    bloom: Option<&crate::Location>,
+) -> Result<(), String> {
+    check_edges_and_area(width, height, area_light)?;
+    let px = u64::from(width) * u64::from(height);
+    if let Some(at) = bloom.filter(|_| px > GLARE_MAX_PIXELS) {
+        let need = px * GLARE_BYTES_PER_PIXEL;
+        return Err(format!(
+            "with the [bloom] at {at} an image has at most {GLARE_MAX_PIXELS} pixels (8192²: the \
+             glare keeps {GLARE_BYTES_PER_PIXEL} bytes a pixel of the whole image, within {} GiB); \
+             {width}×{height} is {px} pixels and would need {:.1} GB",
+            GLARE_MAX_BYTES >> 30,
+            need as f64 / 1e9
+        ));
+    }
+    Ok(())
+}
+
+fn check_edges_and_area(width: u32, height: u32, area_light: bool) -> Result<(), String> {
     for (edge, v) in [("width", width), ("height", height)] {
         if v == 0 || v > MAX_IMAGE_EDGE {
             return Err(format!("image {edge} {v} is outside 1..={MAX_IMAGE_EDGE} pixels"));

@@ -44,6 +44,8 @@ pub struct Scene {
     pub(crate) area_light: Option<AreaLightDef>,
     /// `[bloom]`'s parameters.
     pub(crate) bloom: Option<ParamSet>,
+    /// Where the `[bloom]` table is, for the messages of the limits it brings.
+    pub(crate) bloom_at: Option<crate::Location>,
     pub(crate) tracks: Vec<Track>,
     /// Things that were accepted but deserve a note (a downscaled texture, textures on a mesh
     /// without texture coordinates, …).
@@ -200,7 +202,7 @@ impl Scene {
     /// Checks a size for this scene's images (from a flag or the viewer) against the rules its
     /// `[image]` follows: [`crate::check_image_size`].
     pub fn check_image_size(&self, width: u32, height: u32) -> Result<(), String> {
-        crate::limits::check_image_size(width, height, self.area_light.is_some())
+        crate::limits::check_image_size_with(width, height, self.area_light.is_some(), self.bloom_at.as_ref())
     }
 
     /// Time of the last key of any track in seconds, or the end of the longest clip an object

@@ -323,9 +323,14 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     }
 
     // [bloom]
-    let bloom = match root.sub("bloom", "[bloom]")? {
-        Some(t) => Some(parse_bloom(&t, &mut rd)?),
-        None => None,
+    let (bloom, bloom_at) = match root.sub("bloom", "[bloom]")? {
+        Some(t) => {
+            let at = src.loc(&t.span);
+            crate::limits::check_image_size_with(width, height, false, Some(&at))
+                .map_err(|m| src.value_err(&t.span, format!("[image] {width}×{height}: {m}")))?;
+            (Some(parse_bloom(&t, &mut rd)?), Some(at))
+        }
+        None => (None, None),
     };
 
     let mut scene = Scene {
@@ -345,6 +350,7 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         shadows,
         area_light,
         bloom,
+        bloom_at,
         tracks: Vec::new(),
         // A warning may quote any file's text (a bone's, a material's or an extension's name):
         // its control characters are escaped here, once for every loader, as errors are when

@@ -89,3 +89,36 @@ fn bad_values_point_at_their_place() {
     assert!(e.to_string().contains("the scene has no [bloom]"), "{e}");
     assert_eq!(at(&e).0, 2, "{e}");
 }
+
+/// Issue 41 (glare within the memory promise): an image with a `[bloom]` is at most
+/// `GLARE_MAX_PIXELS` (8192²) pixels, refused past it with the `[bloom]`'s place and the limit,
+/// whether the size comes from the file's `[image]` or from a caller (the command line's flags);
+/// within it, the output bands fit the memory the glare leaves.
+#[test]
+fn issue_41_an_image_with_a_bloom_is_within_the_glares_memory() {
+    use hadou_scene::{
+        glare_band_rows, GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES, GLARE_MAX_PIXELS,
+    };
+    let e = err("[image]\nwidth = 16384\nheight = 8192\n\n[bloom]\nintensity = 1\n");
+    assert_eq!(at(&e), (5, 1), "{e}");
+    assert!(e.to_string().contains("at most 67108864 pixels"), "{e}");
+    let s = parse("[image]\nwidth = 8192\nheight = 8192\n\n[bloom]\n");
+    assert!(s.check_image_size(8192, 8192).is_ok());
+    let m = s.check_image_size(8193, 8192).unwrap_err();
+    assert!(m.contains("scenes/x.toml:5:1") && m.contains("67108864") && m.contains("GB"), "{m}");
+    assert!(s.check_image_size(16384, 16384).is_err());
+    // Without a [bloom] the same sizes are the edges' business only.
+    assert!(parse("[image]\nwidth = 16384\nheight = 16384\n").check_image_size(16384, 16384).is_ok());
+    // The bands: whole images up to about 6 340², never more memory than the limit, at least a row.
+    assert_eq!(glare_band_rows(4096, 4096), 4096);
+    assert_eq!(glare_band_rows(6340, 6340), 6340);
+    for (w, h) in [(8192u32, 8192u32), (16384, 4096), (1, 16384), (7000, 7000), (3, 5)] {
+        let rows = glare_band_rows(w, h);
+        assert!((1..=h).contains(&rows));
+        let px = u64::from(w) * u64::from(h);
+        if px <= GLARE_MAX_PIXELS {
+            let need = px * GLARE_BYTES_PER_PIXEL + u64::from(w) * u64::from(rows) * GLARE_BAND_BYTES_PER_PIXEL;
+            assert!(need <= GLARE_MAX_BYTES, "{w}×{h}: {rows} rows need {need} bytes");
+        }
+    }
+}

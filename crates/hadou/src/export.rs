@@ -319,7 +319,7 @@ fn export_png_sequence(
     }
     for f in range {
         let frame = spec.frame(scene, f);
-        output::write_png_banded(&frame_path(f), frame.width, frame.height, frame.grid().pow(2), |rows| {
+        output::write_png_banded(&frame_path(f), frame.width, frame.height, output::frame_band_rows(&frame), |rows| {
             Ok::<_, ExportError>(backend.render_rows_rgb8(&frame, rows)?)
         })?;
         done += 1;
@@ -334,7 +334,7 @@ fn export_png_sequence(
 fn render_rgba(backend: &mut dyn Backend, frame: &Frame) -> Result<Vec<u8>, ExportError> {
     let (w, h) = (frame.width, frame.height);
     let mut rgba = Vec::with_capacity(w as usize * h as usize * 4);
-    let step = output::band_rows(w, frame.grid().pow(2));
+    let step = output::frame_band_rows(frame);
     let mut y = 0;
     while y < h {
         let rows = y..(y + step).min(h);

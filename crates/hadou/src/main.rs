@@ -203,6 +203,11 @@ impl From<output::OutputError> for Failure {
 
 impl From<RenderError> for Failure {
     fn from(e: RenderError) -> Self {
+        // Memory the machine lacks for a frame within the limits is a size to lower: exit 2, as
+        // a size over the limits is.
+        if let RenderError::Memory(_) = e {
+            return Failure::input(format!("render failed: {e}; nothing was written (a smaller --width/--height or fewer --samples fits)"));
+        }
         Failure::runtime(format!("render failed: {e}"))
     }
 }
@@ -586,14 +591,14 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         let mut backend = make_backend(a.backend)?;
         // Both formats are rendered and encoded band by band: memory follows the band, not the
         // image.
-        let (w, h, samples) = (frame.width, frame.height, frame.grid().pow(2));
+        let (w, h, band_rows) = (frame.width, frame.height, output::frame_band_rows(&frame));
         match output::Format::from_path(&a.output)? {
             // A PNG's bands come as 8-bit sRGB straight from the renderer (the CPU backend's colour
             // stage writes no float buffers for them).
-            output::Format::Png => output::write_png_banded(&a.output, w, h, samples, |rows| {
+            output::Format::Png => output::write_png_banded(&a.output, w, h, band_rows, |rows| {
                 Ok::<_, Failure>(backend.render_rows_rgb8(&frame, rows)?)
             })?,
-            output::Format::Exr => output::write_banded(&a.output, w, h, samples, |rows| {
+            output::Format::Exr => output::write_banded(&a.output, w, h, band_rows, |rows| {
                 let band = backend.render_rows(&frame, rows)?;
                 check_finite(&band)?;
                 Ok::<_, Failure>(band)

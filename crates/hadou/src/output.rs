@@ -98,18 +98,18 @@ pub fn write(image: &Image, path: &Path) -> Result<(), OutputError> {
 
 /// Writes a `width × height` image to `path` in the format its extension names, band by band
 /// ([`write_png_banded`], [`write_exr_banded`]): memory follows the band, not the image.
-/// `samples` is what the renderer draws per pixel (`Frame::grid()²`), which bands are sized by.
+/// `rows_per_band` is the band's height, [`frame_band_rows`] of the frame.
 pub fn write_banded<E: From<OutputError>>(
     path: &Path,
     width: u32,
     height: u32,
-    samples: u32,
+    rows_per_band: u32,
     band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     match Format::from_path(path)? {
         Format::Png => {
             let mut band = band;
-            write_png_banded(path, width, height, samples, |rows| {
+            write_png_banded(path, width, height, rows_per_band, |rows| {
                 let image = band(rows)?;
                 Rgb8Image::from_image(&image).ok_or_else(|| {
                     E::from(OutputError::Io(format!(
@@ -119,7 +119,7 @@ pub fn write_banded<E: From<OutputError>>(
                 })
             })
         }
-        Format::Exr => write_exr_banded(path, width, height, samples, band),
+        Format::Exr => write_exr_banded(path, width, height, rows_per_band, band),
     }
 }
 
@@ -240,6 +240,18 @@ pub fn band_rows(width: u32, samples: u32) -> u32 {
     (u64::from(BAND_PIXELS) / (u64::from(width.max(1)) * u64::from(samples.max(1)))).max(1) as u32
 }
 
+/// Rows per band of a written `frame`: [`band_rows`] for its samples per pixel, or with a
+/// `[bloom]` the most rows whose band fits beside the glare's whole-image planes
+/// ([`hadou_scene::glare_band_rows`]: every band of such a frame draws the whole linear image
+/// again, so its bands are as tall as memory allows; an image up to about 6 340² is one band).
+pub fn frame_band_rows(frame: &hadou_scene::Frame) -> u32 {
+    if frame.bloom.is_some() {
+        hadou_scene::glare_band_rows(frame.width, frame.height)
+    } else {
+        band_rows(frame.width, frame.grid().pow(2))
+    }
+}
+
 /// Pixels per band of a streamed PNG (4 Mi: about 100 MB of float image per band).
 pub const BAND_PIXELS: u32 = 1 << 22;
 
@@ -290,7 +302,7 @@ fn next_band<E: From<OutputError>, B: BandSize>(
 }
 
 /// Writes a `width × height` 8-bit sRGB PNG to `path`, asking `band` for the image rows
-/// `y0..y1` in turn as 8-bit sRGB ([`hadou_scene::Backend::render_rows_rgb8`]) (each at most [`band_rows`] rows, for `samples` per pixel) and streaming them into the encoder, so
+/// `y0..y1` in turn as 8-bit sRGB ([`hadou_scene::Backend::render_rows_rgb8`]) (each at most `rows_per_band` rows: [`frame_band_rows`]) and streaming them into the encoder, so
 /// memory follows the band, not the image. The file is created (and registered for interrupt
 /// clean-up) before the first band is requested, and renamed into place after the last; on any
 /// error nothing is left behind.
@@ -298,7 +310,7 @@ pub fn write_png_banded<E: From<OutputError>>(
     path: &Path,
     width: u32,
     height: u32,
-    samples: u32,
+    rows_per_band: u32,
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Rgb8Image, E>,
 ) -> Result<(), E> {
     let (tmp, file) = begin_banded(path)?;
@@ -312,7 +324,7 @@ pub fn write_png_banded<E: From<OutputError>>(
     let mut w = enc.write_header().map_err(|e| io(e.to_string()))?;
     {
         let mut stream = w.stream_writer().map_err(|e| io(e.to_string()))?;
-        let step = band_rows(width, samples);
+        let step = rows_per_band.max(1);
         let mut y = 0;
         while y < height {
             let rows = y..(y + step).min(height);
@@ -343,7 +355,7 @@ const EXR_CHANNELS: [(&str, ExrSample); 6] = [
 
 /// Writes a `width × height` float EXR (channels `R, G, B, A`: linear colour after mapping,
 /// `energy` and `depth`; RLE-compressed scan lines, layer `hadou`) to `path`, asking `band` for
-/// the image rows `y0..y1` in turn (each at most [`band_rows`] rows, for `samples` per pixel) and writing each band's
+/// the image rows `y0..y1` in turn (each at most `rows_per_band` rows: [`frame_band_rows`]) and writing each band's
 /// lines before asking for the next, so memory follows the band, not the image. The file is
 /// created (and registered for interrupt clean-up) before the first band is requested, and
 /// renamed into place after the last; on any error nothing is left behind.
@@ -351,7 +363,7 @@ pub fn write_exr_banded<E: From<OutputError>>(
     path: &Path,
     width: u32,
     height: u32,
-    samples: u32,
+    rows_per_band: u32,
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     use exr::block::writer::ChunksWriter;
@@ -374,7 +386,7 @@ pub fn write_exr_banded<E: From<OutputError>>(
     let mut failure: Option<E> = None;
     let written =
         exr::block::write(BufWriter::new(file), SmallVec::from_vec(vec![header]), true, |meta, chunks| {
-            let step = band_rows(width, samples);
+            let step = rows_per_band.max(1);
             let mut y = 0;
             while y < height {
                 let rows = y..(y + step).min(height);

@@ -726,6 +726,41 @@ fn sizes_from_flags_obey_the_area_light_pixel_limit_on_every_path() {
     assert!(left.is_empty(), "written: {left:?}");
 }
 
+/// Issue 41 (glare within the memory promise): an image with a `[bloom]` past the glare's
+/// 8192² pixels is refused before anything is allocated or written, on every output path and
+/// backend, naming the flags, the `[bloom]`'s place and the limit; within it, a render's bands
+/// are sized to fit beside the glare (`output::frame_band_rows`).
+#[test]
+fn issue_41_a_bloom_past_its_pixel_limit_exits_2_and_writes_nothing() {
+    let dir = tmpdir("bloom-size");
+    let text = format!("{GOOD}\n[bloom]\nintensity = 0.5\n");
+    let line = text.lines().position(|l| l == "[bloom]").unwrap() + 1;
+    let scene = write_scene(&dir, &text);
+    let s = scene.to_str().unwrap();
+    let out = dir.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let (png, exr) = (out.join("a.png"), out.join("a.exr"));
+    let seq = format!("{}/", out.display());
+    let at = format!("{}:{line}:1", scene.display());
+    for args in [
+        vec!["render", s, "-o", png.to_str().unwrap()],
+        vec!["render", s, "-o", exr.to_str().unwrap()],
+        vec!["render", s, "-o", &seq, "--frames", "0..2"],
+    ] {
+        for backend in ["cpu", "gpu"] {
+            let full: Vec<&str> =
+                args.iter().copied().chain(["--width", "16384", "--height", "4097", "--backend", backend]).collect();
+            assert_exit_2(&full, &["--width 16384 --height 4097", &at, "at most 67108864 pixels", "GB"]);
+        }
+    }
+    let left: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "written: {left:?}");
+    let frame = hadou::Scene::load(&scene).unwrap().at(0.0);
+    let sized = |w: u32, h: u32| hadou::Frame { width: w, height: h, ..frame.clone() };
+    assert_eq!(hadou::output::frame_band_rows(&sized(4096, 4096)), 4096, "one band: the glare is drawn once");
+    assert!(hadou::output::frame_band_rows(&sized(8192, 8192)) >= 1024);
+}
+
 #[test]
 fn a_gif_frame_past_its_pixel_limit_exits_2() {
     let dir = tmpdir("gif-size");

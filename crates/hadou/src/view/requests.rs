@@ -108,7 +108,7 @@ impl App {
             (BackendKind::Gpu, Some(gpu)) => gpu,
             _ => &mut cpu,
         };
-        output::write_banded(path, frame.width, frame.height, frame.grid().pow(2), |rows| {
+        output::write_banded(path, frame.width, frame.height, output::frame_band_rows(&frame), |rows| {
             Ok::<_, ExportError>(backend.render_rows(&frame, rows)?)
         })
         .map_err(|e| e.to_string())
