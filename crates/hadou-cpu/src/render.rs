@@ -43,7 +43,13 @@ impl CpuBackend {
     /// or a benchmark drawing frame after frame wants) and returns the passes' times; the same
     /// pixels as [`render`].
     pub fn render_into(&mut self, frame: &Frame, image: &mut Image) -> PassTimes {
-        expect_memory(render_with(frame, 0..frame.height, &mut self.scratch, Target::Float(image), SimdPath::current()))
+        expect_memory(render_with(
+            frame,
+            0..frame.height,
+            &mut self.scratch,
+            Target::Float(image),
+            SimdPath::current(),
+        ))
     }
 
     /// [`CpuBackend::render_into`] for a PNG: only the 8-bit sRGB bytes, written by the colour
@@ -77,7 +83,13 @@ impl Backend for CpuBackend {
     fn render_rows(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Image, RenderError> {
         let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
         let mut img = Image::new(frame.width, y1.max(y0) - y0);
-        render_with(frame, rows, &mut OpaqueBuffers::default(), Target::Float(&mut img), SimdPath::current())?;
+        render_with(
+            frame,
+            rows,
+            &mut OpaqueBuffers::default(),
+            Target::Float(&mut img),
+            SimdPath::current(),
+        )?;
         Ok(img)
     }
 
@@ -484,7 +496,8 @@ fn glare_rows(
     let mut linear = hadou_math::bloom::Plane::try_new(w, frame.height as usize, src.clone())
         .map_err(|bytes| out_of_memory(bytes, "the glare's linear colour"))?;
     // With an area light the opaque pass draws every row whatever it is asked: one chunk.
-    let chunk = if frame.area_light.is_some() { src.len() } else { (chunk_samples / (w * k * k).max(1)).max(1) };
+    let chunk =
+        if frame.area_light.is_some() { src.len() } else { (chunk_samples / (w * k * k).max(1)).max(1) };
     let (mut opaque_ms, mut wave_ms) = (0.0, 0.0);
     let ms = |a: Instant, b: Instant| (b - a).as_secs_f64() * 1e3;
     let mut t = start;

@@ -396,6 +396,20 @@ impl Backend for GpuBackend {
         self.renderer.render_rows(frame, rows)
     }
 
+    /// A frame with a `[bloom]` needs the linear colour of a row and its glare halo in one
+    /// storage binding ([`wgpu::Limits::max_storage_buffer_binding_size`]); one that does not fit
+    /// is refused here, with the radius that fits.
+    fn check_frame(&self, frame: &Frame) -> Result<(), String> {
+        match &frame.bloom {
+            Some(params) if frame.height > 0 => self
+                .renderer
+                .glare_bands(frame, params, 0..frame.height)
+                .map(|_| ())
+                .map_err(|e| e.to_string()),
+            _ => Ok(()),
+        }
+    }
+
     /// The wave pass writes the 8-bit sRGB codes itself (the same thresholds as
     /// `hadou_math::shade::linear_to_srgb8`), so each tile reads back 4 bytes a pixel instead of
     /// 24; a frame with a `[bloom]` is converted from its float image.

@@ -203,7 +203,9 @@ pub(crate) struct Renderer {
 #[cfg(not(target_arch = "wasm32"))]
 fn alloc_image(width: u32, height: u32) -> Result<Image, RenderError> {
     let n = width as usize * height as usize;
-    let oom = |_| RenderError::Memory(format!("the host's copy of a {width}×{height} image could not be allocated"));
+    let oom = |_| {
+        RenderError::Memory(format!("the host's copy of a {width}×{height} image could not be allocated"))
+    };
     let mut color: Vec<[f32; 4]> = Vec::new();
     color.try_reserve_exact(n).map_err(oom)?;
     let mut energy: Vec<f32> = Vec::new();
@@ -859,7 +861,11 @@ impl Renderer {
         let n = width * rows.len();
         let mut rgb: Vec<u8> = Vec::new();
         rgb.try_reserve_exact(3 * n).map_err(|_| {
-            RenderError::Memory(format!("the host's copy of a {}×{} image could not be allocated", frame.width, rows.len()))
+            RenderError::Memory(format!(
+                "the host's copy of a {}×{} image could not be allocated",
+                frame.width,
+                rows.len()
+            ))
         })?;
         rgb.resize(3 * n, 0);
         let mut finite = true;
@@ -924,10 +930,25 @@ impl Renderer {
             let mut len = rows.end as usize - y;
             while BloomPass::largest_plane(params, frame.width, frame.height, y..y + len) > limit {
                 if len == 1 {
+                    // The most levels (the widest reach) whose halo fits, as a radius.
+                    let (w, h) = (frame.width as usize, frame.height as usize);
+                    let fits = (1..=hadou_math::bloom::MAX_LEVELS).rev().find(|&n| {
+                        // The middle row: its halo is clamped by neither edge.
+                        let rows = hadou_math::bloom::Plan::new(w, h, n, h / 2..h / 2 + 1).source.len();
+                        (rows * w) as u64 * bloom::TEXEL_BYTES <= limit
+                    });
+                    let hint = match fits {
+                        Some(n) => {
+                            format!("a `radius` of at most {:.4} fits", f64::from(1u32 << n) / h as f64)
+                        }
+                        None => "no radius fits".to_owned(),
+                    };
                     return Err(RenderError::Other(format!(
                         "the [bloom] of a {}×{} image needs more than this device's {limit}-byte storage \
-                         binding for one row and its halo; a smaller radius fits",
-                        frame.width, frame.height
+                         binding for one row and its glare halo ({} bytes); {hint} at this size, or `--backend cpu`",
+                        frame.width,
+                        frame.height,
+                        BloomPass::largest_plane(params, frame.width, frame.height, y..y + 1)
                     )));
                 }
                 len = len.div_ceil(2);

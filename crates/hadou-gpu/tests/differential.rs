@@ -448,6 +448,51 @@ fn glare_matches_cpu_whole_and_in_bands() {
     }
 }
 
+/// Issue 41 (glare within the memory promise): a `[bloom]` whose halo does not fit the device's
+/// storage binding is refused by `check_frame` before anything is drawn, naming the binding and a
+/// radius that fits, and that radius passes; an 8192² image (the glare's pixel limit) with the
+/// widest reach is refused exactly where one row's halo needs more than the binding.
+#[test]
+fn issue_41_a_bloom_past_the_storage_binding_is_refused_with_a_radius_that_fits() {
+    use hadou_scene::{Backend, BloomParams};
+    let Some(gpu) = gpu_or_skip("bloom binding") else { return };
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/glare-kamehameha.toml");
+    let scene = hadou_scene::Scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let mut frame = scene.at(1.5);
+    (frame.width, frame.height) = (8192, 8192);
+    let bloom = frame.bloom.expect("the scene has a [bloom]");
+    frame.bloom = Some(BloomParams { radius: 1.0, ..bloom });
+    // Radius 1 at 8192²: the halo is the whole image, 8192² texels of 16 bytes (1 GiB).
+    let need = 8192u64 * 8192 * 16;
+    match gpu.check_frame(&frame) {
+        Ok(()) => {}
+        Err(m) => {
+            assert!(m.contains("storage binding") && m.contains("`--backend cpu`"), "{m}");
+            let fits: f32 = m
+                .split("a `radius` of at most ")
+                .nth(1)
+                .and_then(|r| r.split_whitespace().next())
+                .and_then(|r| r.parse().ok())
+                .unwrap_or_else(|| panic!("no radius in: {m}"));
+            assert!(fits < 1.0, "{m}");
+            frame.bloom = Some(BloomParams { radius: fits, ..bloom });
+            assert_eq!(gpu.check_frame(&frame), Ok(()), "the radius the message names fits");
+            frame.bloom = Some(BloomParams { radius: 1.0, ..bloom });
+            let err = gpu.check_frame(&frame).unwrap_err();
+            let limit: u64 = err
+                .split("this device's ")
+                .nth(1)
+                .and_then(|r| r.split('-').next())
+                .and_then(|r| r.parse().ok())
+                .unwrap_or_else(|| panic!("no limit in: {err}"));
+            assert!(limit < need, "refused although {need} bytes fit the {limit}-byte binding");
+        }
+    }
+    // Within the binding (a small image) every radius passes.
+    (frame.width, frame.height) = (256, 128);
+    assert_eq!(gpu.check_frame(&frame), Ok(()));
+}
+
 /// Outlines closed where objects meet (the edge pass): a box standing on the ground seen from
 /// above, a little off its axis, has an outline ring on the GPU as on the CPU — every one of 64
 /// directions from the box's screen centre meets an outline pixel within 4 pixels past its last

@@ -376,7 +376,12 @@ pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn R
 
 /// [`glare`], each plane reserved fallibly: `Err(bytes)`, the size of the plane that could not
 /// be allocated, where memory ran out (never an abort).
-pub fn try_glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn RowFill) -> Result<Plane, usize> {
+pub fn try_glare(
+    params: &BloomParams,
+    src: &Plane,
+    band: Range<usize>,
+    fill: &dyn RowFill,
+) -> Result<Plane, usize> {
     let (w, h) = (src.width, src.height);
     let n = levels(params.radius * h as f32);
     let plan = Plan::new(w, h, n, band.clone());

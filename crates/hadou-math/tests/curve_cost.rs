@@ -25,10 +25,10 @@ use std::time::Instant;
 /// Measured worst (inverse square): 73 195 for a 64-term sum of ±1e6 coefficients at 128 turns,
 /// 57 474 for a 512-point cubic zigzag B-spline, 17 095 for a helix at 128 turns, 4 212 for a
 /// Bézier curve (denser ray sets, 1 226 rays a corner, found up to 64 489 for the B-spline).
-const DEFAULT_BOUND: u32 = 100_000;
-/// Most evaluations (pieces visited plus exact points) a ray of the nearest-point field takes on
-/// the costliest corners.
-const NEAREST_BOUND: u32 = 1_000_000;
+const DEFAULT_BOUND: u32 = hadou_math::curve::DEFAULT_RAY_WORK as u32;
+/// Most evaluations (pieces visited plus exact points) a ray of the nearest-point field takes:
+/// its bound by construction, which the scene format documents (below 750 000).
+const NEAREST_BOUND: u32 = hadou_math::curve::NEAREST_RAY_WORK as u32;
 
 /// Largest value of a scene number (docs/scene-format.md, Limits).
 const COORD_MAX: f32 = 1e6;
@@ -489,7 +489,8 @@ fn nearest_corners_bound_the_work_per_ray() {
     let construction = (2 * MAX_NEAREST_STEPS + 1) * (MAX_NEAREST_VISITS + 8) + 1;
     let worst = check(nearest_corners(), 1, |_| NEAREST_BOUND);
     println!("nearest: worst {worst:?} (bound by construction {construction})");
-    assert!(NEAREST_BOUND <= construction);
+    assert_eq!(NEAREST_BOUND, construction);
+    assert!(NEAREST_BOUND < 750_000, "the documented bound");
 }
 
 /// Prints evaluations per ray (largest, mean), time per ray (mean, largest) and the preparation

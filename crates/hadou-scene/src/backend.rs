@@ -17,6 +17,13 @@ pub trait Backend {
         let full = self.render(frame)?;
         Ok(full.crop_rows(rows))
     }
+    /// Whether this backend can draw `frame` at all, asked before anything is allocated or
+    /// written (a device limit the frame's size or parameters exceed): `Err` is the reason,
+    /// naming the limit and what fits. The default accepts every frame.
+    fn check_frame(&self, frame: &Frame) -> Result<(), String> {
+        let _ = frame;
+        Ok(())
+    }
     /// The rows `rows` of `frame` as 8-bit sRGB only (what a PNG holds): the same bytes as
     /// [`Rgb8Image::from_image`] of [`Backend::render_rows`]'s image. The default converts that
     /// image (refusing one with a non-finite value); the CPU backend overrides it with a colour

@@ -87,8 +87,10 @@ pub use gltf_vrma::load_vrma_clip;
 pub use image::{Image, Rgb8Image};
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
 pub use limits::{
-    check_image_size, check_image_size_with, glare_band_rows, GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES, GLARE_MAX_PIXELS, ALPHA_MAX, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES,
-    MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
+    check_image_size, check_image_size_with, glare_band_rows, ALPHA_MAX, ANALYTIC_RAY_WORK,
+    GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES, GLARE_MAX_PIXELS, MAX_IMAGE_EDGE,
+    MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
+    PIXEL_WORK_MAX,
 };
 pub use rig::{clip_time, clip_wrap, Clip, Expression, PoseInput, Rig, VrmVersion};
 pub use scene::Scene;

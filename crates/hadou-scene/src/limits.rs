@@ -32,6 +32,19 @@
 //!   wave light may saturate to `+∞`, which the colour mappings turn into white (a finite value),
 //!   and no NaN can arise because every term is `≥ 0`.
 
+/// The most work one pixel may cost, in integrand evaluations: the sum over the scene's waves of
+/// each one's bound per ray ([`Scene::ray_work`](crate::Scene::ray_work)) times the samples per
+/// pixel (where a pixel's samples disagree, at a silhouette, the waves run once per sample). 2²⁵
+/// = 33 554 432, about a second of one core at the costliest corners: a 48×32 image within it
+/// takes at most a few minutes on two cores whatever its scene (docs/scene-format.md, "Work per
+/// pixel"). Checked when a scene is loaded and whenever a caller sets the samples.
+pub const PIXEL_WORK_MAX: u64 = 1 << 25;
+
+/// Work of one analytic wave on one ray, in the same units: at most five closed-form pieces (a
+/// beam), each attenuated one marched in at most [`hadou_math::energy::MAX_CELLS`] cells and a
+/// last one.
+pub const ANALYTIC_RAY_WORK: u64 = 5 * (hadou_math::energy::MAX_CELLS as u64 + 1);
+
 /// Largest image edge in pixels, for `[image]`, command-line sizes and the viewer alike.
 pub const MAX_IMAGE_EDGE: u32 = 16384;
 

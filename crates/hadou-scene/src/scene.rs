@@ -227,6 +227,59 @@ impl Scene {
         tracks.max(clips).min(crate::limits::COORD_MAX)
     }
 
+    /// Each wave's most work on one ray, in integrand evaluations (scene order):
+    /// [`crate::ANALYTIC_RAY_WORK`] for the closed-form shapes, the integrator's bound for a curve
+    /// ([`hadou_math::curve::Integrator::ray_work_bound`]).
+    pub fn ray_work(&self) -> Vec<u64> {
+        use hadou_math::curve::{Integrator, Reduction};
+        self.waves
+            .iter()
+            .map(|w| match (w.kind, w.integrator) {
+                (WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam, _) => {
+                    crate::ANALYTIC_RAY_WORK
+                }
+                (_, IntegratorDef::Default) => Integrator::Default.ray_work_bound(),
+                (_, IntegratorDef::Nearest) => Integrator::Nearest.ray_work_bound(),
+                (_, IntegratorDef::Simpson { m, n }) => {
+                    let reduction = n.map(|n| Reduction { n, epsilon: 0.0 });
+                    Integrator::Simpson { m, reduction }.ray_work_bound()
+                }
+            })
+            .collect()
+    }
+
+    /// Checks the most work one pixel may cost at `samples` per pixel (1, 4, 9 or 16): every
+    /// wave's [`Scene::ray_work`] times `samples`, summed, at most [`crate::PIXEL_WORK_MAX`]. `Err`
+    /// holds the first wave (scene order) whose sum passes it, and the message.
+    pub fn check_pixel_work(&self, samples: u32) -> Result<(), (usize, String)> {
+        let mut sum = 0u64;
+        for (i, work) in self.ray_work().into_iter().enumerate() {
+            sum += work * u64::from(samples);
+            if sum > crate::PIXEL_WORK_MAX {
+                return Err((
+                    i,
+                    format!(
+                        "the waves up to [[wave]] \"{}\" may cost {sum} integrand evaluations a pixel at \
+                         {samples} sample(s) (each wave's most per ray, times the samples), over the {} a pixel \
+                         may cost; fewer samples, fewer waves or cheaper integrators (the default field: at \
+                         most {} per ray, `field = \"nearest\"` {}) fit",
+                        crate::error::escape_controls(&self.waves[i].name),
+                        crate::PIXEL_WORK_MAX,
+                        hadou_math::curve::DEFAULT_RAY_WORK,
+                        hadou_math::curve::NEAREST_RAY_WORK
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Where the scene's `[bloom]` table is, if it has one (for messages about the limits it
+    /// brings).
+    pub fn bloom_location(&self) -> Option<&crate::Location> {
+        self.bloom_at.as_ref()
+    }
+
     /// The scene file's path.
     pub fn path(&self) -> &Path {
         &self.path

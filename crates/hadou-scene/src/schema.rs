@@ -365,6 +365,11 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         }
     }
 
+    // The most work a pixel may cost, at the file's samples.
+    if let Err((i, msg)) = scene.check_pixel_work(scene.samples) {
+        return Err(src.value_err(&wave_tables[i].span, msg));
+    }
+
     if let (Some(a), Some(t)) = (&scene.area_light, &area_table) {
         let vals = &scene.values;
         let g = interest_at(a, vals, |o| {

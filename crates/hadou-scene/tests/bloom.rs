@@ -117,7 +117,8 @@ fn issue_41_an_image_with_a_bloom_is_within_the_glares_memory() {
         assert!((1..=h).contains(&rows));
         let px = u64::from(w) * u64::from(h);
         if px <= GLARE_MAX_PIXELS {
-            let need = px * GLARE_BYTES_PER_PIXEL + u64::from(w) * u64::from(rows) * GLARE_BAND_BYTES_PER_PIXEL;
+            let need =
+                px * GLARE_BYTES_PER_PIXEL + u64::from(w) * u64::from(rows) * GLARE_BAND_BYTES_PER_PIXEL;
             assert!(need <= GLARE_MAX_BYTES, "{w}×{h}: {rows} rows need {need} bytes");
         }
     }

@@ -148,3 +148,54 @@ fn between_keys_the_curve_is_brought_within() {
         assert_eq!(&prepare(c).wave, c, "t = {t}");
     }
 }
+
+/// Issue 41 (a bounded cost per frame): the most work a pixel may cost, every wave's bound per ray
+/// times the samples, is at most `PIXEL_WORK_MAX`; the wave that passes it is named with its
+/// line, at the file's samples; a caller's samples are checked by `check_pixel_work`.
+#[test]
+fn issue_41_the_work_a_pixel_may_cost_is_bounded() {
+    use hadou_math::curve::{DEFAULT_RAY_WORK, NEAREST_RAY_WORK};
+    use hadou_scene::{ANALYTIC_RAY_WORK, PIXEL_WORK_MAX};
+    let helix = |i: usize, field: &str| {
+        format!(
+            "[[wave]]\nname = \"h{i}\"\nkind = \"helix\"\nO = [0, {i}, 0]\nD = [1, 0, 0]\nalpha = 1\n\
+             radius = 1\nrate = 6\nlength = 10\n{field}"
+        )
+    };
+    let sphere = "[[wave]]\nname = \"s\"\nkind = \"sphere\"\nM = [0, 0, 0]\nalpha_s = 1\n";
+    let simpson = "[[wave]]\nname = \"p\"\nkind = \"helix\"\nO = [0, 0, 0]\nD = [1, 0, 0]\nalpha = 1\n\
+                   radius = 1\nrate = 6\nlength = 10\nintegrator = \"simpson\"\nm = 1000\nn = 10\n";
+    let mut text = format!("{sphere}{}{}{simpson}", helix(0, ""), helix(1, "field = \"nearest\"\n"));
+    let s = Scene::parse(&text, Path::new("scenes/x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        s.ray_work(),
+        vec![ANALYTIC_RAY_WORK, DEFAULT_RAY_WORK, NEAREST_RAY_WORK, 3 * 1001 + DEFAULT_RAY_WORK]
+    );
+    let one: u64 = s.ray_work().iter().sum();
+    assert!(one * 16 <= PIXEL_WORK_MAX);
+    assert!(s.check_pixel_work(16).is_ok());
+    // Nearest-field helices at 16 samples: the third passes the bound (3 × 742 217 × 16 > 2²⁵).
+    text = "[image]\nsamples = 16\n".to_owned();
+    let mut lines = 2;
+    let mut third = 0;
+    for i in 0..4 {
+        if i == 2 {
+            third = lines + 1;
+        }
+        let h = helix(i, "field = \"nearest\"\n");
+        lines += h.lines().count();
+        text += &h;
+    }
+    let e = err(&text);
+    assert_eq!(at(&e), (third, 1), "{e}");
+    assert!(msg(&e).contains("[[wave]] \"h2\"") && msg(&e).contains(&PIXEL_WORK_MAX.to_string()), "{e}");
+    // At 4 samples the four fit; a caller asking 16 is told which wave passes.
+    let s = Scene::parse(&text.replace("samples = 16", "samples = 4"), Path::new("scenes/x.toml")).unwrap();
+    assert!(s.check_pixel_work(4).is_ok());
+    let (i, m) = s.check_pixel_work(16).unwrap_err();
+    assert_eq!(i, 2, "{m}");
+    // 256 analytic waves at 16 samples are always within it.
+    let many: String = (0..256).map(|i| sphere.replace("\"s\"", &format!("\"s{i}\""))).collect();
+    let s = Scene::parse(&format!("[image]\nsamples = 16\n{many}"), Path::new("scenes/x.toml")).unwrap();
+    assert!(s.check_pixel_work(16).is_ok());
+}

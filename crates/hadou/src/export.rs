@@ -261,10 +261,25 @@ pub fn export_animation(
     spec.validate()?;
     let (w, h) = spec.size(scene);
     scene.check_image_size(w, h).map_err(ExportError::Spec)?;
+    if let Some(n) = spec.samples {
+        scene.check_pixel_work(n).map_err(|(_, m)| ExportError::Spec(format!("samples {n}: {m}")))?;
+    }
+    // What the backend cannot draw (a GPU's bloom halo past its storage binding), refused
+    // before anything is written for the first frame, and before each later frame is drawn (the
+    // radius is animatable).
+    check_frame(scene, backend, &spec.frame(scene, spec.frames.start), spec.frames.start)?;
     match AnimationFormat::from_path(path)? {
         AnimationFormat::PngSequence => export_png_sequence(scene, backend, spec, path, progress),
         AnimationFormat::Gif => export_gif(scene, backend, spec, path, progress),
     }
+}
+
+/// [`Backend::check_frame`] of frame `f`, its message located at the scene's `[bloom]`.
+fn check_frame(scene: &Scene, backend: &dyn Backend, frame: &Frame, f: u32) -> Result<(), ExportError> {
+    backend.check_frame(frame).map_err(|m| {
+        let at = scene.bloom_location().map_or_else(|| scene.path().display().to_string(), |l| l.to_string());
+        ExportError::Spec(format!("{at}: frame {f}: {m}"))
+    })
 }
 
 /// The last line of defence of the invariant that no NaN or infinity reaches an image.
@@ -319,9 +334,14 @@ fn export_png_sequence(
     }
     for f in range {
         let frame = spec.frame(scene, f);
-        output::write_png_banded(&frame_path(f), frame.width, frame.height, output::frame_band_rows(&frame), |rows| {
-            Ok::<_, ExportError>(backend.render_rows_rgb8(&frame, rows)?)
-        })?;
+        check_frame(scene, backend, &frame, f)?;
+        output::write_png_banded(
+            &frame_path(f),
+            frame.width,
+            frame.height,
+            output::frame_band_rows(&frame),
+            |rows| Ok::<_, ExportError>(backend.render_rows_rgb8(&frame, rows)?),
+        )?;
         done += 1;
         if progress(Progress { done, total }) == Control::Cancel && done < total {
             return Ok(ExportOutcome::Cancelled { frames_written: done });
@@ -387,6 +407,7 @@ fn export_gif(
     }
     for (k, f) in spec.frames.clone().enumerate() {
         let frame = first.take().unwrap_or_else(|| spec.frame(scene, f));
+        check_frame(scene, backend, &frame, f)?;
         if (frame.width, frame.height) != (w, h) {
             return Err(ExportError::Render(RenderError::Other(format!(
                 "frame {f} is {}×{}, the GIF's first frame {w}×{h}; a GIF's frames share one size",

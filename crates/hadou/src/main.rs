@@ -264,6 +264,7 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
     }
     let scene = load_scene(&a.scene)?;
     let (w, h) = check_image_size(&scene, &a.scene, a.width, a.height)?;
+    check_samples_work(&scene, a.samples)?;
     if hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::Gif {
         hadou::export::check_gif_size(w, h).map_err(|m| {
             Failure::input(format!("{}: {m}", size_origin(&scene, &a.scene, a.width, a.height)))
@@ -355,6 +356,14 @@ fn check_image_size(
         .check_image_size(width, height)
         .map_err(|m| Failure::input(format!("{}: {m}", size_origin(scene, path, w, h))))?;
     Ok((width, height))
+}
+
+/// `--samples n`'s cost per pixel with the scene's waves ([`Scene::check_pixel_work`]).
+fn check_samples_work(scene: &Scene, samples: Option<u32>) -> Result<(), Failure> {
+    match samples {
+        Some(n) => scene.check_pixel_work(n).map_err(|(_, m)| Failure::input(format!("--samples {n}: {m}"))),
+        None => Ok(()),
+    }
 }
 
 /// Where an image size came from, for a message: the flags as given, with the edge the scene
@@ -587,8 +596,13 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         output::check_directory(&a.output)?;
         let scene = load_scene(&a.scene)?;
         check_image_size(&scene, &a.scene, a.width, a.height)?;
+        check_samples_work(&scene, a.samples)?;
         let frame = frame_at(&scene, time, a.width, a.height, a.samples);
         let mut backend = make_backend(a.backend)?;
+        backend.check_frame(&frame).map_err(|m| {
+            let at = scene.bloom_location().map_or_else(|| a.scene.display().to_string(), |l| l.to_string());
+            Failure::input(format!("{at}: {m}"))
+        })?;
         // Both formats are rendered and encoded band by band: memory follows the band, not the
         // image.
         let (w, h, band_rows) = (frame.width, frame.height, output::frame_band_rows(&frame));

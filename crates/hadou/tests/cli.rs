@@ -748,8 +748,11 @@ fn issue_41_a_bloom_past_its_pixel_limit_exits_2_and_writes_nothing() {
         vec!["render", s, "-o", &seq, "--frames", "0..2"],
     ] {
         for backend in ["cpu", "gpu"] {
-            let full: Vec<&str> =
-                args.iter().copied().chain(["--width", "16384", "--height", "4097", "--backend", backend]).collect();
+            let full: Vec<&str> = args
+                .iter()
+                .copied()
+                .chain(["--width", "16384", "--height", "4097", "--backend", backend])
+                .collect();
             assert_exit_2(&full, &["--width 16384 --height 4097", &at, "at most 67108864 pixels", "GB"]);
         }
     }

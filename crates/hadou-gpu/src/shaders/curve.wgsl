@@ -967,7 +967,7 @@ fn curve_simpson(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
 // Mirrors nearest.rs NEAREST_STEP, MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE,
 // TAIL_RADII; keep in sync.
 const NEAREST_STEP: f32 = 0.25;
-const MAX_NEAREST_STEPS: u32 = 512u;
+const MAX_NEAREST_STEPS: u32 = 180u;
 const MAX_NEAREST_VISITS: u32 = 2048u;
 const NEAREST_PRUNE: f32 = 1e-4;
 const TAIL_RADII: f32 = 64.0;

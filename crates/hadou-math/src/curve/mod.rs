@@ -72,7 +72,9 @@ pub use integrate::{
     attenuation_split, CurveSample, DefaultSettings, DEFAULT_SETTINGS, MAX_ATTENUATION_PARTS,
 };
 pub use lanes::{curve_energy_lanes, PACKET};
-pub use nearest::{MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_STEP, TAIL_RADII};
+pub use nearest::{
+    MAX_NEAREST_STEPS, MAX_NEAREST_VISITS, NEAREST_PRUNE, NEAREST_RAY_WORK, NEAREST_STEP, TAIL_RADII,
+};
 pub use prepare::{
     prepare, try_prepare, PieceTable, PreparedCurve, LEAF_TOLERANCE, LIGHT_TOLERANCE, MAX_LIGHT_POINTS,
     MAX_PIECES, MIN_CORE,
@@ -81,6 +83,6 @@ pub use reference::{curve_energy_reference, nearest_energy_reference};
 pub use shape::clamped_uniform_knots;
 pub use validate::CurveError;
 pub use wave::{
-    CurveFrame, CurveShape, CurveWave, Integrator, Reduction, MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS,
-    MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
+    CurveFrame, CurveShape, CurveWave, Integrator, Reduction, DEFAULT_RAY_WORK, MAX_BEZIER_POINTS,
+    MAX_BSPLINE_POINTS, MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
 };
