@@ -206,7 +206,10 @@ pub fn remove_pending() -> usize {
 pub fn install_interrupt_cleanup() -> Result<(), String> {
     ctrlc::set_handler(|| {
         let n = remove_pending();
-        eprintln!("\ninterrupted: removed {n} partial output file(s)");
+        // Never `eprintln!`: on a closed stderr it panics, and this thread would then never
+        // exit, leaving the process blocked on the temporary-file lock it keeps.
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "\ninterrupted: removed {n} partial output file(s)");
         std::process::exit(130);
     })
     .map_err(|e| format!("cannot install the interrupt handler: {e}"))

@@ -677,6 +677,98 @@ fn an_interrupted_writer_leaves_nothing_for_every_signal() {
     }
 }
 
+/// Issue 41 (no temp file under any timing): `hadou render` writing a GIF and a PNG is sent
+/// SIGTERM at timings from 0 to 3 s (before the handler is installed, while the scene loads,
+/// while frames render, while the encoder writes) with both cores kept busy by other threads;
+/// whenever it stops, no temporary file is left: it exited 130 with its file removed, or was
+/// stopped before its handler was installed (no file yet), or finished with its output whole.
+#[cfg(unix)]
+#[test]
+fn issue_41_no_temp_file_under_any_signal_timing() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let dir = tmpdir("signal-timing");
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let kame = scenes.join("kamehameha.toml");
+    let k = kame.to_str().unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let load: Vec<_> = (0..2)
+        .map(|_| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                let mut x = 0u64;
+                while !stop.load(Ordering::Relaxed) {
+                    x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+                }
+            })
+        })
+        .collect();
+    for (i, ms) in
+        [0u64, 1, 3, 7, 15, 30, 60, 100, 160, 250, 400, 600, 900, 1300, 1900, 3000].into_iter().enumerate()
+    {
+        let out = dir.join(format!("t{i}"));
+        std::fs::create_dir(&out).unwrap();
+        let (gif, png) = (out.join("out.gif"), out.join("out.png"));
+        // Both writers at once, signalled at the same moment.
+        let runs: Vec<_> = [
+            ("gif", &gif, &["--frames", "0..240"][..]),
+            ("png", &png, &["--width", "2048", "--height", "1536"][..]),
+        ]
+        .into_iter()
+        .map(|(what, target, extra)| {
+            let mut args = vec!["render", k, "-o", target.to_str().unwrap(), "--backend", "cpu"];
+            if what == "gif" {
+                args.extend(["--width", "512", "--height", "384"]);
+            }
+            args.extend(extra);
+            let child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+                .args(&args)
+                .stderr(std::process::Stdio::null())
+                .stdout(std::process::Stdio::null())
+                .spawn()
+                .unwrap();
+            (what, target, child)
+        })
+        .collect();
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+        for (_, _, child) in &runs {
+            let _ = Command::new("kill").args(["-TERM", &child.id().to_string()]).status();
+        }
+        let ended: Vec<_> =
+            runs.into_iter().map(|(what, target, mut c)| (what, target, c.wait().unwrap())).collect();
+        let left: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect();
+        assert!(left.is_empty(), "at {ms} ms ({ended:?}): left {left:?}");
+        for (what, target, status) in ended {
+            use std::os::unix::process::ExitStatusExt;
+            assert!(
+                matches!((status.code(), status.signal()), (Some(130 | 0), _) | (_, Some(15))),
+                "{what} at {ms} ms: unexpected end {status}"
+            );
+            // An output there is whole: it was renamed into place before the signal came.
+            if target.exists() {
+                let bytes = std::fs::read(target).unwrap();
+                let whole = if what == "gif" {
+                    bytes.starts_with(b"GIF89a") && bytes.last() == Some(&0x3B)
+                } else {
+                    png::Decoder::new(std::io::Cursor::new(&bytes)).read_info().is_ok_and(|mut r| {
+                        let mut buf = vec![0; r.output_buffer_size().unwrap_or(0)];
+                        r.next_frame(&mut buf).is_ok()
+                    })
+                };
+                assert!(whole, "{what} at {ms} ms ({status}): a partial output");
+            }
+        }
+    }
+    stop.store(true, Ordering::Relaxed);
+    for t in load {
+        t.join().unwrap();
+    }
+}
+
 /// The scene `GOOD` with an `[area_light]` (whose images are at most 4096² pixels) and an
 /// `[image]` of `w×h`.
 fn area_light_scene(w: u32, h: u32) -> String {
