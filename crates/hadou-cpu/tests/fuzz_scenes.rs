@@ -2,7 +2,9 @@
 //! hand-made hostile cases of `fuzz_corpus` (curves at the corners of their parameter boxes,
 //! scenes past the triangle and image limits, textured materials whose PNG carries ancillary
 //! chunks, a skin whose weights overflow, every shadow kind with an `[area_light]`, tracks with
-//! extreme key times, control bytes in paths), and the files they name (a few glTF files, the
+//! extreme key times, control bytes in paths, a `[bloom]` past its pixel limit and on an
+//! anti-aliased frame of grazing ground, nearest-field curves past the work a pixel may cost and
+//! the B-spline zigzag that once cost 1.87 million evaluations a ray), and the files they name (a few glTF files, the
 //! examples' skinned and textured `hero.glb` and the animated `brace.glb`, a PNG) are mutated at random (byte flips, lines deleted, duplicated, swapped or
 //! spliced in from another scene, numbers replaced by extreme values, keys swapped, truncation),
 //! written to a temporary directory and loaded with `Scene::load`. Each case must not panic, must
@@ -279,6 +281,8 @@ fn seed_expectation(name: &str) -> Option<&'static str> {
         "ten 1024-segment spheres" => Some("triangles"),
         "area light over a 4097×4096 image" => Some("16777216 pixels"),
         "control bytes in a path" => Some("a\\0b\\u{1b}[2J.glb"),
+        "bloom over an 8193×8192 image" => Some("at most 67108864 pixels"),
+        "nearest-field helices past the pixel's work" => Some("[[wave]] \"h2\" may cost"),
         _ => None,
     }
 }

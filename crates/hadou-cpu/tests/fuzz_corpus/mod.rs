@@ -110,6 +110,49 @@ pub fn seeds() -> Vec<(String, Vec<u8>)> {
             ),
         ),
         (
+            // Issue 41: a [bloom] past the glare's 8192² pixels, refused at the [bloom].
+            "bloom over an 8193×8192 image".into(),
+            "[image]\nwidth = 8193\nheight = 8192\n\n[[object]]\nname = \"box\"\nkind = \"box\"\n\n[bloom]\n".into(),
+        ),
+        (
+            // Issue 41: a [bloom] on an anti-aliased frame over ground seen at a grazing angle
+            // (every pixel a silhouette); loads, renders within its budget.
+            "bloom, 16 samples, grazing ground".into(),
+            "[image]\nwidth = 64\nheight = 48\nsamples = 16\n\n[camera]\nposition = [0, 0.05, 6]\n\
+             target = [0, 0, -50]\n\n[[object]]\nname = \"ground\"\nkind = \"plane\"\nsize = [400, 400]\n\n\
+             [[wave]]\nname = \"w\"\nkind = \"sphere\"\nM = [0, 0.5, 0]\nalpha_s = 5\n\n\
+             [bloom]\nintensity = 16\nradius = 1\nstreak = 16\nstreak_length = 4\nthreshold = 0\n"
+                .into(),
+        ),
+        (
+            // Issue 41: nearest-field helices past the work a pixel may cost at 16 samples (the
+            // third passes it).
+            "nearest-field helices past the pixel's work".into(),
+            format!(
+                "[image]\nwidth = 48\nheight = 32\nsamples = 16\n\n{}",
+                (0..3)
+                    .map(|i| format!(
+                        "[[wave]]\nname = \"h{i}\"\nkind = \"helix\"\nO = [-0.5, {i}, 0]\nD = [1, 0, 0]\n\
+                         alpha = 1\nradius = 1\nrate = 804\nlength = 1\nfield = \"nearest\"\n\n"
+                    ))
+                    .collect::<String>()
+            ),
+        ),
+        (
+            // Issue 41: the zigzag the nearest field once spent 1.87 million evaluations a ray on
+            // (a 512-point order-2 B-spline seen down its axis), now at most 742 217.
+            "nearest-field B-spline zigzag down its axis".into(),
+            format!(
+                "[image]\nwidth = 48\nheight = 32\n\n[camera]\nposition = [-8, 0.3, 0.05]\ntarget = [10, 0, 0]\n\
+                 fov = 30\n\n[[wave]]\nname = \"z\"\nkind = \"bspline\"\nO = [-5, 0, 0]\nD = [1, 0, 0]\nalpha = 1\n\
+                 gamma = 10\norder = 2\nfield = \"nearest\"\npoints = [{}]\n",
+                (0..512)
+                    .map(|i| format!("[{}, {}]", if i % 2 == 1 { 0.5 } else { -0.5 }, ((i / 2) % 2) as f32 * 0.5 - 0.25))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ),
+        (
             "control bytes in a path".into(),
             format!("{head}[[object]]\nname = \"g\"\nkind = \"gltf\"\npath = \"a\\u0000b\\u001b[2J.glb\"\n"),
         ),
