@@ -282,7 +282,7 @@ fn seed_expectation(name: &str) -> Option<&'static str> {
         "area light over a 4097×4096 image" => Some("16777216 pixels"),
         "control bytes in a path" => Some("a\\0b\\u{1b}[2J.glb"),
         "bloom over an 8193×8192 image" => Some("at most 67108864 pixels"),
-        "nearest-field helices past the pixel's work" => Some("[[wave]] \"h2\" may cost"),
+        "nearest-field helices past the pixel's work" => Some("[[wave]] \"h11\" may cost"),
         _ => None,
     }
 }

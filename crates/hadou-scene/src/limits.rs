@@ -34,11 +34,12 @@
 
 /// The most work one pixel may cost, in integrand evaluations: the sum over the scene's waves of
 /// each one's bound per ray ([`Scene::ray_work`](crate::Scene::ray_work)) times the samples per
-/// pixel (where a pixel's samples disagree, at a silhouette, the waves run once per sample). 2²⁵
-/// = 33 554 432, about a second of one core at the costliest corners: a 48×32 image within it
-/// takes at most a few minutes on two cores whatever its scene (docs/scene-format.md, "Work per
-/// pixel"). Checked when a scene is loaded and whenever a caller sets the samples.
-pub const PIXEL_WORK_MAX: u64 = 1 << 25;
+/// pixel (where a pixel's samples disagree, at a silhouette, the waves run once per sample).
+/// 2²⁷ = 134 217 728: every wave count and kind the other limits allow at the default 4 samples
+/// (256 curves: 102 million), 83 curves or 11 nearest-field ones at 16; past it, what issue 41
+/// timed at about 13 minutes for a 48×32 image (256 nearest-field helices). Checked when a scene is
+/// loaded and whenever a caller sets the samples (docs/scene-format.md, "Work per pixel").
+pub const PIXEL_WORK_MAX: u64 = 1 << 27;
 
 /// Work of one analytic wave on one ray, in the same units: at most five closed-form pieces (a
 /// beam), each attenuated one marched in at most [`hadou_math::energy::MAX_CELLS`] cells and a

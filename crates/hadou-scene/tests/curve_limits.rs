@@ -174,12 +174,12 @@ fn issue_41_the_work_a_pixel_may_cost_is_bounded() {
     let one: u64 = s.ray_work().iter().sum();
     assert!(one * 16 <= PIXEL_WORK_MAX);
     assert!(s.check_pixel_work(16).is_ok());
-    // Nearest-field helices at 16 samples: the third passes the bound (3 × 742 217 × 16 > 2²⁵).
+    // Nearest-field helices at 16 samples: the twelfth passes the bound (12 × 742 217 × 16 > 2²⁷).
     text = "[image]\nsamples = 16\n".to_owned();
     let mut lines = 2;
     let mut third = 0;
-    for i in 0..4 {
-        if i == 2 {
+    for i in 0..13 {
+        if i == 11 {
             third = lines + 1;
         }
         let h = helix(i, "field = \"nearest\"\n");
@@ -188,12 +188,16 @@ fn issue_41_the_work_a_pixel_may_cost_is_bounded() {
     }
     let e = err(&text);
     assert_eq!(at(&e), (third, 1), "{e}");
-    assert!(msg(&e).contains("[[wave]] \"h2\"") && msg(&e).contains(&PIXEL_WORK_MAX.to_string()), "{e}");
-    // At 4 samples the four fit; a caller asking 16 is told which wave passes.
+    assert!(msg(&e).contains("[[wave]] \"h11\"") && msg(&e).contains(&PIXEL_WORK_MAX.to_string()), "{e}");
+    // At 4 samples the thirteen fit; a caller asking 16 is told which wave passes.
     let s = Scene::parse(&text.replace("samples = 16", "samples = 4"), Path::new("scenes/x.toml")).unwrap();
     assert!(s.check_pixel_work(4).is_ok());
     let (i, m) = s.check_pixel_work(16).unwrap_err();
-    assert_eq!(i, 2, "{m}");
+    assert_eq!(i, 11, "{m}");
+    // 256 curves (the most a scene may have) at the default 4 samples fit.
+    let curves: String = (0..256).map(|i| helix(i, "")).collect();
+    let s = Scene::parse(&curves, Path::new("scenes/x.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(s.check_pixel_work(4).is_ok() && s.check_pixel_work(16).is_err());
     // 256 analytic waves at 16 samples are always within it.
     let many: String = (0..256).map(|i| sphere.replace("\"s\"", &format!("\"s{i}\""))).collect();
     let s = Scene::parse(&format!("[image]\nsamples = 16\n{many}"), Path::new("scenes/x.toml")).unwrap();

@@ -856,6 +856,38 @@ fn issue_41_a_bloom_past_its_pixel_limit_exits_2_and_writes_nothing() {
     assert!(hadou::output::frame_band_rows(&sized(8192, 8192)) >= 1024);
 }
 
+/// Issue 41 (a bounded cost per frame): `--samples` is checked against the work a pixel may cost
+/// with the scene's waves, before anything is rendered or written, naming the flag and the wave.
+#[test]
+fn issue_41_samples_past_the_pixels_work_exit_2() {
+    let dir = tmpdir("pixel-work");
+    let helices: String = (0..12)
+        .map(|i| {
+            format!(
+                "[[wave]]\nname = \"h{i}\"\nkind = \"helix\"\nO = [-0.5, {i}, 0]\nD = [1, 0, 0]\nalpha = 1\n\
+                 radius = 1\nrate = 6\nlength = 1\nfield = \"nearest\"\n\n"
+            )
+        })
+        .collect();
+    let scene = write_scene(&dir, &format!("[image]\nwidth = 8\nheight = 8\nsamples = 4\n\n{helices}"));
+    let s = scene.to_str().unwrap();
+    let out = dir.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let (png, gif) = (out.join("a.png"), out.join("a.gif"));
+    assert_exit_2(
+        &["render", s, "-o", png.to_str().unwrap(), "--samples", "16"],
+        &["--samples 16:", "[[wave]] \"h11\""],
+    );
+    assert_exit_2(
+        &["render", s, "-o", gif.to_str().unwrap(), "--samples", "16", "--frames", "0..2"],
+        &["--samples 16:", "[[wave]] \"h11\""],
+    );
+    let left: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "written: {left:?}");
+    let o = hadou(&["render", s, "-o", png.to_str().unwrap(), "--samples", "9", "--backend", "cpu"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
 #[test]
 fn a_gif_frame_past_its_pixel_limit_exits_2() {
     let dir = tmpdir("gif-size");

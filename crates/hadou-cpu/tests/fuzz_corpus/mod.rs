@@ -126,11 +126,11 @@ pub fn seeds() -> Vec<(String, Vec<u8>)> {
         ),
         (
             // Issue 41: nearest-field helices past the work a pixel may cost at 16 samples (the
-            // third passes it).
+            // twelfth passes it).
             "nearest-field helices past the pixel's work".into(),
             format!(
                 "[image]\nwidth = 48\nheight = 32\nsamples = 16\n\n{}",
-                (0..3)
+                (0..12)
                     .map(|i| format!(
                         "[[wave]]\nname = \"h{i}\"\nkind = \"helix\"\nO = [-0.5, {i}, 0]\nD = [1, 0, 0]\n\
                          alpha = 1\nradius = 1\nrate = 804\nlength = 1\nfield = \"nearest\"\n\n"
