@@ -55,6 +55,7 @@
 
 mod closed;
 mod cost;
+pub use cost::DEFAULT_RAY_WORK;
 mod dispatch;
 pub mod integrate;
 mod lanes;
@@ -83,6 +84,6 @@ pub use reference::{curve_energy_reference, nearest_energy_reference};
 pub use shape::clamped_uniform_knots;
 pub use validate::CurveError;
 pub use wave::{
-    CurveFrame, CurveShape, CurveWave, Integrator, Reduction, DEFAULT_RAY_WORK, MAX_BEZIER_POINTS,
-    MAX_BSPLINE_POINTS, MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
+    CurveFrame, CurveShape, CurveWave, Integrator, Reduction, MAX_BEZIER_POINTS, MAX_BSPLINE_POINTS,
+    MAX_ORDER, MAX_SIMPSON_M, MAX_SLOPE, MAX_TRIG_TERMS, MAX_TURNS,
 };

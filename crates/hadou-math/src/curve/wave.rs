@@ -137,27 +137,6 @@ pub enum Integrator {
     Nearest,
 }
 
-/// Most evaluations one ray of the default integrator takes through any curve within the limits
-/// (turns, terms, control points, steepness; `tests/curve_cost.rs` holds every corner to it: the
-/// measured worst is 73 195, a 64-term `trig` sum at 128 turns).
-pub const DEFAULT_RAY_WORK: u64 = 100_000;
-
-impl Integrator {
-    /// The most evaluations one ray of this integrator may take through any curve within the
-    /// limits: [`DEFAULT_RAY_WORK`]; Simpson's `m + 1` samples per region (three regions with
-    /// a reduction) plus the default integrator's tail past the far point; the nearest-point
-    /// field's [`NEAREST_RAY_WORK`](super::NEAREST_RAY_WORK).
-    pub fn ray_work_bound(&self) -> u64 {
-        match self {
-            Integrator::Default => DEFAULT_RAY_WORK,
-            Integrator::Simpson { m, reduction } => {
-                (if reduction.is_some() { 3 } else { 1 }) * (u64::from(*m) + 1) + DEFAULT_RAY_WORK
-            }
-            Integrator::Nearest => super::NEAREST_RAY_WORK,
-        }
-    }
-}
-
 /// A curved wave: everything needed to integrate its energy along a ray.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CurveWave {
