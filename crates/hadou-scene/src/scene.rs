@@ -111,6 +111,17 @@ pub(crate) enum WaveKind {
     BSpline,
 }
 
+impl WaveKind {
+    /// Whether the kind is a curve (integrated numerically) rather than a closed-form shape;
+    /// exhaustive, so a new kind must say which.
+    pub(crate) fn is_curve(self) -> bool {
+        match self {
+            WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => false,
+            WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => true,
+        }
+    }
+}
+
 /// How a curve is integrated (the structural, non-animatable part).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum IntegratorDef {
@@ -234,16 +245,19 @@ impl Scene {
         use hadou_math::curve::{Integrator, Reduction};
         self.waves
             .iter()
-            .map(|w| match (w.kind, w.integrator) {
-                (WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam, _) => {
+            .map(|w| match w.kind {
+                WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => {
                     crate::ANALYTIC_RAY_WORK
                 }
-                (_, IntegratorDef::Default) => Integrator::Default.ray_work_bound(),
-                (_, IntegratorDef::Nearest) => Integrator::Nearest.ray_work_bound(),
-                (_, IntegratorDef::Simpson { m, n }) => {
-                    let reduction = n.map(|n| Reduction { n, epsilon: 0.0 });
-                    Integrator::Simpson { m, reduction }.ray_work_bound()
-                }
+                WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => match w.integrator
+                {
+                    IntegratorDef::Default => Integrator::Default.ray_work_bound(),
+                    IntegratorDef::Nearest => Integrator::Nearest.ray_work_bound(),
+                    IntegratorDef::Simpson { m, n } => {
+                        let reduction = n.map(|n| Reduction { n, epsilon: 0.0 });
+                        Integrator::Simpson { m, reduction }.ray_work_bound()
+                    }
+                },
             })
             .collect()
     }
@@ -494,7 +508,9 @@ impl Scene {
                 head_alpha: p.f(vals, "head_alpha"),
                 muzzle_alpha: p.f(vals, "muzzle_alpha"),
             }),
-            _ => WaveShape::Curve(self.build_curve(w, vals)),
+            WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => {
+                WaveShape::Curve(self.build_curve(w, vals))
+            }
         };
         Wave {
             name: w.name.clone(),

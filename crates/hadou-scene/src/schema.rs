@@ -774,7 +774,8 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
         "helix" => WaveKind::Helix,
         "trig" => WaveKind::Trig,
         "bezier" => WaveKind::Bezier,
-        _ => WaveKind::BSpline,
+        "bspline" => WaveKind::BSpline,
+        other => return Err(t.src.value_err(&t.key_span("kind"), format!("unknown wave kind \"{other}\""))),
     };
     let extra: &[&str] = match kind {
         WaveKind::Sphere => &["M", "alpha_s"],
@@ -786,7 +787,7 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
         WaveKind::Bezier => &["points"],
         WaveKind::BSpline => &["points", "order", "knots"],
     };
-    let is_curve = matches!(kind, WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline);
+    let is_curve = kind.is_curve();
     let allowed: Vec<&str> = WAVE_COMMON
         .iter()
         .chain(if is_curve { CURVE_COMMON } else { ANALYTIC_COMMON })
@@ -882,7 +883,9 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
                 rd.add(t, &mut p, "muzzle_alpha", S, ALPHA, Fallback::Value(&[0.0]), false)?;
             }
         }
-        _ => parse_curve(t, &mut def, &mut p, rd)?,
+        WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => {
+            parse_curve(t, &mut def, &mut p, rd)?
+        }
     }
     def.params = p;
     Ok(def)
@@ -1072,7 +1075,7 @@ fn check_curve(w: &WaveDef, p: &ParamSet, vals: &[f32]) -> Result<(), (&'static 
 /// [`hadou_math::curve::CurveWave::validate`] on the curve built from `vals` (a no-op for analytic
 /// waves); the error names the scene-file key.
 fn validate_curve(scene: &Scene, w: &WaveDef, vals: &[f32]) -> Result<(), (&'static str, String)> {
-    if matches!(w.kind, WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam) {
+    if !w.kind.is_curve() {
         return Ok(());
     }
     scene.build_curve(w, vals).validate().map_err(|e| {
