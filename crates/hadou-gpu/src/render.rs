@@ -281,7 +281,13 @@ impl Renderer {
         }
         self.targets = None; // free the old ones first
         let d = &self.ctx.device;
-        let texture = |label, format, usage| texture_view(d, label, size, format, usage);
+        // The textures are allocated at the next power of two of the tile (the passes' viewports
+        // and dispatches cover only the tile): llvmpipe keys each compiled shader by whether its
+        // textures' edges are powers of two, so tiles of every size then share one compile of
+        // each pipeline instead of up to four (a cold uber-shader compile is ~20 s on lavapipe).
+        let limit = self.ctx.limits.max_texture_dimension_2d;
+        let pot = size.map(|e| if e.next_power_of_two() <= limit { e.next_power_of_two() } else { e });
+        let texture = |label, format, usage| texture_view(d, label, pot, format, usage);
         let attach_and_read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let scene_view = texture("normal and distance", SCENE_FORMAT, attach_and_read);
         let attributes_view = texture("uv, colour and material", SCENE_FORMAT, attach_and_read);
