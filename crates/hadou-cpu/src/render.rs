@@ -207,7 +207,11 @@ fn render_chunked(
     // background, so the opaque pass and its per-pixel buffers are skipped.
     let blank = frame.objects.is_empty() && frame.area_light.is_none();
     if let Some(params) = glare {
-        let parts = GlareParts { frame, surfaces, setup: &setup, params, k, blank, simd, chunk_samples };
+        let parts = GlareParts {
+            draw: DrawParts { frame, surfaces, setup: &setup, k, blank, simd },
+            params,
+            chunk_samples,
+        };
         return match target {
             Target::Float(img) => glare_rows(&parts, scratch, src, band, img, start),
             Target::Srgb8(out) => {
@@ -226,16 +230,9 @@ fn render_chunked(
             }
         };
     }
-    let oy0 = if blank { 0 } else { opaque_pass(surfaces, &setup, k * src.start..k * src.end, scratch) };
+    let draw = DrawParts { frame, surfaces, setup: &setup, k, blank, simd };
+    let source = draw.row_source(src.clone(), scratch);
     let opaque_done = Instant::now();
-    let source = RowSource {
-        k,
-        blank: blank.then(|| blank_color(surfaces.background, k)),
-        opaque: scratch,
-        oy0,
-        pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
-        samples: WavePass::new(surfaces, &setup.basis, &setup.curves).on_path(simd),
-    };
 
     let w = frame.width as usize;
     let n = w * (y1 - y0) as usize;
@@ -437,16 +434,40 @@ fn sample_key(o: &OpaqueBuffers, i: usize) -> Option<(u32, u32, bool)> {
     Some((o.object[i]?, e.material, e.hull))
 }
 
-/// What [`glare_rows`] draws a frame with a `[bloom]` from.
-struct GlareParts<'a> {
+/// What a frame's rows are drawn from: the frame, the frame its opaque pass draws, the set-up,
+/// the sample grid's `k`, whether nothing opaque is drawn, and the vector path.
+#[derive(Clone, Copy)]
+struct DrawParts<'a> {
     frame: &'a Frame,
     /// The frame the opaque pass draws (the sample frame with `k > 1`).
     surfaces: &'a Frame,
     setup: &'a FrameSetup,
-    params: &'a hadou_math::bloom::BloomParams,
     k: usize,
     blank: bool,
     simd: SimdPath,
+}
+
+impl<'a> DrawParts<'a> {
+    /// The opaque pass over the image rows `rows` (skipped for a blank frame) into `scratch`,
+    /// and the [`RowSource`] that lights those rows from it.
+    fn row_source(&self, rows: std::ops::Range<usize>, scratch: &'a mut OpaqueBuffers) -> RowSource<'a> {
+        let DrawParts { frame, surfaces, setup, k, blank, simd } = *self;
+        let oy0 = if blank { 0 } else { opaque_pass(surfaces, setup, k * rows.start..k * rows.end, scratch) };
+        RowSource {
+            k,
+            blank: blank.then(|| blank_color(surfaces.background, k)),
+            opaque: scratch,
+            oy0,
+            pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
+            samples: WavePass::new(surfaces, &setup.basis, &setup.curves).on_path(simd),
+        }
+    }
+}
+
+/// What [`glare_rows`] draws a frame with a `[bloom]` from.
+struct GlareParts<'a> {
+    draw: DrawParts<'a>,
+    params: &'a hadou_math::bloom::BloomParams,
     /// Samples of the opaque pass drawn at once ([`GLARE_CHUNK_SAMPLES`]).
     chunk_samples: usize,
 }
@@ -481,7 +502,8 @@ fn glare_rows(
     img: &mut Image,
     start: Instant,
 ) -> Result<PassTimes, RenderError> {
-    let GlareParts { frame, surfaces, setup, params, k, blank, simd, chunk_samples } = *parts;
+    let GlareParts { draw, params, chunk_samples } = *parts;
+    let DrawParts { frame, k, .. } = draw;
     let w = frame.width as usize;
     let n = w * band.len();
     (img.width, img.height) = (frame.width, band.len() as u32);
@@ -503,16 +525,8 @@ fn glare_rows(
     let mut t = start;
     for (c, lin) in linear.data.chunks_mut(chunk * w).enumerate() {
         let rows = src.start + c * chunk..(src.start + (c + 1) * chunk).min(src.end);
-        let oy0 = if blank { 0 } else { opaque_pass(surfaces, setup, k * rows.start..k * rows.end, scratch) };
+        let source = draw.row_source(rows.clone(), scratch);
         let opaque_done = Instant::now();
-        let source = RowSource {
-            k,
-            blank: blank.then(|| blank_color(surfaces.background, k)),
-            opaque: scratch,
-            oy0,
-            pass: WavePass::new(frame, &setup.basis, &setup.curves).on_path(simd),
-            samples: WavePass::new(surfaces, &setup.basis, &setup.curves).on_path(simd),
-        };
         // The band's rows of this chunk keep their energy and depth; the halo's go to scratch.
         let own = rows.start.max(band.start)..rows.end.min(band.end).max(rows.start.max(band.start));
         let (energy, depth) = if own.is_empty() {
