@@ -98,10 +98,10 @@ fn specialised_variants_render_identically_to_the_uber_shader() {
     let Some(mut gpu) = gpu_or_skip("variants vs uber-shader") else { return };
     // Known cost (issue 28, speed): on llvmpipe OpenGL the uber-shader's first compile takes over
     // ten minutes (its WGSL, translated to GLSL, holds every wave kind and the MToon look), so the
-    // comparison runs on the other adapters (lavapipe Vulkan: about 160 s with an empty shader
-    // cache, within the 900 s a software adapter's wait allows, device.rs SOFTWARE_WAIT_TIMEOUT;
-    // seconds once Mesa has cached it); the variants themselves are held to the CPU on GL by the
-    // differential tests.
+    // comparison runs on the other adapters (lavapipe Vulkan: about 20 s for its first compile
+    // with an empty shader cache, within the 900 s a software adapter's wait allows, device.rs
+    // SOFTWARE_WAIT_TIMEOUT; one compile serves every frame since wave_energy.wgsl's load_frame);
+    // the variants themselves are held to the CPU on GL by the differential tests.
     if gpu.adapter_info().backend == wgpu::Backend::Gl {
         eprintln!("variants vs uber-shader: skipped on OpenGL (issue 28: the uber-shader's compile)");
         return;

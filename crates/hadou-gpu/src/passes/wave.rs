@@ -26,7 +26,7 @@ const CS: wgpu::ShaderStages = wgpu::ShaderStages::COMPUTE;
 /// The bindings of the wave module (wave.wgsl 0–4 and 13, curve.wgsl 5–7, shading_bindings.wgsl
 /// 8–10, shadow_bindings.wgsl 11–12).
 pub(crate) const BINDINGS: [Binding; 14] = [
-    Binding::new(0, "frame", Kind::Uniform, CS),
+    Binding::new(0, "frame_uniforms", Kind::Uniform, CS),
     Binding::new(1, "waves", Kind::Storage, CS),
     Binding::new(2, "scene_texels", Kind::UintTexture, CS),
     Binding::new(3, "attribute_texels", Kind::UintTexture, CS),

@@ -18,7 +18,7 @@ const FS: wgpu::ShaderStages = wgpu::ShaderStages::FRAGMENT;
 /// The bindings of the wave overlay module (wave_energy.wgsl 0–1, wave_overlay.wgsl 2–3,
 /// curve.wgsl 5–7).
 pub(crate) const BINDINGS: [Binding; 7] = [
-    Binding::new(0, "frame", Kind::Uniform, FS),
+    Binding::new(0, "frame_uniforms", Kind::Uniform, FS),
     Binding::new(1, "waves", Kind::Storage, FS),
     Binding::new(2, "depth_texels", Kind::Depth, FS),
     Binding::new(3, "overlay", Kind::Uniform, FS),
@@ -29,7 +29,7 @@ pub(crate) const BINDINGS: [Binding; 7] = [
 
 /// [`BINDINGS`] for a multisampled depth buffer ([`source`]`(true)`).
 pub(crate) const BINDINGS_MULTISAMPLED: [Binding; 7] = [
-    Binding::new(0, "frame", Kind::Uniform, FS),
+    Binding::new(0, "frame_uniforms", Kind::Uniform, FS),
     Binding::new(1, "waves", Kind::Storage, FS),
     Binding::new(2, "depth_texels", Kind::DepthMultisampled, FS),
     Binding::new(3, "overlay", Kind::Uniform, FS),

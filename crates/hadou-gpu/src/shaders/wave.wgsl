@@ -85,6 +85,7 @@ override USE_TONE_FILMIC: bool = true;
 // pixel resolved from grid × grid samples.
 @compute @workgroup_size(8, 8, 1)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    load_frame();
     if (id.x >= frame.tile_size.x || id.y >= frame.tile_size.y) {
         return;
     }

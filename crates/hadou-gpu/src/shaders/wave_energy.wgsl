@@ -4,8 +4,38 @@
 // and Σ rgb·a·I. Prepended by common.wgsl, energy.wgsl and curve.wgsl; the frame's uniforms and
 // waves are bindings 0 and 1 of both modules.
 
-@group(0) @binding(0) var<uniform> frame: FrameUniforms;
+@group(0) @binding(0) var<uniform> frame_uniforms: FrameUniforms;
 @group(0) @binding(1) var<storage, read> waves: array<GpuWave>;
+// The frame's uniforms as the functions below read them: a private copy, made by load_frame() at
+// the top of every entry point of the modules composed with this file.
+var<private> frame: FrameUniforms;
+
+// Copies the uniforms into `frame`, its words that decide branches and loop counts hidden from
+// the driver's constant folding. Mesa's lavapipe (the software Vulkan adapter) compiles a large
+// shader again for every new value of up to four uniforms that decide its branches ("uniform
+// inlining"): a new wave count, tone mapping, sample grid, shadow count or `[area_light]` cost a
+// whole compile (about 20 s for the uber-shader, up to seconds for a specialised variant) once per
+// scene, and a live edit of any of them stalled the viewer. OR-ing each with a zero the driver
+// cannot prove (the top bit of the waves buffer's length: no buffer holds 2³¹ waves) changes no
+// value and no branch, and one compile serves every frame of a variant.
+fn load_frame() {
+    frame = frame_uniforms;
+    let zero = arrayLength(&waves) >> 31u;
+    frame.tone_mode |= zero;
+    frame.wave_count |= zero;
+    frame.any_glow |= zero;
+    frame.image_size |= vec2<u32>(zero);
+    frame.tile_origin |= vec2<u32>(zero);
+    frame.tile_size |= vec2<u32>(zero);
+    frame.shadow_casts |= zero;
+    frame.map_casts |= zero;
+    frame.cast_count |= zero;
+    frame.map_count |= zero;
+    frame.plane_count |= zero;
+    frame.area |= zero;
+    frame.outline_reach |= zero;
+    frame.grid |= zero;
+}
 // The wave kinds a frame contains (pipeline-overridable; see passes/wave.rs WaveVariant).
 override USE_SPHERE: bool = true;
 override USE_CYLINDER: bool = true;

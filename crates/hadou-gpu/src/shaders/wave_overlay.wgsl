@@ -51,6 +51,7 @@ fn vs_overlay(@builtin(vertex_index) k: u32) -> @builtin(position) vec4<f32> {
 
 @fragment
 fn fs_overlay(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    load_frame();
     let px = u32(position.x);
     let py = u32(position.y);
     let dir = pixel_dir(frame, px, py);

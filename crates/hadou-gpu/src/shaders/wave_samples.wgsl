@@ -68,6 +68,7 @@ fn tile_sample(s: vec2<u32>, ns: u32) -> Sample {
 // draws frames of one sample.
 @compute @workgroup_size(8, 8, 1)
 fn cs_samples(@builtin(global_invocation_id) id: vec3<u32>) {
+    load_frame();
     let g = max(frame.grid, 1u);
     let size = frame.tile_size / g;
     if (id.x >= size.x || id.y >= size.y) {
