@@ -9,6 +9,10 @@
    `.md`, `.py`, `.sh`) exists: from the repository root, from the crate of its section, or from
    that crate's `src/` (a bare file name is looked for anywhere under that crate).
 3. No line counts ("(750 lines)"): they drift with every change.
+4. The "Add a wave shape" walk-through names every source file that lists the closed-form wave
+   kinds one by one (a match, table or dispatch over `WaveShape`, `WaveKind`, the GPU's `WAVE_*`
+   codes, `KIND_BIT_*` bits or `USE_*` overrides, or hadou-math's per-shape energies): each must
+   gain the new kind, so the list is checked against the kinds' uses, not kept by hand.
 
 Exit 1 with one line per problem; 0 and a summary otherwise. Run from anywhere.
 """
@@ -102,6 +106,37 @@ def exists(token, crate):
     return False
 
 
+# Groups of names that a place handling every wave kind lists one by one (the closed-form kinds;
+# a curve kind's places are the curve module's and are listed under it).
+KIND_GROUPS = [
+    [f"WaveShape::{k}" for k in ("Sphere", "Cylinder", "Capsule", "Beam")],
+    [f"WaveKind::{k}" for k in ("Sphere", "Cylinder", "Capsule", "Beam")],
+    [f"WAVE_{k}" for k in ("SPHERE", "CYLINDER", "CAPSULE", "BEAM")],
+    [f"KIND_BIT_{k}" for k in ("SPHERE", "CYLINDER", "CAPSULE", "BEAM")],
+    [f"USE_{k}" for k in ("SPHERE", "CYLINDER", "CAPSULE", "BEAM")],
+    [f"{k}_energy" for k in ("sphere", "cylinder", "capsule", "beam")],
+]
+
+
+def wave_kind_sites():
+    """Every source file (`crates/*/src/`, Rust or WGSL) naming all closed-form kinds of one group."""
+    sites = []
+    for f in sorted(FILES):
+        parts = f.split("/")
+        if len(parts) < 4 or parts[0] != "crates" or parts[2] != "src" or not f.endswith((".rs", ".wgsl")):
+            continue
+        code = open(os.path.join(ROOT, f), encoding="utf-8").read()
+        if any(all(re.search(r"(?<![\w])" + re.escape(n) + r"(?![\w])", code) for n in g) for g in KIND_GROUPS):
+            sites.append(f)
+    return sites
+
+
+def walk_through(text):
+    """The body of the "Add a wave shape" section, or None."""
+    m = re.search(r"^### Add a wave shape$(.*?)(?=^#{1,3} )", text, flags=re.M | re.S)
+    return m.group(1) if m else None
+
+
 def main():
     text = open(MAP, encoding="utf-8").read()
     problems = []
@@ -128,6 +163,14 @@ def main():
                 if not exists(token, crate):
                     where = f"crates/{crate}" if crate else "the top"
                     problems.append(f"ARCHITECTURE.md: `{token}` (in {where}) does not exist")
+    walk = walk_through(text)
+    sites = wave_kind_sites()
+    if walk is None:
+        problems.append("ARCHITECTURE.md: no section `### Add a wave shape`")
+    else:
+        for f in sites:
+            if f"`{f}`" not in walk:
+                problems.append(f"ARCHITECTURE.md: \"Add a wave shape\" does not name `{f}`, which lists every wave kind")
     for n, line in enumerate(text.splitlines(), 1):
         if re.search(r"\(\d[\d,]* lines", line):
             problems.append(f"ARCHITECTURE.md:{n}: a line count (they drift): {line.strip()[:80]}")
@@ -136,7 +179,8 @@ def main():
     if problems:
         print(f"{len(problems)} problem(s)")
         return 1
-    print(f"ARCHITECTURE.md: {count} modules named, {paths} paths exist, no line counts")
+    print(f"ARCHITECTURE.md: {count} modules named, {paths} paths exist, no line counts, "
+          f"the {len(sites)} places that list every wave kind in \"Add a wave shape\"")
     return 0
 
 

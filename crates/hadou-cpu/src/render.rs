@@ -190,7 +190,7 @@ fn render_chunked(
     let start = Instant::now();
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
-    let k = frame.grid() as usize;
+    let k = frame.sample_grid().edge() as usize;
     let sampled;
     let surfaces = if k > 1 {
         sampled = frame.sample_frame();

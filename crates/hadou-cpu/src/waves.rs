@@ -12,14 +12,7 @@ use hadou_scene::{CameraBasis, Frame, ToneMode, Wave, WaveShape};
 /// Per-frame preparation of the curved waves (piece tables, bounds), one entry per wave, `None`
 /// for analytic waves.
 pub(crate) fn prepare_curves(frame: &Frame) -> Vec<Option<PreparedCurve>> {
-    frame
-        .waves
-        .iter()
-        .map(|w| match &w.shape {
-            WaveShape::Curve(c) => Some(curve::prepare(c)),
-            _ => None,
-        })
-        .collect()
+    frame.waves.iter().map(|w| w.shape.curve().map(curve::prepare)).collect()
 }
 
 /// Integrand evaluations one analytic wave counts per pixel (closed-form pieces).
@@ -180,7 +173,7 @@ impl<'a> WavePass<'a> {
                 Falloff::Faithful => &rays.faithful,
                 Falloff::InverseSquare => &rays.inverse_square,
             };
-            if wave.attenuation > 0.0 && !matches!(wave.shape, WaveShape::Curve(_)) {
+            if wave.attenuation > 0.0 && wave.shape.curve().is_none() {
                 let e = attenuated_lanes(wave, &p, ray, &rays, valid);
                 sink.wave(wi, lanes::saturate(e), [analytic_evaluations(&wave.shape); LANES]);
                 continue;

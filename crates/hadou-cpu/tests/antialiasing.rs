@@ -161,12 +161,12 @@ fn bands_of_rows_are_the_whole_frames_rows() {
 #[test]
 fn the_grid_follows_the_samples_and_the_soft_shadow_limit() {
     let f = scene(64, 9);
-    assert_eq!(f.grid(), 3);
+    assert_eq!(f.sample_grid().edge(), 3);
     let s = f.sample_frame();
     assert_eq!((s.width, s.height, s.samples), (192, 144, 1));
     assert_eq!(s.camera, f.camera);
-    assert_eq!(Frame { samples: 1, ..f.clone() }.grid(), 1);
-    assert_eq!(Frame { samples: 16, ..f.clone() }.grid(), 4);
+    assert_eq!(Frame { samples: 1, ..f.clone() }.sample_grid().edge(), 1);
+    assert_eq!(Frame { samples: 16, ..f.clone() }.sample_grid().edge(), 4);
     // A count that is not a square (only code can set one) draws one sample.
-    assert_eq!(Frame { samples: 2, ..f.clone() }.grid(), 1);
+    assert_eq!(Frame { samples: 2, ..f.clone() }.sample_grid().edge(), 1);
 }

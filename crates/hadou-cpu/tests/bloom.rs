@@ -115,7 +115,7 @@ fn issue_41_the_glare_drawn_in_chunks_equals_one_chunk() {
     let mut f = scene_frame("repainted.toml", 1.5, 96, 64);
     f.samples = 4;
     f.bloom = glare_frame().bloom;
-    assert!(f.grid() == 2, "the frame is anti-aliased");
+    assert!(f.sample_grid().edge() == 2, "the frame is anti-aliased");
     let one = hadou_cpu::render_rows_glare_chunked(&f, 0..64, usize::MAX);
     assert_eq!(one, hadou_cpu::render(&f), "one chunk is the renderer's own frame here");
     // 1, 3 and 7 rows of samples a chunk (the chunk's size is in samples: width × 4 a row).

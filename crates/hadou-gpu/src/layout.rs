@@ -12,8 +12,8 @@ use hadou_math::shadow::MapFrame;
 use hadou_math::toon::{Filter, Ramp, RampKind, Wrap, MAX_RAMP_BANDS};
 use hadou_math::{Mat4, Vec3f};
 use hadou_scene::{
-    CameraBasis, Frame, LightLine, Object, ShadingModel, ShadowCast, ShadowMethod, TextureRef, ToneMode,
-    Wave, WaveShape,
+    CameraBasis, Frame, LightLine, Object, SampleGrid, ShadingModel, ShadowCast, ShadowMethod, TextureRef,
+    ToneMode, Wave, WaveShape,
 };
 
 /// `GpuWave::kind` of a sphere field. Keep in sync with `WAVE_SPHERE` in common.wgsl.
@@ -132,8 +132,16 @@ fn outline_reach(frame: &Frame) -> u32 {
 }
 
 impl FrameUniforms {
-    /// Uniforms of the tile at `origin` with `size` pixels, for `frame` seen through `basis`.
-    pub fn new(frame: &Frame, basis: &CameraBasis, origin: [u32; 2], size: [u32; 2]) -> Self {
+    /// Uniforms of the tile at `origin` with `size` pixels, for `frame` seen through `basis`;
+    /// `grid` is the sample grid of the image `frame`'s pixels resolve into (`frame` itself is
+    /// the sample frame with anti-aliasing, so its own `samples` is 1).
+    pub fn new(
+        frame: &Frame,
+        basis: &CameraBasis,
+        origin: [u32; 2],
+        size: [u32; 2],
+        grid: SampleGrid,
+    ) -> Self {
         let (w, h) = (frame.width as f32, frame.height as f32);
         let (tw, th) = (size[0] as f32, size[1] as f32);
         let (ox, oy) = (origin[0] as f32, origin[1] as f32);
@@ -173,7 +181,7 @@ impl FrameUniforms {
             area_position: frame.area_light.as_ref().map_or([0.0; 3], |a| a.position.to_array()),
             outline_reach: outline_reach(frame),
             area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
-            grid: 1,
+            grid: grid.edge(),
         }
     }
 }
@@ -1042,14 +1050,14 @@ pub fn frame_waves(frame: &Frame) -> Result<FrameWaves, String> {
     let mut waves = Vec::with_capacity(frame.waves.len());
     let mut prepared = Vec::with_capacity(frame.waves.len());
     for w in &frame.waves {
-        match &w.shape {
-            WaveShape::Curve(c) => {
+        match w.shape.curve() {
+            Some(c) => {
                 let prep = curve::prepare(c);
                 let index = curves.push(&prep).map_err(|e| format!("wave `{}`: {e}", w.name))?;
                 waves.push(GpuWave::curve(w, index));
                 prepared.push(Some(prep));
             }
-            _ => {
+            None => {
                 waves.extend(GpuWave::new(w));
                 prepared.push(None);
             }

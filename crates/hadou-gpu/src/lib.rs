@@ -338,7 +338,7 @@ impl GpuBackend {
         frame: &Frame,
     ) -> Result<(Image, Option<passes::soft::SoftReadback>), RenderError> {
         let image = self.renderer.render(frame)?;
-        let soft = if frame.grid() > 1 {
+        let soft = if !frame.sample_grid().is_single() {
             self.renderer.read_soft(&frame.sample_frame())?
         } else {
             self.renderer.read_soft(frame)?

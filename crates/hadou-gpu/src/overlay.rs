@@ -112,7 +112,8 @@ impl Renderer {
                     usage: wgpu::BufferUsages::UNIFORM,
                 })
             };
-            let frame_uniforms = FrameUniforms::new(frame, &basis, [0, 0], size);
+            let frame_uniforms =
+                FrameUniforms::new(frame, &basis, [0, 0], size, hadou_scene::SampleGrid::SINGLE);
             let uniforms = uniform("overlay frame", bytemuck::bytes_of(&frame_uniforms));
             let depth_model = match target.depth_model {
                 DepthModel::Standard => DEPTH_STANDARD,

@@ -25,7 +25,7 @@ use crate::timing::PassQueries;
 use hadou_scene::BloomParams;
 #[cfg(not(target_arch = "wasm32"))]
 use hadou_scene::Image;
-use hadou_scene::{Frame, RenderError};
+use hadou_scene::{Frame, RenderError, SampleGrid};
 
 /// Largest tile edge in pixels (smaller when the device's limits demand it).
 pub const MAX_TILE: u32 = 1024;
@@ -113,10 +113,10 @@ pub(crate) struct Prepared {
     /// Whether the wave pass writes the linear colour, unmapped, for the glare
     /// ([`Renderer::render_rows`] of a frame with a `[bloom]`).
     linear: bool,
-    /// The edge of the frame's sample grid (`Frame::grid`); with more than one sample per pixel
+    /// The frame's sample grid (`Frame::sample_grid`); with more than one sample per pixel
     /// the tiles, the G-buffer, the shadows and the soft shadows are the sample frame's
     /// (`sampled`), and the wave pass resolves each image pixel from its samples.
-    grid: u32,
+    grid: SampleGrid,
     sampled: Option<Frame>,
     /// The tile the G-buffer holds when the last tile encoded was classified for the soft
     /// shadows (`TileWork::Classify`), and nothing since: the next tile drawn, if it is that
@@ -146,7 +146,7 @@ impl Prepared {
     /// A tile of [`Prepared::tiles`] (in samples) in image pixels: what its wave pass writes and
     /// what is read back.
     pub(crate) fn output_tile(&self, (origin, size): ([u32; 2], [u32; 2])) -> ([u32; 2], [u32; 2]) {
-        let g = self.grid;
+        let g = self.grid.edge();
         ([origin[0] / g, origin[1] / g], [size[0] / g, size[1] / g])
     }
 
@@ -370,8 +370,9 @@ impl Renderer {
         debug_assert!(submit_maps || frame.area_light.is_none());
         self.ctx.check()?;
         prepare::validate_frame(frame)?;
-        let grid = frame.grid();
-        let sampled = (grid > 1).then(|| frame.sample_frame());
+        let sample_grid = frame.sample_grid();
+        let grid = sample_grid.edge();
+        let sampled = (!sample_grid.is_single()).then(|| frame.sample_frame());
         let frame = sampled.as_ref().unwrap_or(frame);
         let rows = grid * rows.start..grid * rows.end;
         let mut tile = tile_size(&self.ctx.limits, frame.width, frame.height)?;
@@ -431,7 +432,7 @@ impl Renderer {
                 raster,
                 groups: None,
                 linear: false,
-                grid,
+                grid: sample_grid,
                 sampled: None,
                 classified_tile: std::sync::Mutex::new(None),
             };
@@ -707,8 +708,7 @@ impl Renderer {
         let t = self.targets.as_ref().expect("targets are created in prepare");
         let basis = frame.camera.basis(frame.width, frame.height);
         let (origin, size) = tile;
-        let mut uniforms = FrameUniforms::new(frame, &basis, origin, size);
-        uniforms.grid = prepared.grid;
+        let mut uniforms = FrameUniforms::new(frame, &basis, origin, size, prepared.grid);
         prepared.shadow_fields.apply(&mut uniforms);
         if prepared.linear {
             uniforms.tone_mode = TONE_LINEAR;

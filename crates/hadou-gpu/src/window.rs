@@ -104,7 +104,7 @@ impl Renderer {
             let (out, encoder) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
             // The present pass reads the tile's place from the uniforms: the band, in image pixels.
             let mut u: FrameUniforms = bytemuck::Zeroable::zeroed();
-            u.grid = 1;
+            u.grid = hadou_scene::SampleGrid::SINGLE.edge();
             u.tile_origin = [0, band.start as u32];
             u.tile_size = [frame.width, band.len() as u32];
             let d = &self.ctx.device;

@@ -66,12 +66,41 @@ pub fn check_samples(samples: u32) -> Result<(), String> {
     }
 }
 
+/// A frame's sample grid: `edge × edge` samples per image pixel, decided once per frame by
+/// [`Frame::sample_grid`] (from `[image] samples` and the `[area_light]`'s budget). Every
+/// consumer, both backends, the CLI's band sizes and the GPU's uniforms, reads it from there;
+/// the sample frame ([`Frame::sample_frame`]) is a frame of one sample per pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SampleGrid {
+    edge: u32,
+}
+
+impl SampleGrid {
+    /// One sample per pixel.
+    pub const SINGLE: SampleGrid = SampleGrid { edge: 1 };
+
+    /// The grid's edge `k`: 1 to 4.
+    pub fn edge(self) -> u32 {
+        self.edge
+    }
+
+    /// Samples per pixel, `k²`.
+    pub fn count(self) -> u32 {
+        self.edge * self.edge
+    }
+
+    /// Whether a pixel is one sample (no anti-aliasing).
+    pub fn is_single(self) -> bool {
+        self.edge == 1
+    }
+}
+
 impl Frame {
-    /// The edge `k` of the frame's `k × k` sample grid: `√samples` (1 for a count that is not
-    /// 4, 9 or 16), made smaller where an `[area_light]` would otherwise shade more than
+    /// The frame's `k × k` sample grid: `k = √samples` (1 for a count that is not 4, 9 or 16),
+    /// made smaller where an `[area_light]` would otherwise shade more than
     /// [`crate::SOFT_MAX_PIXELS`] samples (its penumbra search works on every sample of the image
     /// at once).
-    pub fn grid(&self) -> u32 {
+    pub fn sample_grid(&self) -> SampleGrid {
         let mut k = match self.samples {
             4 => 2,
             9 => 3,
@@ -84,17 +113,17 @@ impl Frame {
                 k -= 1;
             }
         }
-        k
+        SampleGrid { edge: k }
     }
 
     /// The frame whose pixels are this frame's samples: `k` times as wide and as high
-    /// ([`Frame::grid`]), one sample each, without the `[bloom]` (which works on the resolved
+    /// ([`Frame::sample_grid`]), one sample each, without the `[bloom]` (which works on the resolved
     /// image). Sample `(i, j)` of pixel `(x, y)` is the sample frame's pixel `(k·x + i, k·y + j)`,
     /// centred at `x + (i + ½)/k`: an ordered grid. Both backends draw the surfaces of this frame
     /// and resolve each pixel by the box filter over its samples; the camera, and so every ray
     /// through a pixel's centre, is the same in both frames.
     pub fn sample_frame(&self) -> Frame {
-        let k = self.grid();
+        let k = self.sample_grid().edge();
         Frame { width: self.width * k, height: self.height * k, samples: 1, bloom: None, ..self.clone() }
     }
 }
@@ -651,6 +680,39 @@ pub struct Wave {
     pub light: WaveLight,
 }
 
+/// What a front end sets over a scene's frame: the CLI's `--width`, `--height` and `--samples`,
+/// an export's sizes, the web page's `width=` and `height=`. The one place they are applied
+/// ([`FrameOverrides::apply`], [`crate::Scene::at_with`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameOverrides {
+    /// The image width in pixels, over `[image] width`.
+    pub width: Option<u32>,
+    /// The image height in pixels, over `[image] height`.
+    pub height: Option<u32>,
+    /// Samples per pixel, over `[image] samples`.
+    pub samples: Option<u32>,
+}
+
+impl FrameOverrides {
+    /// Sets what is given on `frame`.
+    pub fn apply(&self, frame: &mut Frame) {
+        if let Some(w) = self.width {
+            frame.width = w;
+        }
+        if let Some(h) = self.height {
+            frame.height = h;
+        }
+        if let Some(s) = self.samples {
+            frame.samples = s;
+        }
+    }
+
+    /// Whether a size is given.
+    pub fn sets_size(&self) -> bool {
+        self.width.is_some() || self.height.is_some()
+    }
+}
+
 /// The shape of a wave.
 #[derive(Clone, Debug)]
 pub enum WaveShape {
@@ -664,6 +726,20 @@ pub enum WaveShape {
     Beam(BeamField<f32>),
     /// A curved wave.
     Curve(CurveWave),
+}
+
+impl WaveShape {
+    /// The curve, for a curved wave; `None` for the shapes with a closed form. Exhaustive, so a
+    /// new shape must say which it is; code that treats the two groups apart asks here rather
+    /// than matching with a catch-all.
+    pub fn curve(&self) -> Option<&CurveWave> {
+        match self {
+            WaveShape::Sphere(_) | WaveShape::Cylinder(_) | WaveShape::Capsule(_) | WaveShape::Beam(_) => {
+                None
+            }
+            WaveShape::Curve(c) => Some(c),
+        }
+    }
 }
 
 /// How the summed wave colour and the scene colour become the output colour.
@@ -703,9 +779,9 @@ impl Wave {
     /// [`WaveRay`]) — `j = 0` (none) for curves, which attenuate in their own
     /// integrator.
     pub fn attenuation_on(&self, t_far: f32) -> Attenuation<f32> {
-        match self.shape {
-            WaveShape::Curve(_) => Attenuation::none(),
-            _ => Attenuation { j: self.attenuation, t_far },
+        match self.shape.curve() {
+            Some(_) => Attenuation::none(),
+            None => Attenuation { j: self.attenuation, t_far },
         }
     }
 

@@ -5,7 +5,8 @@
 
 use crate::anim::Interpolation;
 use crate::params::{Constraint, Param, ParamSet, Shape};
-use crate::scene::{Scene, WaveKind};
+use crate::scene::Scene;
+use crate::wave_kind::WaveKind;
 
 /// The table of the scene file a parameter is written in.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -200,10 +201,6 @@ pub struct TrackInfo {
     pub values: Vec<f32>,
 }
 
-/// The kind names of `[[wave]] kind`.
-pub const WAVE_KINDS: &[&str] =
-    &["sphere", "cylinder", "capsule", "beam", "helix", "trig", "bezier", "bspline"];
-
 impl Scene {
     /// Every animatable parameter, grouped by table in the order of `docs/scene-format.md`
     /// (camera, light, colour, top level, objects, materials, waves, shadows, area light, bloom), each
@@ -285,19 +282,9 @@ impl Scene {
         self.tracks.iter().any(|t| t.offset < offset + len && offset < t.offset + t.len)
     }
 
-    /// The kind of the wave named `name` (one of [`WAVE_KINDS`]).
-    pub fn wave_kind(&self, name: &str) -> Option<&'static str> {
-        let w = self.waves.iter().find(|w| w.name == name)?;
-        Some(match w.kind {
-            WaveKind::Sphere => "sphere",
-            WaveKind::Cylinder => "cylinder",
-            WaveKind::Capsule => "capsule",
-            WaveKind::Beam => "beam",
-            WaveKind::Helix => "helix",
-            WaveKind::Trig => "trig",
-            WaveKind::Bezier => "bezier",
-            WaveKind::BSpline => "bspline",
-        })
+    /// The kind of the wave named `name`.
+    pub fn wave_kind(&self, name: &str) -> Option<WaveKind> {
+        self.waves.iter().find(|w| w.name == name).map(|w| w.kind)
     }
 
     /// Material names in file order.

@@ -64,6 +64,8 @@ mod temp_file;
 mod texture;
 mod toml_read;
 mod track_def;
+mod wave_check;
+mod wave_kind;
 
 pub use anim::Interpolation;
 pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
@@ -85,9 +87,9 @@ pub use gltf_load::{
 };
 pub use gltf_vrma::load_vrma_clip;
 pub use image::{Image, Rgb8Image};
-pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo, WAVE_KINDS};
+pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo};
 pub use limits::{
-    check_image_size, check_image_size_with, glare_band_rows, ALPHA_MAX, ANALYTIC_RAY_WORK,
+    check_image_size, check_image_size_with, glare_band_rows, ALPHA_MAX, ANALYTIC_RAY_WORK, ATTENUATION_MAX,
     GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES, GLARE_MAX_PIXELS, MAX_IMAGE_EDGE,
     MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
     PIXEL_WORK_MAX,
@@ -103,3 +105,5 @@ pub use texture::{
     decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_BYTES,
     TEXTURE_MAX_EDGE, TEXTURE_MAX_TEXELS,
 };
+pub use wave_check::WaveError;
+pub use wave_kind::{CurveKind, Growth, StarterValue, WaveKind, WAVE_KINDS};

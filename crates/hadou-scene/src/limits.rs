@@ -144,6 +144,8 @@ pub(crate) const FOV_MIN: f32 = 1e-3;
 pub(crate) const FOV_MAX: f32 = 179.0;
 /// Largest wave strength (`alpha_s`, `alpha_c`, `head_alpha`, `muzzle_alpha`, `alpha`).
 pub const ALPHA_MAX: f32 = 1e5;
+/// Largest attenuation exponent `j` of a wave (002 eq. 3.23, SPEC.md §1.4).
+pub const ATTENUATION_MAX: f32 = 64.0;
 /// Smallest object scale.
 pub(crate) const SCALE_MIN: f32 = 1e-6;
 /// Shortest direction vector (before normalisation).

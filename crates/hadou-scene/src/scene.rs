@@ -7,12 +7,14 @@ use crate::anim::Track;
 use crate::area_light_def::{build_area_light, AreaLightDef};
 use crate::bloom_def::build_bloom;
 use crate::frame::{
-    Camera, ColorMapping, Frame, Light, Material, Mesh, Object, Ramp, ToneMode, Wave, WaveLight, WaveShape,
+    Camera, ColorMapping, Frame, FrameOverrides, Light, Material, Mesh, Object, Ramp, ToneMode, Wave,
+    WaveLight, WaveShape,
 };
 use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
 use crate::rig::{clip_time, clip_wrap, Clip, PoseInput, Rig};
 use crate::shadow_def::{build_shadow, ShadowDef};
+use crate::wave_kind::{CurveKind, WaveKind};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
 use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
 use hadou_math::{Mat4, Vec3, Vec3f};
@@ -95,30 +97,6 @@ impl ObjectDef {
     pub(crate) fn transform(&self, vals: &[f32]) -> Mat4 {
         let v3 = |key: &str| Vec3f::from_array(self.params.arr::<3>(vals, key));
         Mat4::from_trs(v3("position"), v3("rotation"), v3("scale"))
-    }
-}
-
-/// The wave kinds of the schema.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum WaveKind {
-    Sphere,
-    Cylinder,
-    Capsule,
-    Beam,
-    Helix,
-    Trig,
-    Bezier,
-    BSpline,
-}
-
-impl WaveKind {
-    /// Whether the kind is a curve (integrated numerically) rather than a closed-form shape;
-    /// exhaustive, so a new kind must say which.
-    pub(crate) fn is_curve(self) -> bool {
-        match self {
-            WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => false,
-            WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => true,
-        }
     }
 }
 
@@ -249,8 +227,7 @@ impl Scene {
                 WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => {
                     crate::ANALYTIC_RAY_WORK
                 }
-                WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => match w.integrator
-                {
+                WaveKind::Curve(_) => match w.integrator {
                     IntegratorDef::Default => Integrator::Default.ray_work_bound(),
                     IntegratorDef::Nearest => Integrator::Nearest.ray_work_bound(),
                     IntegratorDef::Simpson { m, n } => {
@@ -320,6 +297,13 @@ impl Scene {
     /// The animated targets (`wave.beam.M2.z`, …) in file order.
     pub fn track_targets(&self) -> Vec<&str> {
         self.tracks.iter().map(|t| t.target.as_str()).collect()
+    }
+
+    /// The frame at `time` ([`Scene::at`]) with a front end's overrides applied.
+    pub fn at_with(&self, time: f32, overrides: &FrameOverrides) -> Frame {
+        let mut frame = self.at(time);
+        overrides.apply(&mut frame);
+        frame
     }
 
     /// The scene at `time` seconds. Never fails: animated values are clamped into their valid
@@ -508,9 +492,7 @@ impl Scene {
                 head_alpha: p.f(vals, "head_alpha"),
                 muzzle_alpha: p.f(vals, "muzzle_alpha"),
             }),
-            WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => {
-                WaveShape::Curve(self.build_curve(w, vals))
-            }
+            WaveKind::Curve(kind) => WaveShape::Curve(self.build_curve(w, kind, vals)),
         };
         Wave {
             name: w.name.clone(),
@@ -539,7 +521,7 @@ impl Scene {
         WaveLight { ramp, glow: w.params.f(vals, "light_glow") }
     }
 
-    pub(crate) fn build_curve(&self, w: &WaveDef, vals: &[f32]) -> CurveWave {
+    pub(crate) fn build_curve(&self, w: &WaveDef, kind: CurveKind, vals: &[f32]) -> CurveWave {
         let p = &w.params;
         let base = &self.values;
         let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));
@@ -551,21 +533,21 @@ impl Scene {
                 up = axis.orthonormal_basis().0;
             }
         }
-        let shape = match w.kind {
-            WaveKind::Helix => CurveShape::Helix {
+        let shape = match kind {
+            CurveKind::Helix => CurveShape::Helix {
                 radius: p.f(vals, "radius"),
                 rate: p.f(vals, "rate"),
                 phase: p.f(vals, "phase"),
                 length: p.f(vals, "length"),
             },
-            WaveKind::Trig => CurveShape::TrigSum {
+            CurveKind::Trig => CurveShape::TrigSum {
                 rate: p.f(vals, "rate"),
                 y_terms: p.pairs(vals, "y_terms"),
                 z_terms: p.pairs(vals, "z_terms"),
                 length: p.f(vals, "length"),
             },
-            WaveKind::Bezier => CurveShape::Bezier { points: p.pairs(vals, "points") },
-            _ => {
+            CurveKind::Bezier => CurveShape::Bezier { points: p.pairs(vals, "points") },
+            CurveKind::BSpline => {
                 let knots = w.has_knots.then(|| {
                     let k = p.raw(vals, "knots").to_vec();
                     let np = p.raw(vals, "points").len() / 2;

@@ -18,8 +18,8 @@ use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
 use crate::frame::{Mesh, ToneMode};
 use crate::gltf_load::Budget;
 use crate::limits::{
-    fmt_f32, ALPHA_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS,
-    MAX_TRIANGLES, MAX_VERTICES, MAX_WAVES, NEAR_MIN, SCALE_MIN,
+    fmt_f32, ALPHA_MAX, ATTENUATION_MAX, COORD_MAX, FAR_MAX, FOV_MAX, FOV_MIN, MAX_KEY_CHECKS,
+    MAX_MATERIAL_SLOTS, MAX_TRIANGLES, MAX_VERTICES, MAX_WAVES, NEAR_MIN, SCALE_MIN,
 };
 use crate::materials::{
     parse_material, parse_object_materials, parse_ramp, MaterialDef, TextureCache, OBJECT_MATERIAL_KEYS,
@@ -28,11 +28,12 @@ use crate::mesh::{box_mesh, plane_mesh, sphere_mesh, sphere_size, with_outline_n
 use crate::params::{Constraint, Param, ParamSet, Shape};
 use crate::rig::{Clip, Rig};
 use crate::scene::Motion;
-use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef, WaveKind};
+use crate::scene::{up_is_usable, IntegratorDef, ObjectDef, Scene, WaveDef};
 use crate::shadow::{MAX_SHADOWS, MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES};
 use crate::shadow_def::{check_map_budget, check_shadow, parse_shadow, ShadowDef};
 use crate::toml_read::{echo, read_numbers, Fallback, ParamReader, Res, Span, Src, Table};
 use crate::track_def::{parse_track, Names, Owner};
+use crate::wave_kind::{CurveKind, WaveKind, WAVE_KINDS};
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
 use std::collections::HashMap;
@@ -59,24 +60,6 @@ const LIGHT_KEYS: &[&str] = &["direction", "color", "ambient"];
 const COLOR_KEYS: &[&str] = &["mode", "exposure"];
 const OBJECT_KINDS: &[&str] = &["box", "sphere", "plane", "gltf"];
 const OBJECT_COMMON: &[&str] = &["name", "kind", "position", "rotation", "scale", "color"];
-const WAVE_KINDS: &[&str] = &["sphere", "cylinder", "capsule", "beam", "helix", "trig", "bezier", "bspline"];
-const WAVE_COMMON: &[&str] = &[
-    "name",
-    "kind",
-    "rgba",
-    "falloff",
-    "core_radius",
-    "light_ramp",
-    "light_ramp_kind",
-    "light_ramp_smoothing",
-    "light_glow",
-];
-/// Keys of the analytic kinds (sphere, cylinder, capsule, beam) beyond their shape's own.
-const ANALYTIC_COMMON: &[&str] = &["j"];
-/// Largest attenuation exponent `j` of an analytic wave (002 eq. 3.23, SPEC.md §1.4).
-pub(crate) const ATTENUATION_MAX: f32 = 64.0;
-const CURVE_COMMON: &[&str] =
-    &["O", "D", "up", "alpha", "gamma", "k", "j", "field", "integrator", "m", "n", "epsilon"];
 
 /// Default base colour of a wave: the yellow of 002 Fig. 4.1.
 pub(crate) const DEFAULT_RGBA: [f32; 4] = [0.8, 0.8, 0.2, 1.0];
@@ -766,35 +749,11 @@ fn primitive_budget(t: &Table<'_, '_>, budget: &mut Budget, tris: u64, verts: u6
 
 fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<WaveDef> {
     let kind_s = t.choice("kind", WAVE_KINDS, None)?;
-    let kind = match kind_s {
-        "sphere" => WaveKind::Sphere,
-        "cylinder" => WaveKind::Cylinder,
-        "capsule" => WaveKind::Capsule,
-        "beam" => WaveKind::Beam,
-        "helix" => WaveKind::Helix,
-        "trig" => WaveKind::Trig,
-        "bezier" => WaveKind::Bezier,
-        "bspline" => WaveKind::BSpline,
-        other => return Err(t.src.value_err(&t.key_span("kind"), format!("unknown wave kind \"{other}\""))),
-    };
-    let extra: &[&str] = match kind {
-        WaveKind::Sphere => &["M", "alpha_s"],
-        WaveKind::Cylinder => &["M", "D", "alpha_c"],
-        WaveKind::Capsule => &["M", "M2", "D", "length", "alpha_s", "alpha_c"],
-        WaveKind::Beam => &["M", "M2", "D", "length", "alpha_s", "alpha_c", "head_alpha", "muzzle_alpha"],
-        WaveKind::Helix => &["radius", "rate", "phase", "length"],
-        WaveKind::Trig => &["rate", "y_terms", "z_terms", "length"],
-        WaveKind::Bezier => &["points"],
-        WaveKind::BSpline => &["points", "order", "knots"],
+    let Some(kind) = WaveKind::from_name(kind_s) else {
+        return Err(t.src.value_err(&t.key_span("kind"), format!("unknown wave kind \"{kind_s}\"")));
     };
     let is_curve = kind.is_curve();
-    let allowed: Vec<&str> = WAVE_COMMON
-        .iter()
-        .chain(if is_curve { CURVE_COMMON } else { ANALYTIC_COMMON })
-        .chain(extra)
-        .copied()
-        .collect();
-    t.check_keys(&allowed)?;
+    t.check_keys(&kind.keys())?;
 
     let falloff = match t.choice("falloff", &["faithful", "inverse-square"], Some("inverse-square"))? {
         "faithful" => Falloff::Faithful,
@@ -883,15 +842,19 @@ fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'_>) -> Res<
                 rd.add(t, &mut p, "muzzle_alpha", S, ALPHA, Fallback::Value(&[0.0]), false)?;
             }
         }
-        WaveKind::Helix | WaveKind::Trig | WaveKind::Bezier | WaveKind::BSpline => {
-            parse_curve(t, &mut def, &mut p, rd)?
-        }
+        WaveKind::Curve(kind) => parse_curve(t, &mut def, kind, &mut p, rd)?,
     }
     def.params = p;
     Ok(def)
 }
 
-fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut ParamReader<'_>) -> Res<()> {
+fn parse_curve(
+    t: &Table<'_, '_>,
+    def: &mut WaveDef,
+    kind: CurveKind,
+    p: &mut ParamSet,
+    rd: &mut ParamReader<'_>,
+) -> Res<()> {
     let k_rule = Constraint::Range { lo: 0.0, hi: 1.0, lo_open: true, hi_open: false };
     rd.add(t, p, "O", V3, ANY, Fallback::Required("the launch point"), false)?;
     rd.add(t, p, "D", V3, Constraint::NonZero, Fallback::Required("the travel axis"), false)?;
@@ -900,8 +863,8 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
     rd.add(t, p, "gamma", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
     rd.add(t, p, "k", S, k_rule, Fallback::Value(&[1.0]), false)?;
     rd.add(t, p, "j", S, NONNEG, Fallback::Value(&[0.0]), false)?;
-    match def.kind {
-        WaveKind::Helix => {
+    match kind {
+        CurveKind::Helix => {
             rd.add(t, p, "radius", S, NONNEG, Fallback::Required("the helix radius r"), false)?;
             rd.add(
                 t,
@@ -915,13 +878,13 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
             rd.add(t, p, "phase", S, ANY, Fallback::Value(&[0.0]), false)?;
             rd.add(t, p, "length", S, POSITIVE, Fallback::Required("the parameter range s_end"), false)?;
         }
-        WaveKind::Trig => {
+        CurveKind::Trig => {
             rd.add(t, p, "rate", S, ANY, Fallback::Required("the base angular rate θ"), false)?;
             rd.add(t, p, "y_terms", Shape::List(2), ANY, Fallback::Value(&[]), false)?;
             rd.add(t, p, "z_terms", Shape::List(2), ANY, Fallback::Value(&[]), false)?;
             rd.add(t, p, "length", S, POSITIVE, Fallback::Required("the parameter range s_end"), false)?;
         }
-        _ => {
+        CurveKind::Bezier | CurveKind::BSpline => {
             let meaning = "control points [[y, z], …] across the axis";
             rd.add(t, p, "points", Shape::List(2), ANY, Fallback::Required(meaning), false)?;
             let n_points = p.find("points").map_or(0, |q| q.len / 2);
@@ -932,7 +895,7 @@ fn parse_curve(t: &Table<'_, '_>, def: &mut WaveDef, p: &mut ParamSet, rd: &mut 
                     format!("`points` in {} needs at least 2 control points, got {n_points}", t.what),
                 ));
             }
-            if def.kind == WaveKind::BSpline {
+            if kind == CurveKind::BSpline {
                 let order = t.opt_int("order", 2, n_points as i64)?.map_or(n_points.min(4), |v| v.0 as usize);
                 def.order = order as u32;
                 if let Some(v) = t.get("knots") {
@@ -1075,10 +1038,11 @@ fn check_curve(w: &WaveDef, p: &ParamSet, vals: &[f32]) -> Result<(), (&'static 
 /// [`hadou_math::curve::CurveWave::validate`] on the curve built from `vals` (a no-op for analytic
 /// waves); the error names the scene-file key.
 fn validate_curve(scene: &Scene, w: &WaveDef, vals: &[f32]) -> Result<(), (&'static str, String)> {
-    if !w.kind.is_curve() {
-        return Ok(());
-    }
-    scene.build_curve(w, vals).validate().map_err(|e| {
+    let kind = match w.kind {
+        WaveKind::Sphere | WaveKind::Cylinder | WaveKind::Capsule | WaveKind::Beam => return Ok(()),
+        WaveKind::Curve(kind) => kind,
+    };
+    scene.build_curve(w, kind, vals).validate().map_err(|e| {
         let key = match e.field {
             "origin" => "O",
             "axis" => "D",
@@ -1246,7 +1210,7 @@ fn check_rules(
                     }
                     Ok(())
                 }
-                _ => {
+                WaveKind::Curve(_) => {
                     check_curve(w, &w.params, vals).map_err(|e| format!("{} in {what}", e.1))?;
                     validate_curve(scene, w, vals).map_err(|(key, msg)| format!("`{key}` in {what} {msg}"))
                 }

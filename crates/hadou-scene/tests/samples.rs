@@ -17,7 +17,7 @@ fn an_area_light_scene_shrinks_its_grid_to_the_soft_shadow_limit() {
         [(512, 4, 2), (2048, 4, 2), (2049, 4, 1), (4096, 4, 1), (1365, 9, 3), (1366, 9, 2), (1024, 16, 4)]
     {
         (f.width, f.height, f.samples) = (size, size, samples);
-        assert_eq!(f.grid(), grid, "{size}² at {samples} samples");
+        assert_eq!(f.sample_grid().edge(), grid, "{size}² at {samples} samples");
         let k = u64::from(grid);
         assert!(u64::from(size).pow(2) * k * k <= SOFT_MAX_PIXELS);
     }
@@ -30,7 +30,7 @@ fn the_sample_frame_drops_the_glare_and_keeps_the_camera() {
     assert!(f.bloom.is_some());
     let s = f.sample_frame();
     assert_eq!((s.width, s.height), (4 * f.width, 4 * f.height));
-    assert_eq!((s.samples, s.grid()), (1, 1));
+    assert_eq!((s.samples, s.sample_grid().edge()), (1, 1));
     assert!(s.bloom.is_none());
     assert_eq!(s.camera, f.camera);
     // Every ray through a pixel's centre is the same in both frames.

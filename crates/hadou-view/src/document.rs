@@ -9,7 +9,7 @@
 //! scene follow from). Edits that carry the same merge key in a row (one slider drag, one camera
 //! orbit) form one undo step.
 
-use hadou_scene::{Entity, ParamShape, Scene, SceneError};
+use hadou_scene::{Entity, Growth, ParamShape, Scene, SceneError, StarterValue, WaveKind};
 use std::path::{Path, PathBuf};
 use toml_edit::{Array, ArrayOfTables, DocumentMut, Item, Table, Value};
 
@@ -784,61 +784,28 @@ fn remove_entity(doc: &mut DocumentMut, table: &str, name: &str) -> Result<(), D
 
 /// A new `[[wave]]` table of `kind` with values that render visibly at a typical scene scale.
 fn wave_defaults(kind: &str, name: &str, at: [f32; 3]) -> Result<Table, DocError> {
+    let Some(kind) = WaveKind::from_name(kind) else {
+        return err(format!("wave kinds are {}; not \"{kind}\"", hadou_scene::WAVE_KINDS.join(", ")));
+    };
     let mut t = Table::new();
     let put = |t: &mut Table, k: &str, v: Value| {
         t.insert(k, Item::Value(v));
     };
     t.insert("name", toml_edit::value(name));
-    t.insert("kind", toml_edit::value(kind));
+    t.insert("kind", toml_edit::value(kind.name()));
     put(&mut t, "rgba", Value::Array([1.0f32, 0.6, 0.2, 1.0].iter().map(|&x| number(x)).collect()));
-    let start = [at[0] - 2.0, at[1], at[2]];
-    match kind {
-        "sphere" => {
-            put(&mut t, "M", arr3(at));
-            put(&mut t, "alpha_s", number(0.1));
-        }
-        "cylinder" => {
-            put(&mut t, "M", arr3(at));
-            put(&mut t, "D", arr3([1.0, 0.0, 0.0]));
-            put(&mut t, "alpha_c", number(0.05));
-        }
-        "capsule" | "beam" => {
-            put(&mut t, "M", arr3(start));
-            put(&mut t, "D", arr3([1.0, 0.0, 0.0]));
-            put(&mut t, "length", number(4.0));
-            put(&mut t, "alpha_s", number(0.08));
-            put(&mut t, "alpha_c", number(0.08));
-            if kind == "beam" {
-                put(&mut t, "head_alpha", number(0.1));
-            }
-        }
-        "helix" | "trig" | "bezier" | "bspline" => {
-            put(&mut t, "O", arr3(start));
-            put(&mut t, "D", arr3([1.0, 0.0, 0.0]));
-            put(&mut t, "alpha", number(0.05));
-            let pairs = |p: &[[f32; 2]]| {
-                Value::Array(p.iter().map(|c| Value::Array(c.iter().map(|&x| number(x)).collect())).collect())
-            };
-            match kind {
-                "helix" => {
-                    put(&mut t, "radius", number(0.5));
-                    put(&mut t, "rate", number(6.0));
-                    put(&mut t, "length", number(4.0));
-                }
-                "trig" => {
-                    put(&mut t, "rate", number(3.0));
-                    put(&mut t, "y_terms", pairs(&[[0.5, 0.0]]));
-                    put(&mut t, "length", number(4.0));
-                }
-                _ => {
-                    put(&mut t, "gamma", number(4.0));
-                    put(&mut t, "points", pairs(&[[0.0, 0.0], [1.0, 0.0], [-1.0, 0.5], [0.0, 0.0]]));
-                }
-            }
-        }
-        other => {
-            return err(format!("wave kinds are {}; not \"{other}\"", hadou_scene::WAVE_KINDS.join(", ")))
-        }
+    let pairs = |p: &[[f32; 2]]| {
+        Value::Array(p.iter().map(|c| Value::Array(c.iter().map(|&x| number(x)).collect())).collect())
+    };
+    for &(key, value) in kind.starter() {
+        let v = match value {
+            StarterValue::At => arr3(at),
+            StarterValue::Behind => arr3([at[0] - 2.0, at[1], at[2]]),
+            StarterValue::Vector(v) => arr3(v),
+            StarterValue::Number(x) => number(x),
+            StarterValue::Pairs(p) => pairs(p),
+        };
+        put(&mut t, key, v);
     }
     Ok(t)
 }
@@ -853,8 +820,8 @@ fn fire(doc: &mut DocumentMut, scene: &Scene, wave: &str, start: f32, duration: 
         scene.parameters().into_iter().find(|p| p.target == format!("wave.{wave}.{key}")).map(|p| p.value)
     };
     let end = start + duration;
-    let (key, from, to): (&str, Vec<f32>, Vec<f32>) = match kind {
-        "capsule" | "beam" => {
+    let (key, from, to): (&str, Vec<f32>, Vec<f32>) = match kind.growth() {
+        Growth::Segment => {
             if let Some(m2) = base("M2") {
                 ("M2", base("M").unwrap_or_default(), m2)
             } else {
@@ -862,9 +829,8 @@ fn fire(doc: &mut DocumentMut, scene: &Scene, wave: &str, start: f32, duration: 
                 ("length", vec![0.0], vec![if len > 0.0 { len } else { 6.0 }])
             }
         }
-        "sphere" => ("alpha_s", vec![0.0], base("alpha_s").unwrap_or_default()),
-        "cylinder" => ("alpha_c", vec![0.0], base("alpha_c").unwrap_or_default()),
-        _ => ("k", vec![0.001], vec![1.0]),
+        Growth::Strength(key) => (key, vec![0.0], base(key).unwrap_or_default()),
+        Growth::Reach => ("k", vec![0.001], vec![1.0]),
     };
     let target = format!("wave.{wave}.{key}");
     let (_, _, shape) = split_target(scene, &target)?;

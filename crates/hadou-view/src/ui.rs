@@ -368,7 +368,7 @@ fn colour_mode(ui: &mut egui::Ui, v: &mut Viewer) {
 fn entity_actions(ui: &mut egui::Ui, v: &mut Viewer, e: &Entity) {
     ui.horizontal(|ui| match e {
         Entity::Wave(name) => {
-            let kind = v.scene().wave_kind(name).unwrap_or("?");
+            let kind = v.scene().wave_kind(name).map_or("?", hadou_scene::WaveKind::name);
             ui.weak(kind);
             let selected = v.selected_wave.as_deref() == Some(name.as_str());
             if ui

@@ -531,7 +531,7 @@ impl Viewer {
                 }
             }
             if let (Some(m), Some(d), Some(len), None) = (v3("M"), v3("D"), get("length"), get("M2")) {
-                if matches!(scene.wave_kind(name), Some("capsule" | "beam")) {
+                if scene.wave_kind(name).is_some_and(hadou_scene::WaveKind::is_segment) {
                     push(HandleKind::Head, m + d.normalize_or(Vec3f::new(1.0, 0.0, 0.0)) * len[0]);
                 }
             }

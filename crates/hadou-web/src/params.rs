@@ -29,6 +29,13 @@ pub struct PageParams {
     pub api: ApiChoice,
 }
 
+impl PageParams {
+    /// The URL's size, as overrides of the scene's frame.
+    pub fn overrides(&self) -> hadou_scene::FrameOverrides {
+        hadou_scene::FrameOverrides { width: self.width, height: self.height, samples: None }
+    }
+}
+
 impl Default for PageParams {
     fn default() -> Self {
         PageParams { scene: None, time: None, width: None, height: None, test: false, api: ApiChoice::Auto }

@@ -33,7 +33,7 @@
 //! ([`Scene::check_image_size`]) and, for a GIF, [`GIF_MAX_PIXELS`].
 
 use crate::output::{self, OutputError};
-use hadou_scene::{Backend, Frame, Image, RenderError, Scene};
+use hadou_scene::{Backend, Frame, FrameOverrides, Image, RenderError, Scene};
 use std::io::{BufWriter, Write};
 use std::ops::Range;
 use std::path::Path;
@@ -138,19 +138,10 @@ impl AnimationSpec {
         (self.width.unwrap_or(scene.width()), self.height.unwrap_or(scene.height()))
     }
 
-    /// The scene at frame `f` with the spec's size overrides applied.
+    /// The scene at frame `f` with the spec's size and sample overrides applied.
     pub fn frame(&self, scene: &Scene, f: u32) -> Frame {
-        let mut frame = scene.at(self.time_of(f));
-        if let Some(w) = self.width {
-            frame.width = w;
-        }
-        if let Some(h) = self.height {
-            frame.height = h;
-        }
-        if let Some(s) = self.samples {
-            frame.samples = s;
-        }
-        frame
+        let overrides = FrameOverrides { width: self.width, height: self.height, samples: self.samples };
+        scene.at_with(self.time_of(f), &overrides)
     }
 }
 

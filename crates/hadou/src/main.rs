@@ -469,18 +469,8 @@ fn parse_fps(text: &str, range: &std::ops::Range<u32>) -> Result<f32, Failure> {
     Ok(fps as f32)
 }
 
-fn frame_at(scene: &Scene, t: f32, w: Option<u32>, h: Option<u32>, samples: Option<u32>) -> Frame {
-    let mut frame = scene.at(t);
-    if let Some(s) = samples {
-        frame.samples = s;
-    }
-    if let Some(w) = w {
-        frame.width = w;
-    }
-    if let Some(h) = h {
-        frame.height = h;
-    }
-    frame
+fn frame_at(scene: &Scene, t: f32, width: Option<u32>, height: Option<u32>, samples: Option<u32>) -> Frame {
+    scene.at_with(t, &hadou::FrameOverrides { width, height, samples })
 }
 
 fn make_backend(choice: BackendChoice) -> Result<Box<dyn Backend>, Failure> {

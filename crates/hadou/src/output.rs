@@ -237,7 +237,7 @@ fn atomic_write(path: &Path, write: impl FnOnce(File) -> Result<(), String>) -> 
 }
 
 /// Rows per band of [`write_png_banded`] for an image `width` pixels wide drawn at `samples` per
-/// pixel (`Frame::grid()²`): about `BAND_PIXELS` samples (at least one row), so a band costs a few
+/// pixel (`SampleGrid::count`): about `BAND_PIXELS` samples (at least one row), so a band costs a few
 /// hundred MB at most on any backend whatever the image size and anti-aliasing.
 pub fn band_rows(width: u32, samples: u32) -> u32 {
     (u64::from(BAND_PIXELS) / (u64::from(width.max(1)) * u64::from(samples.max(1)))).max(1) as u32
@@ -251,7 +251,7 @@ pub fn frame_band_rows(frame: &hadou_scene::Frame) -> u32 {
     if frame.bloom.is_some() {
         hadou_scene::glare_band_rows(frame.width, frame.height)
     } else {
-        band_rows(frame.width, frame.grid().pow(2))
+        band_rows(frame.width, frame.sample_grid().count())
     }
 }
 

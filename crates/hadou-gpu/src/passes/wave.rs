@@ -66,6 +66,34 @@ pub(crate) struct WaveInputs<'a> {
     pub(crate) shadow_maps: &'a wgpu::TextureView,
 }
 
+/// Each GPU wave kind (`layout::GpuWave::kind`): its constant in common.wgsl, which the wave
+/// module branches on, and the override that compiles its kernel in. A kind of the scene format
+/// with no row here has no kernel on the GPU (`every_wave_kind_has_a_kernel` fails).
+pub(crate) const KIND_KERNELS: [(u32, &str, &str); 5] = [
+    (layout::WAVE_SPHERE, "WAVE_SPHERE", "USE_SPHERE"),
+    (layout::WAVE_CYLINDER, "WAVE_CYLINDER", "USE_CYLINDER"),
+    (layout::WAVE_CAPSULE, "WAVE_CAPSULE", "USE_CAPSULE"),
+    (layout::WAVE_BEAM, "WAVE_BEAM", "USE_BEAM"),
+    (layout::WAVE_CURVE, "WAVE_CURVE", "USE_CURVE"),
+];
+
+/// Each curve shape (`layout::GpuCurve::shape`), as [`KIND_KERNELS`].
+pub(crate) const SHAPE_KERNELS: [(u32, &str, &str); 4] = [
+    (layout::SHAPE_HELIX, "SHAPE_HELIX", "USE_HELIX"),
+    (layout::SHAPE_TRIG, "SHAPE_TRIG", "USE_TRIG"),
+    (layout::SHAPE_BEZIER, "SHAPE_BEZIER", "USE_BEZIER"),
+    (layout::SHAPE_BSPLINE, "SHAPE_BSPLINE", "USE_BSPLINE"),
+];
+
+/// The override of `code`'s kernel in `table`; for a code with no row (none is made), every
+/// kernel of the table, so nothing it could need is compiled out.
+fn kernels(table: &[(u32, &'static str, &'static str)], code: u32) -> Vec<&'static str> {
+    match table.iter().find(|k| k.0 == code) {
+        Some(k) => vec![k.2],
+        None => table.iter().map(|k| k.2).collect(),
+    }
+}
+
 /// Which parts of the wave pass a frame needs: one bit per pipeline-overridable `USE_*` constant of
 /// the wave module (wave.wgsl, energy.wgsl, curve.wgsl, shading.wgsl, shadow_lookup.wgsl), and
 /// three bits that choose the module's source itself: the samples' entry point, the 8-bit output
@@ -225,13 +253,7 @@ impl WaveVariant {
         let attenuated =
             waves.iter().any(|w| !(w.attenuation == 0.0)) || curves.iter().any(|c| !(c.attenuation == 0.0));
         for w in waves {
-            on.push(match w.kind {
-                layout::WAVE_SPHERE => "USE_SPHERE",
-                layout::WAVE_CYLINDER => "USE_CYLINDER",
-                layout::WAVE_CAPSULE => "USE_CAPSULE",
-                layout::WAVE_BEAM => "USE_BEAM",
-                _ => "USE_CURVE",
-            });
+            on.extend(kernels(&KIND_KERNELS, w.kind));
             on.push(if w.falloff == layout::FALLOFF_FAITHFUL {
                 "USE_FAITHFUL"
             } else {
@@ -244,12 +266,7 @@ impl WaveVariant {
                 layout::INTEGRATOR_NEAREST => "USE_NEAREST",
                 _ => "USE_CHORD",
             });
-            on.push(match c.shape {
-                layout::SHAPE_HELIX => "USE_HELIX",
-                layout::SHAPE_TRIG => "USE_TRIG",
-                layout::SHAPE_BEZIER => "USE_BEZIER",
-                _ => "USE_BSPLINE",
-            });
+            on.extend(kernels(&SHAPE_KERNELS, c.shape));
         }
         if surfaces {
             on.push("USE_SURFACES");
@@ -545,6 +562,106 @@ mod tests {
         let curve = layout::GpuCurve { attenuation: 1.5, ..Zeroable::zeroed() };
         let v = WaveVariant::of(&[], &[curve], &[], &[], false, false, (false, false), false, true, false);
         assert!(v.attenuation());
+    }
+
+    /// Every `[[wave]] kind` of the scene format reaches a kernel of its own: its GPU form has a
+    /// row in [`KIND_KERNELS`] (and, for a curve, [`SHAPE_KERNELS`]) that no other kind shares, and
+    /// the uber-shader's source branches on the row's constant under the row's override. A new
+    /// kind fails here until the WGSL has its kernel (ARCHITECTURE.md, "Add a wave shape").
+    #[test]
+    fn every_wave_kind_has_a_kernel() {
+        use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator};
+        use hadou_math::energy::{BeamField, CapsuleField, CylinderField, Falloff, SphereField};
+        use hadou_math::Vec3;
+        use hadou_scene::{CurveKind, WaveKind, WaveShape};
+        let source = WaveVariant::UBER.source();
+        // The source without its comments, where the overrides are used.
+        let code: String =
+            source.lines().map(|l| l.split("//").next().unwrap_or("")).collect::<Vec<_>>().join("\n");
+        let capsule = CapsuleField { m: Vec3::ZERO, d: Vec3::X, length: 2.0, alpha_s: 0.5, alpha_c: 0.5 };
+        let points = vec![[0.0, 0.0], [1.0, 0.5], [0.0, 1.0]];
+        let mut seen = Vec::new();
+        for kind in WaveKind::ALL {
+            let curve = |shape| CurveWave {
+                frame: CurveFrame { origin: Vec3::ZERO, axis: Vec3::X, up: Vec3::Y },
+                shape,
+                gamma: 1.0,
+                extension: 1.0,
+                attenuation: 0.0,
+                alpha: 0.3,
+                integrator: Integrator::Default,
+            };
+            let shape = match kind {
+                WaveKind::Sphere => WaveShape::Sphere(SphereField { center: Vec3::ZERO, alpha: 1.0 }),
+                WaveKind::Cylinder => {
+                    WaveShape::Cylinder(CylinderField { point: Vec3::ZERO, dir: Vec3::Y, alpha: 1.0 })
+                }
+                WaveKind::Capsule => WaveShape::Capsule(capsule),
+                WaveKind::Beam => WaveShape::Beam(BeamField { capsule, head_alpha: 1.0, muzzle_alpha: 0.2 }),
+                WaveKind::Curve(CurveKind::Helix) => WaveShape::Curve(curve(CurveShape::Helix {
+                    radius: 1.0,
+                    rate: 2.0,
+                    phase: 0.0,
+                    length: 4.0,
+                })),
+                WaveKind::Curve(CurveKind::Trig) => WaveShape::Curve(curve(CurveShape::TrigSum {
+                    rate: 2.0,
+                    y_terms: vec![[0.5, 0.0]],
+                    z_terms: vec![],
+                    length: 4.0,
+                })),
+                WaveKind::Curve(CurveKind::Bezier) => {
+                    WaveShape::Curve(curve(CurveShape::Bezier { points: points.clone() }))
+                }
+                WaveKind::Curve(CurveKind::BSpline) => WaveShape::Curve(curve(CurveShape::BSpline {
+                    points: points.clone(),
+                    order: 3,
+                    knots: None,
+                })),
+            };
+            let wave = hadou_scene::Wave::new(kind.name(), [1.0; 4], Falloff::Faithful, 0.0, shape);
+            // The kind's rows: its wave record's, and its curve record's if it is a curve.
+            let mut rows = Vec::new();
+            let record = match &wave.shape {
+                WaveShape::Curve(c) => {
+                    let mut buffers = layout::CurveBuffers::default();
+                    let index = buffers.push(&hadou_math::curve::prepare(c)).expect("one curve");
+                    let shape = buffers.curves[index as usize].shape;
+                    let row = SHAPE_KERNELS.iter().find(|k| k.0 == shape);
+                    rows.push(
+                        *row.unwrap_or_else(|| panic!("{}: curve shape {shape} has no kernel", kind.name())),
+                    );
+                    layout::GpuWave::curve(&wave, index)
+                }
+                WaveShape::Sphere(_)
+                | WaveShape::Cylinder(_)
+                | WaveShape::Capsule(_)
+                | WaveShape::Beam(_) => layout::GpuWave::new(&wave).expect("an analytic wave"),
+            };
+            let row = KIND_KERNELS.iter().find(|k| k.0 == record.kind);
+            rows.push(
+                *row.unwrap_or_else(|| panic!("{}: wave kind {} has no kernel", kind.name(), record.kind)),
+            );
+            for (_, constant, flag) in &rows {
+                assert!(
+                    source.contains(&format!("const {constant}: u32"))
+                        && (source.contains(&format!("== {constant}"))
+                            || source.contains(&format!("case {constant}"))),
+                    "{}: the wave module does not branch on {constant}",
+                    kind.name()
+                );
+                assert!(
+                    source.contains(&format!("override {flag}: bool")),
+                    "{}: no override {flag}",
+                    kind.name()
+                );
+                let uses = code.matches(flag).count();
+                assert!(uses >= 2, "{}: {flag} is declared but guards nothing", kind.name());
+            }
+            let key: Vec<&str> = rows.iter().map(|r| r.2).collect();
+            assert!(!seen.contains(&key), "{}: shares its kernel {key:?} with another kind", kind.name());
+            seen.push(key);
+        }
     }
 
     /// `WaveVariant::of` sets a part exactly when the frame's data can reach it.

@@ -164,12 +164,15 @@ fn curve_eval(c: GpuCurve, s: f32) -> vec2<f32> {
                 return curve_bezier(c, s);
             }
         }
-        default: {
+        case SHAPE_BSPLINE: {
             if (USE_BSPLINE) {
                 let tau = c.lo + clamp(s, 0.0, 1.0) * (c.hi - c.lo);
                 return curve_bspline(c, tau);
             }
         }
+        // No other shape is made (layout.rs CurveBuffers::push); one without its case has no
+        // kernel (passes/wave.rs every_wave_kind_has_a_kernel).
+        default: {}
     }
     return vec2<f32>(0.0);
 }

@@ -156,13 +156,9 @@ impl WebApp {
     /// The frame the viewport shows now, at the URL's size where it gives one.
     fn frame(&self) -> Result<Frame, String> {
         let mut f = self.viewer.frame();
-        if let Some(w) = self.params.width {
-            f.width = w;
-        }
-        if let Some(h) = self.params.height {
-            f.height = h;
-        }
-        if self.params.width.is_some() || self.params.height.is_some() {
+        let overrides = self.params.overrides();
+        overrides.apply(&mut f);
+        if overrides.sets_size() {
             self.viewer
                 .scene()
                 .check_image_size(f.width, f.height)

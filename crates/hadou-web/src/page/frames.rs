@@ -28,13 +28,7 @@ pub(super) fn cpu_frame_bytes(cpu: &mut CpuBackend, frame: &Frame) -> Result<(Ve
 
 /// The test's frame of `scene`: the URL's time and size.
 pub(super) fn test_frame(scene: &Scene, params: &PageParams) -> Result<Frame, String> {
-    let mut f = scene.at(params.time.unwrap_or(0.0));
-    if let Some(w) = params.width {
-        f.width = w;
-    }
-    if let Some(h) = params.height {
-        f.height = h;
-    }
+    let f = scene.at_with(params.time.unwrap_or(0.0), &params.overrides());
     scene
         .check_image_size(f.width, f.height)
         .map_err(|m| format!("width={} height={}: {m}", f.width, f.height))?;
