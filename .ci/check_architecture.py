@@ -13,6 +13,9 @@
    kinds one by one (a match, table or dispatch over `WaveShape`, `WaveKind`, the GPU's `WAVE_*`
    codes, `KIND_BIT_*` bits or `USE_*` overrides, or hadou-math's per-shape energies): each must
    gain the new kind, so the list is checked against the kinds' uses, not kept by hand.
+5. Every name the map gives in backticks as code (`Frame::sample_grid`, `load_frame`,
+   `WaveVariant::NAMES`: identifiers, `::` paths, a trailing `()`) exists: each of its segments is
+   a word of the workspace's sources, CI scripts, web page or scenes.
 
 Exit 1 with one line per problem; 0 and a summary otherwise. Run from anywhere.
 """
@@ -131,6 +134,33 @@ def wave_kind_sites():
     return sites
 
 
+def source_words():
+    """Every identifier-like word of the sources (crates, CI scripts, the web page, scenes)."""
+    words = set()
+    for f in FILES:
+        if f.split("/")[0] in ("crates", ".ci", "web", "scenes") and f.endswith(
+            (".rs", ".wgsl", ".toml", ".py", ".js", ".html", ".sh")
+        ):
+            with open(os.path.join(ROOT, f), encoding="utf-8", errors="replace") as fh:
+                words |= set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", fh.read()))
+    return words
+
+
+def missing_names(text):
+    """The backticked code names of `text` with a segment no source has."""
+    words = source_words()
+    out = []
+    for token in re.findall(r"`([^`\n]+)`", text):
+        name = token.strip()
+        if name.endswith("()"):
+            name = name[:-2]
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*(::[A-Za-z_][A-Za-z0-9_]*)*", name):
+            continue
+        if any(seg not in words for seg in name.split("::")) and token not in out:
+            out.append(token)
+    return out
+
+
 def walk_through(text):
     """The body of the "Add a wave shape" section, or None."""
     m = re.search(r"^### Add a wave shape$(.*?)(?=^#{1,3} )", text, flags=re.M | re.S)
@@ -171,6 +201,9 @@ def main():
         for f in sites:
             if f"`{f}`" not in walk:
                 problems.append(f"ARCHITECTURE.md: \"Add a wave shape\" does not name `{f}`, which lists every wave kind")
+    names = missing_names(text)
+    for token in names:
+        problems.append(f"ARCHITECTURE.md: `{token}` names nothing in the sources")
     for n, line in enumerate(text.splitlines(), 1):
         if re.search(r"\(\d[\d,]* lines", line):
             problems.append(f"ARCHITECTURE.md:{n}: a line count (they drift): {line.strip()[:80]}")
@@ -180,7 +213,7 @@ def main():
         print(f"{len(problems)} problem(s)")
         return 1
     print(f"ARCHITECTURE.md: {count} modules named, {paths} paths exist, no line counts, "
-          f"the {len(sites)} places that list every wave kind in \"Add a wave shape\"")
+          f"every code name found, the {len(sites)} places that list every wave kind in \"Add a wave shape\"")
     return 0
 
 
