@@ -664,6 +664,47 @@ mod tests {
         }
     }
 
+    /// The wave modules read the uniforms only through `load_frame`'s private copy: the binding
+    /// appears in its declaration and in the copy, nowhere else, and every entry point calls
+    /// `load_frame` first (ARCHITECTURE.md's invariant: lavapipe would compile the pass again for
+    /// every value of a uniform that decides a branch).
+    #[test]
+    fn the_frame_is_read_through_its_private_copy() {
+        let sources = [
+            ("wave", WaveVariant::UBER.source()),
+            ("wave samples", WaveVariant::UBER.with_samples(true).source()),
+            ("wave overlay", crate::shaders::compose(crate::shaders::WAVE_OVERLAY_PARTS)),
+        ];
+        for (name, source) in sources {
+            let code: Vec<&str> = source.lines().map(|l| l.split("//").next().unwrap_or("")).collect();
+            let uses = code.iter().filter(|l| l.contains("frame_uniforms")).count();
+            assert_eq!(uses, 2, "{name}: `frame_uniforms` outside its declaration and load_frame");
+            let module = naga::front::wgsl::parse_str(&source).expect("the module parses");
+            assert!(!module.entry_points.is_empty(), "{name}");
+            for entry in &module.entry_points {
+                // An entry point reading no global and calling nothing (the overlay's vertex
+                // stage) has no frame to read.
+                let f = &entry.function;
+                let reads =
+                    f.expressions.iter().any(|(_, e)| matches!(e, naga::Expression::GlobalVariable(_)))
+                        || f.body.iter().any(|s| matches!(s, naga::Statement::Call { .. }));
+                if !reads {
+                    continue;
+                }
+                let first_call = entry.function.body.iter().find_map(|s| match s {
+                    naga::Statement::Call { function, .. } => module.functions[*function].name.clone(),
+                    _ => None,
+                });
+                assert_eq!(
+                    first_call.as_deref(),
+                    Some("load_frame"),
+                    "{name}: {} calls load_frame first",
+                    entry.name
+                );
+            }
+        }
+    }
+
     /// `WaveVariant::of` sets a part exactly when the frame's data can reach it.
     #[test]
     fn a_variant_has_exactly_what_the_frame_uses() {
