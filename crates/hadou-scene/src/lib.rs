@@ -65,6 +65,7 @@ mod texture;
 mod toml_read;
 mod track_def;
 mod wave_check;
+mod wave_def;
 mod wave_kind;
 
 pub use anim::Interpolation;

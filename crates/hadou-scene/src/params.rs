@@ -2,7 +2,7 @@
 //! names a slice of it, its shape and the range rule it must obey. Tracks write into the slices;
 //! the frame builder reads them back after [`Constraint::clamp`] has made them valid.
 
-use crate::limits::{fmt_f32, fmt_f64, COORD_MAX, DIR_MIN};
+use crate::limits::{fmt_f32, fmt_f64, ALPHA_MAX, COORD_MAX, DIR_MIN};
 
 /// The shape of a parameter's value in the scene file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,6 +47,20 @@ pub(crate) enum Constraint {
     /// Non-decreasing values (a knot vector) within `±COORD_MAX`.
     NonDecreasing,
 }
+
+/// Shorthands of the table readers (`schema.rs`, `wave_def.rs`, …).
+pub(crate) const POSITIVE: Constraint = Constraint::Positive;
+/// Wave strengths: `[0, ALPHA_MAX]`.
+pub(crate) const ALPHA: Constraint =
+    Constraint::Range { lo: 0.0, hi: ALPHA_MAX, lo_open: false, hi_open: false };
+/// See [`Constraint::NonNeg`].
+pub(crate) const NONNEG: Constraint = Constraint::NonNeg;
+/// See [`Constraint::Any`].
+pub(crate) const ANY: Constraint = Constraint::Any;
+/// A 3-vector.
+pub(crate) const V3: Shape = Shape::Vector(3);
+/// A number.
+pub(crate) const S: Shape = Shape::Scalar;
 
 /// `[lo, hi]` with the bracket of each end, for messages.
 fn interval(lo: f32, hi: f32, lo_open: bool, hi_open: bool) -> String {
