@@ -1,7 +1,7 @@
 //! A frame's data on the GPU: the checks against the device that come before any GPU work
 //! (image size, camera, meshes, shadows and their maps, the `[area_light]`, storage-buffer
 //! limits), the records every pass reads (objects, waves, curves, materials, lights, shading data,
-//! shadow casts, laid out by `layout.rs`), their buffers, and each pass's draw lists. The renderer
+//! shadow casts, laid out by `layout/`), their buffers, and each pass's draw lists. The renderer
 //! (`render.rs`) prepares a frame with these and hands each pass its own part.
 
 use crate::layout::{

@@ -4,25 +4,26 @@
 //! and read back on its own (or, in `window.rs`, drawn into a window texture), so GPU memory is
 //! bounded by the tile size whatever the image size.
 
+mod glare;
+mod maps;
+mod soft;
+
 use crate::device::GpuContext;
 use crate::formats::{DEPTH_FORMAT, PLANE_SHADOW_FORMAT, SCENE_FORMAT};
 use crate::layout::{FrameUniforms, TONE_LINEAR};
 use crate::meshes::MeshCache;
-use crate::passes::bloom::{self, BloomInputs, BloomPass};
+use crate::passes::bloom::BloomPass;
 use crate::passes::edges::{EdgeInputs, EdgePass};
 use crate::passes::plane_shadows::{PlaneShadowInputs, PlaneShadowPass};
 use crate::passes::present::Presenter;
 use crate::passes::raster::{GBuffer, RasterInputs, RasterPass};
 use crate::passes::setup::{texture_view, Draw};
 use crate::passes::shadow_maps::{MapPass, ShadowMapInputs, ShadowMapPass, ShadowMaps};
-#[cfg(not(target_arch = "wasm32"))]
-use crate::passes::soft::SoftReadback;
 use crate::passes::soft::{SoftPass, SoftTargets, SoftTileInputs};
 use crate::passes::wave::{WaveInputs, WavePass};
 use crate::passes::wave_overlay::WaveOverlayPass;
 use crate::prepare::{self, FrameBuffers, FrameData, ShadowFields};
 use crate::timing::PassQueries;
-use hadou_scene::BloomParams;
 #[cfg(not(target_arch = "wasm32"))]
 use hadou_scene::Image;
 use hadou_scene::{Frame, RenderError, SampleGrid};
@@ -453,134 +454,6 @@ impl Renderer {
         Ok(prepared)
     }
 
-    /// The `[area_light]`'s soft shadows over the whole image: every tile rasterized and its points
-    /// gathered, the two maps fitted to them and drawn, the classes, then the resolve; the wave
-    /// passes read the visibility.
-    fn draw_soft(&self, frame: &Frame, prepared: &Prepared) -> Result<(), RenderError> {
-        let soft = self.soft.as_ref().expect("created in prepare");
-        let groups = prepared.groups.as_ref().expect("bind groups are made in prepare");
-        let bind_group = groups.soft.as_ref().expect("made with an area light");
-        let d = &self.ctx.device;
-        // Only the area light's casters are drawn into its maps (hadou-cpu's `spot_tris`).
-        let casters = frame.area_light.as_ref().map_or(&[][..], |l| &l.casters[..]);
-        let caster_draws: Vec<Draw> =
-            prepared.draws.iter().copied().filter(|dr| casters.contains(&(dr.object as u32))).collect();
-        // Every tile of the image, whatever rows are asked for: the search needs them all.
-        let tile = prepared.tile;
-        for y in (0..frame.height).step_by(tile[1] as usize) {
-            for x in (0..frame.width).step_by(tile[0] as usize) {
-                let t = ([x, y], [tile[0].min(frame.width - x), tile[1].min(frame.height - y)]);
-                let encoders = self.encode_tile_work(frame, prepared, t, TileWork::Classify, None);
-                self.submit_tile(encoders)?;
-            }
-        }
-        soft.fit_maps(&self.ctx, frame)?;
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
-        let objects = &prepared.buffers.objects;
-        self.passes.soft.encode_maps(&mut enc, d, soft, objects, &self.meshes, frame, &caster_draws);
-        self.passes.soft.encode_class(&mut enc, bind_group, frame);
-        self.passes.soft.encode_resolve(&mut enc, bind_group, frame);
-        self.ctx.queue.submit([enc.finish()]);
-        Ok(())
-    }
-
-    /// See [`crate::GpuBackend::soft_fit`].
-    pub(crate) fn soft_fit(&self) -> crate::passes::soft::SoftFit {
-        self.soft.as_ref().map_or(crate::passes::soft::SoftFit::Settled, SoftTargets::fit_state)
-    }
-
-    /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow
-    /// class (`hadou_math::soft::Class` as `u8`) and visibility, read back (for tests).
-    #[cfg(not(target_arch = "wasm32"))]
-    pub(crate) fn read_soft(&self, frame: &Frame) -> Result<Option<SoftReadback>, RenderError> {
-        let Some(soft) = self.soft.as_ref().filter(|_| frame.area_light.is_some()) else { return Ok(None) };
-        soft.read(&self.ctx, frame).map(Some)
-    }
-
-    /// Records every map cast's casters into its layer of the shadow maps (nothing when the frame
-    /// has no map casts), one render pass per layer.
-    pub(crate) fn encode_shadow_maps(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        frame: &Frame,
-        prepared: &Prepared,
-        timestamps: Option<&mut PassQueries<'_>>,
-    ) {
-        let Some(bind_group) = &prepared.map_bind_group else { return };
-        let maps = self.maps.as_ref().expect("shadow maps are created in prepare");
-        let passes = &prepared.map_passes;
-        let views = &maps.layer_views;
-        self.passes.shadow_maps.encode(enc, views, passes, bind_group, &self.meshes, frame, timestamps);
-    }
-
-    /// Records `frame`'s shadow maps into the layers of the caller's `target` (see
-    /// `GpuBackend::encode_shadow_maps_into`).
-    pub(crate) fn encode_shadow_maps_into(
-        &mut self,
-        frame: &Frame,
-        enc: &mut wgpu::CommandEncoder,
-        target: &wgpu::Texture,
-    ) -> Result<(), RenderError> {
-        self.ctx.check()?;
-        prepare::validate_frame(frame)?;
-        let data = FrameData::new(&self.ctx.limits, frame)?;
-        let shadows = &data.shadows;
-        if shadows.map_casts.is_empty() {
-            return Ok(());
-        }
-        let size = target.size();
-        if target.format() != crate::formats::MAP_FORMAT
-            || size.width < shadows.map_size
-            || size.height < shadows.map_size
-            || size.depth_or_array_layers < shadows.map_casts.len() as u32
-            || !target.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
-        {
-            return Err(RenderError::Other(format!(
-                "the shadow-map target must be Depth32Float with RENDER_ATTACHMENT, at least {0}×{0} texels and \
-                 {1} layers (it is {2:?}, {3}×{4}×{5})",
-                shadows.map_size,
-                shadows.map_casts.len(),
-                target.format(),
-                size.width,
-                size.height,
-                size.depth_or_array_layers
-            )));
-        }
-        let scopes = self.ctx.open_scopes();
-        {
-            self.meshes.upload(&self.ctx.device, frame);
-            let d = &self.ctx.device;
-            let buffers = FrameBuffers::upload(d, &data);
-            let passes = map_passes(&data);
-            let inputs = ShadowMapInputs {
-                objects: &buffers.objects,
-                casts: &buffers.casts,
-                draws: &buffers.shadow_draws,
-            };
-            let bind_group = self.passes.shadow_maps.bind_group(d, &inputs);
-            let views = crate::passes::shadow_maps::layer_views(target, shadows.map_casts.len() as u32);
-            self.passes.shadow_maps.encode(enc, &views, &passes, &bind_group, &self.meshes, frame, None);
-        }
-        self.ctx.close_scopes(scopes, "drawing the shadow maps")
-    }
-
-    /// Submits the frame's shadow maps (see [`Renderer::encode_shadow_maps`]); `None` when it has
-    /// none.
-    pub(crate) fn submit_shadow_maps(
-        &self,
-        frame: &Frame,
-        prepared: &Prepared,
-        timestamps: Option<&mut PassQueries<'_>>,
-    ) -> Option<wgpu::SubmissionIndex> {
-        prepared.map_bind_group.as_ref()?;
-        let mut enc = self
-            .ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("shadow maps") });
-        self.encode_shadow_maps(&mut enc, frame, prepared, timestamps);
-        Some(self.ctx.queue.submit([enc.finish()]))
-    }
-
     /// Encodes and submits every tile of `prepared` (no read-back), one submission per tile;
     /// the last submission.
     #[cfg(not(target_arch = "wasm32"))]
@@ -896,173 +769,6 @@ impl Renderer {
             return Err(non_finite());
         }
         Ok(hadou_scene::Rgb8Image { width: frame.width, height: rows.len() as u32, rgb })
-    }
-
-    /// [`Renderer::render_rows`] of a frame with a `[bloom]` (`rows` non-empty): in bands whose
-    /// rows and halo fit one storage binding, the tiles of the band and its halo drawn with the
-    /// linear colour gathered into one buffer, then the glare pass and the read-back of the band's
-    /// mapped colour.
-    #[cfg(not(target_arch = "wasm32"))]
-    fn render_rows_glare(
-        &mut self,
-        frame: &Frame,
-        params: &BloomParams,
-        rows: std::ops::Range<u32>,
-    ) -> Result<Image, RenderError> {
-        let mut image = alloc_image(frame.width, rows.len() as u32)?;
-        for band in self.glare_bands(frame, params, rows.clone())? {
-            let part = self.glare_band(frame, params, band.clone())?;
-            let w = frame.width as usize;
-            let at = (band.start - rows.start as usize) * w;
-            image.color[at..at + part.color.len()].copy_from_slice(&part.color);
-            image.energy[at..at + part.energy.len()].copy_from_slice(&part.energy);
-            image.depth[at..at + part.depth.len()].copy_from_slice(&part.depth);
-        }
-        Ok(image)
-    }
-
-    /// `rows` cut into the longest bands whose rows and glare halo fit one storage binding.
-    pub(crate) fn glare_bands(
-        &self,
-        frame: &Frame,
-        params: &BloomParams,
-        rows: std::ops::Range<u32>,
-    ) -> Result<Vec<std::ops::Range<usize>>, RenderError> {
-        let limit = self.ctx.limits.max_storage_buffer_binding_size.min(self.ctx.limits.max_buffer_size);
-        let mut bands = Vec::new();
-        let mut y = rows.start as usize;
-        while y < rows.end as usize {
-            // The longest band from y whose source rows fit.
-            let mut len = rows.end as usize - y;
-            while BloomPass::largest_plane(params, frame.width, frame.height, y..y + len) > limit {
-                if len == 1 {
-                    // The most levels (the widest reach) whose halo fits, as a radius.
-                    let (w, h) = (frame.width as usize, frame.height as usize);
-                    let fits = (1..=hadou_math::bloom::MAX_LEVELS).rev().find(|&n| {
-                        // The middle row: its halo is clamped by neither edge.
-                        let rows = hadou_math::bloom::Plan::new(w, h, n, h / 2..h / 2 + 1).source.len();
-                        (rows * w) as u64 * bloom::TEXEL_BYTES <= limit
-                    });
-                    let hint = match fits {
-                        Some(n) => {
-                            format!("a `radius` of at most {:.4} fits", f64::from(1u32 << n) / h as f64)
-                        }
-                        None => "no radius fits".to_owned(),
-                    };
-                    return Err(RenderError::Other(format!(
-                        "the [bloom] of a {}×{} image needs more than this device's {limit}-byte storage \
-                         binding for one row and its glare halo ({} bytes); {hint} at this size, or `--backend cpu`",
-                        frame.width,
-                        frame.height,
-                        BloomPass::largest_plane(params, frame.width, frame.height, y..y + 1)
-                    )));
-                }
-                len = len.div_ceil(2);
-            }
-            bands.push(y..y + len);
-            y += len;
-        }
-        Ok(bands)
-    }
-
-    /// One band of [`Renderer::render_rows_glare`], read back.
-    #[cfg(not(target_arch = "wasm32"))]
-    fn glare_band(
-        &mut self,
-        frame: &Frame,
-        params: &BloomParams,
-        band: std::ops::Range<usize>,
-    ) -> Result<Image, RenderError> {
-        let (w, h) = (frame.width as usize, frame.height as usize);
-        let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
-        let mut image = alloc_image(frame.width, src.len() as u32)?;
-        // Each tile read back after its submission (its energy and depth; the colour comes from
-        // the glare).
-        let (out, mut encoder) =
-            self.glare_chain(frame, params, band.clone(), |r, submission, origin, size| {
-                let origin = [origin[0], origin[1] - src.start as u32];
-                let bytes = u64::from(size[0]) * u64::from(size[1]) * FLOATS_PER_PIXEL * 4;
-                let staging = &r.targets.as_ref().expect("targets exist").staging;
-                r.ctx.read_buffer(staging, bytes, submission, |raw| copy_tile(&mut image, raw, origin, size))
-            })?;
-        let bytes = (band.len() * w) as u64 * bloom::TEXEL_BYTES;
-        let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("bloom read-back"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let submission = self.ctx.scoped("drawing the bloom", || {
-            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
-            self.ctx.queue.submit([encoder.finish()])
-        })?;
-        let first = (band.start - src.start) * w;
-        self.ctx.read_buffer(&staging, bytes, submission, |raw| {
-            let mut floats = vec![0.0f32; raw.len() / 4];
-            for (f, c) in floats.iter_mut().zip(raw.chunks_exact(4)) {
-                *f = f32::from_ne_bytes([c[0], c[1], c[2], c[3]]);
-            }
-            for (px, c) in image.color[first..first + band.len() * w].iter_mut().zip(floats.chunks_exact(4)) {
-                px.copy_from_slice(c);
-            }
-        })?;
-        Ok(image.crop_rows((band.start - src.start) as u32..(band.end - src.start) as u32))
-    }
-
-    /// The glare of the rows `band`: the tiles of its source rows (the band and its halo) drawn
-    /// with the linear colour, each tile's colour gathered into one buffer (`after_tile` runs after
-    /// each tile's submission, with its origin and size in image pixels), then the glare chain
-    /// recorded into a new encoder, not yet submitted. Returns the band's mapped colour (4
-    /// floats a pixel, row-major over the band) and that encoder.
-    pub(crate) fn glare_chain(
-        &mut self,
-        frame: &Frame,
-        params: &BloomParams,
-        band: std::ops::Range<usize>,
-        mut after_tile: impl FnMut(&Self, wgpu::SubmissionIndex, [u32; 2], [u32; 2]) -> Result<(), RenderError>,
-    ) -> Result<(wgpu::Buffer, wgpu::CommandEncoder), RenderError> {
-        let (w, h) = (frame.width as usize, frame.height as usize);
-        let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
-        let mut prepared =
-            self.prepare_frame(frame, src.start as u32..src.end as u32, true, TileOutput::Floats)?;
-        prepared.linear = true;
-        let linear = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("bloom linear colour"),
-            size: (src.len() * w) as u64 * bloom::TEXEL_BYTES,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        for &tile in &prepared.tiles {
-            let (origin, size) = prepared.output_tile(tile);
-            let submission = self.ctx.scoped("rendering a tile", || {
-                let mut encoders = self.encode_tile(frame, &prepared, tile, true, None);
-                // The tile's colour rows into the band's linear colour.
-                let t = self.targets.as_ref().expect("targets exist");
-                let row_bytes = u64::from(size[0]) * bloom::TEXEL_BYTES;
-                for r in 0..u64::from(size[1]) {
-                    let dst = ((u64::from(origin[1]) + r - src.start as u64) * w as u64
-                        + u64::from(origin[0]))
-                        * bloom::TEXEL_BYTES;
-                    encoders.shading.copy_buffer_to_buffer(&t.output, r * row_bytes, &linear, dst, row_bytes);
-                }
-                self.submit_tile(encoders)
-            })??;
-            after_tile(self, submission, origin, size)?;
-        }
-        let d = &self.ctx.device;
-        let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bloom") });
-        let inputs = BloomInputs {
-            params,
-            tone: frame.color_mapping.mode,
-            width: frame.width,
-            height: frame.height,
-            linear: &linear,
-            source: src.clone(),
-            band: band.clone(),
-        };
-        let out =
-            self.ctx.scoped("recording the bloom", || self.passes.bloom.encode(d, &mut encoder, &inputs))?;
-        Ok((out, encoder))
     }
 }
 

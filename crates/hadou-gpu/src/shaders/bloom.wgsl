@@ -4,7 +4,7 @@
 // Prepended by common.wgsl (the colour mappings).
 
 // A plane: (level width, level height, first row held, rows held). Keep in sync with
-// `BloomUniforms` in layout.rs.
+// `BloomUniforms` in layout/.
 struct BloomUniforms {
     // First input.
     a: vec4<u32>,

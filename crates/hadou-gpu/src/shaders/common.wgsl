@@ -1,8 +1,8 @@
 // Shared declarations of the hadou GPU backend: the GPU-visible structs, pixel rays, shading and
 // colour mapping. Prepended to raster.wgsl and wave.wgsl (see crates/hadou-gpu/src/shaders.rs).
 //
-// Every struct here has exactly one Rust definition in crates/hadou-gpu/src/layout.rs:
-// keep in sync with layout.rs (same field order, same explicit padding).
+// Every struct here has exactly one Rust definition in crates/hadou-gpu/src/layout/:
+// keep in sync with layout/ (same field order, same explicit padding).
 
 // ---- Vector products, written out (twins of hadou_math::Vec3::{dot, cross, length}) ----
 // The builtins dot/cross/length leave the evaluation order and the use of fused multiply-adds
@@ -23,7 +23,7 @@ fn length3(a: vec3<f32>) -> f32 {
     return sqrt(dot3(a, a));
 }
 
-// Keep in sync with layout.rs `FrameUniforms`.
+// Keep in sync with layout/ `FrameUniforms`.
 struct FrameUniforms {
     eye: vec3<f32>,
     tan_half_fov: f32,
@@ -61,7 +61,7 @@ struct FrameUniforms {
     grid: u32,
 }
 
-// Keep in sync with layout.rs `GpuSpotMap` (hadou_math::soft::SpotMap and its edge in texels).
+// Keep in sync with layout/ `GpuSpotMap` (hadou_math::soft::SpotMap and its edge in texels).
 struct GpuSpotMap {
     eye: vec3<f32>,
     tan_half: f32,
@@ -79,7 +79,7 @@ fn spot_to_view(s: GpuSpotMap, p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot3(d, s.right), dot3(d, s.up), dot3(d, s.forward));
 }
 
-// Keep in sync with layout.rs `GpuObject`.
+// Keep in sync with layout/ `GpuObject`.
 struct GpuObject {
     model: mat4x4<f32>,
     normal_matrix: mat4x4<f32>,
@@ -88,7 +88,7 @@ struct GpuObject {
     _pad: vec2<u32>,
 }
 
-// Keep in sync with layout.rs `GpuRamp` (hadou_math::toon::Ramp).
+// Keep in sync with layout/ `GpuRamp` (hadou_math::toon::Ramp).
 struct GpuRamp {
     stops: array<vec4<f32>, 8>,
     count: u32,
@@ -97,7 +97,7 @@ struct GpuRamp {
     _pad: u32,
 }
 
-// Keep in sync with layout.rs `GpuTexture`.
+// Keep in sync with layout/ `GpuTexture`.
 struct GpuTexture {
     offset: u32,
     width: u32,
@@ -105,7 +105,7 @@ struct GpuTexture {
     flags: u32,
 }
 
-// Keep in sync with layout.rs `GpuMaterial`.
+// Keep in sync with layout/ `GpuMaterial`.
 struct GpuMaterial {
     base_color: vec3<f32>,
     model: u32,
@@ -120,7 +120,7 @@ struct GpuMaterial {
     ramp: GpuRamp,
 }
 
-// Keep in sync with layout.rs `GpuLight`.
+// Keep in sync with layout/ `GpuLight`.
 struct GpuLight {
     line_kind: u32,
     point_offset: u32,
@@ -132,7 +132,7 @@ struct GpuLight {
     ramp: GpuRamp,
 }
 
-// Keep in sync with layout.rs `GpuWave` (the meaning of p0/p1/p2 per kind is documented there).
+// Keep in sync with layout/ `GpuWave` (the meaning of p0/p1/p2 per kind is documented there).
 struct GpuWave {
     color: vec4<f32>,
     kind: u32,
@@ -145,7 +145,7 @@ struct GpuWave {
 }
 
 // One prepared curved wave (hadou_math::curve::PreparedCurve); offsets index the curve_vec4 and
-// curve_f32 storage buffers of curve.wgsl. Keep in sync with layout.rs `GpuCurve`.
+// curve_f32 storage buffers of curve.wgsl. Keep in sync with layout/ `GpuCurve`.
 struct GpuCurve {
     origin: vec3<f32>,
     alpha: f32,
@@ -190,7 +190,7 @@ struct GpuCurve {
 }
 
 // One shadow cast (hadou_scene::ShadowCast): a plane projection or a shadow map. Keep in sync with
-// layout.rs `GpuShadowCast` (its fields are documented there) and with load_shadow_cast in
+// layout/ `GpuShadowCast` (its fields are documented there) and with load_shadow_cast in
 // shadow_lookup.wgsl, which reads it word by word.
 struct GpuShadowCast {
     k: vec3<f32>,
@@ -209,7 +209,7 @@ struct GpuShadowCast {
     map_bias: f32,
 }
 
-// Keep in sync with layout.rs: wave kinds and falloff/tone codes.
+// Keep in sync with layout/: wave kinds and falloff/tone codes.
 const WAVE_SPHERE: u32 = 0u;
 const WAVE_CYLINDER: u32 = 1u;
 const WAVE_CAPSULE: u32 = 2u;
@@ -237,12 +237,12 @@ const LINE_SEGMENT: u32 = 1u;
 const LINE_LINE: u32 = 2u;
 const LINE_POLYLINE: u32 = 3u;
 const HULL_BIT: u32 = 0x80000000u;
-// Keep in sync with layout.rs `MATERIAL_MASK` and `REACH_SHIFT`: the raster pass's material word
+// Keep in sync with layout/ `MATERIAL_MASK` and `REACH_SHIFT`: the raster pass's material word
 // holds the material index in its low 16 bits and the hull reach (8 bits) from bit 16; the edge
 // pass's output holds the index alone (and HULL_BIT).
 const MATERIAL_MASK: u32 = 0xffffu;
 const REACH_SHIFT: u32 = 16u;
-// Keep in sync with layout.rs `CAST_PLANE` and `SHADOW_CAST_WORDS`.
+// Keep in sync with layout/ `CAST_PLANE` and `SHADOW_CAST_WORDS`.
 const CAST_PLANE: u32 = 0u;
 const SHADOW_CAST_WORDS: u32 = 28u;
 // Mirrors hadou_scene::ON_PLANE: a visible point is on a receiver plane within

@@ -3,10 +3,10 @@
 // (integrate.rs), the faithful Simpson integrator (simpson.rs) and the nearest-point field
 // (nearest.rs). Prepended by common.wgsl and
 // energy.wgsl. The data layout (GpuCurve, curve_vec4, curve_f32) is built by
-// hadou_gpu::layout::CurveBuffers; keep in sync with layout.rs.
+// hadou_gpu::layout::CurveBuffers; keep in sync with layout/.
 
 // Storage buffers of the curve data. Every module that includes this file declares them at
-// these bindings; keep in sync with CurveBuffers in layout.rs.
+// these bindings; keep in sync with CurveBuffers in layout/.
 @group(0) @binding(5) var<storage, read> curves: array<GpuCurve>;
 // PieceTable::nodes then PieceTable::lines of every curve, one vec4 each.
 @group(0) @binding(6) var<storage, read> curve_vec4: array<vec4<f32>>;
@@ -170,7 +170,7 @@ fn curve_eval(c: GpuCurve, s: f32) -> vec2<f32> {
                 return curve_bspline(c, tau);
             }
         }
-        // No other shape is made (layout.rs CurveBuffers::push); one without its case has no
+        // No other shape is made (layout/ CurveBuffers::push); one without its case has no
         // kernel (passes/wave.rs every_wave_kind_has_a_kernel).
         default: {}
     }

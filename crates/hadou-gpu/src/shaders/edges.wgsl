@@ -48,7 +48,7 @@ fn hull_pixels(width: f32, tan_half_fov: f32, height: u32) -> f32 {
     return 0.0;
 }
 
-// Twin of hadou_scene::Material::hull_pixels for a material's GPU outline width (layout.rs
+// Twin of hadou_scene::Material::hull_pixels for a material's GPU outline width (layout/
 // `GpuMaterial::outline_width`: `d`, or `−w` for an MToon outline in world units) where the
 // surface is at view depth `z`.
 fn material_hull_pixels(width: f32, z: f32) -> f32 {

@@ -78,7 +78,7 @@ fn vs_main(v: VertexIn, @builtin(instance_index) object: u32) -> VertexOut {
     return out;
 }
 
-// Whether a material's GPU outline width (layout.rs `GpuMaterial::outline_width`: `d > 0`, or
+// Whether a material's GPU outline width (layout/ `GpuMaterial::outline_width`: `d > 0`, or
 // `−w < 0` for an MToon outline in world units) draws an outline.
 fn has_outline(width: f32) -> bool {
     return width > 0.0 || width < 0.0;

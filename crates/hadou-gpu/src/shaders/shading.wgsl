@@ -167,7 +167,7 @@ fn sample_texture(t: GpuTexture, uv: vec2<f32>) -> vec4<f32> {
 }
 
 // ---- MToon (VRMC_materials_mtoon 1.0): twins of hadou_math::mtoon and hadou-cpu's
-// shading::mtoon_* functions. A material's MToon block (layout.rs `mtoon_block`) is read from
+// shading::mtoon_* functions. A material's MToon block (layout/ `mtoon_block`) is read from
 // shading_data at word offset `o`.
 
 fn mtoon_f32(o: u32) -> f32 {

@@ -19,7 +19,7 @@ fn data_vec3(o: u32) -> vec3<f32> {
     return vec3<f32>(data_f32(o), data_f32(o + 1u), data_f32(o + 2u));
 }
 
-// Cast record j (layout.rs `GpuShadowCast`, SHADOW_CAST_WORDS words, fields in order).
+// Cast record j (layout/ `GpuShadowCast`, SHADOW_CAST_WORDS words, fields in order).
 fn load_shadow_cast(j: u32) -> GpuShadowCast {
     let o = frame.shadow_casts + j * SHADOW_CAST_WORDS;
     var c: GpuShadowCast;

@@ -10,7 +10,7 @@
 // nearest rows of the pixel's column: umbra in the low 16 bits, lit in the high 16, NO_ROW for
 // none), visibility[i]; grid[g] the faithful grid's values.
 
-// Keep in sync with layout.rs `SoftUniforms`.
+// Keep in sync with layout/ `SoftUniforms`.
 struct SoftUniforms {
     maps: array<GpuSpotMap, 2>,
     depth_aware: u32,
@@ -24,7 +24,7 @@ struct SoftUniforms {
     _pad2: u32,
 }
 
-// Keep in sync with layout.rs `GpuCasterBox` (hadou_math::soft::CasterBox).
+// Keep in sync with layout/ `GpuCasterBox` (hadou_math::soft::CasterBox).
 struct GpuCasterBox {
     origin: vec4<f32>,
     dual0: vec4<f32>,

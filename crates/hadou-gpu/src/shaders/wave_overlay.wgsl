@@ -11,7 +11,7 @@
 // depth textures) and how its values map to eye distance.
 @group(0) @binding(2) var depth_texels: texture_2d<f32>;
 
-// Keep in sync with layout.rs `OverlayUniforms`.
+// Keep in sync with layout/ `OverlayUniforms`.
 struct OverlayUniforms {
     // DEPTH_STANDARD: 0 at `near`, 1 at `far` (hadou's raster pass, most engines);
     // DEPTH_REVERSE_INFINITE: near / z, 0 at infinity (Bevy's).
