@@ -53,6 +53,7 @@ mod introspect;
 mod limits;
 mod materials;
 pub mod mesh;
+mod object_def;
 mod params;
 mod rig;
 mod scene;
