@@ -109,7 +109,10 @@ fn cs_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     let dir = pixel_dir_at(frame, centre.x, centre.y);
     // One ray through the centre where the samples agree, else one per sample (a single call
     // site of waves_light, which every wave kind inlines).
-    let agree = same && (!drawn || hi - lo <= SAMPLE_DEPTH_SPREAD * lo);
+    // Without surfaces every pixel's samples agree (no surface, one key); saying so in a constant
+    // compiles the per-sample rays out of a frame of waves alone, which llvmpipe would otherwise
+    // run under a mask for every pixel.
+    let agree = !USE_SURFACES || (same && (!drawn || hi - lo <= SAMPLE_DEPTH_SPREAD * lo));
     var rays = g * g;
     var weight = inv;
     if (agree) {
