@@ -2,27 +2,28 @@
 //! error pointing at the offending key or value. The schema is documented key by key in
 //! `docs/scene-format.md`.
 //!
-//! [`Scene::load`], [`Scene::read_text`] and [`Scene::parse`]; the readers of `[image]`,
-//! `[camera]`, `[light]` and `[color]`; and the cross-key rules, checked on the file's values and
-//! again at every key time of every track. `[[object]]`, `[[wave]]`, `[[material]]`, `[[shadow]]`,
-//! `[area_light]`, `[bloom]` and `[[track]]` are read by `object_def.rs`, `wave_def.rs`,
-//! `materials.rs`, `shadow_def.rs`, `area_light_def.rs`, `bloom_def.rs` and `track_def.rs`.
+//! [`Scene::load`], [`Scene::read_text`] and [`Scene::parse`]: the file's tables in order, the
+//! top-level `background`, and the cross-key rules, checked on the file's values and again at
+//! every key time of every track. Each table has its reader: `[image]` and `[camera]` in
+//! `camera_def.rs`, `[light]` and `[color]` in `light_def.rs`, `[[object]]`, `[[wave]]`,
+//! `[[material]]`, `[[shadow]]`, `[area_light]`, `[bloom]` and `[[track]]` in `object_def.rs`,
+//! `wave_def.rs`, `materials.rs`, `shadow_def.rs`, `area_light_def.rs`, `bloom_def.rs` and
+//! `track_def.rs`.
 
 use crate::area_light::SOFT_MAX_PIXELS;
 use crate::area_light_def::{check_area_light, interest_at, parse_area_light, Target};
 use crate::bloom_def::parse_bloom;
 use crate::bounds::mesh_center;
+use crate::camera_def::{check_camera, parse_camera, parse_image};
 use crate::error::{Location, SceneError};
 use crate::files::{parent_dir, read_regular_file, SceneDir, SCENE_MAX_BYTES};
-use crate::frame::ToneMode;
 use crate::gltf_load::Budget;
-use crate::limits::{
-    fmt_f32, FAR_MAX, FOV_MAX, FOV_MIN, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_WAVES, NEAR_MIN,
-};
+use crate::light_def::{parse_color, parse_light};
+use crate::limits::{fmt_f32, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_WAVES};
 use crate::materials::{parse_material, MaterialDef, TextureCache};
 use crate::object_def::{parse_object, Assets};
-use crate::params::{Constraint, ParamSet, ANY, NONNEG, POSITIVE, S, V3};
-use crate::scene::{up_is_usable, ObjectDef, Scene, WaveDef};
+use crate::params::{ParamSet, NONNEG, V3};
+use crate::scene::{ObjectDef, Scene, WaveDef};
 use crate::shadow::{MAX_SHADOWS, MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES};
 use crate::shadow_def::{check_map_budget, check_shadow, parse_shadow, ShadowDef};
 use crate::toml_read::{Fallback, ParamReader, Res, Span, Src, Table};
@@ -47,9 +48,6 @@ const ROOT_KEYS: &[&str] = &[
     "bloom",
     "track",
 ];
-const CAMERA_KEYS: &[&str] = &["position", "target", "up", "fov", "near", "far"];
-const LIGHT_KEYS: &[&str] = &["direction", "color", "ambient"];
-const COLOR_KEYS: &[&str] = &["mode", "exposure"];
 
 impl Scene {
     /// Reads and parses the scene file at `path`. glTF paths in it are relative to its directory.
@@ -93,65 +91,14 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
     let mut spans = Vec::new();
     let mut rd = ParamReader { values: &mut values, spans: &mut spans };
 
-    // [image]
-    let (mut width, mut height, mut samples) = (512, 512, crate::DEFAULT_SAMPLES);
-    if let Some(t) = root.sub("image", "[image]")? {
-        t.check_keys(&["width", "height", "samples"])?;
-        width = t.opt_int("width", 1, 16384)?.map_or(width, |v| v.0 as u32);
-        height = t.opt_int("height", 1, 16384)?.map_or(height, |v| v.0 as u32);
-        if let Some((v, span)) = t.opt_int("samples", 1, i64::from(crate::MAX_SAMPLES))? {
-            samples = v as u32;
-            crate::check_samples(samples).map_err(|m| src.value_err(&span, m))?;
-        }
-    }
-
-    // [camera]
     let empty = DeTable::new();
     let sub_or_empty = |key: &str, what: &str| -> Res<Table<'_, '_>> {
         Ok(root.sub(key, what)?.unwrap_or(Table { src, t: &empty, span: 0..0, what: what.into() }))
     };
-    let mut camera = ParamSet::default();
-    {
-        let t = sub_or_empty("camera", "[camera]")?;
-        t.check_keys(CAMERA_KEYS)?;
-        let fov = Constraint::Range { lo: FOV_MIN, hi: FOV_MAX, lo_open: false, hi_open: false };
-        let near = Constraint::Range { lo: NEAR_MIN, hi: FAR_MAX, lo_open: false, hi_open: true };
-        let far = Constraint::Range { lo: NEAR_MIN, hi: FAR_MAX, lo_open: false, hi_open: false };
-        rd.add(&t, &mut camera, "position", V3, ANY, Fallback::Value(&[0.0, 0.0, 10.0]), false)?;
-        rd.add(&t, &mut camera, "target", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
-        rd.add(&t, &mut camera, "up", V3, Constraint::NonZero, Fallback::Value(&[0.0, 1.0, 0.0]), false)?;
-        rd.add(&t, &mut camera, "fov", S, fov, Fallback::Value(&[45.0]), false)?;
-        rd.add(&t, &mut camera, "near", S, near, Fallback::Value(&[0.1]), false)?;
-        rd.add(&t, &mut camera, "far", S, far, Fallback::Value(&[100.0]), false)?;
-        if let Err((key, msg)) = check_camera(&camera, rd.values) {
-            return Err(src.value_err(&t.key_span(key), format!("{msg} in [camera]")));
-        }
-    }
-
-    // [light]
-    let mut light = ParamSet::default();
-    {
-        let t = sub_or_empty("light", "[light]")?;
-        t.check_keys(LIGHT_KEYS)?;
-        let dir = Fallback::Value(&[-0.4, -1.0, -0.3]);
-        rd.add(&t, &mut light, "direction", V3, Constraint::NonZero, dir, false)?;
-        rd.add(&t, &mut light, "color", V3, NONNEG, Fallback::Value(&[1.0; 3]), false)?;
-        rd.add(&t, &mut light, "ambient", V3, NONNEG, Fallback::Value(&[0.15; 3]), false)?;
-    }
-
-    // [color]
-    let mut color = ParamSet::default();
-    let tone = {
-        let t = sub_or_empty("color", "[color]")?;
-        t.check_keys(COLOR_KEYS)?;
-        let mode = t.choice("mode", &["faithful", "filmic"], Some("filmic"))?;
-        rd.add(&t, &mut color, "exposure", S, POSITIVE, Fallback::Value(&[1.0]), false)?;
-        if mode == "faithful" {
-            ToneMode::Faithful
-        } else {
-            ToneMode::Filmic
-        }
-    };
+    let (width, height, samples) = parse_image(root.sub("image", "[image]")?.as_ref())?;
+    let camera = parse_camera(&sub_or_empty("camera", "[camera]")?, &mut rd)?;
+    let light = parse_light(&sub_or_empty("light", "[light]")?, &mut rd)?;
+    let (tone, color) = parse_color(&sub_or_empty("color", "[color]")?, &mut rd)?;
 
     // background (top level)
     let mut globals = ParamSet::default();
@@ -383,42 +330,6 @@ fn entity_name(table: &Table<'_, '_>, names: &mut HashMap<String, Span>, what: &
     }
     names.insert(name.to_string(), span);
     Ok(name.to_string())
-}
-
-/// Camera rules across keys: `near < far`, eye ≠ target, `up` not parallel to the view.
-fn check_camera(c: &ParamSet, vals: &[f32]) -> Result<(), (&'static str, String)> {
-    let (near, far) = (c.f(vals, "near"), c.f(vals, "far"));
-    if near >= far {
-        return Err((
-            "far",
-            format!("`far` ({}) must be greater than `near` ({})", fmt_f32(far), fmt_f32(near)),
-        ));
-    }
-    let eye = c.arr::<3>(vals, "position");
-    let target = c.arr::<3>(vals, "target");
-    // In f64: the distance of two points within ±1e6 is exact enough, and it cannot overflow.
-    let dist =
-        eye.iter().zip(&target).map(|(a, b)| (f64::from(*b) - f64::from(*a)).powi(2)).sum::<f64>().sqrt();
-    if dist == 0.0 {
-        return Err(("target", "`target` must differ from `position`".into()));
-    }
-    if dist < 1e-6 {
-        return Err((
-            "target",
-            format!(
-                "`target` is only {} from `position`; keep them at least 1e-6 apart so the view \
-                 direction is defined",
-                fmt_f32(dist as f32)
-            ),
-        ));
-    }
-    let Some(view) = (Vec3f::from_array(target) - Vec3f::from_array(eye)).try_normalize() else {
-        return Err(("target", "`target` and `position` do not give a view direction".into()));
-    };
-    if !up_is_usable(Vec3f::from_array(c.arr(vals, "up")), view) {
-        return Err(("up", "`up` must not be parallel to the view direction (target − position)".into()));
-    }
-    Ok(())
 }
 
 /// The parts of a scene with rules between their keys: each is checked at the key times of the
