@@ -41,8 +41,8 @@ mod wave;
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
 pub use material::{
-    light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS, NO_TEXTURES, SHADOW_DATA,
-    SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
+    light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS,
+    NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
 };
 pub use mesh::{bevy_mesh, bevy_slot_mesh, outline_mesh, slot_indices_of};
 pub use outline::{HadouOutline, HadouOutlineUniform};
@@ -139,7 +139,12 @@ impl Plugin for HadouPlugin {
                 }
             }
         }
+        app.init_resource::<wave::DrawnWaves>();
         app.add_systems(PostUpdate, wave::check_changed_waves.in_set(HadouSystems::CheckWaves))
+            .add_systems(
+                PostUpdate,
+                wave::prepare_drawn_waves.after(HadouSystems::CheckWaves).before(HadouSystems::Lights),
+            )
             .add_systems(PostUpdate, (camera::bind_depth, tone::apply_mapping))
             .add_observer(tone::remove_mapping);
         if !renders {

@@ -6,7 +6,7 @@
 //! from the [`crate::HadouWave`]s by [`update_wave_lights`]); a material's textures are in its
 //! own buffer ([`HadouMaterial::textures`]).
 
-use crate::wave::{HadouWave, WaveRejected};
+use crate::wave::DrawnWaves;
 use bevy::asset::{uuid_handle, RenderAssetUsages};
 use bevy::pbr::Material;
 use bevy::prelude::*;
@@ -14,6 +14,7 @@ use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
 use hadou_gpu::layout::{self, GpuLight, GpuTexture, TextureStore};
+use hadou_math::curve::PreparedCurve;
 use hadou_scene::{Light, Wave};
 
 /// The fragment shader of [`HadouMaterial`], composed at start-up (see [`shader_source`]).
@@ -378,9 +379,16 @@ pub(crate) struct LightsWritten {
 /// The records of `waves` as lights: the `GpuLight`s and the words of [`WAVE_LIGHT_DATA`]
 /// (count, any glow, then polyline points), at most [`MAX_WAVE_LIGHTS`].
 pub fn light_records(waves: &[Wave]) -> (Vec<GpuLight>, Vec<u32>) {
+    prepared_light_records(waves, &[])
+}
+
+/// [`light_records`] with the waves' curves already prepared (`curves[i]` of `waves[i]`, `None`
+/// for an analytic wave; a wave past the end of `curves` is prepared here).
+pub fn prepared_light_records(waves: &[Wave], curves: &[Option<PreparedCurve>]) -> (Vec<GpuLight>, Vec<u32>) {
     let waves = &waves[..waves.len().min(MAX_WAVE_LIGHTS)];
+    let curves = &curves[..curves.len().min(waves.len())];
     let mut data = vec![0u32; LIGHT_DATA_HEADER];
-    let lights = layout::wave_lights(waves, &[], &mut data);
+    let lights = layout::wave_lights(waves, curves, &mut data);
     data[0] = lights.len() as u32;
     data[1] = u32::from(waves.iter().any(|w| w.light.glow > 0.0));
     (lights, data)
@@ -391,23 +399,20 @@ pub fn light_records(waves: &[Wave]) -> (Vec<GpuLight>, Vec<u32>) {
 /// materials' bind groups then stay valid); when the points outgrow [`WAVE_LIGHT_DATA`] it doubles
 /// and every [`HadouMaterial`] is marked changed so that Bevy binds the new buffer.
 pub(crate) fn update_wave_lights(
-    waves: Query<(Entity, &HadouWave), Without<WaveRejected>>,
+    drawn: Res<DrawnWaves>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut written: Local<LightsWritten>,
 ) {
-    let mut drawn: Vec<(Entity, &Wave)> =
-        waves.iter().filter(|(_, w)| w.enabled).map(|(e, w)| (e, &w.wave)).collect();
-    drawn.sort_by_key(|(e, _)| *e);
-    if drawn.len() > MAX_WAVE_LIGHTS && !written.warned {
+    if drawn.waves.len() > MAX_WAVE_LIGHTS && !written.warned {
         written.warned = true;
         warn!(
             "{} waves are drawn; the first {MAX_WAVE_LIGHTS} (by entity) light the HadouMaterials",
-            drawn.len()
+            drawn.waves.len()
         );
     }
-    let owned: Vec<Wave> = drawn.into_iter().map(|(_, w)| w.clone()).collect();
-    let (lights, data) = light_records(&owned);
+    let curves = drawn.prepared.as_ref().as_ref().map_or(&[][..], |p| &p.2[..]);
+    let (lights, data) = prepared_light_records(&drawn.waves, curves);
     if written.capacity != 0 && lights == written.lights && data == written.data {
         return;
     }

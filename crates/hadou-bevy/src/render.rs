@@ -4,7 +4,7 @@
 //! post-processing (bloom, tone mapping), like Bevy's volumetric fog.
 
 use crate::camera::{frame_camera, HadouCamera};
-use crate::wave::{HadouWave, WaveRejected};
+use crate::wave::DrawnWaves;
 use bevy::prelude::*;
 use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::view::{ExtractedView, Msaa, ViewDepthTexture, ViewTarget};
@@ -14,9 +14,10 @@ use hadou_math::Vec3f;
 use hadou_scene::{ColorMapping, Frame, Light, ToneMode, Wave};
 use std::collections::HashSet;
 
-/// The enabled, accepted waves of the main world, copied into the render world every frame.
+/// The main world's [`DrawnWaves`] (the waves and their prepared records, shared, not copied),
+/// in the render world every frame.
 #[derive(Resource, Default)]
-pub(crate) struct ExtractedWaves(pub Vec<Wave>);
+pub(crate) struct ExtractedWaves(pub DrawnWaves);
 
 /// hadou-gpu's backend on Bevy's `RenderDevice` (absent when the adapter cannot run it; that is
 /// logged once at start-up).
@@ -36,12 +37,8 @@ impl Warned {
     }
 }
 
-pub(crate) fn extract_waves(
-    mut extracted: ResMut<ExtractedWaves>,
-    waves: Extract<Query<&HadouWave, Without<WaveRejected>>>,
-) {
-    extracted.0.clear();
-    extracted.0.extend(waves.iter().filter(|w| w.enabled).map(|w| w.wave.clone()));
+pub(crate) fn extract_waves(mut extracted: ResMut<ExtractedWaves>, drawn: Extract<Res<DrawnWaves>>) {
+    extracted.0 = drawn.clone();
 }
 
 /// Opens hadou-gpu's backend on Bevy's device, leaving Bevy's error handlers in place.
@@ -95,7 +92,8 @@ pub(crate) fn wave_pass(
     let entity = view.entity();
     let (extracted, target, depth, settings, msaa) = view.into_inner();
     let Some(mut renderer) = renderer else { return };
-    if waves.0.is_empty() {
+    let drawn = &waves.0;
+    if drawn.waves.is_empty() {
         return;
     }
     if let Err(why) = settings.check() {
@@ -122,7 +120,14 @@ pub(crate) fn wave_pass(
         });
         return;
     };
-    let frame = view_frame(camera, UVec2::new(viewport.z, viewport.w), settings, &waves.0);
+    let prepared = match drawn.prepared.as_ref() {
+        Ok(p) => p,
+        Err(why) => {
+            warned.once(entity, "pass", || format!("hadou waves are not drawn into view {entity}: {why}"));
+            return;
+        }
+    };
+    let frame = view_frame(camera, UVec2::new(viewport.z, viewport.w), settings, &drawn.waves);
     let overlay = OverlayTarget {
         color: target.main_texture_view(),
         color_format: target.main_texture_format(),
@@ -133,7 +138,8 @@ pub(crate) fn wave_pass(
         depth_samples: msaa.samples(),
         blend: OverlayBlend::Add,
     };
-    if let Err(e) = renderer.0.encode_wave_overlay(&frame, ctx.command_encoder(), &overlay) {
+    if let Err(e) = renderer.0.encode_prepared_wave_overlay(&frame, prepared, ctx.command_encoder(), &overlay)
+    {
         warned.once(entity, "pass", || format!("hadou waves are not drawn into view {entity}: {e}"));
     }
 }

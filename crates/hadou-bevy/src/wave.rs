@@ -3,8 +3,10 @@
 //! ([`WaveRejected`]).
 
 use bevy::prelude::*;
+use hadou_gpu::layout::{waves_buffers, FrameWaves};
 use hadou_scene::Wave;
 pub use hadou_scene::WaveError;
+use std::sync::Arc;
 
 /// One energy wave, drawn by [`crate::HadouPlugin`] into every camera with a
 /// [`crate::HadouCamera`]. Change `wave` from any system to animate it (its shape's centre,
@@ -66,5 +68,102 @@ pub(crate) fn check_changed_waves(mut commands: Commands, waves: Query<WaveToChe
                 }
             }
         }
+    }
+}
+
+/// The waves drawn this frame: the enabled, accepted [`HadouWave`]s by entity, and their GPU
+/// records with every curve prepared once ([`hadou_gpu::layout::waves_buffers`]). The wave
+/// lights of the materials (`material::update_wave_lights`) and the wave pass of every view
+/// (`render::wave_pass`, through the render world's copy) read these; nothing prepares a curve
+/// again. Made anew only when a wave changed or the set of drawn waves did.
+#[derive(Resource, Clone)]
+pub(crate) struct DrawnWaves {
+    /// The entities of `waves`, in order.
+    pub entities: Vec<Entity>,
+    /// The waves, by entity.
+    pub waves: Arc<Vec<Wave>>,
+    /// Their records (an error when the curves outgrow the GPU's buffers: nothing is drawn then,
+    /// and the pass says why once per view).
+    pub prepared: Arc<Result<FrameWaves, String>>,
+    /// How many times the records were made (for tests: once per change, not per view).
+    pub preparations: u64,
+}
+
+impl Default for DrawnWaves {
+    fn default() -> Self {
+        DrawnWaves {
+            entities: Vec::new(),
+            waves: Arc::default(),
+            prepared: Arc::new(Ok(FrameWaves::default())),
+            preparations: 0,
+        }
+    }
+}
+
+/// Makes [`DrawnWaves`] anew when a [`HadouWave`] changed or the set of drawn ones did.
+pub(crate) fn prepare_drawn_waves(
+    waves: Query<(Entity, &HadouWave), Without<WaveRejected>>,
+    changed: Query<(), Changed<HadouWave>>,
+    mut drawn: ResMut<DrawnWaves>,
+) {
+    let mut now: Vec<(Entity, &Wave)> =
+        waves.iter().filter(|(_, w)| w.enabled).map(|(e, w)| (e, &w.wave)).collect();
+    now.sort_by_key(|(e, _)| *e);
+    let same_set =
+        now.len() == drawn.entities.len() && now.iter().zip(&drawn.entities).all(|(a, b)| a.0 == *b);
+    if same_set && changed.is_empty() && drawn.preparations > 0 {
+        return;
+    }
+    let list: Vec<Wave> = now.iter().map(|(_, w)| (*w).clone()).collect();
+    drawn.prepared = Arc::new(waves_buffers(&list));
+    drawn.entities = now.iter().map(|(e, _)| *e).collect();
+    drawn.waves = Arc::new(list);
+    drawn.preparations += 1;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::HadouPlugin;
+    use std::path::Path;
+
+    /// The waves' curves are prepared once per change of the drawn waves, not per frame, view or
+    /// consumer: frames without a change keep the records; changing a wave, disabling one or
+    /// adding one makes them anew; every drawn curve has its prepared form there for the lights.
+    #[test]
+    fn the_drawn_waves_are_prepared_once_per_change() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-curve.toml");
+        let waves = hadou_scene::Scene::load(path).expect("the example scene").at(1.0).waves;
+        assert!(waves.iter().any(|w| w.shape.curve().is_some()), "a curved wave");
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, AssetPlugin::default(), HadouPlugin::default()));
+        let first = app.world_mut().spawn(HadouWave::new(waves[0].clone())).id();
+        for w in &waves[1..] {
+            app.world_mut().spawn(HadouWave::new(w.clone()));
+        }
+        let count = |app: &App| app.world().resource::<DrawnWaves>().preparations;
+        app.update();
+        assert_eq!(count(&app), 1);
+        app.update();
+        app.update();
+        assert_eq!(count(&app), 1, "no change, no preparation");
+        {
+            let drawn = app.world().resource::<DrawnWaves>();
+            assert_eq!(drawn.waves.len(), waves.len());
+            let prepared = drawn.prepared.as_ref().as_ref().expect("the records");
+            assert_eq!(prepared.2.len(), waves.len(), "one entry per wave");
+            for (w, c) in drawn.waves.iter().zip(&prepared.2) {
+                assert_eq!(w.shape.curve().is_some(), c.is_some(), "{}", w.name);
+            }
+        }
+        app.world_mut().get_mut::<HadouWave>(first).expect("the wave").wave.color[0] = 0.25;
+        app.update();
+        assert_eq!(count(&app), 2, "a changed wave");
+        app.world_mut().get_mut::<HadouWave>(first).expect("the wave").enabled = false;
+        app.update();
+        assert_eq!(count(&app), 3, "a disabled wave");
+        assert_eq!(app.world().resource::<DrawnWaves>().waves.len(), waves.len() - 1);
+        app.update();
+        assert_eq!(count(&app), 3);
     }
 }

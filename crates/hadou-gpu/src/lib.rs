@@ -260,6 +260,21 @@ impl GpuBackend {
         self.renderer.encode_wave_overlay(frame, encoder, target)
     }
 
+    /// [`GpuBackend::encode_wave_overlay`] with the frame's waves already prepared
+    /// ([`layout::waves_buffers`] of `frame.waves`): a caller drawing the same waves into several
+    /// views, or lighting its own materials with the prepared curves ([`layout::wave_lights`]),
+    /// prepares each curve once per frame. `prepared` must be of `frame.waves` (the counts are
+    /// checked; an error otherwise).
+    pub fn encode_prepared_wave_overlay(
+        &mut self,
+        frame: &Frame,
+        prepared: &layout::FrameWaves,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &OverlayTarget<'_>,
+    ) -> Result<(), RenderError> {
+        self.renderer.encode_prepared_wave_overlay(frame, prepared, encoder, target)
+    }
+
     /// Records `frame`'s shadow maps into `encoder`, drawn into the layers of a texture the
     /// caller owns: every map cast of its `[[shadow]]`s (`ShadowMethod::Map`; 000 §2.4's wave
     /// shadows and 001's sun shadows found by an orthographic map along each projection

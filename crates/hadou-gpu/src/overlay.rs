@@ -62,6 +62,14 @@ impl Renderer {
         enc: &mut wgpu::CommandEncoder,
         target: &OverlayTarget<'_>,
     ) -> Result<(), RenderError> {
+        self.check_overlay(frame, target)?;
+        let prepared = layout::frame_waves(frame).map_err(RenderError::Other)?;
+        self.encode_prepared_wave_overlay(frame, &prepared, enc, target)
+    }
+
+    /// What both overlay entries refuse: a lost device, an invalid frame, a multisampled depth
+    /// buffer on OpenGL.
+    fn check_overlay(&self, frame: &Frame, target: &OverlayTarget<'_>) -> Result<(), RenderError> {
         self.ctx.check()?;
         prepare::validate_frame(frame)?;
         if target.depth_samples > 1 && self.ctx.info.backend == wgpu::Backend::Gl {
@@ -73,12 +81,31 @@ impl Renderer {
                 target.depth_samples
             )));
         }
-        let (waves, curves, _) = layout::frame_waves(frame).map_err(RenderError::Other)?;
-        check_curves(&self.ctx.limits, &curves)?;
+        Ok(())
+    }
+
+    /// See [`crate::GpuBackend::encode_prepared_wave_overlay`].
+    pub(crate) fn encode_prepared_wave_overlay(
+        &mut self,
+        frame: &Frame,
+        prepared: &layout::FrameWaves,
+        enc: &mut wgpu::CommandEncoder,
+        target: &OverlayTarget<'_>,
+    ) -> Result<(), RenderError> {
+        self.check_overlay(frame, target)?;
+        let (waves, curves, curve_of) = prepared;
+        if curve_of.len() != frame.waves.len() {
+            return Err(RenderError::Other(format!(
+                "the prepared waves are of {} waves, the frame has {}",
+                curve_of.len(),
+                frame.waves.len()
+            )));
+        }
+        check_curves(&self.ctx.limits, curves)?;
         let faithful = frame.color_mapping.mode == hadou_scene::ToneMode::Faithful;
         let variant = if self.passes.wave.specialise {
             WaveVariant::of(
-                &waves,
+                waves,
                 &curves.curves,
                 &[],
                 &[],
@@ -122,8 +149,8 @@ impl Renderer {
             let model =
                 OverlayUniforms { depth_model, near: frame.camera.near, far: frame.camera.far, _pad: 0 };
             let overlay = uniform("overlay depth model", bytemuck::bytes_of(&model));
-            let waves = prepare::storage(d, "overlay waves", or_zeroed(&waves, &[GpuWave::zeroed()]));
-            let curves = upload_curves(d, &curves);
+            let waves = prepare::storage(d, "overlay waves", or_zeroed(waves, &[GpuWave::zeroed()]));
+            let curves = upload_curves(d, curves);
             let inputs = OverlayInputs {
                 uniforms: &uniforms,
                 waves: &waves,

@@ -100,6 +100,22 @@ fn overlay_samples(
     clear: [f64; 4],
     samples: u32,
 ) -> Vec<[f32; 4]> {
+    overlay_with(gpu, frame, depth, model, blend, clear, samples, false)
+}
+
+/// [`overlay_samples`], drawn by `encode_prepared_wave_overlay` from the frame's waves prepared
+/// beforehand (`layout::frame_waves`) when `prepared` is set.
+#[allow(clippy::too_many_arguments)]
+fn overlay_with(
+    gpu: &mut GpuBackend,
+    frame: &Frame,
+    depth: f32,
+    model: DepthModel,
+    blend: OverlayBlend,
+    clear: [f64; 4],
+    samples: u32,
+    prepared: bool,
+) -> Vec<[f32; 4]> {
     let (w, h) = (frame.width, frame.height);
     let device = gpu.device().clone();
     let queue = gpu.queue().clone();
@@ -165,7 +181,13 @@ fn overlay_samples(
         depth_samples: samples,
         blend,
     };
-    gpu.encode_wave_overlay(frame, &mut enc, &target).expect("encode_wave_overlay");
+    if prepared {
+        let waves = hadou_gpu::layout::frame_waves(frame).expect("the frame's waves");
+        gpu.encode_prepared_wave_overlay(frame, &waves, &mut enc, &target)
+            .expect("encode_prepared_wave_overlay");
+    } else {
+        gpu.encode_wave_overlay(frame, &mut enc, &target).expect("encode_wave_overlay");
+    }
     let row = (8 * w).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("overlay read-back"),
@@ -286,4 +308,63 @@ fn the_overlay_is_the_waves_light_clipped_at_the_callers_depth() {
     let mut cpu = CpuBackend::new();
     let (a, b) = (cpu.render(&walled).unwrap(), cpu.render(&bare).unwrap());
     assert!(a.energy.iter().zip(&b.energy).any(|(x, y)| (x - y).abs() > 0.1 * y.abs() + 1e-2));
+}
+
+/// A caller that prepares the frame's waves once (hadou-bevy: once per frame for every view and
+/// for its materials' wave lights) gets the very pixels of the overlay that prepares them itself,
+/// curves included; waves prepared for another frame are refused.
+#[test]
+fn prepared_waves_draw_the_same_overlay() {
+    let Some(mut gpu) = gpu_or_skip("prepared wave overlay") else { return };
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let scene = hadou_scene::Scene::load(scenes.join("fig4-2-bspline.toml")).expect("the example scene");
+    let mut frame = scene.at(0.5);
+    (frame.width, frame.height) = (48, 32);
+    let mut with_beam = kamehameha_frame(48, 32);
+    with_beam.waves.extend(frame.waves.iter().cloned());
+    assert!(with_beam.waves.iter().any(|w| w.shape.curve().is_some()), "a curved wave is drawn");
+    let clear = [0.0, 0.0, 0.0, 1.0];
+    let (model, blend) = (DepthModel::Standard, OverlayBlend::Replace);
+    let own = overlay_with(&mut gpu, &with_beam, 1.0, model, blend, clear, 1, false);
+    let prepared = overlay_with(&mut gpu, &with_beam, 1.0, model, blend, clear, 1, true);
+    assert!(own.iter().any(|p| p[0] > 0.0), "the overlay draws light");
+    assert_eq!(own, prepared, "the prepared overlay's pixels");
+
+    let device = gpu.device().clone();
+    let (color, depth) = targets(&device, &with_beam);
+    let target = OverlayTarget {
+        color: &color,
+        color_format: COLOR_FORMAT,
+        depth: &depth,
+        depth_model: model,
+        depth_samples: 1,
+        blend,
+    };
+    let other = hadou_gpu::layout::frame_waves(&frame).expect("the other frame's waves");
+    let mut enc = device.create_command_encoder(&Default::default());
+    let message = gpu
+        .encode_prepared_wave_overlay(&with_beam, &other, &mut enc, &target)
+        .expect_err("waves of another frame")
+        .to_string();
+    assert!(message.contains("prepared waves"), "{message}");
+}
+
+/// A colour target and a single-sample depth buffer of `frame`'s size, as views.
+fn targets(device: &wgpu::Device, frame: &Frame) -> (wgpu::TextureView, wgpu::TextureView) {
+    let size = wgpu::Extent3d { width: frame.width, height: frame.height, depth_or_array_layers: 1 };
+    let make = |format| {
+        device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+    };
+    (make(COLOR_FORMAT), make(wgpu::TextureFormat::Depth32Float))
 }

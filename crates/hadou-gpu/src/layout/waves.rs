@@ -375,10 +375,17 @@ impl CurveBuffers {
 /// Also returns the prepared curves, one entry per wave (`None` for analytic waves), for
 /// [`ShadingBuffers::new`].
 pub fn frame_waves(frame: &Frame) -> Result<FrameWaves, String> {
+    waves_buffers(&frame.waves)
+}
+
+/// [`frame_waves`] of a list of waves: what a caller that draws the same waves into several views
+/// (hadou-bevy's cameras) or also lights its own materials with them prepares once per frame and
+/// hands to [`crate::GpuBackend::encode_prepared_wave_overlay`] and [`wave_lights`].
+pub fn waves_buffers(frame_waves: &[hadou_scene::Wave]) -> Result<FrameWaves, String> {
     let mut curves = CurveBuffers::default();
-    let mut waves = Vec::with_capacity(frame.waves.len());
-    let mut prepared = Vec::with_capacity(frame.waves.len());
-    for w in &frame.waves {
+    let mut waves = Vec::with_capacity(frame_waves.len());
+    let mut prepared = Vec::with_capacity(frame_waves.len());
+    for w in frame_waves {
         match w.shape.curve() {
             Some(c) => {
                 let prep = curve::prepare(c);
