@@ -76,8 +76,8 @@
 //! with [`device_descriptor`]), [`GpuBackend::render_to_texture`],
 //! [`GpuBackend::encode_wave_overlay`],
 //! [`GpuBackend::last_present_timing`], [`GpuBackend::read_presented`] (the drawn texture read
-//! back without waiting), [`GpuBackend::soft_fit`] (whether an `[area_light]` frame should be
-//! drawn again now that its soft shadows' fit has come back) and the accessors. Everything
+//! back without waiting) and the accessors (an `[area_light]`'s maps are fitted on the GPU, so a
+//! web frame's soft shadows are the native ones). Everything
 //! that waits for the GPU — [`GpuBackend::new`], [`find_adapter`], the [`Backend`] impl (it reads
 //! the image back), `render_soft` and [`GpuBackend::time_frame`] — exists only off the web. There,
 //! wgpu error scopes are not used (their results arrive asynchronously): errors reach the
@@ -107,7 +107,7 @@ mod window;
 pub use formats::{PRESENT_FORMAT, PRESENT_USAGE};
 pub use overlay::{DepthModel, OverlayBlend, OverlayTarget};
 pub use passes::present::PresentedFrame;
-pub use passes::soft::{SoftFit, SOFT_BYTES_PER_PIXEL};
+pub use passes::soft::SOFT_BYTES_PER_PIXEL;
 pub use render::MAX_TILE;
 pub use texture_read::TextureRead;
 pub use timing::{FrameTiming, PassTime, PresentTiming, TimingMethod, SOFT_PREPARATION, SOFT_TILES};
@@ -220,16 +220,6 @@ impl GpuBackend {
     /// the web an error from the GPU surfaces on the next call.
     pub fn render_to_texture(&mut self, frame: &Frame) -> Result<PresentedFrame<'_>, RenderError> {
         self.renderer.render_to_texture(frame)
-    }
-
-    /// Whether the soft shadows of the last frame drawn with an `[area_light]` are exact
-    /// ([`SoftFit`]). Natively always [`SoftFit::Settled`]: the frame waits for its maps' fit
-    /// windows. On the web a frame cannot wait, so it is drawn with the windows read back last
-    /// and its own are read back meanwhile: a page draws the frame again while this says
-    /// [`SoftFit::Outdated`], and asks again on a later frame while it says
-    /// [`SoftFit::Pending`]. Never blocks.
-    pub fn soft_fit(&self) -> SoftFit {
-        self.renderer.soft_fit()
     }
 
     /// Starts reading back the texture the last [`GpuBackend::render_to_texture`] drew, without

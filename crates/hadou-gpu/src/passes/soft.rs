@@ -2,7 +2,8 @@
 //! hadou-cpu's `soft`). They need the whole image at once: every tile of the image is rasterized
 //! and its visible points gathered into whole-image buffers, with the bounds of those that a
 //! caster's box lies in front of ([`SoftPass::encode_points`], `cs_points`); the light's two
-//! perspective maps are fitted to those bounds ([`SoftTargets::fit_maps`]) and drawn
+//! perspective maps are fitted to those bounds on the GPU ([`SoftPass::encode_fit`], `cs_fit`: no
+//! read-back in the middle of the frame, on the web as natively) and drawn
 //! ([`SoftPass::encode_maps`]), every pixel is classed umbra / penumbra / lit
 //! ([`SoftPass::encode_class`], `cs_class`), the penumbra is resolved over the whole image ([`SoftPass::encode_resolve`]:
 //! `cs_columns` + `cs_exact`, or 003's grid search `cs_grid` + `cs_interp`), and each tile's wave
@@ -32,7 +33,7 @@ pub(crate) const MAP_BINDINGS: [Binding; 2] =
     [Binding::new(0, "spot", Kind::Uniform, VS), Binding::new(1, "objects", Kind::Storage, VS)];
 
 /// The bindings of soft.wgsl.
-pub(crate) const BINDINGS: [Binding; 13] = [
+pub(crate) const BINDINGS: [Binding; 14] = [
     Binding::new(0, "frame", Kind::Uniform, CS),
     Binding::new(1, "soft", Kind::Uniform, CS),
     Binding::new(2, "scene_texels", Kind::UintTexture, CS),
@@ -46,9 +47,10 @@ pub(crate) const BINDINGS: [Binding; 13] = [
     Binding::new(10, "out_buf", Kind::StorageRw, CS),
     Binding::new(11, "caster_boxes", Kind::Storage, CS),
     Binding::new(12, "fit", Kind::StorageRw, CS),
+    Binding::new(13, "fitted_maps", Kind::StorageRw, CS),
 ];
 
-/// What soft.wgsl reads from a tile (the rest, [`BINDINGS`] 1, 4–9, 11 and 12, is
+/// What soft.wgsl reads from a tile (the rest, [`BINDINGS`] 1, 4–9 and 11–13, is
 /// [`SoftTargets`]'s).
 pub(crate) struct SoftTileInputs<'a> {
     /// The tile's `layout::FrameUniforms`.
@@ -116,49 +118,11 @@ pub(crate) struct SoftTargets {
     /// The casters' boxes (soft.wgsl binding 11), room for `box_capacity`.
     boxes: wgpu::Buffer,
     box_capacity: usize,
-    /// The maps' fit windows (binding 12, `FitWindow` keys) and their read-back copy (not read on
-    /// the web, which cannot wait for it).
+    /// The maps' fit windows (binding 12, `FitWindow` keys), gathered by `cs_points`.
     fit: wgpu::Buffer,
-    fit_staging: wgpu::Buffer,
-    /// On the web: the fit windows read back without waiting (see [`SoftTargets::fit_maps`]).
-    #[cfg(target_arch = "wasm32")]
-    web_fit: std::sync::Mutex<WebFit>,
-}
-
-/// How the soft shadows' maps of the last frame drawn stand on the web, where a frame cannot wait
-/// for the read-back of its fit windows ([`crate::GpuBackend::soft_fit`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SoftFit {
-    /// The maps were fitted to the windows the frame's own points give (always so natively): the
-    /// soft shadows are exactly the CPU backend's.
-    Settled,
-    /// The frame's windows are still being read back: ask again on a later frame.
-    Pending,
-    /// The windows that came back differ from those the frame was drawn with (its first frame, or
-    /// the visible points moved): draw the frame again to have it exact.
-    Outdated,
-}
-
-/// The web's asynchronous fit (see [`SoftTargets::fit_maps`]).
-#[cfg(target_arch = "wasm32")]
-#[derive(Default)]
-struct WebFit {
-    /// The windows the last frame's maps were fitted to (`None`: unfitted).
-    used: Option<[FitWindow; 2]>,
-    /// The newest windows read back.
-    latest: Option<[FitWindow; 2]>,
-    /// The read-back in flight: what its map callback reported, once it has.
-    pending: Option<MapSlot>,
-}
-
-/// What a map callback reported: nothing yet, or the outcome.
-#[cfg(target_arch = "wasm32")]
-type MapSlot = std::sync::Arc<std::sync::Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>;
-
-/// The two maps' fit windows from the read-back bytes of the fit buffer.
-fn fit_keys(raw: &[u8]) -> [FitWindow; 2] {
-    let k: Vec<u32> = raw.chunks_exact(4).map(|c| u32::from_ne_bytes([c[0], c[1], c[2], c[3]])).collect();
-    [0, 1].map(|m| FitWindow { min: [k[4 * m], k[4 * m + 1]], max: [k[4 * m + 2], k[4 * m + 3]] })
+    /// The two maps fitted to them by `cs_fit` (binding 13, `[GpuSpotMap; 2]`), copied into
+    /// `spot_uniforms` on the GPU.
+    fitted: wgpu::Buffer,
 }
 
 /// Bytes of the fit windows: four `u32` keys per map.
@@ -211,18 +175,12 @@ impl SoftTargets {
                 ),
                 box_capacity: boxes,
                 fit: buffer("soft fit", FIT_BYTES, storage | wgpu::BufferUsages::COPY_DST),
-                fit_staging: buffer(
-                    "soft fit read-back",
-                    FIT_BYTES,
-                    wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                ),
-                #[cfg(target_arch = "wasm32")]
-                web_fit: Default::default(),
+                fitted: buffer("soft fitted maps", 2 * spot, storage),
             });
         }
         let soft = soft.as_ref().expect("created above");
-        // The unfitted maps, which cs_points fits the windows in; `fit_maps` narrows them.
-        soft.write_maps(ctx, frame, light.maps);
+        // The unfitted maps, which cs_points fits the windows in; cs_fit narrows them.
+        soft.write_uniforms(ctx, frame);
         let boxes: Vec<GpuCasterBox> = light.caster_boxes.iter().map(GpuCasterBox::new).collect();
         if !boxes.is_empty() {
             ctx.queue.write_buffer(&soft.boxes, 0, bytemuck::cast_slice(&boxes));
@@ -232,20 +190,17 @@ impl SoftTargets {
         ctx.queue.write_buffer(&soft.fit, 0, bytemuck::cast_slice(&keys));
     }
 
-    /// Writes the maps `maps` of the frame's `[area_light]` into soft_map.wgsl's and soft.wgsl's
-    /// uniforms.
-    fn write_maps(&self, ctx: &GpuContext, frame: &Frame, maps: [hadou_math::soft::SpotMap; 2]) {
+    /// Writes the frame's `[area_light]` into soft.wgsl's uniforms: its resolve, and the two maps
+    /// unfitted (`AreaLight::maps`), which `cs_points` gathers the fit windows in and `cs_fit`
+    /// narrows.
+    fn write_uniforms(&self, ctx: &GpuContext, frame: &Frame) {
         let light = frame.area_light.as_ref().expect("an area light");
         let n = match light.resolve {
             SoftResolve::Exact => 0,
             SoftResolve::Faithful { n } => n.max(1),
         };
-        let maps = maps.map(|m| GpuSpotMap::new(&m, self.key.2));
-        let q = &ctx.queue;
-        q.write_buffer(&self.spot_uniforms[0], 0, bytemuck::bytes_of(&maps[0]));
-        q.write_buffer(&self.spot_uniforms[1], 0, bytemuck::bytes_of(&maps[1]));
         let u = SoftUniforms {
-            maps,
+            maps: light.maps.map(|m| GpuSpotMap::new(&m, self.key.2)),
             depth_aware: u32::from(light.depth_aware),
             grid: n,
             grid_size: grid_size(frame.width, frame.height, n.max(1)),
@@ -253,80 +208,7 @@ impl SoftTargets {
             boxes: light.caster_boxes.len() as u32,
             _pad: [0; 2],
         };
-        q.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
-    }
-
-    /// Once every tile's `cs_points` has run: reads the maps' fit windows back and writes the
-    /// maps fitted to them (`SpotMap::fitted`, as hadou-cpu's `soft::fitted_maps`) for the map
-    /// and classification passes.
-    ///
-    /// On the web, where a frame cannot wait for a read-back, the maps are fitted to the newest
-    /// windows read back so far (unfitted before the first), and this frame's windows are copied
-    /// and mapped without waiting; [`SoftTargets::fit_state`] says whether the frame was drawn
-    /// with its own windows, so that a page draws a frame again until it is (one more frame for
-    /// a still image).
-    pub(crate) fn fit_maps(&self, ctx: &GpuContext, frame: &Frame) -> Result<(), RenderError> {
-        let light = frame.area_light.as_ref().expect("an area light");
-        #[cfg(not(target_arch = "wasm32"))]
-        {
-            let mut enc = ctx.device.create_command_encoder(&Default::default());
-            enc.copy_buffer_to_buffer(&self.fit, 0, &self.fit_staging, 0, FIT_BYTES);
-            let submission = ctx.queue.submit([enc.finish()]);
-            let keys = ctx.read_buffer(&self.fit_staging, FIT_BYTES, submission, fit_keys)?;
-            let maps = [0, 1].map(|m| light.maps[m].fitted(&keys[m], light.map_size));
-            self.write_maps(ctx, frame, maps);
-        }
-        #[cfg(target_arch = "wasm32")]
-        {
-            let mut web = self.web_fit.lock().unwrap_or_else(|p| p.into_inner());
-            self.collect_fit(&mut web);
-            web.used = web.latest;
-            if let Some(keys) = web.latest {
-                let maps = [0, 1].map(|m| light.maps[m].fitted(&keys[m], light.map_size));
-                self.write_maps(ctx, frame, maps);
-            }
-            if web.pending.is_none() {
-                let mut enc = ctx.device.create_command_encoder(&Default::default());
-                enc.copy_buffer_to_buffer(&self.fit, 0, &self.fit_staging, 0, FIT_BYTES);
-                ctx.queue.submit([enc.finish()]);
-                let slot: MapSlot = std::sync::Arc::new(std::sync::Mutex::new(None));
-                let s = slot.clone();
-                self.fit_staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                    *s.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
-                });
-                web.pending = Some(slot);
-            }
-        }
-        Ok(())
-    }
-
-    /// Takes the windows of a finished read-back into `web.latest` (a failed read-back is
-    /// dropped: the next frame reads again).
-    #[cfg(target_arch = "wasm32")]
-    fn collect_fit(&self, web: &mut WebFit) {
-        let Some(slot) = &web.pending else { return };
-        let Some(outcome) = slot.lock().unwrap_or_else(|p| p.into_inner()).take() else { return };
-        web.pending = None;
-        if outcome.is_ok() {
-            web.latest = Some(fit_keys(&self.fit_staging.slice(..).get_mapped_range()));
-            self.fit_staging.unmap();
-        }
-    }
-
-    /// How the last frame's maps stand ([`SoftFit`]); natively always settled.
-    pub(crate) fn fit_state(&self) -> SoftFit {
-        #[cfg(target_arch = "wasm32")]
-        {
-            let mut web = self.web_fit.lock().unwrap_or_else(|p| p.into_inner());
-            self.collect_fit(&mut web);
-            if web.pending.is_some() {
-                return SoftFit::Pending;
-            }
-            if web.latest != web.used {
-                return SoftFit::Outdated;
-            }
-        }
-        SoftFit::Settled
+        ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
     }
 
     /// After a frame with an `[area_light]` has been drawn: every pixel's soft-shadow class
@@ -360,6 +242,7 @@ impl SoftTargets {
 /// The compute pipelines of soft.wgsl.
 struct SoftPipelines {
     points: wgpu::ComputePipeline,
+    fit: wgpu::ComputePipeline,
     class: wgpu::ComputePipeline,
     columns: wgpu::ComputePipeline,
     exact: wgpu::ComputePipeline,
@@ -411,6 +294,7 @@ impl SoftPass {
             let pipeline = |entry: &str| setup::compute_pipeline(d, &soft_pl, &soft_module, entry);
             let pipelines = SoftPipelines {
                 points: pipeline("cs_points"),
+                fit: pipeline("cs_fit"),
                 class: pipeline("cs_class"),
                 columns: pipeline("cs_columns"),
                 exact: pipeline("cs_exact"),
@@ -444,6 +328,7 @@ impl SoftPass {
             tile.output.as_entire_binding(),
             targets.boxes.as_entire_binding(),
             targets.fit.as_entire_binding(),
+            targets.fitted.as_entire_binding(),
         ];
         setup::bind_group(device, "soft", &self.layout, &BINDINGS, resources)
     }
@@ -513,6 +398,26 @@ impl SoftPass {
         pass.set_pipeline(&self.pipelines.points);
         pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(size[0].div_ceil(8), size[1].div_ceil(8), 1);
+    }
+
+    /// Records the maps' fit (`cs_fit`), once every tile's points are gathered, and the copies
+    /// of the fitted maps into the map pass's uniforms: the frame goes on without waiting.
+    pub(crate) fn encode_fit(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        bind_group: &wgpu::BindGroup,
+        targets: &SoftTargets,
+    ) {
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipelines.fit);
+            pass.set_bind_group(0, bind_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        let spot = std::mem::size_of::<GpuSpotMap>() as u64;
+        for (k, uniform) in targets.spot_uniforms.iter().enumerate() {
+            enc.copy_buffer_to_buffer(&targets.fitted, k as u64 * spot, uniform, 0, spot);
+        }
     }
 
     /// Records the classification of the whole image's pixels (`cs_class`), once every tile's

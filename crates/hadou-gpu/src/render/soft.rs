@@ -1,11 +1,10 @@
 //! The `[area_light]`'s orchestration: every tile rasterized for its visible points, the two maps
-//! fitted and drawn, the classes and the resolve (passes/soft.rs), once per frame before the tiles.
+//! fitted (on the GPU) and drawn, the classes and the resolve (passes/soft.rs), once per frame before the tiles.
 
 use super::{Prepared, Renderer, TileWork};
 use crate::passes::setup::Draw;
 #[cfg(not(target_arch = "wasm32"))]
 use crate::passes::soft::SoftReadback;
-use crate::passes::soft::SoftTargets;
 use hadou_scene::{Frame, RenderError};
 
 impl Renderer {
@@ -30,19 +29,14 @@ impl Renderer {
                 self.submit_tile(encoders)?;
             }
         }
-        soft.fit_maps(&self.ctx, frame)?;
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
+        self.passes.soft.encode_fit(&mut enc, bind_group, soft);
         let objects = &prepared.buffers.objects;
         self.passes.soft.encode_maps(&mut enc, d, soft, objects, &self.meshes, frame, &caster_draws);
         self.passes.soft.encode_class(&mut enc, bind_group, frame);
         self.passes.soft.encode_resolve(&mut enc, bind_group, frame);
         self.ctx.queue.submit([enc.finish()]);
         Ok(())
-    }
-
-    /// See [`crate::GpuBackend::soft_fit`].
-    pub(crate) fn soft_fit(&self) -> crate::passes::soft::SoftFit {
-        self.soft.as_ref().map_or(crate::passes::soft::SoftFit::Settled, SoftTargets::fit_state)
     }
 
     /// After [`Renderer::render`] of a frame with an `[area_light]`: every pixel's soft-shadow

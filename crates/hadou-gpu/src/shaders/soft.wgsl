@@ -1,6 +1,7 @@
 // Soft shadows of the `[area_light]` (twin of hadou-cpu's soft.rs): every tile's visible points
-// gathered and the maps' fit windows with them (cs_points), every pixel classed umbra / penumbra /
-// lit from the two fitted maps (soft_map.wgsl, cs_class), then the penumbra resolved over the whole
+// gathered and the maps' fit windows with them (cs_points), the two maps fitted to the windows on
+// the GPU (cs_fit: nothing is read back in the middle of a frame), every pixel classed umbra /
+// penumbra / lit from the two fitted maps (soft_map.wgsl, cs_class), then the penumbra resolved over the whole
 // image: exact distances (cs_columns, cs_exact) or 003's grid search with bilinear interpolation
 // (cs_grid, cs_interp); cs_gather hands each tile's visibility to the wave pass. Prepended by
 // common.wgsl.
@@ -51,6 +52,9 @@ struct GpuCasterBox {
 // The maps' fit windows (hadou_math::soft::FitWindow), map k at 4k: keys of min x/z, min y/z,
 // max x/z, max y/z, gathered by cs_points before the maps are fitted and drawn.
 @group(0) @binding(12) var<storage, read_write> fit: array<atomic<u32>, 8>;
+// The two maps as drawn: soft.maps fitted to the windows in `fit` by cs_fit (passes/soft.rs copies
+// each into soft_map.wgsl's uniform before the maps are drawn).
+@group(0) @binding(13) var<storage, read_write> fitted_maps: array<GpuSpotMap, 2>;
 // One workgroup's part of fit (cs_points).
 var<workgroup> wg_fit: array<atomic<u32>, 8>;
 
@@ -65,8 +69,10 @@ const R2: u32 = 65536u;
 // hadou_math::soft::DEPTH_SLOPE, BIAS_TEXELS.
 const DEPTH_SLOPE: f32 = 0.3;
 const BIAS_TEXELS: f32 = 1.5;
-// hadou_math::soft::FIT_MARGIN.
+// hadou_math::soft::FIT_MARGIN, FIT_GAIN, SPOT_MIN_TAN.
 const FIT_MARGIN: f32 = 1e-4;
+const FIT_GAIN: f32 = 0.5;
+const SPOT_MIN_TAN: f32 = 1e-3;
 // A squared distance standing for "none" (hadou_math::soft::FAR).
 const FAR: u32 = 0xffffffffu;
 const NO_ROW: u32 = 0xffffu;
@@ -84,7 +90,7 @@ fn spot_texel(s: GpuSpotMap, z: f32) -> f32 {
 // SpotMap::occludes: facing away from map k's light, or a nearer surface in the texel looked up
 // after the normal offset.
 fn spot_shadowed(k: u32, p: vec3<f32>, n: vec3<f32>) -> bool {
-    let s = soft.maps[k];
+    let s = fitted_maps[k];
     if (dot3(n, s.eye - p) <= 0.0) {
         return true;
     }
@@ -203,6 +209,53 @@ fn cs_points(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoca
             atomicMax(&fit[li], v);
         }
     }
+}
+
+// Twin of hadou_math::soft::FitWindow::value: the f32 of an order-preserving key.
+fn fit_value(k: u32) -> f32 {
+    if ((k & 0x80000000u) != 0u) {
+        return bitcast<f32>(k & 0x7fffffffu);
+    }
+    return bitcast<f32>(~k);
+}
+
+// Twin of hadou_math::soft::SpotMap::fitted: map `s` (unfitted) narrowed to the window of keys
+// `lo..=hi` (FitWindow's min and max), its edge in texels `s.size`.
+fn fitted_map(s: GpuSpotMap, lo_key: vec2<u32>, hi_key: vec2<u32>) -> GpuSpotMap {
+    var out = s;
+    if (s.size < 16u) {
+        return s;
+    }
+    if (lo_key.x > hi_key.x || lo_key.y > hi_key.y) {
+        out.tan_half = SPOT_MIN_TAN;
+        return out;
+    }
+    let lo = vec2<f32>(fit_value(lo_key.x), fit_value(lo_key.y));
+    let hi = vec2<f32>(fit_value(hi_key.x), fit_value(hi_key.y));
+    let c = vec2<f32>(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
+    let h = max(0.5 * (hi.x - lo.x), 0.5 * (hi.y - lo.y));
+    let wide = 1.02 * h / (1.0 - 4.0 / f32(s.size));
+    // f32::max: a NaN gives the other value.
+    var half = SPOT_MIN_TAN;
+    if (wide > SPOT_MIN_TAN) {
+        half = wide;
+    }
+    if (half > FIT_GAIN * s.tan_half || !finite(c.x) || !finite(c.y)) {
+        return s;
+    }
+    out.right = s.right - s.forward * c.x;
+    out.up = s.up - s.forward * c.y;
+    out.tan_half = half;
+    return out;
+}
+
+// Once every tile's cs_points has run: both maps fitted to their windows (hadou-cpu's
+// soft::fitted_maps), for the map pass (through passes/soft.rs's copies) and cs_class.
+@compute @workgroup_size(2, 1, 1)
+fn cs_fit(@builtin(local_invocation_index) k: u32) {
+    let lo = vec2<u32>(atomicLoad(&fit[4u * k]), atomicLoad(&fit[4u * k + 1u]));
+    let hi = vec2<u32>(atomicLoad(&fit[4u * k + 2u]), atomicLoad(&fit[4u * k + 3u]));
+    fitted_maps[k] = fitted_map(soft.maps[k], lo, hi);
 }
 
 // cs_points for one pixel of the tile.

@@ -10,7 +10,7 @@ use crate::export::{png_bytes, GifExport};
 use crate::params::PageParams;
 use crate::presets;
 use hadou_cpu::CpuBackend;
-use hadou_gpu::{GpuBackend, SoftFit, TextureRead};
+use hadou_gpu::{GpuBackend, TextureRead};
 use hadou_scene::Frame;
 use hadou_view::document::Document;
 use hadou_view::ui::{UiState, ViewportImage};
@@ -496,7 +496,6 @@ impl WebApp {
             || self.export.is_some()
             || self.screenshot.is_some()
             || self.test == TestState::Start
-            || self.gpu.as_ref().is_some_and(|g| g.soft_fit() != SoftFit::Settled)
     }
 }
 
