@@ -140,7 +140,9 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 /// multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
     let grid = match resolve {
-        SoftResolve::Traced { samples } => return crate::traced::traced(frame, light, input, samples),
+        SoftResolve::Traced { samples } => {
+            return crate::traced::traced(frame, light, &input.points, input.width, samples)
+        }
         SoftResolve::Exact => None,
         SoftResolve::Faithful { n } => Some(n.max(1) as usize),
     };

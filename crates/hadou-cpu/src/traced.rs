@@ -7,11 +7,13 @@
 //!    moved off its surface by [`TRACE_BIAS`] of its distance to `L`) fit in a ball; every ray
 //!    from one of them to the lamp (inside the ball of radius `l` around `L`) lies in the tapered
 //!    capsule between the two balls ([`capsule_hits`]). The hierarchy is walked once per tile
-//!    with that capsule: no triangle met, and every pixel of the tile sees the whole lamp without
-//!    a single ray (most of the image); up to [`TILE_TRIS`] met, and each pixel tests only those;
-//!    more, and each pixel walks the hierarchy itself.
-//! 2. **Pixels.** A pixel's own capsule (radius 0 at its point) picks the triangles that can hide
-//!    part of its lamp; each sets the samples it hides in the pixel's mask
+//!    with that capsule, a triangle whose plane leaves both balls on one side
+//!    ([`BvhTri::one_side`]) dropped: no triangle kept, and every pixel of the tile sees the whole
+//!    lamp without a single ray (most of the image); up to [`TILE_TRIS`], and each pixel tests
+//!    only those; more, and each pixel walks the hierarchy itself (a node counts when it meets the
+//!    pixel's capsule and its box's projection meets the lamp, [`LampFrame::box_may_hide`]).
+//! 2. **Pixels.** A pixel's own capsule (radius 0 at its point) and [`BvhTri::one_side`] pick the
+//!    triangles that can hide part of its lamp; each sets the samples it hides in the pixel's mask
 //!    ([`hadou_math::soft::occlude`]: clipped, projected onto the lamp's plane, each row of samples
 //!    solved exactly); the walk stops once every sample is hidden (umbra). The visibility is the
 //!    mask's weighted share of clear samples ([`mask_visibility`]).
@@ -23,10 +25,10 @@
 //! two-map resolves give it (shadowed in both maps). [`reference`] is the brute-force check: every
 //! sample ray against every caster triangle, no hierarchy.
 
-use crate::soft::SoftInput;
+use crate::opaque::SoftPoint;
 use hadou_math::soft::{
-    capsule_hits, lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, Bvh, LampFrame, LampPattern,
-    LampShape, MASK_WORDS, TRACE_BIAS, T_MIN,
+    capsule_hits, lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, Bvh, BvhTri, LampFrame,
+    LampPattern, LampShape, MASK_WORDS, TRACE_BIAS, T_MIN,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame};
@@ -97,32 +99,48 @@ impl Lamp {
     }
 }
 
-/// A triangle with its bounding ball, for the per-pixel capsule test.
+/// A triangle with its bounding ball, for the per-pixel tests.
 #[derive(Clone, Copy)]
 struct Cand {
-    tri: [Vec3f; 3],
+    tri: BvhTri,
+    corners: [Vec3f; 3],
     centre: Vec3f,
     radius: f32,
 }
 
 impl Cand {
-    fn new(tri: [Vec3f; 3]) -> Cand {
-        let centre = (tri[0] + tri[1] + tri[2]) * (1.0 / 3.0);
-        let radius = tri.iter().map(|v| (*v - centre).length()).fold(0.0f32, f32::max);
-        Cand { tri, centre, radius }
+    fn new(tri: &BvhTri) -> Cand {
+        let corners = tri.corners();
+        let centre = (corners[0] + corners[1] + corners[2]) * (1.0 / 3.0);
+        let radius = corners.iter().map(|v| (*v - centre).length()).fold(0.0f32, f32::max);
+        Cand { tri: *tri, corners, centre, radius }
     }
 }
 
-/// The traced visibility of every pixel of `input` under `light` with `samples` lamp samples a
-/// pixel (see the module notes); 0 where no point is.
-pub fn traced(frame: &Frame, light: &AreaLight, input: &SoftInput, samples: u32) -> Vec<f32> {
+/// The traced visibility of every pixel of an image `width` pixels wide whose visible points are
+/// `points` (row-major, `None` for none: a [`crate::soft::SoftInput`]'s) under `light` with
+/// `samples` lamp samples a pixel (see the module notes); 0 where no point is.
+pub fn traced(
+    frame: &Frame,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+) -> Vec<f32> {
     let bvh = Bvh::build(&caster_triangles(frame, &light.casters));
-    traced_with(&bvh, light, input, samples)
+    traced_with(&bvh, light, points, width, samples)
 }
 
 /// [`traced`] with the hierarchy already built.
-pub fn traced_with(bvh: &Bvh, light: &AreaLight, input: &SoftInput, samples: u32) -> Vec<f32> {
-    let (w, h) = (input.width, input.height);
+pub fn traced_with(
+    bvh: &Bvh,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+) -> Vec<f32> {
+    let w = width;
+    let h = if w == 0 { 0 } else { points.len() / w };
     let lamp = Lamp::of(light);
     let pat = LampPattern::new(lamp.shape, samples);
     let mut out = vec![0.0f32; w * h];
@@ -140,7 +158,7 @@ pub fn traced_with(bvh: &Bvh, light: &AreaLight, input: &SoftInput, samples: u32
             let mut any = false;
             for y in y0..y0 + rows {
                 for x in x0..x1 {
-                    if let Some(p) = input.points[y * w + x].filter(|p| lit_at_all(p.term)) {
+                    if let Some(p) = points[y * w + x].filter(|p| lit_at_all(p.term)) {
                         let r = receiver(p.world, p.normal, lamp.centre);
                         lo = lo.min(r);
                         hi = hi.max(r);
@@ -155,19 +173,25 @@ pub fn traced_with(bvh: &Bvh, light: &AreaLight, input: &SoftInput, samples: u32
             cands.clear();
             let mut overflow = false;
             bvh.walk(
-                |c, r| capsule_hits(tc, tr, lamp.centre, lamp.size, c, r),
+                |node| {
+                    let (c, r) = node.ball();
+                    capsule_hits(tc, tr, lamp.centre, lamp.size, c, r)
+                },
                 |t| {
+                    if t.one_side(tc, tr, lamp.centre, lamp.size) {
+                        return true;
+                    }
                     if cands.len() == TILE_TRIS {
                         overflow = true;
                         return false;
                     }
-                    cands.push(Cand::new(t.corners()));
+                    cands.push(Cand::new(t));
                     true
                 },
             );
             for y in y0..y0 + rows {
                 for x in x0..x1 {
-                    let Some(p) = input.points[y * w + x] else { continue };
+                    let Some(p) = points[y * w + x] else { continue };
                     let o = &mut band[(y - y0) * w + x];
                     if !lit_at_all(p.term) {
                         *o = 0.0;
@@ -205,15 +229,21 @@ fn pixel(bvh: &Bvh, cands: Option<&[Cand]>, lamp: &Lamp, pat: &LampPattern, r: V
     match cands {
         Some(cands) => {
             for c in cands {
-                if capsule_hits(r, 0.0, lamp.centre, lamp.size, c.centre, c.radius) && !hit(&c.tri, &mut mask)
+                if !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
+                    && capsule_hits(r, 0.0, lamp.centre, lamp.size, c.centre, c.radius)
+                    && !hit(&c.corners, &mut mask)
                 {
                     break;
                 }
             }
         }
         None => bvh.walk(
-            |c, rc| capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc),
-            |t| hit(&t.corners(), &mut mask),
+            |node| {
+                let (c, rc) = node.ball();
+                capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
+                    && f.box_may_hide(node.lo, node.hi, pat.disc)
+            },
+            |t| t.one_side(r, 0.0, lamp.centre, lamp.size) || hit(&t.corners(), &mut mask),
         ),
     }
     mask_visibility(&mask, pat)
@@ -262,8 +292,8 @@ fn ray_triangle(o: Vec3<f64>, d: Vec3<f64>, t: &[Vec3<f64>; 3]) -> Option<f64> {
     Some(e2.dot(q) * inv)
 }
 
-/// The brute-force reference of the traced resolve at the pixels `pixels` of `input` (indices,
-/// row-major): for each, `samples` points of the lamp as seen from the pixel's receiver
+/// The brute-force reference of the traced resolve at the pixels `pixels` (row-major indices) of
+/// the visible points `points`: for each, `samples` points of the lamp as seen from the pixel's receiver
 /// ([`receiver`], [`Lamp::frame`]) — stratified in `⌈√samples⌉²` cells (the segment: `samples`
 /// strata along it) and mapped onto the disc by the concentric map, jittered by a generator
 /// seeded from the pixel's index — each ray tested against every caster triangle whose box meets
@@ -273,7 +303,7 @@ fn ray_triangle(o: Vec3<f64>, d: Vec3<f64>, t: &[Vec3<f64>; 3]) -> Option<f64> {
 pub fn reference(
     frame: &Frame,
     light: &AreaLight,
-    input: &SoftInput,
+    points: &[Option<SoftPoint>],
     samples: u32,
     pixels: &[usize],
 ) -> Vec<f32> {
@@ -288,7 +318,7 @@ pub fn reference(
         .par_iter()
         .with_min_len(4)
         .map(|&i| {
-            let Some(p) = input.points.get(i).copied().flatten() else { return 0.0 };
+            let Some(p) = points.get(i).copied().flatten() else { return 0.0 };
             if !lit_at_all(p.term) {
                 return 0.0;
             }

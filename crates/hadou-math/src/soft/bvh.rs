@@ -62,30 +62,47 @@ impl BvhNode {
     }
 }
 
-/// One triangle (48 bytes, WGSL `struct BvhTri { a: vec4<f32>, b: vec4<f32>, c: vec4<f32> }`, the
-/// corners in `xyz`).
+/// One triangle (48 bytes, WGSL `struct BvhTri { a: vec4<f32>, b: vec4<f32>, c: vec4<f32> }`): the
+/// corners in `xyz` and, in the `w`s, the unit normal: `(a.w, b.w, c.w)` = unit `(b − a) × (c − a)`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BvhTri {
-    /// First corner, `w = 0`.
+    /// First corner, `w` = the normal's `x`.
     pub a: [f32; 4],
-    /// Second corner, `w = 0`.
+    /// Second corner, `w` = the normal's `y`.
     pub b: [f32; 4],
-    /// Third corner, `w = 0`.
+    /// Third corner, `w` = the normal's `z`.
     pub c: [f32; 4],
 }
 
 impl BvhTri {
-    /// The triangle `a b c`.
+    /// The triangle `a b c` and its unit normal (zero for a degenerate one).
     pub fn new(a: Vec3f, b: Vec3f, c: Vec3f) -> Self {
-        let p = |v: Vec3f| [v.x, v.y, v.z, 0.0];
-        BvhTri { a: p(a), b: p(b), c: p(c) }
+        let n = (b - a).cross(c - a).normalize_or(Vec3f::ZERO);
+        BvhTri { a: [a.x, a.y, a.z, n.x], b: [b.x, b.y, b.z, n.y], c: [c.x, c.y, c.z, n.z] }
     }
 
     /// The three corners.
     #[inline]
     pub fn corners(&self) -> [Vec3f; 3] {
         [self.a, self.b, self.c].map(|v| Vec3f::new(v[0], v[1], v[2]))
+    }
+
+    /// The unit normal.
+    #[inline]
+    pub fn normal(&self) -> Vec3f {
+        Vec3f::new(self.a[3], self.b[3], self.c[3])
+    }
+
+    /// Whether the triangle's plane leaves the ball `(p, rp)` (a receiver or a tile of them) and
+    /// the ball `(l, rl)` (the lamp) wholly on one side, so that no segment between them crosses
+    /// the triangle (hadou's own): `n·(p − a)` and `n·(l − a)` of the same sign and each farther
+    /// from the plane than its ball's radius. `false` where unsure (a zero normal, NaN).
+    #[inline]
+    pub fn one_side(&self, p: Vec3f, rp: f32, l: Vec3f, rl: f32) -> bool {
+        let (n, a) = (self.normal(), Vec3f::new(self.a[0], self.a[1], self.a[2]));
+        let (dp, dl) = (n.dot(p - a), n.dot(l - a));
+        (dp > rp && dl > rl) || (dp < -rp && dl < -rl)
     }
 }
 
@@ -196,16 +213,14 @@ impl Bvh {
         self.nodes.len() as u64 * BVH_NODE_BYTES + self.tris.len() as u64 * BVH_TRI_BYTES
     }
 
-    /// The stackless walk: calls `leaf(tri)` for every triangle of every leaf whose box and every
-    /// ancestor's box `hits` (given the box's centre and enclosing radius, [`BvhNode::ball`]),
-    /// in pre-order; `leaf` returns `false` to stop the walk early.
+    /// The stackless walk: calls `leaf(tri)` for every triangle of every leaf that `hits`, every
+    /// ancestor hitting too, in pre-order; `leaf` returns `false` to stop the walk early.
     #[inline]
-    pub fn walk(&self, mut hits: impl FnMut(Vec3f, f32) -> bool, mut leaf: impl FnMut(&BvhTri) -> bool) {
+    pub fn walk(&self, mut hits: impl FnMut(&BvhNode) -> bool, mut leaf: impl FnMut(&BvhTri) -> bool) {
         let mut i = 0usize;
         while i < self.nodes.len() {
             let node = &self.nodes[i];
-            let (c, r) = node.ball();
-            if !hits(c, r) {
+            if !hits(node) {
                 i = node.skip as usize;
                 continue;
             }
@@ -242,14 +257,15 @@ pub fn capsule_hits(a: Vec3f, ra: f32, b: Vec3f, rb: f32, c: Vec3f, rc: f32) -> 
     let rp = rb - ra;
     if dl <= rp.abs() || dl <= 0.0 {
         let (e, r) = if rb >= ra { (b, rb) } else { (a, ra) };
-        return !((c - e).length() > r + rc);
+        let gap = (c - e).length();
+        return gap.is_nan() || rc.is_nan() || gap <= r + rc;
     }
     let axis = d / dl;
     let along = x.dot(axis);
     let h = (x.length_squared() - along * along).max(0.0).sqrt();
     let t = (along / dl + rp * h / (dl * ((dl - rp) * (dl + rp)).sqrt())).clamp(0.0, 1.0);
     let f = (x - d * t).length() - ra - t * rp;
-    !(f > rc)
+    f.is_nan() || rc.is_nan() || f <= rc
 }
 
 #[cfg(test)]
@@ -354,7 +370,10 @@ mod tests {
             let (ra, rb) = (r() * 0.5, r() * 1.5);
             let mut found = Vec::new();
             bvh.walk(
-                |c, rc| capsule_hits(a, ra, b, rb, c, rc),
+                |node| {
+                    let (c, rc) = node.ball();
+                    capsule_hits(a, ra, b, rb, c, rc)
+                },
                 |t| {
                     found.push(*t);
                     true

@@ -107,6 +107,47 @@ pub fn lamp_frame(shape: LampShape, l: Vec3f, axis: Vec3f, size: f32, p: Vec3f) 
     })
 }
 
+impl LampFrame {
+    /// Whether anything inside the box `lo..hi` can hide part of the lamp's box (the square
+    /// `[−1, 1]²` of the disc, the segment `[−1, 1] × {0}`, in units of the radius) from the
+    /// origin: `false` when every corner lies beyond the lamp's plane, or every corner lies
+    /// between the planes and their projections from the origin (whose convex hull holds the
+    /// projection of the whole box: a central projection maps segments to segments there) miss
+    /// the lamp's box; `true` when unsure (a corner at or behind the origin's parallel plane).
+    /// The traced resolve's node test after [`crate::soft::capsule_hits`] (hadou's own).
+    #[inline]
+    pub fn box_may_hide(&self, lo: [f32; 3], hi: [f32; 3], disc: bool) -> bool {
+        let top = self.height * (1.0 - T_MIN);
+        let inv_r = 1.0 / self.radius;
+        let (mut x0, mut x1, mut y0, mut y1) =
+            (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY);
+        let mut beyond = 0;
+        for k in 0..8 {
+            let c = Vec3f::new(
+                if k & 1 == 0 { lo[0] } else { hi[0] },
+                if k & 2 == 0 { lo[1] } else { hi[1] },
+                if k & 4 == 0 { lo[2] } else { hi[2] },
+            );
+            let h = self.n.dot(c - self.centre);
+            if h.is_nan() || h >= top {
+                return true;
+            }
+            if h < 0.0 {
+                beyond += 1;
+            }
+            let s = self.height / (self.height - h);
+            let y = self.origin + (c - self.origin) * s - self.centre;
+            let (px, py) = (self.u.dot(y) * inv_r, self.v.dot(y) * inv_r);
+            x0 = x0.min(px);
+            x1 = x1.max(px);
+            y0 = y0.min(py);
+            y1 = y1.max(py);
+        }
+        let ylim = if disc { 1.0 } else { 0.0 };
+        beyond < 8 && !(x0 > 1.0 || x1 < -1.0 || y0 > ylim || y1 < -ylim)
+    }
+}
+
 /// The sample layout of a lamp: `rows` rows of `per_row` samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LampPattern {
@@ -117,7 +158,13 @@ pub struct LampPattern {
     pub rows: u32,
     /// Samples a row.
     pub per_row: u32,
+    /// Each row's share of the lamp ([`LampPattern::row_weight`]), for rows `0..rows` (at most
+    /// [`MAX_ROWS`]).
+    pub weights: [f32; MAX_ROWS],
 }
+
+/// Most rows of a [`LampPattern`]: `round(√MAX_TRACE_SAMPLES)`.
+pub const MAX_ROWS: usize = 32;
 
 impl LampPattern {
     /// The layout of `samples` (clamped to `1..=MAX_TRACE_SAMPLES`) for `shape`: one row of
@@ -125,13 +172,17 @@ impl LampPattern {
     /// and the sphere (`k·⌊samples/k⌋ ≤ samples` samples in all: 256 → 16 × 16).
     pub fn new(shape: LampShape, samples: u32) -> LampPattern {
         let s = samples.clamp(1, MAX_TRACE_SAMPLES);
-        match shape {
-            LampShape::Segment => LampPattern { disc: false, rows: 1, per_row: s },
+        let mut p = match shape {
+            LampShape::Segment => LampPattern { disc: false, rows: 1, per_row: s, weights: [0.0; MAX_ROWS] },
             _ => {
-                let rows = ((s as f32).sqrt().round() as u32).max(1);
-                LampPattern { disc: true, rows, per_row: (s / rows).max(1) }
+                let rows = ((s as f32).sqrt().round() as u32).clamp(1, MAX_ROWS as u32);
+                LampPattern { disc: true, rows, per_row: (s / rows).max(1), weights: [0.0; MAX_ROWS] }
             }
+        };
+        for j in 0..p.rows {
+            p.weights[j as usize] = p.row_weight(j);
         }
+        p
     }
 
     /// Samples in all.
@@ -185,7 +236,29 @@ pub fn pixel_offset(x: u32, y: u32) -> f32 {
 #[inline]
 pub fn row_offset(o: f32, j: u32) -> f32 {
     let x = o + j as f32 * 0.618_034;
-    x - x.floor()
+    x - floor_small(x)
+}
+
+/// `⌊x⌋` of an `x` already clamped to a small range (no libm call).
+#[inline]
+fn floor_small(x: f32) -> f32 {
+    let i = x as i32 as f32;
+    if i > x {
+        i - 1.0
+    } else {
+        i
+    }
+}
+
+/// `⌈x⌉` of an `x` already clamped to a small range.
+#[inline]
+fn ceil_small(x: f32) -> f32 {
+    let i = x as i32 as f32;
+    if i < x {
+        i + 1.0
+    } else {
+        i
+    }
 }
 
 /// Sets the bits `a..b` of `mask`.
@@ -220,7 +293,9 @@ fn count_bits(mask: &[u32; MASK_WORDS], a: u32, b: u32) -> u32 {
 #[inline]
 pub fn mask_full(mask: &[u32; MASK_WORDS], pat: &LampPattern) -> bool {
     let n = pat.samples();
-    count_bits(mask, 0, n) == n
+    let (whole, rest) = ((n / 32) as usize, n % 32);
+    mask[..whole].iter().all(|&w| w == u32::MAX)
+        && (rest == 0 || mask[whole] | !((1u32 << rest) - 1) == u32::MAX)
 }
 
 /// The visible share of the lamp: `Σⱼ weightⱼ·(clear samples of row j)/per_row`, in `[0, 1]`.
@@ -228,7 +303,7 @@ pub fn mask_visibility(mask: &[u32; MASK_WORDS], pat: &LampPattern) -> f32 {
     let mut v = 0.0f32;
     for j in 0..pat.rows {
         let hidden = count_bits(mask, j * pat.per_row, (j + 1) * pat.per_row);
-        v += pat.row_weight(j) * (pat.per_row - hidden) as f32 / pat.per_row as f32;
+        v += pat.weights[j as usize] * (pat.per_row - hidden) as f32 / pat.per_row as f32;
     }
     v.clamp(0.0, 1.0)
 }
@@ -237,7 +312,9 @@ pub fn mask_visibility(mask: &[u32; MASK_WORDS], pat: &LampPattern) -> f32 {
 /// [`pixel_offset`]) that the triangle `tri` hides from `f.origin` (see the module notes): the
 /// triangle clipped to `0 ≤ h ≤ (1 − T_MIN)·height` (`h` the height over the lamp's plane),
 /// projected from the origin onto the plane in units of the radius, and each row's interval of
-/// the polygon turned into the samples `i` with `−c + (i + oⱼ)·2c/per_row` inside it.
+/// the polygon turned into the samples `i` with `−c + (i + oⱼ)·2c/per_row` inside it (only the
+/// rows within the polygon's height range; every sample at once when the polygon holds the lamp's
+/// box).
 pub fn occlude(f: &LampFrame, pat: &LampPattern, o: f32, tri: &[Vec3f; 3], mask: &mut [u32; MASK_WORDS]) {
     let hp = f.height;
     let top = hp * (1.0 - T_MIN);
@@ -293,8 +370,43 @@ pub fn occlude(f: &LampFrame, pat: &LampPattern, o: f32, tri: &[Vec3f; 3], mask:
         let y = f.origin + (a[i] - f.origin) * s - f.centre;
         xy[i] = (f.u.dot(y) * inv_r, f.v.dot(y) * inv_r);
     }
+    // The polygon's extent; nothing to do when it misses the lamp's box.
+    let (mut x0, mut x1, mut y0, mut y1) =
+        (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY);
+    for &(x, y) in &xy[..na] {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let ylim = if pat.disc { 1.0 } else { 0.0 };
+    if x0 > 1.0 || x1 < -1.0 || y0 > ylim || y1 < -ylim || x0.is_nan() || y0.is_nan() {
+        return;
+    }
+    // A polygon holding the lamp's box (the square [−1, 1]², the segment [−1, 1] × {0}) hides
+    // every sample: the corners on the inner side of every edge (the sign of the polygon's
+    // orientation, or on it).
+    let area: f32 = (0..na).map(|i| xy[i].0 * xy[(i + 1) % na].1 - xy[(i + 1) % na].0 * xy[i].1).sum();
+    let holds = |px: f32, py: f32| {
+        (0..na).all(|i| {
+            let (a, b) = (xy[i], xy[(i + 1) % na]);
+            ((b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0)) * area >= 0.0
+        })
+    };
+    if area != 0.0 && holds(-1.0, -ylim) && holds(1.0, -ylim) && holds(-1.0, ylim) && holds(1.0, ylim) {
+        set_bits(mask, 0, pat.samples());
+        return;
+    }
+    // The rows whose height `−1 + (2j + 1)/rows` lies in `[y0, y1]`.
+    let (j0, j1) = if pat.disc {
+        let r = pat.rows as f32;
+        let k = |y: f32| ((y.clamp(-1.0, 1.0) + 1.0) * 0.5 * r - 0.5);
+        (ceil_small(k(y0)).max(0.0) as u32, floor_small(k(y1)).clamp(0.0, r - 1.0) as u32)
+    } else {
+        (0, 0)
+    };
     let m = pat.per_row as f32;
-    for j in 0..pat.rows {
+    for j in j0..=j1 {
         let (yj, c) = pat.row(j);
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         for i in 0..na {
@@ -311,13 +423,13 @@ pub fn occlude(f: &LampFrame, pat: &LampPattern, o: f32, tri: &[Vec3f; 3], mask:
                 hi = hi.max(x);
             }
         }
-        if !(lo <= hi) || c <= 0.0 {
+        if lo.is_nan() || hi.is_nan() || lo > hi || c <= 0.0 {
             continue;
         }
         let oj = row_offset(o, j);
         let scale = m / (2.0 * c);
-        let i0 = ((lo + c) * scale - oj).ceil().max(0.0);
-        let i1 = ((hi + c) * scale - oj).floor().min(m - 1.0);
+        let i0 = ceil_small(((lo + c) * scale - oj).clamp(-1.0, m + 1.0)).max(0.0);
+        let i1 = floor_small(((hi + c) * scale - oj).clamp(-1.0, m + 1.0)).min(m - 1.0);
         if i0 <= i1 {
             let base = j * pat.per_row;
             set_bits(mask, base + i0 as u32, base + i1 as u32 + 1);
@@ -368,7 +480,7 @@ pub fn lamp_cosine(m: f32, sin_sigma: f32) -> f32 {
         return 0.0;
     }
     let m = m.clamp(-1.0, 1.0);
-    if !(sin_sigma > 1e-4) || m * m >= sin_sigma * sin_sigma {
+    if sin_sigma.is_nan() || sin_sigma <= 1e-4 || m * m >= sin_sigma * sin_sigma {
         return m.max(0.0);
     }
     let s2 = (sin_sigma * sin_sigma).min(1.0 - 1e-6);
@@ -385,7 +497,7 @@ pub fn lamp_cosine(m: f32, sin_sigma: f32) -> f32 {
 /// max(0, m)`: `m` itself wherever the lamp is wholly above or below the horizon (so a toon ramp
 /// sees the same negative values as with the segment), continuous across it.
 pub fn lamp_toon_cosine(m: f32, sin_sigma: f32) -> f32 {
-    if !(sin_sigma > 1e-4) {
+    if sin_sigma.is_nan() || sin_sigma <= 1e-4 {
         return m;
     }
     m + lamp_cosine(m, sin_sigma) - m.max(0.0)
