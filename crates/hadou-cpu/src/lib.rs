@@ -23,6 +23,7 @@ mod setup;
 mod shading;
 mod shadows;
 pub mod soft;
+pub mod traced;
 mod waves;
 
 pub use probe::{probe, Probe, WaveProbe};

@@ -14,7 +14,7 @@ use crate::soft;
 use crate::waves::{BatchLight, RowOut, WavePass};
 use hadou_math::energy::lanes::LANES;
 use hadou_math::simd::SimdPath;
-use hadou_scene::{Backend, Frame, Image, RenderError, Rgb8Image};
+use hadou_scene::{Backend, Frame, Image, RenderError, Rgb8Image, SoftResolve};
 use rayon::prelude::*;
 #[cfg(target_arch = "wasm32")]
 use web_time::Instant;
@@ -188,6 +188,11 @@ fn render_chunked(
     chunk_samples: usize,
 ) -> Result<PassTimes, RenderError> {
     let start = Instant::now();
+    if let Some(light) = frame.area_light.as_ref().filter(|l| matches!(l.resolve, SoftResolve::Traced { .. }))
+    {
+        let tris = crate::traced::caster_triangle_count(frame, &light.casters);
+        hadou_scene::check_trace_memory(tris).map_err(RenderError::Memory)?;
+    }
     let (y0, y1) = (rows.start.min(frame.height), rows.end.min(frame.height));
     let y1 = y1.max(y0);
     let k = frame.sample_grid().edge() as usize;

@@ -5,9 +5,10 @@
 use hadou_math::curve::PreparedCurve;
 use hadou_math::energy::Falloff;
 use hadou_math::mtoon;
+use hadou_math::soft::{lamp_cosine, lamp_spread, lamp_toon_cosine};
 use hadou_math::toon;
 use hadou_math::{shade as tone, Vec3f};
-use hadou_scene::{AreaLight, Frame, LightLine, Material, Mtoon, ShadingModel};
+use hadou_scene::{AreaLight, Frame, LampShape, LightLine, Material, Mtoon, ShadingModel};
 
 /// The interpolated attributes of a visible surface point.
 #[derive(Clone, Copy, Debug)]
@@ -135,21 +136,35 @@ fn mtoon_wave(t: &Mtoon, p: &MtoonPoint, m: f32, rgb: [f32; 3]) -> [f32; 3] {
 /// centre `L` and `m = N·l̂`, diffuse `A·E·max(0, m)`, toon `A·E·ramp(m)` (unclamped `m`, as the
 /// waves light toon materials, 000 §2.1), MToon `mix(shade, A, step(m + shift)) · E` (its own
 /// step, at the animated texture coordinates), unlit nothing; `E` the light's colour times
-/// intensity; then the feature texture, as for [`shade`]. Mirrored by `area_term` in
-/// `shading.wgsl`.
+/// intensity; then the feature texture, as for [`shade`]. That is the segment lamp's light
+/// (`shape = "segment"`). A disc or sphere lamp (hadou's own, issue 43) spreads over an angular
+/// radius `σ` and faces the point by `f` ([`lamp_spread`]: the disc `f = max(0, l̂·P)`,
+/// `sin²σ = l²/(l² + d²)`; the sphere `f = 1`, `sin σ = l/d`; `d = |L − p|`): diffuse
+/// `A·E·f·lamp_cosine(m, sin σ)` (the horizon-clipped sphere irradiance, [`lamp_cosine`]), toon
+/// `A·E·f·ramp(m')` and MToon `f·mix(shade, A, step(m' + shift))·E` with
+/// `m' = lamp_toon_cosine(m, sin σ)`. Mirrored by `area_term` in `shading.wgsl`.
 pub(crate) fn area_term(light: &AreaLight, m: &Material, s: &Surface, time: f32) -> [f32; 3] {
     let n = s.normal.normalize_or(Vec3f::ZERO);
     let dir = (light.position - s.world).normalize_or(Vec3f::ZERO);
     let mdot = n.dot(dir);
+    // The diffuse factor, the ramps' input and the facing (the segment's: exactly as before).
+    let (diffuse, ramp_in, facing) = match light.shape {
+        LampShape::Segment => (mdot.max(0.0), mdot, None),
+        shape => {
+            let (f, sin_sigma) = lamp_spread(shape, light.position, light.axis(), light.size, s.world);
+            (f * lamp_cosine(mdot, sin_sigma), lamp_toon_cosine(mdot, sin_sigma), Some(f))
+        }
+    };
+    let face = |k: [f32; 3]| facing.map_or(k, |f| k.map(|x| x * f));
     if let Some(t) = &m.mtoon {
         let p = mtoon_point(m, t, s, time);
-        let k = mtoon_wave(t, &p, mdot, light.color);
+        let k = face(mtoon_wave(t, &p, ramp_in, light.color));
         let f = m.feature_texture.as_ref().map_or([1.0; 4], |x| x.sample(p.uv));
         return std::array::from_fn(|i| hadou_math::energy::saturate(k[i] * f[i]));
     }
     let k: [f32; 3] = match m.model {
-        ShadingModel::Diffuse => [mdot.max(0.0); 3],
-        ShadingModel::Toon => m.ramp.eval(mdot),
+        ShadingModel::Diffuse => [diffuse; 3],
+        ShadingModel::Toon => face(m.ramp.eval(ramp_in)),
         ShadingModel::Unlit => return [0.0; 3],
     };
     let a = albedo(m, s);

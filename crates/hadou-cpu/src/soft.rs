@@ -135,9 +135,17 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 
 /// The soft-shadow visibility of every pixel of `input` under `light` (0 in the umbra, 1 where
 /// lit, `k·D₁/(k·D₁ + D₂)` in the penumbra with `k` = [`AreaLight::penumbra_ratio`]; 0 where no
-/// point is): the two maps, the classes and the resolve `resolve`. What [`crate::render()`]
+/// point is): the two maps, the classes and the resolve `resolve`, or for
+/// [`SoftResolve::Traced`] the share of the lamp each point sees ([`crate::traced`], no maps). What [`crate::render()`]
 /// multiplies the area light's term by.
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
+    let grid = match resolve {
+        SoftResolve::Traced { samples } => {
+            return crate::traced::traced(frame, light, &input.points, input.width, samples)
+        }
+        SoftResolve::Exact => None,
+        SoftResolve::Faithful { n } => Some(n.max(1) as usize),
+    };
     let maps = fitted_maps(light, input).map(|m| (m, light.map_size));
     let [a, b] = maps;
     let (m1, m2) = rayon::join(
@@ -147,9 +155,9 @@ pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: 
     let class = classify(&[m1, m2], input);
     let search =
         Search { input, class: &class, depth_aware: light.depth_aware, ratio: light.penumbra_ratio() };
-    match resolve {
-        SoftResolve::Exact => search.exact(),
-        SoftResolve::Faithful { n } => search.faithful(n.max(1) as usize),
+    match grid {
+        None => search.exact(),
+        Some(n) => search.faithful(n),
     }
 }
 

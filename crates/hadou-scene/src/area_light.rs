@@ -2,9 +2,11 @@
 //! §4). The frame's plain value ([`AreaLight`]) carries everything both backends need: the light
 //! centre `L`, the point of interest `G`, the two shadow-map positions `L₁ = L + l·P`,
 //! `L₂ = L − l·P` and their perspective frames, and how the penumbra is resolved
-//! ([`SoftResolve`], [`Penumbra`]). `area_light_def.rs` reads the table and builds this value.
+//! ([`SoftResolve`], [`Penumbra`]), and the lamp's shape ([`LampShape`]). `area_light_def.rs`
+//! reads the table and builds this value.
 
 use hadou_math::soft::{CasterBox, SpotMap};
+pub use hadou_math::soft::{LampShape, MAX_TRACE_SAMPLES};
 use hadou_math::Vec3f;
 
 /// Most pixels of an image with an `[area_light]` (4096²): the penumbra search works on the whole
@@ -12,6 +14,8 @@ use hadou_math::Vec3f;
 pub const SOFT_MAX_PIXELS: u64 = 1 << 24;
 /// Largest `n` of the faithful resolve.
 pub const MAX_GRID: u32 = 64;
+/// Lamp samples a pixel of the traced resolve when `samples` is not given.
+pub const DEFAULT_TRACE_SAMPLES: u32 = 256;
 
 /// How penumbra pixels find their nearest umbra and lit pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,6 +28,13 @@ pub enum SoftResolve {
     Faithful {
         /// Grid spacing, `1..=MAX_GRID`.
         n: u32,
+    },
+    /// hadou's (issue 43): the share of the lamp each pixel sees, from its samples' rays against
+    /// the casters' triangles through a bounding volume hierarchy
+    /// ([`hadou_math::soft::occlude`], [`hadou_math::soft::Bvh`]); models every [`LampShape`].
+    Traced {
+        /// Lamp samples a pixel, `1..=MAX_TRACE_SAMPLES`.
+        samples: u32,
     },
 }
 
@@ -44,8 +55,11 @@ pub enum Penumbra {
 pub struct AreaLight {
     /// Light centre `L`.
     pub position: Vec3f,
-    /// Size parameter `l > 0` (less than `|L − G|`).
+    /// Size parameter `l > 0` (less than `|L − G|`): the segment's half-length, the disc's or
+    /// the sphere's radius.
     pub size: f32,
+    /// The lamp's shape: what the traced resolve models and whose light is added.
+    pub shape: LampShape,
     /// Point of interest `G`.
     pub interest: Vec3f,
     /// Linear RGB times intensity.
@@ -79,5 +93,10 @@ impl AreaLight {
                 hadou_math::soft::segment_ratio(self.size, (self.position - self.interest).length())
             }
         }
+    }
+
+    /// The lamp's axis `P = (L − G)/|L − G|` (the segment's direction, the disc's normal).
+    pub fn axis(&self) -> Vec3f {
+        (self.position - self.interest).normalize_or(Vec3f::Y)
     }
 }

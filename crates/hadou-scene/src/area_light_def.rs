@@ -2,7 +2,9 @@
 //! checked by [`check_area_light`]) and [`build_area_light`], the frame's [`AreaLight`] at one set
 //! of values: `G` from an object or a point, and the two map frames around every caster.
 
-use crate::area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID};
+use crate::area_light::{
+    AreaLight, LampShape, Penumbra, SoftResolve, DEFAULT_TRACE_SAMPLES, MAX_GRID, MAX_TRACE_SAMPLES,
+};
 use crate::bounds::{box_corners, caster_box, object_bounds, object_center};
 use crate::frame::Object;
 use crate::limits::fmt_f32;
@@ -25,6 +27,8 @@ pub(crate) const AREA_LIGHT_KEYS: &[&str] = &[
     "depth_aware",
     "casters",
     "penumbra",
+    "shape",
+    "samples",
 ];
 
 /// Where `G` comes from.
@@ -45,6 +49,7 @@ pub(crate) struct AreaLightDef {
     pub resolve: SoftResolve,
     pub depth_aware: bool,
     pub penumbra: Penumbra,
+    pub shape: LampShape,
     pub params: ParamSet,
 }
 
@@ -132,20 +137,49 @@ pub(crate) fn parse_area_light(
     rd.add(t, &mut params, "color", Shape::Vector(3), Constraint::NonNeg, Fallback::Value(&[1.0; 3]), false)?;
     rd.add(t, &mut params, "intensity", Shape::Scalar, Constraint::NonNeg, Fallback::Value(&[1.0]), false)?;
     let map_size = t.opt_int("map_size", 1, i64::from(MAX_MAP_SIZE))?.map_or(1024, |v| v.0 as u32);
-    let resolve = match t.choice("resolve", &["exact", "faithful"], Some("exact"))? {
+    let shape = match t.choice("shape", &["segment", "disc", "sphere"], Some("segment"))? {
+        "disc" => LampShape::Disc,
+        "sphere" => LampShape::Sphere,
+        _ => LampShape::Segment,
+    };
+    let resolve_name = t.choice("resolve", &["exact", "faithful", "traced"], Some("exact"))?;
+    // A key that belongs to another resolve than the one chosen.
+    let not_here = |key: &str, why: &str| -> Res<()> {
+        if t.get(key).is_some() {
+            return Err(t.src.value_err(&t.key_span(key), format!("`{key}` in {} {why}", t.what)));
+        }
+        Ok(())
+    };
+    if resolve_name != "traced" {
+        not_here("samples", "applies to `resolve = \"traced\"` (the two-map resolves take no lamp samples)")?;
+    }
+    let resolve = match resolve_name {
         "faithful" => {
             SoftResolve::Faithful { n: t.opt_int("n", 1, i64::from(MAX_GRID))?.map_or(3, |v| v.0 as u32) }
         }
-        _ => {
-            if t.get("n").is_some() {
-                return Err(t.src.value_err(
-                    &t.key_span("n"),
+        "traced" => {
+            not_here("n", "applies to `resolve = \"faithful\"` (the traced resolve needs no grid)")?;
+            not_here(
+                "penumbra",
+                "applies to the two-map resolves (the traced resolve counts the lamp samples each pixel sees)",
+            )?;
+            if let Some(v) = t.get("samples").filter(|v| !matches!(v.get_ref(), DeValue::Integer(_))) {
+                return Err(t.src.type_err(
+                    &v.span(),
                     format!(
-                        "`n` in {} applies to `resolve = \"faithful\"` (the exact resolve needs no grid)",
-                        t.what
+                        "`samples` in {} must be an integer in 1..={MAX_TRACE_SAMPLES} (lamp samples a pixel), got {}",
+                        t.what,
+                        type_name(v.get_ref())
                     ),
                 ));
             }
+            let samples = t
+                .opt_int("samples", 1, i64::from(MAX_TRACE_SAMPLES))?
+                .map_or(DEFAULT_TRACE_SAMPLES, |v| v.0 as u32);
+            SoftResolve::Traced { samples }
+        }
+        _ => {
+            not_here("n", "applies to `resolve = \"faithful\"` (the exact resolve needs no grid)")?;
             SoftResolve::Exact
         }
     };
@@ -155,7 +189,7 @@ pub(crate) fn parse_area_light(
         "linear" => Penumbra::Linear,
         _ => Penumbra::Segment,
     };
-    Ok(AreaLightDef { target, casters, map_size, resolve, depth_aware, penumbra, params })
+    Ok(AreaLightDef { target, casters, map_size, resolve, depth_aware, penumbra, shape, params })
 }
 
 /// `G` of the light at these values.
@@ -237,6 +271,7 @@ pub(crate) fn build_area_light(
     AreaLight {
         position: l,
         size,
+        shape: def.shape,
         interest: g,
         color: color.map(|c| hadou_math::energy::saturate(c * intensity)),
         map_size: def.map_size,

@@ -72,7 +72,10 @@ mod wave_def;
 mod wave_kind;
 
 pub use anim::Interpolation;
-pub use area_light::{AreaLight, Penumbra, SoftResolve, MAX_GRID, SOFT_MAX_PIXELS};
+pub use area_light::{
+    AreaLight, LampShape, Penumbra, SoftResolve, DEFAULT_TRACE_SAMPLES, MAX_GRID, MAX_TRACE_SAMPLES,
+    SOFT_MAX_PIXELS,
+};
 pub use backend::{Backend, RenderError};
 pub use bloom_def::{BLOOM_MAX_STREAK_LENGTH, BLOOM_MAX_THRESHOLD, BLOOM_MAX_WEIGHT};
 pub use bounds::{caster_box, object_bounds, object_center, widest_outline_pixels};
@@ -93,10 +96,10 @@ pub use gltf_vrma::load_vrma_clip;
 pub use image::{Image, Rgb8Image};
 pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo};
 pub use limits::{
-    check_image_size, check_image_size_with, glare_band_rows, ALPHA_MAX, ANALYTIC_RAY_WORK, ATTENUATION_MAX,
-    GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES, GLARE_MAX_PIXELS, MAX_IMAGE_EDGE,
-    MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS, MAX_TRIANGLES, MAX_VERTICES,
-    PIXEL_WORK_MAX,
+    check_image_size, check_image_size_with, check_trace_memory, glare_band_rows, ALPHA_MAX,
+    ANALYTIC_RAY_WORK, ATTENUATION_MAX, GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES,
+    GLARE_MAX_PIXELS, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS,
+    MAX_TRIANGLES, MAX_VERTICES, PIXEL_WORK_MAX, TRACE_MAX_BYTES,
 };
 pub use rig::{clip_time, clip_wrap, Clip, Expression, PoseInput, Rig, VrmVersion};
 pub use scene::Scene;

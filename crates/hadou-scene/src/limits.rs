@@ -132,6 +132,27 @@ fn check_edges_and_area(width: u32, height: u32, area_light: bool) -> Result<(),
     Ok(())
 }
 
+/// The most memory the traced resolve's hierarchy of the casters' triangles may take (256 MiB):
+/// at most [`hadou_math::soft::bvh_bytes_bound`]`(n) = 48·n + 64·n` bytes for `n` caster
+/// triangles (the triangles, fewer than `2n` nodes of 32 bytes), 224 MiB at [`MAX_TRIANGLES`], so
+/// every scene within the limits fits; a frame over it is refused ([`check_trace_memory`]).
+pub const TRACE_MAX_BYTES: u64 = 256 << 20;
+
+/// Checks the traced resolve's hierarchy over `triangles` caster triangles against
+/// [`TRACE_MAX_BYTES`]; the message names the budget.
+pub fn check_trace_memory(triangles: u64) -> Result<(), String> {
+    let need = hadou_math::soft::bvh_bytes_bound(triangles);
+    if need > TRACE_MAX_BYTES {
+        return Err(format!(
+            "the traced resolve of the [area_light] keeps at most {} MiB for its hierarchy of the casters' \
+             triangles (TRACE_MAX_BYTES); {triangles} triangles would need up to {:.1} MiB",
+            TRACE_MAX_BYTES >> 20,
+            need as f64 / f64::from(1u32 << 20)
+        ));
+    }
+    Ok(())
+}
+
 /// Bound on the magnitude of every scene number without a tighter rule.
 pub(crate) const COORD_MAX: f32 = 1e6;
 /// Largest `far`.
@@ -199,6 +220,13 @@ fn shorter(plain: String, sci: String) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_hierarchy_of_a_scene_at_the_triangle_limit_fits_its_budget() {
+        assert!(check_trace_memory(MAX_TRIANGLES).is_ok());
+        let e = check_trace_memory(4 * MAX_TRIANGLES).unwrap_err();
+        assert!(e.contains("256 MiB") && e.contains("TRACE_MAX_BYTES"), "{e}");
+    }
 
     #[test]
     fn numbers_in_messages_are_short() {

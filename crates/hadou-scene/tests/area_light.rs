@@ -5,7 +5,7 @@ mod common;
 
 use common::{at, err};
 use hadou_math::Vec3f;
-use hadou_scene::{Penumbra, Scene, SoftResolve};
+use hadou_scene::{LampShape, Penumbra, Scene, SoftResolve, DEFAULT_TRACE_SAMPLES, MAX_TRACE_SAMPLES};
 use std::path::Path;
 
 const OBJECTS: &str = r#"
@@ -103,6 +103,28 @@ fn light_err(body: &str) -> hadou_scene::SceneError {
 }
 
 #[test]
+fn lamp_shapes_and_the_traced_resolve() {
+    let base = format!("{OBJECTS}\n[area_light]\nposition = [0, 5, 0]\nsize = 0.5\ntarget = \"pillar\"\n");
+    let a = parse(&base).at(0.0).area_light.unwrap();
+    assert_eq!((a.shape, a.resolve), (LampShape::Segment, SoftResolve::Exact));
+    for (text, shape) in
+        [("disc", LampShape::Disc), ("sphere", LampShape::Sphere), ("segment", LampShape::Segment)]
+    {
+        let a =
+            parse(&format!("{base}shape = \"{text}\"\nresolve = \"traced\"\n")).at(0.0).area_light.unwrap();
+        assert_eq!((a.shape, a.resolve), (shape, SoftResolve::Traced { samples: DEFAULT_TRACE_SAMPLES }));
+    }
+    let a = parse(&format!("{base}resolve = \"traced\"\nsamples = {MAX_TRACE_SAMPLES}\n"))
+        .at(0.0)
+        .area_light
+        .unwrap();
+    assert_eq!(a.resolve, SoftResolve::Traced { samples: MAX_TRACE_SAMPLES });
+    // The shape is kept with the two-map resolves (it sets the light the lamp adds).
+    let a = parse(&format!("{base}shape = \"disc\"\n")).at(0.0).area_light.unwrap();
+    assert_eq!((a.shape, a.resolve, a.penumbra), (LampShape::Disc, SoftResolve::Exact, Penumbra::Segment));
+}
+
+#[test]
 fn bad_area_lights_name_their_line_and_column() {
     let l = header_line();
     let ok = "position = [0, 5, 0]\nsize = 0.5\ntarget = \"pillar\"\n";
@@ -133,6 +155,22 @@ fn bad_area_lights_name_their_line_and_column() {
         (format!("{ok}radius = 1\n"), 4, 1, "unknown key `radius`"),
         (format!("{ok}casters = [\"pilar\"]\n"), 4, 12, "did you mean `pillar`"),
         (format!("{ok}casters = []\n"), 4, 11, "at least one object"),
+        (format!("{ok}shape = \"cube\"\n"), 4, 9, "cannot be \"cube\""),
+        (format!("{ok}shape = 2\n"), 4, 9, "shape"),
+        (format!("{ok}resolve = \"traced\"\nsamples = 0\n"), 5, 11, "1..=1024, got 0"),
+        (format!("{ok}resolve = \"traced\"\nsamples = -3\n"), 5, 11, "1..=1024, got -3"),
+        (format!("{ok}resolve = \"traced\"\nsamples = 1025\n"), 5, 11, "1..=1024, got 1025"),
+        (format!("{ok}resolve = \"traced\"\nsamples = nan\n"), 5, 11, "integer in 1..=1024"),
+        (format!("{ok}resolve = \"traced\"\nsamples = 2.5\n"), 5, 11, "integer in 1..=1024"),
+        (format!("{ok}samples = 64\n"), 4, 1, "applies to `resolve = \"traced\"`"),
+        (format!("{ok}resolve = \"traced\"\nn = 3\n"), 5, 1, "applies to `resolve = \"faithful\"`"),
+        (format!("{ok}resolve = \"traced\"\npenumbra = \"linear\"\n"), 5, 1, "two-map resolves"),
+        (
+            "position = [0, 5, 0]\nsize = 4\ntarget = \"pillar\"\nshape = \"sphere\"\n".into(),
+            2,
+            1,
+            "must be less than the distance",
+        ),
     ];
     // A hostile value is quoted shortened, still located.
     let e = light_err(&format!("{ok}penumbra = \"{}\"\n", "x".repeat(5000)));

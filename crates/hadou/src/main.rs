@@ -159,6 +159,14 @@ struct BenchArgs {
     /// radius whose penumbra matches the two maps' band, docs/soft-shadows.md].
     #[arg(long, allow_hyphen_values = true)]
     disc_radius: Option<f32>,
+    /// shadows only: the scene file (in --scenes) to measure, at t = 0 [default:
+    /// soft-gradient.toml]. Its [area_light] gives the traced rows' sample count.
+    #[arg(long)]
+    scene: Option<String>,
+    /// shadows only: measure only the traced rows, their references and the whole frames (not
+    /// the two-map resolves, PCSS and their disc truth).
+    #[arg(long)]
+    traced_only: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -749,6 +757,12 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         }
         _ => {}
     }
+    if let Some(f) = a.scene.as_ref().filter(|_| a.table != BenchTable::Shadows) {
+        return Err(Failure::input(format!("--scene {f}: applies to `hadou bench shadows` only")));
+    }
+    if a.traced_only && a.table != BenchTable::Shadows {
+        return Err(Failure::input("--traced-only: applies to `hadou bench shadows` only"));
+    }
     if iterations == 0 {
         return Err(Failure::input("--iterations 0: need at least one timed repetition"));
     }
@@ -774,7 +788,11 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         }
     }
     if toon || shadows {
-        let file = if toon { hadou::bench::TOON_SCENE.0 } else { hadou::bench::SOFT_SCENE.0 };
+        let file = if toon {
+            hadou::bench::TOON_SCENE.0
+        } else {
+            a.scene.as_deref().unwrap_or(hadou::bench::SOFT_SCENE.0)
+        };
         let scene = Scene::load(a.scenes.join(file)).map_err(|e| {
             Failure::input(format!(
                 "--scenes {}: this bench needs the example scenes (scenes/ of the repository): {e}",
@@ -792,6 +810,8 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         let t = hadou::bench::soft_table(
             &mut *timer,
             &a.scenes,
+            a.scene.as_deref(),
+            a.traced_only,
             &sizes,
             iterations,
             &name,

@@ -75,6 +75,13 @@ pub const SOFT_BYTES_PER_PIXEL: u64 = 36;
 /// texture, the whole-image buffers within the storage-buffer limits.
 pub(crate) fn check_area_light(limits: &wgpu::Limits, frame: &Frame) -> Result<(), RenderError> {
     let Some(light) = &frame.area_light else { return Ok(()) };
+    if let SoftResolve::Traced { .. } = light.resolve {
+        return Err(RenderError::Other(
+            "[area_light]: resolve = \"traced\" is not drawn by the GPU backend yet (render it with the CPU \
+             backend, or use resolve = \"exact\")"
+                .into(),
+        ));
+    }
     if light.map_size > limits.max_texture_dimension_2d {
         return Err(RenderError::Device(format!(
             "[area_light]: map_size {} exceeds this adapter's largest texture ({})",
@@ -133,7 +140,7 @@ impl SoftTargets {
     pub(crate) fn ensure(soft: &mut Option<SoftTargets>, ctx: &GpuContext, frame: &Frame) {
         let light = frame.area_light.as_ref().expect("an area light");
         let n = match light.resolve {
-            SoftResolve::Exact => 0,
+            SoftResolve::Exact | SoftResolve::Traced { .. } => 0,
             SoftResolve::Faithful { n } => n.max(1),
         };
         let gs = grid_size(frame.width, frame.height, n.max(1));
@@ -196,7 +203,7 @@ impl SoftTargets {
     fn write_uniforms(&self, ctx: &GpuContext, frame: &Frame) {
         let light = frame.area_light.as_ref().expect("an area light");
         let n = match light.resolve {
-            SoftResolve::Exact => 0,
+            SoftResolve::Exact | SoftResolve::Traced { .. } => 0,
             SoftResolve::Faithful { n } => n.max(1),
         };
         let u = SoftUniforms {

@@ -4,14 +4,20 @@
 //! corrected weights, a pixel's class), `distance` (the exact Euclidean distance transform that
 //! gives every pixel those distances in linear time), `search` (how far and on which surface a
 //! penumbra pixel looks) and `spot_map` (a shadow map's perspective frame and its fitting to what
-//! can be shadowed in view). Every item is re-exported here: `hadou_math::soft::SpotMap`, ….
+//! can be shadowed in view), and for the traced resolve `lamp` (the lamp's shape, what a receiver
+//! sees of it, the light it adds) and `bvh` (the casters' triangles in a flattened hierarchy).
+//! Every item is re-exported here: `hadou_math::soft::SpotMap`, ….
 
+mod bvh;
 mod distance;
+mod lamp;
 mod penumbra;
 mod search;
 mod spot_map;
 
+pub use bvh::*;
 pub use distance::*;
+pub use lamp::*;
 pub use penumbra::*;
 pub use search::*;
 pub use spot_map::*;

@@ -1,0 +1,413 @@
+//! The traced resolve of the `[area_light]` (hadou's own, issue 43): each pixel's visibility is
+//! the share of the lamp ([`LampShape`]) its point sees, from the lamp's samples' rays against the
+//! casters' world-space triangles, found through a flattened bounding volume hierarchy
+//! ([`Bvh`]). No shadow maps: the hierarchy itself says where a shadow edge can be.
+//!
+//! 1. **Tiles.** The image is cut into [`TILE`]² tiles. A tile's receivers (each visible point
+//!    moved off its surface by [`TRACE_BIAS`] of its distance to `L`) fit in a ball; every ray
+//!    from one of them to the lamp (inside the ball of radius `l` around `L`) lies in the tapered
+//!    capsule between the two balls ([`capsule_hits`]). The hierarchy is walked once per tile
+//!    with that capsule, a triangle whose plane leaves both balls on one side
+//!    ([`BvhTri::one_side`]) dropped: no triangle kept, and every pixel of the tile sees the whole
+//!    lamp without a single ray (most of the image); up to [`TILE_TRIS`], and each pixel tests
+//!    only those; more, and each pixel walks the hierarchy itself (a node counts when it meets the
+//!    pixel's capsule and its box's projection meets the lamp, [`LampFrame::box_may_hide`]).
+//! 2. **Pixels.** A pixel's own capsule (radius 0 at its point) and [`BvhTri::one_side`] pick the
+//!    triangles that can hide part of its lamp; each sets the samples it hides in the pixel's mask
+//!    ([`hadou_math::soft::occlude`]: clipped, projected onto the lamp's plane, each row of samples
+//!    solved exactly); the walk stops once every sample is hidden (umbra). The visibility is the
+//!    mask's weighted share of clear samples ([`mask_visibility`]).
+//! 3. **Determinism.** A pixel's samples depend only on its global coordinates
+//!    ([`pixel_offset`]), and the mask's OR does not depend on the order of the triangles, so the
+//!    same frame gives the same bits, banded or whole, on any number of threads.
+//!
+//! A point the lamp adds nothing to (its unshadowed term is zero: facing away) is given 0, as the
+//! two-map resolves give it (shadowed in both maps). [`reference`] is the brute-force check: every
+//! sample ray against every caster triangle, no hierarchy.
+
+use crate::opaque::SoftPoint;
+use hadou_math::soft::{
+    capsule_hits, lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, Bvh, BvhTri, LampFrame,
+    LampPattern, LampShape, MASK_WORDS, TRACE_BIAS, T_MIN,
+};
+use hadou_math::{Vec3, Vec3f};
+use hadou_scene::{AreaLight, Frame};
+use rayon::prelude::*;
+
+/// Edge of a tile of pixels that walks the hierarchy once for all its pixels.
+pub const TILE: usize = 8;
+/// Most triangles a tile keeps for its pixels (more: each pixel walks the hierarchy).
+pub const TILE_TRIS: usize = 128;
+
+/// The world-space triangles of the objects `casters` of `frame` (their meshes under their
+/// transforms; what the two maps draw, [`crate::soft::SpotDepth::render`]).
+pub fn caster_triangles(frame: &Frame, casters: &[u32]) -> Vec<[Vec3f; 3]> {
+    let mut out = Vec::new();
+    for obj in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
+        let world: Vec<Vec3f> =
+            obj.mesh.positions.iter().map(|p| obj.transform.transform_point(Vec3::from_array(*p))).collect();
+        for tri in obj.mesh.indices.chunks_exact(3) {
+            let v = [tri[0], tri[1], tri[2]].map(|i| world.get(i as usize).copied());
+            if let [Some(a), Some(b), Some(c)] = v {
+                out.push([a, b, c]);
+            }
+        }
+    }
+    out
+}
+
+/// The number of triangles of the objects `casters` (what the hierarchy is built over, before
+/// the degenerate ones are dropped).
+pub fn caster_triangle_count(frame: &Frame, casters: &[u32]) -> u64 {
+    casters
+        .iter()
+        .filter_map(|&c| frame.objects.get(c as usize))
+        .map(|o| o.mesh.indices.len() as u64 / 3)
+        .sum()
+}
+
+/// The receiver point of a visible point: moved along its unit normal by [`TRACE_BIAS`] of its
+/// distance to `L` (not at all without a normal).
+#[inline]
+pub fn receiver(world: Vec3f, normal: Vec3f, l: Vec3f) -> Vec3f {
+    world + normal * (TRACE_BIAS * (world - l).length())
+}
+
+/// The lamp of `light` as the traced resolve sees it: its shape, centre, axis and size.
+#[derive(Clone, Copy, Debug)]
+pub struct Lamp {
+    /// Shape.
+    pub shape: LampShape,
+    /// Centre `L`.
+    pub centre: Vec3f,
+    /// `P = (L − G)/|L − G|`.
+    pub axis: Vec3f,
+    /// `l`: half-length or radius (also the radius of the ball that holds the lamp).
+    pub size: f32,
+}
+
+impl Lamp {
+    /// The lamp of `light`.
+    pub fn of(light: &AreaLight) -> Lamp {
+        Lamp { shape: light.shape, centre: light.position, axis: light.axis(), size: light.size }
+    }
+
+    /// The lamp seen from the receiver `p` ([`lamp_frame`]).
+    #[inline]
+    pub fn frame(&self, p: Vec3f) -> Option<LampFrame> {
+        lamp_frame(self.shape, self.centre, self.axis, self.size, p)
+    }
+}
+
+/// A triangle with its bounding ball, for the per-pixel tests.
+#[derive(Clone, Copy)]
+struct Cand {
+    tri: BvhTri,
+    corners: [Vec3f; 3],
+    centre: Vec3f,
+    radius: f32,
+}
+
+impl Cand {
+    fn new(tri: &BvhTri) -> Cand {
+        let corners = tri.corners();
+        let centre = (corners[0] + corners[1] + corners[2]) * (1.0 / 3.0);
+        let radius = corners.iter().map(|v| (*v - centre).length()).fold(0.0f32, f32::max);
+        Cand { tri: *tri, corners, centre, radius }
+    }
+}
+
+/// The traced visibility of every pixel of an image `width` pixels wide whose visible points are
+/// `points` (row-major, `None` for none: a [`crate::soft::SoftInput`]'s) under `light` with
+/// `samples` lamp samples a pixel (see the module notes); 0 where no point is.
+pub fn traced(
+    frame: &Frame,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+) -> Vec<f32> {
+    let bvh = Bvh::build(&caster_triangles(frame, &light.casters));
+    traced_with(&bvh, light, points, width, samples)
+}
+
+/// [`traced`] with the hierarchy already built.
+pub fn traced_with(
+    bvh: &Bvh,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+) -> Vec<f32> {
+    let w = width;
+    let h = if w == 0 { 0 } else { points.len() / w };
+    let lamp = Lamp::of(light);
+    let pat = LampPattern::new(lamp.shape, samples);
+    let mut out = vec![0.0f32; w * h];
+    if w == 0 || h == 0 {
+        return out;
+    }
+    out.par_chunks_mut(w * TILE).enumerate().for_each(|(ty, band)| {
+        let y0 = ty * TILE;
+        let rows = band.len() / w;
+        let mut cands: Vec<Cand> = Vec::with_capacity(TILE_TRIS);
+        for x0 in (0..w).step_by(TILE) {
+            let x1 = (x0 + TILE).min(w);
+            // The tile's receivers and their ball.
+            let (mut lo, mut hi) = (Vec3f::splat(f32::INFINITY), Vec3f::splat(f32::NEG_INFINITY));
+            let mut any = false;
+            for y in y0..y0 + rows {
+                for x in x0..x1 {
+                    if let Some(p) = points[y * w + x].filter(|p| lit_at_all(p.term)) {
+                        let r = receiver(p.world, p.normal, lamp.centre);
+                        lo = lo.min(r);
+                        hi = hi.max(r);
+                        any = true;
+                    }
+                }
+            }
+            if !any {
+                continue;
+            }
+            let (tc, tr) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+            cands.clear();
+            let mut overflow = false;
+            bvh.walk(
+                |node| {
+                    let (c, r) = node.ball();
+                    capsule_hits(tc, tr, lamp.centre, lamp.size, c, r)
+                },
+                |t| {
+                    if t.one_side(tc, tr, lamp.centre, lamp.size) {
+                        return true;
+                    }
+                    if cands.len() == TILE_TRIS {
+                        overflow = true;
+                        return false;
+                    }
+                    cands.push(Cand::new(t));
+                    true
+                },
+            );
+            for y in y0..y0 + rows {
+                for x in x0..x1 {
+                    let Some(p) = points[y * w + x] else { continue };
+                    let o = &mut band[(y - y0) * w + x];
+                    if !lit_at_all(p.term) {
+                        *o = 0.0;
+                        continue;
+                    }
+                    if cands.is_empty() && !overflow {
+                        *o = 1.0;
+                        continue;
+                    }
+                    let r = receiver(p.world, p.normal, lamp.centre);
+                    *o = pixel(bvh, (!overflow).then_some(&cands[..]), &lamp, &pat, r, x as u32, y as u32);
+                }
+            }
+        }
+    });
+    out
+}
+
+/// Whether an unshadowed term adds anything.
+#[inline]
+fn lit_at_all(term: [f32; 3]) -> bool {
+    term.iter().any(|&t| t > 0.0)
+}
+
+/// One pixel's visibility from the receiver `r` at global pixel `(x, y)`: the triangles `cands`
+/// (the tile's) or, without them, a walk of the hierarchy.
+fn pixel(bvh: &Bvh, cands: Option<&[Cand]>, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32) -> f32 {
+    let Some(f) = lamp.frame(r) else { return 1.0 };
+    let o = pixel_offset(x, y);
+    let mut mask = [0u32; MASK_WORDS];
+    let hit = |tri: &[Vec3f; 3], mask: &mut [u32; MASK_WORDS]| -> bool {
+        occlude(&f, pat, o, tri, mask);
+        !mask_full(mask, pat)
+    };
+    match cands {
+        Some(cands) => {
+            for c in cands {
+                if !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
+                    && capsule_hits(r, 0.0, lamp.centre, lamp.size, c.centre, c.radius)
+                    && !hit(&c.corners, &mut mask)
+                {
+                    break;
+                }
+            }
+        }
+        None => bvh.walk(
+            |node| {
+                let (c, rc) = node.ball();
+                capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
+                    && f.box_may_hide(node.lo, node.hi, pat.disc)
+            },
+            |t| t.one_side(r, 0.0, lamp.centre, lamp.size) || hit(&t.corners(), &mut mask),
+        ),
+    }
+    mask_visibility(&mask, pat)
+}
+
+/// Point `k` of `n` stratified points of the unit square: stratum `k` of a `⌈√n⌉`-wide grid,
+/// jittered by `rand`.
+fn stratified(k: u32, side: u32, rand: &mut impl FnMut() -> f64) -> (f64, f64) {
+    let (i, j) = (k % side, k / side);
+    ((f64::from(i) + rand()) / f64::from(side), (f64::from(j) + rand()) / f64::from(side))
+}
+
+/// Shirley and Chiu's concentric map of the unit square onto the unit disc (equal areas).
+fn concentric(u: f64, v: f64) -> (f64, f64) {
+    let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a * a > b * b {
+        (a, std::f64::consts::FRAC_PI_4 * (b / a))
+    } else {
+        (b, std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a / b))
+    };
+    (r * phi.cos(), r * phi.sin())
+}
+
+/// Möller–Trumbore in `f64`, both sides: the ray parameter where `o + t·d` meets the triangle.
+fn ray_triangle(o: Vec3<f64>, d: Vec3<f64>, t: &[Vec3<f64>; 3]) -> Option<f64> {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - t[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(e2.dot(q) * inv)
+}
+
+/// The brute-force reference of the traced resolve at the pixels `pixels` (row-major indices) of
+/// the visible points `points`: for each, `samples` points of the lamp as seen from the pixel's receiver
+/// ([`receiver`], [`Lamp::frame`]) — stratified in `⌈√samples⌉²` cells (the segment: `samples`
+/// strata along it) and mapped onto the disc by the concentric map, jittered by a generator
+/// seeded from the pixel's index — each ray tested against every caster triangle whose box meets
+/// the box of the receiver and the lamp's ball (no hierarchy), in `f64`, a blocker counting at
+/// `t ∈ [T_MIN, 1]`. The share of clear rays; 0 where no point is or the lamp adds nothing, 1
+/// where the lamp has no frame. Slow: for tests and `hadou bench shadows`.
+pub fn reference(
+    frame: &Frame,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    samples: u32,
+    pixels: &[usize],
+) -> Vec<f32> {
+    let tris: Vec<[Vec3<f64>; 3]> =
+        caster_triangles(frame, &light.casters).iter().map(|t| t.map(|v| v.as_f64())).collect();
+    let boxes: Vec<(Vec3<f64>, Vec3<f64>)> =
+        tris.iter().map(|t| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]))).collect();
+    let lamp = Lamp::of(light);
+    let samples = samples.max(1);
+    let side = (f64::from(samples).sqrt().ceil() as u32).max(1);
+    pixels
+        .par_iter()
+        .with_min_len(4)
+        .map(|&i| {
+            let Some(p) = points.get(i).copied().flatten() else { return 0.0 };
+            if !lit_at_all(p.term) {
+                return 0.0;
+            }
+            let r = receiver(p.world, p.normal, lamp.centre);
+            let Some(f) = lamp.frame(r) else { return 1.0 };
+            let (o, c) = (r.as_f64(), lamp.centre.as_f64());
+            let reach = f64::from(lamp.size) * 1.001 + 1e-9;
+            let (blo, bhi) = (o.min(c - Vec3::splat(reach)), o.max(c + Vec3::splat(reach)));
+            let near: Vec<&[Vec3<f64>; 3]> = tris
+                .iter()
+                .zip(&boxes)
+                .filter(|(_, (lo, hi))| {
+                    lo.x <= bhi.x
+                        && lo.y <= bhi.y
+                        && lo.z <= bhi.z
+                        && hi.x >= blo.x
+                        && hi.y >= blo.y
+                        && hi.z >= blo.z
+                })
+                .map(|(t, _)| t)
+                .collect();
+            let mut state = (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0xd1b5_4a32_d192_ed03;
+            let mut rand = move || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let (centre, u, v, rad) = (f.centre.as_f64(), f.u.as_f64(), f.v.as_f64(), f64::from(f.radius));
+            let mut clear = 0u32;
+            for k in 0..samples {
+                let (x, y) = if lamp.shape == LampShape::Segment {
+                    (-1.0 + 2.0 * (f64::from(k) + rand()) / f64::from(samples), 0.0)
+                } else {
+                    let (a, b) = stratified(k % (side * side), side, &mut rand);
+                    concentric(a, b)
+                };
+                let target = centre + (u * x + v * y) * rad;
+                let d = target - o;
+                let blocked = near
+                    .iter()
+                    .any(|t| ray_triangle(o, d, t).is_some_and(|t| t >= f64::from(T_MIN) && t <= 1.0));
+                clear += u32::from(!blocked);
+            }
+            clear as f32 / samples as f32
+        })
+        .collect()
+}
+
+/// The pixels the reference is computed at for a traced image `traced` (`width` wide, `visible`
+/// pixels marked): every visible pixel within 2 pixels (Chebyshev) of one whose value lies in
+/// `(0.005, 0.995)`, and every 61st other visible pixel (to check the tiles' and the umbra's
+/// verdicts away from any edge), then every `k`-th of those so that at most `cap` remain.
+pub fn reference_pixels(traced: &[f32], visible: &[bool], width: usize, cap: usize) -> Vec<usize> {
+    let h = traced.len() / width.max(1);
+    let soft = |i: usize| traced[i] > 0.005 && traced[i] < 0.995;
+    let mut near = vec![false; traced.len()];
+    for i in (0..traced.len()).filter(|&i| visible[i] && soft(i)) {
+        let (x, y) = ((i % width) as i64, (i / width) as i64);
+        for dy in -2..=2 {
+            for dx in -2..=2 {
+                let (u, v) = (x + dx, y + dy);
+                if u >= 0 && v >= 0 && (u as usize) < width && (v as usize) < h {
+                    near[v as usize * width + u as usize] = true;
+                }
+            }
+        }
+    }
+    let all: Vec<usize> = (0..traced.len()).filter(|&i| visible[i] && (near[i] || i % 61 == 0)).collect();
+    let step = all.len().div_ceil(cap.max(1)).max(1);
+    all.into_iter().step_by(step).collect()
+}
+
+/// The truth measure of issue 43 over the pixels `pixels`, `a` and `b` their two values (same
+/// order): the pixels where either value lies in `(0.005, 0.995)`, their mean and 99th-percentile
+/// `|a − b|`, and how many there were. `(0, 0, 0)` when none.
+pub fn truth_errors(a: &[f32], b: &[f32]) -> (f64, f64, usize) {
+    let soft = |v: f32| v > 0.005 && v < 0.995;
+    let mut e: Vec<f64> = a
+        .iter()
+        .zip(b)
+        .filter(|(&x, &y)| soft(x) || soft(y))
+        .map(|(&x, &y)| f64::from((x - y).abs()))
+        .collect();
+    if e.is_empty() {
+        return (0.0, 0.0, 0);
+    }
+    e.sort_by(f64::total_cmp);
+    let mean = e.iter().sum::<f64>() / e.len() as f64;
+    let p99 = e[((e.len() - 1) as f64 * 0.99).round() as usize];
+    (mean, p99, e.len())
+}
