@@ -96,6 +96,10 @@ struct HadouShadeFrame {
     any_glow: u32,
     area_position: vec3<f32>,
     area_color: vec3<f32>,
+    // The `[area_light]` is not drawn in Bevy: its lamp reads as the segment's.
+    area_axis: vec3<f32>,
+    area_size: f32,
+    area_shape: u32,
     shadow_casts: u32,
     map_casts: u32,
     cast_count: u32,

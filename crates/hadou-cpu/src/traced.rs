@@ -39,22 +39,10 @@ pub const TILE: usize = 8;
 /// Most triangles a tile keeps for its pixels (more: each pixel walks the hierarchy).
 pub const TILE_TRIS: usize = 128;
 
-/// The world-space triangles of the objects `casters` of `frame` (their meshes under their
-/// transforms; what the two maps draw, [`crate::soft::SpotDepth::render`]).
-pub fn caster_triangles(frame: &Frame, casters: &[u32]) -> Vec<[Vec3f; 3]> {
-    let mut out = Vec::new();
-    for obj in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
-        let world: Vec<Vec3f> =
-            obj.mesh.positions.iter().map(|p| obj.transform.transform_point(Vec3::from_array(*p))).collect();
-        for tri in obj.mesh.indices.chunks_exact(3) {
-            let v = [tri[0], tri[1], tri[2]].map(|i| world.get(i as usize).copied());
-            if let [Some(a), Some(b), Some(c)] = v {
-                out.push([a, b, c]);
-            }
-        }
-    }
-    out
-}
+/// The world-space triangles of the objects `casters` of `frame` (what the two maps draw,
+/// [`crate::soft::SpotDepth::render`]): [`hadou_scene::caster_triangles`], which the GPU backend
+/// builds the same hierarchy from.
+pub use hadou_scene::caster_triangles;
 
 /// The number of triangles of the objects `casters` (what the hierarchy is built over, before
 /// the degenerate ones are dropped).

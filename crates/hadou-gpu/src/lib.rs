@@ -99,6 +99,8 @@ mod texture_read;
 mod time_frame;
 mod timing;
 #[cfg(test)]
+mod trace_twins;
+#[cfg(test)]
 mod twin_kernel;
 #[cfg(test)]
 mod twins;

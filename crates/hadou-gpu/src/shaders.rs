@@ -61,6 +61,10 @@ pub const SHADOW_RASTER: &str = include_str!("shaders/shadow_raster.wgsl");
 pub const SOFT_MAP: &str = include_str!("shaders/soft_map.wgsl");
 /// The soft shadows' classification and penumbra resolve (compute passes).
 pub const SOFT: &str = include_str!("shaders/soft.wgsl");
+/// The traced resolve's per-pixel work (`occlude`, the hierarchy's tests).
+pub const SOFT_TRACE: &str = include_str!("shaders/soft_trace.wgsl");
+/// The traced resolve of the `[area_light]` (`cs_traced`).
+pub const SOFT_TRACED: &str = include_str!("shaders/soft_traced.wgsl");
 /// The edge pass: outlines closed where objects meet (render pass over the G-buffer).
 pub const EDGES: &str = include_str!("shaders/edges.wgsl");
 /// The present pass: a tile's final colour into the full-frame sRGB texture (render pass).
@@ -84,6 +88,8 @@ pub const FILES: &[(&str, &str)] = &[
     ("shadow_raster.wgsl", SHADOW_RASTER),
     ("soft.wgsl", SOFT),
     ("soft_map.wgsl", SOFT_MAP),
+    ("soft_trace.wgsl", SOFT_TRACE),
+    ("soft_traced.wgsl", SOFT_TRACED),
     ("wave.wgsl", WAVE),
     ("wave_energy.wgsl", WAVE_ENERGY),
     ("wave_samples.wgsl", WAVE_SAMPLES),
@@ -116,6 +122,8 @@ pub const SHADOW_PARTS: &[&str] = &[COMMON, SHADOW_RASTER];
 pub const SOFT_MAP_PARTS: &[&str] = &[COMMON, SOFT_MAP];
 /// The parts of the soft-shadow compute module, in order.
 pub const SOFT_PARTS: &[&str] = &[COMMON, SOFT];
+/// The traced resolve's module.
+pub const SOFT_TRACED_PARTS: &[&str] = &[COMMON, SOFT_TRACE, SOFT_TRACED];
 /// The parts of the present module, in order.
 pub const PRESENT_PARTS: &[&str] = &[COMMON, PRESENT];
 /// The parts of the glare module, in order.
@@ -235,6 +243,8 @@ mod tests {
             ("shadow_raster", SHADOW_RASTER),
             ("soft_map", SOFT_MAP),
             ("soft", SOFT),
+            ("soft_trace", SOFT_TRACE),
+            ("soft_traced", SOFT_TRACED),
             ("edges", EDGES),
             ("present", PRESENT),
             ("bloom", BLOOM),
@@ -302,6 +312,7 @@ mod tests {
             ("shadow module", validate("shadow module", &compose(SHADOW_PARTS))),
             ("soft map module", validate("soft map module", &compose(SOFT_MAP_PARTS))),
             ("soft module", validate("soft module", &compose(SOFT_PARTS))),
+            ("soft traced module", validate("soft traced module", &compose(SOFT_TRACED_PARTS))),
             ("present module", validate("present module", &compose(PRESENT_PARTS))),
             ("edge module", validate("edge module", &compose(EDGES_PARTS))),
             ("wave overlay module", validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS))),
@@ -403,6 +414,7 @@ mod tests {
                 .chain(SHADOW_PARTS)
                 .chain(SOFT_MAP_PARTS)
                 .chain(SOFT_PARTS)
+                .chain(SOFT_TRACED_PARTS)
                 .chain(PRESENT_PARTS)
                 .chain(EDGES_PARTS)
                 .chain(WAVE_OVERLAY_PARTS)
@@ -438,6 +450,43 @@ mod tests {
             }
             _ => panic!("{name} is not a struct"),
         }
+    }
+
+    /// The traced resolve's structs lay out as their Rust twins, and the hierarchy's as
+    /// hadou-math's own (whose bytes are uploaded as they are).
+    #[test]
+    fn traced_structs_match_their_rust_definitions() {
+        use crate::layout::{GpuBvhNode, GpuBvhTri, TracedUniforms};
+        use std::mem::{offset_of, size_of};
+        let module = validate("soft traced module", &compose(SOFT_TRACED_PARTS));
+        let field = |name: &str, offset: usize| (name.to_string(), offset as u32);
+        let (members, span) = wgsl_layout(&module, "TracedUniforms");
+        let rust = vec![
+            field("rows", offset_of!(TracedUniforms, rows)),
+            field("per_row", offset_of!(TracedUniforms, per_row)),
+            field("disc", offset_of!(TracedUniforms, disc)),
+            field("node_count", offset_of!(TracedUniforms, node_count)),
+            field("weights", offset_of!(TracedUniforms, weights)),
+        ];
+        assert_eq!((members, span as usize), (rust, size_of::<TracedUniforms>()));
+        assert_eq!(size_of::<TracedUniforms>() / 16 * 4 - 4, hadou_math::soft::MAX_ROWS, "a weight a row");
+        let (members, span) = wgsl_layout(&module, "BvhNode");
+        let rust = vec![
+            field("lo", offset_of!(GpuBvhNode, lo)),
+            field("skip", offset_of!(GpuBvhNode, skip)),
+            field("hi", offset_of!(GpuBvhNode, hi)),
+            field("tris", offset_of!(GpuBvhNode, tris)),
+        ];
+        assert_eq!((members, span as u64), (rust, hadou_math::soft::BVH_NODE_BYTES));
+        assert_eq!(size_of::<GpuBvhNode>() as u64, hadou_math::soft::BVH_NODE_BYTES);
+        let (members, span) = wgsl_layout(&module, "BvhTri");
+        let rust = vec![
+            field("a", offset_of!(GpuBvhTri, a)),
+            field("b", offset_of!(GpuBvhTri, b)),
+            field("c", offset_of!(GpuBvhTri, c)),
+        ];
+        assert_eq!((members, span as u64), (rust, hadou_math::soft::BVH_TRI_BYTES));
+        assert_eq!(size_of::<GpuBvhTri>() as u64, hadou_math::soft::BVH_TRI_BYTES);
     }
 
     #[test]
@@ -515,6 +564,12 @@ mod tests {
                 outline_reach,
                 area_color,
                 grid,
+                area_axis,
+                area_size,
+                area_shape,
+                _pad0,
+                _pad1,
+                _pad2,
             ]
         );
         check!(GpuSpotMap, "GpuSpotMap", [eye, tan_half, forward, near, right, size, up, _pad]);
@@ -649,6 +704,9 @@ mod tests {
         assert_eq!(value("REACH_SHIFT"), REACH_SHIFT);
         assert_eq!(value("CAST_PLANE"), CAST_PLANE);
         assert_eq!(value("SHADOW_CAST_WORDS"), SHADOW_CAST_WORDS);
+        assert_eq!(value("LAMP_SEGMENT"), LAMP_SEGMENT);
+        assert_eq!(value("LAMP_DISC"), LAMP_DISC);
+        assert_eq!(value("LAMP_SPHERE"), LAMP_SPHERE);
         let overlay = validate("wave overlay module", &compose(WAVE_OVERLAY_PARTS));
         let overlay_value = |name: &str| -> u32 {
             let (_, c) = overlay.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).expect(name);

@@ -108,3 +108,81 @@ fn the_gpu_fits_the_maps_as_the_cpu_does() {
     );
     check(&mut gpu, "soft-plaster.toml t=1.5 at 192²", &frame);
 }
+
+/// Largest share of lit pixels whose traced visibility may differ from the CPU's by more than
+/// `TRACED_STEP`: a sample within rounding of a triangle's edge may go either way on the two
+/// backends (the visible points themselves come from two rasterizers).
+const TRACED_SHARE: f64 = 0.005;
+/// How far a lit pixel's visibility may move: about two samples of a disc's row (a row holds at
+/// most 8 % of the disc at 256 samples, 16 to a row) or two and a half of the segment's 256.
+const TRACED_STEP: f32 = 0.01;
+
+/// The traced resolve on the GPU walks the same hierarchy as hadou-cpu's `traced` and sets the
+/// same samples: every pixel the lamp lights (its unshadowed term not zero) within
+/// `TRACED_STEP` of the CPU's visibility at all but `TRACED_SHARE` of them, for every lamp shape
+/// on the gradient close-up, the plaster cast and the pebble, and on the disc's and the sphere's
+/// own scenes; the frame's colours as the differential tests hold them. And the resolve must
+/// matter: many pixels partly lit.
+#[test]
+fn traced_resolve_matches_cpu() {
+    let Some(mut gpu) = gpu_or_skip("traced soft shadows") else { return };
+    let scenes = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../hadou-cpu/tests/data/");
+    let load = |path: String, t: f32| {
+        let mut f = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}")).at(t);
+        (f.width, f.height, f.samples) = (128, 96, 1);
+        f
+    };
+    let mut frames = Vec::new();
+    for (name, t) in
+        [("soft-gradient.toml", 1.0), ("soft-plaster.toml", 1.5), ("soft-small-occluder.toml", 0.0)]
+    {
+        for shape in
+            [hadou_scene::LampShape::Segment, hadou_scene::LampShape::Disc, hadou_scene::LampShape::Sphere]
+        {
+            let mut f = load(format!("{scenes}{name}"), t);
+            let light = f.area_light.as_mut().expect("an area light");
+            light.shape = shape;
+            light.resolve = SoftResolve::Traced { samples: 256 };
+            frames.push((format!("{name} {shape:?}"), f));
+        }
+    }
+    for name in ["soft-disc.toml", "soft-sphere.toml"] {
+        frames.push((name.to_string(), load(format!("{data}{name}"), 1.0)));
+    }
+    let mut partly = 0;
+    for (label, frame) in &frames {
+        let (g, soft) = gpu.render_soft(frame).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
+        let (_, g_vis) = soft.expect("an area light");
+        let c = CpuBackend::new().render(frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
+        let light = frame.area_light.as_ref().expect("an area light");
+        let input = soft_input(frame).expect("an area light");
+        let c_vis = visibility(frame, light, &input, light.resolve);
+        let lit: Vec<usize> = (0..c_vis.len())
+            .filter(|&i| input.points[i].is_some_and(|p| p.term.iter().any(|&t| t > 0.0)))
+            .collect();
+        let off = lit.iter().filter(|&&i| (g_vis[i] - c_vis[i]).abs() > TRACED_STEP).count();
+        let max = lit.iter().map(|&i| (g_vis[i] - c_vis[i]).abs()).fold(0.0f32, f32::max);
+        partly += lit.iter().filter(|&&i| c_vis[i] > 0.005 && c_vis[i] < 0.995).count();
+        let n = g.color.len();
+        let color_bad = (0..n)
+            .filter(|&i| {
+                (0..4).any(|k| {
+                    let d = (g.color[i][k] - c.color[i][k]).abs();
+                    d.is_nan() || d > COLOR_ABS
+                })
+            })
+            .count();
+        eprintln!(
+            "{label}: {off} of {} lit pixels off (max {max}), {color_bad} colours beyond {COLOR_ABS}",
+            lit.len()
+        );
+        assert!(
+            off as f64 <= TRACED_SHARE * lit.len() as f64,
+            "{label}: {off} of {} pixels differ",
+            lit.len()
+        );
+        assert!(color_bad as f64 <= COLOR_SHARE * n as f64, "{label}: {color_bad} of {n} colours differ");
+    }
+    assert!(partly > 1000, "only {partly} pixels in a penumbra");
+}

@@ -114,3 +114,21 @@ pub fn widest_outline_pixels(frame: &Frame) -> f32 {
     }
     widest
 }
+
+/// The world-space triangles of the objects `casters` of `frame` (their meshes under their
+/// transforms, indices out of range skipped): what an `[area_light]`'s traced resolve builds its
+/// hierarchy over (`hadou_math::soft::Bvh`), on both backends.
+pub fn caster_triangles(frame: &Frame, casters: &[u32]) -> Vec<[Vec3f; 3]> {
+    let mut out = Vec::new();
+    for obj in casters.iter().filter_map(|&c| frame.objects.get(c as usize)) {
+        let world: Vec<Vec3f> =
+            obj.mesh.positions.iter().map(|p| obj.transform.transform_point(Vec3::from_array(*p))).collect();
+        for tri in obj.mesh.indices.chunks_exact(3) {
+            let v = [tri[0], tri[1], tri[2]].map(|i| world.get(i as usize).copied());
+            if let [Some(a), Some(b), Some(c)] = v {
+                out.push([a, b, c]);
+            }
+        }
+    }
+    out
+}

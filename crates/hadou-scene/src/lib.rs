@@ -78,7 +78,7 @@ pub use area_light::{
 };
 pub use backend::{Backend, RenderError};
 pub use bloom_def::{BLOOM_MAX_STREAK_LENGTH, BLOOM_MAX_THRESHOLD, BLOOM_MAX_WEIGHT};
-pub use bounds::{caster_box, object_bounds, object_center, widest_outline_pixels};
+pub use bounds::{caster_box, caster_triangles, object_bounds, object_center, widest_outline_pixels};
 pub use error::{escape_controls, Location, SceneError};
 pub use file_kinds::file_size_limit;
 pub use files::{

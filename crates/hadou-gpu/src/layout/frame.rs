@@ -85,6 +85,34 @@ pub struct FrameUniforms {
     /// The edge of the sample grid (`Frame::grid`): 1, or with anti-aliasing these are the
     /// sample frame's uniforms and the wave pass resolves `grid × grid` samples per pixel.
     pub grid: u32,
+    /// The area light's axis `P = (L − G)/|L − G|` (`AreaLight::axis`).
+    pub area_axis: [f32; 3],
+    /// The area light's size `l`.
+    pub area_size: f32,
+    /// The area light's lamp shape ([`LAMP_SEGMENT`], [`LAMP_DISC`], [`LAMP_SPHERE`]).
+    pub area_shape: u32,
+    /// Padding to the uniform's 16-byte alignment.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
+}
+
+/// `FrameUniforms::area_shape` of `LampShape::Segment`. Keep in sync with `LAMP_SEGMENT`.
+pub const LAMP_SEGMENT: u32 = 0;
+/// `FrameUniforms::area_shape` of `LampShape::Disc`. Keep in sync with `LAMP_DISC`.
+pub const LAMP_DISC: u32 = 1;
+/// `FrameUniforms::area_shape` of `LampShape::Sphere`. Keep in sync with `LAMP_SPHERE`.
+pub const LAMP_SPHERE: u32 = 2;
+
+/// The `FrameUniforms::area_shape` of `shape`.
+pub fn lamp_shape(shape: hadou_scene::LampShape) -> u32 {
+    match shape {
+        hadou_scene::LampShape::Segment => LAMP_SEGMENT,
+        hadou_scene::LampShape::Disc => LAMP_DISC,
+        hadou_scene::LampShape::Sphere => LAMP_SPHERE,
+    }
 }
 
 /// How far the edge pass looks (pixels): the widest outline's hull width on screen, rounded up
@@ -144,6 +172,12 @@ impl FrameUniforms {
             outline_reach: outline_reach(frame),
             area_color: frame.area_light.as_ref().map_or([0.0; 3], |a| a.color),
             grid: grid.edge(),
+            area_axis: frame.area_light.as_ref().map_or([0.0; 3], |a| a.axis().to_array()),
+            area_size: frame.area_light.as_ref().map_or(0.0, |a| a.size),
+            area_shape: frame.area_light.as_ref().map_or(LAMP_SEGMENT, |a| lamp_shape(a.shape)),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         }
     }
 }

@@ -1,5 +1,6 @@
 //! The `[area_light]`'s records: its maps (`GpuSpotMap`), uniforms (`SoftUniforms`) and casters'
-//! boxes (`GpuCasterBox`).
+//! boxes (`GpuCasterBox`); the traced resolve's uniforms (`TracedUniforms`) and hierarchy
+//! (`GpuBvhNode`, `GpuBvhTri`).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -79,5 +80,79 @@ impl GpuCasterBox {
     pub fn new(b: &hadou_math::soft::CasterBox) -> Self {
         let v = |v: hadou_math::Vec3f| [v.x, v.y, v.z, 0.0];
         GpuCasterBox { origin: v(b.origin), dual: b.dual.map(v) }
+    }
+}
+
+/// The traced resolve's uniforms: the lamp's sample layout (`hadou_math::soft::LampPattern`) and
+/// the hierarchy's node count. Keep in sync with `TracedUniforms` in soft_traced.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TracedUniforms {
+    /// Rows of samples.
+    pub rows: u32,
+    /// Samples a row.
+    pub per_row: u32,
+    /// 1 for chords of the unit disc (disc, sphere), 0 for the segment's one row.
+    pub disc: u32,
+    /// Nodes of the hierarchy (0: no caster triangle).
+    pub node_count: u32,
+    /// Row `j`'s share of the lamp at `[j / 4][j % 4]`.
+    pub weights: [[f32; 4]; 8],
+}
+
+impl TracedUniforms {
+    /// The uniforms of `pattern` over a hierarchy of `node_count` nodes.
+    pub fn new(pattern: &hadou_math::soft::LampPattern, node_count: u32) -> Self {
+        let mut weights = [[0.0; 4]; 8];
+        for (j, w) in pattern.weights.iter().enumerate() {
+            weights[j / 4][j % 4] = *w;
+        }
+        TracedUniforms {
+            rows: pattern.rows,
+            per_row: pattern.per_row,
+            disc: u32::from(pattern.disc),
+            node_count,
+            weights,
+        }
+    }
+}
+
+/// One node of the traced resolve's hierarchy: `hadou_math::soft::BvhNode`'s bytes. Keep in sync
+/// with `BvhNode` in soft_traced.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuBvhNode {
+    /// Smallest corner.
+    pub lo: [f32; 3],
+    /// The next node once this subtree is done.
+    pub skip: u32,
+    /// Largest corner.
+    pub hi: [f32; 3],
+    /// `first << 4 | count` (0: an inner node).
+    pub tris: u32,
+}
+
+impl From<&hadou_math::soft::BvhNode> for GpuBvhNode {
+    fn from(n: &hadou_math::soft::BvhNode) -> Self {
+        GpuBvhNode { lo: n.lo, skip: n.skip, hi: n.hi, tris: n.tris }
+    }
+}
+
+/// One triangle of the traced resolve's hierarchy: `hadou_math::soft::BvhTri`'s bytes. Keep in
+/// sync with `BvhTri` in soft_traced.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuBvhTri {
+    /// First corner, `w` the normal's `x`.
+    pub a: [f32; 4],
+    /// Second corner, `w` the normal's `y`.
+    pub b: [f32; 4],
+    /// Third corner, `w` the normal's `z`.
+    pub c: [f32; 4],
+}
+
+impl From<&hadou_math::soft::BvhTri> for GpuBvhTri {
+    fn from(t: &hadou_math::soft::BvhTri) -> Self {
+        GpuBvhTri { a: t.a, b: t.b, c: t.c }
     }
 }

@@ -18,11 +18,11 @@ use super::setup::{
 };
 use crate::device::GpuContext;
 use crate::formats::{MAP_FORMAT, SPOT_FORMAT};
-use crate::layout::{GpuCasterBox, GpuSpotMap, SoftUniforms};
+use crate::layout::{GpuBvhNode, GpuBvhTri, GpuCasterBox, GpuSpotMap, SoftUniforms, TracedUniforms};
 use crate::meshes::MeshCache;
 use crate::shaders;
 use crate::timing::PassQueries;
-use hadou_math::soft::FitWindow;
+use hadou_math::soft::{Bvh, FitWindow, LampPattern, BVH_NODE_BYTES, BVH_TRI_BYTES};
 use hadou_scene::{Frame, RenderError, SoftResolve};
 
 const VS: wgpu::ShaderStages = wgpu::ShaderStages::VERTEX;
@@ -48,6 +48,17 @@ pub(crate) const BINDINGS: [Binding; 14] = [
     Binding::new(11, "caster_boxes", Kind::Storage, CS),
     Binding::new(12, "fit", Kind::StorageRw, CS),
     Binding::new(13, "fitted_maps", Kind::StorageRw, CS),
+];
+
+/// The bindings of soft_traced.wgsl.
+pub(crate) const TRACED_BINDINGS: [Binding; 7] = [
+    Binding::new(0, "frame", Kind::Uniform, CS),
+    Binding::new(1, "traced", Kind::Uniform, CS),
+    Binding::new(2, "soft_world", Kind::Storage, CS),
+    Binding::new(3, "soft_normal", Kind::Storage, CS),
+    Binding::new(4, "visibility", Kind::StorageRw, CS),
+    Binding::new(5, "nodes", Kind::Storage, CS),
+    Binding::new(6, "tris", Kind::Storage, CS),
 ];
 
 /// What soft.wgsl reads from a tile (the rest, [`BINDINGS`] 1, 4–9 and 11–13, is
@@ -76,11 +87,22 @@ pub const SOFT_BYTES_PER_PIXEL: u64 = 36;
 pub(crate) fn check_area_light(limits: &wgpu::Limits, frame: &Frame) -> Result<(), RenderError> {
     let Some(light) = &frame.area_light else { return Ok(()) };
     if let SoftResolve::Traced { .. } = light.resolve {
-        return Err(RenderError::Other(
-            "[area_light]: resolve = \"traced\" is not drawn by the GPU backend yet (render it with the CPU \
-             backend, or use resolve = \"exact\")"
-                .into(),
-        ));
+        // The hierarchy's two buffers, at most (every caster triangle kept).
+        let tris: u64 = light
+            .casters
+            .iter()
+            .filter_map(|&c| frame.objects.get(c as usize))
+            .map(|o| o.mesh.indices.len() as u64 / 3)
+            .sum();
+        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let (node_bytes, tri_bytes) = (2 * tris * BVH_NODE_BYTES, tris * BVH_TRI_BYTES);
+        if node_bytes.max(tri_bytes) > max {
+            return Err(RenderError::Device(format!(
+                "[area_light]: the traced resolve's hierarchy over {tris} caster triangles needs buffers of up to \
+                 {} bytes, more than this adapter's storage buffer limit of {max} bytes",
+                node_bytes.max(tri_bytes)
+            )));
+        }
     }
     if light.map_size > limits.max_texture_dimension_2d {
         return Err(RenderError::Device(format!(
@@ -130,6 +152,18 @@ pub(crate) struct SoftTargets {
     /// The two maps fitted to them by `cs_fit` (binding 13, `[GpuSpotMap; 2]`), copied into
     /// `spot_uniforms` on the GPU.
     fitted: wgpu::Buffer,
+    /// The traced resolve's uniforms and hierarchy (soft_traced.wgsl), made on its first frame and
+    /// grown as needed.
+    traced: Option<TracedBuffers>,
+}
+
+/// The traced resolve's buffers: its uniforms ([`TracedUniforms`]) and the hierarchy's nodes and
+/// triangles, with room for `capacity` of each.
+struct TracedBuffers {
+    uniforms: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    tris: wgpu::Buffer,
+    capacity: (u64, u64),
 }
 
 /// Bytes of the fit windows: four `u32` keys per map.
@@ -137,7 +171,7 @@ const FIT_BYTES: u64 = 32;
 
 impl SoftTargets {
     /// Makes `soft` fit `frame` (which has an `[area_light]`) and writes its uniforms.
-    pub(crate) fn ensure(soft: &mut Option<SoftTargets>, ctx: &GpuContext, frame: &Frame) {
+    pub(crate) fn ensure(slot: &mut Option<SoftTargets>, ctx: &GpuContext, frame: &Frame) {
         let light = frame.area_light.as_ref().expect("an area light");
         let n = match light.resolve {
             SoftResolve::Exact | SoftResolve::Traced { .. } => 0,
@@ -147,8 +181,8 @@ impl SoftTargets {
         let grid_len = if n == 0 { 1 } else { gs[0] * gs[1] };
         let key = (frame.width, frame.height, light.map_size.max(1), grid_len);
         let boxes = light.caster_boxes.len().max(1);
-        if soft.as_ref().is_none_or(|s| s.key != key || s.box_capacity < boxes) {
-            *soft = None; // free the old ones first
+        if slot.as_ref().is_none_or(|s| s.key != key || s.box_capacity < boxes) {
+            *slot = None; // free the old ones first
             let d = &ctx.device;
             let size = key.2;
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
@@ -165,7 +199,7 @@ impl SoftTargets {
             let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
             let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
             let spot = std::mem::size_of::<GpuSpotMap>() as u64;
-            *soft = Some(SoftTargets {
+            *slot = Some(SoftTargets {
                 key,
                 spot_views: [texture("soft map 1", SPOT_FORMAT), texture("soft map 2", SPOT_FORMAT)],
                 spot_depth: texture("soft map depth", MAP_FORMAT),
@@ -183,9 +217,10 @@ impl SoftTargets {
                 box_capacity: boxes,
                 fit: buffer("soft fit", FIT_BYTES, storage | wgpu::BufferUsages::COPY_DST),
                 fitted: buffer("soft fitted maps", 2 * spot, storage),
+                traced: None,
             });
         }
-        let soft = soft.as_ref().expect("created above");
+        let soft = slot.as_ref().expect("created above");
         // The unfitted maps, which cs_points fits the windows in; cs_fit narrows them.
         soft.write_uniforms(ctx, frame);
         let boxes: Vec<GpuCasterBox> = light.caster_boxes.iter().map(GpuCasterBox::new).collect();
@@ -195,6 +230,9 @@ impl SoftTargets {
         let empty = FitWindow::EMPTY;
         let keys = [empty.min, empty.max, empty.min, empty.max].concat();
         ctx.queue.write_buffer(&soft.fit, 0, bytemuck::cast_slice(&keys));
+        if let Some(soft) = slot.as_mut() {
+            soft.write_traced(ctx, frame);
+        }
     }
 
     /// Writes the frame's `[area_light]` into soft.wgsl's uniforms: its resolve, and the two maps
@@ -216,6 +254,49 @@ impl SoftTargets {
             _pad: [0; 2],
         };
         ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+    }
+
+    /// For a frame of the traced resolve: builds the hierarchy of the light's casters' world-space
+    /// triangles (`hadou_math::soft::Bvh`, as hadou-cpu's `traced` does) and writes it and the
+    /// lamp's sample layout for soft_traced.wgsl, growing the buffers as needed.
+    pub(crate) fn write_traced(&mut self, ctx: &GpuContext, frame: &Frame) {
+        let light = frame.area_light.as_ref().expect("an area light");
+        let SoftResolve::Traced { samples } = light.resolve else { return };
+        let bvh = Bvh::build(&hadou_scene::caster_triangles(frame, &light.casters));
+        let nodes: Vec<GpuBvhNode> = bvh.nodes.iter().map(GpuBvhNode::from).collect();
+        let tris: Vec<GpuBvhTri> = bvh.tris.iter().map(GpuBvhTri::from).collect();
+        let need = (nodes.len().max(1) as u64, tris.len().max(1) as u64);
+        let d = &ctx.device;
+        if self.traced.as_ref().is_none_or(|t| t.capacity.0 < need.0 || t.capacity.1 < need.1) {
+            let buffer = |label, size: u64, usage| {
+                d.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage,
+                    mapped_at_creation: false,
+                })
+            };
+            let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+            let capacity = (need.0.next_power_of_two(), need.1.next_power_of_two());
+            self.traced = Some(TracedBuffers {
+                uniforms: buffer(
+                    "traced uniforms",
+                    std::mem::size_of::<TracedUniforms>() as u64,
+                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                ),
+                nodes: buffer("traced hierarchy nodes", capacity.0 * BVH_NODE_BYTES, storage),
+                tris: buffer("traced hierarchy triangles", capacity.1 * BVH_TRI_BYTES, storage),
+                capacity,
+            });
+        }
+        let t = self.traced.as_ref().expect("made above");
+        let pattern = LampPattern::new(light.shape, samples);
+        let u = TracedUniforms::new(&pattern, nodes.len() as u32);
+        ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&u));
+        if !nodes.is_empty() {
+            ctx.queue.write_buffer(&t.nodes, 0, bytemuck::cast_slice(&nodes));
+            ctx.queue.write_buffer(&t.tris, 0, bytemuck::cast_slice(&tris));
+        }
     }
 
     /// After a frame with an `[area_light]` has been drawn: every pixel's soft-shadow class
@@ -260,6 +341,9 @@ struct SoftPipelines {
 
 /// The soft-shadow pipelines and bind group layouts.
 pub(crate) struct SoftPass {
+    /// The traced resolve (soft_traced.wgsl) and its layout.
+    traced: wgpu::ComputePipeline,
+    traced_layout: wgpu::BindGroupLayout,
     /// The `[area_light]`'s maps (soft_map.wgsl).
     spot_map: wgpu::RenderPipeline,
     spot_map_layout: wgpu::BindGroupLayout,
@@ -273,6 +357,8 @@ impl SoftPass {
     pub(crate) fn new(ctx: &GpuContext) -> Result<Self, RenderError> {
         let spot_module = setup::compile_module(ctx, "soft map", &shaders::compose(shaders::SOFT_MAP_PARTS))?;
         let soft_module = setup::compile_module(ctx, "soft", &shaders::compose(shaders::SOFT_PARTS))?;
+        let traced_module =
+            setup::compile_module(ctx, "soft traced", &shaders::compose(shaders::SOFT_TRACED_PARTS))?;
         ctx.scoped("building the soft-shadow pipelines", || {
             let d = &ctx.device;
             let spot_map_layout = setup::bind_group_layout(d, "soft maps", &MAP_BINDINGS);
@@ -309,7 +395,10 @@ impl SoftPass {
                 interp: pipeline("cs_interp"),
                 gather: pipeline("cs_gather"),
             };
-            Self { spot_map, spot_map_layout, pipelines, layout }
+            let traced_layout = setup::bind_group_layout(d, "soft traced", &TRACED_BINDINGS);
+            let traced_pl = setup::pipeline_layout(d, "soft traced", &traced_layout);
+            let traced = setup::compute_pipeline(d, &traced_pl, &traced_module, "cs_traced");
+            Self { traced, traced_layout, spot_map, spot_map_layout, pipelines, layout }
         })
     }
 
@@ -425,6 +514,37 @@ impl SoftPass {
         for (k, uniform) in targets.spot_uniforms.iter().enumerate() {
             enc.copy_buffer_to_buffer(&targets.fitted, k as u64 * spot, uniform, 0, spot);
         }
+    }
+
+    /// Records the traced resolve over the whole image (`cs_traced`), once every tile's points are
+    /// gathered and [`SoftTargets::write_traced`] has written the hierarchy; `uniforms` is the
+    /// tiles' `layout::FrameUniforms` (any tile's: the image size and the light are the frame's).
+    pub(crate) fn encode_traced(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        device: &wgpu::Device,
+        targets: &SoftTargets,
+        uniforms: &wgpu::Buffer,
+        frame: &Frame,
+    ) {
+        let Some(t) = targets.traced.as_ref() else { return };
+        let resources = vec![
+            uniforms.as_entire_binding(),
+            t.uniforms.as_entire_binding(),
+            targets.world.as_entire_binding(),
+            targets.normal.as_entire_binding(),
+            targets.visibility.as_entire_binding(),
+            t.nodes.as_entire_binding(),
+            t.tris.as_entire_binding(),
+        ];
+        let bg = setup::bind_group(device, "soft traced", &self.traced_layout, &TRACED_BINDINGS, resources);
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("soft traced"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.traced);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(frame.width.div_ceil(8), frame.height.div_ceil(8), 1);
     }
 
     /// Records the classification of the whole image's pixels (`cs_class`), once every tile's

@@ -29,6 +29,15 @@ impl Renderer {
                 self.submit_tile(encoders)?;
             }
         }
+        if let Some(hadou_scene::SoftResolve::Traced { .. }) = frame.area_light.as_ref().map(|l| l.resolve) {
+            // No maps: the hierarchy says where a shadow edge can be.
+            let uniforms = &self.targets.as_ref().expect("targets are created in prepare").uniforms;
+            let mut enc =
+                d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft traced") });
+            self.passes.soft.encode_traced(&mut enc, d, soft, uniforms, frame);
+            self.ctx.queue.submit([enc.finish()]);
+            return Ok(());
+        }
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soft maps") });
         self.passes.soft.encode_fit(&mut enc, bind_group, soft);
         let objects = &prepared.buffers.objects;

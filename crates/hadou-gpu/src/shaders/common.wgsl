@@ -59,7 +59,19 @@ struct FrameUniforms {
     // uniforms are the sample frame's (image_size, tile_origin and tile_size count samples) and
     // the wave pass resolves grid × grid samples per image pixel.
     grid: u32,
+    // The area light's axis P, size l and lamp shape (LAMP_*).
+    area_axis: vec3<f32>,
+    area_size: f32,
+    area_shape: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
+
+// layout/ LAMP_SEGMENT, LAMP_DISC, LAMP_SPHERE (hadou_math::soft::LampShape).
+const LAMP_SEGMENT: u32 = 0u;
+const LAMP_DISC: u32 = 1u;
+const LAMP_SPHERE: u32 = 2u;
 
 // Keep in sync with layout/ `GpuSpotMap` (hadou_math::soft::SpotMap and its edge in texels).
 struct GpuSpotMap {

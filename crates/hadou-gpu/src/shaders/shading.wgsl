@@ -401,11 +401,75 @@ fn shade_surface(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec
     return c;
 }
 
+// Twin of hadou_math::soft::lamp_spread: (facing, sin σ) of the lamp for a receiver at p (the
+// segment (1, 0); the disc max(0, l̂·P) and sin²σ = l²/(l² + d²); the sphere (1, min(l/d, 1))).
+fn lamp_spread(p: vec3<f32>) -> vec2<f32> {
+    let r = frame.area_position - p;
+    let d = length3(r);
+    let size = frame.area_size;
+    if (frame.area_shape == LAMP_DISC) {
+        let facing = max(dot3(r / max(d, 1.17549435e-38), frame.area_axis), 0.0);
+        let s2 = size * size / (size * size + d * d);
+        var out = vec2<f32>(0.0);
+        if (is_finite_value(facing)) {
+            out.x = facing;
+        }
+        if (is_finite_value(s2)) {
+            out.y = sqrt(s2);
+        }
+        return out;
+    }
+    if (frame.area_shape == LAMP_SPHERE) {
+        var s = 1.0;
+        if (d > size) {
+            s = size / d;
+        }
+        return vec2<f32>(1.0, s);
+    }
+    return vec2<f32>(1.0, 0.0);
+}
+
+// Whether `v` is neither NaN nor infinite (by its exponent bits).
+fn is_finite_value(v: f32) -> bool {
+    return (bitcast<u32>(v) & 0x7f800000u) != 0x7f800000u;
+}
+
+// Twin of hadou_math::soft::lamp_cosine: the horizon-clipped irradiance factor of a lamp of
+// angular radius σ at m = N·l̂ (Snyder 1996 in Lagarde & de Rousiers 2014, eq. 34), max(0, m)
+// where the lamp is wholly above or below the horizon.
+fn lamp_cosine(m_in: f32, sin_sigma: f32) -> f32 {
+    if (m_in != m_in) {
+        return 0.0;
+    }
+    let m = clamp(m_in, -1.0, 1.0);
+    if (!(sin_sigma > 1e-4) || m * m >= sin_sigma * sin_sigma) {
+        return max(m, 0.0);
+    }
+    let s2 = min(sin_sigma * sin_sigma, 1.0 - 1e-6);
+    let x = sqrt(1.0 / s2 - 1.0);
+    let sin_t = max(sqrt(max(1.0 - m * m, 0.0)), 1e-6);
+    let y = clamp(-x * m / sin_t, -1.0, 1.0);
+    let sy = sin_t * sqrt(max(1.0 - y * y, 0.0));
+    let e = (m * acos(y) - x * sy) * s2 + atan(sy / x);
+    return clamp(e / (3.14159265358979 * s2), 0.0, 1.0);
+}
+
+// Twin of hadou_math::soft::lamp_toon_cosine: the ramps' input, m plus what the lamp's horizon
+// adds to the diffuse factor.
+fn lamp_toon_cosine(m: f32, sin_sigma: f32) -> f32 {
+    if (!(sin_sigma > 1e-4)) {
+        return m;
+    }
+    return m + lamp_cosine(m, sin_sigma) - max(m, 0.0);
+}
+
 // Twin of hadou_cpu::shading::area_term: what the `[area_light]` adds to a visible point where it
 // is fully visible (the soft shadow's visibility scales it): with l̂ the unit vector from the point
-// to the light centre and m = N·l̂, diffuse A·E·max(0, m), toon A·E·ramp(m), MToon
-// mix(shade, A, step(m + shift))·E, unlit nothing; then the feature texture. E = frame.area_color
-// (colour times intensity).
+// to the light centre and m = N·l̂, for the segment lamp diffuse A·E·max(0, m), toon A·E·ramp(m),
+// MToon mix(shade, A, step(m + shift))·E, unlit nothing; a disc or sphere lamp of facing f and
+// angular radius σ (lamp_spread) diffuse A·E·f·lamp_cosine(m, sin σ), toon A·E·f·ramp(m') and
+// MToon f·mix(shade, A, step(m' + shift))·E with m' = lamp_toon_cosine(m, sin σ); then the feature
+// texture. E = frame.area_color (colour times intensity).
 fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f32>, vcolor: vec4<f32>) -> vec3<f32> {
     let is_mtoon = USE_MTOON && m.mtoon != 0u;
     if (!is_mtoon && m.model != MODEL_DIFFUSE && m.model != MODEL_TOON) {
@@ -423,9 +487,22 @@ fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f3
         dir = to_light / dl;
     }
     let mdot = dot3(n, dir);
+    // The diffuse factor, the ramps' input and the facing (the segment's: m itself).
+    var diffuse = max(mdot, 0.0);
+    var ramp_in = mdot;
+    var facing = 1.0;
+    if (frame.area_shape != LAMP_SEGMENT) {
+        let spread = lamp_spread(world);
+        facing = spread.x;
+        diffuse = spread.x * lamp_cosine(mdot, spread.y);
+        ramp_in = lamp_toon_cosine(mdot, spread.y);
+    }
     if (is_mtoon) {
         let p = mtoon_point(m, uv, vcolor);
-        let k = mtoon_wave(m.mtoon, p, mdot, frame.area_color);
+        var k = mtoon_wave(m.mtoon, p, ramp_in, frame.area_color);
+        if (frame.area_shape != LAMP_SEGMENT) {
+            k = k * facing;
+        }
         var f = vec3<f32>(1.0);
         if (m.feature_texture.offset != 0u) {
             f = sample_texture(m.feature_texture, p.uv).xyz;
@@ -433,9 +510,12 @@ fn area_term(m: GpuMaterial, world: vec3<f32>, normal_in: vec3<f32>, uv: vec2<f3
         let t = k * f;
         return vec3<f32>(energy_saturate(t.x), energy_saturate(t.y), energy_saturate(t.z));
     }
-    var k = vec3<f32>(max(mdot, 0.0));
+    var k = vec3<f32>(diffuse);
     if (USE_TOON && m.model == MODEL_TOON) {
-        k = ramp_eval(m.ramp, mdot);
+        k = ramp_eval(m.ramp, ramp_in);
+        if (frame.area_shape != LAMP_SEGMENT) {
+            k = k * facing;
+        }
     }
     let tex = sample_texture(m.base_texture, uv);
     let a = m.base_color * tex.xyz * vcolor.xyz;
