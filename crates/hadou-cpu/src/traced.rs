@@ -128,7 +128,7 @@ pub fn traced_with(
     samples: u32,
 ) -> Vec<f32> {
     let w = width;
-    let h = if w == 0 { 0 } else { points.len() / w };
+    let h = points.len().checked_div(w).unwrap_or(0);
     let lamp = Lamp::of(light);
     let pat = LampPattern::new(lamp.shape, samples);
     let mut out = vec![0.0f32; w * h];
@@ -225,14 +225,31 @@ fn pixel(bvh: &Bvh, cands: Option<&[Cand]>, lamp: &Lamp, pat: &LampPattern, r: V
                 }
             }
         }
-        None => bvh.walk(
-            |node| {
+        None => {
+            // `Bvh::walk`, with a node test that reads the mask the leaves write.
+            let mut i = 0usize;
+            while i < bvh.nodes.len() {
+                let node = &bvh.nodes[i];
                 let (c, rc) = node.ball();
-                capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
-                    && f.box_may_hide(node.lo, node.hi, pat.disc)
-            },
-            |t| t.one_side(r, 0.0, lamp.centre, lamp.size) || hit(&t.corners(), &mut mask),
-        ),
+                if !(capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
+                    && f.box_may_hide(node.lo, node.hi, pat, o, &mask))
+                {
+                    i = node.skip as usize;
+                    continue;
+                }
+                match node.leaf() {
+                    None => i += 1,
+                    Some(range) => {
+                        for t in &bvh.tris[range] {
+                            if !t.one_side(r, 0.0, lamp.centre, lamp.size) && !hit(&t.corners(), &mut mask) {
+                                return 0.0;
+                            }
+                        }
+                        i = node.skip as usize;
+                    }
+                }
+            }
+        }
     }
     mask_visibility(&mask, pat)
 }

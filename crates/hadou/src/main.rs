@@ -810,12 +810,14 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         let t = hadou::bench::soft_table(
             &mut *timer,
             &a.scenes,
-            a.scene.as_deref(),
-            a.traced_only,
             &sizes,
             iterations,
             &name,
-            a.disc_radius,
+            hadou::bench::SoftOptions {
+                scene: a.scene.as_deref(),
+                traced_only: a.traced_only,
+                disc_radius: a.disc_radius,
+            },
             &mut progress,
         )?;
         (t.to_text(), t.to_json())

@@ -108,15 +108,23 @@ pub fn lamp_frame(shape: LampShape, l: Vec3f, axis: Vec3f, size: f32, p: Vec3f) 
 }
 
 impl LampFrame {
-    /// Whether anything inside the box `lo..hi` can hide part of the lamp's box (the square
-    /// `[−1, 1]²` of the disc, the segment `[−1, 1] × {0}`, in units of the radius) from the
-    /// origin: `false` when every corner lies beyond the lamp's plane, or every corner lies
-    /// between the planes and their projections from the origin (whose convex hull holds the
-    /// projection of the whole box: a central projection maps segments to segments there) miss
-    /// the lamp's box; `true` when unsure (a corner at or behind the origin's parallel plane).
-    /// The traced resolve's node test after [`crate::soft::capsule_hits`] (hadou's own).
+    /// Whether anything inside the box `lo..hi` can hide a sample of the lamp (layout `pat`,
+    /// first-row offset `o`) that `mask` does not hide yet: `false` when every corner lies beyond
+    /// the lamp's plane, or when every corner lies between the planes and the bounding rectangle
+    /// of their projections from the origin (the convex hull of those projections holds the
+    /// projection of the whole box: a central projection maps segments to segments there) holds
+    /// no sample that is still clear; `true` when unsure (a corner at or behind the origin's
+    /// parallel plane, NaN). The traced resolve's node test after [`crate::soft::capsule_hits`]:
+    /// it also skips what lies behind samples already hidden (hadou's own).
     #[inline]
-    pub fn box_may_hide(&self, lo: [f32; 3], hi: [f32; 3], disc: bool) -> bool {
+    pub fn box_may_hide(
+        &self,
+        lo: [f32; 3],
+        hi: [f32; 3],
+        pat: &LampPattern,
+        o: f32,
+        mask: &[u32; MASK_WORDS],
+    ) -> bool {
         let top = self.height * (1.0 - T_MIN);
         let inv_r = 1.0 / self.radius;
         let (mut x0, mut x1, mut y0, mut y1) =
@@ -143,8 +151,22 @@ impl LampFrame {
             y0 = y0.min(py);
             y1 = y1.max(py);
         }
-        let ylim = if disc { 1.0 } else { 0.0 };
-        beyond < 8 && !(x0 > 1.0 || x1 < -1.0 || y0 > ylim || y1 < -ylim)
+        if beyond == 8 || x0.is_nan() || y0.is_nan() {
+            return beyond < 8;
+        }
+        let (j0, j1) = pat.rows_within(y0, y1);
+        for j in j0..=j1 {
+            let (yj, c) = pat.row(j);
+            if yj < y0 || yj > y1 {
+                continue;
+            }
+            if let Some((a, b)) = pat.samples_within(o, j, c, x0, x1) {
+                if count_bits(mask, a, b) < b - a {
+                    return true;
+                }
+            }
+        }
+        false
     }
 }
 
@@ -199,6 +221,35 @@ impl LampPattern {
         }
         let y = -1.0 + (2 * j + 1) as f32 / self.rows as f32;
         (y, (1.0 - y * y).max(0.0).sqrt())
+    }
+
+    /// The rows whose height `−1 + (2j + 1)/rows` lies in `[y0, y1]` (the disc's; the segment's
+    /// one row always), as `j0..=j1` (empty when `j0 > j1`; a row outside adds nothing since it
+    /// meets no edge).
+    #[inline]
+    pub fn rows_within(&self, y0: f32, y1: f32) -> (u32, u32) {
+        if !self.disc {
+            return (0, 0);
+        }
+        let r = self.rows as f32;
+        let k = |y: f32| (y.clamp(-1.0, 1.0) + 1.0) * 0.5 * r - 0.5;
+        (ceil_small(k(y0)).max(0.0) as u32, floor_small(k(y1)).clamp(0.0, r - 1.0) as u32)
+    }
+
+    /// The bits `a..b` of row `j` (chord half-length `c`, first-row offset `o`) whose samples
+    /// `x = −c + (i + oⱼ)·2c/per_row` lie in `[lo, hi]`; `None` when none does.
+    #[inline]
+    pub fn samples_within(&self, o: f32, j: u32, c: f32, lo: f32, hi: f32) -> Option<(u32, u32)> {
+        if lo.is_nan() || hi.is_nan() || lo > hi || c <= 0.0 {
+            return None;
+        }
+        let m = self.per_row as f32;
+        let oj = row_offset(o, j);
+        let scale = m / (2.0 * c);
+        let i0 = ceil_small(((lo + c) * scale - oj).clamp(-1.0, m + 1.0)).max(0.0);
+        let i1 = floor_small(((hi + c) * scale - oj).clamp(-1.0, m + 1.0)).min(m - 1.0);
+        let base = j * self.per_row;
+        (i0 <= i1).then(|| (base + i0 as u32, base + i1 as u32 + 1))
     }
 
     /// Row `j`'s share of the lamp: the area of its strip `[−1 + 2j/rows, −1 + 2(j+1)/rows]` of the
@@ -397,15 +448,7 @@ pub fn occlude(f: &LampFrame, pat: &LampPattern, o: f32, tri: &[Vec3f; 3], mask:
         set_bits(mask, 0, pat.samples());
         return;
     }
-    // The rows whose height `−1 + (2j + 1)/rows` lies in `[y0, y1]`.
-    let (j0, j1) = if pat.disc {
-        let r = pat.rows as f32;
-        let k = |y: f32| ((y.clamp(-1.0, 1.0) + 1.0) * 0.5 * r - 0.5);
-        (ceil_small(k(y0)).max(0.0) as u32, floor_small(k(y1)).clamp(0.0, r - 1.0) as u32)
-    } else {
-        (0, 0)
-    };
-    let m = pat.per_row as f32;
+    let (j0, j1) = pat.rows_within(y0, y1);
     for j in j0..=j1 {
         let (yj, c) = pat.row(j);
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -423,16 +466,8 @@ pub fn occlude(f: &LampFrame, pat: &LampPattern, o: f32, tri: &[Vec3f; 3], mask:
                 hi = hi.max(x);
             }
         }
-        if lo.is_nan() || hi.is_nan() || lo > hi || c <= 0.0 {
-            continue;
-        }
-        let oj = row_offset(o, j);
-        let scale = m / (2.0 * c);
-        let i0 = ceil_small(((lo + c) * scale - oj).clamp(-1.0, m + 1.0)).max(0.0);
-        let i1 = floor_small(((hi + c) * scale - oj).clamp(-1.0, m + 1.0)).min(m - 1.0);
-        if i0 <= i1 {
-            let base = j * pat.per_row;
-            set_bits(mask, base + i0 as u32, base + i1 as u32 + 1);
+        if let Some((a, b)) = pat.samples_within(o, j, c, lo, hi) {
+            set_bits(mask, a, b);
         }
     }
 }
@@ -556,6 +591,50 @@ mod tests {
         }
         // Samples within rounding of a triangle's edge may differ.
         assert!(total > 10_000 && agree as f64 >= 0.999 * total as f64, "{agree} of {total}");
+    }
+
+    #[test]
+    fn a_box_said_not_to_hide_hides_no_clear_sample() {
+        let mut s = 0x0bad_5eedu32;
+        let mut r = move || {
+            s = hash32(s.wrapping_add(0x9e37_79b9));
+            (s >> 8) as f32 / 16_777_216.0
+        };
+        let (mut skipped, mut kept) = (0, 0);
+        for case in 0..3000 {
+            let shape = [LampShape::Segment, LampShape::Disc, LampShape::Sphere][case % 3];
+            let l = Vec3f::new(0.0, 4.0, 0.0);
+            let p = Vec3f::new(r() * 4.0 - 2.0, 0.0, r() * 4.0 - 2.0);
+            let Some(f) = lamp_frame(shape, l, Vec3f::Y, 0.6, p) else { continue };
+            let pat = LampPattern::new(shape, 144);
+            let o = pixel_offset(case as u32, 7);
+            // Some samples hidden already by one triangle, then a random box.
+            let mut mask = [0u32; MASK_WORDS];
+            let c0 = Vec3f::new(r() * 2.0 - 1.0, 1.0 + r() * 2.5, r() * 2.0 - 1.0);
+            occlude(
+                &f,
+                &pat,
+                o,
+                &[0, 1, 2].map(|_| c0 + Vec3f::new(r() - 0.5, r() - 0.5, r() - 0.5) * 2.0),
+                &mut mask,
+            );
+            let c = Vec3f::new(r() * 3.0 - 1.5, r() * 5.0, r() * 3.0 - 1.5);
+            let e = Vec3f::new(r(), r(), r()) * 0.6;
+            let (lo, hi) = (c - e, c + e);
+            if f.box_may_hide(lo.to_array(), hi.to_array(), &pat, o, &mask) {
+                kept += 1;
+                continue;
+            }
+            skipped += 1;
+            for _ in 0..20 {
+                let mut pt = || lo + Vec3f::new(r() * 2.0 * e.x, r() * 2.0 * e.y, r() * 2.0 * e.z);
+                let tri = [pt(), pt(), pt()];
+                let mut m = mask;
+                occlude(&f, &pat, o, &tri, &mut m);
+                assert_eq!(m, mask, "case {case}: a triangle in a skipped box hid a clear sample");
+            }
+        }
+        assert!(skipped > 300 && kept > 300, "{skipped} skipped, {kept} kept");
     }
 
     #[test]

@@ -20,7 +20,8 @@ pub use curve_accuracy::{curve_accuracy, curve_reference, with_integrator, ACCUR
 pub use curves::{curve_integrators, curve_table, AcceptanceRow, ACCEPTANCE_SCENES, CURVE_SCENES};
 pub use limit::{limit_table, plain_beam_loop};
 pub use soft::{
-    soft_disc_radius, soft_errors, soft_table, truth_map, SOFT_METHODS, SOFT_SCENE, TRUTH_MAP, TRUTH_SAMPLES,
+    soft_disc_radius, soft_errors, soft_table, truth_map, SoftOptions, REFERENCE_PIXELS, REFERENCE_SAMPLES,
+    SOFT_METHODS, SOFT_SCENE, TRACED_SHAPES, TRUTH_MAP, TRUTH_SAMPLES,
 };
 pub use table::{rows_json, Align, Cell, Column, Report, Row, Table};
 pub use timing::{median, median_ms, rgb8_output_ms, time_cpu, Timer, Timing};

@@ -44,7 +44,19 @@ pub const SOFT_METHODS: [&str; 7] =
 /// One row of the soft-shadow table.
 pub use hadou_cpu::soft::{disc_radius as soft_disc_radius, edge_errors as soft_errors};
 
-/// Measures the soft-shadow table: `scene_file` (by default [`SOFT_SCENE`]; at t = 0) at each
+/// What `hadou bench shadows` measures besides the sizes: the scene, whether only the traced rows,
+/// and the ground truth's disc radius.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SoftOptions<'a> {
+    /// The scene file in the scenes folder (`None`: [`SOFT_SCENE`]), taken at t = 0.
+    pub scene: Option<&'a str>,
+    /// Only the traced rows, their references and the whole frames.
+    pub traced_only: bool,
+    /// The ground truth's disc radius (`None`: [`soft_disc_radius`]).
+    pub disc_radius: Option<f32>,
+}
+
+/// Measures the soft-shadow table: `options.scene` (by default [`SOFT_SCENE`]; at t = 0) at each
 /// size, every method's soft-shadow stage on the CPU against the ground truth
 /// ([`hadou_cpu::soft::truth`], a disc of radius `disc_radius`, by default [`soft_disc_radius`];
 /// skipped with `traced_only`), then for each lamp shape ([`TRACED_SHAPES`]) the traced resolve
@@ -64,16 +76,15 @@ pub use hadou_cpu::soft::{disc_radius as soft_disc_radius, edge_errors as soft_e
 pub fn soft_table(
     time: &mut Timer<'_>,
     scenes: &Path,
-    scene_file: Option<&str>,
-    traced_only: bool,
     sizes: &[u32],
     iterations: u32,
     backend: &str,
-    disc_radius: Option<f32>,
+    options: SoftOptions<'_>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Report, RenderError> {
     use hadou_cpu::soft;
     use hadou_scene::{Penumbra, SoftResolve};
+    let SoftOptions { scene: scene_file, traced_only, disc_radius } = options;
     let (file, t) = scene_file.map_or(SOFT_SCENE, |f| (f, 0.0));
     let scene = Scene::load(scenes.join(file)).map_err(|e| RenderError::Other(e.to_string()))?;
     let mut rows = Vec::new();
