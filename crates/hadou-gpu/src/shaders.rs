@@ -394,7 +394,7 @@ mod tests {
         validate("common.wgsl + energy.wgsl", &compose(&[COMMON, ENERGY]));
         validate("common.wgsl + energy.wgsl + curve.wgsl", &compose(&[COMMON, ENERGY, CURVE]));
         let modules = modules();
-        assert_eq!(modules.len(), 10);
+        assert_eq!(modules.len(), 11);
         // Every file on disk is listed in FILES and used by a module.
         let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/src/shaders");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)

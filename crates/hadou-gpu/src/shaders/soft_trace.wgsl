@@ -200,7 +200,7 @@ fn box_corner(f: LampFrame, c: vec3<f32>, e: ptr<function, vec4<f32>>, state: pt
 // Twin of hadou_math::soft::LampFrame::box_may_hide: the eight corners straight, with no loop
 // (each node of the walk would spend eight of llvmpipe's loop iterations, see pixel_visibility).
 fn box_may_hide(f: LampFrame, lo: vec3<f32>, hi: vec3<f32>, disc: bool) -> bool {
-    var e = vec4<f32>(3.4028235e38, -3.4028235e38, 3.4028235e38, -3.4028235e38);
+    var e = vec4<f32>(3.4028234663852886e38, -3.4028234663852886e38, 3.4028234663852886e38, -3.4028234663852886e38);
     var state = vec2<u32>(0u, 0u);
     box_corner(f, vec3<f32>(lo.x, lo.y, lo.z), &e, &state);
     box_corner(f, vec3<f32>(hi.x, lo.y, lo.z), &e, &state);
@@ -359,10 +359,10 @@ fn occlude_polygon(f: LampFrame, o: f32, a: array<vec3<f32>, 5>, ha: array<f32, 
     // Project from the origin onto the plane, in units of the radius.
     var xy: array<vec2<f32>, 5>;
     let inv_r = 1.0 / f.radius;
-    var x0 = 3.4028235e38;
-    var x1 = -3.4028235e38;
-    var y0 = 3.4028235e38;
-    var y1 = -3.4028235e38;
+    var x0 = 3.4028234663852886e38;
+    var x1 = -3.4028234663852886e38;
+    var y0 = 3.4028234663852886e38;
+    var y1 = -3.4028234663852886e38;
     for (var i = 0u; i < 5u; i++) {
         if (i >= na) {
             break;
@@ -438,8 +438,8 @@ fn occlude_rows(f: LampFrame, o: f32, xy: array<vec2<f32>, 5>, na: u32, x0: f32,
         let row = pattern_row(j);
         let yj = row.x;
         let c = row.y;
-        var lo = 3.4028235e38;
-        var hi = -3.4028235e38;
+        var lo = 3.4028234663852886e38;
+        var hi = -3.4028234663852886e38;
         var any = false;
         for (var i = 0u; i < 5u; i++) {
             if (i >= na) {
