@@ -391,7 +391,14 @@ fn export_png_sequence(
     progress: &mut dyn FnMut(Progress) -> Control,
     notes: &mut dyn FnMut(SequenceNote),
 ) -> Result<ExportOutcome, SequenceError> {
+    let range = spec.frames.clone();
+    let pattern = &options.pattern;
+    let frame_path = |f: u32| dir.join(pattern.name(f));
     if !dir.is_dir() {
+        // A file in the way is named as such; a missing directory says so.
+        if dir.ancestors().any(|a| a.is_file()) {
+            output::check_directory(&frame_path(range.start))?;
+        }
         let what = if dir.exists() { "is not a directory" } else { "does not exist" };
         return Err(OutputError::BadPath(format!(
             "{}: {what}; a PNG sequence is written into an existing directory, create it first",
@@ -399,9 +406,6 @@ fn export_png_sequence(
         ))
         .into());
     }
-    let range = spec.frames.clone();
-    let pattern = &options.pattern;
-    let frame_path = |f: u32| dir.join(pattern.name(f));
     // Every frame's path is checked before the first frame is rendered: the directory accepts new
     // files, and no entry a frame would replace is a directory. Read from the directory's listing,
     // not frame by frame, so a huge range costs nothing here.

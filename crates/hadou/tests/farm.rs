@@ -45,9 +45,9 @@ fn render_frames(scene: &Path, dir: &Path, frames: &str, simd: Option<&str>, ext
         .arg(scene)
         .arg("-o")
         .arg(format!("{}/", dir.display()))
-        .args(["--frames", frames, "--backend", "cpu", "--progress", "none"]);
-    // 64×36 unless `extra` says otherwise.
-    for pair in SIZE.chunks(2) {
+        .args(["--frames", frames, "--backend", "cpu"]);
+    // 64×36 and no progress unless `extra` says otherwise.
+    for pair in SIZE.chunks(2).chain([&["--progress", "none"][..]]) {
         if !extra.contains(&pair[0]) {
             c.args(pair);
         }
@@ -79,6 +79,17 @@ fn assert_same_files(a: &Path, b: &Path, what: &str) {
     for name in listing(a) {
         assert!(std::fs::read(a.join(&name)).unwrap() == std::fs::read(b.join(&name)).unwrap(), "{what}: {name} differs");
     }
+}
+
+/// A copy of the example scene (with the glTF file it names) at `dir/NAME`, its text with
+/// `extra` appended: the same scene file or, with `extra`, an edited one.
+fn copy_scene(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    std::fs::create_dir_all(dir.join("assets")).unwrap();
+    let glb = Path::new(KAME).with_file_name("assets/crystal.glb");
+    std::fs::copy(glb, dir.join("assets/crystal.glb")).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, std::fs::read_to_string(KAME).unwrap() + extra).unwrap();
+    path
 }
 
 /// The error output is one line (`error: …`), whatever went wrong.
@@ -156,7 +167,7 @@ fn the_template_run_by_openjd_gives_the_frames_of_one_process() {
     assert_same_files(&out, &reference, "openjd run of farm/hadou-sequence.yaml");
     // One hadou process per chunk: each reports its own progress up to 100 %.
     for chunk in ["0-4", "5-9", "10-14", "15-19", "20-23"] {
-        assert!(log.contains(&format!("--frames {chunk}")), "no task for chunk {chunk}: {log}");
+        assert!(log.contains(&format!("Frames(CHUNK[INT]) = {chunk}\n")), "no task for chunk {chunk}: {log}");
     }
     assert_eq!(log.matches("openjd_progress: 100.0").count(), 5, "{log}");
     assert!(log.contains("openjd_progress: 20.0") && log.contains("openjd_progress: 25.0"), "{log}");
@@ -190,7 +201,7 @@ fn the_template_run_by_openjd_gives_the_frames_of_one_process() {
     let o = openjd_run(&openjd, &broken, &empty, &[]);
     let log = format!("{}{}", stdout(&o), stderr(&o));
     assert!(!o.status.success(), "{log}");
-    assert!(log.contains("broken.toml:2:") && log.contains("exit code 2"), "{log}");
+    assert!(log.contains("broken.toml:2:") && log.contains("exited with code: 2"), "{log}");
     assert!(listing(&empty).is_empty());
     // A missing output folder, the same.
     let o = openjd_run(&openjd, Path::new(KAME), &dir.join("missing"), &[]);
@@ -218,6 +229,24 @@ fn every_vector_path_and_every_chunking_gives_the_same_bytes() {
             }
             assert_same_files(&out, &reference, &format!("{path}, chunks {chunks:?}"));
         }
+    }
+    // Nor does the number of threads a node gives the process change a byte.
+    for threads in ["1", "3"] {
+        let out = dir.join(format!("threads-{threads}"));
+        std::fs::create_dir(&out).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_hadou"))
+            .env("RAYON_NUM_THREADS", threads)
+            .arg("render")
+            .arg(KAME)
+            .arg("-o")
+            .arg(format!("{}/", out.display()))
+            .args(["--frames", "5..24", "--backend", "cpu", "--progress", "none"])
+            .args(SIZE)
+            .output()
+            .unwrap();
+        ok(&o);
+        ok(&render_frames(Path::new(KAME), &out, "0..5", None, &[]));
+        assert_same_files(&out, &reference, &format!("{threads} threads"));
     }
 }
 
@@ -336,8 +365,7 @@ fn skip_existing_keeps_complete_frames_and_replaces_the_rest() {
     let mut old = stamp_of(&path(4));
     old.scene.version = "0.0.1".into();
     rewrite_png(&path(4), &old.text_chunks());
-    let edited = dir.join("edited.toml");
-    std::fs::write(&edited, std::fs::read_to_string(KAME).unwrap() + "\n# edited\n").unwrap();
+    let edited = copy_scene(&dir, "edited.toml", "\n# edited\n");
     let other = dir.join("other");
     std::fs::create_dir(&other).unwrap();
     ok(&render_frames(&edited, &other, "5..6", None, &[]));
@@ -438,9 +466,8 @@ fn a_chunk_killed_mid_frame_and_run_again_completes_identically() {
 #[test]
 fn frames_carry_their_scene_and_validate_catches_a_changed_scene() {
     let dir = tmpdir("validate");
-    let scene = dir.join("shot.toml");
+    let scene = copy_scene(&dir, "shot.toml", "");
     let text = std::fs::read_to_string(KAME).unwrap();
-    std::fs::write(&scene, &text).unwrap();
     let out = dir.join("out");
     std::fs::create_dir(&out).unwrap();
     ok(&render_frames(&scene, &out, "0..5", None, &[]));
