@@ -261,10 +261,16 @@ pub fn export_animation(
     // radius is animatable).
     check_frame(scene, backend, &spec.frame(scene, spec.frames.start), spec.frames.start)?;
     match AnimationFormat::from_path(path)? {
-        AnimationFormat::PngSequence => {
-            export_png_sequence(scene, backend, spec, path, &SequenceOptions::default(), progress, &mut |_| {})
-                .map_err(|e| e.error)
-        }
+        AnimationFormat::PngSequence => export_png_sequence(
+            scene,
+            backend,
+            spec,
+            path,
+            &SequenceOptions::default(),
+            progress,
+            &mut |_| {},
+        )
+        .map_err(|e| e.error),
         AnimationFormat::Gif => export_gif(scene, backend, spec, path, progress),
     }
 }
@@ -321,7 +327,13 @@ pub enum SequenceNote {
 }
 
 /// The stamp frame `f` of `spec` gets when drawn by `backend_name`.
-pub fn frame_stamp(scene: &SceneStamp, spec: &AnimationSpec, frame: &Frame, f: u32, backend_name: &str) -> FrameStamp {
+pub fn frame_stamp(
+    scene: &SceneStamp,
+    spec: &AnimationSpec,
+    frame: &Frame,
+    f: u32,
+    backend_name: &str,
+) -> FrameStamp {
     FrameStamp {
         scene: scene.clone(),
         frame: Some(f),
@@ -349,7 +361,10 @@ pub fn export_sequence(
         scene.check_pixel_work(n).map_err(|(_, m)| ExportError::Spec(format!("samples {n}: {m}")))?;
     }
     if options.skip_existing && options.stamp.is_none() {
-        return Err(ExportError::Spec("skip_existing needs the scene's stamp to recognise its frames".into()).into());
+        return Err(ExportError::Spec(
+            "skip_existing needs the scene's stamp to recognise its frames".into(),
+        )
+        .into());
     }
     check_frame(scene, backend, &spec.frame(scene, spec.frames.start), spec.frames.start)?;
     if AnimationFormat::from_path(dir)? != AnimationFormat::PngSequence {
@@ -431,14 +446,16 @@ fn export_png_sequence(
         let stamp = options.stamp.as_ref().map(|s| frame_stamp(s, spec, &frame, f, backend.name()));
         let path = frame_path(f);
         let keep = match (&stamp, options.skip_existing) {
-            (Some(stamp), true) => match crate::farm::check_frame_file(&path, stamp, (frame.width, frame.height)) {
-                OnDisk::Complete => true,
-                OnDisk::Missing => false,
-                OnDisk::Replace(why) => {
-                    notes(SequenceNote::Replacing(f, format!("{}: {why}", path.display())));
-                    false
+            (Some(stamp), true) => {
+                match crate::farm::check_frame_file(&path, stamp, (frame.width, frame.height)) {
+                    OnDisk::Complete => true,
+                    OnDisk::Missing => false,
+                    OnDisk::Replace(why) => {
+                        notes(SequenceNote::Replacing(f, format!("{}: {why}", path.display())));
+                        false
+                    }
                 }
-            },
+            }
             _ => false,
         };
         if keep {

@@ -1,6 +1,6 @@
 //! What a render farm needs of a frame on disk (docs/farm.md): each frame carries a stamp — the
 //! BLAKE3 hash of the scene file's bytes, the hadou version, the frame number and the settings it
-//! was drawn with — in its PNG `tEXt` chunks (an EXR's header attributes); a frame file is
+//! was drawn with — in its PNG `tEXt` chunks (an EXR's header text attribute); a frame file is
 //! *complete* when it decodes to its last chunk at the expected size, and *the job's own* when its
 //! stamp is the expected one. `hadou render --skip-existing` keeps exactly the frames that are
 //! both and renders the rest; `hadou validate --frames DIR` reports frames of another scene,
@@ -12,7 +12,9 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The `tEXt` keyword (and EXR attribute name) of the scene file's BLAKE3 hash, 64 hex digits.
+/// The `tEXt` keyword of the scene file's BLAKE3 hash, 64 hex digits (in an EXR, a line
+/// `KEY=VALUE` of the header's text attribute [`crate::output::EXR_TEXT_ATTRIBUTE`], as the
+/// others).
 pub const KEY_SCENE: &str = "hadou-scene-blake3";
 /// The `tEXt` keyword of the hadou version that drew the frame.
 pub const KEY_VERSION: &str = "hadou-version";
@@ -357,7 +359,11 @@ pub fn check_frames_dir(
             why.push(format!("its stamp says frame {n}"));
         }
         if settings.as_deref().is_some_and(|m| m != strip_time(&s.settings)) {
-            why.push(format!("other settings ({}; most frames: {})", s.settings, settings.as_deref().unwrap_or("")));
+            why.push(format!(
+                "other settings ({}; most frames: {})",
+                s.settings,
+                settings.as_deref().unwrap_or("")
+            ));
         }
         if !why.is_empty() {
             problems.push((f, FrameProblem { path, frame: Some(f), message: why.join("; ") }));

@@ -327,14 +327,19 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
             // Open Job Description reads a task's progress from these stdout lines (a percentage).
             use std::io::Write;
             let mut out = std::io::stdout().lock();
-            let _ = writeln!(out, "openjd_progress: {:.1}", 100.0 * f64::from(p.done) / f64::from(p.total.max(1)));
+            let _ = writeln!(
+                out,
+                "openjd_progress: {:.1}",
+                100.0 * f64::from(p.done) / f64::from(p.total.max(1))
+            );
             let _ = out.flush();
         }
         Control::Continue
     };
     let (mut kept, mut replaced) = (0u32, 0u32);
     let outcome = if sequence {
-        let options = hadou::export::SequenceOptions { pattern, stamp: Some(stamp), skip_existing: a.skip_existing };
+        let options =
+            hadou::export::SequenceOptions { pattern, stamp: Some(stamp), skip_existing: a.skip_existing };
         let mut notes = |n: hadou::export::SequenceNote| match n {
             hadou::export::SequenceNote::Kept(_) => kept += 1,
             hadou::export::SequenceNote::Replacing(f, why) => {
@@ -344,7 +349,15 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
                 });
             }
         };
-        hadou::export::export_sequence(&scene, backend.as_mut(), &spec, &a.output, &options, &mut report, &mut notes)
+        hadou::export::export_sequence(
+            &scene,
+            backend.as_mut(),
+            &spec,
+            &a.output,
+            &options,
+            &mut report,
+            &mut notes,
+        )
     } else {
         export_animation(&scene, backend.as_mut(), &spec, &a.output, &mut report)
             .map_err(|error| hadou::export::SequenceError { frame: None, error })
@@ -708,14 +721,18 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         match output::Format::from_path(&a.output)? {
             // A PNG's bands come as 8-bit sRGB straight from the renderer (the CPU backend's colour
             // stage writes no float buffers for them).
-            output::Format::Png => output::write_png_banded_with_text(&a.output, w, h, band_rows, &stamp, |rows| {
-                Ok::<_, Failure>(backend.render_rows_rgb8(&frame, rows)?)
-            })?,
-            output::Format::Exr => output::write_banded_with_text(&a.output, w, h, band_rows, &stamp, |rows| {
-                let band = backend.render_rows(&frame, rows)?;
-                check_finite(&band)?;
-                Ok::<_, Failure>(band)
-            })?,
+            output::Format::Png => {
+                output::write_png_banded_with_text(&a.output, w, h, band_rows, &stamp, |rows| {
+                    Ok::<_, Failure>(backend.render_rows_rgb8(&frame, rows)?)
+                })?
+            }
+            output::Format::Exr => {
+                output::write_banded_with_text(&a.output, w, h, band_rows, &stamp, |rows| {
+                    let band = backend.render_rows(&frame, rows)?;
+                    check_finite(&band)?;
+                    Ok::<_, Failure>(band)
+                })?
+            }
         }
         eprintln!(
             "wrote {} ({}×{}, {} backend)",

@@ -401,8 +401,13 @@ pub fn write_exr_banded<E: From<OutputError>>(
     write_exr_banded_with_text(path, width, height, rows_per_band, &[], band)
 }
 
-/// [`write_exr_banded`] with `text` written as text attributes of the layer's header (the frame
-/// stamp of [`crate::farm::FrameStamp::text_chunks`]).
+/// The EXR header's text attribute that holds [`write_exr_banded_with_text`]'s pairs, one
+/// `KEY=VALUE` a line.
+pub const EXR_TEXT_ATTRIBUTE: &str = "hadou";
+
+/// [`write_exr_banded`] with `text` written into the layer's header: one text attribute,
+/// [`EXR_TEXT_ATTRIBUTE`], of `KEY=VALUE` lines (the frame stamp of
+/// [`crate::farm::FrameStamp::text_chunks`]).
 pub fn write_exr_banded_with_text<E: From<OutputError>>(
     path: &Path,
     width: u32,
@@ -425,10 +430,15 @@ pub fn write_exr_banded_with_text<E: From<OutputError>>(
         BlockDescription::ScanLines,
         LineOrder::Increasing,
     );
-    for (name, value) in text {
+    // One attribute holding every pair: the header's attributes are a hash map, written in an
+    // order that changes from run to run, and the same frame must be the same bytes.
+    if !text.is_empty() {
+        let joined: Vec<String> = text.iter().map(|(k, v)| format!("{k}={v}")).collect();
         header.own_attributes.other.insert(
-            exr::meta::attribute::Text::from(name.as_str()),
-            exr::meta::attribute::AttributeValue::Text(exr::meta::attribute::Text::from(value.as_str())),
+            exr::meta::attribute::Text::from(EXR_TEXT_ATTRIBUTE),
+            exr::meta::attribute::AttributeValue::Text(exr::meta::attribute::Text::from(
+                joined.join("\n").as_str(),
+            )),
         );
     }
     // RLE compresses one scan line per block, so block `y` is line `y`.

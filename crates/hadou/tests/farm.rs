@@ -41,20 +41,19 @@ fn render_frames(scene: &Path, dir: &Path, frames: &str, simd: Option<&str>, ext
     if let Some(s) = simd {
         c.env("HADOU_SIMD", s);
     }
-    c.arg("render")
-        .arg(scene)
-        .arg("-o")
-        .arg(format!("{}/", dir.display()))
-        .args(["--frames", frames, "--backend", "cpu"]);
+    c.arg("render").arg(scene).arg("-o").arg(format!("{}/", dir.display())).args([
+        "--frames",
+        frames,
+        "--backend",
+        "cpu",
+    ]);
     // 64×36 and no progress unless `extra` says otherwise.
     for pair in SIZE.chunks(2).chain([&["--progress", "none"][..]]) {
         if !extra.contains(&pair[0]) {
             c.args(pair);
         }
     }
-    c.args(extra)
-        .output()
-        .expect("binary runs")
+    c.args(extra).output().expect("binary runs")
 }
 
 fn ok(o: &Output) {
@@ -77,7 +76,10 @@ fn frame_names(range: std::ops::Range<u32>) -> Vec<String> {
 fn assert_same_files(a: &Path, b: &Path, what: &str) {
     assert_eq!(listing(a), listing(b), "{what}");
     for name in listing(a) {
-        assert!(std::fs::read(a.join(&name)).unwrap() == std::fs::read(b.join(&name)).unwrap(), "{what}: {name} differs");
+        assert!(
+            std::fs::read(a.join(&name)).unwrap() == std::fs::read(b.join(&name)).unwrap(),
+            "{what}: {name} differs"
+        );
     }
 }
 
@@ -127,7 +129,9 @@ fn openjd() -> Option<PathBuf> {
         "HADOU_REQUIRE_OPENJD=1 but `{}` does not run; install it with `pip install openjd-cli`",
         exe.display()
     );
-    eprintln!("SKIPPED: no `openjd` (pip install openjd-cli) on PATH; set HADOU_REQUIRE_OPENJD=1 to fail instead");
+    eprintln!(
+        "SKIPPED: no `openjd` (pip install openjd-cli) on PATH; set HADOU_REQUIRE_OPENJD=1 to fail instead"
+    );
     None
 }
 
@@ -281,7 +285,11 @@ impl Backend for FailingAt {
     fn render(&mut self, frame: &Frame) -> Result<Image, RenderError> {
         self.inner.render(frame)
     }
-    fn render_rows_rgb8(&mut self, frame: &Frame, rows: std::ops::Range<u32>) -> Result<Rgb8Image, RenderError> {
+    fn render_rows_rgb8(
+        &mut self,
+        frame: &Frame,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Rgb8Image, RenderError> {
         if frame.time == self.time {
             return Err(RenderError::Device("the device was lost".into()));
         }
@@ -302,15 +310,22 @@ fn a_failing_frame_is_named_and_leaves_nothing_half_written() {
         skip_existing: true,
     };
     let mut backend = FailingAt { inner: CpuBackend::new(), time: 4.0 / 24.0 };
-    let e = export_sequence(&scene, &mut backend, &spec, &dir, &options, &mut |_| Control::Continue, &mut |_| {})
-        .unwrap_err();
+    let e =
+        export_sequence(&scene, &mut backend, &spec, &dir, &options, &mut |_| Control::Continue, &mut |_| {})
+            .unwrap_err();
     assert_eq!(e.frame, Some(4));
     assert_eq!(e.to_string(), "frame 4: render failed: device error: the device was lost");
     assert_eq!(listing(&dir), frame_names(2..4), "no temporary or partial file");
     let mut notes = Vec::new();
-    export_sequence(&scene, &mut CpuBackend::new(), &spec, &dir, &options, &mut |_| Control::Continue, &mut |n| {
-        notes.push(n)
-    })
+    export_sequence(
+        &scene,
+        &mut CpuBackend::new(),
+        &spec,
+        &dir,
+        &options,
+        &mut |_| Control::Continue,
+        &mut |n| notes.push(n),
+    )
     .unwrap();
     assert_eq!(notes, [SequenceNote::Kept(2), SequenceNote::Kept(3)]);
     assert_eq!(listing(&dir), frame_names(2..7));
@@ -386,7 +401,8 @@ fn skip_existing_keeps_complete_frames_and_replaces_the_rest() {
         (6, "32x36, not 64x36"),
         (7, "not a readable PNG"),
     ] {
-        let line = e.lines().find(|l| l.starts_with(&format!("note: frame {f}: "))).unwrap_or_else(|| panic!("{e}"));
+        let line =
+            e.lines().find(|l| l.starts_with(&format!("note: frame {f}: "))).unwrap_or_else(|| panic!("{e}"));
         assert!(line.contains(why), "frame {f}: {line}");
     }
     assert!(!e.contains("note: frame 1:") && !e.contains("note: frame 0:"), "{e}");
@@ -447,15 +463,23 @@ fn a_chunk_killed_mid_frame_and_run_again_completes_identically() {
             // validate names the stray partial file of the killed writer (and the missing frames).
             let o = hadou(&["validate", KAME, "--frames", out.to_str().unwrap()]);
             assert_eq!(o.status.code(), Some(2), "{}", stdout(&o));
-            assert!(stdout(&o).contains("a partial frame left by a writer that was killed"), "{}", stdout(&o));
+            assert!(
+                stdout(&o).contains("a partial frame left by a writer that was killed"),
+                "{}",
+                stdout(&o)
+            );
         }
-        let o = render_frames(Path::new(KAME), &out, "0..4", None, &[&big[..], &["--skip-existing"]].concat());
+        let o =
+            render_frames(Path::new(KAME), &out, "0..4", None, &[&big[..], &["--skip-existing"]].concat());
         ok(&o);
         assert!(stderr(&o).contains(&format!("{done} kept as they were, 0 replaced")), "{}", stderr(&o));
         let frames: Vec<String> = listing(&out).into_iter().filter(|n| n.ends_with(".png")).collect();
         assert_eq!(frames, frame_names(0..4));
         for name in frames {
-            assert!(std::fs::read(out.join(&name)).unwrap() == std::fs::read(reference.join(&name)).unwrap(), "{signal}: {name}");
+            assert!(
+                std::fs::read(out.join(&name)).unwrap() == std::fs::read(reference.join(&name)).unwrap(),
+                "{signal}: {name}"
+            );
         }
     }
 }
@@ -496,7 +520,10 @@ fn frames_carry_their_scene_and_validate_catches_a_changed_scene() {
     let o = hadou(&["validate", "--frames", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     let report = stdout(&o);
-    assert!(report.contains("frame_00005.png: from another scene file") && report.contains("most frames'"), "{report}");
+    assert!(
+        report.contains("frame_00005.png: from another scene file") && report.contains("most frames'"),
+        "{report}"
+    );
     assert!(!report.contains("frame_00000.png"), "{report}");
 
     // Another version, an unstamped file, a truncated file and a gap.
@@ -526,19 +553,50 @@ fn frames_carry_their_scene_and_validate_catches_a_changed_scene() {
 
     // A single PNG and an EXR carry the stamp too.
     let png_path = dir.join("one.png");
-    ok(&hadou(&["render", KAME, "-o", png_path.to_str().unwrap(), "--time", "0.5", "--backend", "cpu", "--width", "16", "--height", "9"]));
+    ok(&hadou(&[
+        "render",
+        KAME,
+        "-o",
+        png_path.to_str().unwrap(),
+        "--time",
+        "0.5",
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "9",
+    ]));
     let s = stamp_of(&png_path);
-    assert_eq!((s.scene, s.frame, s.settings.as_str()), (SceneStamp::of_text(&text), None, "16x9, 4 samples, t=0.5 s, cpu backend"));
+    assert_eq!(
+        (s.scene, s.frame, s.settings.as_str()),
+        (SceneStamp::of_text(&text), None, "16x9, 4 samples, t=0.5 s, cpu backend")
+    );
     let exr_path = dir.join("one.exr");
-    ok(&hadou(&["render", KAME, "-o", exr_path.to_str().unwrap(), "--time", "0.5", "--backend", "cpu", "--width", "16", "--height", "9"]));
+    ok(&hadou(&[
+        "render",
+        KAME,
+        "-o",
+        exr_path.to_str().unwrap(),
+        "--time",
+        "0.5",
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "9",
+    ]));
     let meta = exr::meta::MetaData::read_from_file(&exr_path, false).unwrap();
     let attrs = &meta.headers[0].own_attributes.other;
-    let text_of = |k: &str| match attrs.get(&exr::meta::attribute::Text::from(k)) {
+    let stamp = match attrs.get(&exr::meta::attribute::Text::from(hadou::output::EXR_TEXT_ATTRIBUTE)) {
         Some(exr::meta::attribute::AttributeValue::Text(t)) => t.to_string(),
-        other => panic!("{k}: {other:?}"),
+        other => panic!("{other:?}"),
     };
-    assert_eq!(text_of("hadou-scene-blake3"), SceneStamp::of_text(&text).scene_hash);
-    assert_eq!(text_of("hadou-version"), env!("CARGO_PKG_VERSION"));
+    let pairs: Vec<(&str, &str)> = stamp.lines().filter_map(|l| l.split_once('=')).collect();
+    let s = FrameStamp::from_text_chunks(pairs).expect("a stamp");
+    assert_eq!(s.scene, SceneStamp::of_text(&text));
+    assert_eq!(s.settings, "16x9, 4 samples, t=0.5 s, cpu backend");
 }
 
 /// Bad input for a farm job: each is exit 2 with one line naming the problem, and writes nothing.
@@ -601,7 +659,9 @@ fn bad_farm_input_is_one_line_and_writes_nothing() {
         std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o755)).unwrap();
     }
     // validate --frames on what is not a sequence.
-    for (target, needle) in [(missing.as_path(), "does not exist"), (out.as_path(), "no frames named frame_#####.png")] {
+    for (target, needle) in
+        [(missing.as_path(), "does not exist"), (out.as_path(), "no frames named frame_#####.png")]
+    {
         let o = hadou(&["validate", "--frames", target.to_str().unwrap()]);
         assert_eq!(o.status.code(), Some(2));
         assert!(one_line_error(&o).contains(needle), "{}", stderr(&o));
@@ -614,7 +674,13 @@ fn a_frame_name_pattern_names_the_frames() {
     let dir = tmpdir("pattern");
     ok(&render_frames(Path::new(KAME), &dir, "8-11", None, &["--frame-name", "shot.###.png"]));
     assert_eq!(listing(&dir), ["shot.008.png", "shot.009.png", "shot.010.png", "shot.011.png"]);
-    let o = render_frames(Path::new(KAME), &dir, "8..12", None, &["--frame-name", "shot.###.png", "--skip-existing"]);
+    let o = render_frames(
+        Path::new(KAME),
+        &dir,
+        "8..12",
+        None,
+        &["--frame-name", "shot.###.png", "--skip-existing"],
+    );
     ok(&o);
     assert!(stderr(&o).contains("wrote 0 frames") && stderr(&o).contains("4 kept"), "{}", stderr(&o));
     let o = hadou(&["validate", "--frames", dir.to_str().unwrap(), "--frame-name", "shot.###.png"]);
