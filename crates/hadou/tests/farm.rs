@@ -484,6 +484,46 @@ fn a_chunk_killed_mid_frame_and_run_again_completes_identically() {
     }
 }
 
+/// A frame that cannot be written part-way through a chunk (a directory appeared at its path
+/// after the chunk started) fails the process with one line naming the frame, exit 2; the frames
+/// before it are whole and no partial file is left.
+#[cfg(unix)]
+#[test]
+fn a_frame_failing_mid_chunk_is_named_in_one_line() {
+    let dir = tmpdir("mid-chunk");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hadou"))
+        .arg("render")
+        .arg(KAME)
+        .arg("-o")
+        .arg(format!("{}/", dir.display()))
+        .args(["--frames", "0..6", "--backend", "cpu", "--progress", "none", "--skip-existing"])
+        .args(["--width", "1280", "--height", "720", "--samples", "16"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !dir.join("frame_00000.png").exists() {
+        assert!(child.try_wait().unwrap().is_none(), "finished before frame 0 was seen");
+        assert!(start.elapsed().as_secs() < 120, "no frame after 120 s");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    std::fs::create_dir(dir.join("frame_00004.png")).unwrap();
+    let o = child.wait_with_output().unwrap();
+    // A path a frame cannot take is the user's to fix: exit 2, as the same directory found before
+    // the first frame is.
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let line = one_line_error(&o);
+    assert!(
+        line.starts_with("error: frame 4: ")
+            && line.ends_with("frame_00004.png: is a directory; give a file name"),
+        "{line}"
+    );
+    let mut expected = frame_names(0..4);
+    expected.push("frame_00004.png".into());
+    assert_eq!(listing(&dir), expected, "frames 0–3 whole, nothing partial");
+    assert!(dir.join("frame_00004.png").is_dir());
+}
+
 /// Every frame (a sequence's, a single PNG's, an EXR's) carries the scene file's BLAKE3 hash and
 /// the hadou version; a scene edited between chunks is caught by `hadou validate --frames`, with
 /// or without the scene given, and so are another version's frames, an unstamped file and a gap.
@@ -654,9 +694,15 @@ fn bad_farm_input_is_one_line_and_writes_nothing() {
             assert!(one_line_error(&o).contains("cannot create files"), "{}", stderr(&o));
             assert!(listing(&locked).is_empty());
         } else {
-            eprintln!("SKIPPED the unwritable folder: this user writes into a 0555 folder (root)");
+            eprintln!("this user writes into a 0555 folder (root): /sys stands for an unwritable one");
         }
         std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o755)).unwrap();
+        // A folder no one writes into, root included (sysfs), where Linux has one.
+        if Path::new("/sys/kernel").is_dir() {
+            let o = render_frames(Path::new(KAME), Path::new("/sys"), "0..4", None, &[]);
+            assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+            assert!(one_line_error(&o).contains("cannot create files in `/sys`"), "{}", stderr(&o));
+        }
     }
     // validate --frames on what is not a sequence.
     for (target, needle) in
