@@ -509,6 +509,13 @@ fn flag_error(e: clap::Error) -> ExitCode {
         _ => None,
     };
     let line = match (e.kind(), text(ContextKind::InvalidArg), text(ContextKind::InvalidValue)) {
+        // The missing arguments are on the parser's second line: named here, on the one line.
+        (ErrorKind::MissingRequiredArgument, _, _) => match e.get(ContextKind::InvalidArg) {
+            Some(ContextValue::Strings(missing)) => {
+                format!("missing {}", missing.join(", "))
+            }
+            _ => "a required argument is missing".to_string(),
+        },
         (ErrorKind::InvalidValue | ErrorKind::ValueValidation, Some(arg), Some(value)) => {
             // The argument as clap names it: `--samples <SAMPLES>`; the flag is its first word.
             let flag = arg.split_whitespace().next().unwrap_or(&arg).to_string();

@@ -710,6 +710,10 @@ fn bad_farm_input_is_one_line_and_writes_nothing() {
             assert!(one_line_error(&o).contains("cannot create files in `/sys`"), "{}", stderr(&o));
         }
     }
+    // validate with neither a scene nor frames names what is missing.
+    let o = hadou(&["validate"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(one_line_error(&o).contains("missing <SCENE>"), "{}", stderr(&o));
     // validate --frames on what is not a sequence.
     for (target, needle) in
         [(missing.as_path(), "does not exist"), (out.as_path(), "no frames named frame_#####.png")]
