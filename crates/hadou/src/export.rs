@@ -32,6 +32,7 @@
 //! change it), checked before the first frame against the scene's image limits
 //! ([`Scene::check_image_size`]) and, for a GIF, [`GIF_MAX_PIXELS`].
 
+use crate::farm::{FramePattern, FrameStamp, OnDisk, SceneStamp};
 use crate::output::{self, OutputError};
 use hadou_scene::{Backend, Frame, FrameOverrides, Image, RenderError, Scene};
 use std::io::{BufWriter, Write};
@@ -226,9 +227,9 @@ impl From<RenderError> for ExportError {
 }
 
 /// The file name of frame `f` in a PNG sequence: `frame_00042.png` (at least five digits), the
-/// name `hadou render --frames` gives it.
+/// name `hadou render --frames` gives it ([`FramePattern::default`]).
 pub fn frame_file_name(f: u32) -> String {
-    format!("frame_{f:05}.png")
+    FramePattern::default().name(f)
 }
 
 /// Renders `spec`'s frames of `scene` with `backend` and writes them to `path` in the format
@@ -260,9 +261,120 @@ pub fn export_animation(
     // radius is animatable).
     check_frame(scene, backend, &spec.frame(scene, spec.frames.start), spec.frames.start)?;
     match AnimationFormat::from_path(path)? {
-        AnimationFormat::PngSequence => export_png_sequence(scene, backend, spec, path, progress),
+        AnimationFormat::PngSequence => export_png_sequence(
+            scene,
+            backend,
+            spec,
+            path,
+            &SequenceOptions::default(),
+            progress,
+            &mut |_| {},
+        )
+        .map_err(|e| e.error),
         AnimationFormat::Gif => export_gif(scene, backend, spec, path, progress),
     }
+}
+
+/// How [`export_sequence`] names, stamps and resumes a PNG sequence's frames (docs/farm.md).
+#[derive(Clone, Debug, Default)]
+pub struct SequenceOptions {
+    /// The frames' file names (`frame_#####.png` by default).
+    pub pattern: FramePattern,
+    /// The scene file and hadou version every frame's stamp names
+    /// ([`crate::farm::FrameStamp`]); `None` writes unstamped frames (as [`export_animation`]
+    /// does: its scene may be an edited one that no file holds).
+    pub stamp: Option<SceneStamp>,
+    /// Keep the frames already on disk that are complete and carry this job's stamp
+    /// ([`crate::farm::check_frame_file`]); anything else at a frame's path is rendered again
+    /// and replaced. Needs `stamp`.
+    pub skip_existing: bool,
+}
+
+/// A sequence that failed, with the frame it failed at (`None`: before the first frame).
+#[derive(Debug)]
+pub struct SequenceError {
+    /// The frame being checked, rendered or written when it failed.
+    pub frame: Option<u32>,
+    /// What failed.
+    pub error: ExportError,
+}
+
+impl std::fmt::Display for SequenceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.frame {
+            Some(n) => write!(f, "frame {n}: {}", self.error),
+            None => write!(f, "{}", self.error),
+        }
+    }
+}
+
+impl std::error::Error for SequenceError {}
+
+impl<E: Into<ExportError>> From<E> for SequenceError {
+    fn from(e: E) -> Self {
+        SequenceError { frame: None, error: e.into() }
+    }
+}
+
+/// What [`export_sequence`] did with a frame already on disk, with `skip_existing`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SequenceNote {
+    /// The frame was complete and this job's: kept, not rendered.
+    Kept(u32),
+    /// Something else was at the frame's path (the text says what); the frame is rendered and
+    /// replaces it.
+    Replacing(u32, String),
+}
+
+/// The stamp frame `f` of `spec` gets when drawn by `backend_name`.
+pub fn frame_stamp(
+    scene: &SceneStamp,
+    spec: &AnimationSpec,
+    frame: &Frame,
+    f: u32,
+    backend_name: &str,
+) -> FrameStamp {
+    FrameStamp {
+        scene: scene.clone(),
+        frame: Some(f),
+        settings: crate::farm::frame_settings(frame, &format!("t={f}/{}", spec.fps), backend_name),
+    }
+}
+
+/// A PNG sequence into the directory `dir`, as [`export_animation`] writes one, with the frames
+/// named, stamped and resumed as `options` says; `notes` hears of every frame kept or replaced.
+/// Errors name the frame they happened at. The checks before the first frame are
+/// [`export_animation`]'s.
+pub fn export_sequence(
+    scene: &Scene,
+    backend: &mut dyn Backend,
+    spec: &AnimationSpec,
+    dir: &Path,
+    options: &SequenceOptions,
+    progress: &mut dyn FnMut(Progress) -> Control,
+    notes: &mut dyn FnMut(SequenceNote),
+) -> Result<ExportOutcome, SequenceError> {
+    spec.validate()?;
+    let (w, h) = spec.size(scene);
+    scene.check_image_size(w, h).map_err(ExportError::Spec)?;
+    if let Some(n) = spec.samples {
+        scene.check_pixel_work(n).map_err(|(_, m)| ExportError::Spec(format!("samples {n}: {m}")))?;
+    }
+    if options.skip_existing && options.stamp.is_none() {
+        return Err(ExportError::Spec(
+            "skip_existing needs the scene's stamp to recognise its frames".into(),
+        )
+        .into());
+    }
+    check_frame(scene, backend, &spec.frame(scene, spec.frames.start), spec.frames.start)?;
+    if AnimationFormat::from_path(dir)? != AnimationFormat::PngSequence {
+        return Err(OutputError::BadPath(format!(
+            "{}: a PNG sequence is written into a directory (a path ending in `/`)",
+            dir.display()
+        ))
+        .into());
+    }
+    export_png_sequence(scene, backend, spec, dir, options, progress, notes)
 }
 
 /// [`Backend::check_frame`] of frame `f`, its message located at the scene's `[bloom]`.
@@ -290,9 +402,18 @@ fn export_png_sequence(
     backend: &mut dyn Backend,
     spec: &AnimationSpec,
     dir: &Path,
+    options: &SequenceOptions,
     progress: &mut dyn FnMut(Progress) -> Control,
-) -> Result<ExportOutcome, ExportError> {
+    notes: &mut dyn FnMut(SequenceNote),
+) -> Result<ExportOutcome, SequenceError> {
+    let range = spec.frames.clone();
+    let pattern = &options.pattern;
+    let frame_path = |f: u32| dir.join(pattern.name(f));
     if !dir.is_dir() {
+        // A file in the way is named as such; a missing directory says so.
+        if dir.ancestors().any(|a| a.is_file()) {
+            output::check_directory(&frame_path(range.start))?;
+        }
         let what = if dir.exists() { "is not a directory" } else { "does not exist" };
         return Err(OutputError::BadPath(format!(
             "{}: {what}; a PNG sequence is written into an existing directory, create it first",
@@ -300,21 +421,17 @@ fn export_png_sequence(
         ))
         .into());
     }
-    let range = spec.frames.clone();
-    let frame_path = |f: u32| dir.join(frame_file_name(f));
     // Every frame's path is checked before the first frame is rendered: the directory accepts new
     // files, and no entry a frame would replace is a directory. Read from the directory's listing,
     // not frame by frame, so a huge range costs nothing here.
-    output::check_writable(&frame_path(range.start))?;
+    output::check_directory(&frame_path(range.start))?;
+    drop(output::create_temp(&frame_path(range.start))?);
     let listing = std::fs::read_dir(dir).map_err(|e| {
         OutputError::BadPath(format!("{}: cannot list the output directory: {e}", dir.display()))
     })?;
     for entry in listing.flatten() {
         let name = entry.file_name();
-        let number =
-            name.to_str().and_then(|n| n.strip_prefix("frame_")?.strip_suffix(".png")?.parse::<u32>().ok());
-        if number.is_some_and(|f| range.contains(&f) && name == frame_path(f).file_name().unwrap_or_default())
-        {
+        if name.to_str().and_then(|n| pattern.frame_of(n)).is_some_and(|f| range.contains(&f)) {
             output::check_directory(&entry.path())?;
         }
     }
@@ -324,15 +441,38 @@ fn export_png_sequence(
         return Ok(ExportOutcome::Cancelled { frames_written: 0 });
     }
     for f in range {
+        let in_frame = |e: ExportError| SequenceError { frame: Some(f), error: e };
         let frame = spec.frame(scene, f);
-        check_frame(scene, backend, &frame, f)?;
-        output::write_png_banded(
-            &frame_path(f),
-            frame.width,
-            frame.height,
-            output::frame_band_rows(&frame),
-            |rows| Ok::<_, ExportError>(backend.render_rows_rgb8(&frame, rows)?),
-        )?;
+        let stamp = options.stamp.as_ref().map(|s| frame_stamp(s, spec, &frame, f, backend.name()));
+        let path = frame_path(f);
+        let keep = match (&stamp, options.skip_existing) {
+            (Some(stamp), true) => {
+                match crate::farm::check_frame_file(&path, stamp, (frame.width, frame.height)) {
+                    OnDisk::Complete => true,
+                    OnDisk::Missing => false,
+                    OnDisk::Replace(why) => {
+                        notes(SequenceNote::Replacing(f, format!("{}: {why}", path.display())));
+                        false
+                    }
+                }
+            }
+            _ => false,
+        };
+        if keep {
+            notes(SequenceNote::Kept(f));
+        } else {
+            check_frame(scene, backend, &frame, f).map_err(in_frame)?;
+            let text = stamp.map(|s| s.text_chunks()).unwrap_or_default();
+            output::write_png_banded_with_text(
+                &path,
+                frame.width,
+                frame.height,
+                output::frame_band_rows(&frame),
+                &text,
+                |rows| Ok::<_, ExportError>(backend.render_rows_rgb8(&frame, rows)?),
+            )
+            .map_err(in_frame)?;
+        }
         done += 1;
         if progress(Progress { done, total }) == Control::Cancel && done < total {
             return Ok(ExportOutcome::Cancelled { frames_written: done });

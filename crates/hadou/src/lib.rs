@@ -13,6 +13,7 @@
 //! ```
 //!
 //! Modules: [`output`] writes images (PNG, EXR), [`export`] animations with progress and cancel,
+//! [`farm`] the frame stamps, names and checks a render farm relies on,
 //! [`bench`](mod@bench) measures the thesis's tables, and `view` is the window of `hadou view`.
 //!
 //! ## Features
@@ -23,6 +24,7 @@
 
 pub mod bench;
 pub mod export;
+pub mod farm;
 pub mod output;
 #[cfg(feature = "view")]
 pub mod view;

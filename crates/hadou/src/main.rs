@@ -21,11 +21,10 @@ enum Command {
     /// Render a scene to a PNG/EXR image, or with --frames a numbered PNG sequence or a GIF.
     Render(RenderArgs),
     /// Check a scene file; exit 0 if valid (listing the animation clips and VRM expressions of its
-    /// glTF objects), 2 with `file:line:col: message` if not.
-    Validate {
-        /// The scene file (TOML).
-        scene: PathBuf,
-    },
+    /// glTF objects), 2 with `file:line:col: message` if not. With --frames DIR, check a rendered
+    /// sequence too: every frame complete, of this scene (or, without SCENE, of one scene), of this
+    /// hadou version and of one set of settings, none missing.
+    Validate(ValidateArgs),
     /// Print, as JSON, each wave's energy, the final colour and the depth at one pixel.
     Probe(ProbeArgs),
     /// Measure rendering speed in the layout of the thesis's tables.
@@ -97,6 +96,42 @@ struct RenderArgs {
     /// Which backend renders.
     #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
     backend: BackendChoice,
+    /// How --frames reports progress: a bar on stderr, `openjd_progress: PERCENT` lines on stdout
+    /// (Open Job Description), or nothing.
+    #[arg(long, value_enum, default_value_t = ProgressChoice::Bar)]
+    progress: ProgressChoice,
+    /// With --frames into a directory: keep the frames already there that are complete and
+    /// stamped with this scene file, hadou version and settings; render the rest, replacing
+    /// anything else at their paths (docs/farm.md).
+    #[arg(long)]
+    skip_existing: bool,
+    /// With --frames into a directory: the frames' file names, one run of `#` for the frame
+    /// number (zero-padded to at least that many digits).
+    #[arg(long, default_value = "frame_#####.png")]
+    frame_name: String,
+}
+
+#[derive(Args, Debug)]
+struct ValidateArgs {
+    /// The scene file (TOML).
+    #[arg(required_unless_present = "frames")]
+    scene: Option<PathBuf>,
+    /// A directory of frames written by `hadou render --frames` to check (docs/farm.md).
+    #[arg(long)]
+    frames: Option<PathBuf>,
+    /// The frames' file names, as given to `hadou render --frame-name`.
+    #[arg(long, default_value = "frame_#####.png")]
+    frame_name: String,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ProgressChoice {
+    /// A progress bar on stderr.
+    Bar,
+    /// `openjd_progress: PERCENT` lines on stdout, as Open Job Description reads them.
+    Openjd,
+    /// Nothing until the summary line.
+    None,
 }
 
 #[derive(Args, Debug)]
@@ -240,11 +275,7 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Render(a) => render(a),
-        Command::Validate { scene } => load_scene(&scene).map(|s| {
-            for line in clip_summary(&s) {
-                println!("{line}");
-            }
-        }),
+        Command::Validate(a) => validate(a),
         Command::Probe(a) => probe(a),
         Command::Bench(a) => bench(a),
         Command::View(a) => view(a),
@@ -264,13 +295,23 @@ fn main() -> ExitCode {
 /// `hadou::export` (every path checked before the first frame), with a progress bar.
 fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Result<(), Failure> {
     use hadou::export::{export_animation, AnimationSpec, Control, ExportError, ExportOutcome};
+    let sequence =
+        hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::PngSequence;
+    let pattern = hadou::farm::FramePattern::parse(&a.frame_name).map_err(Failure::input)?;
+    if !sequence && (a.skip_existing || pattern != hadou::farm::FramePattern::default()) {
+        let flag = if a.skip_existing { "--skip-existing" } else { "--frame-name" };
+        return Err(Failure::input(format!(
+            "{flag}: applies to a PNG sequence (-o DIR/ with --frames), not to {}",
+            a.output.display()
+        )));
+    }
     let spec =
         AnimationSpec { frames: range.clone(), fps, width: a.width, height: a.height, samples: a.samples };
     spec.validate().map_err(|e| Failure::input(e.to_string()))?;
     if hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::Gif {
         output::check_directory(&a.output)?;
     }
-    let scene = load_scene(&a.scene)?;
+    let (scene, stamp) = load_scene_stamped(&a.scene)?;
     let (w, h) = check_image_size(&scene, &a.scene, a.width, a.height)?;
     check_samples_work(&scene, a.samples)?;
     if hadou::export::AnimationFormat::from_path(&a.output)? == hadou::export::AnimationFormat::Gif {
@@ -279,24 +320,86 @@ fn render_animation(a: &RenderArgs, range: std::ops::Range<u32>, fps: f32) -> Re
         })?;
     }
     let mut backend = make_backend(a.backend)?;
-    let bar = indicatif::ProgressBar::new(range.len() as u64);
+    let bar = match a.progress {
+        ProgressChoice::Bar => indicatif::ProgressBar::new(range.len() as u64),
+        ProgressChoice::Openjd | ProgressChoice::None => indicatif::ProgressBar::hidden(),
+    };
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, eta {eta}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let outcome = export_animation(&scene, backend.as_mut(), &spec, &a.output, &mut |p| {
+    let openjd = a.progress == ProgressChoice::Openjd;
+    let mut report = |p: hadou::export::Progress| {
         bar.set_position(u64::from(p.done));
+        if openjd {
+            // Open Job Description reads a task's progress from these stdout lines (a percentage).
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
+            let _ = writeln!(
+                out,
+                "openjd_progress: {:.1}",
+                100.0 * f64::from(p.done) / f64::from(p.total.max(1))
+            );
+            let _ = out.flush();
+        }
         Control::Continue
-    });
+    };
+    let (mut kept, mut replaced) = (0u32, 0u32);
+    let outcome = if sequence {
+        let options =
+            hadou::export::SequenceOptions { pattern, stamp: Some(stamp), skip_existing: a.skip_existing };
+        let mut notes = |n: hadou::export::SequenceNote| match n {
+            hadou::export::SequenceNote::Kept(_) => kept += 1,
+            hadou::export::SequenceNote::Replacing(f, why) => {
+                replaced += 1;
+                bar.suspend(|| {
+                    eprintln!("note: frame {f}: rendering it again: {}", hadou_scene::escape_controls(&why))
+                });
+            }
+        };
+        hadou::export::export_sequence(
+            &scene,
+            backend.as_mut(),
+            &spec,
+            &a.output,
+            &options,
+            &mut report,
+            &mut notes,
+        )
+    } else {
+        export_animation(&scene, backend.as_mut(), &spec, &a.output, &mut report)
+            .map_err(|error| hadou::export::SequenceError { frame: None, error })
+    };
     bar.finish_and_clear();
     match outcome {
         Ok(ExportOutcome::Finished { frames }) | Ok(ExportOutcome::Cancelled { frames_written: frames }) => {
-            eprintln!("wrote {frames} frames to {} ({} backend)", a.output.display(), backend.name());
+            let resumed = if a.skip_existing {
+                format!(", {kept} kept as they were, {replaced} replaced")
+            } else {
+                String::new()
+            };
+            eprintln!(
+                "wrote {} frames to {} ({} backend{resumed})",
+                frames.saturating_sub(kept),
+                a.output.display(),
+                backend.name()
+            );
             Ok(())
         }
-        Err(ExportError::Spec(m)) => Err(Failure::input(m)),
-        Err(ExportError::Output(e)) => Err(e.into()),
-        Err(ExportError::Render(e)) => Err(e.into()),
+        Err(e) => {
+            let at = e.frame.map_or_else(String::new, |f| format!("frame {f}: "));
+            Err(match e.error {
+                ExportError::Spec(m) => Failure::input(format!("{at}{m}")),
+                ExportError::Output(o) => {
+                    let f: Failure = o.into();
+                    Failure { message: format!("{at}{}", f.message), ..f }
+                }
+                ExportError::Render(r) => {
+                    let f: Failure = r.into();
+                    Failure { message: format!("{at}{}", f.message), ..f }
+                }
+            })
+        }
     }
 }
 
@@ -414,6 +517,13 @@ fn flag_error(e: clap::Error) -> ExitCode {
         _ => None,
     };
     let line = match (e.kind(), text(ContextKind::InvalidArg), text(ContextKind::InvalidValue)) {
+        // The missing arguments are on the parser's second line: named here, on the one line.
+        (ErrorKind::MissingRequiredArgument, _, _) => match e.get(ContextKind::InvalidArg) {
+            Some(ContextValue::Strings(missing)) => {
+                format!("missing {}", missing.join(", "))
+            }
+            _ => "a required argument is missing".to_string(),
+        },
         (ErrorKind::InvalidValue | ErrorKind::ValueValidation, Some(arg), Some(value)) => {
             // The argument as clap names it: `--samples <SAMPLES>`; the flag is its first word.
             let flag = arg.split_whitespace().next().unwrap_or(&arg).to_string();
@@ -556,17 +666,23 @@ fn make_timer(choice: BackendChoice) -> Result<(Box<hadou::bench::Timer<'static>
     Ok((Box::new(timer), format!("cpu ({threads} threads)"), "wall clock, whole render".into()))
 }
 
-/// Parses `A..B` (B excluded) or `A..=B`.
+/// Parses `A..B` (B excluded) or `A..=B`, or an Open Job Description range of contiguous frames
+/// (a task chunk's value): `A-B` (B included) or a single frame `N`.
 fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, Failure> {
     let bad = || {
         Failure::input(format!(
-            "--frames {s}: expected a range of non-negative frame numbers like `0..48` (48 excluded) or `0..=47`"
+            "--frames {s}: expected a range of non-negative frame numbers like `0..48` (48 excluded), \
+             `0..=47` or `0-47`"
         ))
     };
     let (a, b, inclusive) = if let Some((a, b)) = s.split_once("..=") {
         (a, b, true)
     } else if let Some((a, b)) = s.split_once("..") {
         (a, b, false)
+    } else if let Some((a, b)) = s.trim().split_once('-').filter(|(a, _)| !a.is_empty()) {
+        (a, b, true)
+    } else if s.trim().bytes().all(|c| c.is_ascii_digit()) && !s.trim().is_empty() {
+        (s, s, true)
     } else {
         return Err(bad());
     };
@@ -589,10 +705,16 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
     // Ctrl-C, SIGTERM and SIGHUP remove the temporary file of an output being written.
     output::install_interrupt_cleanup().map_err(Failure::runtime)?;
     let Some(frames) = &a.frames else {
+        if a.skip_existing {
+            return Err(Failure::input("--skip-existing: applies to a PNG sequence (-o DIR/ with --frames)"));
+        }
+        if a.frame_name != "frame_#####.png" {
+            return Err(Failure::input("--frame-name: applies to a PNG sequence (-o DIR/ with --frames)"));
+        }
         let time = parse_time("--time", &a.time)?;
         output::Format::from_path(&a.output)?;
         output::check_directory(&a.output)?;
-        let scene = load_scene(&a.scene)?;
+        let (scene, stamp) = load_scene_stamped(&a.scene)?;
         check_image_size(&scene, &a.scene, a.width, a.height)?;
         check_samples_work(&scene, a.samples)?;
         let frame = frame_at(&scene, time, a.width, a.height, a.samples);
@@ -604,17 +726,28 @@ fn render(a: RenderArgs) -> Result<(), Failure> {
         // Both formats are rendered and encoded band by band: memory follows the band, not the
         // image.
         let (w, h, band_rows) = (frame.width, frame.height, output::frame_band_rows(&frame));
+        // The image's stamp (docs/farm.md): the scene file's hash, the version, the settings.
+        let stamp = hadou::farm::FrameStamp {
+            scene: stamp,
+            frame: None,
+            settings: hadou::farm::frame_settings(&frame, &format!("t={} s", a.time.trim()), backend.name()),
+        }
+        .text_chunks();
         match output::Format::from_path(&a.output)? {
             // A PNG's bands come as 8-bit sRGB straight from the renderer (the CPU backend's colour
             // stage writes no float buffers for them).
-            output::Format::Png => output::write_png_banded(&a.output, w, h, band_rows, |rows| {
-                Ok::<_, Failure>(backend.render_rows_rgb8(&frame, rows)?)
-            })?,
-            output::Format::Exr => output::write_banded(&a.output, w, h, band_rows, |rows| {
-                let band = backend.render_rows(&frame, rows)?;
-                check_finite(&band)?;
-                Ok::<_, Failure>(band)
-            })?,
+            output::Format::Png => {
+                output::write_png_banded_with_text(&a.output, w, h, band_rows, &stamp, |rows| {
+                    Ok::<_, Failure>(backend.render_rows_rgb8(&frame, rows)?)
+                })?
+            }
+            output::Format::Exr => {
+                output::write_banded_with_text(&a.output, w, h, band_rows, &stamp, |rows| {
+                    let band = backend.render_rows(&frame, rows)?;
+                    check_finite(&band)?;
+                    Ok::<_, Failure>(band)
+                })?
+            }
         }
         eprintln!(
             "wrote {} ({}×{}, {} backend)",
@@ -855,6 +988,60 @@ fn bench(a: BenchArgs) -> Result<(), Failure> {
         println!("{}", serde_json::to_string_pretty(&json).unwrap_or_default());
     }
     Ok(())
+}
+
+/// [`load_scene`], with the stamp its frames carry: the hash of the very bytes parsed.
+fn load_scene_stamped(path: &std::path::Path) -> Result<(Scene, hadou::farm::SceneStamp), Failure> {
+    let text = Scene::read_text(path)?;
+    let scene = Scene::parse(&text, path)?;
+    for w in scene.warnings() {
+        eprintln!("{}: warning: {w}", hadou_scene::escape_controls(&path.display().to_string()));
+    }
+    Ok((scene, hadou::farm::SceneStamp::of_text(&text)))
+}
+
+/// `hadou validate [SCENE] [--frames DIR]`: the scene (its clips listed), then the frames.
+fn validate(a: ValidateArgs) -> Result<(), Failure> {
+    let pattern = hadou::farm::FramePattern::parse(&a.frame_name).map_err(Failure::input)?;
+    let stamp = match &a.scene {
+        Some(path) => {
+            let (scene, stamp) = load_scene_stamped(path)?;
+            for line in clip_summary(&scene) {
+                println!("{line}");
+            }
+            Some(stamp)
+        }
+        None => None,
+    };
+    let Some(dir) = &a.frames else { return Ok(()) };
+    let report = hadou::farm::check_frames_dir(dir, &pattern, stamp.as_ref()).map_err(Failure::input)?;
+    let esc = |p: &std::path::Path| hadou_scene::escape_controls(&p.display().to_string()).into_owned();
+    for p in &report.problems {
+        println!("{}: {}", esc(&p.path), hadou_scene::escape_controls(&p.message));
+    }
+    let (lo, hi) = (report.frames.keys().next().copied(), report.frames.keys().last().copied());
+    let range = match (lo, hi) {
+        (Some(lo), Some(hi)) => format!("frames {lo}..={hi}"),
+        _ => "no frames".into(),
+    };
+    if report.problems.is_empty() {
+        let first = report.frames.values().flatten().next();
+        println!(
+            "{}: {} frames ({range}), all complete, of scene blake3 {}…, hadou {}",
+            esc(dir),
+            report.frames.len(),
+            first.map_or("", |s| s.scene.short_hash()),
+            hadou::farm::VERSION
+        );
+        Ok(())
+    } else {
+        Err(Failure::input(format!(
+            "{}: {} problem(s) in {} frames ({range}), listed above",
+            esc(dir),
+            report.problems.len(),
+            report.frames.len()
+        )))
+    }
 }
 
 /// Loads a scene and prints its warnings (downscaled textures, meshes without texture

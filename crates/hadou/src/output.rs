@@ -106,10 +106,23 @@ pub fn write_banded<E: From<OutputError>>(
     rows_per_band: u32,
     band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
+    write_banded_with_text(path, width, height, rows_per_band, &[], band)
+}
+
+/// [`write_banded`] with `text` in the file's metadata: PNG `tEXt` chunks or EXR header text
+/// attributes ([`write_png_banded_with_text`], [`write_exr_banded_with_text`]).
+pub fn write_banded_with_text<E: From<OutputError>>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rows_per_band: u32,
+    text: &[(String, String)],
+    band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+) -> Result<(), E> {
     match Format::from_path(path)? {
         Format::Png => {
             let mut band = band;
-            write_png_banded(path, width, height, rows_per_band, |rows| {
+            write_png_banded_with_text(path, width, height, rows_per_band, text, |rows| {
                 let image = band(rows)?;
                 Rgb8Image::from_image(&image).ok_or_else(|| {
                     E::from(OutputError::Io(format!(
@@ -119,7 +132,7 @@ pub fn write_banded<E: From<OutputError>>(
                 })
             })
         }
-        Format::Exr => write_exr_banded(path, width, height, rows_per_band, band),
+        Format::Exr => write_exr_banded_with_text(path, width, height, rows_per_band, text, band),
     }
 }
 
@@ -314,6 +327,19 @@ pub fn write_png_banded<E: From<OutputError>>(
     width: u32,
     height: u32,
     rows_per_band: u32,
+    band: impl FnMut(std::ops::Range<u32>) -> Result<Rgb8Image, E>,
+) -> Result<(), E> {
+    write_png_banded_with_text(path, width, height, rows_per_band, &[], band)
+}
+
+/// [`write_png_banded`] with `text` written as `tEXt` chunks (keyword, Latin-1 text) before the
+/// image data: the frame stamp of [`crate::farm::FrameStamp::text_chunks`].
+pub fn write_png_banded_with_text<E: From<OutputError>>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rows_per_band: u32,
+    text: &[(String, String)],
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Rgb8Image, E>,
 ) -> Result<(), E> {
     let (tmp, file) = begin_banded(path)?;
@@ -324,6 +350,9 @@ pub fn write_png_banded<E: From<OutputError>>(
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     // fdeflate's PNG-tuned compressor: several times faster than the default level.
     enc.set_compression(png::Compression::Fast);
+    for (keyword, value) in text {
+        enc.add_text_chunk(keyword.clone(), value.clone()).map_err(|e| io(e.to_string()))?;
+    }
     let mut w = enc.write_header().map_err(|e| io(e.to_string()))?;
     {
         let mut stream = w.stream_writer().map_err(|e| io(e.to_string()))?;
@@ -367,6 +396,24 @@ pub fn write_exr_banded<E: From<OutputError>>(
     width: u32,
     height: u32,
     rows_per_band: u32,
+    band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
+) -> Result<(), E> {
+    write_exr_banded_with_text(path, width, height, rows_per_band, &[], band)
+}
+
+/// The EXR header's text attribute that holds [`write_exr_banded_with_text`]'s pairs, one
+/// `KEY=VALUE` a line.
+pub const EXR_TEXT_ATTRIBUTE: &str = "hadou";
+
+/// [`write_exr_banded`] with `text` written into the layer's header: one text attribute,
+/// [`EXR_TEXT_ATTRIBUTE`], of `KEY=VALUE` lines (the frame stamp of
+/// [`crate::farm::FrameStamp::text_chunks`]).
+pub fn write_exr_banded_with_text<E: From<OutputError>>(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rows_per_band: u32,
+    text: &[(String, String)],
     mut band: impl FnMut(std::ops::Range<u32>) -> Result<Image, E>,
 ) -> Result<(), E> {
     use exr::block::writer::ChunksWriter;
@@ -378,11 +425,22 @@ pub fn write_exr_banded<E: From<OutputError>>(
     let (tmp, file) = begin_banded(path)?;
     let io = |e: String| write_failed(path, e);
     let channels = EXR_CHANNELS.iter().map(|&(n, _)| ChannelDescription::named(n, SampleType::F32)).collect();
-    let header = Header::new("hadou".into(), (width as usize, height as usize), channels).with_encoding(
+    let mut header = Header::new("hadou".into(), (width as usize, height as usize), channels).with_encoding(
         Compression::RLE,
         BlockDescription::ScanLines,
         LineOrder::Increasing,
     );
+    // One attribute holding every pair: the header's attributes are a hash map, written in an
+    // order that changes from run to run, and the same frame must be the same bytes.
+    if !text.is_empty() {
+        let joined: Vec<String> = text.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        header.own_attributes.other.insert(
+            exr::meta::attribute::Text::from(EXR_TEXT_ATTRIBUTE),
+            exr::meta::attribute::AttributeValue::Text(exr::meta::attribute::Text::from(
+                joined.join("\n").as_str(),
+            )),
+        );
+    }
     // RLE compresses one scan line per block, so block `y` is line `y`.
     debug_assert_eq!(header.compression.scan_lines_per_block(), 1);
     // An error of `band` (or a band of the wrong size) stops the writer; it is kept here.

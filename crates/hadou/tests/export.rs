@@ -5,9 +5,10 @@ mod common;
 
 use common::Scratch;
 use hadou::export::{
-    export_animation, frame_file_name, gif_delay_cs, AnimationFormat, AnimationSpec, Control, ExportError,
-    ExportOutcome, Progress,
+    export_animation, export_sequence, frame_file_name, gif_delay_cs, AnimationFormat, AnimationSpec,
+    Control, ExportError, ExportOutcome, Progress, SequenceOptions,
 };
+use hadou::farm::SceneStamp;
 use hadou::output::{self, OutputError};
 use hadou::{Backend, CpuBackend, Scene};
 use std::path::{Path, PathBuf};
@@ -141,12 +142,31 @@ fn a_png_sequence_is_what_hadou_render_writes() {
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(listing(&cli), listing(&out));
+    // The CLI stamps its frames (docs/farm.md); `export_sequence` with the same stamp writes its
+    // files byte for byte, and the pixels are `export_animation`'s.
+    let stamped = dir.join("stamped");
+    std::fs::create_dir(&stamped).unwrap();
+    let options = SequenceOptions {
+        stamp: Some(SceneStamp::of_text(&std::fs::read_to_string(SCENE).unwrap())),
+        ..SequenceOptions::default()
+    };
+    export_sequence(
+        &scene,
+        &mut CpuBackend::new(),
+        &spec,
+        &stamped,
+        &options,
+        &mut |_| Control::Continue,
+        &mut |_| {},
+    )
+    .unwrap();
     for name in listing(&out) {
         assert_eq!(
             std::fs::read(cli.join(&name)).unwrap(),
-            std::fs::read(out.join(&name)).unwrap(),
+            std::fs::read(stamped.join(&name)).unwrap(),
             "{name}"
         );
+        assert_eq!(common::decode_png(&cli.join(&name)), common::decode_png(&out.join(&name)), "{name}");
     }
 }
 
