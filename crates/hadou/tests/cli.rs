@@ -1011,6 +1011,86 @@ fn bench_shadows_prints_every_method_with_its_error() {
     let err = |m: &str| rows.iter().find(|r| r["method"] == m).unwrap()["mean_error"].as_f64().unwrap();
     assert_eq!(err("exact-linear"), err("faithful-n1"));
     assert_ne!(err("exact"), err("exact-linear"));
+    // The traced rows, each against its own lamp's brute-force reference (issue 43's bounds), the
+    // two maps against the same references, the references' own rows, the traced frames.
+    for shape in ["segment", "disc", "sphere"] {
+        let row = |m: String| rows.iter().find(|r| r["method"] == m.as_str()).cloned();
+        let t = row(format!("traced-{shape}")).unwrap_or_else(|| panic!("no traced-{shape} row: {j}"));
+        assert!(t["ms"].as_f64().is_some_and(|v| v > 0.0), "{t}");
+        assert!(t["pixels"].as_u64().is_some_and(|n| n > 0), "{t}");
+        assert!(t["mean_error"].as_f64().is_some_and(|v| v <= 0.02), "{t}");
+        assert!(t["p99_error"].as_f64().is_some_and(|v| v <= 0.08), "{t}");
+        let e = row(format!("exact-vs-{shape}")).unwrap_or_else(|| panic!("no exact-vs-{shape} row"));
+        assert!(e["mean_error"].as_f64().is_some_and(|v| v > t["mean_error"].as_f64().unwrap()), "{e}");
+        assert!(
+            row(format!("reference-{shape}")).is_some_and(|r| r["pixels"].as_u64().is_some_and(|n| n > 0))
+        );
+        assert!(
+            row(format!("frame-traced-{shape}")).is_some_and(|r| r["ms"].as_f64().is_some_and(|v| v > 0.0))
+        );
+    }
+    // --traced-only drops the two-map rows; --scene picks the scene; both are shadows-only.
+    let o = hadou(&[
+        "bench",
+        "shadows",
+        "--sizes",
+        "32",
+        "--iterations",
+        "1",
+        "--json",
+        "--backend",
+        "cpu",
+        "--traced-only",
+        "--scene",
+        "soft-overlap.toml",
+        "--scenes",
+        scenes.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
+    assert_eq!(j["scene"], "soft-overlap.toml");
+    let rows = j["rows"].as_array().expect("rows");
+    assert!(rows.iter().any(|r| r["method"] == "traced-disc") && !rows.iter().any(|r| r["method"] == "pcss"));
+    assert_exit_2(
+        &["bench", "analytic", "--traced-only"],
+        &["--traced-only: applies to `hadou bench shadows` only"],
+    );
+    assert_exit_2(
+        &["bench", "toon", "--scene", "x.toml"],
+        &["--scene x.toml: applies to `hadou bench shadows` only"],
+    );
+}
+
+/// A traced frame renders on the CPU backend, and the GPU backend (until it draws the traced
+/// resolve) refuses it with a message rather than drawing something else.
+#[test]
+fn a_traced_area_light_renders_on_the_cpu_and_is_refused_by_the_gpu() {
+    let dir = tmpdir("traced");
+    let light = "\n[[object]]\nname = \"floor\"\nkind = \"plane\"\nsize = [80.0, 80.0]\nposition = [0.0, -3.0, -20.0]\n\n[area_light]\nposition = [0.0, 20.0, -20.0]\nsize = 1.0\ntarget = \"cube\"\nshape = \"disc\"\nresolve = \"traced\"\nsamples = 64\n";
+    let s = write_scene(&dir, &format!("{GOOD}{light}"));
+    let out = dir.join("o.png");
+    let o = hadou(&["render", s.to_str().unwrap(), "-o", out.to_str().unwrap(), "--backend", "cpu"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+    let gpu = dir.join("g.png");
+    let o = hadou(&["render", s.to_str().unwrap(), "-o", gpu.to_str().unwrap(), "--backend", "gpu"]);
+    let e = stderr(&o);
+    if e.contains("no usable device") {
+        eprintln!("no GPU adapter: the refusal is not checked here");
+        return;
+    }
+    assert!(
+        !o.status.success() && e.contains("resolve = \"traced\" is not drawn by the GPU backend yet"),
+        "{e}"
+    );
+    assert!(!gpu.exists());
+    // A bad sample count is an input error at its position.
+    let bad = write_scene(&dir, &format!("{GOOD}{light}").replace("samples = 64", "samples = 0"));
+    let line = format!("{GOOD}{light}").lines().position(|l| l == "samples = 64").unwrap() + 1;
+    assert_exit_2(
+        &["render", bad.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        &[&format!(":{line}:11:"), "1..=1024, got 0"],
+    );
 }
 
 #[test]
