@@ -186,7 +186,7 @@ fn a_traced_frame_renders_finite() {
 /// load, render finite at two times, and have a soft shadow true to their lamp.
 #[test]
 fn the_traced_example_scenes_render_true_to_their_lamp() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     for (name, shape) in [("soft-disc.toml", LampShape::Disc), ("soft-sphere.toml", LampShape::Sphere)] {
         let s = Scene::load(dir.join(name)).unwrap_or_else(|e| panic!("{e}"));
         for t in [0.0, 1.5] {

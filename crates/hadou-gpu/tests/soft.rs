@@ -70,7 +70,11 @@ fn soft_shadows_match_cpu() {
     // tests compare the anti-aliased frames' colours).
     for (label, mut frame) in example_frames(|name| name.starts_with("soft-")) {
         frame.samples = 1;
-        check(&mut gpu, &label, &frame);
+        // A traced scene's own resolve draws no maps (traced_resolve_matches_cpu holds it); its
+        // maps' resolves are checked below.
+        if !matches!(frame.area_light.as_ref().map(|l| l.resolve), Some(SoftResolve::Traced { .. })) {
+            check(&mut gpu, &label, &frame);
+        }
         let mut faithful = frame.clone();
         faithful.area_light.as_mut().expect("an area light").resolve = SoftResolve::Faithful { n: 3 };
         check(&mut gpu, &format!("{label} faithful n=3"), &faithful);
@@ -127,7 +131,6 @@ const TRACED_STEP: f32 = 0.01;
 fn traced_resolve_matches_cpu() {
     let Some(mut gpu) = gpu_or_skip("traced soft shadows") else { return };
     let scenes = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/../hadou-cpu/tests/data/");
     let load = |path: String, t: f32| {
         let mut f = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}")).at(t);
         (f.width, f.height, f.samples) = (128, 96, 1);
@@ -148,7 +151,7 @@ fn traced_resolve_matches_cpu() {
         }
     }
     for name in ["soft-disc.toml", "soft-sphere.toml"] {
-        frames.push((name.to_string(), load(format!("{data}{name}"), 1.0)));
+        frames.push((name.to_string(), load(format!("{scenes}{name}"), 1.0)));
     }
     let mut partly = 0;
     for (label, frame) in &frames {
