@@ -24,6 +24,21 @@ const COLOR_SHARE: f64 = 0.01;
 /// Largest share of same-class pixels whose visibility may differ.
 const VIS_SHARE: f64 = 0.01;
 
+/// The pixels of `g` whose colour differs from `c`'s by more than `COLOR_ABS` in a channel (or is
+/// NaN).
+fn colours_beyond(g: &hadou_scene::Image, c: &hadou_scene::Image) -> usize {
+    g.color
+        .iter()
+        .zip(&c.color)
+        .filter(|(g, c)| {
+            (0..4).any(|k| {
+                let d = (g[k] - c[k]).abs();
+                d.is_nan() || d > COLOR_ABS
+            })
+        })
+        .count()
+}
+
 fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
     let (g, soft) = gpu.render_soft(frame).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
     let (g_class, g_vis) = soft.expect("an area light");
@@ -40,14 +55,7 @@ fn check(gpu: &mut hadou_gpu::GpuBackend, label: &str, frame: &Frame) {
     let same: Vec<usize> = (0..n).filter(|&i| g_class[i] == c_class[i] as u8).collect();
     let vis_diff = same.iter().filter(|&&i| g_vis[i] != c_vis[i]).count();
     let max_vis = same.iter().map(|&i| (g_vis[i] - c_vis[i]).abs()).fold(0.0f32, f32::max);
-    let color_bad = (0..n)
-        .filter(|&i| {
-            (0..4).any(|k| {
-                let d = (g.color[i][k] - c.color[i][k]).abs();
-                d.is_nan() || d > COLOR_ABS
-            })
-        })
-        .count();
+    let color_bad = colours_beyond(&g, &c);
     assert!(g.color.iter().flatten().all(|v| v.is_finite()), "{label}: non-finite colour");
     let penumbra = c_class.iter().filter(|&&k| k as u8 == 2).count();
     eprintln!(
@@ -168,14 +176,7 @@ fn traced_resolve_matches_cpu() {
         let max = lit.iter().map(|&i| (g_vis[i] - c_vis[i]).abs()).fold(0.0f32, f32::max);
         partly += lit.iter().filter(|&&i| c_vis[i] > 0.005 && c_vis[i] < 0.995).count();
         let n = g.color.len();
-        let color_bad = (0..n)
-            .filter(|&i| {
-                (0..4).any(|k| {
-                    let d = (g.color[i][k] - c.color[i][k]).abs();
-                    d.is_nan() || d > COLOR_ABS
-                })
-            })
-            .count();
+        let color_bad = colours_beyond(&g, &c);
         eprintln!(
             "{label}: {off} of {} lit pixels off (max {max}), {color_bad} colours beyond {COLOR_ABS}",
             lit.len()
