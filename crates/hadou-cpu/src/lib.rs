@@ -25,6 +25,7 @@ mod shadows;
 pub mod soft;
 pub mod traced;
 mod waves;
+mod winding;
 
 pub use probe::{probe, Probe, WaveProbe};
 pub use render::{render, render_rows, render_rows_glare_chunked, render_timed, CpuBackend, PassTimes};

@@ -8,11 +8,11 @@
 //!    from one of them to the lamp (inside the ball of radius `l` around `L`) lies in the tapered
 //!    capsule between the two balls ([`capsule_hits`]). The hierarchy is walked once per tile
 //!    with that capsule, a triangle whose plane leaves both balls on one side
-//!    ([`BvhTri::one_side`]) dropped: no triangle kept, and every pixel of the tile sees the whole
+//!    ([`hadou_math::soft::BvhTri::one_side`]) dropped: no triangle kept, and every pixel of the tile sees the whole
 //!    lamp without a single ray (most of the image); up to [`TILE_TRIS`], and each pixel tests
 //!    only those; more, and each pixel walks the hierarchy itself (a node counts when it meets the
 //!    pixel's capsule and its box's projection meets the lamp, [`LampFrame::box_may_hide`]).
-//! 2. **Pixels.** A pixel's own capsule (radius 0 at its point) and [`BvhTri::one_side`] pick the
+//! 2. **Pixels.** A pixel's own capsule (radius 0 at its point) and [`hadou_math::soft::BvhTri::one_side`] pick the
 //!    triangles that can hide part of its lamp; each sets the samples it hides in the pixel's mask
 //!    ([`hadou_math::soft::occlude`]: clipped, projected onto the lamp's plane, each row of samples
 //!    solved exactly); the walk stops once every sample is hidden (umbra). The visibility is the
@@ -26,9 +26,10 @@
 //! sample ray against every caster triangle, no hierarchy.
 
 use crate::opaque::SoftPoint;
+use crate::winding::TileCasters;
 use hadou_math::soft::{
-    capsule_hits, lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, Bvh, BvhTri, LampFrame,
-    LampPattern, LampShape, MASK_WORDS, TRACE_BIAS, T_MIN,
+    capsule_hits, lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, segment_triangle_distance,
+    Bvh, BvhTri, LampFrame, LampPattern, LampShape, Topology, MASK_WORDS, TRACE_BIAS, T_MIN,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame};
@@ -37,7 +38,9 @@ use rayon::prelude::*;
 /// Edge of a tile of pixels that walks the hierarchy once for all its pixels.
 pub const TILE: usize = 8;
 /// Most triangles a tile keeps for its pixels (more: each pixel walks the hierarchy).
-pub const TILE_TRIS: usize = 128;
+pub const TILE_TRIS: usize = 4096;
+/// The same for the segment lamp, whose pixels test the triangles one by one.
+pub const SEGMENT_TILE_TRIS: usize = 128;
 
 /// The world-space triangles of the objects `casters` of `frame` (what the two maps draw,
 /// [`crate::soft::SpotDepth::render`]): [`hadou_scene::caster_triangles`], which the GPU backend
@@ -87,7 +90,7 @@ impl Lamp {
     }
 }
 
-/// A triangle with its bounding ball, for the per-pixel tests.
+/// A triangle with its bounding ball, for the segment's per-pixel tests.
 #[derive(Clone, Copy)]
 struct Cand {
     tri: BvhTri,
@@ -135,10 +138,14 @@ pub fn traced_with(
     if w == 0 || h == 0 {
         return out;
     }
+    let topo = Topology::of(bvh);
     out.par_chunks_mut(w * TILE).enumerate().for_each(|(ty, band)| {
         let y0 = ty * TILE;
         let rows = band.len() / w;
-        let mut cands: Vec<Cand> = Vec::with_capacity(TILE_TRIS);
+        let mut ids: Vec<u32> = Vec::with_capacity(TILE_TRIS);
+        let mut casters = TileCasters::default();
+        let mut cands: Vec<Cand> = Vec::new();
+        let cap = if lamp.shape == LampShape::Segment { SEGMENT_TILE_TRIS } else { TILE_TRIS };
         for x0 in (0..w).step_by(TILE) {
             let x1 = (x0 + TILE).min(w);
             // The tile's receivers and their ball.
@@ -158,25 +165,37 @@ pub fn traced_with(
                 continue;
             }
             let (tc, tr) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
-            cands.clear();
+            ids.clear();
             let mut overflow = false;
             bvh.walk(
                 |node| {
                     let (c, r) = node.ball();
                     capsule_hits(tc, tr, lamp.centre, lamp.size, c, r)
                 },
-                |t| {
-                    if t.one_side(tc, tr, lamp.centre, lamp.size) {
+                |i, t| {
+                    // Outside the straight capsule of the larger radius around the axis from the
+                    // tile's centre to `L`, which holds the tapered one.
+                    if t.one_side(tc, tr, lamp.centre, lamp.size)
+                        || segment_triangle_distance(tc, lamp.centre, &t.corners()) > tr.max(lamp.size)
+                    {
                         return true;
                     }
-                    if cands.len() == TILE_TRIS {
+                    if ids.len() == cap {
                         overflow = true;
                         return false;
                     }
-                    cands.push(Cand::new(t));
+                    ids.push(i as u32);
                     true
                 },
             );
+            if !ids.is_empty() && !overflow {
+                if lamp.shape == LampShape::Segment {
+                    cands.clear();
+                    cands.extend(ids.iter().map(|&i| Cand::new(&bvh.tris[i as usize])));
+                } else {
+                    casters.set(bvh, &topo, &ids, tc, tr);
+                }
+            }
             for y in y0..y0 + rows {
                 for x in x0..x1 {
                     let Some(p) = points[y * w + x] else { continue };
@@ -185,12 +204,23 @@ pub fn traced_with(
                         *o = 0.0;
                         continue;
                     }
-                    if cands.is_empty() && !overflow {
+                    if ids.is_empty() && !overflow {
                         *o = 1.0;
                         continue;
                     }
                     let r = receiver(p.world, p.normal, lamp.centre);
-                    *o = pixel(bvh, (!overflow).then_some(&cands[..]), &lamp, &pat, r, x as u32, y as u32);
+                    *o = if overflow {
+                        pixel(bvh, &lamp, &pat, r, x as u32, y as u32)
+                    } else {
+                        let o = pixel_offset(x as u32, y as u32);
+                        match lamp.frame(r) {
+                            Some(f) if lamp.shape == LampShape::Segment => {
+                                by_triangles(&cands, &f, &pat, o, &lamp)
+                            }
+                            Some(f) => casters.visibility(bvh, &f, &pat, o, lamp.centre, lamp.size),
+                            None => 1.0,
+                        }
+                    };
                 }
             }
         }
@@ -204,50 +234,55 @@ fn lit_at_all(term: [f32; 3]) -> bool {
     term.iter().any(|&t| t > 0.0)
 }
 
-/// One pixel's visibility from the receiver `r` at global pixel `(x, y)`: the triangles `cands`
-/// (the tile's) or, without them, a walk of the hierarchy.
-fn pixel(bvh: &Bvh, cands: Option<&[Cand]>, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32) -> f32 {
+/// One pixel's visibility from its lamp frame `f` by the tile's candidates one by one
+/// ([`occlude`] each, in the mask), stopping once every sample is hidden: what the segment lamp
+/// uses, whose plane runs through the casters its axis points at (so that most of them reach
+/// past it and are clipped whatever the method) and whose single row makes each triangle cheap.
+fn by_triangles(cands: &[Cand], f: &LampFrame, pat: &LampPattern, o: f32, lamp: &Lamp) -> f32 {
+    let r = f.origin;
+    let mut mask = [0u32; MASK_WORDS];
+    for c in cands {
+        if !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
+            && capsule_hits(r, 0.0, lamp.centre, lamp.size, c.centre, c.radius)
+        {
+            occlude(f, pat, o, &c.corners, &mut mask);
+            if mask_full(&mask, pat) {
+                return 0.0;
+            }
+        }
+    }
+    mask_visibility(&mask, pat)
+}
+
+/// One pixel's visibility from the receiver `r` at global pixel `(x, y)` by a walk of the
+/// whole hierarchy (a tile with more than [`TILE_TRIS`] candidates), triangle by triangle.
+fn pixel(bvh: &Bvh, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32) -> f32 {
     let Some(f) = lamp.frame(r) else { return 1.0 };
     let o = pixel_offset(x, y);
     let mut mask = [0u32; MASK_WORDS];
-    let hit = |tri: &[Vec3f; 3], mask: &mut [u32; MASK_WORDS]| -> bool {
-        occlude(&f, pat, o, tri, mask);
-        !mask_full(mask, pat)
-    };
-    match cands {
-        Some(cands) => {
-            for c in cands {
-                if !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
-                    && capsule_hits(r, 0.0, lamp.centre, lamp.size, c.centre, c.radius)
-                    && !hit(&c.corners, &mut mask)
-                {
-                    break;
-                }
-            }
+    // `Bvh::walk`, with a node test that reads the mask the leaves write.
+    let mut i = 0usize;
+    while i < bvh.nodes.len() {
+        let node = &bvh.nodes[i];
+        let (c, rc) = node.ball();
+        if !(capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
+            && f.box_may_hide(node.lo, node.hi, pat, o, &mask))
+        {
+            i = node.skip as usize;
+            continue;
         }
-        None => {
-            // `Bvh::walk`, with a node test that reads the mask the leaves write.
-            let mut i = 0usize;
-            while i < bvh.nodes.len() {
-                let node = &bvh.nodes[i];
-                let (c, rc) = node.ball();
-                if !(capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
-                    && f.box_may_hide(node.lo, node.hi, pat, o, &mask))
-                {
-                    i = node.skip as usize;
-                    continue;
-                }
-                match node.leaf() {
-                    None => i += 1,
-                    Some(range) => {
-                        for t in &bvh.tris[range] {
-                            if !t.one_side(r, 0.0, lamp.centre, lamp.size) && !hit(&t.corners(), &mut mask) {
-                                return 0.0;
-                            }
+        match node.leaf() {
+            None => i += 1,
+            Some(range) => {
+                for t in &bvh.tris[range] {
+                    if !t.one_side(r, 0.0, lamp.centre, lamp.size) {
+                        occlude(&f, pat, o, &t.corners(), &mut mask);
+                        if mask_full(&mask, pat) {
+                            return 0.0;
                         }
-                        i = node.skip as usize;
                     }
                 }
+                i = node.skip as usize;
             }
         }
     }

@@ -207,3 +207,42 @@ fn the_traced_example_scenes_render_true_to_their_lamp() {
         }
     }
 }
+
+/// The outline count of the tiles (`hadou_cpu::traced`'s module notes) gives every receiver the
+/// visibility the triangles give one by one ([`occlude`] over the whole hierarchy), on the plaster
+/// cast (a figure of many pieces and a wall: closed and open parts, triangles reaching past the
+/// lamp's plane) for each lamp shape: within one sample a row, and equal at nearly every receiver.
+#[test]
+fn the_outline_count_equals_the_triangles_one_by_one() {
+    use hadou_cpu::traced::{receiver, traced_with, Lamp};
+    use hadou_math::soft::{mask_visibility, occlude, pixel_offset, Bvh, LampPattern, MASK_WORDS};
+    let frame = example("soft-plaster.toml", 1.5, 96);
+    for shape in SHAPES {
+        let (f, light) = with_shape(&frame, shape);
+        let input = soft_input(&f).expect("an area light");
+        let bvh = Bvh::build(&hadou_scene::caster_triangles(&f, &light.casters));
+        let got = traced_with(&bvh, &light, &input.points, input.width, 256);
+        let (lamp, pat) = (Lamp::of(&light), LampPattern::new(shape, 256));
+        let (mut off, mut differ, mut n) = (0, 0, 0);
+        for (i, p) in input.points.iter().enumerate() {
+            let Some(p) = p.filter(|p| p.term.iter().any(|&t| t > 0.0)) else { continue };
+            let r = receiver(p.world, p.normal, lamp.centre);
+            let Some(fr) = lamp.frame(r) else { continue };
+            let o = pixel_offset((i % input.width) as u32, (i / input.width) as u32);
+            let mut mask = [0u32; MASK_WORDS];
+            for t in &bvh.tris {
+                occlude(&fr, &pat, o, &t.corners(), &mut mask);
+            }
+            let want = mask_visibility(&mask, &pat);
+            n += 1;
+            differ += usize::from(got[i] != want);
+            if (got[i] - want).abs() > pat.rows as f32 / 256.0 + 1e-6 {
+                off += 1;
+                eprintln!("{shape:?} pixel {i}: outline {} triangles {want}", got[i]);
+            }
+        }
+        eprintln!("{shape:?}: {n} receivers, {differ} differ, {off} by more than a sample a row");
+        assert_eq!(off, 0, "{shape:?}");
+        assert!(differ * 200 <= n, "{shape:?}: {differ} of {n} differ");
+    }
+}

@@ -213,10 +213,11 @@ impl Bvh {
         self.nodes.len() as u64 * BVH_NODE_BYTES + self.tris.len() as u64 * BVH_TRI_BYTES
     }
 
-    /// The stackless walk: calls `leaf(tri)` for every triangle of every leaf that `hits`, every
-    /// ancestor hitting too, in pre-order; `leaf` returns `false` to stop the walk early.
+    /// The stackless walk: calls `leaf(index, tri)` for every triangle of every leaf that `hits`,
+    /// every ancestor hitting too, in pre-order (so in increasing `index`); `leaf` returns `false`
+    /// to stop the walk early.
     #[inline]
-    pub fn walk(&self, mut hits: impl FnMut(&BvhNode) -> bool, mut leaf: impl FnMut(&BvhTri) -> bool) {
+    pub fn walk(&self, mut hits: impl FnMut(&BvhNode) -> bool, mut leaf: impl FnMut(usize, &BvhTri) -> bool) {
         let mut i = 0usize;
         while i < self.nodes.len() {
             let node = &self.nodes[i];
@@ -227,8 +228,8 @@ impl Bvh {
             match node.leaf() {
                 None => i += 1,
                 Some(range) => {
-                    for t in &self.tris[range] {
-                        if !leaf(t) {
+                    for t in range {
+                        if !leaf(t, &self.tris[t]) {
                             return;
                         }
                     }
@@ -266,6 +267,97 @@ pub fn capsule_hits(a: Vec3f, ra: f32, b: Vec3f, rb: f32, c: Vec3f, rc: f32) -> 
     let t = (along / dl + rp * h / (dl * ((dl - rp) * (dl + rp)).sqrt())).clamp(0.0, 1.0);
     let f = (x - d * t).length() - ra - t * rp;
     f.is_nan() || rc.is_nan() || f <= rc
+}
+
+/// The closest point of the triangle `t` to `p` (Ericson, *Real-Time Collision Detection* §5.1.5:
+/// the Voronoi regions of the corners, edges and face in turn).
+#[inline]
+pub fn closest_on_triangle(p: Vec3f, t: &[Vec3f; 3]) -> Vec3f {
+    let [a, b, c] = *t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// The least distance between the segments `p₁q₁` and `p₂q₂` (Ericson §5.1.9, degenerate
+/// segments included).
+#[inline]
+pub fn segment_distance(p1: Vec3f, q1: Vec3f, p2: Vec3f, q2: Vec3f) -> f32 {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.dot(d1), d2.dot(d2), d2.dot(r));
+    let eps = 1e-12;
+    let (s, t) = if a <= eps && e <= eps {
+        (0.0, 0.0)
+    } else if a <= eps {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(r);
+        if e <= eps {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > 0.0 { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    ((p1 + d1 * s) - (p2 + d2 * t)).length()
+}
+
+/// The least distance between the segment `pq` and the triangle `t` (0 where they cross): the
+/// smaller of the ends' distances to the triangle and the segment's to its three edges, unless
+/// the segment pierces the face. NaN where an input is (callers count that as near).
+#[inline]
+pub fn segment_triangle_distance(p: Vec3f, q: Vec3f, t: &[Vec3f; 3]) -> f32 {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    let (dp, dq) = (n.dot(p - t[0]), n.dot(q - t[0]));
+    if (dp <= 0.0) != (dq <= 0.0) {
+        // The segment crosses the plane: inside the triangle there?
+        let x = p + (q - p) * (dp / (dp - dq));
+        let inside = (0..3).all(|k| n.dot((t[(k + 1) % 3] - t[k]).cross(x - t[k])) >= 0.0);
+        if inside {
+            return 0.0;
+        }
+    }
+    let mut d = (closest_on_triangle(p, t) - p).length().min((closest_on_triangle(q, t) - q).length());
+    for k in 0..3 {
+        d = d.min(segment_distance(p, q, t[k], t[(k + 1) % 3]));
+    }
+    d
 }
 
 #[cfg(test)]
@@ -374,7 +466,7 @@ mod tests {
                     let (c, rc) = node.ball();
                     capsule_hits(a, ra, b, rb, c, rc)
                 },
-                |t| {
+                |_, t| {
                     found.push(*t);
                     true
                 },
@@ -416,5 +508,29 @@ mod tests {
             }
         }
         assert!(capsule_hits(Vec3f::ZERO, 0.0, Vec3f::X, 1.0, Vec3f::splat(f32::NAN), 0.0));
+    }
+
+    #[test]
+    fn segment_triangle_distance_matches_sampling() {
+        let mut r = rng(21);
+        for _ in 0..3000 {
+            let v = |r: &mut dyn FnMut() -> f32| Vec3f::new(r(), r(), r()) * 4.0;
+            let t = [v(&mut r), v(&mut r), v(&mut r)];
+            let (p, q) = (v(&mut r), v(&mut r));
+            let d = segment_triangle_distance(p, q, &t);
+            // Sampled: points of the segment against points of the triangle.
+            let mut best = f32::INFINITY;
+            for i in 0..=60 {
+                let x = p.lerp(q, i as f32 / 60.0);
+                best = best.min((closest_on_triangle(x, &t) - x).length());
+            }
+            assert!(d <= best + 1e-4, "{d} > sampled {best}");
+            assert!(d >= best - 0.15, "{d} far below sampled {best}");
+        }
+        let t = [Vec3f::ZERO, Vec3f::X, Vec3f::Y];
+        let d = segment_triangle_distance(Vec3f::new(0.2, 0.2, -1.0), Vec3f::new(0.2, 0.2, 1.0), &t);
+        assert_eq!(d, 0.0);
+        let d = segment_triangle_distance(Vec3f::new(2.0, 0.0, 1.0), Vec3f::new(2.0, 0.0, -1.0), &t);
+        assert!((d - 1.0).abs() < 1e-6);
     }
 }

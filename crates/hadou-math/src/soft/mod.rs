@@ -5,7 +5,8 @@
 //! gives every pixel those distances in linear time), `search` (how far and on which surface a
 //! penumbra pixel looks) and `spot_map` (a shadow map's perspective frame and its fitting to what
 //! can be shadowed in view), and for the traced resolve `lamp` (the lamp's shape, what a receiver
-//! sees of it, the light it adds) and `bvh` (the casters' triangles in a flattened hierarchy).
+//! sees of it, the light it adds), `bvh` (the casters' triangles in a flattened hierarchy) and
+//! `topology` (how those triangles share corners and edges and which bound closed solids).
 //! Every item is re-exported here: `hadou_math::soft::SpotMap`, ….
 
 mod bvh;
@@ -14,6 +15,7 @@ mod lamp;
 mod penumbra;
 mod search;
 mod spot_map;
+mod topology;
 
 pub use bvh::*;
 pub use distance::*;
@@ -21,6 +23,7 @@ pub use lamp::*;
 pub use penumbra::*;
 pub use search::*;
 pub use spot_map::*;
+pub use topology::*;
 
 #[cfg(test)]
 mod tests {
