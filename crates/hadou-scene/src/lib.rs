@@ -63,6 +63,11 @@ mod schema;
 mod shadow;
 mod shadow_casts;
 mod shadow_def;
+mod spring;
+mod spring_def;
+mod spring_scene;
+#[cfg(test)]
+mod spring_tests;
 mod temp_file;
 mod texture;
 mod toml_read;
@@ -106,6 +111,10 @@ pub use scene::Scene;
 pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,
     MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES, ON_PLANE,
+};
+pub use spring::{
+    SpringBones, MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX,
+    SPRING_MAX_STEPS, SPRING_RATE,
 };
 pub use temp_file::{remove_pending_temp_files, TempFile};
 pub use texture::{

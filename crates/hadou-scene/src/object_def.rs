@@ -51,8 +51,15 @@ pub(crate) fn parse_object(
         _ => &["path"],
     };
     let motion_keys: &[&str] = if kind == "gltf" { MOTION_KEYS } else { &[] };
-    let allowed: Vec<&str> =
-        OBJECT_COMMON.iter().chain(OBJECT_MATERIAL_KEYS).chain(extra).chain(motion_keys).copied().collect();
+    let spring_keys: &[&str] = if kind == "gltf" { &["spring"] } else { &[] };
+    let allowed: Vec<&str> = OBJECT_COMMON
+        .iter()
+        .chain(OBJECT_MATERIAL_KEYS)
+        .chain(extra)
+        .chain(motion_keys)
+        .chain(spring_keys)
+        .copied()
+        .collect();
     t.check_keys(&allowed)?;
     if t.get("color").is_some() && (t.get("material").is_some() || t.get("materials").is_some()) {
         let other = if t.get("material").is_some() { "material" } else { "materials" };
@@ -161,6 +168,16 @@ pub(crate) fn parse_object(
     assets.slots_left -= slots;
     let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
     let motion = parse_motion(t, rig.as_deref(), &mut params, rd, &mut assets.dir, warnings)?;
+    let spring = match t.opt_bool("spring")? {
+        Some(true) if rig.as_ref().and_then(|r| r.springs()).is_none() => {
+            return Err(t.src.value_err(
+                &t.key_span("spring"),
+                format!("{} gives `spring = true`, but its glTF file has no VRM spring bones", t.what),
+            ))
+        }
+        Some(s) => s,
+        None => true,
+    };
     Ok(ObjectDef {
         name,
         mesh,
@@ -171,6 +188,8 @@ pub(crate) fn parse_object(
         rig,
         motion,
         pose_cache: Default::default(),
+        spring,
+        spring_cache: Default::default(),
     })
 }
 

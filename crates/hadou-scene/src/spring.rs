@@ -1,0 +1,321 @@
+//! VRM spring bones (`VRMC_springBone` 1.0; VRM 0.x `secondaryAnimation` converted to it by
+//! `spring_def`): hair, skirts and tails that swing behind a character and that a wave's wind
+//! blows. The simulation follows the reference implementation of the VRMC_springBone-1.0
+//! specification ("Reference implementation"): per joint, in the order of the spring's chain, with
+//! the joint's tail position kept from the last two steps,
+//!
+//! ```text
+//! head      = G(parent) · L₀ · 0                         (L₀: the joint's local transform with its
+//!                                                          rest rotation, animated translation/scale)
+//! restDir   = normalize(G(parent) · L₀ · tail − head)     (tail: the tail's rest offset in the joint)
+//! length    = |G(parent) · L₀ · tail − head|
+//! next      = current + (current − previous)·(1 − dragForce)
+//!           + restDir · stiffness · Δt
+//!           + gravityDir · gravityPower · Δt
+//!           + wind(current) · Δt                          (the waves' push, `wind` below)
+//! next      = head + normalize(next − head) · length
+//! collisions: for each collider of the spring's collider groups, a sphere (centre c, radius r) or
+//!   a capsule (the point c of its segment nearest `next`): if |next − c| < r + hitRadius then
+//!   next = c + normalize(next − c)·(r + hitRadius), and again next = head + normalize(next − head)·length
+//! previous  = current; current = next
+//! rotation  = R₀ · fromTo(normalize(tail), normalize((G(parent) · L₀)⁻¹ · next))
+//! ```
+//!
+//! With a `center` node the tail positions are kept in that node's space (so the spring follows it
+//! without lag). The last joint of a 1.0 spring is only a tail and does not rotate; a VRM 0.x chain's
+//! last bone gets a tail 0.07 units along its parent-to-bone direction, as VRM 0.x does.
+//!
+//! **Determinism.** The simulation runs at a fixed [`SPRING_RATE`] from scene time 0: the pose at
+//! time `t` is the state after `n = ⌊t·SPRING_RATE⌋` steps, each step `k` driven by the animation
+//! and waves at time `k/SPRING_RATE`. A frame is thus a pure function of its time, whether it is
+//! rendered alone, in a sequence or in chunks; a per-object cache continues from the last state
+//! when a later time is asked for, which gives the same bits. Past [`SPRING_MAX_STEPS`] steps the
+//! simulation starts from rest [`SPRING_MAX_STEPS`] steps before `n` (a damped spring has long
+//! forgotten its start by then), so no frame costs more.
+//!
+//! **Wind.** A wave with `wind = w > 0` pushes each joint's tail `p` (world space) away from its
+//! centre line: `wind(p) = Σ w · ρ(|p − E|) · (p − E)/|p − E|`, `E` the nearest point of the
+//! wave's centre line ([`crate::LightLine::nearest`]: a curve's polyline) and `ρ` the energy density
+//! the shading weighs waves by ([`hadou_math::toon::dominance`] with the wave's core radius,
+//! strength `α·a` and falloff). The force is carried into the character's space and its length
+//! clamped to [`SPRING_FORCE_MAX`].
+
+pub use crate::limits::{
+    MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
+    SPRING_RATE,
+};
+use crate::rig::{Clip, PoseInput, RestLocal, Rig};
+use hadou_math::keyframes::{normalize_quat, quat_mul, trs_matrix};
+use hadou_math::{Mat4, Vec3f};
+
+/// A spring-bone collider's shape, in its node's space (VRMC_springBone-1.0 `shape`).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum ColliderShape {
+    /// A sphere at `offset`.
+    Sphere { offset: Vec3f, radius: f32 },
+    /// A capsule from `offset` to `tail`.
+    Capsule { offset: Vec3f, tail: Vec3f, radius: f32 },
+}
+
+/// A collider attached to a node.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Collider {
+    pub node: usize,
+    pub shape: ColliderShape,
+}
+
+/// One joint of a spring: a node that turns so that its tail follows the simulation.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Joint {
+    pub node: usize,
+    /// The tail's rest position in the node's local space (the next joint's rest translation, or a
+    /// VRM 0.x leaf's 7 cm tail).
+    pub tail: Vec3f,
+    pub hit_radius: f32,
+    pub stiffness: f32,
+    pub gravity_power: f32,
+    /// Unit, in the file's space.
+    pub gravity_dir: Vec3f,
+    /// In `[0, 1]`.
+    pub drag: f32,
+}
+
+/// A chain of joints, each the parent of the next.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Spring {
+    pub joints: Vec<Joint>,
+    /// The colliders of its collider groups (indices into [`SpringBones::colliders`]).
+    pub colliders: Vec<usize>,
+    /// The node whose space the tails are kept in.
+    pub center: Option<usize>,
+}
+
+/// The spring bones of a VRM file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SpringBones {
+    pub(crate) springs: Vec<Spring>,
+    pub(crate) colliders: Vec<Collider>,
+}
+
+impl SpringBones {
+    /// The number of joints that turn (a 1.0 spring's last joint is only a tail).
+    pub fn joint_count(&self) -> usize {
+        self.springs.iter().map(|s| s.joints.len()).sum()
+    }
+
+    /// The number of colliders.
+    pub fn collider_count(&self) -> usize {
+        self.colliders.len()
+    }
+}
+
+/// What drives one step: the animation at the step's time and the wind there.
+pub(crate) struct StepInput<'a> {
+    /// The clip and its time at the step.
+    pub clip: Option<&'a Clip>,
+    pub clip_time: f32,
+    /// The external force on a point of the character's space (rig space), per second.
+    pub wind: &'a dyn Fn(Vec3f) -> Vec3f,
+}
+
+/// The state of a character's springs after some steps.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct SpringState {
+    /// Steps done since the state was made at rest.
+    pub step: u64,
+    /// The step it was made at rest at.
+    pub start: u64,
+    /// Per joint (springs in order), the previous and current tail, in the spring's center space.
+    tails: Vec<(Vec3f, Vec3f)>,
+    /// Per joint, its local rotation now.
+    rotations: Vec<[f32; 4]>,
+}
+
+/// A node's translation, rotation and scale (a matrix node: `None`).
+type Trs = Option<([f32; 3], [f32; 4], [f32; 3])>;
+
+impl SpringState {
+    /// The joints' local rotations `(node, quaternion)`, for [`PoseInput::rotations`].
+    pub(crate) fn rotations(&self, springs: &SpringBones) -> Vec<(usize, [f32; 4])> {
+        springs
+            .springs
+            .iter()
+            .flat_map(|s| s.joints.iter().map(|j| j.node))
+            .zip(self.rotations.iter().copied())
+            .collect()
+    }
+}
+
+impl Rig {
+    /// The state of the springs at rest at step `start`, under the animation `input` gives.
+    pub(crate) fn spring_rest(&self, start: u64, input: &StepInput<'_>) -> Option<SpringState> {
+        let sb = self.springs.as_ref()?;
+        let locals = self.step_locals(input);
+        let mut tails = Vec::with_capacity(sb.joint_count());
+        let mut rotations = Vec::with_capacity(sb.joint_count());
+        for s in &sb.springs {
+            let center = s.center.map_or(Mat4::IDENTITY, |c| self.global_of(c, &locals));
+            let to_center = affine_inverse(&center);
+            for j in &s.joints {
+                let g = self.global_of(j.node, &locals);
+                let tail = to_center.transform_point(g.transform_point(j.tail));
+                let tail = if tail.is_finite() { tail } else { Vec3f::ZERO };
+                tails.push((tail, tail));
+                rotations.push(match self.nodes[j.node].rest {
+                    RestLocal::Trs { r, .. } => r,
+                    RestLocal::Matrix(_) => [0.0, 0.0, 0.0, 1.0],
+                });
+            }
+        }
+        Some(SpringState { step: start, start, tails, rotations })
+    }
+
+    /// The nodes' local transforms for `input`'s clip time (no spring rotations).
+    fn step_locals(&self, input: &StepInput<'_>) -> Vec<Trs> {
+        let pose = PoseInput { clip: input.clip, time: input.clip_time, ..Default::default() };
+        self.sample_locals(&pose).0
+    }
+
+    /// Node `node`'s global matrix from local transforms `locals` (walking up its ancestors).
+    fn global_of(&self, node: usize, locals: &[Trs]) -> Mat4 {
+        let mut m = self.local_matrix(node, locals[node]);
+        let mut at = node;
+        let mut guard = self.nodes.len();
+        while let Some(p) = self.nodes[at].parent {
+            if guard == 0 {
+                break;
+            }
+            guard -= 1;
+            m = self.local_matrix(p, locals[p]) * m;
+            at = p;
+        }
+        self.base * m
+    }
+
+    /// One step of `state` (module docs), driven by `input`; `dt` is the step in seconds.
+    pub(crate) fn spring_step(&self, state: &mut SpringState, input: &StepInput<'_>, dt: f32) {
+        let Some(sb) = self.springs.as_ref() else { return };
+        let mut locals = self.step_locals(input);
+        // The last step's rotations, so colliders and springs below other springs see them.
+        for (j, r) in sb.springs.iter().flat_map(|s| &s.joints).zip(&state.rotations) {
+            if let Some((_, rot, _)) = locals[j.node].as_mut() {
+                *rot = *r;
+            }
+        }
+        let colliders: Vec<Mat4> = sb.colliders.iter().map(|c| self.global_of(c.node, &locals)).collect();
+        let mut k = 0;
+        for s in &sb.springs {
+            let center = s.center.map_or(Mat4::IDENTITY, |c| self.global_of(c, &locals));
+            let to_center = affine_inverse(&center);
+            let mut parent = match s.joints.first().and_then(|j| self.nodes[j.node].parent) {
+                Some(p) => self.global_of(p, &locals),
+                None => self.base,
+            };
+            for j in &s.joints {
+                let idx = k;
+                k += 1;
+                let (RestLocal::Trs { r: rest_r, .. }, Some((t, _, sc))) =
+                    (&self.nodes[j.node].rest, locals[j.node])
+                else {
+                    parent = parent * self.local_matrix(j.node, locals[j.node]);
+                    continue;
+                };
+                let m0 = parent * trs_matrix(t, *rest_r, sc);
+                let head = m0.transform_point(Vec3f::ZERO);
+                let rest_tail = m0.transform_point(j.tail);
+                let length = (rest_tail - head).length();
+                let axis = j.tail.try_normalize();
+                let (Some(rest_dir), Some(axis)) = ((rest_tail - head).try_normalize(), axis) else {
+                    parent = m0;
+                    continue;
+                };
+                if !length.is_finite() {
+                    parent = m0;
+                    continue;
+                }
+                let (prev, cur) = state.tails[idx];
+                let (prev, cur) = (center.transform_point(prev), center.transform_point(cur));
+                let mut force = (j.gravity_dir * j.gravity_power) + (input.wind)(cur);
+                let f = force.length();
+                if !(f <= SPRING_FORCE_MAX) {
+                    force = if f.is_finite() { force * (SPRING_FORCE_MAX / f) } else { Vec3f::ZERO };
+                }
+                let mut next =
+                    cur + (cur - prev) * (1.0 - j.drag) + rest_dir * (j.stiffness * dt) + force * dt;
+                next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
+                for &c in &s.colliders {
+                    let (Some(col), Some(g)) = (sb.colliders.get(c), colliders.get(c)) else { continue };
+                    let (at, radius) = match col.shape {
+                        ColliderShape::Sphere { offset, radius } => (g.transform_point(offset), radius),
+                        ColliderShape::Capsule { offset, tail, radius } => {
+                            let (a, b) = (g.transform_point(offset), g.transform_point(tail));
+                            (nearest_on_segment(next, a, b), radius)
+                        }
+                    };
+                    let reach = radius + j.hit_radius;
+                    let d = next - at;
+                    let dist = d.length();
+                    if dist < reach {
+                        if let Some(n) = d.try_normalize() {
+                            next = at + n * reach;
+                            next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
+                        }
+                    }
+                }
+                if !next.is_finite() {
+                    next = rest_tail;
+                }
+                let back = to_center.transform_point(next);
+                let back = if back.is_finite() { back } else { to_center.transform_point(rest_tail) };
+                state.tails[idx] = (state.tails[idx].1, back);
+                let local = affine_inverse(&m0).transform_point(next);
+                let turn = from_to(axis, local.try_normalize().unwrap_or(axis));
+                let r = normalize_quat(quat_mul(*rest_r, turn));
+                state.rotations[idx] = r;
+                if let Some((_, rot, _)) = locals[j.node].as_mut() {
+                    *rot = r;
+                }
+                parent = parent * trs_matrix(t, r, sc);
+            }
+        }
+        state.step += 1;
+    }
+}
+
+/// The point of segment `a..b` nearest `p`.
+fn nearest_on_segment(p: Vec3f, a: Vec3f, b: Vec3f) -> Vec3f {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    if !(l2 > 0.0) {
+        return a;
+    }
+    a + ab * ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
+}
+
+/// The shortest rotation (unit quaternion `[x, y, z, w]`) turning unit `a` onto unit `b`; half a
+/// turn about an axis normal to `a` when they are opposite.
+pub(crate) fn from_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
+    let d = a.dot(b);
+    if d < -1.0 + 1e-6 {
+        let (n, _) = a.orthonormal_basis();
+        return [n.x, n.y, n.z, 0.0];
+    }
+    let c = a.cross(b);
+    normalize_quat([c.x, c.y, c.z, 1.0 + d])
+}
+
+/// The inverse of an affine matrix (its 3×3 block inverted in f64); the identity for a singular
+/// one.
+pub(crate) fn affine_inverse(m: &Mat4) -> Mat4 {
+    // `normal_matrix` is the block's inverse transposed.
+    let inv_t = m.normal_matrix();
+    let mut inv = inv_t.transpose();
+    inv.cols[3] = [0.0, 0.0, 0.0, 1.0];
+    for r in 0..3 {
+        inv.cols[r][3] = 0.0;
+    }
+    let t = Vec3f::new(m.cols[3][0], m.cols[3][1], m.cols[3][2]);
+    let it = inv.transform_vector(t);
+    inv.cols[3] = [-it.x, -it.y, -it.z, 1.0];
+    inv
+}

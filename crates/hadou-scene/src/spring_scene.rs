@@ -1,0 +1,108 @@
+//! Driving a character's spring bones from the scene: the fixed-rate steps from time 0 (module
+//! docs of `spring`), each under the object's clip, placement and the waves' wind at the step's
+//! time, and the per-object cache that lets a sequence of frames continue where the last left off.
+
+use crate::rig::Rig;
+use crate::scene::{ObjectDef, Scene};
+use crate::spring::{affine_inverse, StepInput, SPRING_MAX_STEPS, SPRING_RATE};
+use hadou_math::energy::Falloff;
+use hadou_math::Vec3f;
+
+/// The steps of the simulation done by scene time `time`: `⌊time · SPRING_RATE⌋` (0 before 0).
+pub fn spring_steps_at(time: f32) -> u64 {
+    if !(time > 0.0) {
+        return 0;
+    }
+    let n = (time as f64 * SPRING_RATE).floor();
+    if n >= u64::MAX as f64 {
+        u64::MAX
+    } else {
+        n as u64
+    }
+}
+
+/// One wave's wind at a step: its centre line, strength and falloff.
+struct WindSource {
+    line: crate::LightLine,
+    wind: f32,
+    core: f32,
+    strength: f32,
+    inverse_square: bool,
+}
+
+impl Scene {
+    /// The spring bones' local rotations of object `o` at scene time `time`: the state after
+    /// [`spring_steps_at`] steps (empty when it has none or `spring = false`).
+    pub(crate) fn spring_rotations(&self, o: &ObjectDef, rig: &Rig, time: f32) -> Vec<(usize, [f32; 4])> {
+        let Some(springs) = rig.springs.as_ref().filter(|_| o.spring) else { return Vec::new() };
+        let n = spring_steps_at(time);
+        let start = n.saturating_sub(SPRING_MAX_STEPS);
+        let cached = o.spring_cache.lock().ok().and_then(|c| c.clone());
+        let mut state = match cached {
+            Some(s) if s.start == start && s.step <= n => s,
+            _ => {
+                let Some(s) = self.with_step_input(o, start, |input| rig.spring_rest(start, input)) else {
+                    return Vec::new();
+                };
+                s
+            }
+        };
+        let dt = (1.0 / SPRING_RATE) as f32;
+        while state.step < n {
+            let k = state.step + 1;
+            self.with_step_input(o, k, |input| rig.spring_step(&mut state, input, dt));
+        }
+        let out = state.rotations(springs);
+        if let Ok(mut c) = o.spring_cache.lock() {
+            *c = Some(state);
+        }
+        out
+    }
+
+    /// Calls `f` with what drives step `k` of object `o`: its clip time and the wind at time
+    /// `k / SPRING_RATE`.
+    fn with_step_input<R>(&self, o: &ObjectDef, k: u64, f: impl FnOnce(&StepInput<'_>) -> R) -> R {
+        let time = (k as f64 / SPRING_RATE) as f32;
+        let vals = self.values_at(time);
+        let clip = o.motion.as_ref().and_then(|m| m.clip.as_deref());
+        let clip_time = self.clip_time_of(o, &vals, time).unwrap_or(0.0);
+        let sources: Vec<WindSource> = self
+            .waves
+            .iter()
+            .filter(|w| w.params.f(&vals, "wind") > 0.0)
+            .map(|w| {
+                let wave = self.build_wave(w, &vals);
+                WindSource {
+                    line: wave.light_line(None),
+                    wind: w.params.f(&vals, "wind"),
+                    core: wave.core_radius,
+                    strength: wave.light_strength(),
+                    inverse_square: wave.falloff == Falloff::InverseSquare,
+                }
+            })
+            .collect();
+        let to_world = o.transform(&vals);
+        let to_rig = affine_inverse(&to_world);
+        let wind = move |p: Vec3f| -> Vec3f {
+            if sources.is_empty() {
+                return Vec3f::ZERO;
+            }
+            let pw = to_world.transform_point(p);
+            let mut f = Vec3f::ZERO;
+            for s in &sources {
+                let away = pw - s.line.nearest(pw);
+                let d = away.length();
+                let Some(dir) = away.try_normalize() else { continue };
+                let rho = hadou_math::toon::dominance(d, s.core, s.strength, s.inverse_square);
+                f += dir * (s.wind * rho);
+            }
+            let f = to_rig.transform_vector(f);
+            if f.is_finite() {
+                f
+            } else {
+                Vec3f::ZERO
+            }
+        };
+        f(&StepInput { clip, clip_time, wind: &wind })
+    }
+}
