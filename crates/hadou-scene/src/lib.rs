@@ -64,6 +64,7 @@ mod shadow;
 mod shadow_casts;
 mod shadow_def;
 mod spring;
+mod spring_bones;
 mod spring_def;
 mod spring_scene;
 #[cfg(test)]
@@ -113,9 +114,10 @@ pub use shadow::{
     MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES, ON_PLANE,
 };
 pub use spring::{
-    SpringBones, MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX,
-    SPRING_MAX_STEPS, SPRING_RATE,
+    MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
+    SPRING_RATE,
 };
+pub use spring_bones::SpringBones;
 pub use temp_file::{remove_pending_temp_files, TempFile};
 pub use texture::{
     decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_BYTES,

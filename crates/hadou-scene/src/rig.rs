@@ -140,7 +140,7 @@ pub struct Rig {
     pub(crate) groups: Vec<u32>,
     pub(crate) group_count: usize,
     /// A VRM's spring bones (`VRMC_springBone`, VRM 0.x `secondaryAnimation`), if it has any.
-    pub(crate) springs: Option<crate::spring::SpringBones>,
+    pub(crate) springs: Option<crate::spring_bones::SpringBones>,
 }
 
 /// What to pose: a clip at a time, and expression weights.
@@ -196,7 +196,7 @@ impl Rig {
     }
 
     /// The file's spring bones, if it has any.
-    pub fn springs(&self) -> Option<&crate::spring::SpringBones> {
+    pub fn springs(&self) -> Option<&crate::spring_bones::SpringBones> {
         self.springs.as_ref()
     }
 

@@ -15,11 +15,9 @@
 //! joint, finite numbers, radii ≥ 0, stiffness, drag and gravity power ≥ 0 (drag ≤ 1), and the
 //! limits of `spring`. A problem is an error naming the JSON path.
 
+use crate::limits::{MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS};
 use crate::rig::{RestLocal, RigNode};
-use crate::spring::{
-    Collider, ColliderShape, Joint, Spring, SpringBones, MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS,
-    MAX_SPRING_JOINTS,
-};
+use crate::spring_bones::{Collider, ColliderShape, Joint, Spring, SpringBones};
 use hadou_math::keyframes::trs_matrix;
 use hadou_math::{Mat4, Vec3f};
 use serde_json::Value;

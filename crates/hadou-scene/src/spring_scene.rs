@@ -10,7 +10,7 @@ use hadou_math::Vec3f;
 
 /// The steps of the simulation done by scene time `time`: `⌊time · SPRING_RATE⌋` (0 before 0).
 pub fn spring_steps_at(time: f32) -> u64 {
-    if !(time > 0.0) {
+    if time.is_nan() || time <= 0.0 {
         return 0;
     }
     let n = (time as f64 * SPRING_RATE).floor();

@@ -1,0 +1,65 @@
+//! The spring bones of a VRM file as `spring_def` reads them and `spring` steps them: springs
+//! (chains of joints with their parameters), colliders and their groups (flattened per spring).
+
+use hadou_math::Vec3f;
+
+/// A spring-bone collider's shape, in its node's space (VRMC_springBone-1.0 `shape`).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum ColliderShape {
+    /// A sphere at `offset`.
+    Sphere { offset: Vec3f, radius: f32 },
+    /// A capsule from `offset` to `tail`.
+    Capsule { offset: Vec3f, tail: Vec3f, radius: f32 },
+}
+
+/// A collider attached to a node.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Collider {
+    pub node: usize,
+    pub shape: ColliderShape,
+}
+
+/// One joint of a spring: a node that turns so that its tail follows the simulation.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Joint {
+    pub node: usize,
+    /// The tail's rest position in the node's local space (the next joint's rest translation, or a
+    /// VRM 0.x leaf's 7 cm tail).
+    pub tail: Vec3f,
+    pub hit_radius: f32,
+    pub stiffness: f32,
+    pub gravity_power: f32,
+    /// Unit, in the file's space.
+    pub gravity_dir: Vec3f,
+    /// In `[0, 1]`.
+    pub drag: f32,
+}
+
+/// A chain of joints, each the parent of the next.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Spring {
+    pub joints: Vec<Joint>,
+    /// The colliders of its collider groups (indices into [`SpringBones::colliders`]).
+    pub colliders: Vec<usize>,
+    /// The node whose space the tails are kept in.
+    pub center: Option<usize>,
+}
+
+/// The spring bones of a VRM file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SpringBones {
+    pub(crate) springs: Vec<Spring>,
+    pub(crate) colliders: Vec<Collider>,
+}
+
+impl SpringBones {
+    /// The number of joints that turn (a 1.0 spring's last joint is only a tail).
+    pub fn joint_count(&self) -> usize {
+        self.springs.iter().map(|s| s.joints.len()).sum()
+    }
+
+    /// The number of colliders.
+    pub fn collider_count(&self) -> usize {
+        self.colliders.len()
+    }
+}
