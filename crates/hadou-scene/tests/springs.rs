@@ -172,3 +172,31 @@ fn spring_and_wind_keys_report_their_place() {
     let e = scene(&d, "path = \"bad.vrm\"", "").unwrap_err();
     assert!(e.contains("VRMC_springBone.colliders[0].shape.capsule.radius is -1"), "{e}");
 }
+
+#[test]
+fn the_generated_blast_character_has_spring_hair_and_skirt_that_fall_and_settle() {
+    let (mesh, rig) = hadou_scene::load_gltf_rig(&asset("blast.vrm")).unwrap();
+    let rig = rig.expect("a rig");
+    let springs = rig.springs().expect("blast.vrm has spring bones");
+    // make_brace.py: 12 hair strands of 9 joints and 16 skirt strands of 7, each last joint a tail.
+    assert_eq!(springs.joint_count(), 12 * 8 + 16 * 6);
+    assert_eq!(springs.collider_count(), 4);
+    let d = std::env::temp_dir().join(format!("hadou-springs-blast-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::copy(asset("blast.vrm"), d.join("blast.vrm")).unwrap();
+    let s = scene(&d, "path = \"blast.vrm\"", "").unwrap();
+    let (a, b, c) = (s.at(0.0), s.at(3.0), s.at(3.5));
+    let moved = |x: &hadou_scene::Frame, y: &hadou_scene::Frame| {
+        x.objects[0]
+            .mesh
+            .positions
+            .iter()
+            .zip(&y.objects[0].mesh.positions)
+            .map(|(p, q)| (p[0] - q[0]).hypot(p[1] - q[1]).hypot(p[2] - q[2]))
+            .fold(0.0f32, f32::max)
+    };
+    assert_eq!(a.objects[0].mesh.positions, mesh.positions, "at time 0 the springs are at rest");
+    assert!(moved(&a, &b) > 0.01, "the strands fall: {}", moved(&a, &b));
+    assert!(moved(&b, &c) < 1e-3, "and settle: {}", moved(&b, &c));
+    assert!(b.objects[0].mesh.positions.iter().flatten().all(|x| x.is_finite()));
+}
