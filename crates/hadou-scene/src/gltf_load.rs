@@ -464,6 +464,7 @@ fn build_rig(
     let expressions = crate::gltf_vrm::read_expressions(raw, &rig_nodes, &mesh_of)?;
     let humanoid = crate::gltf_vrm::read_humanoid(raw, nodes.len())?;
     let springs = crate::spring_def::read_springs(raw, &rig_nodes, &order)?;
+    let look_at = crate::look_at::read_look_at(raw, &humanoid)?;
     Ok(Some(Rig {
         nodes: rig_nodes,
         order,
@@ -477,6 +478,7 @@ fn build_rig(
         groups: Vec::new(),
         group_count: 0,
         springs,
+        look_at,
     }))
 }
 

@@ -53,6 +53,7 @@ mod image;
 mod introspect;
 mod light_def;
 mod limits;
+mod look_at;
 mod materials;
 pub mod mesh;
 mod object_def;

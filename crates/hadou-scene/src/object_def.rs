@@ -51,7 +51,7 @@ pub(crate) fn parse_object(
         _ => &["path"],
     };
     let motion_keys: &[&str] = if kind == "gltf" { MOTION_KEYS } else { &[] };
-    let spring_keys: &[&str] = if kind == "gltf" { &["spring"] } else { &[] };
+    let spring_keys: &[&str] = if kind == "gltf" { &["spring", "look_at"] } else { &[] };
     let allowed: Vec<&str> = OBJECT_COMMON
         .iter()
         .chain(OBJECT_MATERIAL_KEYS)
@@ -178,6 +178,7 @@ pub(crate) fn parse_object(
         Some(s) => s,
         None => true,
     };
+    let look_at = parse_look_at(t, rig.as_deref(), &mut params, rd)?;
     Ok(ObjectDef {
         name,
         mesh,
@@ -190,7 +191,39 @@ pub(crate) fn parse_object(
         pose_cache: Default::default(),
         spring,
         spring_cache: Default::default(),
+        look_at,
     })
+}
+
+/// A `kind = "gltf"` object's `look_at`: `"camera"`, a wave's name (resolved once the waves are
+/// read) or a point `[x, y, z]` (an animatable parameter).
+fn parse_look_at(
+    t: &Table<'_, '_>,
+    rig: Option<&Rig>,
+    params: &mut ParamSet,
+    rd: &mut ParamReader<'_>,
+) -> Res<Option<crate::look_at::LookTarget>> {
+    use crate::look_at::LookTarget;
+    let Some(v) = t.get("look_at") else { return Ok(None) };
+    if rig.and_then(|r| r.look_at.as_ref()).is_none() {
+        return Err(t.src.value_err(
+            &t.key_span("look_at"),
+            format!(
+                "{} gives `look_at`, but its glTF file has no VRM look-at (a head bone and `lookAt` with eye                  bones or look expressions)",
+                t.what
+            ),
+        ));
+    }
+    if let Some((name, span)) = t.opt_str("look_at").ok().flatten() {
+        return Ok(Some(if name == "camera" {
+            LookTarget::Camera
+        } else {
+            LookTarget::WaveName(name.to_string(), span)
+        }));
+    }
+    let _ = v;
+    rd.add(t, params, "look_at", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
+    Ok(Some(LookTarget::Point))
 }
 
 /// The animation keys of a `kind = "gltf"` object.

@@ -141,6 +141,8 @@ pub struct Rig {
     pub(crate) group_count: usize,
     /// A VRM's spring bones (`VRMC_springBone`, VRM 0.x `secondaryAnimation`), if it has any.
     pub(crate) springs: Option<crate::spring_bones::SpringBones>,
+    /// A VRM's look-at (`VRMC_vrm.lookAt`, VRM 0.x `firstPerson`), if it has one with a head.
+    pub(crate) look_at: Option<crate::look_at::LookAt>,
 }
 
 /// What to pose: a clip at a time, and expression weights.

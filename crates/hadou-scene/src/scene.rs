@@ -75,6 +75,8 @@ pub(crate) struct ObjectDef {
     pub spring: bool,
     /// The spring simulation's last state, shared by clones (`spring_scene`).
     pub spring_cache: SpringCache,
+    /// What its VRM eyes follow (`look_at`).
+    pub look_at: Option<crate::look_at::LookTarget>,
 }
 
 /// An object's last spring-bone state.
@@ -445,7 +447,7 @@ impl Scene {
     fn posed_mesh(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Arc<Mesh> {
         let Some(rig) = &o.rig else { return o.mesh.clone() };
         let springs = o.spring && rig.springs.is_some();
-        if o.motion.is_none() && !springs {
+        if o.motion.is_none() && !springs && o.look_at.is_none() {
             return o.mesh.clone();
         }
         let clip_t = self.clip_time_of(o, vals, time).unwrap_or(0.0);
@@ -454,7 +456,9 @@ impl Scene {
         } else {
             Vec::new()
         };
-        let rotations = if springs { self.spring_rotations(o, rig, time) } else { Vec::new() };
+        let mut expressions = expressions;
+        let mut rotations = if springs { self.spring_rotations(o, rig, time) } else { Vec::new() };
+        self.add_gaze(o, rig, vals, clip_t, &mut rotations, &mut expressions);
         let key: Vec<u32> = std::iter::once(clip_t.to_bits())
             .chain(expressions.iter().map(|e| e.1.to_bits()))
             .chain(rotations.iter().flat_map(|(_, r)| r.map(f32::to_bits)))

@@ -45,7 +45,7 @@ pub use crate::limits::{
     SPRING_RATE,
 };
 use crate::rig::{Clip, PoseInput, RestLocal, Rig};
-pub(crate) use crate::spring_bones::{ColliderShape, SpringBones};
+pub(crate) use crate::spring_bones::{affine_inverse, ColliderShape, SpringBones};
 use hadou_math::keyframes::{normalize_quat, quat_mul, trs_matrix};
 use hadou_math::{Mat4, Vec3f};
 
@@ -242,20 +242,4 @@ pub(crate) fn from_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
     }
     let c = a.cross(b);
     normalize_quat([c.x, c.y, c.z, 1.0 + d])
-}
-
-/// The inverse of an affine matrix (its 3×3 block inverted in f64); the identity for a singular
-/// one.
-pub(crate) fn affine_inverse(m: &Mat4) -> Mat4 {
-    // `normal_matrix` is the block's inverse transposed.
-    let inv_t = m.normal_matrix();
-    let mut inv = inv_t.transpose();
-    inv.cols[3] = [0.0, 0.0, 0.0, 1.0];
-    for r in 0..3 {
-        inv.cols[r][3] = 0.0;
-    }
-    let t = Vec3f::new(m.cols[3][0], m.cols[3][1], m.cols[3][2]);
-    let it = inv.transform_vector(t);
-    inv.cols[3] = [-it.x, -it.y, -it.z, 1.0];
-    inv
 }

@@ -1,7 +1,7 @@
 //! The spring bones of a VRM file as `spring_def` reads them and `spring` steps them: springs
 //! (chains of joints with their parameters), colliders and their groups (flattened per spring).
 
-use hadou_math::Vec3f;
+use hadou_math::{Mat4, Vec3f};
 
 /// A spring-bone collider's shape, in its node's space (VRMC_springBone-1.0 `shape`).
 #[derive(Clone, Debug, PartialEq)]
@@ -62,4 +62,20 @@ impl SpringBones {
     pub fn collider_count(&self) -> usize {
         self.colliders.len()
     }
+}
+
+/// The inverse of an affine matrix (its 3×3 block inverted in f64); the identity for a singular
+/// one.
+pub(crate) fn affine_inverse(m: &Mat4) -> Mat4 {
+    // `normal_matrix` is the block's inverse transposed.
+    let inv_t = m.normal_matrix();
+    let mut inv = inv_t.transpose();
+    inv.cols[3] = [0.0, 0.0, 0.0, 1.0];
+    for r in 0..3 {
+        inv.cols[r][3] = 0.0;
+    }
+    let t = Vec3f::new(m.cols[3][0], m.cols[3][1], m.cols[3][2]);
+    let it = inv.transform_vector(t);
+    inv.cols[3] = [-it.x, -it.y, -it.z, 1.0];
+    inv
 }

@@ -1,8 +1,11 @@
-//! Driving a character's spring bones from the scene: the fixed-rate steps from time 0 (module
-//! docs of `spring`), each under the object's clip, placement and the waves' wind at the step's
-//! time, and the per-object cache that lets a sequence of frames continue where the last left off.
+//! Driving a character's spring bones and eyes from the scene: the fixed-rate steps from time 0
+//! (module docs of `spring`), each under the object's clip, placement and the waves' wind at the
+//! step's time, the per-object cache that lets a sequence of frames continue where the last left
+//! off, and the gaze of `look_at` (module docs of `look_at`) at the frame's values.
 
-use crate::rig::Rig;
+use crate::frame::WaveShape;
+use crate::look_at::LookTarget;
+use crate::rig::{PoseInput, Rig};
 use crate::scene::{ObjectDef, Scene};
 use crate::spring::{affine_inverse, StepInput, SPRING_MAX_STEPS, SPRING_RATE};
 use hadou_math::energy::Falloff;
@@ -31,6 +34,18 @@ struct WindSource {
 }
 
 impl Scene {
+    /// Per object in file order, the spring joints that turn and the colliders of its VRM file
+    /// (`(0, 0)` for objects without spring bones or with `spring = false`).
+    pub fn object_springs(&self) -> Vec<(usize, usize)> {
+        self.objects
+            .iter()
+            .map(|o| match o.rig.as_ref().and_then(|r| r.springs()).filter(|_| o.spring) {
+                Some(s) => (s.joint_count(), s.collider_count()),
+                None => (0, 0),
+            })
+            .collect()
+    }
+
     /// The spring bones' local rotations of object `o` at scene time `time`: the state after
     /// [`spring_steps_at`] steps (empty when it has none or `spring = false`).
     pub(crate) fn spring_rotations(&self, o: &ObjectDef, rig: &Rig, time: f32) -> Vec<(usize, [f32; 4])> {
@@ -104,5 +119,63 @@ impl Scene {
             }
         };
         f(&StepInput { clip, clip_time, wind: &wind })
+    }
+}
+
+impl Scene {
+    /// Adds object `o`'s gaze (`look_at`) to the pose: its eye bones' rotations to `rotations`,
+    /// its look expressions to `expressions`. The target is found at these values, in world space,
+    /// and carried into the character's space; the head is where the clip and the spring bones put
+    /// it.
+    pub(crate) fn add_gaze(
+        &self,
+        o: &ObjectDef,
+        rig: &Rig,
+        vals: &[f32],
+        clip_time: f32,
+        rotations: &mut Vec<(usize, [f32; 4])>,
+        expressions: &mut Vec<(usize, f32)>,
+    ) {
+        let (Some(target), Some(look)) = (o.look_at.as_ref(), rig.look_at.as_ref()) else { return };
+        let world = match target {
+            LookTarget::Camera => Vec3f::from_array(self.camera.arr::<3>(vals, "position")),
+            LookTarget::Point => Vec3f::from_array(o.params.arr::<3>(vals, "look_at")),
+            LookTarget::WaveName(..) => return,
+            LookTarget::Wave(i) => {
+                let Some(w) = self.waves.get(*i) else { return };
+                match self.build_wave(w, vals).shape {
+                    WaveShape::Sphere(f) => f.center,
+                    WaveShape::Cylinder(f) => f.point,
+                    WaveShape::Capsule(f) => f.m2(),
+                    WaveShape::Beam(f) => f.capsule.m2(),
+                    WaveShape::Curve(c) => {
+                        let prep = hadou_math::curve::prepare(&c);
+                        match prep.light_polyline().last() {
+                            Some(p) => *p,
+                            None => return,
+                        }
+                    }
+                }
+            }
+        };
+        let target = affine_inverse(&o.transform(vals)).transform_point(world);
+        if !target.is_finite() {
+            return;
+        }
+        let clip = o.motion.as_ref().and_then(|m| m.clip.as_deref());
+        let globals = rig.node_globals(&PoseInput { clip, time: clip_time, rotations, ..Default::default() });
+        let rest = |n: usize| match rig.nodes.get(n).map(|n| &n.rest) {
+            Some(crate::rig::RestLocal::Trs { r, .. }) => *r,
+            _ => [0.0, 0.0, 0.0, 1.0],
+        };
+        let gaze = look.gaze(&globals, target, rest);
+        rotations.extend(gaze.rotations);
+        for (name, w) in gaze.expressions {
+            if let Some(e) = rig.expressions.iter().position(|x| x.name == name) {
+                if w > 0.0 {
+                    expressions.push((e, w));
+                }
+            }
+        }
     }
 }

@@ -33,6 +33,7 @@ fn rig(nodes: Vec<RigNode>, ext: Value) -> Rig {
         groups: Vec::new(),
         group_count: 0,
         springs,
+        look_at: None,
     }
 }
 
@@ -462,4 +463,80 @@ fn bad_spring_data_is_a_located_error() {
     )
     .expect_err("too many joints");
     assert!(e.contains("past the limit of 4096"), "{e}");
+}
+
+mod look {
+    use crate::look_at::{LookAt, LookAtKind, RangeMap};
+    use hadou_math::keyframes::quat_matrix;
+    use hadou_math::{Mat4, Vec3f};
+
+    fn look(kind: LookAtKind, v0: bool) -> LookAt {
+        LookAt {
+            head: 0,
+            offset: Vec3f::new(0.0, 0.1, 0.0),
+            kind,
+            inner: RangeMap { input_max: 90.0, output_scale: 8.0 },
+            outer: RangeMap { input_max: 60.0, output_scale: 12.0 },
+            down: RangeMap { input_max: 90.0, output_scale: 6.0 },
+            up: RangeMap { input_max: 30.0, output_scale: 10.0 },
+            v0,
+        }
+    }
+
+    /// The direction eye rotation `q` turns the eye's forward (`+z`, or `−z` for VRM 0.x) to, as
+    /// yaw and pitch in degrees (in the +z-facing frame).
+    fn turned(q: [f32; 4], v0: bool) -> (f32, f32) {
+        let f = if v0 { -Vec3f::Z } else { Vec3f::Z };
+        let mut d = quat_matrix(q).transform_vector(f);
+        if v0 {
+            d = Vec3f::new(-d.x, d.y, -d.z);
+        }
+        (d.x.atan2(d.z).to_degrees(), d.y.atan2(d.x.hypot(d.z)).to_degrees())
+    }
+
+    #[test]
+    fn eye_bones_turn_by_the_range_maps() {
+        let head = [Mat4::translation(Vec3f::new(0.0, 1.5, 0.0))];
+        let rest = |_| [0.0, 0.0, 0.0, 1.0];
+        for v0 in [false, true] {
+            let l = look(LookAtKind::Bone { left: Some(1), right: Some(2) }, v0);
+            let s = if v0 { -1.0 } else { 1.0 };
+            // 45° to the character's left (+x, or −x in a VRM 0.x file), level with the offset.
+            let g = l.gaze(&head, Vec3f::new(s, 1.6, s), rest);
+            assert_eq!(g.rotations.len(), 2);
+            let (yl, pl) = turned(g.rotations[0].1, v0);
+            let (yr, _) = turned(g.rotations[1].1, v0);
+            assert!((yl - 9.0).abs() < 1e-3 && pl.abs() < 1e-3, "left eye, outer map: {yl} {pl}");
+            assert!((yr - 4.0).abs() < 1e-3, "right eye, inner map: {yr}");
+            // 45° to its right: the right eye turns outwards, the left inwards.
+            let g = l.gaze(&head, Vec3f::new(-s, 1.6, s), rest);
+            let ((yl, _), (yr, _)) = (turned(g.rotations[0].1, v0), turned(g.rotations[1].1, v0));
+            assert!((yl + 4.0).abs() < 1e-3 && (yr + 9.0).abs() < 1e-3, "{yl} {yr}");
+            // Up 45°: past the up map's 30°, its full 10°; down 45°: 45/90 · 6 = 3°.
+            let g = l.gaze(&head, Vec3f::new(0.0, 2.6, s), rest);
+            let (_, p) = turned(g.rotations[0].1, v0);
+            assert!((p - 10.0).abs() < 1e-3, "up: {p}");
+            let g = l.gaze(&head, Vec3f::new(0.0, 0.6, s), rest);
+            let (_, p) = turned(g.rotations[0].1, v0);
+            assert!((p + 3.0).abs() < 1e-3, "down: {p}");
+        }
+    }
+
+    #[test]
+    fn look_expressions_take_the_maps_as_weights() {
+        let head = [Mat4::IDENTITY];
+        let mut l = look(LookAtKind::Expression, false);
+        l.outer = RangeMap { input_max: 90.0, output_scale: 1.0 };
+        l.up = RangeMap { input_max: 90.0, output_scale: 1.0 };
+        let g = l.gaze(&head, Vec3f::new(-1.0, 0.1, 1.0), |_| [0.0, 0.0, 0.0, 1.0]);
+        let w = |n: &str| g.expressions.iter().find(|e| e.0 == n).map_or(-1.0, |e| e.1);
+        assert!((w("lookRight") - 0.5).abs() < 1e-5 && w("lookLeft") == 0.0, "{g:?}");
+        assert!(w("lookUp") == 0.0 && w("lookDown") == 0.0, "{g:?}");
+        let g = l.gaze(&head, Vec3f::new(0.0, 1.1, 1.0), |_| [0.0, 0.0, 0.0, 1.0]);
+        let w = |n: &str| g.expressions.iter().find(|e| e.0 == n).map_or(-1.0, |e| e.1);
+        assert!((w("lookUp") - 0.5).abs() < 1e-5, "{g:?}");
+        // A target at the eye gives no gaze; a NaN one neither.
+        assert_eq!(l.gaze(&head, Vec3f::new(0.0, 0.1, 0.0), |_| [0.0; 4]).expressions.len(), 0);
+        assert_eq!(l.gaze(&head, Vec3f::new(f32::NAN, 0.1, 0.0), |_| [0.0; 4]).expressions.len(), 0);
+    }
 }

@@ -200,3 +200,73 @@ fn the_generated_blast_character_has_spring_hair_and_skirt_that_fall_and_settle(
     assert!(moved(&b, &c) < 1e-3, "and settle: {}", moved(&b, &c));
     assert!(b.objects[0].mesh.positions.iter().flatten().all(|x| x.is_finite()));
 }
+
+/// `brace.vrm` with look-at of type expression: `lookLeft` closes the eyes (the blink morph target),
+/// `lookUp` opens the mouth (`aa`), range maps 0–90° → 0–1.
+fn look_folder(tag: &str) -> PathBuf {
+    let d = folder(tag);
+    let data = std::fs::read(asset("brace.vrm")).unwrap();
+    let mut j = json_of(&data);
+    let head_mesh = j["nodes"].as_array().unwrap().iter().position(|n| n["name"] == "head_mesh").unwrap();
+    let vrm = &mut j["extensions"]["VRMC_vrm"];
+    let map = json!({ "inputMaxValue": 90.0, "outputScale": 1.0 });
+    vrm["lookAt"] = json!({ "type": "expression", "offsetFromHeadBone": [0.0, 0.1, 0.1],
+        "rangeMapHorizontalInner": map, "rangeMapHorizontalOuter": map,
+        "rangeMapVerticalDown": map, "rangeMapVerticalUp": map });
+    vrm["expressions"]["preset"]["lookLeft"] =
+        json!({ "morphTargetBinds": [{ "node": head_mesh, "index": 0, "weight": 1.0 }] });
+    vrm["expressions"]["preset"]["lookUp"] =
+        json!({ "morphTargetBinds": [{ "node": head_mesh, "index": 1, "weight": 1.0 }] });
+    std::fs::write(d.join("eyes.vrm"), with_json(&data, &j)).unwrap();
+    d
+}
+
+#[test]
+fn the_eyes_follow_a_point_the_camera_and_a_waves_head() {
+    let d = look_folder("look");
+    // The head (1.53) plus the offset (0.1) is at y 1.63, z 0.1: a point straight to the character's
+    // left, level with it, is 90° of yaw: `lookLeft` at its full weight, as `blink = 1` gives.
+    let blink = scene(&d, "path = \"eyes.vrm\"\nexpressions = { blink = 1.0 }", "").unwrap();
+    let left = scene(&d, "path = \"eyes.vrm\"\nlook_at = [5.0, 1.63, 0.1]", "").unwrap();
+    let pos = |s: &Scene, t: f32| s.at(t).objects[0].mesh.positions.clone();
+    let close = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| (p[0] - q[0]).abs().max((p[1] - q[1]).abs()).max((p[2] - q[2]).abs()))
+            .fold(0.0f32, f32::max)
+    };
+    assert!(close(&pos(&left, 0.0), &pos(&blink, 0.0)) < 1e-5);
+    // Straight ahead (the camera at z = 6): no look expression, the rest pose.
+    let ahead = scene(&d, "path = \"eyes.vrm\"\nlook_at = \"camera\"", "").unwrap();
+    let rest = scene(&d, "path = \"brace.vrm\"", "").unwrap();
+    assert!(close(&pos(&ahead, 0.0), &pos(&rest, 0.0)) < 2e-3);
+    // A beam's head rising past the character: the eyes follow it up (the mouth opens, `lookUp`).
+    let beam = "[[wave]]\nname = \"beam\"\nkind = \"beam\"\nM = [0.0, 1.63, 3.0]\nD = [0.0, 1.0, 0.0]\nlength = 0.0\n\
+        alpha_s = 0.02\nalpha_c = 0.02\n[[track]]\ntarget = \"wave.beam.length\"\nkeys = [[0.0, 0.0], [1.0, 3.0]]\n";
+    let follow = scene(&d, "path = \"eyes.vrm\"\nlook_at = \"beam\"", beam).unwrap();
+    let mouth = scene(&d, "path = \"eyes.vrm\"\nexpressions = { aa = 0.5 }", "").unwrap();
+    // At 1 s the head is 3 above and 2.9 in front of the eyes: 45.97° up.
+    let want = scene(
+        &d,
+        &format!("path = \"eyes.vrm\"\nexpressions = {{ aa = {} }}", (3.0f32).atan2(2.9).to_degrees() / 90.0),
+        "",
+    )
+    .unwrap();
+    assert!(close(&pos(&follow, 1.0), &pos(&want, 0.0)) < 1e-4);
+    assert!(close(&pos(&follow, 0.0), &pos(&mouth, 0.0)) > 1e-3);
+    // An animated point.
+    let track =
+        "[[track]]\ntarget = \"object.who.look_at\"\nkeys = [[0.0, [0.0, 1.63, 5.0]], [1.0, [5.0, 1.63, 0.1]]]\n";
+    let moving = scene(&d, "path = \"eyes.vrm\"\nlook_at = [0.0, 1.63, 5.0]", track).unwrap();
+    assert!(close(&pos(&moving, 1.0), &pos(&blink, 0.0)) < 1e-5);
+    // Bad input, located.
+    let e = scene(&d, "path = \"eyes.vrm\"\nlook_at = \"nothing\"", beam).unwrap_err();
+    assert!(
+        e.contains("scene.toml:9:11") && e.contains("names no wave \"nothing\"") && e.contains("\"beam\""),
+        "{e}"
+    );
+    let e = scene(&d, "path = \"brace.vrm\"\nlook_at = \"camera\"", "").unwrap_err();
+    assert!(e.contains("scene.toml:9:1") && e.contains("no VRM look-at"), "{e}");
+    let e = scene(&d, "path = \"eyes.vrm\"\nlook_at = [0.0, nan, 1.0]", "").unwrap_err();
+    assert!(e.contains("scene.toml:9:") && e.contains("look_at"), "{e}");
+}
