@@ -66,9 +66,9 @@ pub(crate) struct SpringState {
     /// The step it was made at rest at.
     pub start: u64,
     /// Per joint (springs in order), the previous and current tail, in the spring's center space.
-    tails: Vec<(Vec3f, Vec3f)>,
+    pub(crate) tails: Vec<(Vec3f, Vec3f)>,
     /// Per joint, its local rotation now.
-    rotations: Vec<[f32; 4]>,
+    pub(crate) rotations: Vec<[f32; 4]>,
 }
 
 /// A node's translation, rotation and scale (a matrix node: `None`).
@@ -135,20 +135,65 @@ impl Rig {
     /// One step of `state` (module docs), driven by `input`; `dt` is the step in seconds.
     pub(crate) fn spring_step(&self, state: &mut SpringState, input: &StepInput<'_>, dt: f32) {
         let Some(sb) = self.springs.as_ref() else { return };
+        self.spring_step_part(0..sb.springs.len(), &mut state.tails, &mut state.rotations, input, dt);
+        state.step += 1;
+    }
+
+    /// One step of springs `part` alone, whose joints' tails and rotations are `tails` and
+    /// `rotations` (a run of [`SpringState`]'s): what [`Rig::spring_step`] does for them when no
+    /// other spring moves what they hang from, centre on or collide with
+    /// ([`SpringBones::independent`]).
+    pub(crate) fn spring_step_part(
+        &self,
+        part: std::ops::Range<usize>,
+        tails: &mut [(Vec3f, Vec3f)],
+        rotations: &mut [[f32; 4]],
+        input: &StepInput<'_>,
+        dt: f32,
+    ) {
+        let Some(sb) = self.springs.as_ref() else { return };
+        let Some(springs) = sb.springs.get(part) else { return };
         let mut locals = self.step_locals(input);
         // The last step's rotations, so colliders and springs below other springs see them.
-        for (j, r) in sb.springs.iter().flat_map(|s| &s.joints).zip(&state.rotations) {
+        for (j, r) in springs.iter().flat_map(|s| &s.joints).zip(rotations.iter()) {
             if let Some((_, rot, _)) = locals[j.node].as_mut() {
                 *rot = *r;
             }
         }
-        let colliders: Vec<Mat4> = sb.colliders.iter().map(|c| self.global_of(c.node, &locals)).collect();
+        // Globals of the nodes no joint moves, worked out once this step.
+        let mut memo: Vec<Option<Mat4>> = vec![None; self.nodes.len()];
+        let mut global = |node: usize, locals: &[Trs]| -> Mat4 {
+            if sb.moving.get(node).copied().unwrap_or(true) {
+                return self.global_of(node, locals);
+            }
+            // Up to the nearest known ancestor, then down.
+            let mut path = Vec::new();
+            let mut at = Some(node);
+            let mut m = self.base;
+            while let Some(n) = at {
+                if let Some(g) = memo[n] {
+                    m = g;
+                    break;
+                }
+                path.push(n);
+                at = self.nodes[n].parent;
+                if path.len() > self.nodes.len() {
+                    break;
+                }
+            }
+            for &n in path.iter().rev() {
+                m = m * self.local_matrix(n, locals[n]);
+                memo[n] = Some(m);
+            }
+            m
+        };
+        let colliders: Vec<Mat4> = sb.colliders.iter().map(|c| global(c.node, &locals)).collect();
         let mut k = 0;
-        for s in &sb.springs {
-            let center = s.center.map_or(Mat4::IDENTITY, |c| self.global_of(c, &locals));
-            let to_center = affine_inverse(&center);
+        for s in springs {
+            let center = s.center.map(|c| global(c, &locals));
+            let to_center = center.as_ref().map(affine_inverse);
             let mut parent = match s.joints.first().and_then(|j| self.nodes[j.node].parent) {
-                Some(p) => self.global_of(p, &locals),
+                Some(p) => global(p, &locals),
                 None => self.base,
             };
             for j in &s.joints {
@@ -173,8 +218,11 @@ impl Rig {
                     parent = m0;
                     continue;
                 }
-                let (prev, cur) = state.tails[idx];
-                let (prev, cur) = (center.transform_point(prev), center.transform_point(cur));
+                let Some(&(prev, cur)) = tails.get(idx) else { return };
+                let (prev, cur) = match &center {
+                    Some(c) => (c.transform_point(prev), c.transform_point(cur)),
+                    None => (prev, cur),
+                };
                 let mut force = (j.gravity_dir * j.gravity_power) + (input.wind)(cur);
                 let f = force.length();
                 if f.is_nan() || f > SPRING_FORCE_MAX {
@@ -205,21 +253,49 @@ impl Rig {
                 if !next.is_finite() {
                     next = rest_tail;
                 }
-                let back = to_center.transform_point(next);
-                let back = if back.is_finite() { back } else { to_center.transform_point(rest_tail) };
-                state.tails[idx] = (state.tails[idx].1, back);
-                let local = affine_inverse(&m0).transform_point(next);
+                let back = match &to_center {
+                    Some(c) => {
+                        let b = c.transform_point(next);
+                        if b.is_finite() {
+                            b
+                        } else {
+                            c.transform_point(rest_tail)
+                        }
+                    }
+                    None => next,
+                };
+                let Some(slot) = tails.get_mut(idx) else { return };
+                *slot = (slot.1, back);
+                let local = local_direction(&m0, next - head);
                 let turn = from_to(axis, local.try_normalize().unwrap_or(axis));
                 let r = normalize_quat(quat_mul(*rest_r, turn));
-                state.rotations[idx] = r;
+                if let Some(slot) = rotations.get_mut(idx) {
+                    *slot = r;
+                }
                 if let Some((_, rot, _)) = locals[j.node].as_mut() {
                     *rot = r;
                 }
                 parent = parent * trs_matrix(t, r, sc);
             }
         }
-        state.step += 1;
     }
+}
+
+/// World vector `v` in the space of `m` (its 3×3 block inverted as `Mᵀ` with each row divided by
+/// that column's squared length: exact for a rotation times a scale, which a joint's global matrix
+/// is unless a parent scales unevenly under a turn). Only its direction is used.
+fn local_direction(m: &Mat4, v: Vec3f) -> Vec3f {
+    let c = |k: usize| Vec3f::new(m.cols[k][0], m.cols[k][1], m.cols[k][2]);
+    let row = |k: usize| {
+        let col = c(k);
+        let l2 = col.length_squared();
+        if l2 > 0.0 {
+            col.dot(v) / l2
+        } else {
+            0.0
+        }
+    };
+    Vec3f::new(row(0), row(1), row(2))
 }
 
 /// The point of segment `a..b` nearest `p`.

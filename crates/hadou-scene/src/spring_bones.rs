@@ -50,6 +50,9 @@ pub(crate) struct Spring {
 pub struct SpringBones {
     pub(crate) springs: Vec<Spring>,
     pub(crate) colliders: Vec<Collider>,
+    /// Per node, whether its global matrix depends on a joint's turn (a joint or below one); the
+    /// others' are worked out once a step.
+    pub(crate) moving: Vec<bool>,
 }
 
 impl SpringBones {
@@ -78,4 +81,36 @@ pub(crate) fn affine_inverse(m: &Mat4) -> Mat4 {
     let it = inv.transform_vector(t);
     inv.cols[3] = [-it.x, -it.y, -it.z, 1.0];
     inv
+}
+
+impl SpringBones {
+    /// Whether every spring hangs from, centres on and collides with nodes that no joint moves:
+    /// then each spring's motion depends on the animation and the wind alone, and springs can be
+    /// stepped apart from each other (on several threads) with the same result.
+    pub(crate) fn independent(&self, parent_of: impl Fn(usize) -> Option<usize>) -> bool {
+        let still = |n: usize| !self.moving.get(n).copied().unwrap_or(true);
+        self.springs.iter().all(|s| {
+            s.joints.first().is_none_or(|j| parent_of(j.node).is_none_or(still))
+                && s.center.is_none_or(still)
+                && s.colliders.iter().all(|&c| self.colliders.get(c).is_some_and(|c| still(c.node)))
+        })
+    }
+
+    /// The springs in at most `parts` runs of about equal joint counts: each run's springs and
+    /// joints (indices into the joints of all springs in order).
+    pub(crate) fn runs(&self, parts: usize) -> Vec<(std::ops::Range<usize>, std::ops::Range<usize>)> {
+        let total = self.joint_count();
+        let parts = parts.clamp(1, self.springs.len().max(1));
+        let mut out = Vec::new();
+        let (mut s0, mut j0, mut j) = (0, 0, 0);
+        for (i, s) in self.springs.iter().enumerate() {
+            j += s.joints.len();
+            if j * parts >= total * (out.len() + 1) && out.len() + 1 < parts {
+                out.push((s0..i + 1, j0..j));
+                (s0, j0) = (i + 1, j);
+            }
+        }
+        out.push((s0..self.springs.len(), j0..j));
+        out
+    }
 }

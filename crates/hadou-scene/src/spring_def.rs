@@ -109,6 +109,17 @@ pub(crate) fn read_springs(
     if sb.springs.iter().all(|s| s.joints.is_empty()) {
         return Ok(None);
     }
+    let mut sb = sb;
+    let mut moving = vec![false; nodes.len()];
+    for j in sb.springs.iter().flat_map(|s| &s.joints) {
+        moving[j.node] = true;
+    }
+    for &i in order {
+        if let Some(p) = nodes[i].parent {
+            moving[i] |= moving[p];
+        }
+    }
+    sb.moving = moving;
     let pairs: usize = sb.springs.iter().map(|s| s.joints.len() * s.colliders.len()).sum();
     if pairs > MAX_SPRING_COLLISION_PAIRS {
         return Err(format!(
@@ -259,7 +270,7 @@ fn read_1(s: &Value, nodes: &[RigNode]) -> Result<SpringBones, String> {
         springs.push(Spring { joints: chain, colliders: members, center });
     }
     check_joints(&springs, &format!("{root}.springs"))?;
-    Ok(SpringBones { springs, colliders })
+    Ok(SpringBones { springs, colliders, moving: Vec::new() })
 }
 
 /// VRM 0.x `secondaryAnimation`, converted (module docs).
@@ -368,7 +379,7 @@ fn read_0(s: &Value, nodes: &[RigNode], order: &[usize]) -> Result<SpringBones, 
         }
     }
     check_joints(&springs, &format!("{root}.boneGroups"))?;
-    Ok(SpringBones { springs, colliders })
+    Ok(SpringBones { springs, colliders, moving: Vec::new() })
 }
 
 /// A VRM 0.x leaf's tail in its local space: 0.07 units past it along its parent-to-it direction.

@@ -24,6 +24,9 @@ pub fn spring_steps_at(time: f32) -> u64 {
     }
 }
 
+/// Least work (steps × joints) worth spreading over threads: below it one thread is quicker.
+const SPRING_PARALLEL_WORK: usize = 4096;
+
 /// One wave's wind at a step: its centre line, strength and falloff.
 struct WindSource {
     line: crate::LightLine,
@@ -63,6 +66,35 @@ impl Scene {
             }
         };
         let dt = (1.0 / SPRING_RATE) as f32;
+        // Springs that move apart from each other are stepped on the machine's threads, each
+        // thread all the steps of its run of springs (the same operations as one thread does).
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let work = (n - state.step) as usize * springs.joint_count();
+        if threads > 1 && work >= SPRING_PARALLEL_WORK && springs.independent(|i| rig.nodes[i].parent) {
+            let runs = springs.runs(threads);
+            let from = state.step;
+            let mut tails: &mut [(Vec3f, Vec3f)] = &mut state.tails;
+            let mut rotations: &mut [[f32; 4]] = &mut state.rotations;
+            let mut jobs = Vec::new();
+            for (part, joints) in runs {
+                let (t, rest_t) = std::mem::take(&mut tails).split_at_mut(joints.len());
+                let (r, rest_r) = std::mem::take(&mut rotations).split_at_mut(joints.len());
+                (tails, rotations) = (rest_t, rest_r);
+                jobs.push((part, t, r));
+            }
+            std::thread::scope(|scope| {
+                for (part, t, r) in jobs {
+                    scope.spawn(move || {
+                        for k in from + 1..=n {
+                            self.with_step_input(o, k, |input| {
+                                rig.spring_step_part(part.clone(), t, r, input, dt)
+                            });
+                        }
+                    });
+                }
+            });
+            state.step = n;
+        }
         while state.step < n {
             let k = state.step + 1;
             self.with_step_input(o, k, |input| rig.spring_step(&mut state, input, dt));
