@@ -46,7 +46,7 @@ pub use crate::limits::{
 };
 use crate::rig::{Clip, PoseInput, RestLocal, Rig};
 pub(crate) use crate::spring_bones::{affine_inverse, ColliderShape, SpringBones};
-use hadou_math::keyframes::{normalize_quat, quat_mul, trs_matrix};
+use hadou_math::keyframes::quat_mul;
 use hadou_math::{Mat4, Vec3f};
 
 /// What drives one step: the animation at the step's time and the wind there.
@@ -205,7 +205,7 @@ impl Rig {
                     parent = parent * self.local_matrix(j.node, locals[j.node]);
                     continue;
                 };
-                let m0 = parent * trs_matrix(t, *rest_r, sc);
+                let m0 = affine_mul(&parent, &fast_trs(t, *rest_r, sc));
                 let head = m0.transform_point(Vec3f::ZERO);
                 let rest_tail = m0.transform_point(j.tail);
                 let length = (rest_tail - head).length();
@@ -268,14 +268,14 @@ impl Rig {
                 *slot = (slot.1, back);
                 let local = local_direction(&m0, next - head);
                 let turn = from_to(axis, local.try_normalize().unwrap_or(axis));
-                let r = normalize_quat(quat_mul(*rest_r, turn));
+                let r = unit_quat(quat_mul(*rest_r, turn));
                 if let Some(slot) = rotations.get_mut(idx) {
                     *slot = r;
                 }
                 if let Some((_, rot, _)) = locals[j.node].as_mut() {
                     *rot = r;
                 }
-                parent = parent * trs_matrix(t, r, sc);
+                parent = affine_mul(&parent, &fast_trs(t, r, sc));
             }
         }
     }
@@ -298,6 +298,49 @@ fn local_direction(m: &Mat4, v: Vec3f) -> Vec3f {
     Vec3f::new(row(0), row(1), row(2))
 }
 
+/// `q / |q|` in f32, or the identity for a zero or non-finite `q` (the simulation's own, cheaper than
+/// `hadou_math::keyframes::normalize_quat`'s f64).
+fn unit_quat(q: [f32; 4]) -> [f32; 4] {
+    let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    if l > 1e-30 && l.is_finite() {
+        q.map(|c| c / l)
+    } else {
+        [0.0, 0.0, 0.0, 1.0]
+    }
+}
+
+/// `T·R·S` built directly (the rotation normalised): what `hadou_math::keyframes::trs_matrix`
+/// gives, without its two matrix products.
+fn fast_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
+    let [x, y, z, w] = unit_quat(r);
+    let (xx, yy, zz) = (x * x, y * y, z * z);
+    let (xy, xz, yz, wx, wy, wz) = (x * y, x * z, y * z, w * x, w * y, w * z);
+    Mat4 {
+        cols: [
+            [(1.0 - 2.0 * (yy + zz)) * s[0], 2.0 * (xy + wz) * s[0], 2.0 * (xz - wy) * s[0], 0.0],
+            [2.0 * (xy - wz) * s[1], (1.0 - 2.0 * (xx + zz)) * s[1], 2.0 * (yz + wx) * s[1], 0.0],
+            [2.0 * (xz + wy) * s[2], 2.0 * (yz - wx) * s[2], (1.0 - 2.0 * (xx + yy)) * s[2], 0.0],
+            [t[0], t[1], t[2], 1.0],
+        ],
+    }
+}
+
+/// `a·b` for affine matrices (last rows `0 0 0 1`).
+fn affine_mul(a: &Mat4, b: &Mat4) -> Mat4 {
+    let mut m = Mat4::IDENTITY;
+    for c in 0..4 {
+        for r in 0..3 {
+            let mut s =
+                a.cols[0][r] * b.cols[c][0] + a.cols[1][r] * b.cols[c][1] + a.cols[2][r] * b.cols[c][2];
+            if c == 3 {
+                s += a.cols[3][r];
+            }
+            m.cols[c][r] = s;
+        }
+    }
+    m
+}
+
 /// The point of segment `a..b` nearest `p`.
 fn nearest_on_segment(p: Vec3f, a: Vec3f, b: Vec3f) -> Vec3f {
     let ab = b - a;
@@ -317,5 +360,5 @@ pub(crate) fn from_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
         return [n.x, n.y, n.z, 0.0];
     }
     let c = a.cross(b);
-    normalize_quat([c.x, c.y, c.z, 1.0 + d])
+    unit_quat([c.x, c.y, c.z, 1.0 + d])
 }
