@@ -540,3 +540,53 @@ mod look {
         assert_eq!(l.gaze(&head, Vec3f::new(f32::NAN, 0.1, 0.0), |_| [0.0; 4]).expressions.len(), 0);
     }
 }
+
+#[test]
+fn a_center_carries_the_tails_with_it() {
+    use crate::rig::{Channel, ChannelPath, Clip};
+    // The root slides 1 unit along +x in 0.5 s. A free chain (no stiffness, no gravity) lags
+    // behind it; with `center` = the root, the tails are kept in the root's space and the chain
+    // moves with it, unbent.
+    let clip = Clip {
+        name: "slide".into(),
+        duration: 0.5,
+        channels: vec![Channel {
+            node: 0,
+            path: ChannelPath::Translation,
+            sampling: hadou_math::keyframes::Sampling::Linear,
+            times: vec![0.0, 0.5],
+            values: vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            width: 3,
+        }],
+    };
+    let bend = |center: bool| {
+        let nodes =
+            vec![node(None, [0.0; 3]), node(Some(0), [0.0, 1.0, 0.0]), node(Some(1), [0.0, -0.5, 0.0])];
+        let j = |n| joint(n, json!({ "gravityPower": 0.0, "dragForce": 0.1 }));
+        let mut spring = json!({ "joints": [j(1), j(2)] });
+        if center {
+            spring["center"] = json!(0);
+        }
+        let r = rig(nodes, json!({ "VRMC_springBone": { "springs": [spring] } }));
+        let wind = no_wind;
+        let input = |k: u64| StepInput { clip: Some(&clip), clip_time: (k as f64 * DT) as f32, wind: &wind };
+        let mut state = r.spring_rest(0, &input(0)).expect("springs");
+        let sb = r.springs.as_ref().expect("springs");
+        let mut worst = 0.0f64;
+        for k in 1..=30u64 {
+            r.spring_step(&mut state, &input(k), DT as f32);
+            let rot = state.rotations(sb);
+            let g = r.node_globals(&PoseInput {
+                clip: Some(&clip),
+                time: (k as f64 * DT) as f32,
+                rotations: &rot,
+                ..Default::default()
+            });
+            let d = sub(pos(&g[2]), pos(&g[1]));
+            worst = worst.max(d[0].abs());
+        }
+        worst
+    };
+    assert!(bend(false) > 0.05, "without a center the chain lags: {}", bend(false));
+    assert!(bend(true) < 1e-5, "with the root as center it moves along unbent: {}", bend(true));
+}
