@@ -157,6 +157,8 @@ pub struct PoseInput<'a> {
     /// `(node, unit quaternion)`: local rotations that replace the clip's and the rest's (the
     /// spring bones' turns).
     pub rotations: &'a [(usize, [f32; 4])],
+    /// Only the nodes' transforms are wanted (the spring simulation): no morph weights.
+    pub skip_weights: bool,
 }
 
 impl Rig {
@@ -236,7 +238,11 @@ impl Rig {
                 RestLocal::Matrix(_) => None,
             })
             .collect();
-        let mut weights: Vec<Vec<f32>> = self.nodes.iter().map(|node| node.weights.clone()).collect();
+        let mut weights: Vec<Vec<f32>> = if input.skip_weights {
+            Vec::new()
+        } else {
+            self.nodes.iter().map(|node| node.weights.clone()).collect()
+        };
         let mut clip_expressions: Vec<(usize, f32)> = Vec::new();
         if let Some(clip) = input.clip {
             let mut buf = [0.0f32; 4];
@@ -248,7 +254,7 @@ impl Rig {
                 }
                 let rotation = ch.path == ChannelPath::Rotation;
                 if ch.path == ChannelPath::Weights {
-                    let w = &mut weights[ch.node];
+                    let Some(w) = weights.get_mut(ch.node) else { continue };
                     if w.len() == ch.width {
                         sample(ch.sampling, &ch.times, &ch.values, ch.width, false, input.time, w);
                     }

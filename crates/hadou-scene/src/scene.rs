@@ -471,7 +471,13 @@ impl Scene {
             }
         }
         let clip = o.motion.as_ref().and_then(|m| m.clip.as_deref());
-        let input = PoseInput { clip, time: clip_t, expressions: &expressions, rotations: &rotations };
+        let input = PoseInput {
+            clip,
+            time: clip_t,
+            expressions: &expressions,
+            rotations: &rotations,
+            skip_weights: false,
+        };
         let mesh = Arc::new(rig.pose(&o.mesh, &input));
         if let Ok(mut cache) = o.pose_cache.lock() {
             *cache = Some((key, mesh.clone()));

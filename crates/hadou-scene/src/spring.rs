@@ -112,7 +112,8 @@ impl Rig {
 
     /// The nodes' local transforms for `input`'s clip time (no spring rotations).
     fn step_locals(&self, input: &StepInput<'_>) -> Vec<Trs> {
-        let pose = PoseInput { clip: input.clip, time: input.clip_time, ..Default::default() };
+        let pose =
+            PoseInput { clip: input.clip, time: input.clip_time, skip_weights: true, ..Default::default() };
         self.sample_locals(&pose).0
     }
 
@@ -275,7 +276,7 @@ impl Rig {
                 if let Some((_, rot, _)) = locals[j.node].as_mut() {
                     *rot = r;
                 }
-                parent = affine_mul(&parent, &fast_trs(t, r, sc));
+                parent = affine_mul(&parent, &unit_trs(t, r, sc));
             }
         }
     }
@@ -303,7 +304,8 @@ fn local_direction(m: &Mat4, v: Vec3f) -> Vec3f {
 fn unit_quat(q: [f32; 4]) -> [f32; 4] {
     let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
     if l > 1e-30 && l.is_finite() {
-        q.map(|c| c / l)
+        let inv = 1.0 / l;
+        q.map(|c| c * inv)
     } else {
         [0.0, 0.0, 0.0, 1.0]
     }
@@ -312,7 +314,12 @@ fn unit_quat(q: [f32; 4]) -> [f32; 4] {
 /// `T·R·S` built directly (the rotation normalised): what `hadou_math::keyframes::trs_matrix`
 /// gives, without its two matrix products.
 fn fast_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
-    let [x, y, z, w] = unit_quat(r);
+    unit_trs(t, unit_quat(r), s)
+}
+
+/// [`fast_trs`] of a rotation already of unit length.
+fn unit_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
+    let [x, y, z, w] = r;
     let (xx, yy, zz) = (x * x, y * y, z * z);
     let (xy, xz, yz, wx, wy, wz) = (x * y, x * z, y * z, w * x, w * y, w * z);
     Mat4 {

@@ -138,10 +138,13 @@ impl Scene {
             let mut f = Vec3f::ZERO;
             for s in &sources {
                 let away = pw - s.line.nearest(pw);
-                let d = away.length();
-                let Some(dir) = away.try_normalize() else { continue };
+                let d2 = away.length_squared();
+                if d2.is_nan() || d2 <= 0.0 {
+                    continue;
+                }
+                let d = d2.sqrt();
                 let rho = hadou_math::toon::dominance(d, s.core, s.strength, s.inverse_square);
-                f += dir * (s.wind * rho);
+                f += away * (s.wind * rho / d);
             }
             let f = to_rig.transform_vector(f);
             if f.is_finite() {
