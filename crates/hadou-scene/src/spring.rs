@@ -44,7 +44,7 @@ pub use crate::limits::{
     MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
     SPRING_RATE,
 };
-use crate::rig::{Clip, PoseInput, RestLocal, Rig};
+use crate::rig::{Clip, PoseInput, Rig};
 pub(crate) use crate::spring_bones::{affine_inverse, ColliderShape, SpringBones};
 use hadou_math::keyframes::quat_mul;
 use hadou_math::{Mat4, Vec3f};
@@ -101,10 +101,7 @@ impl Rig {
                 let tail = to_center.transform_point(g.transform_point(j.tail));
                 let tail = if tail.is_finite() { tail } else { Vec3f::ZERO };
                 tails.push((tail, tail));
-                rotations.push(match self.nodes[j.node].rest {
-                    RestLocal::Trs { r, .. } => r,
-                    RestLocal::Matrix(_) => [0.0, 0.0, 0.0, 1.0],
-                });
+                rotations.push(j.rest);
             }
         }
         Some(SpringState { step: start, start, tails, rotations })
@@ -188,7 +185,23 @@ impl Rig {
             }
             m
         };
-        let colliders: Vec<Mat4> = sb.colliders.iter().map(|c| global(c.node, &locals)).collect();
+        // Each collider this step: a segment `a..b` (a sphere's is a point) and its radius.
+        let colliders: Vec<(Vec3f, Vec3f, f32)> = sb
+            .colliders
+            .iter()
+            .map(|c| {
+                let g = global(c.node, &locals);
+                match c.shape {
+                    ColliderShape::Sphere { offset, radius } => {
+                        let p = g.transform_point(offset);
+                        (p, p, radius)
+                    }
+                    ColliderShape::Capsule { offset, tail, radius } => {
+                        (g.transform_point(offset), g.transform_point(tail), radius)
+                    }
+                }
+            })
+            .collect();
         let mut k = 0;
         for s in springs {
             let center = s.center.map(|c| global(c, &locals));
@@ -200,25 +213,21 @@ impl Rig {
             for j in &s.joints {
                 let idx = k;
                 k += 1;
-                let (RestLocal::Trs { r: rest_r, .. }, Some((t, _, sc))) =
-                    (&self.nodes[j.node].rest, locals[j.node])
-                else {
+                let (Some((t, _, sc)), Some(axis)) = (locals[j.node], j.axis) else {
                     parent = parent * self.local_matrix(j.node, locals[j.node]);
                     continue;
                 };
-                let m0 = affine_mul(&parent, &fast_trs(t, *rest_r, sc));
-                let head = m0.transform_point(Vec3f::ZERO);
-                let rest_tail = m0.transform_point(j.tail);
-                let length = (rest_tail - head).length();
-                let axis = j.tail.try_normalize();
-                let (Some(rest_dir), Some(axis)) = ((rest_tail - head).try_normalize(), axis) else {
-                    parent = m0;
-                    continue;
-                };
-                if !length.is_finite() {
+                let rest_r = &j.rest;
+                let m0 = affine_mul(&parent, &unit_trs(t, *rest_r, sc));
+                let head = Vec3f::new(m0.cols[3][0], m0.cols[3][1], m0.cols[3][2]);
+                let span = m0.transform_point(j.tail) - head;
+                let rest_tail = head + span;
+                let length = span.length();
+                if !(length > 0.0 && length.is_finite()) {
                     parent = m0;
                     continue;
                 }
+                let rest_dir = span * (1.0 / length);
                 let Some(&(prev, cur)) = tails.get(idx) else { return };
                 let (prev, cur) = match &center {
                     Some(c) => (c.transform_point(prev), c.transform_point(cur)),
@@ -233,14 +242,8 @@ impl Rig {
                     cur + (cur - prev) * (1.0 - j.drag) + rest_dir * (j.stiffness * dt) + force * dt;
                 next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
                 for &c in &s.colliders {
-                    let (Some(col), Some(g)) = (sb.colliders.get(c), colliders.get(c)) else { continue };
-                    let (at, radius) = match col.shape {
-                        ColliderShape::Sphere { offset, radius } => (g.transform_point(offset), radius),
-                        ColliderShape::Capsule { offset, tail, radius } => {
-                            let (a, b) = (g.transform_point(offset), g.transform_point(tail));
-                            (nearest_on_segment(next, a, b), radius)
-                        }
-                    };
+                    let Some(&(a, b, radius)) = colliders.get(c) else { continue };
+                    let at = nearest_on_segment(next, a, b);
                     let reach = radius + j.hit_radius;
                     let d = next - at;
                     let dist = d.length();
@@ -311,13 +314,8 @@ fn unit_quat(q: [f32; 4]) -> [f32; 4] {
     }
 }
 
-/// `T·R·S` built directly (the rotation normalised): what `hadou_math::keyframes::trs_matrix`
-/// gives, without its two matrix products.
-fn fast_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
-    unit_trs(t, unit_quat(r), s)
-}
-
-/// [`fast_trs`] of a rotation already of unit length.
+/// `T·R·S` built directly from a rotation of unit length: what
+/// `hadou_math::keyframes::trs_matrix` gives, without its normalisation and two matrix products.
 fn unit_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
     let [x, y, z, w] = r;
     let (xx, yy, zz) = (x * x, y * y, z * z);

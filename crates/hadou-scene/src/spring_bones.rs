@@ -33,6 +33,12 @@ pub(crate) struct Joint {
     pub gravity_dir: Vec3f,
     /// In `[0, 1]`.
     pub drag: f32,
+    /// The node's rest rotation, of unit length (a joint turns from it); the identity for a node
+    /// with a matrix.
+    pub rest: [f32; 4],
+    /// `tail` of unit length; `None` for a zero tail or a node with a matrix (such a joint stays
+    /// at rest).
+    pub axis: Option<Vec3f>,
 }
 
 /// A chain of joints, each the parent of the next.

@@ -230,6 +230,8 @@ fn read_1(s: &Value, nodes: &[RigNode]) -> Result<SpringBones, String> {
             let joint = Joint {
                 node,
                 tail: Vec3f::ZERO,
+                rest: [0.0, 0.0, 0.0, 1.0],
+                axis: None,
                 hit_radius: number(j.get("hitRadius"), 0.0, 0.0, &format!("{jat}.hitRadius"))?,
                 stiffness: number(j.get("stiffness"), 1.0, 0.0, &format!("{jat}.stiffness"))?,
                 gravity_power: number(j.get("gravityPower"), 0.0, 0.0, &format!("{jat}.gravityPower"))?,
@@ -246,7 +248,7 @@ fn read_1(s: &Value, nodes: &[RigNode]) -> Result<SpringBones, String> {
         for w in js.windows(2) {
             let mut j = w[0].1.clone();
             j.tail = rest_translation(&nodes[w[1].0]);
-            chain.push(j);
+            chain.push(finish(j, nodes));
         }
         let mut members = Vec::new();
         for (k, g) in array(sp.get("colliderGroups"), &format!("{at}.colliderGroups"))?.iter().enumerate() {
@@ -313,6 +315,8 @@ fn read_0(s: &Value, nodes: &[RigNode], order: &[usize]) -> Result<SpringBones, 
         let template = Joint {
             node: 0,
             tail: Vec3f::ZERO,
+            rest: [0.0, 0.0, 0.0, 1.0],
+            axis: None,
             hit_radius: number(g.get("hitRadius"), 0.02, 0.0, &format!("{at}.hitRadius"))?,
             stiffness: number(g.get("stiffiness"), 1.0, 0.0, &format!("{at}.stiffiness"))?,
             gravity_power: number(g.get("gravityPower"), 0.0, 0.0, &format!("{at}.gravityPower"))?,
@@ -365,7 +369,7 @@ fn read_0(s: &Value, nodes: &[RigNode], order: &[usize]) -> Result<SpringBones, 
                         Some(&c) => rest_translation(&nodes[c]),
                         None => leaf_tail(nodes, &globals, n),
                     };
-                    chain.push(Joint { node: n, tail, ..template.clone() });
+                    chain.push(finish(Joint { node: n, tail, ..template.clone() }, nodes));
                     starts.extend(kids.iter().skip(1).rev());
                     match kids.first() {
                         Some(&c) => n = c,
@@ -380,6 +384,19 @@ fn read_0(s: &Value, nodes: &[RigNode], order: &[usize]) -> Result<SpringBones, 
     }
     check_joints(&springs, &format!("{root}.boneGroups"))?;
     Ok(SpringBones { springs, colliders, moving: Vec::new() })
+}
+
+/// `j` with its node's unit rest rotation and its unit tail direction (none for a matrix node or a
+/// zero tail: the joint stays at rest).
+fn finish(mut j: Joint, nodes: &[RigNode]) -> Joint {
+    match &nodes[j.node].rest {
+        RestLocal::Trs { r, .. } => {
+            j.rest = hadou_math::keyframes::normalize_quat(*r);
+            j.axis = j.tail.try_normalize().filter(|a| a.is_finite());
+        }
+        RestLocal::Matrix(_) => j.axis = None,
+    }
+    j
 }
 
 /// A VRM 0.x leaf's tail in its local space: 0.07 units past it along its parent-to-it direction.

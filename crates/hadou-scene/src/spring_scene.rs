@@ -130,11 +130,12 @@ impl Scene {
             .collect();
         let to_world = o.transform(&vals);
         let to_rig = affine_inverse(&to_world);
+        let placed = to_world != hadou_math::Mat4::IDENTITY;
         let wind = move |p: Vec3f| -> Vec3f {
             if sources.is_empty() {
                 return Vec3f::ZERO;
             }
-            let pw = to_world.transform_point(p);
+            let pw = if placed { to_world.transform_point(p) } else { p };
             let mut f = Vec3f::ZERO;
             for s in &sources {
                 let away = pw - s.line.nearest(pw);
@@ -146,7 +147,7 @@ impl Scene {
                 let rho = hadou_math::toon::dominance(d, s.core, s.strength, s.inverse_square);
                 f += away * (s.wind * rho / d);
             }
-            let f = to_rig.transform_vector(f);
+            let f = if placed { to_rig.transform_vector(f) } else { f };
             if f.is_finite() {
                 f
             } else {
