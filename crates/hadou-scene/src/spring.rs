@@ -29,7 +29,9 @@
 //! time `t` is the state after `n = ⌊t·SPRING_RATE⌋` steps, each step `k` driven by the animation
 //! and waves at time `k/SPRING_RATE`. A frame is thus a pure function of its time, whether it is
 //! rendered alone, in a sequence or in chunks; a per-object cache continues from the last state
-//! when a later time is asked for, which gives the same bits. Past [`SPRING_MAX_STEPS`] steps the
+//! when a later time is asked for, which gives the same bits. Springs that do not move each other
+//! (`SpringBones::independent`) may be stepped on several threads, each spring by the same
+//! operations, so again the same bits. Past [`SPRING_MAX_STEPS`] steps the
 //! simulation starts from rest [`SPRING_MAX_STEPS`] steps before `n` (a damped spring has long
 //! forgotten its start by then), so no frame costs more.
 //!
@@ -37,8 +39,8 @@
 //! centre line: `wind(p) = Σ w · ρ(|p − E|) · (p − E)/|p − E|`, `E` the nearest point of the
 //! wave's centre line ([`crate::LightLine::nearest`]: a curve's polyline) and `ρ` the energy density
 //! the shading weighs waves by ([`hadou_math::toon::dominance`] with the wave's core radius,
-//! strength `α·a` and falloff). The force is carried into the character's space and its length
-//! clamped to [`SPRING_FORCE_MAX`].
+//! strength `α·a` and falloff). The force is carried into the character's space, and gravity
+//! plus wind is shortened to at most [`SPRING_FORCE_MAX`].
 
 pub use crate::limits::{
     MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
