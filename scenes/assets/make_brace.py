@@ -20,6 +20,10 @@
   bound to the head's morph targets; `VRMC_materials_mtoon` on every material), T-pose at rest.
 - brace0.vrm: the same as a VRM 0.x avatar (the `VRM` extension: humanoid bone list, blend shape
   groups, MToon `materialProperties`), turned 180 degrees about y (VRM 0.x faces -z).
+- blast.vrm: brace.vrm with twelve hair strands (nine joints each) down the back of the head and a
+  skirt of sixteen strands (seven joints each) round the hips, every strand a VRMC_springBone
+  spring (the last joint of each only its tail: 192 joints turn), with sphere and capsule colliders
+  on the head, chest and upper legs; what a wave's wind blows (scenes/light-blast.toml).
 - brace.vrma: a `VRMC_vrm_animation` 1.0 clip `brace` on a humanoid skeleton of nodes whose upper
   arms rest 10 degrees lower than brace.vrm's, with a bone the avatars lack (leftThumbProximal) and
   a `blink` expression track (the expression node's translation x).
@@ -650,10 +654,76 @@ for _t, _s in (("L", "left"), ("R", "right")):
                   "upperLeg." + _t: _s + "UpperLeg", "lowerLeg." + _t: _s + "LowerLeg", "foot." + _t: _s + "Foot"})
 
 
+HAIR_STRANDS, HAIR_JOINTS, HAIR_TOP, HAIR_STEP = 12, 9, 1.66, 0.035
+SKIRT_STRANDS, SKIRT_JOINTS, SKIRT_TOP, SKIRT_STEP = 16, 7, 1.0, 0.045
+
+
+def add_strands(sk):
+    """blast.vrm's hair strands (on the head) and skirt strands (on the hips): lists of joints."""
+    hair, skirt = [], []
+    head, hips = sk.index("head"), sk.index("hips")
+    for k in range(HAIR_STRANDS):
+        a = math.radians(105.0 + 150.0 * k / (HAIR_STRANDS - 1))
+        x, z = 0.125 * math.sin(a), 0.125 * math.cos(a) - 0.01
+        p, chain = head, []
+        for i in range(HAIR_JOINTS):
+            p = sk.add("hair.%d.%d" % (k, i), p, (x, HAIR_TOP - HAIR_STEP * i, z))
+            chain.append(p)
+        hair.append(chain)
+    for k in range(SKIRT_STRANDS):
+        a = 2 * math.pi * (k + 0.5) / SKIRT_STRANDS
+        x, z = 0.2 * math.sin(a), 0.13 * math.cos(a)
+        p, chain = hips, []
+        for i in range(SKIRT_JOINTS):
+            p = sk.add("skirt.%d.%d" % (k, i), p, (x, SKIRT_TOP - SKIRT_STEP * i, z))
+            chain.append(p)
+        skirt.append(chain)
+    return hair, skirt
+
+
+def strand_geometry(sk, parts, hair, skirt):
+    """A thin tube down every strand, each segment bent by the joint above it."""
+    for chains, part, r, seg, step in ((hair, parts[HAIR], (0.014, 0.008), 5, HAIR_STEP),
+                                      (skirt, parts[SUIT], (0.03, 0.012), 6, SKIRT_STEP)):
+        for chain in chains:
+            x, y0, z = sk.pos[chain[0]]
+            y1 = sk.pos[chain[-1]][1]
+            centres = [-(sk.pos[j][1] - 0.5 * step) for j in chain[:-1]]
+            tube(part, (x, 0.0, z), "y", r[0], r[1], y1, y0, seg, len(chain) - 1,
+                 chain4(chain[:-1], centres, step), t_sign=-1.0)
+
+
+def spring_bones(hair, skirt, J):
+    """VRMC_springBone for blast.vrm: a spring per strand, colliders on head, chest and legs."""
+    colliders = [
+        {"node": J("head"), "shape": {"sphere": {"offset": [0.0, 0.11, 0.0], "radius": 0.13}}},
+        {"node": J("chest"), "shape": {"capsule": {"offset": [0.0, -0.12, 0.0], "tail": [0.0, 0.12, 0.0],
+                                                   "radius": 0.11}}},
+        {"node": J("upperLeg.L"), "shape": {"capsule": {"offset": [0.0, 0.0, 0.0], "tail": [0.0, -0.4, 0.0],
+                                                        "radius": 0.08}}},
+        {"node": J("upperLeg.R"), "shape": {"capsule": {"offset": [0.0, 0.0, 0.0], "tail": [0.0, -0.4, 0.0],
+                                                        "radius": 0.08}}},
+    ]
+    groups = [{"name": "head", "colliders": [0, 1]}, {"name": "legs", "colliders": [2, 3]}]
+    springs = []
+    for chains, name, group, params in ((hair, "hair", 0, (0.6, 0.4, 0.4, 0.012)),
+                                         (skirt, "skirt", 1, (1.0, 0.3, 0.5, 0.02))):
+        st, gp, dr, hr = params
+        for k, chain in enumerate(chains):
+            springs.append({"name": "%s.%d" % (name, k), "colliderGroups": [group],
+                            "joints": [{"node": j, "stiffness": st, "gravityPower": gp, "gravityDir": [0.0, -1.0, 0.0],
+                                        "dragForce": dr, "hitRadius": hr} for j in chain]})
+    return {"specVersion": "1.0", "colliders": colliders, "colliderGroups": groups, "springs": springs}
+
+
 def write_brace(path, kind):
-    """kind: "glb" (A-pose rest, clips), "vrm" (VRM 1.0, T-pose), "vrm0" (VRM 0.x, T-pose, faces -z)."""
+    """kind: "glb" (A-pose rest, clips), "vrm" (VRM 1.0, T-pose), "vrm0" (VRM 0.x, T-pose, faces -z),
+    "blast" (the VRM 1.0 avatar with spring-bone hair and skirt)."""
     sk = body_skeleton()
+    hair, skirt = add_strands(sk) if kind == "blast" else ([], [])
     parts = build_body(sk, 1.0)
+    if kind == "blast":
+        strand_geometry(sk, parts, hair, skirt)
     targets = face_targets(parts[FACE])
     flip = kind == "vrm0"
     if flip:
@@ -700,13 +770,13 @@ def write_brace(path, kind):
                    {"name": "head", "primitives": [head_prim], "weights": [0.0, 0.25],
                     "extras": {"targetNames": ["blink", "aa"]}},
                    {"name": "headband", "primitives": [band_prim]}],
-        "materials": materials(kind == "vrm"),
+        "materials": materials(kind in ("vrm", "blast")),
     })
     used = ["VRMC_materials_mtoon"]
     if kind == "glb":
         doc["animations"] = [add_clip(d, name, ch)
                              for name, ch in brace_clips(sk, nodes, band_node, head_node, arm_rest_l)]
-    elif kind == "vrm":
+    elif kind in ("vrm", "blast"):
         used.append("VRMC_vrm")
         doc["extensions"] = {"VRMC_vrm": {
             "specVersion": "1.0",
@@ -716,7 +786,7 @@ def write_brace(path, kind):
                      "commercialUsage": "personalNonProfit", "allowPoliticalOrReligiousUsage": False,
                      "allowAntisocialOrHateUsage": False, "creditNotation": "required", "allowRedistribution": True,
                      "modification": "allowModificationRedistribution"},
-            "humanoid": {"humanBones": {HUMAN[n]: {"node": j} for j, n in enumerate(sk.names)}},
+            "humanoid": {"humanBones": {HUMAN[n]: {"node": j} for j, n in enumerate(sk.names) if n in HUMAN}},
             "expressions": {"preset": {
                 "happy": {"morphTargetBinds": [{"node": head_node, "index": 1, "weight": 0.4}], "isBinary": False,
                           "overrideBlink": "none", "overrideLookAt": "none", "overrideMouth": "none"},
@@ -725,6 +795,9 @@ def write_brace(path, kind):
             }},
             "lookAt": {"offsetFromHeadBone": [0.0, 0.1, 0.1], "type": "bone"},
         }}
+        if kind == "blast":
+            used.append("VRMC_springBone")
+            doc["extensions"]["VRMC_springBone"] = spring_bones(hair, skirt, sk.index)
     else:
         used = ["VRM"]
         doc["materials"] = [{k: v for k, v in m.items() if k != "extensions"} for m in doc["materials"]]
@@ -903,5 +976,6 @@ if __name__ == "__main__":
     write_brace("brace.glb", "glb")
     write_brace("brace.vrm", "vrm")
     write_brace("brace0.vrm", "vrm0")
+    write_brace("blast.vrm", "blast")
     write_vrma("brace.vrma")
     write_dancer("dancer.glb")

@@ -463,6 +463,8 @@ fn build_rig(
     let mesh_of: Vec<Option<usize>> = nodes.iter().map(|n| n.mesh().map(|m| m.index())).collect();
     let expressions = crate::gltf_vrm::read_expressions(raw, &rig_nodes, &mesh_of)?;
     let humanoid = crate::gltf_vrm::read_humanoid(raw, nodes.len())?;
+    let springs = crate::spring_def::read_springs(raw, &rig_nodes, &order)?;
+    let look_at = crate::look_at::read_look_at(raw, &humanoid)?;
     Ok(Some(Rig {
         nodes: rig_nodes,
         order,
@@ -475,6 +477,8 @@ fn build_rig(
         base: Mat4::IDENTITY,
         groups: Vec::new(),
         group_count: 0,
+        springs,
+        look_at,
     }))
 }
 

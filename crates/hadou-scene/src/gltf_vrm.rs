@@ -163,7 +163,22 @@ pub(crate) fn read_expressions(
     Ok(out)
 }
 
-/// The humanoid bone map of a VRM file: `(bone name, node)` pairs (empty for other files).
+/// A VRM 0.x humanoid bone name as VRM 1.0 names that bone: 0.x counts the thumb's segments from
+/// the proximal one (`thumbProximal`, `thumbIntermediate`, `thumbDistal`), 1.0 from the metacarpal
+/// (`thumbMetacarpal`, `thumbProximal`, `thumbDistal`), as the VRM 1.0 migration maps them. Every
+/// other name is the same in both.
+pub(crate) fn thumb_1(name: &str) -> &str {
+    match name {
+        "leftThumbProximal" => "leftThumbMetacarpal",
+        "leftThumbIntermediate" => "leftThumbProximal",
+        "rightThumbProximal" => "rightThumbMetacarpal",
+        "rightThumbIntermediate" => "rightThumbProximal",
+        other => other,
+    }
+}
+
+/// The humanoid bone map of a VRM file: `(bone name, node)` pairs (empty for other files), VRM 0.x
+/// thumb names mapped to VRM 1.0's ([`thumb_1`]).
 pub(crate) fn read_humanoid(raw: &Value, n_nodes: usize) -> Result<Vec<(String, usize)>, String> {
     let Some(ext) = raw.get("extensions") else { return Ok(Vec::new()) };
     let mut out = Vec::new();
@@ -180,7 +195,7 @@ pub(crate) fn read_humanoid(raw: &Value, n_nodes: usize) -> Result<Vec<(String, 
             let name =
                 b.get("bone").and_then(Value::as_str).ok_or_else(|| format!("{at}.bone must be a string"))?;
             out.push((
-                name.to_string(),
+                thumb_1(name).to_string(),
                 index(b.get("node").unwrap_or(&Value::Null), n_nodes, &format!("{at}.node"))?,
             ));
         }

@@ -53,6 +53,7 @@ mod image;
 mod introspect;
 mod light_def;
 mod limits;
+mod look_at;
 mod materials;
 pub mod mesh;
 mod object_def;
@@ -63,6 +64,12 @@ mod schema;
 mod shadow;
 mod shadow_casts;
 mod shadow_def;
+mod spring;
+mod spring_bones;
+mod spring_def;
+mod spring_scene;
+#[cfg(test)]
+mod spring_tests;
 mod temp_file;
 mod texture;
 mod toml_read;
@@ -107,6 +114,11 @@ pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,
     MAX_SHADOW_CASTERS, MAX_SHADOW_TRIANGLES, ON_PLANE,
 };
+pub use spring::{
+    MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
+    SPRING_RATE,
+};
+pub use spring_bones::SpringBones;
 pub use temp_file::{remove_pending_temp_files, TempFile};
 pub use texture::{
     decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_BYTES,

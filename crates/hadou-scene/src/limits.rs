@@ -217,6 +217,30 @@ fn shorter(plain: String, sci: String) -> String {
     }
 }
 
+// Spring bones (`spring.rs`): what bounds one pose's simulation.
+
+/// Simulation steps per second of scene time (VRM players step once per displayed frame; a fixed
+/// rate makes the pose a function of the time alone).
+pub const SPRING_RATE: f64 = 60.0;
+
+/// Most steps simulated for one pose: 3 600 (one minute at [`SPRING_RATE`]). A later time starts
+/// from rest this many steps before it.
+pub const SPRING_MAX_STEPS: u64 = 3_600;
+
+/// Most spring joints of one file (VRM 1.0 joints, VRM 0.x bones with their descendants).
+pub const MAX_SPRING_JOINTS: usize = 4_096;
+
+/// Most spring-bone colliders of one file.
+pub const MAX_SPRING_COLLIDERS: usize = 1_024;
+
+/// Largest joint-collider pair count of one file (each spring's joints times its colliders,
+/// summed): what one step may cost in collision tests.
+pub const MAX_SPRING_COLLISION_PAIRS: usize = 1 << 18;
+
+/// Largest length of the external force (gravity plus wind) on a joint, in the character's units
+/// per second; a larger one is shortened to it (the tail is held at its bone length anyway).
+pub const SPRING_FORCE_MAX: f32 = 1e6;
+
 #[cfg(test)]
 mod tests {
     use super::*;

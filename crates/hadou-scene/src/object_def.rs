@@ -51,8 +51,15 @@ pub(crate) fn parse_object(
         _ => &["path"],
     };
     let motion_keys: &[&str] = if kind == "gltf" { MOTION_KEYS } else { &[] };
-    let allowed: Vec<&str> =
-        OBJECT_COMMON.iter().chain(OBJECT_MATERIAL_KEYS).chain(extra).chain(motion_keys).copied().collect();
+    let spring_keys: &[&str] = if kind == "gltf" { &["spring", "look_at"] } else { &[] };
+    let allowed: Vec<&str> = OBJECT_COMMON
+        .iter()
+        .chain(OBJECT_MATERIAL_KEYS)
+        .chain(extra)
+        .chain(motion_keys)
+        .chain(spring_keys)
+        .copied()
+        .collect();
     t.check_keys(&allowed)?;
     if t.get("color").is_some() && (t.get("material").is_some() || t.get("materials").is_some()) {
         let other = if t.get("material").is_some() { "material" } else { "materials" };
@@ -161,6 +168,17 @@ pub(crate) fn parse_object(
     assets.slots_left -= slots;
     let materials = parse_object_materials(t, &mesh, materials, material_index, &mut params, rd, warnings)?;
     let motion = parse_motion(t, rig.as_deref(), &mut params, rd, &mut assets.dir, warnings)?;
+    let spring = match t.opt_bool("spring")? {
+        Some(true) if rig.as_ref().and_then(|r| r.springs()).is_none() => {
+            return Err(t.src.value_err(
+                &t.key_span("spring"),
+                format!("{} gives `spring = true`, but its glTF file has no VRM spring bones", t.what),
+            ))
+        }
+        Some(s) => s,
+        None => true,
+    };
+    let look_at = parse_look_at(t, rig.as_deref(), &mut params, rd)?;
     Ok(ObjectDef {
         name,
         mesh,
@@ -171,7 +189,41 @@ pub(crate) fn parse_object(
         rig,
         motion,
         pose_cache: Default::default(),
+        spring,
+        spring_cache: Default::default(),
+        look_at,
     })
+}
+
+/// A `kind = "gltf"` object's `look_at`: `"camera"`, a wave's name (resolved once the waves are
+/// read) or a point `[x, y, z]` (an animatable parameter).
+fn parse_look_at(
+    t: &Table<'_, '_>,
+    rig: Option<&Rig>,
+    params: &mut ParamSet,
+    rd: &mut ParamReader<'_>,
+) -> Res<Option<crate::look_at::LookTarget>> {
+    use crate::look_at::LookTarget;
+    let Some(v) = t.get("look_at") else { return Ok(None) };
+    if rig.and_then(|r| r.look_at.as_ref()).is_none() {
+        return Err(t.src.value_err(
+            &t.key_span("look_at"),
+            format!(
+                "{} gives `look_at`, but its glTF file has no VRM look-at (a head bone and `lookAt` with eye                  bones or look expressions)",
+                t.what
+            ),
+        ));
+    }
+    if let Some((name, span)) = t.opt_str("look_at").ok().flatten() {
+        return Ok(Some(if name == "camera" {
+            LookTarget::Camera
+        } else {
+            LookTarget::WaveName(name.to_string(), span)
+        }));
+    }
+    let _ = v;
+    rd.add(t, params, "look_at", V3, ANY, Fallback::Value(&[0.0; 3]), false)?;
+    Ok(Some(LookTarget::Point))
 }
 
 /// The animation keys of a `kind = "gltf"` object.

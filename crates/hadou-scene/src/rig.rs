@@ -139,6 +139,10 @@ pub struct Rig {
     /// outline normals are the normalised sum of their normals).
     pub(crate) groups: Vec<u32>,
     pub(crate) group_count: usize,
+    /// A VRM's spring bones (`VRMC_springBone`, VRM 0.x `secondaryAnimation`), if it has any.
+    pub(crate) springs: Option<crate::spring_bones::SpringBones>,
+    /// A VRM's look-at (`VRMC_vrm.lookAt`, VRM 0.x `firstPerson`), if it has one with a head.
+    pub(crate) look_at: Option<crate::look_at::LookAt>,
 }
 
 /// What to pose: a clip at a time, and expression weights.
@@ -150,6 +154,11 @@ pub struct PoseInput<'a> {
     pub time: f32,
     /// `(expression index, weight in [0, 1])`.
     pub expressions: &'a [(usize, f32)],
+    /// `(node, unit quaternion)`: local rotations that replace the clip's and the rest's (the
+    /// spring bones' turns).
+    pub rotations: &'a [(usize, [f32; 4])],
+    /// Only the nodes' transforms are wanted (the spring simulation): no morph weights.
+    pub skip_weights: bool,
 }
 
 impl Rig {
@@ -190,9 +199,37 @@ impl Rig {
             || self.parts.iter().any(|p| !p.targets.is_empty())
     }
 
+    /// The file's spring bones, if it has any.
+    pub fn springs(&self) -> Option<&crate::spring_bones::SpringBones> {
+        self.springs.as_ref()
+    }
+
     /// Every node's global matrix and morph weights for `input`.
     fn node_pose(&self, input: &PoseInput<'_>) -> (Vec<Mat4>, Vec<Vec<f32>>) {
         let n = self.nodes.len();
+        let (trs, weights) = self.sample_locals(input);
+        let mut globals = vec![Mat4::IDENTITY; n];
+        for &i in &self.order {
+            let local = self.local_matrix(i, trs[i]);
+            globals[i] = match self.nodes[i].parent {
+                Some(p) => globals[p] * local,
+                None => self.base * local,
+            };
+        }
+        (globals, weights)
+    }
+
+    /// Node `i`'s local matrix from its sampled transform (`None`: its rest matrix).
+    pub(crate) fn local_matrix(&self, i: usize, trs: Option<Trs>) -> Mat4 {
+        match (&self.nodes[i].rest, trs) {
+            (_, Some((t, r, s))) => trs_matrix(t, r, s),
+            (RestLocal::Matrix(m), None) => *m,
+            (RestLocal::Trs { .. }, None) => Mat4::IDENTITY,
+        }
+    }
+
+    /// Every node's local transform (`None` for a matrix node) and morph weights for `input`.
+    pub(crate) fn sample_locals(&self, input: &PoseInput<'_>) -> (Vec<Option<Trs>>, Vec<Vec<f32>>) {
         let mut trs: Vec<Option<Trs>> = self
             .nodes
             .iter()
@@ -201,7 +238,11 @@ impl Rig {
                 RestLocal::Matrix(_) => None,
             })
             .collect();
-        let mut weights: Vec<Vec<f32>> = self.nodes.iter().map(|node| node.weights.clone()).collect();
+        let mut weights: Vec<Vec<f32>> = if input.skip_weights {
+            Vec::new()
+        } else {
+            self.nodes.iter().map(|node| node.weights.clone()).collect()
+        };
         let mut clip_expressions: Vec<(usize, f32)> = Vec::new();
         if let Some(clip) = input.clip {
             let mut buf = [0.0f32; 4];
@@ -213,7 +254,7 @@ impl Rig {
                 }
                 let rotation = ch.path == ChannelPath::Rotation;
                 if ch.path == ChannelPath::Weights {
-                    let w = &mut weights[ch.node];
+                    let Some(w) = weights.get_mut(ch.node) else { continue };
                     if w.len() == ch.width {
                         sample(ch.sampling, &ch.times, &ch.values, ch.width, false, input.time, w);
                     }
@@ -238,19 +279,12 @@ impl Rig {
                 }
             }
         }
-        let mut globals = vec![Mat4::IDENTITY; n];
-        for &i in &self.order {
-            let local = match (&self.nodes[i].rest, trs[i]) {
-                (_, Some((t, r, s))) => trs_matrix(t, r, s),
-                (RestLocal::Matrix(m), None) => *m,
-                (RestLocal::Trs { .. }, None) => Mat4::IDENTITY,
-            };
-            globals[i] = match self.nodes[i].parent {
-                Some(p) => globals[p] * local,
-                None => self.base * local,
-            };
+        for &(node, r) in input.rotations {
+            if let Some((_, rot, _)) = trs.get_mut(node).and_then(|x| x.as_mut()) {
+                *rot = r;
+            }
         }
-        (globals, weights)
+        (trs, weights)
     }
 
     /// `base` (this rig's rest mesh) posed by `input`: positions, normals and outline normals
@@ -370,7 +404,7 @@ impl Rig {
 }
 
 /// A node's translation, rotation (unit quaternion) and scale.
-type Trs = ([f32; 3], [f32; 4], [f32; 3]);
+pub(crate) type Trs = ([f32; 3], [f32; 4], [f32; 3]);
 
 /// What posing every vertex of one part shares.
 struct PartSetup<'a> {

@@ -71,7 +71,16 @@ pub(crate) struct ObjectDef {
     pub motion: Option<Motion>,
     /// The last pose built and its key (clip time and expression weights), shared by clones.
     pub pose_cache: PoseCache,
+    /// Its spring bones move (`spring`, default true; only a VRM with spring bones has any).
+    pub spring: bool,
+    /// The spring simulation's last state, shared by clones (`spring_scene`).
+    pub spring_cache: SpringCache,
+    /// What its VRM eyes follow (`look_at`).
+    pub look_at: Option<crate::look_at::LookTarget>,
 }
+
+/// An object's last spring-bone state.
+pub(crate) type SpringCache = Arc<std::sync::Mutex<Option<crate::spring::SpringState>>>;
 
 /// An object's last pose and its key (clip time and expression weights, as bits).
 pub(crate) type PoseCache = Arc<std::sync::Mutex<Option<(Vec<u32>, Arc<Mesh>)>>>;
@@ -436,15 +445,24 @@ impl Scene {
     /// Object `o`'s mesh at scene time `time`: its rest mesh, or the pose its clip and expressions
     /// give (cached for the last pose asked for).
     fn posed_mesh(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Arc<Mesh> {
-        let (Some(motion), Some(rig)) = (&o.motion, &o.rig) else { return o.mesh.clone() };
+        let Some(rig) = &o.rig else { return o.mesh.clone() };
+        let springs = o.spring && rig.springs.is_some();
+        if o.motion.is_none() && !springs && o.look_at.is_none() {
+            return o.mesh.clone();
+        }
         let clip_t = self.clip_time_of(o, vals, time).unwrap_or(0.0);
-        let expressions: Vec<(usize, f32)> = if motion.expressions {
+        let expressions: Vec<(usize, f32)> = if o.motion.as_ref().is_some_and(|m| m.expressions) {
             o.params.raw(vals, "expressions").iter().copied().enumerate().filter(|e| e.1 != 0.0).collect()
         } else {
             Vec::new()
         };
-        let key: Vec<u32> =
-            std::iter::once(clip_t.to_bits()).chain(expressions.iter().map(|e| e.1.to_bits())).collect();
+        let mut expressions = expressions;
+        let mut rotations = if springs { self.spring_rotations(o, rig, time) } else { Vec::new() };
+        self.add_gaze(o, rig, vals, clip_t, &mut rotations, &mut expressions);
+        let key: Vec<u32> = std::iter::once(clip_t.to_bits())
+            .chain(expressions.iter().map(|e| e.1.to_bits()))
+            .chain(rotations.iter().flat_map(|(_, r)| r.map(f32::to_bits)))
+            .collect();
         if let Ok(cache) = o.pose_cache.lock() {
             if let Some((k, m)) = cache.as_ref() {
                 if *k == key {
@@ -452,7 +470,14 @@ impl Scene {
                 }
             }
         }
-        let input = PoseInput { clip: motion.clip.as_deref(), time: clip_t, expressions: &expressions };
+        let clip = o.motion.as_ref().and_then(|m| m.clip.as_deref());
+        let input = PoseInput {
+            clip,
+            time: clip_t,
+            expressions: &expressions,
+            rotations: &rotations,
+            skip_weights: false,
+        };
         let mesh = Arc::new(rig.pose(&o.mesh, &input));
         if let Ok(mut cache) = o.pose_cache.lock() {
             *cache = Some((key, mesh.clone()));
@@ -460,7 +485,7 @@ impl Scene {
         mesh
     }
 
-    fn build_wave(&self, w: &WaveDef, vals: &[f32]) -> Wave {
+    pub(crate) fn build_wave(&self, w: &WaveDef, vals: &[f32]) -> Wave {
         let p = &w.params;
         let base = &self.values;
         let v3 = |vals: &[f32], key: &str| Vec3f::from_array(p.arr::<3>(vals, key));

@@ -163,6 +163,25 @@ pub(crate) fn parse_scene(text: &str, path: &Path) -> Res<Scene> {
         wave_tables.push(table);
     }
 
+    // An object's `look_at` naming a wave.
+    for o in &mut objects {
+        if let Some(crate::look_at::LookTarget::WaveName(name, span)) = &o.look_at {
+            let Some(i) = waves.iter().position(|w| &w.name == name) else {
+                let list = waves.iter().map(|w| format!("\"{}\"", w.name)).collect::<Vec<_>>().join(", ");
+                return Err(src.unknown(
+                    span,
+                    format!(
+                        "`look_at` of [[object]] \"{}\" names no wave \"{}\" (nor \"camera\"); the waves are {}",
+                        o.name,
+                        crate::toml_read::echo(name),
+                        if list.is_empty() { "none".to_string() } else { list }
+                    ),
+                ));
+            };
+            o.look_at = Some(crate::look_at::LookTarget::Wave(i));
+        }
+    }
+
     // [[shadow]]
     let mut shadows: Vec<ShadowDef> = Vec::new();
     let mut shadow_tables = Vec::new();

@@ -32,6 +32,8 @@ pub(crate) fn parse_wave(t: &Table<'_, '_>, name: String, rd: &mut ParamReader<'
     rd.add(t, &mut p, "rgba", Shape::Vector(4), Constraint::Rgba, Fallback::Value(&DEFAULT_RGBA), false)?;
     rd.add(t, &mut p, "core_radius", S, NONNEG, Fallback::Value(&[DEFAULT_CORE_RADIUS]), false)?;
     rd.add(t, &mut p, "light_glow", S, NONNEG, Fallback::Value(&[0.0]), false)?;
+    // The push on VRM spring bones (`spring` module docs): 0 = none.
+    rd.add(t, &mut p, "wind", S, NONNEG, Fallback::Value(&[0.0]), false)?;
     if !is_curve {
         // The distance attenuation (1 − u)^j of 002 eq. 3.23 (SPEC.md §1.4); curves read theirs
         // in parse_curve.

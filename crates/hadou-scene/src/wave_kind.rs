@@ -42,6 +42,7 @@ const WAVE_COMMON: &[&str] = &[
     "light_ramp_kind",
     "light_ramp_smoothing",
     "light_glow",
+    "wind",
 ];
 /// Keys of every closed-form kind (sphere, cylinder, capsule, beam) beyond their own.
 const ANALYTIC_COMMON: &[&str] = &["j"];

@@ -54,7 +54,7 @@ fn every_bone_turns_as_the_vrma_bone_turns_from_its_rest() {
         let mut checked = 0;
         for t in [0.3f32, 0.9, 1.6] {
             let src = vrma.node_globals(Some(("brace", t as f64)));
-            let dst = rig.node_globals(&PoseInput { clip: Some(&clip), time: t, expressions: &[] });
+            let dst = rig.node_globals(&PoseInput { clip: Some(&clip), time: t, ..Default::default() });
             for (bone, a) in &bones {
                 let Some(&(_, b)) = rig.humanoid().iter().find(|h| &h.0 == bone) else { continue };
                 let want = delta(&mat(&src_rest[*a]), &mat(&src[*a]));
@@ -95,7 +95,7 @@ fn the_vrma_blink_track_drives_the_blink_expression() {
     let blink = rig.expressions().iter().position(|e| e.name == "blink").unwrap();
     // Vertex positions in the head bone's frame, posed at `t` with extra expression weights.
     let pose = |t: f32, extra: &[(usize, f32)]| {
-        let input = PoseInput { clip: Some(&clip), time: t, expressions: extra };
+        let input = PoseInput { clip: Some(&clip), time: t, expressions: extra, ..Default::default() };
         let g = rig.node_globals(&input)[head];
         let inv = g.normal_matrix().transpose();
         let o = hadou_math::Vec3f::new(g.cols[3][0], g.cols[3][1], g.cols[3][2]);
