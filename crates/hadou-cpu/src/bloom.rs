@@ -1,9 +1,12 @@
 //! The `[bloom]` on the CPU: `hadou_math::bloom`'s glare chain over a band of rows, each level's
 //! rows filled in parallel (every texel from the same texels in the same order, so the picture is
-//! the same for any number of threads), and the colour mapping after it.
+//! the same for any number of threads), every level from the first downsample on in eight lanes
+//! (`hadou_math::bloom::lanes`, the same planes bit for bit on every vector path), and the colour
+//! mapping after it.
 
 use hadou_math::bloom::{self, BloomParams, Plane, RowFill};
 use hadou_math::shade;
+use hadou_math::simd::SimdPath;
 use hadou_scene::{Frame, ToneMode};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -24,23 +27,27 @@ pub(crate) fn source_rows(frame: &Frame, params: &BloomParams, band: Range<usize
     bloom::source_rows(params, frame.width as usize, frame.height as usize, band)
 }
 
-/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added and the
-/// frame's colour mapping applied, into `color` (`band.len()` rows).
+/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added (over those
+/// rows of `linear`) and the frame's colour mapping applied, into `color` (`band.len()` rows);
+/// the glare's levels on the vector path `simd`.
 pub(crate) fn glare_and_map(
     frame: &Frame,
     params: &BloomParams,
-    linear: &Plane,
+    linear: &mut Plane,
     band: Range<usize>,
     color: &mut [[f32; 4]],
+    simd: SimdPath,
 ) -> Result<(), hadou_scene::RenderError> {
-    let glared = bloom::try_glare(params, linear, band, &Parallel).map_err(|bytes| {
+    bloom::lanes::glare_in_place(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
         hadou_scene::RenderError::Memory(format!(
             "the glare's planes need {:.2} GB that could not be allocated",
             bytes as f64 / 1e9
         ))
     })?;
     let mode = frame.color_mapping.mode;
-    color.par_iter_mut().zip(glared.data.par_iter()).for_each(|(out, c)| {
+    let w = linear.width;
+    let at = (band.start - linear.rows.start) * w..(band.end - linear.rows.start) * w;
+    color.par_iter_mut().zip(linear.data[at].par_iter()).for_each(|(out, c)| {
         let m = match mode {
             ToneMode::Faithful => shade::map_faithful(*c),
             ToneMode::Filmic => shade::map_filmic(*c),
