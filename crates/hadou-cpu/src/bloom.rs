@@ -2,11 +2,11 @@
 //! rows filled in parallel (every texel from the same texels in the same order, so the picture is
 //! the same for any number of threads), every level from the first downsample on in eight lanes
 //! (`hadou_math::bloom::lanes`, the same planes bit for bit on every vector path), and the colour
-//! mapping after it.
+//! mapping after it (eight pixels at a time).
 
 use hadou_math::bloom::{self, BloomParams, Plane, RowFill};
 use hadou_math::shade;
-use hadou_math::simd::SimdPath;
+use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
 use hadou_scene::{Frame, ToneMode};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -47,12 +47,41 @@ pub(crate) fn glare_and_map(
     let mode = frame.color_mapping.mode;
     let w = linear.width;
     let at = (band.start - linear.rows.start) * w..(band.end - linear.rows.start) * w;
-    color.par_iter_mut().zip(linear.data[at].par_iter()).for_each(|(out, c)| {
-        let m = match mode {
-            ToneMode::Faithful => shade::map_faithful(*c),
-            ToneMode::Filmic => shade::map_filmic(*c),
-        };
-        *out = [m[0], m[1], m[2], 1.0];
+    color.par_chunks_mut(w.max(1)).zip(linear.data[at].par_chunks(w.max(1))).for_each(|(out, c)| {
+        dispatch(simd, MapRow { mode, linear: c, out });
     });
     Ok(())
+}
+
+/// The colour mapping of a row of linear colour, eight pixels at a time (`shade`'s lane mappings:
+/// lane for lane the values of the scalar ones).
+struct MapRow<'a> {
+    mode: ToneMode,
+    linear: &'a [[f32; 3]],
+    out: &'a mut [[f32; 4]],
+}
+
+impl WithLanes for MapRow<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for (c, o) in self.linear.chunks(8).zip(self.out.chunks_mut(8)) {
+            // The channels as lanes (zeros past the row's end).
+            let mut ch = [[0.0f32; 8]; 3];
+            for (i, p) in c.iter().enumerate() {
+                ch[0][i] = p[0];
+                ch[1][i] = p[1];
+                ch[2][i] = p[2];
+            }
+            let v = [L::from_array(ch[0]), L::from_array(ch[1]), L::from_array(ch[2])];
+            let m = match self.mode {
+                ToneMode::Faithful => shade::map_faithful_lanes(v),
+                ToneMode::Filmic => shade::map_filmic_lanes(v),
+            };
+            let (r, g, b) = (m[0].to_array(), m[1].to_array(), m[2].to_array());
+            for (i, px) in o.iter_mut().enumerate() {
+                *px = [r[i], g[i], b[i], 1.0];
+            }
+        }
+    }
 }
