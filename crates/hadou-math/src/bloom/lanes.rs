@@ -272,29 +272,36 @@ fn down_row_in(path: SimdPath, src: &Plane, y: usize, out: &mut [[f32; 3]], s: &
     );
 }
 
+/// Rows of the streak shorter than this take the texel-by-texel kernels (the same values): their
+/// lanes would cost more in padding and splitting than they save.
+const SHORT: usize = 16;
+
+/// What [`tent_h`] adds to the tent.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum BaseIn {
+    /// Nothing.
+    None,
+    /// The texels `out` holds when it is called.
+    Out,
+}
+
 /// The horizontal half of the tent: `low` (one row) to `out` (`out.len()` texels, the level
-/// above's width), each high texel `i` the sum of the four taps of [`tent`]`(i)`, plus `base`.
-/// `s` holds five rows.
-fn tent_h(
-    path: SimdPath,
-    low: &[[f32; 3]],
-    base: Option<&[[f32; 3]]>,
-    out: &mut [[f32; 3]],
-    s: &mut [Vec<f32>],
-) {
+/// above's width), each high texel `i` the sum of the four taps of [`tent`]`(i)`, plus the base
+/// ([`BaseIn`]). `s` holds five rows.
+fn tent_h(path: SimdPath, low: &[[f32; 3]], base: BaseIn, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
     let wh = out.len();
     let (ne, no) = (wh.div_ceil(2), wh / 2);
     let [q, he, ho, be, bo] = s else { unreachable!("five rows") };
     pad(low, ne + 4, q);
     // Even i = 2j reads low j−2 … j+1 = q[j … j+3]; odd i = 2j+1 reads j−1 … j+2 = q[j+1 … j+4].
     let (we, wo) = (tent(0).1, tent(1).1);
-    if let Some(b) = base {
-        // The base's even and odd texels: split's e[m + 1] = b[2m], o[m + 1] = b[2m + 1].
-        split(b, ne + 1, be, bo);
-    }
     let (be, bo) = match base {
-        Some(_) => (Some(&be[3..3 + 3 * ne]), Some(&bo[3..3 + 3 * no])),
-        None => (None, None),
+        BaseIn::Out => {
+            // The base's even and odd texels: split's e[m + 1] = b[2m], o[m + 1] = b[2m + 1].
+            split(out, ne + 1, be, bo);
+            (Some(&be[3..3 + 3 * ne]), Some(&bo[3..3 + 3 * no]))
+        }
+        BaseIn::None => (None, None),
     };
     he.resize(3 * ne, 0.0);
     ho.resize(3 * no, 0.0);
@@ -310,7 +317,9 @@ fn tent_h(
 /// level above: row `y` of the result is [`tent_h`] of `low`'s row `y`.
 pub fn up_plane(path: SimdPath, low: &Plane, width: usize, fill: &dyn RowFill) -> Result<Plane, usize> {
     let mut h = Plane::try_new(width, low.height, low.rows.clone())?;
-    fill.fill(&mut h, &|y, row| with_scratch(5, |s| tent_h(path, low.row(y), None, row, &mut s.rows[..5])));
+    fill.fill(&mut h, &|y, row| {
+        with_scratch(5, |s| tent_h(path, low.row(y), BaseIn::None, row, &mut s.rows[..5]))
+    });
     Ok(h)
 }
 
@@ -361,18 +370,25 @@ fn streak_row_in(
         let (done, rest) = levels.split_at_mut(k);
         let src: &[[f32; 3]] = if k == 0 { t } else { &done[k - 1] };
         rest[0].resize(len, [0.0; 3]);
-        down_row_h_in(path, src, &mut rest[0], &mut rows[..2]);
+        if src.len() < SHORT {
+            super::down_row_h(src, &mut rest[0]);
+        } else {
+            down_row_h_in(path, src, &mut rest[0], &mut rows[..2]);
+        }
     }
-    // U_N = D_N; U_k = D_k + up(U_{k+1}): into rows' scratch texels, then back into levels[k].
+    // U_N = D_N; U_k = D_k + up(U_{k+1}), over D_k in place.
     for k in (0..n - 1).rev() {
         let (lo, hi) = levels.split_at_mut(k + 1);
         let (d, u) = (&mut lo[k], &hi[0]);
-        let mut next = std::mem::take(d);
-        let base = next.clone();
-        tent_h(path, u, Some(&base), &mut next, rows);
-        *d = next;
+        if d.len() < SHORT {
+            let mut base = [[0.0f32; 3]; SHORT];
+            base[..d.len()].copy_from_slice(d);
+            super::up_row_h(u, Some(&base[..d.len()]), d);
+        } else {
+            tent_h(path, u, BaseIn::Out, d, rows);
+        }
     }
-    tent_h(path, &levels[0], None, out, rows);
+    tent_h(path, &levels[0], BaseIn::None, out, rows);
 }
 
 /// [`super::try_glare`] on the vector path `path`: the same planes, bit for bit.
