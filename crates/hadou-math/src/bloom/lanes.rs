@@ -1,6 +1,6 @@
-//! The glare chain of [`super`] over flat rows, eight lanes at a time: every level from the first
-//! downsample on (the 13-tap downsample, the tent upsample, the streak) as weighted sums of whole
-//! rows, each texel from the same texels, the same weights and the same additions in the same
+//! The glare chain of [`super`] (hadou's own; SPEC.md has no glare) over flat rows, eight lanes at
+//! a time: the soft threshold ([`prefilter_row`]) and every level from the first downsample on (the
+//! 13-tap downsample, the tent upsample, the streak) as weighted sums of whole rows, each texel from the same texels, the same weights and the same additions in the same
 //! order as the texel-by-texel kernels ([`super::down_row`], [`super::up_row`],
 //! [`super::down_row_h`], [`super::up_row_h`]), with no fused multiply-add: the planes are those
 //! kernels' bit for bit, on every vector path (`tests/bloom.rs` holds them together).
