@@ -1,9 +1,12 @@
 //! The `[bloom]` on the CPU: `hadou_math::bloom`'s glare chain over a band of rows, each level's
 //! rows filled in parallel (every texel from the same texels in the same order, so the picture is
-//! the same for any number of threads), and the colour mapping after it.
+//! the same for any number of threads), every level from the first downsample on in eight lanes
+//! (`hadou_math::bloom::lanes`, the same planes bit for bit on every vector path), and the colour
+//! mapping after it (eight pixels at a time).
 
 use hadou_math::bloom::{self, BloomParams, Plane, RowFill};
 use hadou_math::shade;
+use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
 use hadou_scene::{Frame, ToneMode};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -24,28 +27,61 @@ pub(crate) fn source_rows(frame: &Frame, params: &BloomParams, band: Range<usize
     bloom::source_rows(params, frame.width as usize, frame.height as usize, band)
 }
 
-/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added and the
-/// frame's colour mapping applied, into `color` (`band.len()` rows).
+/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added (over those
+/// rows of `linear`) and the frame's colour mapping applied, into `color` (`band.len()` rows);
+/// the glare's levels on the vector path `simd`.
 pub(crate) fn glare_and_map(
     frame: &Frame,
     params: &BloomParams,
-    linear: &Plane,
+    linear: &mut Plane,
     band: Range<usize>,
     color: &mut [[f32; 4]],
+    simd: SimdPath,
 ) -> Result<(), hadou_scene::RenderError> {
-    let glared = bloom::try_glare(params, linear, band, &Parallel).map_err(|bytes| {
+    bloom::lanes::glare_in_place(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
         hadou_scene::RenderError::Memory(format!(
             "the glare's planes need {:.2} GB that could not be allocated",
             bytes as f64 / 1e9
         ))
     })?;
     let mode = frame.color_mapping.mode;
-    color.par_iter_mut().zip(glared.data.par_iter()).for_each(|(out, c)| {
-        let m = match mode {
-            ToneMode::Faithful => shade::map_faithful(*c),
-            ToneMode::Filmic => shade::map_filmic(*c),
-        };
-        *out = [m[0], m[1], m[2], 1.0];
+    let w = linear.width;
+    let at = (band.start - linear.rows.start) * w..(band.end - linear.rows.start) * w;
+    color.par_chunks_mut(w.max(1)).zip(linear.data[at].par_chunks(w.max(1))).for_each(|(out, c)| {
+        dispatch(simd, MapRow { mode, linear: c, out });
     });
     Ok(())
+}
+
+/// The colour mapping of a row of linear colour, eight pixels at a time (`shade`'s lane mappings:
+/// lane for lane the values of the scalar ones).
+struct MapRow<'a> {
+    mode: ToneMode,
+    linear: &'a [[f32; 3]],
+    out: &'a mut [[f32; 4]],
+}
+
+impl WithLanes for MapRow<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        for (c, o) in self.linear.chunks(8).zip(self.out.chunks_mut(8)) {
+            // The channels as lanes (zeros past the row's end).
+            let mut ch = [[0.0f32; 8]; 3];
+            for (i, p) in c.iter().enumerate() {
+                ch[0][i] = p[0];
+                ch[1][i] = p[1];
+                ch[2][i] = p[2];
+            }
+            let v = [L::from_array(ch[0]), L::from_array(ch[1]), L::from_array(ch[2])];
+            let m = match self.mode {
+                ToneMode::Faithful => shade::map_faithful_lanes(v),
+                ToneMode::Filmic => shade::map_filmic_lanes(v),
+            };
+            let (r, g, b) = (m[0].to_array(), m[1].to_array(), m[2].to_array());
+            for (i, px) in o.iter_mut().enumerate() {
+                *px = [r[i], g[i], b[i], 1.0];
+            }
+        }
+    }
 }

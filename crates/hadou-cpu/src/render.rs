@@ -508,7 +508,7 @@ fn glare_rows(
     start: Instant,
 ) -> Result<PassTimes, RenderError> {
     let GlareParts { draw, params, chunk_samples } = *parts;
-    let DrawParts { frame, k, .. } = draw;
+    let DrawParts { frame, k, simd, .. } = draw;
     let w = frame.width as usize;
     let n = w * band.len();
     (img.width, img.height) = (frame.width, band.len() as u32);
@@ -566,7 +566,7 @@ fn glare_rows(
         wave_ms += ms(opaque_done, waves_done);
         t = waves_done;
     }
-    bloom::glare_and_map(frame, params, &linear, band, &mut img.color)?;
+    bloom::glare_and_map(frame, params, &mut linear, band, &mut img.color, simd)?;
     Ok(PassTimes { opaque_ms, wave_ms, color_ms: ms(t, Instant::now()) })
 }
 

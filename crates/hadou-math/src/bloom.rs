@@ -32,8 +32,11 @@
 //! `N = clamp(⌈log₂(radius·height)⌉, 1, MAX_LEVELS)` ([`levels`]), `N_s` likewise from
 //! `streak_length·height`. [`Plan`] gives, for a band of output rows, the rows of every level the
 //! band reads, so a band computed with that halo has the whole image's pixels bit for bit.
+//! [`lanes`] is the same chain eight texels at a time, with the same bits.
 
 use std::ops::Range;
+
+pub mod lanes;
 
 /// The most pyramid levels (texels of `2¹⁰ = 1024` pixels at the top).
 pub const MAX_LEVELS: u32 = 10;
@@ -375,7 +378,9 @@ pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn R
 }
 
 /// [`glare`], each plane reserved fallibly: `Err(bytes)`, the size of the plane that could not
-/// be allocated, where memory ran out (never an abort).
+/// be allocated, where memory ran out (never an abort). Texel by texel with the kernels above:
+/// the definition that the chain in lanes (`lanes::try_glare`, which renderers run) equals bit
+/// for bit.
 pub fn try_glare(
     params: &BloomParams,
     src: &Plane,

@@ -1,11 +1,14 @@
 //! The glare chain (`hadou_math::bloom`): the soft threshold's pieces, the filters' weights, a
 //! uniform area blooming to itself, the streak staying on its row, finite output for any colour,
-//! and a band computed with its plan's halo equal to the whole image bit for bit.
+//! a band computed with its plan's halo equal to the whole image bit for bit, and the chain in
+//! lanes (`bloom::lanes`) equal to the texel-by-texel kernels bit for bit on every vector path.
 
 use hadou_math::bloom::{
-    down_row, glare, levels, prefilter, up_row, BloomParams, Plan, Plane, Sequential, BLOOM_CLAMP,
+    down_row, glare, lanes, levels, prefilter, try_glare, up_row, BloomParams, Plan, Plane, Sequential,
+    BLOOM_CLAMP,
 };
 use hadou_math::rng::Rng;
+use hadou_math::simd::SimdPath;
 
 fn params() -> BloomParams {
     BloomParams {
@@ -188,6 +191,49 @@ fn band_with_its_halo_equals_the_whole_image() {
             part.data.copy_from_slice(&src.data[plan.source.start * w..plan.source.end * w]);
             let band = glare(&p, &part, a..b, &Sequential);
             assert_eq!(band.data, whole.data[a * w..b * w], "case {case}: {w}×{h} rows {a}..{b}");
+        }
+    }
+}
+
+/// Every level of the chain in lanes, on every path the machine has, against the kernels texel by
+/// texel: the same bits for images of one to a few dozen texels a side (the clamped edges, the
+/// lanes' tails), whole and in bands, with and without a streak, for colours from zero (and
+/// negative zero) to beyond the clamp, infinite, negative and NaN.
+#[test]
+fn lanes_equal_the_texel_kernels_bit_for_bit() {
+    let mut rng = Rng(44);
+    let sizes =
+        [(1, 1), (1, 7), (2, 2), (3, 5), (7, 3), (8, 8), (9, 17), (17, 9), (31, 40), (64, 33), (70, 70)];
+    for (case, &(w, h)) in sizes.iter().enumerate() {
+        let vals: Vec<[f32; 3]> = (0..w * h)
+            .map(|_| match rng.below(6) {
+                0 => [0.0, -0.0, 0.0],
+                1 => [rng.range_f32(0.0, 1.0), rng.range_f32(0.0, 1.0), rng.range_f32(0.0, 1.0)],
+                2 => [1e6, 0.5, 3.0e38],
+                3 => [f32::NAN, -1.0, f32::INFINITY],
+                _ => [rng.range_f32(0.0, 8.0), rng.range_f32(0.0, 3.0), rng.range_f32(0.0, 20.0)],
+            })
+            .collect();
+        let src = plane(w, h, |x, y| vals[y * w + x]);
+        for p in [
+            params(),
+            BloomParams { radius: 1.0, streak: 0.0, ..params() },
+            BloomParams { radius: 0.01, streak: 2.0, streak_length: 4.0, soft_knee: 0.0, ..params() },
+        ] {
+            let reference = try_glare(&p, &src, 0..h, &Sequential).unwrap();
+            for path in SimdPath::supported() {
+                let whole = lanes::try_glare(path, &p, &src, 0..h, &Sequential).unwrap();
+                let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&whole.data), bits(&reference.data), "case {case} {w}×{h} {p:?} on {path}");
+                let a = rng.below(h);
+                let b = a + 1 + rng.below(h - a);
+                let band = lanes::try_glare(path, &p, &src, a..b, &Sequential).unwrap();
+                assert_eq!(
+                    bits(&band.data),
+                    bits(&reference.data[a * w..b * w]),
+                    "case {case} rows {a}..{b} on {path}"
+                );
+            }
         }
     }
 }

@@ -1,0 +1,59 @@
+//! Times a `[bloom]` against none: `cargo run --release -p hadou-cpu --example glare_cost --
+//! [SIZES]` renders `scenes/glare-kamehameha.toml` at t = 1.5 s with its `[bloom]` and with it
+//! removed, the two alternating (so a busy machine slows both alike), and prints per size the
+//! median of nine whole frames of each (`CpuBackend::render_into`, buffers reused) and their
+//! ratio, and the bloom frame's colour stage (the glare and the colour mapping) against the one
+//! without. `SIZES` is a comma-separated list (default `512,1024`).
+use hadou_cpu::CpuBackend;
+use hadou_scene::{Frame, Image, Scene};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// The median of `v` (non-empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let sizes: Vec<u32> = match std::env::args().nth(1) {
+        None => vec![512, 1024],
+        Some(a) => a
+            .split(',')
+            .map(|s| match s.trim().parse::<u32>() {
+                Ok(n) if (1..=8192).contains(&n) => n,
+                _ => {
+                    eprintln!("glare_cost: size {s}: expected a whole number in 1..=8192");
+                    std::process::exit(2)
+                }
+            })
+            .collect(),
+    };
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/glare-kamehameha.toml");
+    let scene = Scene::load(&path).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
+    println!("| size | bloom ms | no bloom ms | bloom / none | colour stage, bloom / none ms |\n|---|---|---|---|---|");
+    let (mut backend, mut image) = (CpuBackend::new(), Image::new(1, 1));
+    for size in sizes {
+        let mut frame = scene.at(1.5);
+        (frame.width, frame.height, frame.samples) = (size, size, 1);
+        let bare = Frame { bloom: None, ..frame.clone() };
+        // One frame of each first (the thread pool, the buffers), then nine pairs.
+        backend.render_into(&frame, &mut image);
+        backend.render_into(&bare, &mut image);
+        let (mut on, mut off, mut con, mut coff) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..9 {
+            for (f, times, color) in [(&frame, &mut on, &mut con), (&bare, &mut off, &mut coff)] {
+                let t = Instant::now();
+                let parts = backend.render_into(f, &mut image);
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+                color.push(parts.color_ms);
+            }
+        }
+        let (on, off) = (median(on), median(off));
+        let (con, coff) = (median(con), median(coff));
+        println!("| {size}² | {on:.2} | {off:.2} | {:.2}× | {con:.2} / {coff:.2} |", on / off);
+    }
+}

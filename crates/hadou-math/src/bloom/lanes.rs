@@ -1,0 +1,470 @@
+//! The glare chain of [`super`] (hadou's own; SPEC.md has no glare) over flat rows, eight lanes at
+//! a time: the soft threshold ([`prefilter_row`]) and every level from the first downsample on (the
+//! 13-tap downsample, the tent upsample, the streak) as weighted sums of whole rows, each texel from the same texels, the same weights and the same additions in the same
+//! order as the texel-by-texel kernels ([`super::down_row`], [`super::up_row`],
+//! [`super::down_row_h`], [`super::up_row_h`]), with no fused multiply-add: the planes are those
+//! kernels' bit for bit, on every vector path (`tests/bloom.rs` holds them together).
+//!
+//! The rows are read through copies padded by clamping at the edges and split into even and odd
+//! texels, so that each of the filters' taps is one contiguous slice:
+//! - the downsample's 2×2 box averages `A` are whole rows of boxes (the even-`x` boxes of rows
+//!   `2j−2, 2j, 2j+2` and the odd-`x` ones of rows `2j ± 1`), and its thirteen taps are those
+//!   rows shifted by a texel;
+//! - the tent is separable as written (each low row's four horizontal taps summed first, then the
+//!   four rows): the horizontal sums of every low row are made once into a plane of their own
+//!   ([`up_plane`]), and each high row sums four of its rows.
+
+use super::{composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, MAX_LEVELS};
+use crate::simd::{dispatch, Lane, SimdPath, WithLanes};
+
+/// The downsample's weights in its order of summation (see [`super::down_row`]).
+const DOWN_W: [f32; 13] =
+    [0.125, 0.125, 0.125, 0.125, 0.125, 0.0625, 0.0625, 0.0625, 0.0625, 0.03125, 0.03125, 0.03125, 0.03125];
+
+/// The streak's 1-D downsample weights (see [`super::down_row_h`]).
+const DOWN_H_W: [f32; 6] = [1.0 / 16.0, 3.0 / 16.0, 4.0 / 16.0, 4.0 / 16.0, 3.0 / 16.0, 1.0 / 16.0];
+
+/// `out[k] = base[k] + (((0 + w₀·s₀[k]) + w₁·s₁[k]) + …)` (no `base`: the sum alone), in lanes.
+struct WeightedSum<'a, const N: usize> {
+    srcs: [&'a [f32]; N],
+    w: [f32; N],
+    base: Option<&'a [f32]>,
+    out: &'a mut [f32],
+}
+
+impl<const N: usize> WithLanes for WeightedSum<'_, N> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let n = self.out.len();
+        let mut ws = [L::splat(0.0); N];
+        for (l, &w) in ws.iter_mut().zip(&self.w) {
+            *l = L::splat(w);
+        }
+        let lane = load::<L>;
+        let mut k = 0;
+        while k + 8 <= n {
+            let mut acc = L::splat(0.0);
+            for (&w, s) in ws.iter().zip(&self.srcs) {
+                acc += w * lane(s, k);
+            }
+            if let Some(b) = self.base {
+                acc += lane(b, k);
+            }
+            self.out[k..k + 8].copy_from_slice(&acc.to_array());
+            k += 8;
+        }
+        for k in k..n {
+            let mut acc = 0.0f32;
+            for (&w, s) in self.w.iter().zip(&self.srcs) {
+                acc += w * s[k];
+            }
+            if let Some(b) = self.base {
+                acc += b[k];
+            }
+            self.out[k] = acc;
+        }
+    }
+}
+
+/// Floats `k … k+7` of `s` as lanes.
+#[inline(always)]
+fn load<L: Lane>(s: &[f32], k: usize) -> L {
+    L::from_array(s[k..k + 8].try_into().expect("eight floats"))
+}
+
+/// `out[k] = ¼·(((a[k] + b[k]) + c[k]) + d[k])`, the 2×2 box average, in lanes.
+struct BoxSum<'a> {
+    srcs: [&'a [f32]; 4],
+    out: &'a mut [f32],
+}
+
+impl WithLanes for BoxSum<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let n = self.out.len();
+        let [a, b, c, d] = self.srcs;
+        let lane = load::<L>;
+        let q = L::splat(0.25);
+        let mut k = 0;
+        while k + 8 <= n {
+            let v = q * (((lane(a, k) + lane(b, k)) + lane(c, k)) + lane(d, k));
+            self.out[k..k + 8].copy_from_slice(&v.to_array());
+            k += 8;
+        }
+        for k in k..n {
+            self.out[k] = 0.25 * (((a[k] + b[k]) + c[k]) + d[k]);
+        }
+    }
+}
+
+/// [`super::prefilter`] of a row of texels, eight at a time: the same comparisons, selects and
+/// arithmetic per lane (so the same bits), texels gathered into a lane per channel.
+struct PrefilterRow<'a> {
+    src: &'a [[f32; 3]],
+    out: &'a mut [[f32; 3]],
+    threshold: f32,
+    soft_knee: f32,
+}
+
+impl WithLanes for PrefilterRow<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let (th, kn) = (self.threshold, self.soft_knee);
+        let k = th * kn;
+        let (zero, max, clamp) = (L::splat(0.0), L::splat(f32::MAX), L::splat(super::BLOOM_CLAMP));
+        let (lth, lk, l2k, l4k) = (L::splat(th), L::splat(k), L::splat(2.0 * k), L::splat(4.0 * k));
+        let mut src = self.src.chunks_exact(8);
+        let mut out = self.out.chunks_exact_mut(8);
+        for (s, o) in (&mut src).zip(&mut out) {
+            let mut ch = [zero; 3];
+            for (c, lane) in ch.iter_mut().enumerate() {
+                let mut a = [0.0f32; 8];
+                for j in 0..8 {
+                    a[j] = s[j][c];
+                }
+                // NaN → 0, then clamped to [0, f32::MAX] as `f32::clamp` does.
+                let v = L::from_array(a);
+                let v = v.simd_lt(zero).select(zero, v);
+                let v = v.simd_gt(max).select(max, v);
+                *lane = v.is_nan().select(zero, v);
+            }
+            let b = ch[0].max(ch[1]).max(ch[2]);
+            let q = if k > 0.0 {
+                let x = (b - lth) + lk;
+                let x = x.simd_lt(zero).select(zero, x);
+                let x = x.simd_gt(l2k).select(l2k, x);
+                x * x / l4k
+            } else {
+                zero
+            };
+            let w = q.max(b - lth) / b;
+            let dark = b.simd_le(zero);
+            let mut r = [[0.0f32; 8]; 3];
+            for c in 0..3 {
+                r[c] = dark.select(zero, (ch[c] * w).min(clamp)).to_array();
+            }
+            for j in 0..8 {
+                o[j] = [r[0][j], r[1][j], r[2][j]];
+            }
+        }
+        for (s, o) in src.remainder().iter().zip(out.into_remainder()) {
+            *o = super::prefilter(*s, th, kn);
+        }
+    }
+}
+
+/// [`super::prefilter`] of every texel of `src` into `out`, in lanes.
+pub fn prefilter_row(path: SimdPath, src: &[[f32; 3]], threshold: f32, soft_knee: f32, out: &mut [[f32; 3]]) {
+    dispatch(path, PrefilterRow { src, out, threshold, soft_knee });
+}
+
+/// [`WeightedSum`] of `N` slices of `src`, tap `t` starting `3·offsets[t]` floats (texels) in,
+/// into `out`.
+fn taps<const N: usize>(
+    path: SimdPath,
+    src: [&[f32]; N],
+    offsets: [usize; N],
+    w: [f32; N],
+    base: Option<&[f32]>,
+    out: &mut [f32],
+) {
+    let n = out.len();
+    let srcs = std::array::from_fn(|t| &src[t][3 * offsets[t]..3 * offsets[t] + n]);
+    dispatch(path, WeightedSum { srcs, w, base, out });
+}
+
+/// Rows a kernel works in, kept per thread between calls ([`with_scratch`]) so that a row costs
+/// no allocation once the buffers have grown.
+#[derive(Default)]
+struct Scratch {
+    /// Flat rows of floats.
+    rows: Vec<Vec<f32>>,
+    /// The streak's levels.
+    levels: Vec<Vec<[f32; 3]>>,
+    /// A row of the bloom.
+    bloom: Vec<[f32; 3]>,
+    /// A row of the streak.
+    streak: Vec<[f32; 3]>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
+}
+
+/// Runs `f` with this thread's [`Scratch`] (at least `rows` rows); `f` must not call it again.
+fn with_scratch<R>(rows: usize, f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|s| {
+        let mut s = s.borrow_mut();
+        if s.rows.len() < rows {
+            s.rows.resize_with(rows, Vec::new);
+        }
+        f(&mut s)
+    })
+}
+
+/// `row`'s texels padded by clamping, split: `even[m] = row[clamp(2m − 2)]`,
+/// `odd[m] = row[clamp(2m − 1)]` for `m < count` (flat, three floats a texel).
+fn split(row: &[[f32; 3]], count: usize, even: &mut Vec<f32>, odd: &mut Vec<f32>) {
+    let last = row.len() as isize - 1;
+    even.resize(3 * count, 0.0);
+    odd.resize(3 * count, 0.0);
+    let (ev, od) = (even.as_chunks_mut::<3>().0, odd.as_chunks_mut::<3>().0);
+    for (m, (e, o)) in ev.iter_mut().zip(od.iter_mut()).enumerate() {
+        let x = 2 * m as isize;
+        *e = row[(x - 2).clamp(0, last) as usize];
+        *o = row[(x - 1).clamp(0, last) as usize];
+    }
+}
+
+/// `row`'s texels padded by clamping: `out[m] = row[clamp(m − 2)]` for `m < count` (flat).
+fn pad(row: &[[f32; 3]], count: usize, out: &mut Vec<f32>) {
+    let last = row.len() as isize - 1;
+    out.resize(3 * count, 0.0);
+    for (m, o) in out.as_chunks_mut::<3>().0.iter_mut().enumerate() {
+        *o = row[(m as isize - 2).clamp(0, last) as usize];
+    }
+}
+
+/// Row `y` of the next level from `src` (which holds rows `2y−2 … 2y+3`, clamped) into `out`
+/// (`half(src.width)` texels): [`super::down_row`] in lanes.
+pub fn down_row(path: SimdPath, src: &Plane, y: usize, out: &mut [[f32; 3]]) {
+    with_scratch(17, |s| down_row_in(path, src, y, out, &mut s.rows[..17]));
+}
+
+fn down_row_in(path: SimdPath, src: &Plane, y: usize, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
+    let wo = out.len();
+    let count = wo + 3;
+    let last = src.height as isize - 1;
+    let (splits, boxes) = s.split_at_mut(12);
+    // The six source rows 2y−2 … 2y+3, each split into even and odd padded texels.
+    for r in 0..6 {
+        let yy = (2 * y as isize - 2 + r as isize).clamp(0, last) as usize;
+        let (e, o) = splits[2 * r..2 * r + 2].split_at_mut(1);
+        split(src.row(yy), count, &mut e[0], &mut o[0]);
+    }
+    // Box rows r = dy + 2: even-x boxes BE[m] = A at x = 2m − 2 for r = 0, 2, 4, odd-x boxes
+    // BO[m] = A at x = 2m − 1 for r = 1, 3.
+    for (r, bx) in boxes.iter_mut().enumerate() {
+        let (e0, o0, e1, o1) = (&splits[2 * r], &splits[2 * r + 1], &splits[2 * r + 2], &splits[2 * r + 3]);
+        let n = 3 * (wo + 2);
+        bx.resize(n, 0.0);
+        let srcs: [&[f32]; 4] = if r % 2 == 0 {
+            [&e0[..n], &o0[..n], &e1[..n], &o1[..n]]
+        } else {
+            [&o0[..n], &e0[3..3 + n], &o1[..n], &e1[3..3 + n]]
+        };
+        dispatch(path, BoxSum { srcs, out: bx });
+    }
+    let [be0, bo1, be2, bo3, be4] = [&boxes[0], &boxes[1], &boxes[2], &boxes[3], &boxes[4]].map(|v| &v[..]);
+    // The taps in super::down_row's order: A(0,0), A(−1,−1), A(1,−1), A(−1,1), A(1,1), A(0,−2),
+    // A(−2,0), A(2,0), A(0,2), A(−2,−2), A(2,−2), A(−2,2), A(2,2); A(2i + dx) is BE[i + 1 + dx/2]
+    // for even dx and BO[i + (dx + 1)/2] for odd dx.
+    taps(
+        path,
+        [be2, bo1, bo1, bo3, bo3, be0, be2, be2, be4, be0, be0, be4, be4],
+        [1, 0, 1, 0, 1, 1, 0, 2, 1, 0, 2, 0, 2],
+        DOWN_W,
+        None,
+        out.as_flattened_mut(),
+    );
+}
+
+/// Rows of the streak shorter than this take the texel-by-texel kernels (the same values): their
+/// lanes would cost more in padding and splitting than they save.
+const SHORT: usize = 16;
+
+/// What [`tent_h`] adds to the tent.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum BaseIn {
+    /// Nothing.
+    None,
+    /// The texels `out` holds when it is called.
+    Out,
+}
+
+/// The horizontal half of the tent: `low` (one row) to `out` (`out.len()` texels, the level
+/// above's width), each high texel `i` the sum of the four taps of [`tent`]`(i)`, plus the base
+/// ([`BaseIn`]). `s` holds five rows.
+fn tent_h(path: SimdPath, low: &[[f32; 3]], base: BaseIn, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
+    let wh = out.len();
+    let (ne, no) = (wh.div_ceil(2), wh / 2);
+    let [q, he, ho, be, bo] = s else { unreachable!("five rows") };
+    pad(low, ne + 4, q);
+    // Even i = 2j reads low j−2 … j+1 = q[j … j+3]; odd i = 2j+1 reads j−1 … j+2 = q[j+1 … j+4].
+    let (we, wo) = (tent(0).1, tent(1).1);
+    let (be, bo) = match base {
+        BaseIn::Out => {
+            // The base's even and odd texels: split's e[m + 1] = b[2m], o[m + 1] = b[2m + 1].
+            split(out, ne + 1, be, bo);
+            (Some(&be[3..3 + 3 * ne]), Some(&bo[3..3 + 3 * no]))
+        }
+        BaseIn::None => (None, None),
+    };
+    he.resize(3 * ne, 0.0);
+    ho.resize(3 * no, 0.0);
+    taps(path, [&q[..]; 4], [0, 1, 2, 3], we, be, he);
+    taps(path, [&q[..]; 4], [1, 2, 3, 4], wo, bo, ho);
+    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = if i % 2 == 0 { he[i / 2] } else { ho[i / 2] };
+    }
+}
+
+/// The horizontal sums of the tent over `low` (every row it holds) at the width `width` of the
+/// level above: row `y` of the result is [`tent_h`] of `low`'s row `y`.
+pub fn up_plane(path: SimdPath, low: &Plane, width: usize, fill: &dyn RowFill) -> Result<Plane, usize> {
+    let mut h = Plane::try_new(width, low.height, low.rows.clone())?;
+    fill.fill(&mut h, &|y, row| {
+        with_scratch(5, |s| tent_h(path, low.row(y), BaseIn::None, row, &mut s.rows[..5]))
+    });
+    Ok(h)
+}
+
+/// Row `y` of the level above from the horizontal sums `h` ([`up_plane`]): the tent's four rows
+/// summed, plus `base`: [`super::up_row`] in lanes.
+pub fn up_row(path: SimdPath, h: &Plane, y: usize, base: Option<&[[f32; 3]]>, out: &mut [[f32; 3]]) {
+    let (y0, wy) = tent(y);
+    let last = h.height as isize - 1;
+    let rows: [&[f32]; 4] =
+        std::array::from_fn(|d| h.row((y0 + d as isize).clamp(0, last) as usize).as_flattened());
+    taps(path, rows, [0; 4], wy, base.map(|b| b.as_flattened()), out.as_flattened_mut());
+}
+
+/// Step 4's downsample in lanes: [`super::down_row_h`].
+pub fn down_row_h(path: SimdPath, src: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    with_scratch(2, |s| down_row_h_in(path, src, out, &mut s.rows[..2]));
+}
+
+fn down_row_h_in(path: SimdPath, src: &[[f32; 3]], out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
+    let [e, o] = s else { unreachable!("two rows") };
+    split(src, out.len() + 3, e, o);
+    // Tap d reads texel 2i − 2 + d: even d from e[i + d/2], odd d from o[i + (d − 1)/2].
+    taps(path, [&e[..], o, e, o, e, o], [0, 0, 1, 1, 2, 2], DOWN_H_W, None, out.as_flattened_mut());
+}
+
+/// The streak sum `up_h(U₁ʰ)` of one row `t` with `n` levels: [`super::streak_row`] in lanes.
+pub fn streak_row(path: SimdPath, t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
+    with_scratch(5, |s| streak_row_in(path, t, n, out, &mut s.rows[..5], &mut s.levels));
+}
+
+/// [`streak_row`] in the scratch rows `rows` (five) and `levels`.
+fn streak_row_in(
+    path: SimdPath,
+    t: &[[f32; 3]],
+    n: u32,
+    out: &mut [[f32; 3]],
+    rows: &mut [Vec<f32>],
+    levels: &mut Vec<Vec<[f32; 3]>>,
+) {
+    let n = n.clamp(1, MAX_LEVELS) as usize;
+    // levels[k] is D_{k+1}; then, from the top down, U_k in place of D_k.
+    if levels.len() < n {
+        levels.resize_with(n, Vec::new);
+    }
+    let mut len = t.len();
+    for k in 0..n {
+        len = half(len);
+        let (done, rest) = levels.split_at_mut(k);
+        let src: &[[f32; 3]] = if k == 0 { t } else { &done[k - 1] };
+        rest[0].resize(len, [0.0; 3]);
+        if src.len() < SHORT {
+            super::down_row_h(src, &mut rest[0]);
+        } else {
+            down_row_h_in(path, src, &mut rest[0], &mut rows[..2]);
+        }
+    }
+    // U_N = D_N; U_k = D_k + up(U_{k+1}), over D_k in place.
+    for k in (0..n - 1).rev() {
+        let (lo, hi) = levels.split_at_mut(k + 1);
+        let (d, u) = (&mut lo[k], &hi[0]);
+        if d.len() < SHORT {
+            let mut base = [[0.0f32; 3]; SHORT];
+            base[..d.len()].copy_from_slice(d);
+            super::up_row_h(u, Some(&base[..d.len()]), d);
+        } else {
+            tent_h(path, u, BaseIn::Out, d, rows);
+        }
+    }
+    tent_h(path, &levels[0], BaseIn::None, out, rows);
+}
+
+/// [`super::try_glare`] on the vector path `path`: the same planes, bit for bit.
+pub fn try_glare(
+    path: SimdPath,
+    params: &BloomParams,
+    src: &Plane,
+    band: std::ops::Range<usize>,
+    fill: &dyn RowFill,
+) -> Result<Plane, usize> {
+    let mut work = Plane::try_new(src.width, src.height, src.rows.clone())?;
+    work.data.copy_from_slice(&src.data);
+    glare_in_place(path, params, &mut work, band.clone(), fill)?;
+    let mut out = Plane::try_new(src.width, src.height, band.clone())?;
+    let w = src.width;
+    out.data.copy_from_slice(&work.data[(band.start - src.rows.start) * w..(band.end - src.rows.start) * w]);
+    Ok(out)
+}
+
+/// The glare of [`super::try_glare`] over the rows `band` of the linear image `src` (which holds
+/// at least the rows [`super::source_rows`] names), written over those rows of `src` (its other
+/// rows are left as they were): no plane the size of the band is made for the result.
+/// `Err(bytes)` where a plane of that size could not be allocated (`src` is then unchanged).
+pub fn glare_in_place(
+    path: SimdPath,
+    params: &BloomParams,
+    src: &mut Plane,
+    band: std::ops::Range<usize>,
+    fill: &dyn RowFill,
+) -> Result<(), usize> {
+    let (w, h) = (src.width, src.height);
+    let n = levels(params.radius * h as f32);
+    let plan = Plan::new(w, h, n, band.clone());
+    let (th, kn) = (params.threshold, params.soft_knee);
+    let mut t = Plane::try_new(w, h, plan.source.clone())?;
+    {
+        let src = &*src;
+        fill.fill(&mut t, &|y, row| prefilter_row(path, src.row(y), th, kn, row));
+    }
+    let mut downs: Vec<Plane> = Vec::with_capacity(plan.levels.len());
+    for l in &plan.levels {
+        let mut d = Plane::try_new(l.width, l.height, l.down.clone())?;
+        let prev = downs.last().unwrap_or(&t);
+        fill.fill(&mut d, &|y, row| down_row(path, prev, y, row));
+        downs.push(d);
+    }
+    let mut u = downs.pop().unwrap_or_default();
+    while let Some(d) = downs.pop() {
+        let l = &plan.levels[downs.len()];
+        let hs = up_plane(path, &u, l.width, fill)?;
+        let mut next = Plane::try_new(l.width, l.height, l.up.clone())?;
+        fill.fill(&mut next, &|y, row| up_row(path, &hs, y, Some(d.row(y)), row));
+        u = next;
+    }
+    let kb = params.intensity / n as f32;
+    let ns = levels(params.streak_length * h as f32);
+    let ks = params.streak / ns as f32;
+    let hs = up_plane(path, &u, w, fill)?;
+    drop(u);
+    fill.fill(src, &|y, row| {
+        if !band.contains(&y) {
+            return;
+        }
+        with_scratch(5, |s| {
+            let Scratch { rows, levels, bloom, streak } = s;
+            bloom.resize(w, [0.0; 3]);
+            up_row(path, &hs, y, None, bloom);
+            if ks > 0.0 {
+                streak.resize(w, [0.0; 3]);
+                streak_row_in(path, t.row(y), ns, streak, &mut rows[..5], levels);
+            }
+            for (x, c) in row.iter_mut().enumerate() {
+                let st = if ks > 0.0 { streak[x] } else { [0.0; 3] };
+                *c = composite(*c, bloom[x], kb, st, ks);
+            }
+        });
+    });
+    Ok(())
+}
