@@ -26,13 +26,15 @@ import zlib
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WEB = os.path.join(ROOT, "target", "web")
 WIDTH, HEIGHT = 320, 180
-# (scene, time): the Kamehameha at 1.5 s, one light-, one shadow- and one soft- scene, and the
-# glare (drawn on the GPU in the page too).
+# (scene, time): the Kamehameha at 1.5 s, one light-, one shadow- and two soft- scenes (the two
+# maps' exact resolve, and the traced resolve of a disc lamp), and the glare (drawn on the GPU in
+# the page too).
 CASES = [
     ("kamehameha", 1.5),
     ("light-from-front", 1.0),
     ("shadow-wave-top", 1.0),
     ("soft-gradient", 0.5),
+    ("soft-disc", 0.5),
     ("glare-kamehameha", 1.5),
 ]
 MAX_MEAN_DIFF = 1.0
