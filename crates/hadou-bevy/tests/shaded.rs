@@ -91,22 +91,34 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
         .collect();
     assert_eq!(hulls.len(), shaded.len(), "every mesh gets its outline hull");
     assert!(hulls.iter().all(|&skinned| skinned), "the hulls of the skinned hero are skinned by its joints");
-    // The hulls are drawn (skinned, front faces culled): magenta pixels at the silhouette.
-    let shot: Arc<Mutex<Option<Image>>> = Arc::default();
-    let sink = shot.clone();
-    app.world_mut().spawn(Screenshot::image(image)).observe(move |captured: On<ScreenshotCaptured>| {
-        *sink.lock().unwrap() = Some(captured.image.clone());
-    });
-    for _ in 0..200 {
-        app.update();
-        if shot.lock().unwrap().is_some() {
-            break;
+    // The hulls are drawn (skinned, front faces culled): magenta pixels at the silhouette. Bevy
+    // compiles the pipelines in the background (a cold shader cache on a software adapter can take
+    // a while), and a frame taken before they are ready lacks what they draw: screenshots are
+    // taken until one shows the outline, for at most three minutes.
+    let started = std::time::Instant::now();
+    let (magenta, lit) = loop {
+        let shot: Arc<Mutex<Option<Image>>> = Arc::default();
+        let sink = shot.clone();
+        app.world_mut().spawn(Screenshot::image(image.clone())).observe(
+            move |captured: On<ScreenshotCaptured>| {
+                *sink.lock().unwrap() = Some(captured.image.clone());
+            },
+        );
+        for _ in 0..200 {
+            app.update();
+            if shot.lock().unwrap().is_some() {
+                break;
+            }
         }
-    }
-    let picture = shot.lock().unwrap().take().expect("the screenshot came back");
-    let data = picture.data.expect("a captured image has its bytes");
-    let magenta = data.chunks_exact(4).filter(|p| p[0] > 200 && p[1] < 60 && p[2] > 200).count();
-    let lit = data.chunks_exact(4).filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count();
+        let picture = shot.lock().unwrap().take().expect("the screenshot came back");
+        let data = picture.data.expect("a captured image has its bytes");
+        let magenta = data.chunks_exact(4).filter(|p| p[0] > 200 && p[1] < 60 && p[2] > 200).count();
+        let lit = data.chunks_exact(4).filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count();
+        if magenta > 20 || started.elapsed() > std::time::Duration::from_secs(180) {
+            break (magenta, lit);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
     eprintln!("{magenta} outline pixels of {lit} drawn");
     assert!(magenta > 20, "the outline hulls show ({magenta} magenta pixels)");
     assert!(lit > 2 * magenta, "the character is drawn inside its outline");
