@@ -82,8 +82,6 @@ pub(crate) struct TileCasters {
     /// Counted triangles clipped or beyond the planes (this pixel's).
     spill: Vec<u32>,
     diff: Vec<i32>,
-    /// The box of every candidate.
-    bounds: ([f32; 3], [f32; 3]),
 }
 
 impl TileCasters {
@@ -166,12 +164,6 @@ impl TileCasters {
         self.stamp = 0;
         self.w.clear();
         self.w.resize(self.tris.len(), 0);
-        let (mut lo, mut hi) = (Vec3f::splat(f32::INFINITY), Vec3f::splat(f32::NEG_INFINITY));
-        for v in &self.verts {
-            lo = lo.min(*v);
-            hi = hi.max(*v);
-        }
-        self.bounds = (lo.to_array(), hi.to_array());
     }
 
     /// The visibility of the lamp `f` (layout `pat`, first-row offset `o`) from its origin, the
@@ -188,11 +180,6 @@ impl TileCasters {
         lamp_centre: Vec3f,
         lamp_size: f32,
     ) -> f32 {
-        // Nothing to do where the candidates' box cannot hide a sample (most pixels beside a
-        // caster that see the whole lamp).
-        if !f.box_may_hide(self.bounds.0, self.bounds.1, pat, o, &[0; MASK_WORDS]) {
-            return 1.0;
-        }
         let TileCasters {
             verts, tris, edges, live, h, xy, projected, stamp, edge_stamp, w, spill, diff, ..
         } = self;
