@@ -114,6 +114,7 @@ impl Renderer {
                 (false, false),
                 false,
                 faithful,
+                frame.color_mapping.exposure,
                 false,
             )
         } else {

@@ -282,6 +282,7 @@ impl FrameData {
             (self.shadow_fields.plane_count > 0, self.shadow_fields.map_count > 0),
             frame.area_light.is_some(),
             frame.color_mapping.mode == hadou_scene::ToneMode::Faithful,
+            frame.color_mapping.exposure,
             samples,
         )
     }

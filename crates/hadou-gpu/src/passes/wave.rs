@@ -77,6 +77,11 @@ pub(crate) const KIND_KERNELS: [(u32, &str, &str); 5] = [
     (layout::WAVE_CURVE, "WAVE_CURVE", "USE_CURVE"),
 ];
 
+/// The largest α of an analytic wave for which energy.wgsl's α·I can be one multiplication
+/// (`USE_WIDE_SCALE` off): α·2·`ENERGY_MAX` (2·10³⁰, two pieces summed) stays below `f32::MAX`
+/// (3.4·10³⁸) with room to spare.
+const WIDE_ALPHA: f32 = 1.0e8;
+
 /// Each curve shape (`layout::GpuCurve::shape`), as [`KIND_KERNELS`].
 pub(crate) const SHAPE_KERNELS: [(u32, &str, &str); 4] = [
     (layout::SHAPE_HELIX, "SHAPE_HELIX", "USE_HELIX"),
@@ -108,11 +113,11 @@ fn kernels(table: &[(u32, &'static str, &'static str)], code: u32) -> Vec<&'stat
 /// both sides of every `if` and every `switch` case, whichever the pixels take; the uber-shader
 /// made a one-sphere frame pay for every wave kind, the curve walker and the surface shading.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(crate) struct WaveVariant(u32);
+pub(crate) struct WaveVariant(u64);
 
 impl WaveVariant {
     /// The `USE_*` overrides, bit `i` of the variant is the `i`-th name.
-    pub(crate) const NAMES: [&'static str; 28] = [
+    pub(crate) const NAMES: [&'static str; 31] = [
         // wave.wgsl
         "USE_SPHERE",
         "USE_CYLINDER",
@@ -126,6 +131,9 @@ impl WaveVariant {
         // energy.wgsl
         "USE_FAITHFUL",
         "USE_INVERSE_SQUARE",
+        "USE_WIDE_SCALE",
+        "USE_BEAM_HEAD",
+        "USE_BEAM_MUZZLE",
         // curve.wgsl
         "USE_CHORD",
         "USE_SIMPSON",
@@ -153,15 +161,15 @@ impl WaveVariant {
     /// The bit past the overrides: pixels are resolved from several samples, by the wave samples
     /// module's entry point `cs_samples` instead of the wave module's `cs_main` (a module of its
     /// own, so a frame of one sample per pixel compiles nothing of the samples' loops).
-    const SAMPLES: u32 = 1 << Self::NAMES.len();
+    const SAMPLES: u64 = 1 << Self::NAMES.len();
     /// The next bit: the pass writes each pixel's 8-bit sRGB bytes (what a PNG holds) instead of
     /// its float colour, energy and depth (the source feature `SRGB8`: a module without it holds
     /// none of the encoding).
-    const SRGB8: u32 = 1 << (Self::NAMES.len() + 1);
+    const SRGB8: u64 = 1 << (Self::NAMES.len() + 1);
     /// The next bit: some wave of the frame is attenuated, `j > 0` (002 eq. 3.23; the source
     /// feature `ATTENUATION`: a module without it holds none of the attenuated march, which a
     /// software adapter would otherwise run under a mask for every piece of every pixel).
-    const ATTENUATION: u32 = 1 << (Self::NAMES.len() + 2);
+    const ATTENUATION: u64 = 1 << (Self::NAMES.len() + 2);
 
     /// Whether this variant resolves pixels from several samples (`cs_samples`).
     pub(crate) fn samples(self) -> bool {
@@ -216,7 +224,7 @@ impl WaveVariant {
     }
 
     /// The bit of override `name`.
-    fn bit(name: &str) -> u32 {
+    fn bit(name: &str) -> u64 {
         let i = Self::NAMES.iter().position(|n| *n == name).expect("a USE_* name");
         1 << i
     }
@@ -246,14 +254,40 @@ impl WaveVariant {
         shadows: (bool, bool),
         area: bool,
         tone_faithful: bool,
+        exposure: f32,
         samples: bool,
     ) -> Self {
         let mut on: Vec<&str> = Vec::new();
+        // energy.wgsl's USE_WIDE_SCALE: every α·I fits in f32 only when every analytic wave's α
+        // is at most WIDE_ALPHA (its pieces are at most ENERGY_MAX, two summed at most twice
+        // that), every curve's α and the exposure at most 1 (their sums are only saturated).
+        // A NaN (never validated through) takes the wide road, as the shader's `alpha <= 1.0` sends it.
+        let above = |x: f32, limit: f32| x.is_nan() || x > limit;
+        let analytic_alphas = |w: &layout::GpuWave| [w.p0[3], w.p1[3], w.p2[1], w.p2[2]];
+        let wide = above(exposure, 1.0)
+            || waves.iter().any(|w| {
+                w.kind != layout::WAVE_CURVE && analytic_alphas(w).iter().any(|a| above(*a, WIDE_ALPHA))
+            })
+            || curves.iter().any(|c| above(c.alpha, 1.0));
+        if wide {
+            on.push("USE_WIDE_SCALE");
+        }
         // `!(j == 0)`: the shaders' own test, so a NaN (never validated through) is attenuated too.
         let attenuated =
             waves.iter().any(|w| !(w.attenuation == 0.0)) || curves.iter().any(|c| !(c.attenuation == 0.0));
         for w in waves {
             on.extend(kernels(&KIND_KERNELS, w.kind));
+            // The beam's bulbs (p2.y head, p2.z muzzle), by the shader's own test `α ≠ 0`.
+            let bulbs = !matches!(
+                w.kind,
+                layout::WAVE_SPHERE | layout::WAVE_CYLINDER | layout::WAVE_CAPSULE | layout::WAVE_CURVE
+            );
+            if bulbs && w.p2[1] != 0.0 {
+                on.push("USE_BEAM_HEAD");
+            }
+            if bulbs && w.p2[2] != 0.0 {
+                on.push("USE_BEAM_MUZZLE");
+            }
             on.push(if w.falloff == layout::FALLOFF_FAITHFUL {
                 "USE_FAITHFUL"
             } else {
@@ -505,7 +539,7 @@ mod tests {
             ..layout::GpuWave::zeroed()
         };
         let plain =
-            WaveVariant::of(&[sphere], &[], &[], &[], false, false, (false, false), false, true, false);
+            WaveVariant::of(&[sphere], &[], &[], &[], false, false, (false, false), false, true, 1.0, false);
         // The code of each feature: functions, global variables (bindings) and entry points.
         const ATTENUATION: &[&str] = &[
             "rq_attenuated",
@@ -547,6 +581,7 @@ mod tests {
             (false, false),
             false,
             true,
+            1.0,
             false,
         );
         assert!(attenuated.attenuation() && !plain.attenuation());
@@ -560,7 +595,8 @@ mod tests {
         assert!(!ATTENUATION.iter().chain(SRGB8).any(|item| has(aa, item)));
         // A curve's attenuation counts too.
         let curve = layout::GpuCurve { attenuation: 1.5, ..Zeroable::zeroed() };
-        let v = WaveVariant::of(&[], &[curve], &[], &[], false, false, (false, false), false, true, false);
+        let v =
+            WaveVariant::of(&[], &[curve], &[], &[], false, false, (false, false), false, true, 1.0, false);
         assert!(v.attenuation());
     }
 
@@ -732,6 +768,7 @@ mod tests {
             (false, true),
             false,
             false,
+            1.0,
             false,
         );
         assert_eq!(
@@ -763,9 +800,50 @@ mod tests {
             (true, true),
             true,
             true,
+            1.0,
             false,
         );
         assert_eq!(names(v), ["USE_SPHERE", "USE_TONE_FAITHFUL", "USE_FAITHFUL"]);
+        // α·I in one multiplication unless some product can overflow; a beam's bulbs only where
+        // their α is not 0 (a NaN counts as not 0, and takes the wide road).
+        let of_waves = |waves: &[layout::GpuWave], curves: &[layout::GpuCurve], exposure: f32| {
+            names(WaveVariant::of(
+                waves,
+                curves,
+                &[],
+                &[],
+                false,
+                false,
+                (false, false),
+                false,
+                true,
+                exposure,
+                false,
+            ))
+        };
+        let mut beam = wave(layout::WAVE_BEAM, layout::FALLOFF_FAITHFUL);
+        beam.p0[3] = 4.0;
+        beam.p1[3] = 4.0;
+        beam.p2 = [5.0, 8.0, 0.0, 0.0];
+        assert_eq!(
+            of_waves(&[beam], &[], 1.0),
+            ["USE_BEAM", "USE_TONE_FAITHFUL", "USE_FAITHFUL", "USE_BEAM_HEAD"]
+        );
+        beam.p2[2] = f32::NAN;
+        assert!(of_waves(&[beam], &[], 1.0).contains(&"USE_BEAM_MUZZLE"));
+        assert!(of_waves(&[beam], &[], 1.0).contains(&"USE_WIDE_SCALE"));
+        beam.p2[2] = 0.0;
+        for (w, c, exposure) in [
+            (layout::GpuWave { p1: [0.0, 0.0, 1.0, 2.0e8], ..beam }, curve, 1.0),
+            (layout::GpuWave { p0: [0.0, 0.0, 0.0, f32::NAN], ..beam }, curve, 1.0),
+            (beam, layout::GpuCurve { alpha: 1.5, ..curve }, 1.0),
+            (beam, curve, 1.5),
+        ] {
+            assert!(of_waves(&[w], &[c], exposure).contains(&"USE_WIDE_SCALE"), "{w:?} {c:?} {exposure}");
+        }
+        // A curve wave's p0 holds its curve's index, not an α.
+        let curve_wave = layout::GpuWave { p0: [3.0e9, 0.0, 0.0, 0.0], ..wave(layout::WAVE_CURVE, 0) };
+        assert!(!of_waves(&[beam, curve_wave], &[curve], 1.0).contains(&"USE_WIDE_SCALE"));
         // Samples choose the entry point, not an override: the same parts, another pipeline.
         let aa = v.with_samples(true);
         assert!(aa.samples() && !v.samples());
@@ -778,10 +856,101 @@ mod tests {
         assert_eq!(names(png), names(v));
         assert_eq!(png.with_srgb8(false), aa);
         toon.wave_blend = 0.0;
-        let v = WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true, false);
+        let v =
+            WaveVariant::of(&[], &[], &[toon], &[light], false, true, (true, false), true, true, 1.0, false);
         assert_eq!(
             names(v),
             ["USE_SURFACES", "USE_AREA", "USE_TONE_FAITHFUL", "USE_TOON", "USE_PLANE_SHADOWS"]
         );
+    }
+
+    /// wave.wgsl's `srgb8_code` (the 8-bit output) from its source.
+    fn srgb8_source() -> &'static str {
+        let wave = shaders::WAVE;
+        let start =
+            wave.find("// hadou_math::shade::linear_to_srgb8 exactly").expect("srgb8_code in wave.wgsl");
+        let end = wave.find("// Whether `v` is neither NaN").expect("is_finite_f32 after it");
+        &wave[start..end]
+    }
+
+    /// The values the 8-bit tests encode: every threshold of `linear_to_srgb8` and the three
+    /// floats on each side of it, values spread over every octave from 10⁻¹² to 2, and the edges
+    /// (zeros, negatives, 1, NaN, infinities, the largest float, a subnormal).
+    fn srgb8_probes() -> Vec<f32> {
+        let next = hadou_math::shade::srgb8_encoder().next_thresholds();
+        let mut xs = Vec::new();
+        for t in next.iter().filter(|t| t.is_finite()) {
+            let (mut lo, mut hi) = (*t, *t);
+            xs.push(*t);
+            for _ in 0..3 {
+                lo = lo.next_down();
+                hi = hi.next_up();
+                xs.extend([lo, hi]);
+            }
+        }
+        let n = 20_000;
+        xs.extend((0..n).map(|i| (1e-12f64 * (2e12f64).powf(i as f64 / n as f64)) as f32));
+        xs.extend([0.0, -0.0, -1.0, 1.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, f32::MAX, 1e-40]);
+        xs
+    }
+
+    /// The first guess of `srgb8_code`, in f32 as the shader computes it, is within one code of
+    /// `linear_to_srgb8` wherever a code changes and everywhere between: what lets one comparison
+    /// on each side settle the code.
+    #[test]
+    fn srgb8_guess_is_within_one_code() {
+        let source = srgb8_source();
+        let fit_line = source.lines().find(|l| l.starts_with("const SRGB8_FIT")).expect("SRGB8_FIT");
+        let inside =
+            &fit_line[fit_line.find("vec4<f32>(").expect("a vec4") + 10..fit_line.rfind(')').expect(")")];
+        let fit: Vec<f32> = inside.split(',').map(|w| w.trim().parse().expect("a number")).collect();
+        assert_eq!(fit.len(), 4);
+        let mut worst = 0.0f64;
+        for x in srgb8_probes() {
+            let v = if x > 0.0 { x.min(1.0) } else { 0.0 };
+            let (s1, s2) = (v.sqrt(), v.sqrt().sqrt());
+            let s3 = s2.sqrt();
+            let guess = if v <= 0.003_130_8 {
+                3294.6 * v
+            } else {
+                fit[0] * s1 + fit[1] * s2 + fit[2] * s3 + fit[3] * v
+            };
+            let rounded = (guess + 0.5).clamp(0.0, 255.0).floor();
+            let code = f32::from(hadou_math::shade::linear_to_srgb8(x));
+            assert!((rounded - code).abs() <= 1.0, "{x:e}: guess {guess} against code {code}");
+            let exact = 255.0 * f64::from(hadou_math::shade::linear_to_srgb(v));
+            worst = worst.max((f64::from(guess) - exact).abs());
+        }
+        // The margin: the guess is far closer than the one code the comparisons can correct.
+        assert!(worst < 0.05, "the fit is {worst} codes off");
+    }
+
+    /// `srgb8_code` on the GPU gives `linear_to_srgb8`'s code for every probe, bit for bit.
+    #[test]
+    fn srgb8_code_is_linear_to_srgb8() {
+        let Some((ctx, _gpu)) = crate::device::context_or_skip("8-bit codes") else { return };
+        let source = format!(
+            "@group(0) @binding(2) var<storage, read> srgb8_next: array<vec4<f32>, 64>;\n\
+             @group(0) @binding(0) var<storage, read> xs: array<f32>;\n\
+             @group(0) @binding(1) var<storage, read_write> results: array<f32>;\n{}\n\
+             @compute @workgroup_size(64, 1, 1)\n\
+             fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {{\n\
+                 if (id.x < arrayLength(&xs)) {{ results[id.x] = f32(srgb8_code(xs[id.x])); }}\n\
+             }}\n",
+            srgb8_source()
+        );
+        let xs = srgb8_probes();
+        let next = hadou_math::shade::srgb8_encoder().next_thresholds();
+        let inputs: [(u32, &[u8]); 2] = [(0, bytemuck::cast_slice(&xs)), (2, bytemuck::cast_slice(next))];
+        let got = crate::twin_kernel::run(&ctx, "8-bit codes", &source, &inputs, xs.len())
+            .expect("GPU 8-bit codes");
+        for (x, g) in xs.iter().zip(&got) {
+            assert_eq!(
+                *g,
+                f32::from(hadou_math::shade::linear_to_srgb8(*x)),
+                "code of {x:e} ({:#x})",
+                x.to_bits()
+            );
+        }
     }
 }

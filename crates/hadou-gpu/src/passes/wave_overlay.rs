@@ -54,7 +54,7 @@ pub(crate) fn source(multisampled: bool, attenuation: bool) -> String {
 
 /// The overrides of the wave overlay module: the wave variant's wave kinds, falloffs and curve
 /// parts (the rest of [`WaveVariant::NAMES`] belongs to the wave pass's surfaces).
-pub(crate) const OVERRIDES: [&str; 14] = [
+pub(crate) const OVERRIDES: [&str; 17] = [
     "USE_SPHERE",
     "USE_CYLINDER",
     "USE_CAPSULE",
@@ -62,6 +62,9 @@ pub(crate) const OVERRIDES: [&str; 14] = [
     "USE_CURVE",
     "USE_FAITHFUL",
     "USE_INVERSE_SQUARE",
+    "USE_WIDE_SCALE",
+    "USE_BEAM_HEAD",
+    "USE_BEAM_MUZZLE",
     "USE_CHORD",
     "USE_SIMPSON",
     "USE_NEAREST",

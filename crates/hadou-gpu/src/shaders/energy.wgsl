@@ -13,6 +13,16 @@
 // other one's integral is compiled out of rq_integral.
 override USE_FAITHFUL: bool = true;
 override USE_INVERSE_SQUARE: bool = true;
+// Whether some product α·I of the frame can overflow f32 (energy_scaled's exponent arithmetic);
+// without it every α·I of the frame is known to fit (passes/wave.rs WaveVariant::of: the analytic
+// pieces are at most ENERGY_MAX, two of them summed at most twice that, and every α of an
+// analytic wave at most WIDE_ALPHA there; every curve's α and the exposure at most 1), and α·I is
+// one multiplication.
+override USE_WIDE_SCALE: bool = true;
+// Whether some beam of the frame has a head bulb (α_h ≠ 0), a muzzle bulb (α_m ≠ 0). A bulb of
+// α = 0 adds nothing; a software adapter would still integrate it for every pixel under a mask.
+override USE_BEAM_HEAD: bool = true;
+override USE_BEAM_MUZZLE: bool = true;
 
 const T_OPEN: f32 = 3.0e38;
 // Mirrors hadou_math::energy::T_LIMIT.
@@ -45,7 +55,7 @@ fn energy_add(x: f32, y: f32) -> f32 {
 // subnormal for α ≥ 2¹²⁶, and NVIDIA's saturated every energy of an α near f32::MAX.)
 fn energy_scaled(integral: f32, alpha: f32) -> f32 {
     let i = energy_saturate(integral);
-    if (alpha <= 1.0) {
+    if (!USE_WIDE_SCALE || alpha <= 1.0) {
         return i * alpha;
     }
     let a = frexp(i);
@@ -161,12 +171,9 @@ fn rq_faithful(q: RayQuadratic, t0_in: f32, t1_in: f32) -> f32 {
     }
     let k = dt * num * a / (rs * b);
     let z = s * k;
-    var v = k;
-    if (z >= 0.0625) {
-        v = log(1.0 + z) / s;
-    } else if (z > F32_EPSILON) {
-        v = ln_1p_small(z) / s;
-    }
+    // ln(1 + z)/s, by the series for small z: both forms share one division.
+    let ln_1p = select(ln_1p_small(z), log(1.0 + z), z >= 0.0625);
+    let v = select(k, ln_1p / s, z > F32_EPSILON);
     return min(max(v, 0.0), ENERGY_MAX);
 }
 
@@ -543,10 +550,10 @@ fn analytic_energy(p: FieldParams, ray: Ray, t0: f32, t1: f32, att: Attenuation,
     // α_s = p0.w, α_c = p1.w; the beam's head and muzzle strengths p2.y, p2.z.
     var energy = energy_add(energy_scaled(e[0] + e[1], w.p0.w), energy_scaled(e[2], w.p1.w));
     if (beam) {
-        if (w.p2.y != 0.0) {
+        if (USE_BEAM_HEAD && w.p2.y != 0.0) {
             energy = energy_add(energy, energy_scaled(e[3], w.p2.y));
         }
-        if (w.p2.z != 0.0) {
+        if (USE_BEAM_MUZZLE && w.p2.z != 0.0) {
             energy = energy_add(energy, energy_scaled(e[4], w.p2.z));
         }
     }
@@ -576,10 +583,10 @@ fn analytic_energy_direct(p: FieldParams, ray: Ray, t0: f32, t1: f32, w: GpuWave
     let ends = rq_integral(c.first, p.falloff, c.c0, c.lo) + rq_integral(c.last, p.falloff, c.hi, c.c1);
     var energy = energy_add(energy_scaled(ends, w.p0.w), energy_scaled(rq_integral(c.cylinder, p.falloff, c.lo, c.hi), w.p1.w));
     if (beam) {
-        if (w.p2.y != 0.0) {
+        if (USE_BEAM_HEAD && w.p2.y != 0.0) {
             energy = energy_add(energy, energy_scaled(rq_integral(c.at_m2, p.falloff, t0, t1), w.p2.y));
         }
-        if (w.p2.z != 0.0) {
+        if (USE_BEAM_MUZZLE && w.p2.z != 0.0) {
             energy = energy_add(energy, energy_scaled(rq_integral(c.at_m, p.falloff, t0, t1), w.p2.z));
         }
     }
