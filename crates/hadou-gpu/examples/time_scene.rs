@@ -6,7 +6,10 @@
 //! (defaults: time 0, sizes 512 1024 2048; 5 timed iterations after one warm-up), then the wall
 //! time of a whole `render` (preparation and read-back included) and of a PNG's rows, by
 //! `render_rows_rgb8` (8-bit words from the wave pass) and by `render` converted on the CPU. `HADOU_UBER=1` times the
-//! uber-shader instead of the frame's wave-pass variant.
+//! uber-shader instead of the frame's wave-pass variant. `HADOU_ITERS=N` times `N` iterations
+//! and skips the wall-clock part: the process's CPU time at two values of `N` then gives the CPU
+//! time of one frame (what docs/benchmarks.md's lavapipe tables call "CPU ms per frame"), which
+//! other processes on the machine disturb far less than the wall time.
 
 use hadou_gpu::GpuBackend;
 
@@ -41,12 +44,12 @@ fn main() {
         gpu.set_specialise(false);
     }
     println!("adapter: {} (software: {})", gpu.adapter_name(), gpu.is_software());
+    let iterations: Option<u32> = std::env::var("HADOU_ITERS").ok().and_then(|v| v.parse().ok());
     for size in sizes {
         let mut frame = scene.at(time);
         frame.width = size;
         frame.height = size;
-        let iters: u32 = std::env::var("HADOU_ITERS").ok().and_then(|v| v.parse().ok()).unwrap_or(5);
-        match gpu.time_frame(&frame, iters) {
+        match gpu.time_frame(&frame, iterations.unwrap_or(5)) {
             Ok(t) => {
                 let passes: Vec<String> =
                     t.passes.iter().map(|p| format!("{} {:.3} ms", p.name, p.median_ms)).collect();
@@ -63,7 +66,7 @@ fn main() {
             }
             Err(e) => println!("{path} {size}²: {e}"),
         }
-        if std::env::var("HADOU_ITERS").is_ok() {
+        if iterations.is_some() {
             continue;
         }
         // The whole render as a caller sees it: preparation, every pass and the read-back; then
