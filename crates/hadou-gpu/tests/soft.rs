@@ -206,8 +206,11 @@ fn outlines_under_an_area_light_in_one_tile_match_cpu() {
     let figure = "material = \"plaster\"\n";
     assert!(text.contains(figure), "soft-plaster's figure");
     let path = dir.join("outlined.toml");
-    std::fs::write(&path, text.replacen(figure, "material = \"plaster\"\noutline = true\noutline_width = 0.006\n", 1))
-        .unwrap();
+    std::fs::write(
+        &path,
+        text.replacen(figure, "material = \"plaster\"\noutline = true\noutline_width = 0.006\n", 1),
+    )
+    .unwrap();
     let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
     for (w, h) in [(128, 96), (160, 120)] {
         let mut frame = scene.at(1.0);
