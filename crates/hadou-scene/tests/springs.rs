@@ -289,9 +289,9 @@ fn the_showcase_blows_its_hair_and_skirt_away_from_the_beam() {
     assert!(text.contains(gust), "the showcase's wind track");
     std::fs::write(d.join("showcase.toml"), &text).unwrap();
     std::fs::write(d.join("calm.toml"), text.replace(gust, "keys = [[0.0, 0.0]]")).unwrap();
-    let blown = Scene::load(&d.join("showcase.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let blown = Scene::load(d.join("showcase.toml")).unwrap_or_else(|e| panic!("{e}"));
     assert!(blown.warnings().is_empty(), "the README's first command warns: {:?}", blown.warnings());
-    let calm = Scene::load(&d.join("calm.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let calm = Scene::load(d.join("calm.toml")).unwrap_or_else(|e| panic!("{e}"));
     let hero = blown.object_names().iter().position(|n| *n == "hero").expect("the character");
     let (a, b) = (blown.at(1.8), calm.at(1.8));
     let (wind, still) = (&a.objects[hero].mesh, &b.objects[hero].mesh);
