@@ -24,9 +24,13 @@
   skirt of sixteen strands (seven joints each) round the hips, every strand a VRMC_springBone
   spring (the last joint of each only its tail: 192 joints turn), with sphere and capsule colliders
   on the head, chest and upper legs; what a wave's wind blows (scenes/light-blast.toml).
+- showcase.vrm: blast.vrm with sixteen golden hair strands (ten joints each, down to the shoulders)
+  and a longer skirt of twenty strands (eight joints each): the character of scenes/showcase.toml
+  (u16 joint indices: 339 joints).
 - brace.vrma: a `VRMC_vrm_animation` 1.0 clip `brace` on a humanoid skeleton of nodes whose upper
   arms rest 10 degrees lower than brace.vrm's, with a bone the avatars lack (leftThumbProximal) and
   a `blink` expression track (the expression node's translation x).
+- showcase.vrma: the same clip without leftThumbProximal (every bone it names, the avatars have).
 
 Run from this folder: `python3 make_brace.py`.
 """
@@ -654,37 +658,46 @@ for _t, _s in (("L", "left"), ("R", "right")):
                   "upperLeg." + _t: _s + "UpperLeg", "lowerLeg." + _t: _s + "LowerLeg", "foot." + _t: _s + "Foot"})
 
 
-HAIR_STRANDS, HAIR_JOINTS, HAIR_TOP, HAIR_STEP = 12, 9, 1.66, 0.035
-SKIRT_STRANDS, SKIRT_JOINTS, SKIRT_TOP, SKIRT_STEP = 16, 7, 1.0, 0.045
+# The strands of the avatars with spring bones: per part, (strands, joints per strand, top y, joint
+# spacing, the tube's two radii). showcase.vrm's hair is longer and thicker (down to the shoulders)
+# and its skirt longer, so the wind's work reads at a glance.
+STRANDS = {
+    "blast": {"hair": (12, 9, 1.66, 0.035, (0.014, 0.008)), "skirt": (16, 7, 1.0, 0.045, (0.03, 0.012))},
+    "showcase": {"hair": (16, 10, 1.68, 0.05, (0.024, 0.01)), "skirt": (20, 8, 1.0, 0.05, (0.035, 0.012))},
+}
 
 
-def add_strands(sk):
-    """blast.vrm's hair strands (on the head) and skirt strands (on the hips): lists of joints."""
+def add_strands(sk, kind):
+    """The hair strands (on the head) and skirt strands (on the hips) of blast.vrm or
+    showcase.vrm: lists of joints."""
     hair, skirt = [], []
     head, hips = sk.index("head"), sk.index("hips")
-    for k in range(HAIR_STRANDS):
-        a = math.radians(105.0 + 150.0 * k / (HAIR_STRANDS - 1))
+    n, joints, top, step, _ = STRANDS[kind]["hair"]
+    for k in range(n):
+        a = math.radians(105.0 + 150.0 * k / (n - 1))
         x, z = 0.125 * math.sin(a), 0.125 * math.cos(a) - 0.01
         p, chain = head, []
-        for i in range(HAIR_JOINTS):
-            p = sk.add("hair.%d.%d" % (k, i), p, (x, HAIR_TOP - HAIR_STEP * i, z))
+        for i in range(joints):
+            p = sk.add("hair.%d.%d" % (k, i), p, (x, top - step * i, z))
             chain.append(p)
         hair.append(chain)
-    for k in range(SKIRT_STRANDS):
-        a = 2 * math.pi * (k + 0.5) / SKIRT_STRANDS
+    n, joints, top, step, _ = STRANDS[kind]["skirt"]
+    for k in range(n):
+        a = 2 * math.pi * (k + 0.5) / n
         x, z = 0.2 * math.sin(a), 0.13 * math.cos(a)
         p, chain = hips, []
-        for i in range(SKIRT_JOINTS):
-            p = sk.add("skirt.%d.%d" % (k, i), p, (x, SKIRT_TOP - SKIRT_STEP * i, z))
+        for i in range(joints):
+            p = sk.add("skirt.%d.%d" % (k, i), p, (x, top - step * i, z))
             chain.append(p)
         skirt.append(chain)
     return hair, skirt
 
 
-def strand_geometry(sk, parts, hair, skirt):
+def strand_geometry(sk, parts, hair, skirt, kind):
     """A thin tube down every strand, each segment bent by the joint above it."""
-    for chains, part, r, seg, step in ((hair, parts[HAIR], (0.014, 0.008), 5, HAIR_STEP),
-                                      (skirt, parts[SUIT], (0.03, 0.012), 6, SKIRT_STEP)):
+    (_, _, _, hair_step, hair_r), (_, _, _, skirt_step, skirt_r) = STRANDS[kind]["hair"], STRANDS[kind]["skirt"]
+    for chains, part, r, seg, step in ((hair, parts[HAIR], hair_r, 5, hair_step),
+                                      (skirt, parts[SUIT], skirt_r, 6, skirt_step)):
         for chain in chains:
             x, y0, z = sk.pos[chain[0]]
             y1 = sk.pos[chain[-1]][1]
@@ -718,12 +731,14 @@ def spring_bones(hair, skirt, J):
 
 def write_brace(path, kind):
     """kind: "glb" (A-pose rest, clips), "vrm" (VRM 1.0, T-pose), "vrm0" (VRM 0.x, T-pose, faces -z),
-    "blast" (the VRM 1.0 avatar with spring-bone hair and skirt)."""
+    "blast" (the VRM 1.0 avatar with spring-bone hair and skirt), "showcase" (blast with longer,
+    golden hair and a longer skirt)."""
     sk = body_skeleton()
-    hair, skirt = add_strands(sk) if kind == "blast" else ([], [])
+    springy = kind in STRANDS
+    hair, skirt = add_strands(sk, kind) if springy else ([], [])
     parts = build_body(sk, 1.0)
-    if kind == "blast":
-        strand_geometry(sk, parts, hair, skirt)
+    if springy:
+        strand_geometry(sk, parts, hair, skirt, kind)
     targets = face_targets(parts[FACE])
     flip = kind == "vrm0"
     if flip:
@@ -756,9 +771,10 @@ def write_brace(path, kind):
 
     doc = {}
     add_images(d, doc, [png(8, 16, stripes), png(FW, FH, face_img), png(16, 16, matcap_img), png(8, 8, mask_img)])
-    body_prims = [primitive(d, parts[m], m, 8) for m in (SUIT, SKIN, HAIR)]
-    head_prim = primitive(d, parts[FACE], FACE, 8, targets)
-    band_prim = primitive(d, parts[BAND], BAND, 8)
+    bits = 16 if nj > 256 else 8  # u8 joint indices reach 255
+    body_prims = [primitive(d, parts[m], m, bits) for m in (SUIT, SKIN, HAIR)]
+    head_prim = primitive(d, parts[FACE], FACE, bits, targets)
+    band_prim = primitive(d, parts[BAND], BAND, bits)
     ibm = [(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -p[0], -p[1], -p[2], 1) for p in sk.pos]
     doc.update({
         "asset": {"version": "2.0", "generator": "hadou make_brace.py"},
@@ -770,13 +786,17 @@ def write_brace(path, kind):
                    {"name": "head", "primitives": [head_prim], "weights": [0.0, 0.25],
                     "extras": {"targetNames": ["blink", "aa"]}},
                    {"name": "headband", "primitives": [band_prim]}],
-        "materials": materials(kind in ("vrm", "blast")),
+        "materials": materials(kind in ("vrm", "blast", "showcase")),
     })
+    if kind == "showcase":
+        hair_m = doc["materials"][MATERIAL_NAMES.index("hair")]
+        hair_m["pbrMetallicRoughness"]["baseColorFactor"] = [1.0, 0.62, 0.12, 1.0]
+        hair_m["extensions"]["VRMC_materials_mtoon"]["shadeColorFactor"] = [0.55, 0.16, 0.04]
     used = ["VRMC_materials_mtoon"]
     if kind == "glb":
         doc["animations"] = [add_clip(d, name, ch)
                              for name, ch in brace_clips(sk, nodes, band_node, head_node, arm_rest_l)]
-    elif kind in ("vrm", "blast"):
+    elif kind in ("vrm", "blast", "showcase"):
         used.append("VRMC_vrm")
         doc["extensions"] = {"VRMC_vrm": {
             "specVersion": "1.0",
@@ -795,7 +815,7 @@ def write_brace(path, kind):
             }},
             "lookAt": {"offsetFromHeadBone": [0.0, 0.1, 0.1], "type": "bone"},
         }}
-        if kind == "blast":
+        if springy:
             used.append("VRMC_springBone")
             doc["extensions"]["VRMC_springBone"] = spring_bones(hair, skirt, sk.index)
     else:
@@ -912,10 +932,12 @@ def write_dancer(path):
 # ---------------------------------------------------------------------------------------------
 # brace.vrma
 
-def write_vrma(path):
+def write_vrma(path, thumb=True):
+    """thumb: add leftThumbProximal, a bone the avatars lack (brace.vrma); showcase.vrma is the same
+    clip without it."""
     sk = body_skeleton()
     hand_l = sk.index("hand.L")
-    thumb = sk.add("thumbProximal.L", hand_l, (0.74, 1.38, 0.045))
+    thumb = sk.add("thumbProximal.L", hand_l, (0.74, 1.38, 0.045)) if thumb else None
     d = Doc()
     nj = len(sk.names)
     rest_l = q_rot(("z", -10.0))  # the arms rest 10 degrees lower than brace.vrm's T-pose
@@ -951,10 +973,12 @@ def write_vrma(path):
                track("lowerArm." + tag, [mir(q_rot(("z", 105 * k))) for k in ks]),
                track("upperLeg." + tag, [mir(q_rot(("x", -40 * k))) for k in ks]),
                track("lowerLeg." + tag, [mir(q_rot(("x", 75 * k))) for k in ks])]
-    ch.append(track("thumbProximal.L", [q_rot(("y", 30 * k)) for k in ks]))
+    if thumb is not None:
+        ch.append(track("thumbProximal.L", [q_rot(("y", 30 * k)) for k in ks]))
     ch.append((blink_node, "translation", "LINEAR", T, [(w, 0.0, 0.0) for w in (0.0, 1.0, 0.0, 0.0, 1.0)]))
     bones = {HUMAN[n]: {"node": j} for j, n in enumerate(sk.names) if n in HUMAN}
-    bones["leftThumbProximal"] = {"node": thumb}
+    if thumb is not None:
+        bones["leftThumbProximal"] = {"node": thumb}
     doc = {
         "asset": {"version": "2.0", "generator": "hadou make_brace.py"},
         "extensionsUsed": ["VRMC_vrm_animation"],
@@ -978,4 +1002,6 @@ if __name__ == "__main__":
     write_brace("brace0.vrm", "vrm0")
     write_brace("blast.vrm", "blast")
     write_vrma("brace.vrma")
+    write_brace("showcase.vrm", "showcase")
+    write_vrma("showcase.vrma", thumb=False)
     write_dancer("dancer.glb")

@@ -628,9 +628,11 @@ impl Renderer {
             }
             TileWork::Draw { readback } => readback,
         };
-        if let Some(enc) = surfaces.as_mut().filter(|_| prepared.outlines) {
+        // The edge pass follows the raster pass of this tile's G-buffer: this one's, or the
+        // classification's when the G-buffer is reused (which stopped before it).
+        if prepared.outlines && (surfaces.is_some() || reuse) {
             passes.edges.encode(
-                enc,
+                surfaces.get_or_insert_with(|| encoder("tile surfaces")),
                 size,
                 &groups.edges,
                 timestamps.as_deref_mut().and_then(|q| q.compute("edges")),
