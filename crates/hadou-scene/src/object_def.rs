@@ -209,7 +209,8 @@ fn parse_look_at(
         return Err(t.src.value_err(
             &t.key_span("look_at"),
             format!(
-                "{} gives `look_at`, but its glTF file has no VRM look-at (a head bone and `lookAt` with eye                  bones or look expressions)",
+                "{} gives `look_at`, but its glTF file has no VRM look-at (a head bone and `lookAt` with eye \
+                 bones or look expressions)",
                 t.what
             ),
         ));

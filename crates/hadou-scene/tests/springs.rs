@@ -267,6 +267,8 @@ fn the_eyes_follow_a_point_the_camera_and_a_waves_head() {
     );
     let e = scene(&d, "path = \"brace.vrm\"\nlook_at = \"camera\"", "").unwrap_err();
     assert!(e.contains("scene.toml:9:1") && e.contains("no VRM look-at"), "{e}");
+    // One sentence, without a run of spaces from a line break in its source.
+    assert!(e.contains("`lookAt` with eye bones or look expressions") && !e.contains("  "), "{e}");
     let e = scene(&d, "path = \"eyes.vrm\"\nlook_at = [0.0, nan, 1.0]", "").unwrap_err();
     assert!(e.contains("scene.toml:9:") && e.contains("look_at"), "{e}");
 }
