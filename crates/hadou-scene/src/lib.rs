@@ -101,7 +101,7 @@ pub use gltf_load::{
 };
 pub use gltf_vrma::load_vrma_clip;
 pub use image::{Image, Rgb8Image};
-pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo};
+pub use introspect::{CharacterInfo, Entity, LookAtTarget, ParamInfo, ParamRange, ParamShape, TrackInfo};
 pub use limits::{
     check_image_size, check_image_size_with, check_trace_memory, glare_band_rows, ALPHA_MAX,
     ANALYTIC_RAY_WORK, ATTENUATION_MAX, GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES,

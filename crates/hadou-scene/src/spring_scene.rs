@@ -172,28 +172,8 @@ impl Scene {
         rotations: &mut Vec<(usize, [f32; 4])>,
         expressions: &mut Vec<(usize, f32)>,
     ) {
-        let (Some(target), Some(look)) = (o.look_at.as_ref(), rig.look_at.as_ref()) else { return };
-        let world = match target {
-            LookTarget::Camera => Vec3f::from_array(self.camera.arr::<3>(vals, "position")),
-            LookTarget::Point => Vec3f::from_array(o.params.arr::<3>(vals, "look_at")),
-            LookTarget::WaveName(..) => return,
-            LookTarget::Wave(i) => {
-                let Some(w) = self.waves.get(*i) else { return };
-                match self.build_wave(w, vals).shape {
-                    WaveShape::Sphere(f) => f.center,
-                    WaveShape::Cylinder(f) => f.point,
-                    WaveShape::Capsule(f) => f.m2(),
-                    WaveShape::Beam(f) => f.capsule.m2(),
-                    WaveShape::Curve(c) => {
-                        let prep = hadou_math::curve::prepare(&c);
-                        match prep.light_polyline().last() {
-                            Some(p) => *p,
-                            None => return,
-                        }
-                    }
-                }
-            }
-        };
+        let Some(look) = rig.look_at.as_ref() else { return };
+        let Some(world) = self.gaze_target(o, vals) else { return };
         let target = affine_inverse(&o.transform(vals)).transform_point(world);
         if !target.is_finite() {
             return;
@@ -213,5 +193,31 @@ impl Scene {
                 }
             }
         }
+    }
+
+    /// Where object `o`'s eyes look at these values, in world space (module docs of `look_at`):
+    /// the camera's position, a wave's head or the object's `look_at` point; `None` without
+    /// `look_at`.
+    fn gaze_target(&self, o: &ObjectDef, vals: &[f32]) -> Option<Vec3f> {
+        Some(match o.look_at.as_ref()? {
+            LookTarget::Camera => Vec3f::from_array(self.camera.arr::<3>(vals, "position")),
+            LookTarget::Point => Vec3f::from_array(o.params.arr::<3>(vals, "look_at")),
+            LookTarget::WaveName(..) => return None,
+            LookTarget::Wave(i) => match self.build_wave(self.waves.get(*i)?, vals).shape {
+                WaveShape::Sphere(f) => f.center,
+                WaveShape::Cylinder(f) => f.point,
+                WaveShape::Capsule(f) => f.m2(),
+                WaveShape::Beam(f) => f.capsule.m2(),
+                WaveShape::Curve(c) => *hadou_math::curve::prepare(&c).light_polyline().last()?,
+            },
+        })
+    }
+
+    /// Where the eyes of the object named `object` look at scene time `time` (world space): the
+    /// point its `look_at` names there; `None` for an object without `look_at`.
+    pub fn look_at_point(&self, object: &str, time: f32) -> Option<[f32; 3]> {
+        let o = self.objects.iter().find(|o| o.name == object)?;
+        let time = if time.is_finite() { time } else { 0.0 };
+        self.gaze_target(o, &self.values_at(time)).map(Vec3f::to_array)
     }
 }
