@@ -58,6 +58,19 @@ pub(crate) struct StepInput<'a> {
     pub clip_time: f32,
     /// The external force on a point of the character's space (rig space), per second.
     pub wind: &'a dyn Fn(Vec3f) -> Vec3f,
+    /// Whether any wave blows at this step (else `wind` is zero everywhere and is not called).
+    pub windy: bool,
+    /// The nodes' pose when it is the same at every step (no clip): worked out once for all the
+    /// steps instead of at each ([`Rig::still_pose`]).
+    pub still: Option<&'a StillPose>,
+}
+
+/// The nodes' local transforms under no clip, and the global matrices of the nodes no joint
+/// moves: what every step of a character without a clip starts from.
+pub(crate) struct StillPose {
+    locals: Vec<Trs>,
+    /// Per node, its global matrix (`None` for a node a joint moves).
+    globals: Vec<Option<Mat4>>,
 }
 
 /// The state of a character's springs after some steps.
@@ -109,8 +122,23 @@ impl Rig {
         Some(SpringState { step: start, start, tails, rotations })
     }
 
+    /// The pose of the steps of a character without a clip ([`StillPose`]).
+    pub(crate) fn still_pose(&self) -> Option<StillPose> {
+        let sb = self.springs.as_ref()?;
+        let wind = |_: Vec3f| Vec3f::ZERO;
+        let input = StepInput { clip: None, clip_time: 0.0, wind: &wind, windy: false, still: None };
+        let locals = self.step_locals(&input);
+        let globals = (0..self.nodes.len())
+            .map(|n| (!sb.moving.get(n).copied().unwrap_or(true)).then(|| self.global_of(n, &locals)))
+            .collect();
+        Some(StillPose { locals, globals })
+    }
+
     /// The nodes' local transforms for `input`'s clip time (no spring rotations).
     fn step_locals(&self, input: &StepInput<'_>) -> Vec<Trs> {
+        if let Some(still) = input.still {
+            return still.locals.clone();
+        }
         let pose =
             PoseInput { clip: input.clip, time: input.clip_time, skip_weights: true, ..Default::default() };
         self.sample_locals(&pose).0
@@ -160,11 +188,23 @@ impl Rig {
                 *rot = *r;
             }
         }
-        // Globals of the nodes no joint moves, worked out once this step.
-        let mut memo: Vec<Option<Mat4>> = vec![None; self.nodes.len()];
+        // Globals of the nodes no joint moves, worked out once this step (once for all steps
+        // without a clip).
+        let mut memo: Vec<Option<Mat4>> = match input.still {
+            Some(_) => Vec::new(),
+            None => vec![None; self.nodes.len()],
+        };
         let mut global = |node: usize, locals: &[Trs]| -> Mat4 {
             if sb.moving.get(node).copied().unwrap_or(true) {
                 return self.global_of(node, locals);
+            }
+            if let Some(still) = input.still {
+                return still
+                    .globals
+                    .get(node)
+                    .copied()
+                    .flatten()
+                    .unwrap_or_else(|| self.global_of(node, locals));
             }
             // Up to the nearest known ancestor, then down.
             let mut path = Vec::new();
@@ -187,13 +227,14 @@ impl Rig {
             }
             m
         };
-        // Each collider this step: a segment `a..b` (a sphere's is a point) and its radius.
-        let colliders: Vec<(Vec3f, Vec3f, f32)> = sb
+        // Each collider this step: a segment `a..b` (a sphere's is a point), its radius, and the
+        // sphere around it all: the segment's middle and the radius plus half its length.
+        let colliders: Vec<(Vec3f, Vec3f, f32, Vec3f, f32)> = sb
             .colliders
             .iter()
             .map(|c| {
                 let g = global(c.node, &locals);
-                match c.shape {
+                let (a, b, radius) = match c.shape {
                     ColliderShape::Sphere { offset, radius } => {
                         let p = g.transform_point(offset);
                         (p, p, radius)
@@ -201,7 +242,11 @@ impl Rig {
                     ColliderShape::Capsule { offset, tail, radius } => {
                         (g.transform_point(offset), g.transform_point(tail), radius)
                     }
-                }
+                };
+                // A non-finite bound tests every joint, as without it.
+                let bound = radius + 0.5 * (b - a).length();
+                let bound = if bound.is_finite() { bound } else { f32::INFINITY };
+                (a, b, radius, (a + b) * 0.5, bound)
             })
             .collect();
         let mut k = 0;
@@ -235,24 +280,33 @@ impl Rig {
                     Some(c) => (c.transform_point(prev), c.transform_point(cur)),
                     None => (prev, cur),
                 };
-                let mut force = (j.gravity_dir * j.gravity_power) + (input.wind)(cur);
-                let f = force.length();
-                if f.is_nan() || f > SPRING_FORCE_MAX {
+                let mut force = j.gravity_dir * j.gravity_power;
+                if input.windy {
+                    force += (input.wind)(cur);
+                }
+                // The length is taken only for a force past the bound (compared squared).
+                let f2 = force.length_squared();
+                if f2.is_nan() || f2 > SPRING_FORCE_MAX * SPRING_FORCE_MAX {
+                    let f = f2.sqrt();
                     force = if f.is_finite() { force * (SPRING_FORCE_MAX / f) } else { Vec3f::ZERO };
                 }
-                let mut next =
-                    cur + (cur - prev) * (1.0 - j.drag) + rest_dir * (j.stiffness * dt) + force * dt;
-                next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
+                let next = cur + (cur - prev) * (1.0 - j.drag) + rest_dir * (j.stiffness * dt) + force * dt;
+                let mut next = head + scaled_to(next - head, length).unwrap_or(rest_dir * length);
                 for &c in &s.colliders {
-                    let Some(&(a, b, radius)) = colliders.get(c) else { continue };
-                    let at = nearest_on_segment(next, a, b);
+                    let Some(&(a, b, radius, centre, bound)) = colliders.get(c) else { continue };
                     let reach = radius + j.hit_radius;
+                    // Outside the collider's bounding sphere grown by the hit radius: no contact,
+                    // and no nearest point to find.
+                    let far = bound + j.hit_radius;
+                    if (next - centre).length_squared() >= far * far {
+                        continue;
+                    }
+                    let at = nearest_on_segment(next, a, b);
                     let d = next - at;
-                    let dist = d.length();
-                    if dist < reach {
-                        if let Some(n) = d.try_normalize() {
-                            next = at + n * reach;
-                            next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
+                    // Compared squared: the square root only for a contact.
+                    if d.length_squared() < reach * reach {
+                        if let Some(out) = scaled_to(d, reach) {
+                            next = head + scaled_to(at + out - head, length).unwrap_or(rest_dir * length);
                         }
                     }
                 }
@@ -272,9 +326,10 @@ impl Rig {
                 };
                 let Some(slot) = tails.get_mut(idx) else { return };
                 *slot = (slot.1, back);
-                let local = local_direction(&m0, next - head);
-                let turn = from_to(axis, local.try_normalize().unwrap_or(axis));
-                let r = unit_quat(quat_mul(*rest_r, turn));
+                let turn = turn_to(axis, local_direction(&m0, next - head));
+                // Both of unit length, so is their product (to rounding; each step starts again
+                // from the rest rotation, so nothing accumulates).
+                let r = quat_mul(*rest_r, turn);
                 if let Some(slot) = rotations.get_mut(idx) {
                     *slot = r;
                 }
@@ -302,6 +357,18 @@ fn local_direction(m: &Mat4, v: Vec3f) -> Vec3f {
         }
     };
     Vec3f::new(row(0), row(1), row(2))
+}
+
+/// `v` scaled to length `len` (one square root and one division), or `None` for a zero or
+/// non-finite `v`.
+#[inline]
+fn scaled_to(v: Vec3f, len: f32) -> Option<Vec3f> {
+    let l2 = v.length_squared();
+    if l2 > 0.0 && l2.is_finite() {
+        Some(v * (len / l2.sqrt()))
+    } else {
+        None
+    }
 }
 
 /// `q / |q|` in f32, or the identity for a zero or non-finite `q` (the simulation's own, cheaper than
@@ -358,14 +425,20 @@ fn nearest_on_segment(p: Vec3f, a: Vec3f, b: Vec3f) -> Vec3f {
     a + ab * ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
 }
 
-/// The shortest rotation (unit quaternion `[x, y, z, w]`) turning unit `a` onto unit `b`; half a
-/// turn about an axis normal to `a` when they are opposite.
-pub(crate) fn from_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
+/// The shortest rotation (unit quaternion `[x, y, z, w]`) turning unit `a` onto the direction of
+/// `b`, which need not be of unit length: the half-way quaternion `[a × b, |b| + a·b]` normalised
+/// (for unit `b`, `[a × b, 1 + a·b]`), so `b` is not normalised first; half a turn about an axis
+/// normal to `a` when they are opposite, the identity for a zero or non-finite `b`.
+pub(crate) fn turn_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
+    let lb = b.length();
+    if !(lb > 0.0 && lb.is_finite()) {
+        return [0.0, 0.0, 0.0, 1.0];
+    }
     let d = a.dot(b);
-    if d < -1.0 + 1e-6 {
+    if d < (-1.0 + 1e-6) * lb {
         let (n, _) = a.orthonormal_basis();
         return [n.x, n.y, n.z, 0.0];
     }
     let c = a.cross(b);
-    unit_quat([c.x, c.y, c.z, 1.0 + d])
+    unit_quat([c.x, c.y, c.z, lb + d])
 }

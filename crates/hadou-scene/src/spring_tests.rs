@@ -3,7 +3,7 @@
 //! 1.0 conversion and located errors for bad data.
 
 use crate::rig::{PoseInput, RestLocal, Rig, RigNode, VrmVersion};
-use crate::spring::{from_to, SpringBones, SpringState, StepInput};
+use crate::spring::{turn_to, SpringBones, SpringState, StepInput};
 use crate::spring_def::read_springs;
 use hadou_math::{Mat4, Vec3f};
 use serde_json::{json, Value};
@@ -48,7 +48,7 @@ fn run(
     wind: &dyn Fn(Vec3f) -> Vec3f,
     mut each: impl FnMut(usize, &[Mat4]),
 ) -> SpringState {
-    let input = StepInput { clip: None, clip_time: 0.0, wind };
+    let input = StepInput { clip: None, clip_time: 0.0, wind, windy: true, still: None };
     let mut state = rig.spring_rest(0, &input).expect("springs");
     let sb: &SpringBones = rig.springs.as_ref().expect("springs");
     for k in 0..steps {
@@ -284,17 +284,25 @@ fn huge_forces_stay_finite_and_bounded() {
 }
 
 #[test]
-fn from_to_turns_one_direction_onto_another() {
+fn turn_to_turns_one_direction_onto_another_of_any_length() {
     let cases = [
         (Vec3f::X, Vec3f::Y),
         (Vec3f::X, -Vec3f::X),
         (Vec3f::Z, Vec3f::Z),
         (Vec3f::Y, Vec3f::new(0.6, 0.0, 0.8)),
+        (Vec3f::new(0.0, 0.6, -0.8), Vec3f::new(-0.48, 0.0, 0.64)),
     ];
     for (a, b) in cases {
-        let q = from_to(a, b);
-        let got = hadou_math::keyframes::quat_matrix(q).transform_vector(a);
-        assert!((got - b).length() < 1e-5, "{a:?} → {b:?}: {got:?}");
+        for scale in [1.0, 3.7, 0.02] {
+            let q = turn_to(a, b * scale);
+            let unit = (q.iter().map(|c| c * c).sum::<f32>() - 1.0).abs();
+            assert!(unit < 1e-6, "{a:?} → {b:?}·{scale}: |q| − 1 = {unit}");
+            let got = hadou_math::keyframes::quat_matrix(q).transform_vector(a);
+            assert!((got - b * (1.0 / b.length())).length() < 1e-5, "{a:?} → {b:?}·{scale}: {got:?}");
+        }
+    }
+    for nothing in [Vec3f::ZERO, Vec3f::new(f32::NAN, 0.0, 1.0), Vec3f::new(f32::INFINITY, 0.0, 0.0)] {
+        assert_eq!(turn_to(Vec3f::X, nothing), [0.0, 0.0, 0.0, 1.0]);
     }
 }
 
@@ -569,7 +577,13 @@ fn a_center_carries_the_tails_with_it() {
         }
         let r = rig(nodes, json!({ "VRMC_springBone": { "springs": [spring] } }));
         let wind = no_wind;
-        let input = |k: u64| StepInput { clip: Some(&clip), clip_time: (k as f64 * DT) as f32, wind: &wind };
+        let input = |k: u64| StepInput {
+            clip: Some(&clip),
+            clip_time: (k as f64 * DT) as f32,
+            wind: &wind,
+            windy: true,
+            still: None,
+        };
         let mut state = r.spring_rest(0, &input(0)).expect("springs");
         let sb = r.springs.as_ref().expect("springs");
         let mut worst = 0.0f64;

@@ -312,8 +312,11 @@ impl Document {
         if text == self.text {
             return Ok(());
         }
-        let scene =
+        let mut scene =
             Scene::parse(&text, &self.path).map_err(|e| DocError(strip_path(&e.to_string(), &self.path)))?;
+        // An edit that leaves a character's springs alone (the camera, a light, …) continues
+        // their simulation rather than stepping again from time 0: the same bits, sooner.
+        scene.keep_spring_states(&self.scene);
         let merging = merge.is_some() && self.merge.as_deref() == merge && !self.undo.is_empty();
         if !merging {
             self.undo.push(std::mem::take(&mut self.text));
@@ -355,8 +358,10 @@ impl Document {
     /// Rebuilds the tree and the scene from `self.text` (a text that parsed before).
     fn reset_from_text(&mut self) {
         self.merge = None;
-        if let (Ok(doc), Ok(scene)) = (self.text.parse::<DocumentMut>(), Scene::parse(&self.text, &self.path))
+        if let (Ok(doc), Ok(mut scene)) =
+            (self.text.parse::<DocumentMut>(), Scene::parse(&self.text, &self.path))
         {
+            scene.keep_spring_states(&self.scene);
             self.doc = doc;
             self.scene = scene;
         }
@@ -423,7 +428,8 @@ impl Document {
             text.parse::<DocumentMut>().map(|doc| (scene, doc)).map_err(|e| e.message().to_string())
         });
         match parsed {
-            Ok((scene, doc)) => {
+            Ok((mut scene, doc)) => {
+                scene.keep_spring_states(&self.scene);
                 self.disk_text = text.clone();
                 self.reload_error = None;
                 if text != self.text {

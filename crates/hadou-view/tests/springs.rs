@@ -211,3 +211,49 @@ fn scripts_set_spring_look_at_and_wind() {
         assert!(e.contains(&format!("s.txt:1:{col}:")) && e.contains(names), "{line}: {e}");
     }
 }
+
+#[test]
+fn edits_that_leave_the_springs_alone_continue_their_state_with_the_same_bits() {
+    let (mut v, d) = viewer("keep", "");
+    v.timeline.time = 2.0;
+    let cold = positions(&v, 2.0);
+    assert_eq!(v.scene().spring_state_step("hero"), Some(120), "2 s at 60 steps a second");
+    // The camera, a light: the state is kept, and the frame is the one a fresh scene gives.
+    assert!(v.orbit(20.0, 5.0));
+    assert!(v.edit_value("light.ambient", vec![0.3, 0.3, 0.3], None));
+    assert_eq!(v.scene().spring_state_step("hero"), Some(120));
+    assert_eq!(positions(&v, 2.0), cold);
+    v.timeline.time = 2.5;
+    let later = positions(&v, 2.5);
+    assert_eq!(v.scene().spring_state_step("hero"), Some(150));
+    let fresh = Document::from_text(v.doc.text(), &d.join("scene.toml")).unwrap();
+    assert_eq!(fresh.scene().spring_state_step("hero"), None);
+    assert_eq!(fresh.scene().at(2.5).objects[0].mesh.positions, later, "the same bits as stepping from 0");
+    // Undo of an edit that left the springs alone keeps them too.
+    v.undo();
+    assert_eq!(v.scene().spring_state_step("hero"), Some(150));
+    // What drives the springs starts them again: the wind, the character's place, `spring`.
+    for (target, value) in [("wave.beam.wind", vec![5.0]), ("object.hero.position", vec![0.1, 0.0, 0.0])] {
+        assert!(v.edit_value(target, value, None));
+        assert_eq!(v.scene().spring_state_step("hero"), None, "{target}");
+        let _ = positions(&v, 2.5);
+        assert_eq!(v.scene().spring_state_step("hero"), Some(150));
+    }
+    // With wind, any edit of a wave starts them again (the wind follows the waves' shapes).
+    assert!(v.edit_value("wave.beam.length", vec![5.0], None));
+    assert_eq!(v.scene().spring_state_step("hero"), None);
+    let _ = positions(&v, 2.5);
+    assert!(v.set_spring("hero", false));
+    assert_eq!(v.scene().spring_state_step("hero"), None);
+}
+
+#[test]
+fn without_wind_editing_a_wave_keeps_the_springs() {
+    let (mut v, _d) = viewer("calm", "");
+    let _ = positions(&v, 1.0);
+    assert_eq!(v.scene().spring_state_step("hero"), Some(60));
+    assert!(v.edit_value("wave.beam.length", vec![4.0], None));
+    assert_eq!(v.scene().spring_state_step("hero"), Some(60), "no wave blows: the waves do not matter");
+    assert!(v.key_current("wave.beam.wind"));
+    assert_eq!(v.scene().spring_state_step("hero"), None, "an animated wind may blow");
+}
