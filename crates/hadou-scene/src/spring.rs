@@ -32,8 +32,10 @@
 //! when a later time is asked for, which gives the same bits. Springs that do not move each other
 //! (`SpringBones::independent`) may be stepped on several threads, each spring by the same
 //! operations, so again the same bits. Past [`SPRING_MAX_STEPS`] steps the
-//! simulation starts from rest [`SPRING_MAX_STEPS`] steps before `n` (a damped spring has long
-//! forgotten its start by then), so no frame costs more.
+//! simulation starts from rest at the first multiple of [`SPRING_RESTART_STEPS`] at most
+//! [`SPRING_MAX_STEPS`] steps before `n` (`spring_scene::spring_start`; a damped spring has long
+//! forgotten its start by then), so no frame costs more, and the frames between two such starts
+//! continue one state.
 //!
 //! **Wind.** A wave with `wind = w > 0` pushes each joint's tail `p` (world space) away from its
 //! centre line: `wind(p) = Σ w · ρ(|p − E|) · (p − E)/|p − E|`, `E` the nearest point of the
@@ -44,7 +46,7 @@
 
 pub use crate::limits::{
     MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
-    SPRING_RATE,
+    SPRING_RATE, SPRING_RESTART_STEPS,
 };
 use crate::rig::{Clip, PoseInput, Rig};
 pub(crate) use crate::spring_bones::{affine_inverse, ColliderShape, SpringBones};
@@ -336,7 +338,12 @@ impl Rig {
                 if let Some((_, rot, _)) = locals[j.node].as_mut() {
                     *rot = r;
                 }
-                parent = affine_mul(&parent, &unit_trs(t, r, sc));
+                parent = if sc[0] == sc[1] && sc[1] == sc[2] {
+                    // A uniform scale commutes with the turn: `G·T·R₀·S·turn`, `m0` turned.
+                    turned(&m0, turn)
+                } else {
+                    affine_mul(&parent, &unit_trs(t, r, sc))
+                };
             }
         }
     }
@@ -397,6 +404,21 @@ fn unit_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
             [t[0], t[1], t[2], 1.0],
         ],
     }
+}
+
+/// `m · R(q)` for an affine `m` and a unit quaternion `q` (its 3×3 block times the rotation's,
+/// its translation kept): a joint's global matrix after its turn, from the one at its rest
+/// rotation, when its scale is uniform.
+fn turned(m: &Mat4, q: [f32; 4]) -> Mat4 {
+    let r = unit_trs([0.0; 3], q, [1.0; 3]);
+    let mut out = *m;
+    for c in 0..3 {
+        for row in 0..3 {
+            out.cols[c][row] =
+                m.cols[0][row] * r.cols[c][0] + m.cols[1][row] * r.cols[c][1] + m.cols[2][row] * r.cols[c][2];
+        }
+    }
+    out
 }
 
 /// `a·b` for affine matrices (last rows `0 0 0 1`).

@@ -7,7 +7,9 @@ use crate::frame::WaveShape;
 use crate::look_at::LookTarget;
 use crate::rig::{PoseInput, Rig};
 use crate::scene::{ObjectDef, Scene};
-use crate::spring::{affine_inverse, StepInput, StillPose, SPRING_MAX_STEPS, SPRING_RATE};
+use crate::spring::{
+    affine_inverse, StepInput, StillPose, SPRING_MAX_STEPS, SPRING_RATE, SPRING_RESTART_STEPS,
+};
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
 
@@ -21,6 +23,15 @@ pub fn spring_steps_at(time: f32) -> u64 {
         u64::MAX
     } else {
         n as u64
+    }
+}
+
+/// The step the simulation of step `n` starts from rest at: 0 up to [`SPRING_MAX_STEPS`], then
+/// the first multiple of [`SPRING_RESTART_STEPS`] at most [`SPRING_MAX_STEPS`] before `n`.
+pub fn spring_start(n: u64) -> u64 {
+    match n.checked_sub(SPRING_MAX_STEPS) {
+        None | Some(0) => 0,
+        Some(past) => past.div_ceil(SPRING_RESTART_STEPS).saturating_mul(SPRING_RESTART_STEPS),
     }
 }
 
@@ -68,7 +79,7 @@ impl Scene {
     pub(crate) fn spring_rotations(&self, o: &ObjectDef, rig: &Rig, time: f32) -> Vec<(usize, [f32; 4])> {
         let Some(springs) = rig.springs.as_ref().filter(|_| o.spring) else { return Vec::new() };
         let n = spring_steps_at(time);
-        let start = n.saturating_sub(SPRING_MAX_STEPS);
+        let start = spring_start(n);
         let cached = o.spring_cache.lock().ok().and_then(|c| c.clone());
         if let Some(s) = cached.as_ref().filter(|s| s.start == start && s.step == n) {
             return s.rotations(springs);
