@@ -73,6 +73,8 @@ pub(crate) struct StillPose {
     locals: Vec<Trs>,
     /// Per node, its global matrix (`None` for a node a joint moves).
     globals: Vec<Option<Mat4>>,
+    /// Per joint (springs in order), its local matrix at its rest rotation, `T·R₀·S`.
+    rest: Vec<Mat4>,
 }
 
 /// The state of a character's springs after some steps.
@@ -133,7 +135,13 @@ impl Rig {
         let globals = (0..self.nodes.len())
             .map(|n| (!sb.moving.get(n).copied().unwrap_or(true)).then(|| self.global_of(n, &locals)))
             .collect();
-        Some(StillPose { locals, globals })
+        let rest = (sb.springs.iter().flat_map(|s| &s.joints))
+            .map(|j| match locals.get(j.node).copied().flatten() {
+                Some((t, _, sc)) => unit_trs(t, j.rest, sc),
+                None => Mat4::IDENTITY,
+            })
+            .collect();
+        Some(StillPose { locals, globals, rest })
     }
 
     /// The nodes' local transforms for `input`'s clip time (no spring rotations).
@@ -182,7 +190,9 @@ impl Rig {
         dt: f32,
     ) {
         let Some(sb) = self.springs.as_ref() else { return };
-        let Some(springs) = sb.springs.get(part) else { return };
+        let Some(springs) = sb.springs.get(part.clone()) else { return };
+        // The index of the part's first joint among all the springs' joints.
+        let first: usize = sb.springs[..part.start].iter().map(|s| s.joints.len()).sum();
         let mut locals = self.step_locals(input);
         // The last step's rotations, so colliders and springs below other springs see them.
         for (j, r) in springs.iter().flat_map(|s| &s.joints).zip(rotations.iter()) {
@@ -267,9 +277,13 @@ impl Rig {
                     continue;
                 };
                 let rest_r = &j.rest;
-                let m0 = affine_mul(&parent, &unit_trs(t, *rest_r, sc));
+                let rest_local = match input.still.and_then(|p| p.rest.get(first + idx)) {
+                    Some(m) => *m,
+                    None => unit_trs(t, *rest_r, sc),
+                };
+                let m0 = affine_mul(&parent, &rest_local);
                 let head = Vec3f::new(m0.cols[3][0], m0.cols[3][1], m0.cols[3][2]);
-                let span = m0.transform_point(j.tail) - head;
+                let span = m0.transform_vector(j.tail);
                 let rest_tail = head + span;
                 let length = span.length();
                 if !(length > 0.0 && length.is_finite()) {
@@ -351,19 +365,22 @@ impl Rig {
 
 /// World vector `v` in the space of `m` (its 3×3 block inverted as `Mᵀ` with each row divided by
 /// that column's squared length: exact for a rotation times a scale, which a joint's global matrix
-/// is unless a parent scales unevenly under a turn). Only its direction is used.
+/// is unless a parent scales unevenly under a turn; with the three columns of one length, `Mᵀ·v`,
+/// the same direction). Only its direction is used.
+#[inline]
 fn local_direction(m: &Mat4, v: Vec3f) -> Vec3f {
     let c = |k: usize| Vec3f::new(m.cols[k][0], m.cols[k][1], m.cols[k][2]);
-    let row = |k: usize| {
-        let col = c(k);
-        let l2 = col.length_squared();
-        if l2 > 0.0 {
-            col.dot(v) / l2
-        } else {
-            0.0
-        }
-    };
-    Vec3f::new(row(0), row(1), row(2))
+    let (c0, c1, c2) = (c(0), c(1), c(2));
+    let l = [c0.length_squared(), c1.length_squared(), c2.length_squared()];
+    let dots = Vec3f::new(c0.dot(v), c1.dot(v), c2.dot(v));
+    let (lo, hi) = (l[0].min(l[1]).min(l[2]), l[0].max(l[1]).max(l[2]));
+    // Columns of one length (a uniform scale, to rounding): the common divisor does not change
+    // the direction, so `Mᵀ·v` is it.
+    if lo > 0.0 && hi - lo <= 1e-6 * lo {
+        return dots;
+    }
+    let row = |d: f32, l2: f32| if l2 > 0.0 { d / l2 } else { 0.0 };
+    Vec3f::new(row(dots.x, l[0]), row(dots.y, l[1]), row(dots.z, l[2]))
 }
 
 /// `v` scaled to length `len` (one square root and one division), or `None` for a zero or
@@ -409,6 +426,7 @@ fn unit_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
 /// `m · R(q)` for an affine `m` and a unit quaternion `q` (its 3×3 block times the rotation's,
 /// its translation kept): a joint's global matrix after its turn, from the one at its rest
 /// rotation, when its scale is uniform.
+#[inline]
 fn turned(m: &Mat4, q: [f32; 4]) -> Mat4 {
     let r = unit_trs([0.0; 3], q, [1.0; 3]);
     let mut out = *m;
@@ -451,6 +469,7 @@ fn nearest_on_segment(p: Vec3f, a: Vec3f, b: Vec3f) -> Vec3f {
 /// `b`, which need not be of unit length: the half-way quaternion `[a × b, |b| + a·b]` normalised
 /// (for unit `b`, `[a × b, 1 + a·b]`), so `b` is not normalised first; half a turn about an axis
 /// normal to `a` when they are opposite, the identity for a zero or non-finite `b`.
+#[inline]
 pub(crate) fn turn_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
     let lb = b.length();
     if !(lb > 0.0 && lb.is_finite()) {

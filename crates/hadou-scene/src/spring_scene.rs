@@ -43,9 +43,10 @@ struct WindSource {
     line: crate::LightLine,
     /// For a segment line `a..b`: `a`, `b − a` and `1/|b − a|²` (`None`: [`LightLine::nearest`]).
     segment: Option<(Vec3f, Vec3f, f32)>,
-    wind: f32,
-    core: f32,
-    strength: f32,
+    /// `wind · α·a` (the strength at least 0).
+    push: f32,
+    /// The core radius squared (at least `1e-4`, as `hadou_math::toon::dominance`).
+    core_2: f32,
     inverse_square: bool,
 }
 
@@ -169,9 +170,8 @@ impl Scene {
                 WindSource {
                     line,
                     segment,
-                    wind: w.params.f(&vals, "wind"),
-                    core: wave.core_radius,
-                    strength: wave.light_strength(),
+                    push: w.params.f(&vals, "wind") * wave.light_strength().max(0.0),
+                    core_2: wave.core_radius.max(1e-4) * wave.core_radius.max(1e-4),
                     inverse_square: wave.falloff == Falloff::InverseSquare,
                 }
             })
@@ -193,8 +193,14 @@ impl Scene {
                     continue;
                 }
                 let d = d2.sqrt();
-                let rho = hadou_math::toon::dominance(d, s.core, s.strength, s.inverse_square);
-                f += away * (s.wind * rho / d);
+                // `wind · ρ(d) / d` with `ρ` of `hadou_math::toon::dominance` (`α·a / q` inverse
+                // square, `α·a / √q` faithful, `q = d² + r_c²`), in one division.
+                let q = d2 + s.core_2;
+                let k = s.push / (if s.inverse_square { q } else { q.sqrt() } * d);
+                if k.is_nan() {
+                    continue;
+                }
+                f += away * k.min(f32::MAX);
             }
             let f = if placed { to_rig.transform_vector(f) } else { f };
             if f.is_finite() {

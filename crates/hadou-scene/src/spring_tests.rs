@@ -41,14 +41,27 @@ fn no_wind(_: Vec3f) -> Vec3f {
     Vec3f::ZERO
 }
 
-/// Runs `steps` steps, calling `each` with the nodes' globals after each.
+/// Runs `steps` steps, calling `each` with the nodes' globals after each: the steps of a
+/// character without a clip, from its still pose ([`Rig::still_pose`]), as a scene runs them.
 fn run(
     rig: &Rig,
     steps: usize,
     wind: &dyn Fn(Vec3f) -> Vec3f,
+    each: impl FnMut(usize, &[Mat4]),
+) -> SpringState {
+    let still = rig.still_pose();
+    run_from(rig, steps, wind, still.as_ref(), each)
+}
+
+/// [`run`] from `still`, or (`None`) sampling the pose at each step as under a clip.
+fn run_from(
+    rig: &Rig,
+    steps: usize,
+    wind: &dyn Fn(Vec3f) -> Vec3f,
+    still: Option<&crate::spring::StillPose>,
     mut each: impl FnMut(usize, &[Mat4]),
 ) -> SpringState {
-    let input = StepInput { clip: None, clip_time: 0.0, wind, windy: true, still: None };
+    let input = StepInput { clip: None, clip_time: 0.0, wind, windy: true, still };
     let mut state = rig.spring_rest(0, &input).expect("springs");
     let sb: &SpringBones = rig.springs.as_ref().expect("springs");
     for k in 0..steps {
@@ -220,6 +233,35 @@ fn a_chain_settles_under_gravity_as_the_reference_does() {
         let want = [0.0, 2.0 - 0.4 * (i + 1) as f64, 0.0];
         assert!(len(sub(*p, want)) < 1e-3, "joint {i} rests at {p:?}, want {want:?}");
     }
+}
+
+#[test]
+fn the_steps_from_a_still_pose_are_the_steps_that_sample_the_pose() {
+    // A chain hanging from a turned, scaled parent: the pose worked out once for all steps and
+    // the pose sampled at each step give the same motion (to rounding).
+    let mut nodes = vec![node(None, [0.0; 3]), node(Some(0), [0.0, 2.0, 0.0])];
+    nodes[1].rest = RestLocal::Trs { t: [0.0, 2.0, 0.0], r: [0.0, 0.3826834, 0.0, 0.9238795], s: [1.5; 3] };
+    nodes.extend([
+        node(Some(1), [0.4, 0.0, 0.0]),
+        node(Some(2), [0.4, 0.0, 0.0]),
+        node(Some(3), [0.4, 0.0, 0.0]),
+    ]);
+    let j = |n| joint(n, json!({ "gravityPower": 2.0, "dragForce": 0.2, "stiffness": 0.5 }));
+    let r = rig(nodes, json!({ "VRMC_springBone": { "springs": [{ "joints": [j(1), j(2), j(3), j(4)] }] } }));
+    let still = r.still_pose().expect("springs");
+    let wind = |p: Vec3f| Vec3f::new(0.0, 0.0, 1.0 + p.x);
+    let mut a = Vec::new();
+    run_from(&r, 300, &wind, Some(&still), |_, g| a.push(g.to_vec()));
+    let mut worst = 0.0f64;
+    let mut moved = 0.0f64;
+    run_from(&r, 300, &wind, None, |k, g| {
+        for n in 2..5 {
+            worst = worst.max(len(sub(pos(&g[n]), pos(&a[k][n]))));
+            moved = moved.max(len(sub(pos(&g[n]), pos(&a[0][n]))));
+        }
+    });
+    assert!(worst < 1e-4, "the two ways differ by {worst}");
+    assert!(moved > 0.1, "the chain swings: {moved}");
 }
 
 #[test]
