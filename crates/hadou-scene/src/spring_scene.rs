@@ -40,8 +40,8 @@ const SPRING_PARALLEL_WORK: usize = 4096;
 
 /// One wave's wind at a step: its centre line, strength and falloff.
 struct WindSource {
-    line: crate::LightLine,
-    /// For a segment line `a..b`: `a`, `b − a` and `1/|b − a|²` (`None`: [`LightLine::nearest`]).
+    line: crate::frame::LightLine,
+    /// For a segment line `a..b`: `a`, `b − a` and `1/|b − a|²` (`None`: [`LightLine::nearest`](crate::frame::LightLine::nearest)).
     segment: Option<(Vec3f, Vec3f, f32)>,
     /// `wind · α·a` (the strength at least 0).
     push: f32,
@@ -51,7 +51,7 @@ struct WindSource {
 }
 
 impl WindSource {
-    /// The nearest point of the centre line to `p`: [`LightLine::nearest`], with a segment's
+    /// The nearest point of the centre line to `p`: [`LightLine::nearest`](crate::frame::LightLine::nearest), with a segment's
     /// division done once a step.
     #[inline]
     fn nearest(&self, p: Vec3f) -> Vec3f {
@@ -160,7 +160,7 @@ impl Scene {
                 let wave = self.build_wave(w, &vals);
                 let line = wave.light_line(None);
                 let segment = match line {
-                    crate::LightLine::Segment(a, b) => {
+                    crate::frame::LightLine::Segment(a, b) => {
                         let ab = b - a;
                         let l2 = ab.length_squared();
                         (l2 > 0.0 && l2.is_finite()).then(|| (a, ab, 1.0 / l2))
@@ -370,7 +370,7 @@ fn same_springs(a: &ObjectDef, b: &ObjectDef) -> bool {
 /// Whether parameter sets `a` (of scene `sa`) and `b` (of `sb`) hold the same keys, values and
 /// tracks.
 fn same_params(sa: &Scene, a: &crate::params::ParamSet, sb: &Scene, b: &crate::params::ParamSet) -> bool {
-    fn tracks(s: &Scene, off: usize, len: usize) -> Vec<(&str, crate::Interpolation, &[f32], &[f32])> {
+    fn tracks(s: &Scene, off: usize, len: usize) -> Vec<(&str, crate::anim::Interpolation, &[f32], &[f32])> {
         s.tracks
             .iter()
             .filter(|t| t.offset < off + len && off < t.offset + t.len)
