@@ -8,7 +8,7 @@ use crate::look_at::LookTarget;
 use crate::rig::{PoseInput, Rig};
 use crate::scene::{ObjectDef, Scene};
 use crate::spring::{
-    affine_inverse, StepInput, StillPose, SPRING_MAX_STEPS, SPRING_RATE, SPRING_RESTART_STEPS,
+    affine_inverse, SpringState, StepInput, StillPose, SPRING_MAX_STEPS, SPRING_RATE, SPRING_RESTART_STEPS,
 };
 use hadou_math::energy::Falloff;
 use hadou_math::Vec3f;
@@ -33,6 +33,18 @@ pub fn spring_start(n: u64) -> u64 {
         None | Some(0) => 0,
         Some(past) => past.div_ceil(SPRING_RESTART_STEPS).saturating_mul(SPRING_RESTART_STEPS),
     }
+}
+
+/// Steps between the states kept along a simulation (one second): a frame earlier than the last
+/// one asked for continues from the kept state before it, at most this many steps back.
+const SPRING_MARK_STEPS: u64 = 60;
+
+/// An object's spring-bone states: the last one asked for, and the states every
+/// [`SPRING_MARK_STEPS`] steps on the way to it (of its start).
+#[derive(Debug, Default)]
+pub(crate) struct SpringMemo {
+    pub(crate) last: Option<SpringState>,
+    pub(crate) marks: Vec<SpringState>,
 }
 
 /// Least work (steps × joints) worth spreading over threads: below it one thread is quicker.
@@ -81,16 +93,25 @@ impl Scene {
         let Some(springs) = rig.springs.as_ref().filter(|_| o.spring) else { return Vec::new() };
         let n = spring_steps_at(time);
         let start = spring_start(n);
-        let cached = o.spring_cache.lock().ok().and_then(|c| c.clone());
-        if let Some(s) = cached.as_ref().filter(|s| s.start == start && s.step == n) {
+        // The latest kept state of this start at or before step `n`: the last one asked for, or a
+        // mark (so scrubbing back does not step again from the start).
+        let kept = o.spring_cache.lock().ok().and_then(|m| {
+            m.last
+                .iter()
+                .chain(&m.marks)
+                .filter(|s| s.start == start && s.step <= n)
+                .max_by_key(|s| s.step)
+                .cloned()
+        });
+        if let Some(s) = kept.as_ref().filter(|s| s.step == n) {
             return s.rotations(springs);
         }
         // Without a clip the pose the springs hang from is the same at every step.
         let still = if o.motion.as_ref().is_none_or(|m| m.clip.is_none()) { rig.still_pose() } else { None };
         let still = still.as_ref();
-        let mut state = match cached {
-            Some(s) if s.start == start && s.step <= n => s,
-            _ => {
+        let mut state = match kept {
+            Some(s) => s,
+            None => {
                 let Some(s) = self.with_step_input(o, start, still, |input| rig.spring_rest(start, input))
                 else {
                     return Vec::new();
@@ -98,6 +119,38 @@ impl Scene {
                 s
             }
         };
+        let mut marks = Vec::new();
+        while state.step < n {
+            let to = ((state.step / SPRING_MARK_STEPS + 1) * SPRING_MARK_STEPS).min(n);
+            self.spring_advance(o, rig, springs, &mut state, to, still);
+            if to % SPRING_MARK_STEPS == 0 {
+                marks.push(state.clone());
+            }
+        }
+        let out = state.rotations(springs);
+        if let Ok(mut m) = o.spring_cache.lock() {
+            m.marks.retain(|s| s.start == start);
+            for mark in marks {
+                if !m.marks.iter().any(|s| s.step == mark.step) {
+                    m.marks.push(mark);
+                }
+            }
+            m.last = Some(state);
+        }
+        out
+    }
+
+    /// Steps `state` on to step `to`.
+    fn spring_advance(
+        &self,
+        o: &ObjectDef,
+        rig: &Rig,
+        springs: &crate::spring::SpringBones,
+        state: &mut SpringState,
+        to: u64,
+        still: Option<&StillPose>,
+    ) {
+        let n = to;
         let dt = (1.0 / SPRING_RATE) as f32;
         // Springs that move apart from each other are stepped on the machine's threads, each
         // thread all the steps of its run of springs (the same operations as one thread does).
@@ -130,13 +183,8 @@ impl Scene {
         }
         while state.step < n {
             let k = state.step + 1;
-            self.with_step_input(o, k, still, |input| rig.spring_step(&mut state, input, dt));
+            self.with_step_input(o, k, still, |input| rig.spring_step(state, input, dt));
         }
-        let out = state.rotations(springs);
-        if let Ok(mut c) = o.spring_cache.lock() {
-            *c = Some(state);
-        }
-        out
     }
 
     /// Calls `f` with what drives step `k` of object `o`: its clip time and the wind at time
@@ -192,11 +240,11 @@ impl Scene {
                 if d2.is_nan() || d2 <= 0.0 {
                     continue;
                 }
-                let d = d2.sqrt();
                 // `wind · ρ(d) / d` with `ρ` of `hadou_math::toon::dominance` (`α·a / q` inverse
-                // square, `α·a / √q` faithful, `q = d² + r_c²`), in one division.
+                // square, `α·a / √q` faithful, `q = d² + r_c²`), in one division and one square
+                // root (faithful: `√q · d = √(q·d²)`).
                 let q = d2 + s.core_2;
-                let k = s.push / (if s.inverse_square { q } else { q.sqrt() } * d);
+                let k = s.push / if s.inverse_square { q * d2.sqrt() } else { (q * d2).sqrt() };
                 if k.is_nan() {
                     continue;
                 }
@@ -310,7 +358,17 @@ impl Scene {
     /// nothing kept, or no such object): what the next frame continues from.
     pub fn spring_state_step(&self, object: &str) -> Option<u64> {
         let o = self.objects.iter().find(|o| o.name == object)?;
-        o.spring_cache.lock().ok()?.as_ref().map(|s| s.step)
+        o.spring_cache.lock().ok()?.last.as_ref().map(|s| s.step)
+    }
+
+    /// The steps of the states kept on the way to the last one for the object named `object`
+    /// (every [`SPRING_MARK_STEPS`], one second): where an earlier frame continues from.
+    pub fn spring_marks(&self, object: &str) -> Vec<u64> {
+        let Some(o) = self.objects.iter().find(|o| o.name == object) else { return Vec::new() };
+        let mut steps: Vec<u64> =
+            o.spring_cache.lock().map(|m| m.marks.iter().map(|s| s.step).collect()).unwrap_or_default();
+        steps.sort_unstable();
+        steps
     }
 
     /// Whether no wave ever blows: every `wind` is 0 and no track animates one.

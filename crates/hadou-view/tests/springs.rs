@@ -229,6 +229,13 @@ fn edits_that_leave_the_springs_alone_continue_their_state_with_the_same_bits() 
     let fresh = Document::from_text(v.doc.text(), &d.join("scene.toml")).unwrap();
     assert_eq!(fresh.scene().spring_state_step("hero"), None);
     assert_eq!(fresh.scene().at(2.5).objects[0].mesh.positions, later, "the same bits as stepping from 0");
+    // Scrubbing back continues from the state kept each second on the way, the same bits.
+    assert_eq!(v.scene().spring_marks("hero"), [60, 120]);
+    let back = positions(&v, 1.25);
+    assert_eq!(v.scene().spring_state_step("hero"), Some(75));
+    let fresh = Document::from_text(v.doc.text(), &d.join("scene.toml")).unwrap();
+    assert_eq!(fresh.scene().at(1.25).objects[0].mesh.positions, back);
+    let _ = positions(&v, 2.5);
     // Undo of an edit that left the springs alone keeps them too.
     v.undo();
     assert_eq!(v.scene().spring_state_step("hero"), Some(150));
