@@ -29,7 +29,8 @@
 //! time `t` is the state after `n = ⌊t·SPRING_RATE⌋` steps, each step `k` driven by the animation
 //! and waves at time `k/SPRING_RATE`. A frame is thus a pure function of its time, whether it is
 //! rendered alone, in a sequence or in chunks; a per-object cache continues from the last state
-//! when a later time is asked for, which gives the same bits. Springs that do not move each other
+//! when a later time is asked for, and from the state it kept every 60 steps on the way when an
+//! earlier one is (`spring_scene::SpringMemo`), which gives the same bits. Springs that do not move each other
 //! (`SpringBones::independent`) may be stepped on several threads, each spring by the same
 //! operations, so again the same bits. Past [`SPRING_MAX_STEPS`] steps the
 //! simulation starts from rest at the first multiple of [`SPRING_RESTART_STEPS`] at most
