@@ -123,7 +123,7 @@ impl Scene {
         while state.step < n {
             let to = ((state.step / SPRING_MARK_STEPS + 1) * SPRING_MARK_STEPS).min(n);
             self.spring_advance(o, rig, springs, &mut state, to, still);
-            if to % SPRING_MARK_STEPS == 0 {
+            if to.is_multiple_of(SPRING_MARK_STEPS) {
                 marks.push(state.clone());
             }
         }
