@@ -80,7 +80,7 @@ pub(crate) struct ObjectDef {
 }
 
 /// An object's spring-bone states (the last, and marks on the way to it).
-pub(crate) type SpringCache = Arc<std::sync::Mutex<crate::spring_scene::SpringMemo>>;
+pub(crate) type SpringCache = Arc<std::sync::Mutex<crate::spring::SpringMemo>>;
 
 /// An object's last pose and its key (clip time and expression weights, as bits).
 pub(crate) type PoseCache = Arc<std::sync::Mutex<Option<(Vec<u32>, Arc<Mesh>)>>>;

@@ -30,7 +30,7 @@
 //! and waves at time `k/SPRING_RATE`. A frame is thus a pure function of its time, whether it is
 //! rendered alone, in a sequence or in chunks; a per-object cache continues from the last state
 //! when a later time is asked for, and from the state it kept every 60 steps on the way when an
-//! earlier one is (`spring_scene::SpringMemo`), which gives the same bits. Springs that do not move each other
+//! earlier one is ([`SpringMemo`]), which gives the same bits. Springs that do not move each other
 //! (`SpringBones::independent`) may be stepped on several threads, each spring by the same
 //! operations, so again the same bits. Past [`SPRING_MAX_STEPS`] steps the
 //! simulation starts from rest at the first multiple of [`SPRING_RESTART_STEPS`] at most
@@ -89,6 +89,14 @@ pub(crate) struct SpringState {
     pub(crate) tails: Vec<(Vec3f, Vec3f)>,
     /// Per joint, its local rotation now.
     pub(crate) rotations: Vec<[f32; 4]>,
+}
+
+/// An object's spring-bone states: the last one asked for, and the states every 60 steps on the
+/// way to it (of its start), kept by `spring_scene`.
+#[derive(Debug, Default)]
+pub(crate) struct SpringMemo {
+    pub(crate) last: Option<SpringState>,
+    pub(crate) marks: Vec<SpringState>,
 }
 
 /// A node's translation, rotation and scale (a matrix node: `None`).

@@ -39,14 +39,6 @@ pub fn spring_start(n: u64) -> u64 {
 /// one asked for continues from the kept state before it, at most this many steps back.
 const SPRING_MARK_STEPS: u64 = 60;
 
-/// An object's spring-bone states: the last one asked for, and the states every
-/// [`SPRING_MARK_STEPS`] steps on the way to it (of its start).
-#[derive(Debug, Default)]
-pub(crate) struct SpringMemo {
-    pub(crate) last: Option<SpringState>,
-    pub(crate) marks: Vec<SpringState>,
-}
-
 /// Least work (steps × joints) worth spreading over threads: below it one thread is quicker.
 const SPRING_PARALLEL_WORK: usize = 4096;
 
