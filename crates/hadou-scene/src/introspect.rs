@@ -186,6 +186,33 @@ pub struct ParamInfo {
     pub broadcast: bool,
 }
 
+/// What a `kind = "gltf"` object's `look_at` key names, for tools that edit it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LookAtTarget {
+    /// `"camera"`: the camera's position.
+    Camera,
+    /// A wave's name: its head.
+    Wave(String),
+    /// A point `[x, y, z]` (the animatable parameter `object.NAME.look_at`).
+    Point,
+}
+
+/// The spring-bone and look-at keys of a `kind = "gltf"` object whose VRM file has spring bones
+/// or look-at (`spring`, `look_at`; `docs/scene-format.md`), for tools that edit them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CharacterInfo {
+    /// The object's name.
+    pub object: String,
+    /// Its file has spring bones, so `spring` may be given.
+    pub has_springs: bool,
+    /// Its springs move (`spring`, default true); `false` where the file has none.
+    pub spring: bool,
+    /// Its file has VRM look-at, so `look_at` may be given.
+    pub has_look_at: bool,
+    /// What `look_at` names (`None`: no key, the eyes stay at rest).
+    pub look_at: Option<LookAtTarget>,
+}
+
 /// A track, as the timeline shows it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackInfo {
@@ -280,6 +307,38 @@ impl Scene {
     pub fn is_animated(&self, target: &str) -> bool {
         let Some((offset, len)) = self.locate(target) else { return false };
         self.tracks.iter().any(|t| t.offset < offset + len && offset < t.offset + t.len)
+    }
+
+    /// The objects whose VRM file has spring bones or look-at, in file order, with what their
+    /// `spring` and `look_at` keys say.
+    pub fn characters(&self) -> Vec<CharacterInfo> {
+        use crate::look_at::LookTarget;
+        self.objects
+            .iter()
+            .filter_map(|o| {
+                let rig = o.rig.as_ref()?;
+                let has_springs = rig.springs.is_some();
+                let has_look_at = rig.look_at.is_some();
+                if !(has_springs || has_look_at) {
+                    return None;
+                }
+                let look_at = o.look_at.as_ref().map(|t| match t {
+                    LookTarget::Camera => LookAtTarget::Camera,
+                    LookTarget::Point => LookAtTarget::Point,
+                    LookTarget::WaveName(n, _) => LookAtTarget::Wave(n.clone()),
+                    LookTarget::Wave(i) => {
+                        LookAtTarget::Wave(self.waves.get(*i).map_or_else(String::new, |w| w.name.clone()))
+                    }
+                });
+                Some(CharacterInfo {
+                    object: o.name.clone(),
+                    has_springs,
+                    spring: has_springs && o.spring,
+                    has_look_at,
+                    look_at,
+                })
+            })
+            .collect()
     }
 
     /// The kind of the wave named `name`.

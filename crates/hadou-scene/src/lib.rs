@@ -101,7 +101,7 @@ pub use gltf_load::{
 };
 pub use gltf_vrma::load_vrma_clip;
 pub use image::{Image, Rgb8Image};
-pub use introspect::{Entity, ParamInfo, ParamRange, ParamShape, TrackInfo};
+pub use introspect::{CharacterInfo, Entity, LookAtTarget, ParamInfo, ParamRange, ParamShape, TrackInfo};
 pub use limits::{
     check_image_size, check_image_size_with, check_trace_memory, glare_band_rows, ALPHA_MAX,
     ANALYTIC_RAY_WORK, ATTENUATION_MAX, GLARE_BAND_BYTES_PER_PIXEL, GLARE_BYTES_PER_PIXEL, GLARE_MAX_BYTES,
@@ -116,9 +116,10 @@ pub use shadow::{
 };
 pub use spring::{
     MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
-    SPRING_RATE,
+    SPRING_RATE, SPRING_RESTART_STEPS,
 };
 pub use spring_bones::SpringBones;
+pub use spring_scene::{spring_start, spring_steps_at};
 pub use temp_file::{remove_pending_temp_files, TempFile};
 pub use texture::{
     decode_texture, encode_png, MAX_SCENE_TEXELS, TEXTURE_DOWNSCALE_EDGE, TEXTURE_MAX_BYTES,

@@ -224,8 +224,13 @@ fn shorter(plain: String, sci: String) -> String {
 pub const SPRING_RATE: f64 = 60.0;
 
 /// Most steps simulated for one pose: 3 600 (one minute at [`SPRING_RATE`]). A later time starts
-/// from rest this many steps before it.
+/// from rest at the first multiple of [`SPRING_RESTART_STEPS`] at most this many steps before it.
 pub const SPRING_MAX_STEPS: u64 = 3_600;
+
+/// Past [`SPRING_MAX_STEPS`], the steps the simulation's start moves by: 600 (ten seconds). The
+/// frames between two moves continue one state (a sequence or the viewer steps once a frame),
+/// and each frame still starts more than 3 000 steps after its rest.
+pub const SPRING_RESTART_STEPS: u64 = 600;
 
 /// Most spring joints of one file (VRM 1.0 joints, VRM 0.x bones with their descendants).
 pub const MAX_SPRING_JOINTS: usize = 4_096;

@@ -29,7 +29,7 @@ pub(crate) enum RestLocal {
 }
 
 /// A node of the character's hierarchy.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct RigNode {
     pub parent: Option<usize>,
     pub rest: RestLocal,
@@ -81,7 +81,7 @@ pub(crate) enum ChannelPath {
 }
 
 /// One channel: a node property sampled from keys.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Channel {
     pub node: usize,
     pub path: ChannelPath,
@@ -93,7 +93,7 @@ pub(crate) struct Channel {
 }
 
 /// A named animation clip of a glTF file.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Clip {
     /// The animation's `name` (or `animation N` for an unnamed one).
     pub name: String,

@@ -79,8 +79,8 @@ pub(crate) struct ObjectDef {
     pub look_at: Option<crate::look_at::LookTarget>,
 }
 
-/// An object's last spring-bone state.
-pub(crate) type SpringCache = Arc<std::sync::Mutex<Option<crate::spring::SpringState>>>;
+/// An object's spring-bone states (the last, and marks on the way to it).
+pub(crate) type SpringCache = Arc<std::sync::Mutex<crate::spring::SpringMemo>>;
 
 /// An object's last pose and its key (clip time and expression weights, as bits).
 pub(crate) type PoseCache = Arc<std::sync::Mutex<Option<(Vec<u32>, Arc<Mesh>)>>>;

@@ -29,11 +29,14 @@
 //! time `t` is the state after `n = ⌊t·SPRING_RATE⌋` steps, each step `k` driven by the animation
 //! and waves at time `k/SPRING_RATE`. A frame is thus a pure function of its time, whether it is
 //! rendered alone, in a sequence or in chunks; a per-object cache continues from the last state
-//! when a later time is asked for, which gives the same bits. Springs that do not move each other
+//! when a later time is asked for, and from the state it kept every 60 steps on the way when an
+//! earlier one is ([`SpringMemo`]), which gives the same bits. Springs that do not move each other
 //! (`SpringBones::independent`) may be stepped on several threads, each spring by the same
 //! operations, so again the same bits. Past [`SPRING_MAX_STEPS`] steps the
-//! simulation starts from rest [`SPRING_MAX_STEPS`] steps before `n` (a damped spring has long
-//! forgotten its start by then), so no frame costs more.
+//! simulation starts from rest at the first multiple of [`SPRING_RESTART_STEPS`] at most
+//! [`SPRING_MAX_STEPS`] steps before `n` (`spring_scene::spring_start`; a damped spring has long
+//! forgotten its start by then), so no frame costs more, and the frames between two such starts
+//! continue one state.
 //!
 //! **Wind.** A wave with `wind = w > 0` pushes each joint's tail `p` (world space) away from its
 //! centre line: `wind(p) = Σ w · ρ(|p − E|) · (p − E)/|p − E|`, `E` the nearest point of the
@@ -44,7 +47,7 @@
 
 pub use crate::limits::{
     MAX_SPRING_COLLIDERS, MAX_SPRING_COLLISION_PAIRS, MAX_SPRING_JOINTS, SPRING_FORCE_MAX, SPRING_MAX_STEPS,
-    SPRING_RATE,
+    SPRING_RATE, SPRING_RESTART_STEPS,
 };
 use crate::rig::{Clip, PoseInput, Rig};
 pub(crate) use crate::spring_bones::{affine_inverse, ColliderShape, SpringBones};
@@ -58,6 +61,21 @@ pub(crate) struct StepInput<'a> {
     pub clip_time: f32,
     /// The external force on a point of the character's space (rig space), per second.
     pub wind: &'a dyn Fn(Vec3f) -> Vec3f,
+    /// Whether any wave blows at this step (else `wind` is zero everywhere and is not called).
+    pub windy: bool,
+    /// The nodes' pose when it is the same at every step (no clip): worked out once for all the
+    /// steps instead of at each ([`Rig::still_pose`]).
+    pub still: Option<&'a StillPose>,
+}
+
+/// The nodes' local transforms under no clip, and the global matrices of the nodes no joint
+/// moves: what every step of a character without a clip starts from.
+pub(crate) struct StillPose {
+    locals: Vec<Trs>,
+    /// Per node, its global matrix (`None` for a node a joint moves).
+    globals: Vec<Option<Mat4>>,
+    /// Per joint (springs in order), its local matrix at its rest rotation, `T·R₀·S`.
+    rest: Vec<Mat4>,
 }
 
 /// The state of a character's springs after some steps.
@@ -71,6 +89,14 @@ pub(crate) struct SpringState {
     pub(crate) tails: Vec<(Vec3f, Vec3f)>,
     /// Per joint, its local rotation now.
     pub(crate) rotations: Vec<[f32; 4]>,
+}
+
+/// An object's spring-bone states: the last one asked for, and the states every 60 steps on the
+/// way to it (of its start), kept by `spring_scene`.
+#[derive(Debug, Default)]
+pub(crate) struct SpringMemo {
+    pub(crate) last: Option<SpringState>,
+    pub(crate) marks: Vec<SpringState>,
 }
 
 /// A node's translation, rotation and scale (a matrix node: `None`).
@@ -109,8 +135,29 @@ impl Rig {
         Some(SpringState { step: start, start, tails, rotations })
     }
 
+    /// The pose of the steps of a character without a clip ([`StillPose`]).
+    pub(crate) fn still_pose(&self) -> Option<StillPose> {
+        let sb = self.springs.as_ref()?;
+        let wind = |_: Vec3f| Vec3f::ZERO;
+        let input = StepInput { clip: None, clip_time: 0.0, wind: &wind, windy: false, still: None };
+        let locals = self.step_locals(&input);
+        let globals = (0..self.nodes.len())
+            .map(|n| (!sb.moving.get(n).copied().unwrap_or(true)).then(|| self.global_of(n, &locals)))
+            .collect();
+        let rest = (sb.springs.iter().flat_map(|s| &s.joints))
+            .map(|j| match locals.get(j.node).copied().flatten() {
+                Some((t, _, sc)) => unit_trs(t, j.rest, sc),
+                None => Mat4::IDENTITY,
+            })
+            .collect();
+        Some(StillPose { locals, globals, rest })
+    }
+
     /// The nodes' local transforms for `input`'s clip time (no spring rotations).
     fn step_locals(&self, input: &StepInput<'_>) -> Vec<Trs> {
+        if let Some(still) = input.still {
+            return still.locals.clone();
+        }
         let pose =
             PoseInput { clip: input.clip, time: input.clip_time, skip_weights: true, ..Default::default() };
         self.sample_locals(&pose).0
@@ -152,7 +199,9 @@ impl Rig {
         dt: f32,
     ) {
         let Some(sb) = self.springs.as_ref() else { return };
-        let Some(springs) = sb.springs.get(part) else { return };
+        let Some(springs) = sb.springs.get(part.clone()) else { return };
+        // The index of the part's first joint among all the springs' joints.
+        let first: usize = sb.springs[..part.start].iter().map(|s| s.joints.len()).sum();
         let mut locals = self.step_locals(input);
         // The last step's rotations, so colliders and springs below other springs see them.
         for (j, r) in springs.iter().flat_map(|s| &s.joints).zip(rotations.iter()) {
@@ -160,11 +209,23 @@ impl Rig {
                 *rot = *r;
             }
         }
-        // Globals of the nodes no joint moves, worked out once this step.
-        let mut memo: Vec<Option<Mat4>> = vec![None; self.nodes.len()];
+        // Globals of the nodes no joint moves, worked out once this step (once for all steps
+        // without a clip).
+        let mut memo: Vec<Option<Mat4>> = match input.still {
+            Some(_) => Vec::new(),
+            None => vec![None; self.nodes.len()],
+        };
         let mut global = |node: usize, locals: &[Trs]| -> Mat4 {
             if sb.moving.get(node).copied().unwrap_or(true) {
                 return self.global_of(node, locals);
+            }
+            if let Some(still) = input.still {
+                return still
+                    .globals
+                    .get(node)
+                    .copied()
+                    .flatten()
+                    .unwrap_or_else(|| self.global_of(node, locals));
             }
             // Up to the nearest known ancestor, then down.
             let mut path = Vec::new();
@@ -187,13 +248,14 @@ impl Rig {
             }
             m
         };
-        // Each collider this step: a segment `a..b` (a sphere's is a point) and its radius.
-        let colliders: Vec<(Vec3f, Vec3f, f32)> = sb
+        // Each collider this step: a segment `a..b` (a sphere's is a point), its radius, and the
+        // sphere around it all: the segment's middle and the radius plus half its length.
+        let colliders: Vec<(Vec3f, Vec3f, f32, Vec3f, f32)> = sb
             .colliders
             .iter()
             .map(|c| {
                 let g = global(c.node, &locals);
-                match c.shape {
+                let (a, b, radius) = match c.shape {
                     ColliderShape::Sphere { offset, radius } => {
                         let p = g.transform_point(offset);
                         (p, p, radius)
@@ -201,7 +263,11 @@ impl Rig {
                     ColliderShape::Capsule { offset, tail, radius } => {
                         (g.transform_point(offset), g.transform_point(tail), radius)
                     }
-                }
+                };
+                // A non-finite bound tests every joint, as without it.
+                let bound = radius + 0.5 * (b - a).length();
+                let bound = if bound.is_finite() { bound } else { f32::INFINITY };
+                (a, b, radius, (a + b) * 0.5, bound)
             })
             .collect();
         let mut k = 0;
@@ -220,9 +286,13 @@ impl Rig {
                     continue;
                 };
                 let rest_r = &j.rest;
-                let m0 = affine_mul(&parent, &unit_trs(t, *rest_r, sc));
+                let rest_local = match input.still.and_then(|p| p.rest.get(first + idx)) {
+                    Some(m) => *m,
+                    None => unit_trs(t, *rest_r, sc),
+                };
+                let m0 = affine_mul(&parent, &rest_local);
                 let head = Vec3f::new(m0.cols[3][0], m0.cols[3][1], m0.cols[3][2]);
-                let span = m0.transform_point(j.tail) - head;
+                let span = m0.transform_vector(j.tail);
                 let rest_tail = head + span;
                 let length = span.length();
                 if !(length > 0.0 && length.is_finite()) {
@@ -235,24 +305,33 @@ impl Rig {
                     Some(c) => (c.transform_point(prev), c.transform_point(cur)),
                     None => (prev, cur),
                 };
-                let mut force = (j.gravity_dir * j.gravity_power) + (input.wind)(cur);
-                let f = force.length();
-                if f.is_nan() || f > SPRING_FORCE_MAX {
+                let mut force = j.gravity_dir * j.gravity_power;
+                if input.windy {
+                    force += (input.wind)(cur);
+                }
+                // The length is taken only for a force past the bound (compared squared).
+                let f2 = force.length_squared();
+                if f2.is_nan() || f2 > SPRING_FORCE_MAX * SPRING_FORCE_MAX {
+                    let f = f2.sqrt();
                     force = if f.is_finite() { force * (SPRING_FORCE_MAX / f) } else { Vec3f::ZERO };
                 }
-                let mut next =
-                    cur + (cur - prev) * (1.0 - j.drag) + rest_dir * (j.stiffness * dt) + force * dt;
-                next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
+                let next = cur + (cur - prev) * (1.0 - j.drag) + rest_dir * (j.stiffness * dt) + force * dt;
+                let mut next = head + scaled_to(next - head, length).unwrap_or(rest_dir * length);
                 for &c in &s.colliders {
-                    let Some(&(a, b, radius)) = colliders.get(c) else { continue };
-                    let at = nearest_on_segment(next, a, b);
+                    let Some(&(a, b, radius, centre, bound)) = colliders.get(c) else { continue };
                     let reach = radius + j.hit_radius;
+                    // Outside the collider's bounding sphere grown by the hit radius: no contact,
+                    // and no nearest point to find.
+                    let far = bound + j.hit_radius;
+                    if (next - centre).length_squared() >= far * far {
+                        continue;
+                    }
+                    let at = nearest_on_segment(next, a, b);
                     let d = next - at;
-                    let dist = d.length();
-                    if dist < reach {
-                        if let Some(n) = d.try_normalize() {
-                            next = at + n * reach;
-                            next = head + (next - head).try_normalize().unwrap_or(rest_dir) * length;
+                    // Compared squared: the square root only for a contact.
+                    if d.length_squared() < reach * reach {
+                        if let Some(out) = scaled_to(d, reach) {
+                            next = head + scaled_to(at + out - head, length).unwrap_or(rest_dir * length);
                         }
                     }
                 }
@@ -272,16 +351,22 @@ impl Rig {
                 };
                 let Some(slot) = tails.get_mut(idx) else { return };
                 *slot = (slot.1, back);
-                let local = local_direction(&m0, next - head);
-                let turn = from_to(axis, local.try_normalize().unwrap_or(axis));
-                let r = unit_quat(quat_mul(*rest_r, turn));
+                let turn = turn_to(axis, local_direction(&m0, next - head));
+                // Both of unit length, so is their product (to rounding; each step starts again
+                // from the rest rotation, so nothing accumulates).
+                let r = quat_mul(*rest_r, turn);
                 if let Some(slot) = rotations.get_mut(idx) {
                     *slot = r;
                 }
                 if let Some((_, rot, _)) = locals[j.node].as_mut() {
                     *rot = r;
                 }
-                parent = affine_mul(&parent, &unit_trs(t, r, sc));
+                parent = if sc[0] == sc[1] && sc[1] == sc[2] {
+                    // A uniform scale commutes with the turn: `G·T·R₀·S·turn`, `m0` turned.
+                    turned(&m0, turn)
+                } else {
+                    affine_mul(&parent, &unit_trs(t, r, sc))
+                };
             }
         }
     }
@@ -289,19 +374,34 @@ impl Rig {
 
 /// World vector `v` in the space of `m` (its 3×3 block inverted as `Mᵀ` with each row divided by
 /// that column's squared length: exact for a rotation times a scale, which a joint's global matrix
-/// is unless a parent scales unevenly under a turn). Only its direction is used.
+/// is unless a parent scales unevenly under a turn; with the three columns of one length, `Mᵀ·v`,
+/// the same direction). Only its direction is used.
+#[inline]
 fn local_direction(m: &Mat4, v: Vec3f) -> Vec3f {
     let c = |k: usize| Vec3f::new(m.cols[k][0], m.cols[k][1], m.cols[k][2]);
-    let row = |k: usize| {
-        let col = c(k);
-        let l2 = col.length_squared();
-        if l2 > 0.0 {
-            col.dot(v) / l2
-        } else {
-            0.0
-        }
-    };
-    Vec3f::new(row(0), row(1), row(2))
+    let (c0, c1, c2) = (c(0), c(1), c(2));
+    let l = [c0.length_squared(), c1.length_squared(), c2.length_squared()];
+    let dots = Vec3f::new(c0.dot(v), c1.dot(v), c2.dot(v));
+    let (lo, hi) = (l[0].min(l[1]).min(l[2]), l[0].max(l[1]).max(l[2]));
+    // Columns of one length (a uniform scale, to rounding): the common divisor does not change
+    // the direction, so `Mᵀ·v` is it.
+    if lo > 0.0 && hi - lo <= 1e-6 * lo {
+        return dots;
+    }
+    let row = |d: f32, l2: f32| if l2 > 0.0 { d / l2 } else { 0.0 };
+    Vec3f::new(row(dots.x, l[0]), row(dots.y, l[1]), row(dots.z, l[2]))
+}
+
+/// `v` scaled to length `len` (one square root and one division), or `None` for a zero or
+/// non-finite `v`.
+#[inline]
+fn scaled_to(v: Vec3f, len: f32) -> Option<Vec3f> {
+    let l2 = v.length_squared();
+    if l2 > 0.0 && l2.is_finite() {
+        Some(v * (len / l2.sqrt()))
+    } else {
+        None
+    }
 }
 
 /// `q / |q|` in f32, or the identity for a zero or non-finite `q` (the simulation's own, cheaper than
@@ -332,6 +432,22 @@ fn unit_trs(t: [f32; 3], r: [f32; 4], s: [f32; 3]) -> Mat4 {
     }
 }
 
+/// `m · R(q)` for an affine `m` and a unit quaternion `q` (its 3×3 block times the rotation's,
+/// its translation kept): a joint's global matrix after its turn, from the one at its rest
+/// rotation, when its scale is uniform.
+#[inline]
+fn turned(m: &Mat4, q: [f32; 4]) -> Mat4 {
+    let r = unit_trs([0.0; 3], q, [1.0; 3]);
+    let mut out = *m;
+    for c in 0..3 {
+        for row in 0..3 {
+            out.cols[c][row] =
+                m.cols[0][row] * r.cols[c][0] + m.cols[1][row] * r.cols[c][1] + m.cols[2][row] * r.cols[c][2];
+        }
+    }
+    out
+}
+
 /// `a·b` for affine matrices (last rows `0 0 0 1`).
 fn affine_mul(a: &Mat4, b: &Mat4) -> Mat4 {
     let mut m = Mat4::IDENTITY;
@@ -358,14 +474,21 @@ fn nearest_on_segment(p: Vec3f, a: Vec3f, b: Vec3f) -> Vec3f {
     a + ab * ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
 }
 
-/// The shortest rotation (unit quaternion `[x, y, z, w]`) turning unit `a` onto unit `b`; half a
-/// turn about an axis normal to `a` when they are opposite.
-pub(crate) fn from_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
+/// The shortest rotation (unit quaternion `[x, y, z, w]`) turning unit `a` onto the direction of
+/// `b`, which need not be of unit length: the half-way quaternion `[a × b, |b| + a·b]` normalised
+/// (for unit `b`, `[a × b, 1 + a·b]`), so `b` is not normalised first; half a turn about an axis
+/// normal to `a` when they are opposite, the identity for a zero or non-finite `b`.
+#[inline]
+pub(crate) fn turn_to(a: Vec3f, b: Vec3f) -> [f32; 4] {
+    let lb = b.length();
+    if !(lb > 0.0 && lb.is_finite()) {
+        return [0.0, 0.0, 0.0, 1.0];
+    }
     let d = a.dot(b);
-    if d < -1.0 + 1e-6 {
+    if d < (-1.0 + 1e-6) * lb {
         let (n, _) = a.orthonormal_basis();
         return [n.x, n.y, n.z, 0.0];
     }
     let c = a.cross(b);
-    unit_quat([c.x, c.y, c.z, 1.0 + d])
+    unit_quat([c.x, c.y, c.z, lb + d])
 }

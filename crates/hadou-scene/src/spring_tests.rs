@@ -3,7 +3,7 @@
 //! 1.0 conversion and located errors for bad data.
 
 use crate::rig::{PoseInput, RestLocal, Rig, RigNode, VrmVersion};
-use crate::spring::{from_to, SpringBones, SpringState, StepInput};
+use crate::spring::{turn_to, SpringBones, SpringState, StepInput};
 use crate::spring_def::read_springs;
 use hadou_math::{Mat4, Vec3f};
 use serde_json::{json, Value};
@@ -41,14 +41,27 @@ fn no_wind(_: Vec3f) -> Vec3f {
     Vec3f::ZERO
 }
 
-/// Runs `steps` steps, calling `each` with the nodes' globals after each.
+/// Runs `steps` steps, calling `each` with the nodes' globals after each: the steps of a
+/// character without a clip, from its still pose ([`Rig::still_pose`]), as a scene runs them.
 fn run(
     rig: &Rig,
     steps: usize,
     wind: &dyn Fn(Vec3f) -> Vec3f,
+    each: impl FnMut(usize, &[Mat4]),
+) -> SpringState {
+    let still = rig.still_pose();
+    run_from(rig, steps, wind, still.as_ref(), each)
+}
+
+/// [`run`] from `still`, or (`None`) sampling the pose at each step as under a clip.
+fn run_from(
+    rig: &Rig,
+    steps: usize,
+    wind: &dyn Fn(Vec3f) -> Vec3f,
+    still: Option<&crate::spring::StillPose>,
     mut each: impl FnMut(usize, &[Mat4]),
 ) -> SpringState {
-    let input = StepInput { clip: None, clip_time: 0.0, wind };
+    let input = StepInput { clip: None, clip_time: 0.0, wind, windy: true, still };
     let mut state = rig.spring_rest(0, &input).expect("springs");
     let sb: &SpringBones = rig.springs.as_ref().expect("springs");
     for k in 0..steps {
@@ -223,6 +236,35 @@ fn a_chain_settles_under_gravity_as_the_reference_does() {
 }
 
 #[test]
+fn the_steps_from_a_still_pose_are_the_steps_that_sample_the_pose() {
+    // A chain hanging from a turned, scaled parent: the pose worked out once for all steps and
+    // the pose sampled at each step give the same motion (to rounding).
+    let mut nodes = vec![node(None, [0.0; 3]), node(Some(0), [0.0, 2.0, 0.0])];
+    nodes[1].rest = RestLocal::Trs { t: [0.0, 2.0, 0.0], r: [0.0, 0.3826834, 0.0, 0.9238795], s: [1.5; 3] };
+    nodes.extend([
+        node(Some(1), [0.4, 0.0, 0.0]),
+        node(Some(2), [0.4, 0.0, 0.0]),
+        node(Some(3), [0.4, 0.0, 0.0]),
+    ]);
+    let j = |n| joint(n, json!({ "gravityPower": 2.0, "dragForce": 0.2, "stiffness": 0.5 }));
+    let r = rig(nodes, json!({ "VRMC_springBone": { "springs": [{ "joints": [j(1), j(2), j(3), j(4)] }] } }));
+    let still = r.still_pose().expect("springs");
+    let wind = |p: Vec3f| Vec3f::new(0.0, 0.0, 1.0 + p.x);
+    let mut a = Vec::new();
+    run_from(&r, 300, &wind, Some(&still), |_, g| a.push(g.to_vec()));
+    let mut worst = 0.0f64;
+    let mut moved = 0.0f64;
+    run_from(&r, 300, &wind, None, |k, g| {
+        for n in 2..5 {
+            worst = worst.max(len(sub(pos(&g[n]), pos(&a[k][n]))));
+            moved = moved.max(len(sub(pos(&g[n]), pos(&a[0][n]))));
+        }
+    });
+    assert!(worst < 1e-4, "the two ways differ by {worst}");
+    assert!(moved > 0.1, "the chain swings: {moved}");
+}
+
+#[test]
 fn a_sphere_collider_pushes_the_tail_out() {
     // The bone would fall straight down through a sphere below-right of its head; the sphere
     // holds it out, as in the reference.
@@ -284,17 +326,25 @@ fn huge_forces_stay_finite_and_bounded() {
 }
 
 #[test]
-fn from_to_turns_one_direction_onto_another() {
+fn turn_to_turns_one_direction_onto_another_of_any_length() {
     let cases = [
         (Vec3f::X, Vec3f::Y),
         (Vec3f::X, -Vec3f::X),
         (Vec3f::Z, Vec3f::Z),
         (Vec3f::Y, Vec3f::new(0.6, 0.0, 0.8)),
+        (Vec3f::new(0.0, 0.6, -0.8), Vec3f::new(-0.48, 0.0, 0.64)),
     ];
     for (a, b) in cases {
-        let q = from_to(a, b);
-        let got = hadou_math::keyframes::quat_matrix(q).transform_vector(a);
-        assert!((got - b).length() < 1e-5, "{a:?} → {b:?}: {got:?}");
+        for scale in [1.0, 3.7, 0.02] {
+            let q = turn_to(a, b * scale);
+            let unit = (q.iter().map(|c| c * c).sum::<f32>() - 1.0).abs();
+            assert!(unit < 1e-6, "{a:?} → {b:?}·{scale}: |q| − 1 = {unit}");
+            let got = hadou_math::keyframes::quat_matrix(q).transform_vector(a);
+            assert!((got - b * (1.0 / b.length())).length() < 1e-5, "{a:?} → {b:?}·{scale}: {got:?}");
+        }
+    }
+    for nothing in [Vec3f::ZERO, Vec3f::new(f32::NAN, 0.0, 1.0), Vec3f::new(f32::INFINITY, 0.0, 0.0)] {
+        assert_eq!(turn_to(Vec3f::X, nothing), [0.0, 0.0, 0.0, 1.0]);
     }
 }
 
@@ -569,7 +619,13 @@ fn a_center_carries_the_tails_with_it() {
         }
         let r = rig(nodes, json!({ "VRMC_springBone": { "springs": [spring] } }));
         let wind = no_wind;
-        let input = |k: u64| StepInput { clip: Some(&clip), clip_time: (k as f64 * DT) as f32, wind: &wind };
+        let input = |k: u64| StepInput {
+            clip: Some(&clip),
+            clip_time: (k as f64 * DT) as f32,
+            wind: &wind,
+            windy: true,
+            still: None,
+        };
         let mut state = r.spring_rest(0, &input(0)).expect("springs");
         let sb = r.springs.as_ref().expect("springs");
         let mut worst = 0.0f64;

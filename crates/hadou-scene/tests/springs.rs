@@ -84,6 +84,29 @@ fn bits(s: &Scene, t: f32) -> Vec<u32> {
 }
 
 #[test]
+fn past_a_minute_the_start_moves_by_ten_seconds_and_frames_between_continue_one_state() {
+    use hadou_scene::{spring_start, SPRING_MAX_STEPS, SPRING_RESTART_STEPS};
+    assert_eq!((SPRING_MAX_STEPS, SPRING_RESTART_STEPS), (3_600, 600));
+    for (n, start) in [(0, 0), (3_600, 0), (3_601, 600), (4_200, 600), (4_201, 1_200), (10_000, 6_600)] {
+        assert_eq!(spring_start(n), start, "step {n}");
+    }
+    for n in (3_000..20_000).step_by(37).chain([u64::MAX, u64::MAX - 1]) {
+        let back = n - spring_start(n);
+        assert!(back <= SPRING_MAX_STEPS && (n < SPRING_MAX_STEPS || back > SPRING_MAX_STEPS - 600), "{n}");
+    }
+    let d = folder("minute");
+    let rest = format!("{BEAM}wind = 2.0\n{GROW}");
+    let object = "path = \"arms.vrm\"";
+    let times = [61.0f32, 61.5, 69.99, 70.02];
+    let alone: Vec<Vec<u32>> = times.iter().map(|&t| bits(&scene(&d, object, &rest).unwrap(), t)).collect();
+    let s = scene(&d, object, &rest).unwrap();
+    for (t, want) in times.iter().zip(&alone) {
+        assert!(bits(&s, *t) == *want, "at {t} s the sequence differs");
+    }
+    assert_eq!(s.spring_state_step("who"), Some(4_201));
+}
+
+#[test]
 fn a_frame_is_a_function_of_its_time_alone() {
     let d = folder("pure");
     let rest = format!("{BEAM}wind = 2.0\n{GROW}");

@@ -98,7 +98,23 @@ pub enum Edit {
         /// A clip of its glTF file, or `None` for the rest pose.
         clip: Option<String>,
     },
-    /// Removes the named wave, its tracks and the shadows cast by it.
+    /// Sets a `kind = "gltf"` object's `spring` key: whether its VRM spring bones move.
+    Spring {
+        /// The object's name.
+        object: String,
+        /// `spring = true` or `false`.
+        on: bool,
+    },
+    /// Sets what a `kind = "gltf"` object's VRM eyes follow (its `look_at` key); any other than
+    /// [`Gaze::Point`] also removes the track of the point `object.NAME.look_at`.
+    LookAt {
+        /// The object's name.
+        object: String,
+        /// What the eyes follow.
+        gaze: Gaze,
+    },
+    /// Removes the named wave, its tracks, the shadows cast by it and the `look_at` keys that
+    /// name it (those eyes then rest).
     RemoveWave(String),
     /// Removes the named object and its tracks.
     RemoveObject(String),
@@ -114,6 +130,19 @@ pub enum Edit {
         /// Seconds, > 0.
         duration: f32,
     },
+}
+
+/// What an [`Edit::LookAt`] makes a character's eyes follow.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Gaze {
+    /// Nothing: the key is removed and the eyes rest.
+    None,
+    /// `look_at = "camera"`.
+    Camera,
+    /// `look_at = "WAVE"`: the wave's head.
+    Wave(String),
+    /// `look_at = [x, y, z]`, world space (animatable).
+    Point([f32; 3]),
 }
 
 /// Why an edit or a file operation did not happen. `Display` is the message to show.
@@ -229,12 +258,18 @@ impl Document {
         self.reload_error.as_deref()
     }
 
-    /// The keys of `entity`'s table with their TOML text, other than `name` and the animatable
-    /// parameters (which have their own controls): what [`Edit::Raw`] edits. Sub-tables are left
+    /// The keys of `entity`'s table with their TOML text, other than `name`, the animatable
+    /// parameters and a VRM character's `spring` and `look_at` (which have their own controls): what [`Edit::Raw`] edits. Sub-tables are left
     /// out; an entity the file does not write has none.
     pub fn other_keys(&self, entity: &Entity) -> Vec<(String, String)> {
-        let animatable: Vec<&'static str> =
+        let mut animatable: Vec<&'static str> =
             self.scene.parameters().into_iter().filter(|p| &p.entity == entity).map(|p| p.key).collect();
+        if let Entity::Object(name) = entity {
+            if self.scene.characters().iter().any(|c| &c.object == name) {
+                // They have the character's controls (`Edit::Spring`, `Edit::LookAt`).
+                animatable.extend(["spring", "look_at"]);
+            }
+        }
         let table = match entity.name() {
             Some(name) => match self.doc.get(entity.table()) {
                 Some(Item::ArrayOfTables(a)) => {
@@ -277,8 +312,11 @@ impl Document {
         if text == self.text {
             return Ok(());
         }
-        let scene =
+        let mut scene =
             Scene::parse(&text, &self.path).map_err(|e| DocError(strip_path(&e.to_string(), &self.path)))?;
+        // An edit that leaves a character's springs alone (the camera, a light, …) continues
+        // their simulation rather than stepping again from time 0: the same bits, sooner.
+        scene.keep_spring_states(&self.scene);
         let merging = merge.is_some() && self.merge.as_deref() == merge && !self.undo.is_empty();
         if !merging {
             self.undo.push(std::mem::take(&mut self.text));
@@ -320,8 +358,10 @@ impl Document {
     /// Rebuilds the tree and the scene from `self.text` (a text that parsed before).
     fn reset_from_text(&mut self) {
         self.merge = None;
-        if let (Ok(doc), Ok(scene)) = (self.text.parse::<DocumentMut>(), Scene::parse(&self.text, &self.path))
+        if let (Ok(doc), Ok(mut scene)) =
+            (self.text.parse::<DocumentMut>(), Scene::parse(&self.text, &self.path))
         {
+            scene.keep_spring_states(&self.scene);
             self.doc = doc;
             self.scene = scene;
         }
@@ -388,7 +428,8 @@ impl Document {
             text.parse::<DocumentMut>().map(|doc| (scene, doc)).map_err(|e| e.message().to_string())
         });
         match parsed {
-            Ok((scene, doc)) => {
+            Ok((mut scene, doc)) => {
+                scene.keep_spring_states(&self.scene);
                 self.disk_text = text.clone();
                 self.reload_error = None;
                 if text != self.text {
@@ -716,20 +757,38 @@ fn edit_tree(doc: &mut DocumentMut, scene: &Scene, edit: &Edit) -> Result<(), Do
                     }
                     let targets: Vec<String> =
                         CLIP_KEYS[2..].iter().map(|k| format!("object.{object}.{k}")).collect();
-                    if let Some(Item::ArrayOfTables(tr)) = doc.get_mut("track") {
-                        tr.retain(|t| {
-                            !t.get("target")
-                                .and_then(Item::as_str)
-                                .is_some_and(|s| targets.iter().any(|x| x == s))
-                        });
-                        if tr.is_empty() {
-                            doc.remove("track");
-                        }
-                    }
+                    remove_tracks(doc, &targets);
                 }
             }
         }
-        Edit::RemoveWave(name) => remove_entity(doc, "wave", name)?,
+        Edit::Spring { object, on } => {
+            let table = entity_table(doc, &Entity::Object(object.clone()))?;
+            set_key(table, "spring", Value::from(*on));
+        }
+        Edit::LookAt { object, gaze } => {
+            let table = entity_table(doc, &Entity::Object(object.clone()))?;
+            match gaze {
+                Gaze::None => {
+                    table.remove("look_at");
+                }
+                Gaze::Camera => set_key(table, "look_at", Value::from("camera")),
+                Gaze::Wave(w) => set_key(table, "look_at", Value::from(w.as_str())),
+                Gaze::Point(p) => set_key(table, "look_at", arr3(*p)),
+            }
+            if !matches!(gaze, Gaze::Point(_)) {
+                remove_tracks(doc, &[format!("object.{object}.look_at")]);
+            }
+        }
+        Edit::RemoveWave(name) => {
+            if let Some(Item::ArrayOfTables(objects)) = doc.get_mut("object") {
+                for o in objects.iter_mut() {
+                    if o.get("look_at").and_then(Item::as_str) == Some(name.as_str()) {
+                        o.remove("look_at");
+                    }
+                }
+            }
+            remove_entity(doc, "wave", name)?
+        }
         Edit::RemoveObject(name) => remove_entity(doc, "object", name)?,
         Edit::Fire { wave, start, duration } => fire(doc, scene, wave, *start, *duration)?,
     }
@@ -740,6 +799,18 @@ fn edit_tree(doc: &mut DocumentMut, scene: &Scene, edit: &Edit) -> Result<(), Do
 /// [`Edit::Clip`]).
 const CLIP_KEYS: [&str; 6] =
     ["animation", "animation_file", "animation_start", "animation_speed", "animation_loop", "animation_time"];
+
+/// Removes the tracks whose target is one of `targets` (and `[[track]]` with the last).
+fn remove_tracks(doc: &mut DocumentMut, targets: &[String]) {
+    if let Some(Item::ArrayOfTables(tr)) = doc.get_mut("track") {
+        tr.retain(|t| {
+            !t.get("target").and_then(Item::as_str).is_some_and(|s| targets.iter().any(|x| x == s))
+        });
+        if tr.is_empty() {
+            doc.remove("track");
+        }
+    }
+}
 
 /// Moves the `[[name]]` tables to the end of the file (so an added table lands before them in
 /// the order the format documents: objects, waves, shadows, tracks).

@@ -19,6 +19,8 @@
 //! | `add wave KIND`, `add object KIND`, `remove wave NAME`, `remove object NAME` | |
 //! | `select WAVE`, `select none` | whose handles show |
 //! | `clip OBJECT CLIP`, `clip OBJECT` | the object plays its glTF clip `CLIP` on the scene's clock / rests (the clip chooser) |
+//! | `spring OBJECT on\|off` | the object's VRM spring bones move / stay at rest (its `spring` key) |
+//! | `look_at OBJECT none\|camera\|WAVE`, `look_at OBJECT X Y Z` | what the object's VRM eyes follow (its `look_at` key) |
 //! | `probe X Y` | probe the pixel `(X, Y)` of the image |
 //! | `backend cpu` / `backend gpu` | switch the renderer |
 //! | `resize W H` | resize the window (0 0 minimises it to nothing) |
@@ -27,6 +29,7 @@
 //! | `export PATH A..B FPS` | export frames `A..B` as a PNG sequence (`PATH/`) or GIF |
 //! | `quit` | stop here |
 
+use crate::document::Gaze;
 use crate::viewer::{BackendKind, Request, Viewer};
 use hadou_scene::escape_controls;
 use std::path::{Path, PathBuf};
@@ -68,6 +71,10 @@ pub enum Command {
     Select(Option<String>),
     /// `clip OBJECT [CLIP]`.
     Clip(String, Option<String>),
+    /// `spring OBJECT on|off`.
+    Spring(String, bool),
+    /// `look_at OBJECT none|camera|WAVE|X Y Z`.
+    LookAt(String, Gaze),
     /// `probe X Y`.
     Probe(u32, u32),
     /// `backend cpu|gpu`.
@@ -262,6 +269,28 @@ fn parse_command(name: &str, args: &[(usize, &str)], dir: &Path) -> Result<Comma
             count(1..=2, "an object name and optionally one of its clips (none: the rest pose)")?;
             Command::Clip(args[0].1.to_string(), args.get(1).map(|a| a.1.to_string()))
         }
+        "spring" => {
+            count(2..=2, "an object name and `on` or `off`")?;
+            let on = match args[1].1 {
+                "on" => true,
+                "off" => false,
+                w => return Err((Some(args[1].0), format!("expected `on` or `off`, got `{w}`"))),
+            };
+            Command::Spring(args[0].1.to_string(), on)
+        }
+        "look_at" => {
+            let usage = "an object name and `none`, `camera`, a wave's name or a point X Y Z";
+            if !matches!(args.len(), 2 | 4) {
+                return Err((None, format!("`{name}` takes {usage}")));
+            }
+            let gaze = match (args.len(), args[1].1) {
+                (4, _) => Gaze::Point([num(1)?, num(2)?, num(3)?]),
+                (_, "none") => Gaze::None,
+                (_, "camera") => Gaze::Camera,
+                (_, w) => Gaze::Wave(w.to_string()),
+            };
+            Command::LookAt(args[0].1.to_string(), gaze)
+        }
         "probe" => {
             count(2..=2, "pixel coordinates X Y")?;
             Command::Probe(int(0, 16383)?, int(1, 16383)?)
@@ -306,7 +335,7 @@ fn parse_command(name: &str, args: &[(usize, &str)], dir: &Path) -> Result<Comma
                 None,
                 format!(
                     "unknown command `{other}`; commands: wait, time, play, pause, loop, set, key, unkey, fire, \
-                     orbit, pan, zoom, undo, redo, add, remove, select, clip, probe, backend, resize, save, screenshot, \
+                     orbit, pan, zoom, undo, redo, add, remove, select, clip, spring, look_at, probe, backend, resize, save, screenshot, \
                      export, quit"
                 ),
             ))
@@ -330,7 +359,7 @@ pub enum WindowOp {
 /// Carries out one command on the viewer. Failures of edits are errors (a script that does not
 /// do what it says should not pass silently): `Err` has the message, prefixed by
 /// `file:line:col:`. A command naming a wave, object or parameter the scene does not have
-/// (`select`, `fire`, `set`, `key`, `unkey`, `remove`, `clip`) fails before it does anything, at the
+/// (`select`, `fire`, `set`, `key`, `unkey`, `remove`, `clip`, `spring`, `look_at`) fails before it does anything, at the
 /// name's column, listing the names it could be.
 pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, String> {
     viewer.message = None;
@@ -347,7 +376,10 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
         Command::Unkey(target) => viewer.check_target(target).and_then(|()| viewer.check_track(target)),
         Command::Fire(wave, _) | Command::Select(Some(wave)) => viewer.check_wave(wave),
         Command::Remove(true, name) => viewer.check_wave(name),
-        Command::Remove(false, name) | Command::Clip(name, _) => viewer.check_object(name),
+        Command::Remove(false, name)
+        | Command::Clip(name, _)
+        | Command::Spring(name, _)
+        | Command::LookAt(name, _) => viewer.check_object(name),
         _ => Ok(()),
     };
     if let Err(m) = named {
@@ -404,6 +436,8 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
             true
         }
         Command::Clip(object, clip) => viewer.choose_clip(object, clip.as_deref()),
+        Command::Spring(object, on) => viewer.set_spring(object, *on),
+        Command::LookAt(object, gaze) => viewer.set_look_at(object, gaze.clone()),
         Command::Probe(x, y) => {
             viewer.requests.push(Request::Probe([*x, *y]));
             true
@@ -438,8 +472,9 @@ pub fn run(viewer: &mut Viewer, line: &Line, path: &Path) -> Result<WindowOp, St
         Ok(WindowOp::None)
     } else {
         let why = viewer.message.as_ref().map_or("it did nothing".to_string(), |m| m.0.clone());
-        // A clip the object's file lacks: at the clip's name.
-        let k = matches!(line.command, Command::Clip(_, Some(_))).then_some(1);
+        // A clip the object's file lacks, a wave `look_at` cannot name: at that name.
+        let k = matches!(line.command, Command::Clip(_, Some(_)) | Command::LookAt(_, Gaze::Wave(_)))
+            .then_some(1);
         Err(at(k, &why))
     }
 }

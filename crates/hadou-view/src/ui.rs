@@ -3,10 +3,10 @@
 //! edits a [`Viewer`] and pushes [`Request`]s; the window turns those into renders, screenshots
 //! and exports. No threads, no blocking: the same code can run in a browser.
 
-use crate::document::Edit;
+use crate::document::{Edit, Gaze};
 use crate::viewer::{is_colour, project, unproject, view_depth, BackendKind, Handle, Request, Viewer};
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
-use hadou_scene::{Entity, ParamInfo, ParamShape};
+use hadou_scene::{Entity, LookAtTarget, ParamInfo, ParamShape};
 
 /// The image the window shows in the viewport.
 #[derive(Clone, Copy, Debug)]
@@ -294,6 +294,7 @@ fn params(ui: &mut egui::Ui, v: &mut Viewer, st: &mut UiState) {
                             entity_actions(ui, v, e);
                             if let Entity::Object(object) = e {
                                 clip_chooser(ui, v, object);
+                                character_keys(ui, v, object);
                             }
                             param_rows(ui, v, &list);
                             other_keys(ui, v, st, e);
@@ -430,6 +431,59 @@ fn clip_chooser(ui: &mut egui::Ui, v: &mut Viewer, object: &str) {
                 .on_hover_text("the clip's time at the timeline's time (animation_start, _speed, _loop)");
         }
     });
+}
+
+/// A VRM character's `spring` (a checkbox, where its file has spring bones) and `look_at` (a
+/// choice of none, the camera, each wave and a point, where its file has look-at; the point's
+/// numbers are the parameter row `look_at` below).
+fn character_keys(ui: &mut egui::Ui, v: &mut Viewer, object: &str) {
+    let Some(c) = v.characters().into_iter().find(|c| c.object == object) else { return };
+    if c.has_springs {
+        let mut on = c.spring;
+        if ui
+            .checkbox(&mut on, "spring")
+            .on_hover_text("the VRM spring bones move (hair, skirt), blown by the waves' wind")
+            .changed()
+        {
+            v.set_spring(object, on);
+        }
+    }
+    if !c.has_look_at {
+        return;
+    }
+    let now = match &c.look_at {
+        None => Gaze::None,
+        Some(LookAtTarget::Camera) => Gaze::Camera,
+        Some(LookAtTarget::Wave(w)) => Gaze::Wave(w.clone()),
+        Some(LookAtTarget::Point) => Gaze::Point(v.gaze_point(object)),
+    };
+    let label = |g: &Gaze| match g {
+        Gaze::None => "none".to_string(),
+        Gaze::Camera => "camera".to_string(),
+        Gaze::Wave(w) => format!("wave {w}"),
+        Gaze::Point(_) => "a point".to_string(),
+    };
+    let mut choices = vec![Gaze::None, Gaze::Camera];
+    choices.extend(v.scene().wave_names().iter().map(|w| Gaze::Wave(w.to_string())));
+    choices.push(match now {
+        Gaze::Point(p) => Gaze::Point(p),
+        _ => Gaze::Point(v.gaze_point(object)),
+    });
+    let mut chosen = now.clone();
+    ui.horizontal(|ui| {
+        ui.label("look_at").on_hover_text("what the VRM eyes follow");
+        egui::ComboBox::from_id_salt(("look_at", object)).selected_text(label(&now)).show_ui(ui, |ui| {
+            for g in &choices {
+                let on = label(g) == label(&now);
+                if ui.selectable_label(on, label(g)).clicked() && !on {
+                    chosen = g.clone();
+                }
+            }
+        });
+    });
+    if chosen != now {
+        v.set_look_at(object, chosen);
+    }
 }
 
 /// The chooser's entry for no clip.

@@ -2,9 +2,9 @@
 //! gizmo handles, what is shown on screen and what the window should do next ([`Request`]).
 //! Everything here is plain data and runs in tests without a window.
 
-use crate::document::{DocError, Document, Edit, Reload};
+use crate::document::{DocError, Document, Edit, Gaze, Reload};
 use hadou_math::Vec3f;
-use hadou_scene::{Frame, ParamShape, Scene};
+use hadou_scene::{CharacterInfo, Frame, ParamShape, Scene};
 use std::path::PathBuf;
 
 /// The animation clock.
@@ -278,6 +278,33 @@ impl Viewer {
     /// undo step. A clip its file lacks is refused with the loader's list of its clips.
     pub fn choose_clip(&mut self, object: &str, clip: Option<&str>) -> bool {
         self.apply(Edit::Clip { object: object.to_string(), clip: clip.map(str::to_string) })
+    }
+
+    /// The objects whose VRM file has spring bones or look-at, with their `spring` and `look_at`.
+    pub fn characters(&self) -> Vec<CharacterInfo> {
+        self.scene().characters()
+    }
+
+    /// Turns `object`'s spring bones on or off (its `spring` key); one undo step.
+    pub fn set_spring(&mut self, object: &str, on: bool) -> bool {
+        self.apply(Edit::Spring { object: object.to_string(), on })
+    }
+
+    /// Makes `object`'s eyes follow `gaze` (its `look_at` key); one undo step. A wave the scene
+    /// lacks is refused with the loader's list of the waves.
+    pub fn set_look_at(&mut self, object: &str, gaze: Gaze) -> bool {
+        self.apply(Edit::LookAt { object: object.to_string(), gaze })
+    }
+
+    /// The point `object`'s eyes follow now (world space), as a `look_at` point that keeps them
+    /// there: where its `look_at` leads at the current time, or the camera's position when it has
+    /// none.
+    pub fn gaze_point(&self, object: &str) -> [f32; 3] {
+        let t = self.timeline.time;
+        self.scene()
+            .look_at_point(object, t)
+            .or_else(|| self.v3("camera.position").map(Vec3f::to_array))
+            .unwrap_or([0.0; 3])
     }
 
     /// Shows `m` in the status line.
