@@ -58,6 +58,10 @@ def main():
                 tar.extractall(checked, filter="data")
             except TypeError:  # a Python without extraction filters (before 3.11.4)
                 tar.extractall(checked)
+        # A package's files carry one fixed date; dated now (as cargo's own verification dates
+        # them), an edited file is compiled again rather than taken for the last run's.
+        for m in files:
+            os.utime(os.path.join(checked, m.name))
         size = os.path.getsize(crate)
         print(f"{name}-{version}.crate: {size / 1024:.1f} KiB, {len(files)} files")
         members.append((name, f"{name}-{version}"))
