@@ -183,3 +183,8 @@ impl Plugin for HadouPlugin {
             );
     }
 }
+
+/// The package's README (what crates.io shows): its examples compile as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -22,7 +22,7 @@
 //!    same frame gives the same bits, banded or whole, on any number of threads.
 //!
 //! A point the lamp adds nothing to (its unshadowed term is zero: facing away) is given 0, as the
-//! two-map resolves give it (shadowed in both maps). [`reference`] is the brute-force check: every
+//! two-map resolves give it (shadowed in both maps). [`reference()`] is the brute-force check: every
 //! sample ray against every caster triangle, no hierarchy.
 
 use crate::opaque::SoftPoint;

@@ -41,7 +41,7 @@ pub struct Frame {
     /// The `[bloom]` (glare on the linear colour before the colour mapping), if any.
     pub bloom: Option<BloomParams>,
     /// Anti-aliasing samples per pixel (`[image] samples`): 1, 4, 9 or 16, a `k × k` grid
-    /// ([`Frame::grid`]). Every surface is drawn, shaded and shadowed once per sample; the waves'
+    /// ([`Frame::sample_grid`]). Every surface is drawn, shaded and shadowed once per sample; the waves'
     /// integrals once per pixel where its samples see one surface ([`Frame::sample_frame`]).
     pub samples: u32,
 }

@@ -34,3 +34,8 @@ pub use hadou_gpu as gpu;
 pub use hadou_gpu::GpuBackend;
 pub use hadou_math as math;
 pub use hadou_scene::*;
+
+/// The package's README (what crates.io shows): its examples compile as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

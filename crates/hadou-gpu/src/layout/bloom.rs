@@ -18,6 +18,6 @@ pub struct BloomUniforms {
     pub o: [u32; 4],
     /// `threshold`, `soft_knee`, `intensity/N`, `streak/N_s`.
     pub params: [f32; 4],
-    /// 1 when the upsample adds `b`; the tone mode ([`TONE_FAITHFUL`], [`TONE_FILMIC`]); unused.
+    /// 1 when the upsample adds `b`; the tone mode ([`TONE_FAITHFUL`](crate::layout::TONE_FAITHFUL), [`TONE_FILMIC`](crate::layout::TONE_FILMIC)); unused.
     pub flags: [u32; 4],
 }

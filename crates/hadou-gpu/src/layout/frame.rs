@@ -57,8 +57,8 @@ pub struct FrameUniforms {
     pub tile_origin: [u32; 2],
     /// Tile size in pixels.
     pub tile_size: [u32; 2],
-    /// Word offset of the frame's [`GpuShadowCast`] records in the shading data buffer
-    /// ([`ShadingBuffers::push_shadows`]).
+    /// Word offset of the frame's [`GpuShadowCast`](crate::layout::GpuShadowCast) records in the shading data buffer
+    /// ([`ShadingBuffers::push_shadows`](crate::layout::ShadingBuffers::push_shadows)).
     pub shadow_casts: u32,
     /// Word offset of the map casts' indices (into the cast records) in the shading data buffer.
     pub map_casts: u32,

@@ -373,14 +373,14 @@ impl CurveBuffers {
 /// The wave buffer and the curve buffers of a frame: every curved wave is prepared once
 /// ([`curve::prepare`], as the CPU backend does per frame) and appended to the curve buffers.
 /// Also returns the prepared curves, one entry per wave (`None` for analytic waves), for
-/// [`ShadingBuffers::new`].
+/// [`ShadingBuffers::new`](crate::layout::ShadingBuffers::new).
 pub fn frame_waves(frame: &Frame) -> Result<FrameWaves, String> {
     waves_buffers(&frame.waves)
 }
 
 /// [`frame_waves`] of a list of waves: what a caller that draws the same waves into several views
 /// (hadou-bevy's cameras) or also lights its own materials with them prepares once per frame and
-/// hands to [`crate::GpuBackend::encode_prepared_wave_overlay`] and [`wave_lights`].
+/// hands to [`crate::GpuBackend::encode_prepared_wave_overlay`] and [`wave_lights`](crate::layout::wave_lights).
 pub fn waves_buffers(frame_waves: &[hadou_scene::Wave]) -> Result<FrameWaves, String> {
     let mut curves = CurveBuffers::default();
     let mut waves = Vec::with_capacity(frame_waves.len());

@@ -314,7 +314,7 @@ fn tent_h(path: SimdPath, low: &[[f32; 3]], base: BaseIn, out: &mut [[f32; 3]], 
 }
 
 /// The horizontal sums of the tent over `low` (every row it holds) at the width `width` of the
-/// level above: row `y` of the result is [`tent_h`] of `low`'s row `y`.
+/// level above: row `y` of the result is `tent_h` of `low`'s row `y`.
 pub fn up_plane(path: SimdPath, low: &Plane, width: usize, fill: &dyn RowFill) -> Result<Plane, usize> {
     let mut h = Plane::try_new(width, low.height, low.rows.clone())?;
     fill.fill(&mut h, &|y, row| {

@@ -26,7 +26,7 @@
 //! - [`Integrator::Nearest`]: the nearest-point field — the density taken at the ray point's
 //!   true nearest curve point rather than its cross-section partner — by a walk over the ray whose
 //!   steps follow the distance, each distance found by branch and bound over the piece table and
-//!   refined on the exact curve ([`nearest`]).
+//!   refined on the exact curve (`nearest.rs`).
 //! - [`curve_energy_lanes`]: the default integrator on up to eight neighbouring rays at once,
 //!   walking the piece table as one packet in SIMD lanes (`lanes.rs`; what the CPU backend's
 //!   wave pass runs), each ray evaluating the pieces [`curve_energy`] gives it.

@@ -80,7 +80,7 @@ impl<R: Real> RayQuadratic<R> {
     /// `∫_{t0}^{min(t1, t_far)} (1 − t/t_far)^j dt / sqrt(Y² + H)` (faithful) or `/(Y² + H)`
     /// (inverse square): the piece integral of [`Self::integral`] with the distance attenuation
     /// of 002 eq. 3.23 (SPEC.md §1.4), 0 from the far point on. Graded 4-point Gauss–Legendre
-    /// cells weighted by the closed form (see the [module docs](self)); `j = 0` (or NaN) is
+    /// cells weighted by the closed form (see this module's documentation, `energy/attenuated.rs`); `j = 0` (or NaN) is
     /// [`Self::integral`] itself. Finite and in `[0, ENERGY_MAX]` for finite inputs; empty or
     /// NaN spans give 0.
     ///

@@ -9,7 +9,7 @@
 //!   functions are only ever inlined into code compiled with AVX2 and FMA enabled, which runs only
 //!   after the CPU said it has them.
 //!
-//! [`SimdPath`] names a path the running CPU supports ([`SimdPath::detect`] picks the widest;
+//! [`SimdPath`] names a path the running CPU supports ([`SimdPath::widest`] is the widest;
 //! `HADOU_SIMD` may choose a narrower one and is refused, with a message, for one the CPU lacks),
 //! and [`dispatch`] runs a [`WithLanes`] body on it: the body is compiled once per path, the
 //! x86-64 ones inside functions carrying `#[target_feature]`, so a single binary uses AVX2 + FMA

@@ -47,7 +47,7 @@ pub fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Times the CPU backend on the vector path it picks ([`SimdPath::current`]); see
-/// [`time_cpu_on`].
+/// `time_cpu_on`.
 pub fn time_cpu(frame: &Frame, iterations: u32) -> Result<Timing, RenderError> {
     time_cpu_on(frame, iterations, SimdPath::current())
 }
