@@ -354,7 +354,7 @@ impl Scene {
     }
 
     /// The steps of the states kept on the way to the last one for the object named `object`
-    /// (every [`SPRING_MARK_STEPS`], one second): where an earlier frame continues from.
+    /// (every 60 steps, one second): where an earlier frame continues from.
     pub fn spring_marks(&self, object: &str) -> Vec<u64> {
         let Some(o) = self.objects.iter().find(|o| o.name == object) else { return Vec::new() };
         let mut steps: Vec<u64> =
