@@ -975,6 +975,8 @@ const MAX_NEAREST_VISITS: u32 = 2048u;
 const NEAREST_PRUNE: f32 = 1e-4;
 const TAIL_RADII: f32 = 64.0;
 const NEAREST_STACK: u32 = 32u;
+// Mirrors nearest.rs REFINE_STEPS.
+const REFINE_STEPS: u32 = 1u;
 
 // Mirrors nearest.rs `segment`: (distance from p to the segment a..b, parameter of the nearest point).
 fn curve_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec2<f32> {
@@ -988,23 +990,28 @@ fn curve_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(sqrt(dot3(e, e)), f);
 }
 
-// |p − c(s)|² on the exact curve (the `g` closure of nearest.rs `nearest_point`).
-fn curve_nearest_g(c: GpuCurve, p: vec3<f32>, s: f32) -> f32 {
+// The exact curve point c(s) in local coordinates (the `point` closure of nearest.rs
+// `nearest_point`).
+fn curve_nearest_foot(c: GpuCurve, s: f32) -> vec3<f32> {
     let cs = curve_eval(c, s);
-    let dx = c.gamma * s - p.x;
-    let dy = cs.x - p.y;
-    let dz = cs.y - p.z;
-    return dx * dx + dy * dy + dz * dz;
+    return vec3<f32>(c.gamma * s, cs.x, cs.y);
 }
 
-// Mirrors nearest.rs `nearest_point`: branch and bound over the piece table, the winning leaf
-// refined by two parabolic steps on the exact curve. Returns (squared distance, parameter s).
-fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint_in: f32) -> vec2<f32> {
+// Mirrors nearest.rs `Nearest`: the nearest exact curve point found for one query.
+struct NearestHit {
+    d2: f32,
+    s: f32,
+    foot: vec3<f32>,
+}
+
+// Mirrors nearest.rs `nearest_point`: branch and bound over the piece table from the hint (the
+// previous query's exact point, `s` and `c(s)`), the winning leaf refined by one parabolic step
+// on the exact curve.
+fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint: NearestHit) -> NearestHit {
     let n = c.node_count - 1u;
-    let hint = clamp(hint_in, 0.0, c.s_head);
-    var out_d2 = curve_nearest_g(c, p, hint);
-    var out_s = hint;
-    var best = sqrt(out_d2);
+    let e0 = p - hint.foot;
+    var out = NearestHit(dot3(e0, e0), hint.s, hint.foot);
+    var best = sqrt(out.d2);
     let keep = 1.0 - NEAREST_PRUNE;
     var found = false;
     var leaf = 0u;
@@ -1071,23 +1078,23 @@ fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint_in: f32) -> vec2<f32> {
         let hi = min(sb + w * 0.5, c.s_head);
         var s0 = sa + w * leaf_f;
         var h = w * 0.25;
-        for (var it = 0u; it < 2u; it++) {
+        for (var it = 0u; it < REFINE_STEPS; it++) {
             let x1 = max(s0 - h, lo);
             let x3 = min(s0 + h, hi);
-            let g1 = curve_nearest_g(c, p, x1);
-            let g2 = curve_nearest_g(c, p, s0);
-            let g3 = curve_nearest_g(c, p, x3);
-            if (g1 < out_d2) {
-                out_d2 = g1;
-                out_s = x1;
+            let c1 = curve_nearest_foot(c, x1);
+            let c2 = curve_nearest_foot(c, s0);
+            let c3 = curve_nearest_foot(c, x3);
+            let g1 = dot3(p - c1, p - c1);
+            let g2 = dot3(p - c2, p - c2);
+            let g3 = dot3(p - c3, p - c3);
+            if (g1 < out.d2) {
+                out = NearestHit(g1, x1, c1);
             }
-            if (g2 < out_d2) {
-                out_d2 = g2;
-                out_s = s0;
+            if (g2 < out.d2) {
+                out = NearestHit(g2, s0, c2);
             }
-            if (g3 < out_d2) {
-                out_d2 = g3;
-                out_s = x3;
+            if (g3 < out.d2) {
+                out = NearestHit(g3, x3, c3);
             }
             if (!(x1 < s0 && s0 < x3)) {
                 break;
@@ -1109,13 +1116,13 @@ fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint_in: f32) -> vec2<f32> {
             h = min(max(abs(vc - s0) * 2.0, w * (1.0 / 64.0)), h);
             s0 = vc;
         }
-        let gv = curve_nearest_g(c, p, s0);
-        if (gv < out_d2) {
-            out_d2 = gv;
-            out_s = s0;
+        let cv = curve_nearest_foot(c, s0);
+        let gv = dot3(p - cv, p - cv);
+        if (gv < out.d2) {
+            out = NearestHit(gv, s0, cv);
         }
     }
-    return vec2<f32>(out_d2, out_s);
+    return out;
 }
 
 // Mirrors nearest.rs `weight`: w(D) without the attenuation.
@@ -1156,7 +1163,7 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
     // start; 1: a step's midpoint; 2: its end), because a software adapter inlines every call.
     var a = r.t0;
     var b = a;
-    var na = vec2<f32>(0.0);
+    var na = NearestHit(0.0, 0.0, curve_nearest_foot(c, 0.0));
     var fa = 0.0;
     var fm = 0.0;
     var sum = 0.0;
@@ -1164,15 +1171,15 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
     var steps = 0u;
     var phase = 0u;
     var x = a;
-    var hint = 0.0;
+    var hint = na;
     loop {
         let n = curve_nearest_point(c, r.o + r.q * x, hint);
-        let f = curve_nearest_weight(r.falloff, n.x, r.rc2) * curve_attenuation(r, x);
+        let f = curve_nearest_weight(r.falloff, n.d2, r.rc2) * curve_attenuation(r, x);
         if (phase == 1u) {
             fm = f;
             phase = 2u;
             x = b;
-            hint = n.y;
+            hint = n;
             continue;
         }
         if (phase == 2u) {
@@ -1185,7 +1192,7 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
             break;
         }
         steps += 1u;
-        let d = sqrt(na.x + r.rc2);
+        let d = sqrt(na.d2 + r.rc2);
         var h = NEAREST_STEP * d / qn;
 // #if ATTENUATION
         if (r.j > 0.0) {
@@ -1198,12 +1205,10 @@ fn curve_nearest(c: GpuCurve, falloff: u32, core_radius: f32, ray: Ray, t0: f32,
         }
         phase = 1u;
         x = 0.5 * (a + b);
-        hint = na.y;
+        hint = na;
     }
     if (open) {
-        let cs = curve_eval(c, na.y);
-        let point = vec3<f32>(c.gamma * na.y, cs.x, cs.y);
-        let quad = quad_new(r.o + r.q * end - point, r.q, r.rc2);
+        let quad = quad_new(r.o + r.q * end - na.foot, r.q, r.rc2);
         sum += segment_new(r.falloff, quad, T_OPEN, r.rc2).value;
     }
     return energy_scaled(sum, r.alpha);

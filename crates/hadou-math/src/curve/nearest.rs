@@ -19,9 +19,11 @@
 //! (less a relative [`NEAREST_PRUNE`]) is skipped; otherwise its children are visited, the one
 //! nearer in `x` first. At a leaf the distance to its chord between two exact curve points is
 //! taken (within the leaf tolerance of the curve). The search starts from an exact upper bound,
-//! the previous sample's nearest point, so along a ray only the pieces near the answer are
-//! opened. The winning leaf is refined on the exact curve by two parabolic steps on
-//! `g(s) = |P − c(s)|²` (nearly quadratic over a leaf), and the smallest exact `g` is returned:
+//! the previous sample's nearest point `c(s)` (its parameter and its point, so that the bound
+//! costs no curve evaluation), so along a ray only the pieces near the answer are opened. The
+//! winning leaf is refined on the exact curve by one parabolic step on `g(s) = |P − c(s)|²`
+//! (nearly quadratic over a leaf: three exact points about the chord's nearest point, then the
+//! parabola's vertex), and the smallest exact `g` is returned:
 //! the distance is always that of an exact curve point. Every curve point, the two ends included,
 //! is a candidate, so the ends are round without a special case.
 //!
@@ -62,7 +64,8 @@ pub const NEAREST_STEP: f64 = 0.25;
 pub const MAX_NEAREST_STEPS: u32 = 180;
 /// Most work one ray of the nearest-point field takes, by construction: the first query and two
 /// per interval ([`MAX_NEAREST_STEPS`]), each at most [`MAX_NEAREST_VISITS`] pieces and 8 exact
-/// points, and the closed tail: 742 217 (below 750 000).
+/// points (a query takes 4, and the walk's start 1: the bound keeps the margin of the two-step
+/// refinement it was set for), and the closed tail: 742 217 (below 750 000).
 pub const NEAREST_RAY_WORK: u64 = (2 * MAX_NEAREST_STEPS as u64 + 1) * (MAX_NEAREST_VISITS as u64 + 8) + 1;
 /// Most pieces one distance query visits.
 pub const MAX_NEAREST_VISITS: u32 = 2048;
@@ -71,6 +74,10 @@ pub const MAX_NEAREST_VISITS: u32 = 2048;
 pub const NEAREST_PRUNE: f64 = 1e-4;
 /// An infinite span's closed tail starts this many bounding radii from the curve's centre.
 pub const TAIL_RADII: f64 = 64.0;
+/// Parabolic steps of the refinement on the exact curve (one is as accurate as two on the
+/// random rays of `tests/curve_nearest.rs`: the chord's nearest point is already within a leaf's
+/// tolerance).
+const REFINE_STEPS: usize = 1;
 /// Depth of the search stack (the table has at most 15 levels; a depth-first walk holds at most
 /// one pending sibling per level).
 const STACK: usize = 32;
@@ -82,6 +89,8 @@ pub(crate) struct Nearest<R> {
     pub d2: R,
     /// Curve parameter of the point.
     pub s: R,
+    /// The exact curve point `c(s)` in local coordinates.
+    pub foot: Vec3<R>,
     /// Pieces visited plus exact points evaluated.
     pub work: u32,
 }
@@ -116,27 +125,25 @@ fn parabola_vertex<R: Real>(x1: R, g1: R, x2: R, g2: R, x3: R, g3: R) -> Option<
 }
 
 /// The nearest point of the curve to the local point `p`, by branch and bound over the piece
-/// table, refined on the exact curve (see the module docs). `hint` is a curve parameter whose
-/// exact distance starts the search as an upper bound.
-pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: R) -> Nearest<R> {
+/// table, refined on the exact curve (see the module docs). `hint` is an exact curve point
+/// `(s, c(s))` whose distance starts the search as an upper bound.
+pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: (R, Vec3<R>)) -> Nearest<R> {
     let table = &c.table;
     let shape = R::shape(c);
     let gamma = R::from_f64(f64::from(c.wave.gamma));
     let s_head = R::from_f64(c.s_head);
     let n = table.nodes.len() - 1;
     let levels = table.level_offsets.len() - 1;
-    let g = |s: R| {
+    let point = |s: R| {
         let cs = shape.eval(s);
-        let (dx, dy, dz) = (gamma * s - p.x, cs[0] - p.y, cs[1] - p.z);
-        dx * dx + dy * dy + dz * dz
+        Vec3::new(gamma * s, cs[0], cs[1])
     };
     let node = |i: usize| {
         let v = table.nodes[i];
         Vec3::new(R::from_f64(f64::from(v[0])), R::from_f64(f64::from(v[1])), R::from_f64(f64::from(v[2])))
     };
     let node_s = |i: usize| R::from_f64(f64::from(table.nodes[i][3]));
-    let hint = hint.clamp(R::ZERO, s_head);
-    let mut out = Nearest { d2: g(hint), s: hint, work: 1 };
+    let mut out = Nearest { d2: (p - hint.1).length_squared(), s: hint.0, foot: hint.1, work: 0 };
     let mut best = out.d2.sqrt();
     let keep = R::ONE - R::from_f64(NEAREST_PRUNE);
     let mut leaf: Option<(usize, R)> = None;
@@ -193,15 +200,18 @@ pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: R
         let (lo, hi) = ((sa - w * R::HALF).max(R::ZERO), (sb + w * R::HALF).min(s_head));
         let mut s0 = sa + w * f;
         let mut h = w * R::from_f64(0.25);
-        for _ in 0..2 {
+        for _ in 0..REFINE_STEPS {
             let x1 = (s0 - h).max(lo);
             let x3 = (s0 + h).min(hi);
-            let (g1, g2, g3) = (g(x1), g(s0), g(x3));
+            let (c1, c2, c3) = (point(x1), point(s0), point(x3));
+            let (g1, g2, g3) =
+                ((p - c1).length_squared(), (p - c2).length_squared(), (p - c3).length_squared());
             out.work += 3;
-            for (s, v) in [(x1, g1), (s0, g2), (x3, g3)] {
+            for (s, v, f) in [(x1, g1, c1), (s0, g2, c2), (x3, g3, c3)] {
                 if v < out.d2 {
                     out.d2 = v;
                     out.s = s;
+                    out.foot = f;
                 }
             }
             let next = if x1 < s0 && s0 < x3 { parabola_vertex(x1, g1, s0, g2, x3, g3) } else { None };
@@ -210,11 +220,13 @@ pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: R
             h = ((v - s0).abs() * R::TWO).max(w * R::from_f64(1.0 / 64.0)).min(h);
             s0 = v;
         }
-        let gv = g(s0);
+        let cv = point(s0);
+        let gv = (p - cv).length_squared();
         out.work += 1;
         if gv < out.d2 {
             out.d2 = gv;
             out.s = s0;
+            out.foot = cv;
         }
     }
     out
@@ -253,7 +265,9 @@ pub(crate) fn nearest_generic<R: CurveReal>(c: &PreparedCurve, r: &LocalRay<R>) 
         end = r.t0.max(tc + reach);
     }
     let mut a = r.t0;
-    let mut na = nearest_point(c, r.at(a), R::ZERO);
+    let start = R::shape(c).eval(R::ZERO);
+    let mut na = nearest_point(c, r.at(a), (R::ZERO, Vec3::new(R::ZERO, start[0], start[1])));
+    work += 1;
     work += na.work;
     let mut fa = weight(r.falloff, na.d2, r.rc2) * r.attenuation(a);
     let mut sum = R::ZERO;
@@ -268,8 +282,8 @@ pub(crate) fn nearest_generic<R: CurveReal>(c: &PreparedCurve, r: &LocalRay<R>) 
         }
         let b = if steps >= MAX_NEAREST_STEPS || !(a + h < end) { end } else { a + h };
         let m = R::HALF * (a + b);
-        let nm = nearest_point(c, r.at(m), na.s);
-        let nb = nearest_point(c, r.at(b), nm.s);
+        let nm = nearest_point(c, r.at(m), (na.s, na.foot));
+        let nb = nearest_point(c, r.at(b), (nm.s, nm.foot));
         work += nm.work + nb.work;
         let fm = weight(r.falloff, nm.d2, r.rc2) * r.attenuation(m);
         let fb = weight(r.falloff, nb.d2, r.rc2) * r.attenuation(b);
@@ -278,9 +292,7 @@ pub(crate) fn nearest_generic<R: CurveReal>(c: &PreparedCurve, r: &LocalRay<R>) 
     }
     if open {
         // The tail: towards the nearest point found at its start (module docs).
-        let cs = R::shape(c).eval(na.s);
-        let point = Vec3::new(R::from_f64(f64::from(c.wave.gamma)) * na.s, cs[0], cs[1]);
-        let quad = Quad::new(r.at(end) - point, r.q, r.rc2);
+        let quad = Quad::new(r.at(end) - na.foot, r.q, r.rc2);
         sum += Segment::from_quad(r.falloff, &quad, R::INFINITY, r.rc2).value;
         work += 1;
     }
