@@ -978,7 +978,8 @@ const NEAREST_STACK: u32 = 32u;
 // Mirrors nearest.rs REFINE_STEPS.
 const REFINE_STEPS: u32 = 1u;
 
-// Mirrors nearest.rs `segment`: (distance from p to the segment a..b, parameter of the nearest point).
+// Mirrors nearest.rs `segment`: (squared distance from p to the segment a..b, parameter of the
+// nearest point).
 fn curve_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec2<f32> {
     let d = b - a;
     let dd = dot3(d, d);
@@ -987,7 +988,7 @@ fn curve_segment(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>) -> vec2<f32> {
         f = clamp(dot3(p - a, d) / dd, 0.0, 1.0);
     }
     let e = p - (a + d * f);
-    return vec2<f32>(sqrt(dot3(e, e)), f);
+    return vec2<f32>(dot3(e, e), f);
 }
 
 // The exact curve point c(s) in local coordinates (the `point` closure of nearest.rs
@@ -1011,7 +1012,8 @@ fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint: NearestHit) -> NearestHi
     let n = c.node_count - 1u;
     let e0 = p - hint.foot;
     var out = NearestHit(dot3(e0, e0), hint.s, hint.foot);
-    var best = sqrt(out.d2);
+    var best2 = out.d2;
+    var best = sqrt(best2);
     let keep = 1.0 - NEAREST_PRUNE;
     var found = false;
     var leaf = 0u;
@@ -1032,8 +1034,9 @@ fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint: NearestHit) -> NearestHi
         let nb = curve_node(c, b);
         if (l == 0u) {
             let sd = curve_segment(p, na, nb);
-            if (sd.x < best) {
-                best = sd.x;
+            if (sd.x < best2) {
+                best2 = sd.x;
+                best = sqrt(best2);
                 found = true;
                 leaf = a;
                 leaf_f = sd.y;
@@ -1047,7 +1050,8 @@ fn curve_nearest_point(c: GpuCurve, p: vec3<f32>, hint: NearestHit) -> NearestHi
         let ea = vec3<f32>(na.x, ln.x + (na.x - xm) * ln.z, ln.y + (na.x - xm) * ln.w);
         let eb = vec3<f32>(nb.x, ln.x + (nb.x - xm) * ln.z, ln.y + (nb.x - xm) * ln.w);
         let sd = curve_segment(p, ea, eb);
-        if (!(sd.x - delta < best * keep)) {
+        let reach = best * keep + delta;
+        if (!(sd.x < reach * reach)) {
             continue;
         }
         let left = ((l - 1u) << 24u) | (2u * j);

@@ -95,13 +95,14 @@ pub(crate) struct Nearest<R> {
     pub work: u32,
 }
 
-/// Distance from `p` to the segment `a..b` and the segment parameter of the nearest point.
+/// Squared distance from `p` to the segment `a..b` and the segment parameter of the nearest
+/// point (the search compares squares: no square root per piece).
 #[inline]
 fn segment<R: Real>(p: Vec3<R>, a: Vec3<R>, b: Vec3<R>) -> (R, R) {
     let d = b - a;
     let dd = d.dot(d);
     let f = if dd > R::ZERO { ((p - a).dot(d) / dd).clamp(R::ZERO, R::ONE) } else { R::ZERO };
-    ((p - (a + d * f)).length(), f)
+    ((p - (a + d * f)).length_squared(), f)
 }
 
 /// The vertex of the parabola through three points (`x2` between the others), or `None` when
@@ -144,7 +145,8 @@ pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: (
     };
     let node_s = |i: usize| R::from_f64(f64::from(table.nodes[i][3]));
     let mut out = Nearest { d2: (p - hint.1).length_squared(), s: hint.0, foot: hint.1, work: 0 };
-    let mut best = out.d2.sqrt();
+    let mut best2 = out.d2;
+    let mut best = best2.sqrt();
     let keep = R::ONE - R::from_f64(NEAREST_PRUNE);
     let mut leaf: Option<(usize, R)> = None;
     let mut stack = [(0u32, 0u32); STACK];
@@ -159,9 +161,10 @@ pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: (
         let b = ((j + 1) << l).min(n);
         let (na, nb) = (node(a), node(b));
         if l == 0 {
-            let (d, f) = segment(p, na, nb);
-            if d < best {
-                best = d;
+            let (d2, f) = segment(p, na, nb);
+            if d2 < best2 {
+                best2 = d2;
+                best = d2.sqrt();
                 leaf = Some((a, f));
             }
             continue;
@@ -171,8 +174,11 @@ pub(crate) fn nearest_point<R: CurveReal>(c: &PreparedCurve, p: Vec3<R>, hint: (
         let delta = R::from_f64(f64::from(table.errors[k]));
         let xm = R::HALF * (na.x + nb.x);
         let end = |x: R| Vec3::new(x, ly + (x - xm) * my, lz + (x - xm) * mz);
-        let (d, _) = segment(p, end(na.x), end(nb.x));
-        if !(d - delta < best * keep) {
+        // |P − segment| − δ < best·keep, squared (both sides of |P − segment| < best·keep + δ
+        // are non-negative).
+        let (d2, _) = segment(p, end(na.x), end(nb.x));
+        let reach = best * keep + delta;
+        if !(d2 < reach * reach) {
             continue;
         }
         let left = (l as u32 - 1, 2 * j as u32);
