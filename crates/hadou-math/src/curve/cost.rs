@@ -32,8 +32,8 @@
 //!   costs a helix.
 //! - **The nearest-point field** (`nearest.rs`) is bounded by construction: at most
 //!   [`MAX_NEAREST_STEPS`](super::MAX_NEAREST_STEPS) intervals of two distance queries, each
-//!   visiting at most [`MAX_NEAREST_VISITS`](super::MAX_NEAREST_VISITS) pieces and evaluating 7
-//!   exact points, about 2.1 million evaluations. The limits above keep it far below: its work
+//!   visiting at most [`MAX_NEAREST_VISITS`](super::MAX_NEAREST_VISITS) pieces and evaluating 4
+//!   exact points, under [`NEAREST_RAY_WORK`](super::NEAREST_RAY_WORK) evaluations. The limits above keep it far below: its work
 //!   grows with the turns a ray passes near the axis, where every turn is about as near, and the
 //!   costliest corner (a 128-turn helix one unit long) takes about 7.5·10⁵ piece visits on its
 //!   worst ray; the example scenes take 2 000–6 000 (`tests/curve_cost.rs`,
