@@ -566,7 +566,7 @@ fn glare_rows(
         wave_ms += ms(opaque_done, waves_done);
         t = waves_done;
     }
-    bloom::glare_and_map(frame, params, &mut linear, band, &mut img.color, simd)?;
+    bloom::glare_and_map(frame, params, &linear, band, &mut img.color, simd)?;
     Ok(PassTimes { opaque_ms, wave_ms, color_ms: ms(t, Instant::now()) })
 }
 

@@ -14,7 +14,7 @@
 //!   four rows): the horizontal sums of every low row are made once into a plane of their own
 //!   ([`up_plane`]), and each high row sums four of its rows.
 
-use super::{composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, MAX_LEVELS};
+use super::{bilinear, composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, BLUR, MAX_LEVELS};
 use crate::simd::{dispatch, Lane, SimdPath, WithLanes};
 
 /// The downsample's weights in its order of summation (see [`super::down_row`]).
@@ -184,10 +184,8 @@ struct Scratch {
     rows: Vec<Vec<f32>>,
     /// The streak's levels.
     levels: Vec<Vec<[f32; 3]>>,
-    /// A row of the bloom.
-    bloom: Vec<[f32; 3]>,
-    /// A row of the streak.
-    streak: Vec<[f32; 3]>,
+    /// The streak's row pair.
+    pair: Vec<[f32; 3]>,
 }
 
 thread_local! {
@@ -345,20 +343,17 @@ fn down_row_h_in(path: SimdPath, src: &[[f32; 3]], out: &mut [[f32; 3]], s: &mut
     taps(path, [&e[..], o, e, o, e, o], [0, 0, 1, 1, 2, 2], DOWN_H_W, None, out.as_flattened_mut());
 }
 
-/// The streak sum `up_h(U₁ʰ)` of one row `t` with `n` levels: [`super::streak_row`] in lanes.
+/// The streak's `U₁ʰ` of one half-height row `t` with `n` levels into `out` (`half(t.len())`
+/// texels): [`super::streak_row`] in lanes.
 pub fn streak_row(path: SimdPath, t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
-    with_scratch(5, |s| streak_row_in(path, t, n, out, &mut s.rows[..5], &mut s.levels));
+    with_scratch(5, |s| {
+        streak_row_in(path, t, n, &mut s.rows[..5], &mut s.levels);
+        out.copy_from_slice(&s.levels[0][..out.len()]);
+    });
 }
 
-/// [`streak_row`] in the scratch rows `rows` (five) and `levels`.
-fn streak_row_in(
-    path: SimdPath,
-    t: &[[f32; 3]],
-    n: u32,
-    out: &mut [[f32; 3]],
-    rows: &mut [Vec<f32>],
-    levels: &mut Vec<Vec<[f32; 3]>>,
-) {
+/// [`streak_row`] in the scratch rows `rows` (five) and `levels`, leaving `U₁ʰ` in `levels[0]`.
+fn streak_row_in(path: SimdPath, t: &[[f32; 3]], n: u32, rows: &mut [Vec<f32>], levels: &mut Vec<Vec<[f32; 3]>>) {
     let n = n.clamp(1, MAX_LEVELS) as usize;
     // levels[k] is D_{k+1}; then, from the top down, U_k in place of D_k.
     if levels.len() < n {
@@ -388,7 +383,59 @@ fn streak_row_in(
             tent_h(path, u, BaseIn::Out, d, rows);
         }
     }
-    tent_h(path, &levels[0], BaseIn::None, out, rows);
+}
+
+/// [`super::blur_row_h`] in lanes (`q`: a scratch row).
+fn blur_row_h_in(path: SimdPath, row: &[[f32; 3]], out: &mut [[f32; 3]], q: &mut Vec<f32>) {
+    // q[m] = row[clamp(m − 2)]: texel x − 1 + d is q[x + 1 + d].
+    pad(row, out.len() + 4, q);
+    taps(path, [&q[..]; 3], [1, 2, 3], BLUR, None, out.as_flattened_mut());
+}
+
+/// [`super::blur_row_h`] in lanes.
+pub fn blur_row_h(path: SimdPath, row: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    with_scratch(1, |s| blur_row_h_in(path, row, out, &mut s.rows[0]));
+}
+
+/// [`super::glare_row`] in lanes.
+pub fn glare_row(path: SimdPath, hb: &Plane, hs: Option<&Plane>, y: usize, kb: f32, ks: f32, out: &mut [[f32; 3]]) {
+    let w = super::glare_weights(kb, ks);
+    let last = hb.height as isize - 1;
+    let b: [&[f32]; 3] =
+        std::array::from_fn(|d| hb.row((y as isize - 1 + d as isize).clamp(0, last) as usize).as_flattened());
+    let out = out.as_flattened_mut();
+    match hs {
+        Some(hs) => taps(path, [b[0], b[1], b[2], hs.row(y).as_flattened()], [0; 4], w, None, out),
+        None => taps(path, b, [0; 3], [w[0], w[1], w[2]], None, out),
+    }
+}
+
+/// [`super::upsample_row`] in lanes: row `y` of the full-resolution glare from `g`.
+pub fn upsample_row(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]]) {
+    with_scratch(4, |s| upsample_row_in(path, g, y, out, &mut s.rows[..4]));
+}
+
+fn upsample_row_in(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
+    let [v, q, he, ho] = s else { unreachable!("four rows") };
+    let (y0, wy) = bilinear(y);
+    let last = g.height as isize - 1;
+    let rows: [&[f32]; 2] =
+        std::array::from_fn(|d| g.row((y0 + d as isize).clamp(0, last) as usize).as_flattened());
+    v.resize(3 * g.width, 0.0);
+    taps(path, rows, [0; 2], wy, None, v);
+    let w = out.len();
+    let (ne, no) = (w.div_ceil(2), w / 2);
+    // q[m] = v[clamp(m − 2)]: even x = 2j reads v[j − 1], v[j] = q[j + 1], q[j + 2]; odd x = 2j + 1
+    // reads v[j], v[j + 1] = q[j + 2], q[j + 3].
+    pad(v.as_chunks::<3>().0, ne + 4, q);
+    he.resize(3 * ne, 0.0);
+    ho.resize(3 * no, 0.0);
+    taps(path, [&q[..]; 2], [1, 2], bilinear(0).1, None, he);
+    taps(path, [&q[..]; 2], [2, 3], bilinear(1).1, None, ho);
+    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = if i % 2 == 0 { he[i / 2] } else { ho[i / 2] };
+    }
 }
 
 /// [`super::try_glare`] on the vector path `path`: the same planes, bit for bit.
@@ -399,35 +446,34 @@ pub fn try_glare(
     band: std::ops::Range<usize>,
     fill: &dyn RowFill,
 ) -> Result<Plane, usize> {
-    let mut work = Plane::try_new(src.width, src.height, src.rows.clone())?;
-    work.data.copy_from_slice(&src.data);
-    glare_in_place(path, params, &mut work, band.clone(), fill)?;
-    let mut out = Plane::try_new(src.width, src.height, band.clone())?;
-    let w = src.width;
-    out.data.copy_from_slice(&work.data[(band.start - src.rows.start) * w..(band.end - src.rows.start) * w]);
+    let g = try_glare_plane(path, params, src, band.clone(), fill)?;
+    let mut out = Plane::try_new(src.width, src.height, band)?;
+    fill.fill(&mut out, &|y, row| {
+        upsample_row(path, &g, y, row);
+        for (o, c) in row.iter_mut().zip(src.row(y)) {
+            *o = composite(*c, *o);
+        }
+    });
     Ok(out)
 }
 
-/// The glare of [`super::try_glare`] over the rows `band` of the linear image `src` (which holds
-/// at least the rows [`super::source_rows`] names), written over those rows of `src` (its other
-/// rows are left as they were): no plane the size of the band is made for the result.
-/// `Err(bytes)` where a plane of that size could not be allocated (`src` is then unchanged).
-pub fn glare_in_place(
+/// The glare `G` at level 1 of [`super::try_glare`] for the rows `band` of the linear image `src`
+/// (which holds at least the rows [`super::source_rows`] names): the plane over the level-1 rows
+/// [`super::bilinear_rows`] names, from which [`upsample_row`] and [`super::composite`] give the
+/// band's rows. `Err(bytes)` where a plane of that size could not be allocated.
+pub fn try_glare_plane(
     path: SimdPath,
     params: &BloomParams,
-    src: &mut Plane,
+    src: &Plane,
     band: std::ops::Range<usize>,
     fill: &dyn RowFill,
-) -> Result<(), usize> {
+) -> Result<Plane, usize> {
     let (w, h) = (src.width, src.height);
     let n = levels(params.radius * h as f32);
     let plan = Plan::new(w, h, n, band.clone());
     let (th, kn) = (params.threshold, params.soft_knee);
     let mut t = Plane::try_new(w, h, plan.source.clone())?;
-    {
-        let src = &*src;
-        fill.fill(&mut t, &|y, row| prefilter_row(path, src.row(y), th, kn, row));
-    }
+    fill.fill(&mut t, &|y, row| prefilter_row(path, src.row(y), th, kn, row));
     let mut downs: Vec<Plane> = Vec::with_capacity(plan.levels.len());
     for l in &plan.levels {
         let mut d = Plane::try_new(l.width, l.height, l.down.clone())?;
@@ -443,28 +489,30 @@ pub fn glare_in_place(
         fill.fill(&mut next, &|y, row| up_row(path, &hs, y, Some(d.row(y)), row));
         u = next;
     }
-    let kb = params.intensity / n as f32;
-    let ns = levels(params.streak_length * h as f32);
-    let ks = params.streak / ns as f32;
-    let hs = up_plane(path, &u, w, fill)?;
+    let (kb, ks) = super::weights(params, h);
+    let l1 = &plan.levels[0];
+    let mut hb = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+    fill.fill(&mut hb, &|y, row| blur_row_h(path, u.row(y), row));
     drop(u);
-    fill.fill(src, &|y, row| {
-        if !band.contains(&y) {
-            return;
-        }
-        with_scratch(5, |s| {
-            let Scratch { rows, levels, bloom, streak } = s;
-            bloom.resize(w, [0.0; 3]);
-            up_row(path, &hs, y, None, bloom);
-            if ks > 0.0 {
-                streak.resize(w, [0.0; 3]);
-                streak_row_in(path, t.row(y), ns, streak, &mut rows[..5], levels);
-            }
-            for (x, c) in row.iter_mut().enumerate() {
-                let st = if ks > 0.0 { streak[x] } else { [0.0; 3] };
-                *c = composite(*c, bloom[x], kb, st, ks);
-            }
+    let hs = if ks > 0.0 {
+        let ns = levels(params.streak_length * h as f32);
+        let mut hs = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+        fill.fill(&mut hs, &|y, row| {
+            with_scratch(5, |s| {
+                let Scratch { rows, levels, pair, .. } = s;
+                pair.resize(w, [0.0; 3]);
+                let (a, b) = (t.row(2 * y), t.row((2 * y + 1).min(h - 1)));
+                taps(path, [a.as_flattened(), b.as_flattened()], [0; 2], [0.5; 2], None, pair.as_flattened_mut());
+                streak_row_in(path, pair, ns, &mut rows[..5], levels);
+                blur_row_h_in(path, &levels[0], row, &mut rows[0]);
+            })
         });
-    });
-    Ok(())
+        Some(hs)
+    } else {
+        None
+    };
+    drop(t);
+    let mut g = Plane::try_new(l1.width, l1.height, super::bilinear_rows(&band, l1.height))?;
+    fill.fill(&mut g, &|y, row| glare_row(path, &hb, hs.as_ref(), y, kb, ks, row));
+    Ok(g)
 }
