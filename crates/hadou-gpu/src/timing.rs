@@ -30,7 +30,8 @@ pub struct PassTime {
     /// (opaque geometry and outline hulls into the G-buffer), `"edges"` (outlines closed where
     /// objects meet), `"plane shadows"` (only when the
     /// frame has plane shadows) and `"wave"` (shading, shadow lookups, the energy integrals and
-    /// the colour mapping).
+    /// the colour mapping), then, for a frame with a `[bloom]`, once per glare band `"bloom"` (the
+    /// whole glare chain, its composite and colour mapping).
     pub name: String,
     /// Median over the timed iterations of this pass's time summed over the frame's tiles (or
     /// map layers), in milliseconds.
@@ -66,7 +67,7 @@ pub struct FrameTiming {
 /// windows read back, the two maps, the classes and the resolve), until the GPU has finished them.
 pub const SOFT_PREPARATION: &str = "soft preparation (wall clock)";
 /// The second part: the tiles drawn (raster, edges, plane shadows, the soft gather, the wave
-/// pass), until the GPU has finished them.
+/// pass) and a `[bloom]`'s glare chain, until the GPU has finished them.
 pub const SOFT_TILES: &str = "tiles (wall clock)";
 
 /// The median of `samples` (0 when empty).
