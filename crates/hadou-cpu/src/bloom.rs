@@ -20,6 +20,22 @@ impl RowFill for Parallel {
         let (w, y0) = (plane.width, plane.rows.start);
         plane.data.par_chunks_mut(w).enumerate().for_each(|(r, row)| f(y0 + r, row));
     }
+
+    fn fill_blocks(&self, a: &mut Plane, b: Option<&mut Plane>, block: usize, f: &bloom::BlockFn<'_>) {
+        let (y0, wa, block) = (a.rows.start, a.width, block.max(1));
+        let rows = |i: usize, len: usize| y0 + i * block..y0 + i * block + len / wa;
+        match b {
+            Some(b) => {
+                let wb = b.width;
+                a.data.par_chunks_mut(wa * block).zip(b.data.par_chunks_mut(wb * block)).enumerate().for_each(
+                    |(i, (ca, cb))| f(rows(i, ca.len()), ca, cb),
+                );
+            }
+            None => {
+                a.data.par_chunks_mut(wa * block).enumerate().for_each(|(i, ca)| f(rows(i, ca.len()), ca, &mut []));
+            }
+        }
+    }
 }
 
 /// The rows of the linear image the band `band` (non-empty) of `frame` needs under `params`: the

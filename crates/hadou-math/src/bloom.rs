@@ -346,7 +346,24 @@ pub fn source_rows(params: &BloomParams, width: usize, height: usize, band: Rang
 pub trait RowFill {
     /// Calls `f(y, row)` for every row of `plane`.
     fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync));
+
+    /// Calls `f(rows, a_rows, b_rows)` for the blocks of `block` rows of `a` (the last one
+    /// shorter) and the same rows of `b` (which holds `a`'s rows; `None`: no second plane, an
+    /// empty slice). One block after the other here; a renderer may run them in parallel.
+    fn fill_blocks(&self, a: &mut Plane, b: Option<&mut Plane>, block: usize, f: &BlockFn<'_>) {
+        let (y0, block) = (a.rows.start, block.max(1));
+        let (wa, wb) = (a.width, b.as_ref().map_or(0, |b| b.width));
+        let mut b = b.map(|b| b.data.chunks_mut(wb * block));
+        for (i, ca) in a.data.chunks_mut(wa * block).enumerate() {
+            let cb = b.as_mut().and_then(|b| b.next()).unwrap_or_default();
+            let start = y0 + i * block;
+            f(start..start + ca.len() / wa, ca, cb);
+        }
+    }
 }
+
+/// What [`RowFill::fill_blocks`] calls per block.
+pub type BlockFn<'a> = dyn Fn(Range<usize>, &mut [[f32; 3]], &mut [[f32; 3]]) + Sync + 'a;
 
 /// Rows one after the other.
 #[derive(Clone, Copy, Debug, Default)]
