@@ -15,8 +15,15 @@ use std::ops::Range;
 /// Fills a plane's rows with rayon.
 struct Parallel;
 
+/// Planes of fewer texels than this are filled on the calling thread: the pyramid's small levels
+/// cost less than handing their rows to other threads.
+const SMALL_PLANE: usize = 1 << 14;
+
 impl RowFill for Parallel {
     fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync)) {
+        if plane.data.len() < SMALL_PLANE {
+            return bloom::Sequential.fill(plane, f);
+        }
         let (w, y0) = (plane.width, plane.rows.start);
         plane.data.par_chunks_mut(w).enumerate().for_each(|(r, row)| f(y0 + r, row));
     }
