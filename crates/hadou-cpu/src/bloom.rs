@@ -34,12 +34,17 @@ impl RowFill for Parallel {
         match b {
             Some(b) => {
                 let wb = b.width;
-                a.data.par_chunks_mut(wa * block).zip(b.data.par_chunks_mut(wb * block)).enumerate().for_each(
-                    |(i, (ca, cb))| f(rows(i, ca.len()), ca, cb),
-                );
+                a.data
+                    .par_chunks_mut(wa * block)
+                    .zip(b.data.par_chunks_mut(wb * block))
+                    .enumerate()
+                    .for_each(|(i, (ca, cb))| f(rows(i, ca.len()), ca, cb));
             }
             None => {
-                a.data.par_chunks_mut(wa * block).enumerate().for_each(|(i, ca)| f(rows(i, ca.len()), ca, &mut []));
+                a.data
+                    .par_chunks_mut(wa * block)
+                    .enumerate()
+                    .for_each(|(i, ca)| f(rows(i, ca.len()), ca, &mut []));
             }
         }
     }
@@ -63,12 +68,13 @@ pub(crate) fn glare_and_map(
     color: &mut [[f32; 4]],
     simd: SimdPath,
 ) -> Result<(), hadou_scene::RenderError> {
-    let g = bloom::lanes::try_glare_plane(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
-        hadou_scene::RenderError::Memory(format!(
-            "the glare's planes need {:.2} GB that could not be allocated",
-            bytes as f64 / 1e9
-        ))
-    })?;
+    let g =
+        bloom::lanes::try_glare_plane(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
+            hadou_scene::RenderError::Memory(format!(
+                "the glare's planes need {:.2} GB that could not be allocated",
+                bytes as f64 / 1e9
+            ))
+        })?;
     let mode = frame.color_mapping.mode;
     let w = linear.width;
     color.par_chunks_mut(w.max(1)).enumerate().for_each_init(Vec::new, |row, (r, out)| {

@@ -525,7 +525,8 @@ fn glare_rows(
     data.clear();
     try_grow(&mut data, w * src.len(), "the glare's linear colour")?;
     data.resize(w * src.len(), [0.0; 3]);
-    let mut linear = hadou_math::bloom::Plane { width: w, height: frame.height as usize, rows: src.clone(), data };
+    let mut linear =
+        hadou_math::bloom::Plane { width: w, height: frame.height as usize, rows: src.clone(), data };
     // With an area light the opaque pass draws every row whatever it is asked: one chunk.
     let chunk =
         if frame.area_light.is_some() { src.len() } else { (chunk_samples / (w * k * k).max(1)).max(1) };

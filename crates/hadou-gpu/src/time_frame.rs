@@ -29,7 +29,8 @@ pub(crate) fn time_frame(
     // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
     let last = r.ctx.scoped("warming up", || {
         let maps = r.submit_shadow_maps(frame, &prepared, None);
-        r.submit_tiles(frame, &prepared, None).map(|tiles| r.submit_glare(frame, &glare, None).or(tiles).or(maps))
+        r.submit_tiles(frame, &prepared, None)
+            .map(|tiles| r.submit_glare(frame, &glare, None).or(tiles).or(maps))
     })??;
     if let Some(s) = last {
         r.ctx.wait(s)?;
@@ -125,7 +126,8 @@ pub(crate) fn time_frame(
             r.ctx.wait(r.ctx.queue.submit([]))?;
             let prepared_at = Instant::now();
             let last = r.ctx.scoped("timing a frame", || {
-                r.submit_tiles(frame, &prepared, None).map(|tiles| r.submit_glare(frame, &glare, None).or(tiles))
+                r.submit_tiles(frame, &prepared, None)
+                    .map(|tiles| r.submit_glare(frame, &glare, None).or(tiles))
             })??;
             if let Some(s) = last {
                 r.ctx.wait(s)?;

@@ -132,7 +132,8 @@ impl Renderer {
         let mut sources = Vec::new();
         for band in self.glare_bands(frame, &params, 0..frame.height)? {
             let (_, encoder, linear) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
-            let submission = self.ctx.scoped("drawing the bloom", || self.ctx.queue.submit([encoder.finish()]))?;
+            let submission =
+                self.ctx.scoped("drawing the bloom", || self.ctx.queue.submit([encoder.finish()]))?;
             self.ctx.wait(submission)?;
             let source = hadou_math::bloom::source_rows(&params, w, h, band.clone());
             sources.push(GlareSource { linear, source, band });
@@ -227,8 +228,9 @@ impl Renderer {
             source: src.clone(),
             band: band.clone(),
         };
-        let out =
-            self.ctx.scoped("recording the bloom", || self.passes.bloom.encode(d, &mut encoder, &inputs, None))?;
+        let out = self
+            .ctx
+            .scoped("recording the bloom", || self.passes.bloom.encode(d, &mut encoder, &inputs, None))?;
         Ok((out, encoder, linear))
     }
 }

@@ -355,7 +355,13 @@ pub fn streak_row(path: SimdPath, t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) 
 }
 
 /// [`streak_row`] in the scratch rows `rows` (five) and `levels`, leaving `U₁ʰ` in `levels[0]`.
-fn streak_row_in(path: SimdPath, t: &[[f32; 3]], n: u32, rows: &mut [Vec<f32>], levels: &mut Vec<Vec<[f32; 3]>>) {
+fn streak_row_in(
+    path: SimdPath,
+    t: &[[f32; 3]],
+    n: u32,
+    rows: &mut [Vec<f32>],
+    levels: &mut Vec<Vec<[f32; 3]>>,
+) {
     if levels.is_empty() {
         levels.push(Vec::new());
     }
@@ -372,7 +378,13 @@ fn streak_row_in(path: SimdPath, t: &[[f32; 3]], n: u32, rows: &mut [Vec<f32>], 
 
 /// The streak's chain from its first level `d1` (`D₁ʰ`) with `n` levels, leaving `U₁ʰ` in
 /// `levels[0]`.
-fn streak_from_first(path: SimdPath, d1: &[[f32; 3]], n: u32, rows: &mut [Vec<f32>], levels: &mut Vec<Vec<[f32; 3]>>) {
+fn streak_from_first(
+    path: SimdPath,
+    d1: &[[f32; 3]],
+    n: u32,
+    rows: &mut [Vec<f32>],
+    levels: &mut Vec<Vec<[f32; 3]>>,
+) {
     if levels.is_empty() {
         levels.push(Vec::new());
     }
@@ -426,7 +438,15 @@ pub fn blur_row_h(path: SimdPath, row: &[[f32; 3]], out: &mut [[f32; 3]]) {
 }
 
 /// [`super::glare_row`] in lanes.
-pub fn glare_row(path: SimdPath, hb: &Plane, hs: Option<&Plane>, y: usize, kb: f32, ks: f32, out: &mut [[f32; 3]]) {
+pub fn glare_row(
+    path: SimdPath,
+    hb: &Plane,
+    hs: Option<&Plane>,
+    y: usize,
+    kb: f32,
+    ks: f32,
+    out: &mut [[f32; 3]],
+) {
     let w = super::glare_weights(kb, ks);
     let last = hb.height as isize - 1;
     let b: [&[f32]; 3] =
@@ -520,7 +540,8 @@ fn first_level(
             };
             dispatch(path, BoxSum { srcs, out: bx });
         }
-        let [be0, bo1, be2, bo3, be4] = [&boxes[0], &boxes[1], &boxes[2], &boxes[3], &boxes[4]].map(|v| &v[..]);
+        let [be0, bo1, be2, bo3, be4] =
+            [&boxes[0], &boxes[1], &boxes[2], &boxes[3], &boxes[4]].map(|v| &v[..]);
         taps(
             path,
             [be2, bo1, bo1, bo3, bo3, be0, be2, be2, be4, be0, be0, be4, be4],
