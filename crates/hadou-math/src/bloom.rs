@@ -430,8 +430,8 @@ pub fn glare_row(hb: &Plane, hs: Option<&Plane>, y: usize, kb: f32, ks: f32, out
     let w = glare_weights(kb, ks);
     for (x, o) in out.iter_mut().enumerate() {
         let mut acc = [0.0f32; 3];
-        for d in 0..3 {
-            madd(&mut acc, w[d], hb.at(x as isize, y as isize - 1 + d as isize));
+        for (d, &wd) in w[..3].iter().enumerate() {
+            madd(&mut acc, wd, hb.at(x as isize, y as isize - 1 + d as isize));
         }
         if let Some(hs) = hs {
             madd(&mut acc, w[3], hs.at(x as isize, y as isize));
