@@ -12,7 +12,15 @@
 //!   rows shifted by a texel;
 //! - the tent is separable as written (each low row's four horizontal taps summed first, then the
 //!   four rows): the horizontal sums of every low row are made once into a plane of their own
-//!   ([`up_plane`]), and each high row sums four of its rows.
+//!   ([`up_plane`]), and each high row sums four of its rows;
+//! - the glare at level 1 and its bilinear tap ([`glare_row`], [`upsample_row`]) the same way:
+//!   the vertical weights over whole rows, the horizontal ones over a padded row split into the
+//!   even and odd texels of the output.
+//!
+//! [`try_glare_plane`] makes the prefilter, the first downsample and the streak's first level in
+//! one pass over the linear image, in blocks of level-1 rows whose prefiltered rows are made and
+//! split once (no prefiltered plane); a renderer then reads each output row once for the tap, the
+//! composite and its colour mapping.
 
 use super::{bilinear, composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, BLUR, MAX_LEVELS};
 use crate::simd::{dispatch, Lane, SimdPath, WithLanes};
