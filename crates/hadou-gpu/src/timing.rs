@@ -13,7 +13,7 @@ pub enum TimingMethod {
     /// GPU timestamps (`Features::TIMESTAMP_QUERY`) written at the beginning and end of every pass
     /// (`timestamp_writes` of the pass descriptors): the frame is the shadow-map passes' span plus,
     /// per tile, the span from its first pass's beginning to its last pass's end, summed over
-    /// tiles: pure GPU execution time. [`FrameTiming::passes`] splits it by pass.
+    /// tiles, plus a `[bloom]`'s glare pass of each band: pure GPU execution time. [`FrameTiming::passes`] splits it by pass.
     GpuTimestamps,
     /// Wall-clock time from the first submit of a frame (its shadow maps, then its tiles) until the
     /// GPU reports it finished; includes submission and driver overhead. Frames with an `[area_light]` are always timed this way,
