@@ -1,8 +1,9 @@
 //! The `[bloom]` on the CPU: `hadou_math::bloom`'s glare chain over a band of rows, each level's
 //! rows filled in parallel (every texel from the same texels in the same order, so the picture is
 //! the same for any number of threads), every level from the first downsample on in eight lanes
-//! (`hadou_math::bloom::lanes`, the same planes bit for bit on every vector path), and the colour
-//! mapping after it (eight pixels at a time).
+//! (`hadou_math::bloom::lanes`, the same planes bit for bit on every vector path), the last
+//! upsample and the streak at level 1 (half the resolution), and the bilinear glare, the
+//! composite and the colour mapping in one pass over the band (eight pixels at a time).
 
 use hadou_math::bloom::{self, BloomParams, Plane, RowFill};
 use hadou_math::shade;
@@ -14,10 +15,38 @@ use std::ops::Range;
 /// Fills a plane's rows with rayon.
 struct Parallel;
 
+/// Planes of fewer texels than this are filled on the calling thread: the pyramid's small levels
+/// cost less than handing their rows to other threads.
+const SMALL_PLANE: usize = 1 << 14;
+
 impl RowFill for Parallel {
     fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync)) {
+        if plane.data.len() < SMALL_PLANE {
+            return bloom::Sequential.fill(plane, f);
+        }
         let (w, y0) = (plane.width, plane.rows.start);
         plane.data.par_chunks_mut(w).enumerate().for_each(|(r, row)| f(y0 + r, row));
+    }
+
+    fn fill_blocks(&self, a: &mut Plane, b: Option<&mut Plane>, block: usize, f: &bloom::BlockFn<'_>) {
+        let (y0, wa, block) = (a.rows.start, a.width, block.max(1));
+        let rows = |i: usize, len: usize| y0 + i * block..y0 + i * block + len / wa;
+        match b {
+            Some(b) => {
+                let wb = b.width;
+                a.data
+                    .par_chunks_mut(wa * block)
+                    .zip(b.data.par_chunks_mut(wb * block))
+                    .enumerate()
+                    .for_each(|(i, (ca, cb))| f(rows(i, ca.len()), ca, cb));
+            }
+            None => {
+                a.data
+                    .par_chunks_mut(wa * block)
+                    .enumerate()
+                    .for_each(|(i, ca)| f(rows(i, ca.len()), ca, &mut []));
+            }
+        }
     }
 }
 
@@ -27,28 +56,35 @@ pub(crate) fn source_rows(frame: &Frame, params: &BloomParams, band: Range<usize
     bloom::source_rows(params, frame.width as usize, frame.height as usize, band)
 }
 
-/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added (over those
-/// rows of `linear`) and the frame's colour mapping applied, into `color` (`band.len()` rows);
-/// the glare's levels on the vector path `simd`.
+/// The band `band` of `linear` (which holds [`source_rows`]) with the glare added and the frame's
+/// colour mapping applied, into `color` (`band.len()` rows); the glare's levels on the vector
+/// path `simd`. After the glare's plane at level 1 ([`bloom::lanes::try_glare_plane`]), each row
+/// of the band is read once: its bilinear glare, the composite and the mapping in one pass.
 pub(crate) fn glare_and_map(
     frame: &Frame,
     params: &BloomParams,
-    linear: &mut Plane,
+    linear: &Plane,
     band: Range<usize>,
     color: &mut [[f32; 4]],
     simd: SimdPath,
 ) -> Result<(), hadou_scene::RenderError> {
-    bloom::lanes::glare_in_place(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
-        hadou_scene::RenderError::Memory(format!(
-            "the glare's planes need {:.2} GB that could not be allocated",
-            bytes as f64 / 1e9
-        ))
-    })?;
+    let g =
+        bloom::lanes::try_glare_plane(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
+            hadou_scene::RenderError::Memory(format!(
+                "the glare's planes need {:.2} GB that could not be allocated",
+                bytes as f64 / 1e9
+            ))
+        })?;
     let mode = frame.color_mapping.mode;
     let w = linear.width;
-    let at = (band.start - linear.rows.start) * w..(band.end - linear.rows.start) * w;
-    color.par_chunks_mut(w.max(1)).zip(linear.data[at].par_chunks(w.max(1))).for_each(|(out, c)| {
-        dispatch(simd, MapRow { mode, linear: c, out });
+    color.par_chunks_mut(w.max(1)).enumerate().for_each_init(Vec::new, |row, (r, out)| {
+        let y = band.start + r;
+        row.resize(w, [0.0; 3]);
+        bloom::lanes::upsample_row(simd, &g, y, row);
+        for (o, c) in row.iter_mut().zip(linear.row(y)) {
+            *o = bloom::composite(*c, *o);
+        }
+        dispatch(simd, MapRow { mode, linear: row, out });
     });
     Ok(())
 }

@@ -48,6 +48,8 @@ pub(crate) struct OpaqueBuffers {
     pub visibility: Vec<f32>,
     /// What the edge pass ([`crate::edges`]) reads of each drawn pixel.
     pub edge: Vec<EdgeTexel>,
+    /// A `[bloom]` frame's linear colour, kept from frame to frame (not the opaque pass's).
+    pub glare_linear: Vec<[f32; 3]>,
 }
 
 /// A drawn pixel as the edge pass reads it (the GPU's G-buffer holds the same).
@@ -93,7 +95,7 @@ pub(crate) fn draw_opaque_into(
     let far = frame.camera.far;
     let bands = Bands::new(&tris, frame.height as usize, &rows);
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
-    let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge } = out;
+    let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge, .. } = out;
     // Sized only: every band clears its own rows below, the bands in parallel (a frame of waves
     // alone pays for these writes, some 50 bytes a pixel, on every thread rather than one).
     color.resize(w * h, [0.0f32; 3]);

@@ -520,8 +520,13 @@ fn glare_rows(
     img.color.clear();
     try_grow(&mut img.color, n, "the band's colour")?;
     img.color.resize(n, [0.0; 4]);
-    let mut linear = hadou_math::bloom::Plane::try_new(w, frame.height as usize, src.clone())
-        .map_err(|bytes| out_of_memory(bytes, "the glare's linear colour"))?;
+    // The linear colour in the buffer the last frame left (no fresh pages to fault in).
+    let mut data = std::mem::take(&mut scratch.glare_linear);
+    data.clear();
+    try_grow(&mut data, w * src.len(), "the glare's linear colour")?;
+    data.resize(w * src.len(), [0.0; 3]);
+    let mut linear =
+        hadou_math::bloom::Plane { width: w, height: frame.height as usize, rows: src.clone(), data };
     // With an area light the opaque pass draws every row whatever it is asked: one chunk.
     let chunk =
         if frame.area_light.is_some() { src.len() } else { (chunk_samples / (w * k * k).max(1)).max(1) };
@@ -566,7 +571,8 @@ fn glare_rows(
         wave_ms += ms(opaque_done, waves_done);
         t = waves_done;
     }
-    bloom::glare_and_map(frame, params, &mut linear, band, &mut img.color, simd)?;
+    bloom::glare_and_map(frame, params, &linear, band, &mut img.color, simd)?;
+    scratch.glare_linear = linear.data;
     Ok(PassTimes { opaque_ms, wave_ms, color_ms: ms(t, Instant::now()) })
 }
 

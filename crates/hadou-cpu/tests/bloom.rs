@@ -39,6 +39,16 @@ fn bands_equal_the_whole_frame() {
             );
         }
     }
+    // Odd width and height: the last row's streak pair and the bilinear taps clamp at the edges.
+    let odd = scene_frame("glare-kamehameha.toml", 1.5, 161, 91);
+    let whole = hadou_cpu::render(&odd);
+    for rows in [0..1, 44..47, 80..91, 90..91] {
+        assert_eq!(
+            hadou_cpu::render_rows(&odd, rows.clone()),
+            whole.crop_rows(rows.clone()),
+            "161×91 {rows:?}"
+        );
+    }
 }
 
 #[test]

@@ -20,20 +20,23 @@ pub(crate) fn time_frame(
         return Err(RenderError::Other("time_frame needs at least one iteration".into()));
     }
     // As `hadou render` draws a PNG's pixels: the wave pass writes their 8-bit sRGB codes (a frame
-    // with a `[bloom]` writes the float colour its glare reads; the glare itself is not timed).
+    // with a `[bloom]` writes the float colour its glare reads, and the glare chain runs after the
+    // tiles on each band's linear colour, drawn once here: the pass "bloom").
     let output = if frame.bloom.is_some() { TileOutput::Floats } else { TileOutput::Srgb8 };
+    let glare = r.glare_sources(frame)?;
     let prepared = r.prepare(frame, 0..frame.height, output)?;
     let tiles = prepared.tiles.len() as u32;
     // Warm-up: pipelines, caches and first-use costs stay out of the measurement.
     let last = r.ctx.scoped("warming up", || {
         let maps = r.submit_shadow_maps(frame, &prepared, None);
-        r.submit_tiles(frame, &prepared, None).map(|tiles| tiles.or(maps))
+        r.submit_tiles(frame, &prepared, None)
+            .map(|tiles| r.submit_glare(frame, &glare, None).or(tiles).or(maps))
     })??;
     if let Some(s) = last {
         r.ctx.wait(s)?;
     }
 
-    let queries = 2 * (PASSES_PER_TILE * tiles + prepared.map_pass_count());
+    let queries = 2 * (PASSES_PER_TILE * tiles + prepared.map_pass_count() + glare.len() as u32);
     let soft = frame.area_light.is_some();
     let use_timestamps = !soft
         && r.ctx.features.contains(wgpu::Features::TIMESTAMP_QUERY)
@@ -70,6 +73,7 @@ pub(crate) fn time_frame(
             let (last, used) = r.ctx.scoped("timing a frame", || {
                 r.submit_shadow_maps(frame, &prepared, Some(&mut q));
                 r.submit_tiles(frame, &prepared, Some(&mut q))?;
+                r.submit_glare(frame, &glare, Some(&mut q));
                 let used = q.used();
                 let mut enc = r.ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("timestamp resolve"),
@@ -121,7 +125,10 @@ pub(crate) fn time_frame(
             let prepared = r.prepare(frame, 0..frame.height, output)?;
             r.ctx.wait(r.ctx.queue.submit([]))?;
             let prepared_at = Instant::now();
-            let last = r.ctx.scoped("timing a frame", || r.submit_tiles(frame, &prepared, None))??;
+            let last = r.ctx.scoped("timing a frame", || {
+                r.submit_tiles(frame, &prepared, None)
+                    .map(|tiles| r.submit_glare(frame, &glare, None).or(tiles))
+            })??;
             if let Some(s) = last {
                 r.ctx.wait(s)?;
             }
@@ -140,7 +147,8 @@ pub(crate) fn time_frame(
         let start = Instant::now();
         let last = r.ctx.scoped("timing a frame", || {
             let maps = r.submit_shadow_maps(frame, &prepared, None);
-            r.submit_tiles(frame, &prepared, None).map(|tiles| tiles.or(maps))
+            r.submit_tiles(frame, &prepared, None)
+                .map(|tiles| r.submit_glare(frame, &glare, None).or(tiles).or(maps))
         })??;
         if let Some(s) = last {
             r.ctx.wait(s)?;

@@ -13,7 +13,7 @@ pub enum TimingMethod {
     /// GPU timestamps (`Features::TIMESTAMP_QUERY`) written at the beginning and end of every pass
     /// (`timestamp_writes` of the pass descriptors): the frame is the shadow-map passes' span plus,
     /// per tile, the span from its first pass's beginning to its last pass's end, summed over
-    /// tiles: pure GPU execution time. [`FrameTiming::passes`] splits it by pass.
+    /// tiles, plus a `[bloom]`'s glare pass of each band: pure GPU execution time. [`FrameTiming::passes`] splits it by pass.
     GpuTimestamps,
     /// Wall-clock time from the first submit of a frame (its shadow maps, then its tiles) until the
     /// GPU reports it finished; includes submission and driver overhead. Frames with an `[area_light]` are always timed this way,
@@ -30,7 +30,8 @@ pub struct PassTime {
     /// (opaque geometry and outline hulls into the G-buffer), `"edges"` (outlines closed where
     /// objects meet), `"plane shadows"` (only when the
     /// frame has plane shadows) and `"wave"` (shading, shadow lookups, the energy integrals and
-    /// the colour mapping).
+    /// the colour mapping), then, for a frame with a `[bloom]`, once per glare band `"bloom"` (the
+    /// whole glare chain, its composite and colour mapping).
     pub name: String,
     /// Median over the timed iterations of this pass's time summed over the frame's tiles (or
     /// map layers), in milliseconds.
@@ -66,7 +67,7 @@ pub struct FrameTiming {
 /// windows read back, the two maps, the classes and the resolve), until the GPU has finished them.
 pub const SOFT_PREPARATION: &str = "soft preparation (wall clock)";
 /// The second part: the tiles drawn (raster, edges, plane shadows, the soft gather, the wave
-/// pass), until the GPU has finished them.
+/// pass) and a `[bloom]`'s glare chain, until the GPU has finished them.
 pub const SOFT_TILES: &str = "tiles (wall clock)";
 
 /// The median of `samples` (0 when empty).

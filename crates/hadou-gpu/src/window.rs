@@ -101,7 +101,7 @@ impl Renderer {
             .ctx
             .scoped("creating the window texture", || present.ensure_target(&self.ctx.device, size))?;
         for band in self.glare_bands(frame, &params, 0..frame.height)? {
-            let (out, encoder) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
+            let (out, encoder, _) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
             // The present pass reads the tile's place from the uniforms: the band, in image pixels.
             let mut u: FrameUniforms = bytemuck::Zeroable::zeroed();
             u.grid = hadou_scene::SampleGrid::SINGLE.edge();

@@ -26,8 +26,8 @@ fn names(t: &hadou_gpu::FrameTiming) -> Vec<&str> {
     t.passes.iter().map(|p| p.name.as_str()).collect()
 }
 
-/// With timestamps every pass of the frame is timed (shadow maps, raster, plane shadows, wave)
-/// and, in one iteration, the passes sum to no more than the frame; without them (some GL drivers) there is no
+/// With timestamps every pass of the frame is timed (shadow maps, raster, plane shadows, wave,
+/// a `[bloom]`'s glare chain) and, in one iteration, the passes sum to no more than the frame; without them (some GL drivers) there is no
 /// split. A frame with nothing to draw skips the raster pass.
 #[test]
 fn time_frame_splits_the_frame_into_its_passes() {
@@ -35,10 +35,15 @@ fn time_frame_splits_the_frame_into_its_passes() {
     let (_, shadows) = example_frames(|name| name == "shadow-uneven.toml").remove(0);
     let mut waves_only = kamehameha_frame(64, 48);
     waves_only.objects.clear();
+    let (_, mut glare) = example_frames(|name| name == "glare-kamehameha.toml").remove(0);
+    assert!(glare.bloom.is_some());
+    (glare.width, glare.height) = (160, 120);
     let cases = [
         (kamehameha_frame(200, 150), vec!["raster", "wave"]),
         (shadows, vec!["shadow maps", "raster", "edges", "plane shadows", "wave"]),
         (waves_only, vec!["wave"]),
+        // The glare chain after the tiles, inside the frame's time.
+        (glare, vec!["raster", "wave", "bloom"]),
     ];
     for (frame, expected) in cases {
         let t = gpu.time_frame(&frame, 1).expect("timing");
@@ -53,6 +58,9 @@ fn time_frame_splits_the_frame_into_its_passes() {
         let sum: f64 = t.passes.iter().map(|p| p.median_ms).sum();
         assert!(sum <= t.median_ms * (1.0 + 1e-9), "passes {sum} ms > frame {} ms: {t:?}", t.median_ms);
         assert!(t.passes.iter().any(|p| p.name == "wave" && p.median_ms > 0.0), "{t:?}");
+        if frame.bloom.is_some() {
+            assert!(t.passes.iter().any(|p| p.name == "bloom" && p.median_ms > 0.0), "{t:?}");
+        }
         // Several iterations: each pass's median is within the frame's.
         let t = gpu.time_frame(&frame, 3).expect("timing");
         let max = t.per_iteration_ms.iter().cloned().fold(0.0, f64::max);

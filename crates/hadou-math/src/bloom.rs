@@ -20,14 +20,24 @@
 //! 3. **Upsample** ([`up_row`]): the 3×3 tent of bilinear taps one low texel apart, written out
 //!    exactly: per axis, an even high texel `2j` reads low texels `j−2 … j+1` weighted
 //!    `(1, 5, 7, 3)/16` and an odd one `2j+1` reads `j−1 … j+2` weighted `(3, 7, 5, 1)/16`; the 2-D
-//!    weights are the products. `U_N = D_N`, `U_k = D_k + up(U_{k+1})`, and the bloom at full
-//!    resolution is `B = up(U₁)/N`, so a uniform bright area blooms to its own `T`.
-//! 4. **Streak** ([`down_row_h`], [`up_row_h`]): the same chain along `x` only (every level keeps
-//!    the image's rows): the 1-D 13-tap `(1, 3, 4, 4, 3, 1)/16` over texels `2i−2 … 2i+3` and the
-//!    1-D tent, `S = up_h(U₁ʰ)/N_s`.
-//! 5. **Composite** ([`composite`]): `c' = c + (intensity/N)·up(U₁) + (streak/N_s)·up_h(U₁ʰ)`
-//!    (`= c + intensity·B + streak·S`), each channel saturated at `f32::MAX` (never infinite), then
-//!    the frame's colour mapping. [`glare`] runs the whole chain over a band of rows.
+//!    weights are the products. `U_N = D_N`, `U_k = D_k + up(U_{k+1})` down to `U₁`.
+//! 4. **Streak** ([`pair_row`], [`streak_row`]): at level 1's height, row `j` the average of the
+//!    prefiltered rows `2j` and `2j+1`, then the same chain along `x` only: the 1-D 13-tap
+//!    `(1, 3, 4, 4, 3, 1)/16` over texels `2i−2 … 2i+3` ([`down_row_h`]) and the 1-D tent
+//!    ([`up_row_h`]) down to `U₁ʰ`, half the image's width.
+//! 5. **Glare at level 1** ([`glare_row`]): the tent from `U₁` to full resolution is the
+//!    `[1, 2, 1]/4` blur per axis at level 1 followed by a bilinear tap (`(1, 3)/4 ∗ (1, 2, 1)/4 =
+//!    (1, 5, 7, 3)/16`), so the last upsample is done at level 1: `G = (intensity/N)·blur(U₁) +
+//!    (streak/N_s)·blur_h(U₁ʰ)` (the streak blurred along `x` only), one plane of
+//!    `⌈w/2⌉ × ⌈h/2⌉` texels.
+//! 6. **Composite** ([`upsample_row`], [`composite`]): `c' = c + bilinear(G)` (per axis `2j` reads
+//!    `j−1, j` by `¼, ¾` and `2j+1` reads `j, j+1` by `¾, ¼`, clamped; [`bilinear`]), each
+//!    channel saturated at `f32::MAX` (never infinite), then the frame's colour mapping: the one
+//!    pass at full resolution after the prefilter and the first downsample. [`glare`] runs the
+//!    whole chain over a band of rows.
+//!
+//! The bloom is the tent of `U₁` as before but for rounding and the clamped edge texels; the
+//! streak, made from row pairs and tapped bilinearly, reaches a row either side of its source.
 //!
 //! `N = clamp(⌈log₂(radius·height)⌉, 1, MAX_LEVELS)` ([`levels`]), `N_s` likewise from
 //! `streak_length·height`. [`Plan`] gives, for a band of output rows, the rows of every level the
@@ -96,10 +106,10 @@ pub fn prefilter(c: [f32; 3], threshold: f32, soft_knee: f32) -> [f32; 3] {
     c.map(|v| (v * w).min(BLOOM_CLAMP))
 }
 
-/// Step 5: `c + intensity·B + streak·S`, saturated at `f32::MAX`.
+/// Step 6: `c + g` per channel (`g` the full-resolution glare), saturated at `f32::MAX`.
 #[inline]
-pub fn composite(c: [f32; 3], bloom: [f32; 3], intensity: f32, streak: [f32; 3], streak_k: f32) -> [f32; 3] {
-    std::array::from_fn(|i| (c[i] + intensity * bloom[i] + streak_k * streak[i]).min(f32::MAX))
+pub fn composite(c: [f32; 3], g: [f32; 3]) -> [f32; 3] {
+    std::array::from_fn(|i| (c[i] + g[i]).min(f32::MAX))
 }
 
 /// Rows `rows` of one pyramid level `width × height` (row-major, `rows.len()·width` texels).
@@ -325,7 +335,7 @@ impl Plan {
 }
 
 /// The rows of the linear image a band `band` of a `height`-row image needs for `params`: the
-/// band with the bloom's halo (the streak needs no rows beyond the band).
+/// band with the bloom's halo (the streak's rows lie within it).
 pub fn source_rows(params: &BloomParams, width: usize, height: usize, band: Range<usize>) -> Range<usize> {
     let n = levels(params.radius * height as f32);
     Plan::new(width, height, n, band).source
@@ -336,7 +346,24 @@ pub fn source_rows(params: &BloomParams, width: usize, height: usize, band: Rang
 pub trait RowFill {
     /// Calls `f(y, row)` for every row of `plane`.
     fn fill(&self, plane: &mut Plane, f: &(dyn Fn(usize, &mut [[f32; 3]]) + Sync));
+
+    /// Calls `f(rows, a_rows, b_rows)` for the blocks of `block` rows of `a` (the last one
+    /// shorter) and the same rows of `b` (which holds `a`'s rows; `None`: no second plane, an
+    /// empty slice). One block after the other here; a renderer may run them in parallel.
+    fn fill_blocks(&self, a: &mut Plane, b: Option<&mut Plane>, block: usize, f: &BlockFn<'_>) {
+        let (y0, block) = (a.rows.start, block.max(1));
+        let (wa, wb) = (a.width, b.as_ref().map_or(0, |b| b.width));
+        let mut b = b.map(|b| b.data.chunks_mut(wb * block));
+        for (i, ca) in a.data.chunks_mut(wa * block).enumerate() {
+            let cb = b.as_mut().and_then(|b| b.next()).unwrap_or_default();
+            let start = y0 + i * block;
+            f(start..start + ca.len() / wa, ca, cb);
+        }
+    }
 }
+
+/// What [`RowFill::fill_blocks`] calls per block.
+pub type BlockFn<'a> = dyn Fn(Range<usize>, &mut [[f32; 3]], &mut [[f32; 3]]) + Sync + 'a;
 
 /// Rows one after the other.
 #[derive(Clone, Copy, Debug, Default)]
@@ -351,7 +378,16 @@ impl RowFill for Sequential {
     }
 }
 
-/// The streak sum `up_h(U₁ʰ)` of one row `t` (prefiltered) with `n` levels, into `out`.
+/// The streak's first row at level-1 height: row `j` of the half-height image, the average
+/// `(0 + ½·a) + ½·b` of the prefiltered rows `a = T(2j)` and `b = T(min(2j + 1, h − 1))`.
+pub fn pair_row(a: &[[f32; 3]], b: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
+        *o = std::array::from_fn(|k| (0.0 + 0.5 * a[k]) + 0.5 * b[k]);
+    }
+}
+
+/// The streak's `U₁ʰ` of one half-height row `t` ([`pair_row`]) with `n` levels, into `out`
+/// (`half(t.len())` texels): `D₁ʰ = down_h(t)`, …, `U_Nʰ = D_Nʰ`, `U_kʰ = D_kʰ + up_h(U_{k+1}ʰ)`.
 pub fn streak_row(t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
     let n = n.clamp(1, MAX_LEVELS) as usize;
     let mut down: Vec<Vec<[f32; 3]>> = Vec::with_capacity(n);
@@ -368,10 +404,95 @@ pub fn streak_row(t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
         up_row_h(&u, Some(&d), &mut next);
         u = next;
     }
-    up_row_h(&u, None, out);
+    out.copy_from_slice(&u);
 }
 
-/// The glare of steps 1–5 over the rows `band` of a `src.width × src.height` linear image: `src`
+/// The horizontal half of the level-1 blur: `((0 + ¼·r[x−1]) + ½·r[x]) + ¼·r[x+1]` (clamped).
+pub fn blur_row_h(row: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    let last = row.len() as isize - 1;
+    for (x, o) in out.iter_mut().enumerate() {
+        let mut acc = [0.0f32; 3];
+        for (d, &w) in BLUR.iter().enumerate() {
+            madd(&mut acc, w, row[(x as isize - 1 + d as isize).clamp(0, last) as usize]);
+        }
+        *o = acc;
+    }
+}
+
+/// The `[1, 2, 1]/4` blur, once per axis, that with the bilinear tap makes the tent.
+pub const BLUR: [f32; 3] = [0.25, 0.5, 0.25];
+
+/// Row `y` of the glare `G` at level 1 (step 5): from the horizontal blurs `hb` of `U₁`
+/// ([`blur_row_h`]) and `hs` of the streak's `U₁ʰ` (`None`: no streak),
+/// `(((0 + kb·¼·hb[y−1]) + kb·½·hb[y]) + kb·¼·hb[y+1]) + ks·hs[y]` (rows clamped, each weight
+/// product rounded once).
+pub fn glare_row(hb: &Plane, hs: Option<&Plane>, y: usize, kb: f32, ks: f32, out: &mut [[f32; 3]]) {
+    let w = glare_weights(kb, ks);
+    for (x, o) in out.iter_mut().enumerate() {
+        let mut acc = [0.0f32; 3];
+        for (d, &wd) in w[..3].iter().enumerate() {
+            madd(&mut acc, wd, hb.at(x as isize, y as isize - 1 + d as isize));
+        }
+        if let Some(hs) = hs {
+            madd(&mut acc, w[3], hs.at(x as isize, y as isize));
+        }
+        *o = acc;
+    }
+}
+
+/// The weights of [`glare_row`]: `kb·¼, kb·½, kb·¼, ks`.
+pub fn glare_weights(kb: f32, ks: f32) -> [f32; 4] {
+    [kb * BLUR[0], kb * BLUR[1], kb * BLUR[2], ks]
+}
+
+/// The bilinear tap of a full-resolution texel `i` from level 1 (either axis): the first level-1
+/// texel read and the two weights (`2j`: `j−1, j` by `¼, ¾`; `2j+1`: `j, j+1` by `¾, ¼`).
+#[inline]
+pub fn bilinear(i: usize) -> (isize, [f32; 2]) {
+    let j = (i / 2) as isize;
+    if i.is_multiple_of(2) {
+        (j - 1, [0.25, 0.75])
+    } else {
+        (j, [0.75, 0.25])
+    }
+}
+
+/// Rows of level 1 (`height` rows) that the bilinear taps of the full-resolution rows `r` read.
+pub fn bilinear_rows(r: &Range<usize>, height: usize) -> Range<usize> {
+    let a = (r.start / 2).saturating_sub(1);
+    let b = ((r.end - 1) / 2 + 1).min(height - 1);
+    a..b + 1
+}
+
+/// Row `y` of the full-resolution glare from `g` ([`glare_row`]'s plane, which holds the rows
+/// [`bilinear_rows`] names): the vertical pair `(0 + wa·g[ya]) + wb·g[yb]` first, then along the
+/// row the horizontal pair the same way; `out.len()` texels.
+pub fn upsample_row(g: &Plane, y: usize, out: &mut [[f32; 3]]) {
+    let (y0, wy) = bilinear(y);
+    let (r0, r1) = (g.row(clamp_row(y0, g.height)), g.row(clamp_row(y0 + 1, g.height)));
+    let last = g.width as isize - 1;
+    let v = |x: isize| {
+        let x = x.clamp(0, last) as usize;
+        let mut acc = [0.0f32; 3];
+        madd(&mut acc, wy[0], r0[x]);
+        madd(&mut acc, wy[1], r1[x]);
+        acc
+    };
+    for (x, o) in out.iter_mut().enumerate() {
+        let (x0, wx) = bilinear(x);
+        let mut acc = [0.0f32; 3];
+        madd(&mut acc, wx[0], v(x0));
+        madd(&mut acc, wx[1], v(x0 + 1));
+        *o = acc;
+    }
+}
+
+#[inline]
+fn clamp_row(y: isize, height: usize) -> usize {
+    y.clamp(0, height as isize - 1) as usize
+}
+
+/// The glare of steps 1–6 over the rows `band` of a `src.width × src.height` linear image: `src`
 /// holds at least the rows `source_rows` names; returns the band's composited colour.
 pub fn glare(params: &BloomParams, src: &Plane, band: Range<usize>, fill: &dyn RowFill) -> Plane {
     try_glare(params, src, band, fill).unwrap_or_else(|bytes| panic!("the glare's planes need {bytes} bytes"))
@@ -412,20 +533,40 @@ pub fn try_glare(
         fill.fill(&mut next, &|y, row| up_row(&u, y, Some(d.row(y)), row));
         u = next;
     }
-    let kb = params.intensity / n as f32;
-    let ns = levels(params.streak_length * h as f32);
-    let ks = params.streak / ns as f32;
+    let (kb, ks) = weights(params, h);
+    let l1 = &plan.levels[0];
+    let mut hb = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+    fill.fill(&mut hb, &|y, row| blur_row_h(u.row(y), row));
+    drop(u);
+    let hs = if ks > 0.0 {
+        let ns = levels(params.streak_length * h as f32);
+        let mut hs = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+        fill.fill(&mut hs, &|y, row| {
+            let mut pair = vec![[0.0f32; 3]; w];
+            pair_row(t.row(2 * y), t.row((2 * y + 1).min(h - 1)), &mut pair);
+            let mut s = vec![[0.0f32; 3]; l1.width];
+            streak_row(&pair, ns, &mut s);
+            blur_row_h(&s, row);
+        });
+        Some(hs)
+    } else {
+        None
+    };
+    let mut g = Plane::try_new(l1.width, l1.height, bilinear_rows(&band, l1.height))?;
+    fill.fill(&mut g, &|y, row| glare_row(&hb, hs.as_ref(), y, kb, ks, row));
     let mut out = Plane::try_new(w, h, band)?;
     fill.fill(&mut out, &|y, row| {
-        let mut b = vec![[0.0f32; 3]; w];
-        up_row(&u, y, None, &mut b);
-        let mut s = vec![[0.0f32; 3]; w];
-        if ks > 0.0 {
-            streak_row(t.row(y), ns, &mut s);
-        }
-        for (x, o) in row.iter_mut().enumerate() {
-            *o = composite(src.row(y)[x], b[x], kb, s[x], ks);
+        upsample_row(&g, y, row);
+        for (o, c) in row.iter_mut().zip(src.row(y)) {
+            *o = composite(*c, *o);
         }
     });
     Ok(out)
+}
+
+/// The glare's two weights for a `height`-row image: `(intensity/N, streak/N_s)`.
+pub fn weights(params: &BloomParams, height: usize) -> (f32, f32) {
+    let n = levels(params.radius * height as f32);
+    let ns = levels(params.streak_length * height as f32);
+    (params.intensity / n as f32, params.streak / ns as f32)
 }

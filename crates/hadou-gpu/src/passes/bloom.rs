@@ -1,15 +1,17 @@
 //! The glare pass (`shaders/bloom.wgsl`): `hadou_math::bloom`'s chain over a band of rows, on
 //! whole-image planes of `vec4<f32>` texels in storage buffers (so it needs no float storage
 //! textures, which OpenGL ES may not offer): the soft threshold over the band and its halo, the
-//! 13-tap downsamples and tent upsamples of [`Plan`]'s rows, the horizontal streak over the band's
-//! rows, and the composite with the frame's colour mapping into the band's colour. One dispatch
-//! per step, each with its own small uniform buffer and bind group.
+//! 13-tap downsamples and tent upsamples of [`Plan`]'s rows down to level 1, the horizontal streak
+//! over level 1's rows (from the prefiltered row pairs), the glare `G` at level 1, and the
+//! bilinear tap of `G`, the composite and the frame's colour mapping into the band's colour. One
+//! dispatch per step, each with its own small uniform buffer and bind group, all in one compute
+//! pass (timed as `"bloom"`).
 
 use super::setup::{self, Binding, Kind};
 use crate::device::GpuContext;
 use crate::layout::{BloomUniforms, TONE_FAITHFUL, TONE_FILMIC};
 use crate::shaders;
-use hadou_math::bloom::{half, levels, BloomParams, Plan};
+use hadou_math::bloom::{bilinear_rows, half, levels, weights, BloomParams, Plan};
 use hadou_scene::{RenderError, ToneMode};
 use std::ops::Range;
 use wgpu::util::DeviceExt;
@@ -36,6 +38,8 @@ pub(crate) struct BloomPass {
     up: wgpu::ComputePipeline,
     down_h: wgpu::ComputePipeline,
     up_h: wgpu::ComputePipeline,
+    pair: wgpu::ComputePipeline,
+    glare: wgpu::ComputePipeline,
     composite: wgpu::ComputePipeline,
 }
 
@@ -73,6 +77,8 @@ impl BloomPass {
                 up: pipeline("cs_up"),
                 down_h: pipeline("cs_down_h"),
                 up_h: pipeline("cs_up_h"),
+                pair: pipeline("cs_pair"),
+                glare: pipeline("cs_glare"),
                 composite: pipeline("cs_composite"),
                 layout,
             }
@@ -86,13 +92,15 @@ impl BloomPass {
         src.len() as u64 * width as u64 * TEXEL_BYTES
     }
 
-    /// Records the glare of `inputs` into `encoder` and returns the buffer it leaves the band's
-    /// mapped colour in (`vec4<f32>` per pixel, alpha 1, row-major, `band.len()` rows).
-    pub(crate) fn encode(
-        &self,
+    /// Records the glare of `inputs` into `encoder`, every step a dispatch of one compute pass
+    /// (named `"bloom"` where `timestamps` asks for its time), and returns the buffer it leaves the
+    /// band's mapped colour in (`vec4<f32>` per pixel, alpha 1, row-major, `band.len()` rows).
+    pub(crate) fn encode<'p>(
+        &'p self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         inputs: &BloomInputs<'_>,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) -> wgpu::Buffer {
         let p = inputs.params;
         let (w, h) = (inputs.width as usize, inputs.height as usize);
@@ -103,7 +111,8 @@ impl BloomPass {
             ToneMode::Faithful => TONE_FAITHFUL,
             ToneMode::Filmic => TONE_FILMIC,
         };
-        let params = [p.threshold, p.soft_knee, p.intensity / n as f32, p.streak / ns as f32];
+        let (kb, ks) = weights(p, h);
+        let params = [p.threshold, p.soft_knee, kb, ks];
         let plane = |label: &str, width: usize, height: usize, rows: &Range<usize>| {
             let size = (width * rows.len()) as u64 * TEXEL_BYTES;
             GpuPlane {
@@ -116,21 +125,18 @@ impl BloomPass {
                 desc: [width as u32, height as u32, rows.start as u32, rows.len() as u32],
             }
         };
-        let desc = |width: usize, rows: &Range<usize>| {
-            [width as u32, h as u32, rows.start as u32, rows.len() as u32]
-        };
-        let linear_desc = desc(w, &inputs.source);
-        // One dispatch over `o`'s texels, reading a (and b, c).
-        let step = |encoder: &mut wgpu::CommandEncoder,
-                    pipeline: &wgpu::ComputePipeline,
-                    a: (&wgpu::Buffer, [u32; 4]),
-                    b: Option<(&wgpu::Buffer, [u32; 4])>,
-                    c: Option<(&wgpu::Buffer, [u32; 4])>,
-                    o: &GpuPlane| {
+        let linear_desc = [w as u32, h as u32, inputs.source.start as u32, inputs.source.len() as u32];
+        // The dispatches, recorded into one compute pass at the end.
+        let mut steps: Vec<(&'p wgpu::ComputePipeline, wgpu::BindGroup, [u32; 2])> = Vec::new();
+        // One dispatch over `o`'s texels, reading a (and b).
+        let mut step = |pipeline: &'p wgpu::ComputePipeline,
+                        a: (&wgpu::Buffer, [u32; 4]),
+                        b: Option<(&wgpu::Buffer, [u32; 4])>,
+                        o: &GpuPlane| {
             let uniforms = BloomUniforms {
                 a: a.1,
                 b: b.map_or([1, 1, 0, 1], |b| b.1),
-                c: c.map_or([1, 1, 0, 1], |c| c.1),
+                c: [1, 1, 0, 1],
                 o: o.desc,
                 params,
                 flags: [u32::from(b.is_some()), tone, 0, 0],
@@ -141,7 +147,6 @@ impl BloomPass {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
             let b_buf = b.map_or(a.0, |b| b.0);
-            let c_buf = c.map_or(a.0, |c| c.0);
             let group = setup::bind_group(
                 device,
                 "bloom step",
@@ -151,76 +156,72 @@ impl BloomPass {
                     ubuf.as_entire_binding(),
                     a.0.as_entire_binding(),
                     b_buf.as_entire_binding(),
-                    c_buf.as_entire_binding(),
+                    a.0.as_entire_binding(),
                     o.buffer.as_entire_binding(),
                 ],
             );
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("bloom"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(o.desc[0].div_ceil(8), o.desc[3].div_ceil(8), 1);
+            steps.push((pipeline, group, [o.desc[0].div_ceil(8), o.desc[3].div_ceil(8)]));
         };
         // 1. T over the source rows.
         let t = plane("bloom T", w, h, &plan.source);
-        step(encoder, &self.prefilter, (inputs.linear, linear_desc), None, None, &t);
+        step(&self.prefilter, (inputs.linear, linear_desc), None, &t);
         // 2. D_1 … D_N.
         let mut downs: Vec<GpuPlane> = Vec::with_capacity(plan.levels.len());
         for l in &plan.levels {
             let d = plane("bloom D", l.width, l.height, &l.down);
             let prev = downs.last().unwrap_or(&t);
-            step(encoder, &self.down, (&prev.buffer, prev.desc), None, None, &d);
+            step(&self.down, (&prev.buffer, prev.desc), None, &d);
             downs.push(d);
         }
-        // 3. U_N = D_N, U_k = D_k + up(U_{k+1}), then up(U₁) over the band.
+        // 3. U_N = D_N, U_k = D_k + up(U_{k+1}) down to U₁.
         let mut u = downs.pop().expect("at least one level");
         while let Some(d) = downs.pop() {
             let l = &plan.levels[downs.len()];
             let next = plane("bloom U", l.width, l.height, &l.up);
-            step(encoder, &self.up, (&u.buffer, u.desc), Some((&d.buffer, d.desc)), None, &next);
+            step(&self.up, (&u.buffer, u.desc), Some((&d.buffer, d.desc)), &next);
             u = next;
         }
-        let bloom = plane("bloom B", w, h, &inputs.band);
-        step(encoder, &self.up, (&u.buffer, u.desc), None, None, &bloom);
-        // 4. The streak along x over the band's rows.
-        let streak = (p.streak > 0.0).then(|| {
+        // 4. The streak along x over level 1's rows, from the prefiltered row pairs.
+        let l1 = &plan.levels[0];
+        let (hl, rows1) = (l1.height, &l1.up);
+        let streak = (ks > 0.0).then(|| {
+            let pair = plane("streak pair", w, hl, rows1);
+            step(&self.pair, (&t.buffer, t.desc), None, &pair);
             let mut widths = vec![w];
             for k in 0..ns as usize {
                 widths.push(half(widths[k]));
             }
             let mut downs: Vec<GpuPlane> = Vec::new();
             for &lw in &widths[1..] {
-                let d = plane("streak D", lw, h, &inputs.band);
-                let (src, sdesc) = match downs.last() {
-                    Some(prev) => (&prev.buffer, prev.desc),
-                    None => (&t.buffer, t.desc),
-                };
-                step(encoder, &self.down_h, (src, sdesc), None, None, &d);
+                let d = plane("streak D", lw, hl, rows1);
+                let prev = downs.last().unwrap_or(&pair);
+                step(&self.down_h, (&prev.buffer, prev.desc), None, &d);
                 downs.push(d);
             }
             let mut u = downs.pop().expect("at least one level");
             while let Some(d) = downs.pop() {
-                let next = plane("streak U", d.desc[0] as usize, h, &inputs.band);
-                step(encoder, &self.up_h, (&u.buffer, u.desc), Some((&d.buffer, d.desc)), None, &next);
+                let next = plane("streak U", d.desc[0] as usize, hl, rows1);
+                step(&self.up_h, (&u.buffer, u.desc), Some((&d.buffer, d.desc)), &next);
                 u = next;
             }
-            let s = plane("streak S", w, h, &inputs.band);
-            step(encoder, &self.up_h, (&u.buffer, u.desc), None, None, &s);
-            s
+            u
         });
-        // 5. The composite and the colour mapping.
+        // 5. G at level 1.
+        let g = plane("bloom G", l1.width, hl, &bilinear_rows(&inputs.band, hl));
+        step(&self.glare, (&u.buffer, u.desc), streak.as_ref().map(|s| (&s.buffer, s.desc)), &g);
+        // 6. The bilinear tap of G, the composite and the colour mapping.
         let out = plane("bloom out", w, h, &inputs.band);
-        let c = streak.as_ref().map(|s| (&s.buffer, s.desc));
-        step(
-            encoder,
-            &self.composite,
-            (inputs.linear, linear_desc),
-            Some((&bloom.buffer, bloom.desc)),
-            c,
-            &out,
-        );
+        step(&self.composite, (inputs.linear, linear_desc), Some((&g.buffer, g.desc)), &out);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("bloom"),
+            timestamp_writes: timestamps,
+        });
+        for (pipeline, group, [x, y]) in &steps {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups(*x, *y, 1);
+        }
+        drop(pass);
         out.buffer
     }
 }

@@ -91,7 +91,7 @@ impl Renderer {
         let mut image = alloc_image(frame.width, src.len() as u32)?;
         // Each tile read back after its submission (its energy and depth; the colour comes from
         // the glare).
-        let (out, mut encoder) =
+        let (out, mut encoder, _) =
             self.glare_chain(frame, params, band.clone(), |r, submission, origin, size| {
                 let origin = [origin[0], origin[1] - src.start as u32];
                 let bytes = u64::from(size[0]) * u64::from(size[1]) * FLOATS_PER_PIXEL * 4;
@@ -122,18 +122,73 @@ impl Renderer {
         Ok(image.crop_rows((band.start - src.start) as u32..(band.end - src.start) as u32))
     }
 
+    /// The linear colour of every band of a frame with a `[bloom]` ([`Renderer::glare_bands`]),
+    /// drawn once as `render_rows` draws it (tiles and glare chain, waited for), for
+    /// [`crate::GpuBackend::time_frame`] to run the glare chain on again in each timed frame.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub(crate) fn glare_sources(&mut self, frame: &Frame) -> Result<Vec<GlareSource>, RenderError> {
+        let Some(params) = frame.bloom else { return Ok(Vec::new()) };
+        let (w, h) = (frame.width as usize, frame.height as usize);
+        let mut sources = Vec::new();
+        for band in self.glare_bands(frame, &params, 0..frame.height)? {
+            let (_, encoder, linear) = self.glare_chain(frame, &params, band.clone(), |_, _, _, _| Ok(()))?;
+            let submission =
+                self.ctx.scoped("drawing the bloom", || self.ctx.queue.submit([encoder.finish()]))?;
+            self.ctx.wait(submission)?;
+            let source = hadou_math::bloom::source_rows(&params, w, h, band.clone());
+            sources.push(GlareSource { linear, source, band });
+        }
+        Ok(sources)
+    }
+
+    /// The glare chain of every band of `sources` (from [`Renderer::glare_sources`]) submitted,
+    /// each band's compute pass its own group of `timestamps` named `"bloom"`. Returns the last
+    /// submission (`None` when there is none).
+    #[cfg(not(target_arch = "wasm32"))]
+    pub(crate) fn submit_glare(
+        &self,
+        frame: &Frame,
+        sources: &[GlareSource],
+        mut timestamps: Option<&mut crate::timing::PassQueries<'_>>,
+    ) -> Option<wgpu::SubmissionIndex> {
+        let params = frame.bloom.as_ref()?;
+        let mut last = None;
+        for s in sources {
+            let d = &self.ctx.device;
+            let mut encoder =
+                d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bloom") });
+            let inputs = BloomInputs {
+                params,
+                tone: frame.color_mapping.mode,
+                width: frame.width,
+                height: frame.height,
+                linear: &s.linear,
+                source: s.source.clone(),
+                band: s.band.clone(),
+            };
+            let writes = timestamps.as_deref_mut().and_then(|q| {
+                q.next_group();
+                q.compute("bloom")
+            });
+            self.passes.bloom.encode(d, &mut encoder, &inputs, writes);
+            last = Some(self.ctx.queue.submit([encoder.finish()]));
+        }
+        last
+    }
+
     /// The glare of the rows `band`: the tiles of its source rows (the band and its halo) drawn
     /// with the linear colour, each tile's colour gathered into one buffer (`after_tile` runs after
     /// each tile's submission, with its origin and size in image pixels), then the glare chain
     /// recorded into a new encoder, not yet submitted. Returns the band's mapped colour (4
-    /// floats a pixel, row-major over the band) and that encoder.
+    /// floats a pixel, row-major over the band), that encoder and the band's linear colour (its
+    /// source rows, which [`crate::GpuBackend::time_frame`] runs the chain on again).
     pub(crate) fn glare_chain(
         &mut self,
         frame: &Frame,
         params: &BloomParams,
         band: std::ops::Range<usize>,
         mut after_tile: impl FnMut(&Self, wgpu::SubmissionIndex, [u32; 2], [u32; 2]) -> Result<(), RenderError>,
-    ) -> Result<(wgpu::Buffer, wgpu::CommandEncoder), RenderError> {
+    ) -> Result<(wgpu::Buffer, wgpu::CommandEncoder, wgpu::Buffer), RenderError> {
         let (w, h) = (frame.width as usize, frame.height as usize);
         let src = hadou_math::bloom::source_rows(params, w, h, band.clone());
         let mut prepared =
@@ -173,8 +228,18 @@ impl Renderer {
             source: src.clone(),
             band: band.clone(),
         };
-        let out =
-            self.ctx.scoped("recording the bloom", || self.passes.bloom.encode(d, &mut encoder, &inputs))?;
-        Ok((out, encoder))
+        let out = self
+            .ctx
+            .scoped("recording the bloom", || self.passes.bloom.encode(d, &mut encoder, &inputs, None))?;
+        Ok((out, encoder, linear))
     }
+}
+
+/// One band's linear colour for timing the glare ([`Renderer::glare_sources`]).
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) struct GlareSource {
+    /// The linear colour of the rows `source`.
+    linear: wgpu::Buffer,
+    source: std::ops::Range<usize>,
+    band: std::ops::Range<usize>,
 }

@@ -8,9 +8,9 @@
 struct BloomUniforms {
     // First input.
     a: vec4<u32>,
-    // Second input (cs_up's base, cs_composite's bloom).
+    // Second input (cs_up's base, cs_glare's streak, cs_composite's glare).
     b: vec4<u32>,
-    // Third input (cs_composite's streak).
+    // Third input (unused).
     c: vec4<u32>,
     // Output.
     o: vec4<u32>,
@@ -186,19 +186,80 @@ fn cs_up_h(@builtin(global_invocation_id) id: vec3<u32>) {
     o_buf[out_index(id)] = vec4<f32>(acc, 0.0);
 }
 
-// hadou_math::bloom::composite, then the frame's colour mapping (a: the linear colour, b: the
-// bloom sum up(U₁), c: the streak sum, read only when its weight is positive).
+// hadou_math::bloom::pair_row: the streak's half-height row j, the average of the prefiltered
+// rows 2j and 2j + 1 (a: T, clamped to its height).
+@compute @workgroup_size(8, 8, 1)
+fn cs_pair(@builtin(global_invocation_id) id: vec3<u32>) {
+    let t = out_texel(id);
+    if (t.x < 0) {
+        return;
+    }
+    let acc = (0.0 + 0.5 * at_a(t.x, 2 * t.y)) + 0.5 * at_a(t.x, 2 * t.y + 1);
+    o_buf[out_index(id)] = vec4<f32>(acc, 0.0);
+}
+
+// hadou_math::bloom::glare_row (with blur_row_h): G at level 1, the [1, 2, 1]/4 blur per axis of
+// a (U₁) weighted by params.z, plus the streak's b (U₁ʰ) blurred along x, weighted by params.w
+// (read only when that weight is positive).
+@compute @workgroup_size(8, 8, 1)
+fn cs_glare(@builtin(global_invocation_id) id: vec3<u32>) {
+    let t = out_texel(id);
+    if (t.x < 0) {
+        return;
+    }
+    let w = vec3<f32>(0.25, 0.5, 0.25);
+    var acc = vec3<f32>(0.0);
+    for (var dy = 0; dy < 3; dy++) {
+        var row = vec3<f32>(0.0);
+        for (var dx = 0; dx < 3; dx++) {
+            row += w[dx] * at_a(t.x - 1 + dx, t.y - 1 + dy);
+        }
+        acc += (u.params.z * w[dy]) * row;
+    }
+    if (u.params.w > 0.0) {
+        var row = vec3<f32>(0.0);
+        for (var dx = 0; dx < 3; dx++) {
+            row += w[dx] * b_buf[plane_index(u.b, t.x - 1 + dx, t.y)].xyz;
+        }
+        acc += u.params.w * row;
+    }
+    o_buf[out_index(id)] = vec4<f32>(acc, 0.0);
+}
+
+// hadou_math::bloom::bilinear: the first level-1 texel the bilinear tap of texel i reads.
+fn bilinear_first(i: i32) -> i32 {
+    let j = i / 2;
+    if ((i & 1) == 0) {
+        return j - 1;
+    }
+    return j;
+}
+
+// Its weight of that first texel (the second's is 1 minus it).
+fn bilinear_weight(i: i32) -> f32 {
+    if ((i & 1) == 0) {
+        return 0.25;
+    }
+    return 0.75;
+}
+
+// hadou_math::bloom::upsample_row and composite, then the frame's colour mapping (a: the linear
+// colour, b: the glare G at level 1).
 @compute @workgroup_size(8, 8, 1)
 fn cs_composite(@builtin(global_invocation_id) id: vec3<u32>) {
     let t = out_texel(id);
     if (t.x < 0) {
         return;
     }
-    var rgb = at_a(t.x, t.y) + u.params.z * b_buf[plane_index(u.b, t.x, t.y)].xyz;
-    if (u.params.w > 0.0) {
-        rgb += u.params.w * c_buf[plane_index(u.c, t.x, t.y)].xyz;
-    }
-    rgb = min(rgb, vec3<f32>(F32_MAX));
+    let x0 = bilinear_first(t.x);
+    let y0 = bilinear_first(t.y);
+    let wx = bilinear_weight(t.x);
+    let wy = bilinear_weight(t.y);
+    let top = wy * b_buf[plane_index(u.b, x0, y0)].xyz + (1.0 - wy) * b_buf[plane_index(u.b, x0, y0 + 1)].xyz;
+    let bottom =
+        wy * b_buf[plane_index(u.b, x0 + 1, y0)].xyz + (1.0 - wy) * b_buf[plane_index(u.b, x0 + 1, y0 + 1)].xyz;
+    let g = wx * top + (1.0 - wx) * bottom;
+    let rgb = min(at_a(t.x, t.y) + g, vec3<f32>(F32_MAX));
     var mapped = vec3<f32>(0.0);
     if (u.flags.y == TONE_FAITHFUL) {
         mapped = map_faithful(rgb);

@@ -12,9 +12,17 @@
 //!   rows shifted by a texel;
 //! - the tent is separable as written (each low row's four horizontal taps summed first, then the
 //!   four rows): the horizontal sums of every low row are made once into a plane of their own
-//!   ([`up_plane`]), and each high row sums four of its rows.
+//!   ([`up_plane`]), and each high row sums four of its rows;
+//! - the glare at level 1 and its bilinear tap ([`glare_row`], [`upsample_row`]) the same way:
+//!   the vertical weights over whole rows, the horizontal ones over a padded row split into the
+//!   even and odd texels of the output.
+//!
+//! [`try_glare_plane`] makes the prefilter, the first downsample and the streak's first level in
+//! one pass over the linear image, in blocks of level-1 rows whose prefiltered rows are made and
+//! split once (no prefiltered plane); a renderer then reads each output row once for the tap, the
+//! composite and its colour mapping.
 
-use super::{composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, MAX_LEVELS};
+use super::{bilinear, composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, BLUR, MAX_LEVELS};
 use crate::simd::{dispatch, Lane, SimdPath, WithLanes};
 
 /// The downsample's weights in its order of summation (see [`super::down_row`]).
@@ -184,10 +192,10 @@ struct Scratch {
     rows: Vec<Vec<f32>>,
     /// The streak's levels.
     levels: Vec<Vec<[f32; 3]>>,
-    /// A row of the bloom.
-    bloom: Vec<[f32; 3]>,
-    /// A row of the streak.
-    streak: Vec<[f32; 3]>,
+    /// A prefiltered row.
+    pre: Vec<[f32; 3]>,
+    /// The prefiltered rows of a block of level 1, each split into even and odd padded texels.
+    block: Vec<Vec<f32>>,
 }
 
 thread_local! {
@@ -345,30 +353,65 @@ fn down_row_h_in(path: SimdPath, src: &[[f32; 3]], out: &mut [[f32; 3]], s: &mut
     taps(path, [&e[..], o, e, o, e, o], [0, 0, 1, 1, 2, 2], DOWN_H_W, None, out.as_flattened_mut());
 }
 
-/// The streak sum `up_h(U₁ʰ)` of one row `t` with `n` levels: [`super::streak_row`] in lanes.
+/// The streak's `U₁ʰ` of one half-height row `t` with `n` levels into `out` (`half(t.len())`
+/// texels): [`super::streak_row`] in lanes.
 pub fn streak_row(path: SimdPath, t: &[[f32; 3]], n: u32, out: &mut [[f32; 3]]) {
-    with_scratch(5, |s| streak_row_in(path, t, n, out, &mut s.rows[..5], &mut s.levels));
+    with_scratch(5, |s| {
+        streak_row_in(path, t, n, &mut s.rows[..5], &mut s.levels);
+        out.copy_from_slice(&s.levels[0][..out.len()]);
+    });
 }
 
-/// [`streak_row`] in the scratch rows `rows` (five) and `levels`.
+/// [`streak_row`] in the scratch rows `rows` (five) and `levels`, leaving `U₁ʰ` in `levels[0]`.
 fn streak_row_in(
     path: SimdPath,
     t: &[[f32; 3]],
     n: u32,
-    out: &mut [[f32; 3]],
     rows: &mut [Vec<f32>],
     levels: &mut Vec<Vec<[f32; 3]>>,
 ) {
+    if levels.is_empty() {
+        levels.push(Vec::new());
+    }
+    let mut d1 = std::mem::take(&mut levels[0]);
+    d1.resize(half(t.len()), [0.0; 3]);
+    if t.len() < SHORT {
+        super::down_row_h(t, &mut d1);
+    } else {
+        down_row_h_in(path, t, &mut d1, &mut rows[..2]);
+    }
+    levels[0] = d1;
+    streak_levels(path, n, rows, levels);
+}
+
+/// The streak's chain from its first level `d1` (`D₁ʰ`) with `n` levels, leaving `U₁ʰ` in
+/// `levels[0]`.
+fn streak_from_first(
+    path: SimdPath,
+    d1: &[[f32; 3]],
+    n: u32,
+    rows: &mut [Vec<f32>],
+    levels: &mut Vec<Vec<[f32; 3]>>,
+) {
+    if levels.is_empty() {
+        levels.push(Vec::new());
+    }
+    levels[0].clear();
+    levels[0].extend_from_slice(d1);
+    streak_levels(path, n, rows, levels);
+}
+
+/// Levels `D₂ʰ … D_nʰ` from `levels[0]` (`D₁ʰ`), then `U_kʰ` over them, `U₁ʰ` in `levels[0]`.
+fn streak_levels(path: SimdPath, n: u32, rows: &mut [Vec<f32>], levels: &mut Vec<Vec<[f32; 3]>>) {
     let n = n.clamp(1, MAX_LEVELS) as usize;
-    // levels[k] is D_{k+1}; then, from the top down, U_k in place of D_k.
     if levels.len() < n {
         levels.resize_with(n, Vec::new);
     }
-    let mut len = t.len();
-    for k in 0..n {
+    let mut len = levels[0].len();
+    for k in 1..n {
         len = half(len);
         let (done, rest) = levels.split_at_mut(k);
-        let src: &[[f32; 3]] = if k == 0 { t } else { &done[k - 1] };
+        let src: &[[f32; 3]] = &done[k - 1];
         rest[0].resize(len, [0.0; 3]);
         if src.len() < SHORT {
             super::down_row_h(src, &mut rest[0]);
@@ -388,7 +431,154 @@ fn streak_row_in(
             tent_h(path, u, BaseIn::Out, d, rows);
         }
     }
-    tent_h(path, &levels[0], BaseIn::None, out, rows);
+}
+
+/// [`super::blur_row_h`] in lanes (`q`: a scratch row).
+fn blur_row_h_in(path: SimdPath, row: &[[f32; 3]], out: &mut [[f32; 3]], q: &mut Vec<f32>) {
+    // q[m] = row[clamp(m − 2)]: texel x − 1 + d is q[x + 1 + d].
+    pad(row, out.len() + 4, q);
+    taps(path, [&q[..]; 3], [1, 2, 3], BLUR, None, out.as_flattened_mut());
+}
+
+/// [`super::blur_row_h`] in lanes.
+pub fn blur_row_h(path: SimdPath, row: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    with_scratch(1, |s| blur_row_h_in(path, row, out, &mut s.rows[0]));
+}
+
+/// [`super::glare_row`] in lanes.
+pub fn glare_row(
+    path: SimdPath,
+    hb: &Plane,
+    hs: Option<&Plane>,
+    y: usize,
+    kb: f32,
+    ks: f32,
+    out: &mut [[f32; 3]],
+) {
+    let w = super::glare_weights(kb, ks);
+    let last = hb.height as isize - 1;
+    let b: [&[f32]; 3] =
+        std::array::from_fn(|d| hb.row((y as isize - 1 + d as isize).clamp(0, last) as usize).as_flattened());
+    let out = out.as_flattened_mut();
+    match hs {
+        Some(hs) => taps(path, [b[0], b[1], b[2], hs.row(y).as_flattened()], [0; 4], w, None, out),
+        None => taps(path, b, [0; 3], [w[0], w[1], w[2]], None, out),
+    }
+}
+
+/// [`super::upsample_row`] in lanes: row `y` of the full-resolution glare from `g`.
+pub fn upsample_row(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]]) {
+    with_scratch(4, |s| upsample_row_in(path, g, y, out, &mut s.rows[..4]));
+}
+
+fn upsample_row_in(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
+    let [v, q, he, ho] = s else { unreachable!("four rows") };
+    let (y0, wy) = bilinear(y);
+    let last = g.height as isize - 1;
+    let rows: [&[f32]; 2] =
+        std::array::from_fn(|d| g.row((y0 + d as isize).clamp(0, last) as usize).as_flattened());
+    v.resize(3 * g.width, 0.0);
+    taps(path, rows, [0; 2], wy, None, v);
+    let w = out.len();
+    let (ne, no) = (w.div_ceil(2), w / 2);
+    // q[m] = v[clamp(m − 2)]: even x = 2j reads v[j − 1], v[j] = q[j + 1], q[j + 2]; odd x = 2j + 1
+    // reads v[j], v[j + 1] = q[j + 2], q[j + 3].
+    pad(v.as_chunks::<3>().0, ne + 4, q);
+    he.resize(3 * ne, 0.0);
+    ho.resize(3 * no, 0.0);
+    taps(path, [&q[..]; 2], [1, 2], bilinear(0).1, None, he);
+    taps(path, [&q[..]; 2], [2, 3], bilinear(1).1, None, ho);
+    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = if i % 2 == 0 { he[i / 2] } else { ho[i / 2] };
+    }
+}
+
+/// Level-1 rows a block of [`first_level`] makes at once: the prefiltered rows it reads (two per
+/// row and four more) are made and split once for the block.
+const BLOCK: usize = 8;
+
+/// `D₁` and the streak's `D₁ʰ` for the level-1 rows `rows`, straight from the linear image `src`
+/// (which holds the rows they read): the prefiltered rows `2·rows.start − 2 … 2·rows.end + 1`
+/// (clamped) each made once ([`prefilter_row`]) and split, then for each row `y` [`down_row`] of
+/// them into `d1`, and (`s1` not empty) `down_row_h` of the pair `(0 + ½·T(2y)) + ½·T(2y + 1)`
+/// into `s1` (the split of the pair is the pair of the splits, texel for texel): the planes of the
+/// prefilter, [`super::down_row`], [`super::pair_row`] and [`super::down_row_h`], bit for bit.
+#[allow(clippy::too_many_arguments)]
+fn first_level(
+    path: SimdPath,
+    src: &Plane,
+    threshold: f32,
+    soft_knee: f32,
+    rows: std::ops::Range<usize>,
+    d1: &mut [[f32; 3]],
+    s1: &mut [[f32; 3]],
+    s: &mut Scratch,
+) {
+    let last = src.height as isize - 1;
+    let wo = d1.len() / rows.len();
+    let count = wo + 3;
+    let clamp = |y: isize| y.clamp(0, last) as usize;
+    let ta = clamp(2 * rows.start as isize - 2);
+    let tb = clamp(2 * rows.end as isize + 1);
+    let Scratch { rows: work, pre, block, .. } = s;
+    let n = tb + 1 - ta;
+    if block.len() < 2 * n {
+        block.resize_with(2 * n, Vec::new);
+    }
+    pre.resize(src.width, [0.0; 3]);
+    for (i, y) in (ta..=tb).enumerate() {
+        prefilter_row(path, src.row(y), threshold, soft_knee, pre);
+        let (e, o) = block[2 * i..2 * i + 2].split_at_mut(1);
+        split(pre, count, &mut e[0], &mut o[0]);
+    }
+    let (boxes, pair) = work.split_at_mut(5);
+    for (r, y) in rows.clone().enumerate() {
+        let at = |dy: isize| 2 * (clamp(2 * y as isize - 2 + dy) - ta);
+        // The six source rows 2y−2 … 2y+3, split: (even, odd) of row 2y − 2 + r at `at(r)`.
+        for (k, bx) in boxes.iter_mut().enumerate() {
+            let (i0, i1) = (at(k as isize), at(k as isize + 1));
+            let (e0, o0, e1, o1) = (&block[i0], &block[i0 + 1], &block[i1], &block[i1 + 1]);
+            let m = 3 * (wo + 2);
+            bx.resize(m, 0.0);
+            let srcs: [&[f32]; 4] = if k % 2 == 0 {
+                [&e0[..m], &o0[..m], &e1[..m], &o1[..m]]
+            } else {
+                [&o0[..m], &e0[3..3 + m], &o1[..m], &e1[3..3 + m]]
+            };
+            dispatch(path, BoxSum { srcs, out: bx });
+        }
+        let [be0, bo1, be2, bo3, be4] =
+            [&boxes[0], &boxes[1], &boxes[2], &boxes[3], &boxes[4]].map(|v| &v[..]);
+        taps(
+            path,
+            [be2, bo1, bo1, bo3, bo3, be0, be2, be2, be4, be0, be0, be4, be4],
+            [1, 0, 1, 0, 1, 1, 0, 2, 1, 0, 2, 0, 2],
+            DOWN_W,
+            None,
+            d1[r * wo..(r + 1) * wo].as_flattened_mut(),
+        );
+        if s1.is_empty() {
+            continue;
+        }
+        // The pair's even and odd texels, then the 1-D downsample's six taps.
+        let (ia, ib) = (at(2), at(3));
+        let [pe, po] = &mut pair[..2] else { unreachable!("two rows") };
+        let k = 3 * count;
+        for (out, (a, b)) in [(&mut *pe, (ia, ib)), (&mut *po, (ia + 1, ib + 1))] {
+            out.resize(k, 0.0);
+            taps(path, [&block[a][..k], &block[b][..k]], [0; 2], [0.5; 2], None, out);
+        }
+        let (pe, po) = (&pe[..], &po[..]);
+        taps(
+            path,
+            [pe, po, pe, po, pe, po],
+            [0, 0, 1, 1, 2, 2],
+            DOWN_H_W,
+            None,
+            s1[r * wo..(r + 1) * wo].as_flattened_mut(),
+        );
+    }
 }
 
 /// [`super::try_glare`] on the vector path `path`: the same planes, bit for bit.
@@ -399,39 +589,45 @@ pub fn try_glare(
     band: std::ops::Range<usize>,
     fill: &dyn RowFill,
 ) -> Result<Plane, usize> {
-    let mut work = Plane::try_new(src.width, src.height, src.rows.clone())?;
-    work.data.copy_from_slice(&src.data);
-    glare_in_place(path, params, &mut work, band.clone(), fill)?;
-    let mut out = Plane::try_new(src.width, src.height, band.clone())?;
-    let w = src.width;
-    out.data.copy_from_slice(&work.data[(band.start - src.rows.start) * w..(band.end - src.rows.start) * w]);
+    let g = try_glare_plane(path, params, src, band.clone(), fill)?;
+    let mut out = Plane::try_new(src.width, src.height, band)?;
+    fill.fill(&mut out, &|y, row| {
+        upsample_row(path, &g, y, row);
+        for (o, c) in row.iter_mut().zip(src.row(y)) {
+            *o = composite(*c, *o);
+        }
+    });
     Ok(out)
 }
 
-/// The glare of [`super::try_glare`] over the rows `band` of the linear image `src` (which holds
-/// at least the rows [`super::source_rows`] names), written over those rows of `src` (its other
-/// rows are left as they were): no plane the size of the band is made for the result.
-/// `Err(bytes)` where a plane of that size could not be allocated (`src` is then unchanged).
-pub fn glare_in_place(
+/// The glare `G` at level 1 of [`super::try_glare`] for the rows `band` of the linear image `src`
+/// (which holds at least the rows [`super::source_rows`] names): the plane over the level-1 rows
+/// [`super::bilinear_rows`] names, from which [`upsample_row`] and [`super::composite`] give the
+/// band's rows. `Err(bytes)` where a plane of that size could not be allocated.
+pub fn try_glare_plane(
     path: SimdPath,
     params: &BloomParams,
-    src: &mut Plane,
+    src: &Plane,
     band: std::ops::Range<usize>,
     fill: &dyn RowFill,
-) -> Result<(), usize> {
+) -> Result<Plane, usize> {
     let (w, h) = (src.width, src.height);
     let n = levels(params.radius * h as f32);
     let plan = Plan::new(w, h, n, band.clone());
     let (th, kn) = (params.threshold, params.soft_knee);
-    let mut t = Plane::try_new(w, h, plan.source.clone())?;
-    {
-        let src = &*src;
-        fill.fill(&mut t, &|y, row| prefilter_row(path, src.row(y), th, kn, row));
-    }
+    let (kb, ks) = super::weights(params, h);
+    let l1 = &plan.levels[0];
+    // D₁ and the streak's D₁ʰ in one pass over the linear image.
+    let mut d1 = Plane::try_new(l1.width, l1.height, l1.down.clone())?;
+    let mut s1 = if ks > 0.0 { Some(Plane::try_new(l1.width, l1.height, l1.down.clone())?) } else { None };
+    fill.fill_blocks(&mut d1, s1.as_mut(), BLOCK, &|rows, d, s| {
+        with_scratch(7, |scratch| first_level(path, src, th, kn, rows, d, s, scratch))
+    });
     let mut downs: Vec<Plane> = Vec::with_capacity(plan.levels.len());
-    for l in &plan.levels {
+    downs.push(d1);
+    for l in &plan.levels[1..] {
         let mut d = Plane::try_new(l.width, l.height, l.down.clone())?;
-        let prev = downs.last().unwrap_or(&t);
+        let prev = downs.last().expect("D₁");
         fill.fill(&mut d, &|y, row| down_row(path, prev, y, row));
         downs.push(d);
     }
@@ -443,28 +639,25 @@ pub fn glare_in_place(
         fill.fill(&mut next, &|y, row| up_row(path, &hs, y, Some(d.row(y)), row));
         u = next;
     }
-    let kb = params.intensity / n as f32;
-    let ns = levels(params.streak_length * h as f32);
-    let ks = params.streak / ns as f32;
-    let hs = up_plane(path, &u, w, fill)?;
+    let mut hb = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+    fill.fill(&mut hb, &|y, row| blur_row_h(path, u.row(y), row));
     drop(u);
-    fill.fill(src, &|y, row| {
-        if !band.contains(&y) {
-            return;
+    let hs = match s1 {
+        Some(s1) => {
+            let ns = levels(params.streak_length * h as f32);
+            let mut hs = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+            fill.fill(&mut hs, &|y, row| {
+                with_scratch(5, |s| {
+                    let Scratch { rows, levels, .. } = s;
+                    streak_from_first(path, s1.row(y), ns, &mut rows[..5], levels);
+                    blur_row_h_in(path, &levels[0], row, &mut rows[0]);
+                })
+            });
+            Some(hs)
         }
-        with_scratch(5, |s| {
-            let Scratch { rows, levels, bloom, streak } = s;
-            bloom.resize(w, [0.0; 3]);
-            up_row(path, &hs, y, None, bloom);
-            if ks > 0.0 {
-                streak.resize(w, [0.0; 3]);
-                streak_row_in(path, t.row(y), ns, streak, &mut rows[..5], levels);
-            }
-            for (x, c) in row.iter_mut().enumerate() {
-                let st = if ks > 0.0 { streak[x] } else { [0.0; 3] };
-                *c = composite(*c, bloom[x], kb, st, ks);
-            }
-        });
-    });
-    Ok(())
+        None => None,
+    };
+    let mut g = Plane::try_new(l1.width, l1.height, super::bilinear_rows(&band, l1.height))?;
+    fill.fill(&mut g, &|y, row| glare_row(path, &hb, hs.as_ref(), y, kb, ks, row));
+    Ok(g)
 }
