@@ -26,7 +26,10 @@
 //! [`RayQuadratic`]: super::RayQuadratic
 //! [`RayQuadratic::attenuated`]: super::RayQuadratic::attenuated
 
-use super::attenuated::{GL_W, GL_X, INNER_CELL, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE};
+use super::attenuated::{
+    tail_reach, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
+    TAIL_MIN_J,
+};
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
 use crate::simd::{Lane, Outlined};
@@ -299,11 +302,43 @@ impl<L: Lane> Quad<L> {
         let half = k(0.5);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
+        // The far tail (the scalar march's): where the peak's singularities are far from t_far.
+        let tail_on = att.j >= TAIL_MIN_J as f32;
+        let (tail_reach, beyond, nodes) = if tail_on {
+            let dc = tf - tc;
+            let eps = sh / s;
+            let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
+            let j1 = att.j + 1.0;
+            let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
+            (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
+        } else {
+            (zero, zero, [zero; 8])
+        };
         let mut x = a;
         let mut acc = zero;
         let mut used = zero;
         let mut cells = zero;
         while active.bitmask() != 0 {
+            if tail_on {
+                let near = (tf - x).simd_le(tail_reach);
+                if (active & near).bitmask() != 0 {
+                    // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first.
+                    let within = (tf - x) * att.factor(x);
+                    let now = active & near & beyond.simd_le(k(0.5) * within);
+                    if now.bitmask() != 0 {
+                        let mut tail = self.tail(falloff, tf, tf - x, within, att.j, &nodes);
+                        if (now & beyond.simd_gt(zero)).bitmask() != 0 {
+                            let past = self.tail(falloff, tf, tf - b, beyond, att.j, &nodes);
+                            tail = tail - beyond.simd_gt(zero).select(past, zero);
+                        }
+                        acc += now.select(tail.max(zero), zero);
+                        active = active & !now;
+                        if active.bitmask() == 0 {
+                            break;
+                        }
+                    }
+                }
+            }
             let graded = b.min(tf - q * (tf - x));
             let capped = cells.simd_ge(last_cell);
             // Approaching the peak: halve the distance, down to the inner cell; inside it: to its
@@ -338,6 +373,25 @@ impl<L: Lane> Quad<L> {
             active = active & x.simd_lt(b) & !done;
         }
         clamp_energy(live, acc)
+    }
+
+    /// The far tail `∫_x^{t_far} g w dt` by 8-point Gauss–Laguerre for `span = t_far − x` and
+    /// `weight = span·g(x)`, `nodes` the factors `e^{−u_i/(j+1)}` (the scalar `tail`).
+    #[inline(always)]
+    fn tail(&self, falloff: Falloff, tf: L, span: L, weight: L, j: f32, nodes: &[L; 8]) -> L {
+        let k = L::splat;
+        let mut sum = k(0.0);
+        for (e, &wu) in nodes.iter().zip(LAGUERRE_W.iter()) {
+            let t = tf - span * *e;
+            let yv = self.s * t + self.beta;
+            let r2 = yv * yv + self.h;
+            let density = match falloff {
+                Falloff::Faithful => k(1.0) / r2.sqrt(),
+                Falloff::InverseSquare => k(1.0) / r2,
+            };
+            sum += k(wu as f32) * density;
+        }
+        weight / k(j + 1.0) * sum
     }
 
     /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
