@@ -357,12 +357,14 @@ impl<L: Lane> Quad<L> {
             let nudged = nudged.simd_gt(x).select(nudged, b);
             let y = y.simd_gt(x).select(y, nudged);
             let i0 = self.integral(falloff, x, y);
-            let g_line =
-                if (active & !inner).bitmask() != 0 { self.mean_g_line(falloff, x, y, att) } else { zero };
-            let gbar = if (active & inner).bitmask() != 0 {
-                inner.select(self.mean_g_peak(falloff, x, y, att), g_line)
+            let any_line = (active & !inner).bitmask() != 0;
+            let any_inner = (active & inner).bitmask() != 0;
+            let gbar = if any_line && any_inner {
+                self.mean_g_mixed(falloff, x, y, att, inner)
+            } else if any_inner {
+                self.mean_g_peak(falloff, x, y, att)
             } else {
-                g_line
+                self.mean_g_line(falloff, x, y, att)
             };
             acc += active.select(i0 * gbar, zero);
             used += active.select(i0, zero);
@@ -420,6 +422,53 @@ impl<L: Lane> Quad<L> {
         }
         let ok = den.simd_gt(k(0.0)) & finite(den) & finite(num);
         ok.select(num / den, plain)
+    }
+
+    /// [`Self::mean_g_peak`] on the `inner` lanes and [`Self::mean_g_line`] on the others, with
+    /// one power per node: each lane's node positions are chosen first, then `g` is taken once
+    /// at them (a pass in which the lanes disagree would otherwise pay for both rules' powers).
+    #[inline(always)]
+    fn mean_g_mixed(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>, inner: L) -> L {
+        let k = L::splat;
+        let sh = self.h.sqrt();
+        let (yx, yy) = ((self.s * x + self.beta) / sh, (self.s * y + self.beta) / sh);
+        let (px, py) = match falloff {
+            Falloff::Faithful => (yx.asinh(), yy.asinh()),
+            Falloff::InverseSquare => (yx.atan(), yy.atan()),
+        };
+        let dt = y - x;
+        let mut num = k(0.0);
+        let mut den = k(0.0);
+        let mut plain = k(0.0);
+        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
+            let wi = k(wi as f32);
+            // The line rule's node and weight.
+            let t_line = x + k(xi as f32) * dt;
+            let yv = self.s * t_line + self.beta;
+            let r2 = yv * yv + self.h;
+            let density = match falloff {
+                Falloff::Faithful => k(1.0) / r2.sqrt(),
+                Falloff::InverseSquare => k(1.0) / r2,
+            };
+            // The peak rule's node.
+            let p = px + k(xi as f32) * (py - px);
+            let v = match falloff {
+                Falloff::Faithful => {
+                    let e = p.exp();
+                    k(0.5) * (e - k(1.0) / e)
+                }
+                Falloff::InverseSquare => p.tan(),
+            };
+            let t_peak = ((v * sh - self.beta) / self.s).max(x).min(y);
+            let g = att.factor(inner.select(t_peak, t_line));
+            let w = wi * density;
+            num += w * g;
+            den += w;
+            plain += wi * g;
+        }
+        let ok = den.simd_gt(k(0.0)) & finite(den) & finite(num);
+        // The peak rule's mean is the plain one at its nodes.
+        inner.select(plain, ok.select(num / den, plain))
     }
 
     /// `g` averaged over `[x, y]` against `w` on the inner cell around the peak, with 4
