@@ -26,7 +26,23 @@
 //!   of `t`'s floating-point values is approached by halving down to that spacing, its mass then
 //!   taken by the closed form over one step of it;
 //! - the march stops once the rest cannot add more than `10⁻⁵` of the sum: `g` falls along the
-//!   ray, so the rest is at most `g(x)·(I − Σ I_cell)`, `I` the unattenuated integral.
+//!   ray, so the rest is at most `g(x)·(I − Σ I_cell)`, `I` the unattenuated integral;
+//! - the far tail `[x, t_far]` is one step as soon as the peak is far from it: with
+//!   `h = 1 − t/t_far` and `u = (j + 1)·ln(h(x)/h(t))`, the attenuation times the measure is
+//!   exactly `(t_far − x)·g(x)/(j + 1)·e^{−u} du` (`g dt = −t_far h^j dh`), so
+//!   `∫_x^{t_far} g w dt = (t_far − x)·g(x)/(j + 1)·∫_0^∞ e^{−u} w(t(u)) du`,
+//!   `t(u) = t_far − (t_far − x)·e^{−u/(j+1)}`, which 8-point Gauss–Laguerre integrates from
+//!   eight densities (no power per node: `e^{−u_i/(j+1)}` is one set per call). The branch point
+//!   of `g` at `t_far` is in the weight, not the integrand; what is left, `w(t(u)) =
+//!   F(e^{−u/(j+1)})` with `F(ζ) = w(t_far − (t_far − x)ζ)`, has its singularities (the peak's
+//!   `t_c ± iε`) at `|ζ| = |t_far − t_c ∓ iε|/(t_far − x)`. Expanding `F` in powers of `ζ`, the
+//!   rule errs by about `Σ_k |ζ|^{−k}·E(k/(j + 1))`, `E(λ)` its error on `e^{−λu}`; taking the
+//!   step once `|ζ| ≥ reach(j) = max(1 + 2·j^{−2/3}, 1.25)` ([`TAIL_REACH`]) keeps that near
+//!   `10⁻⁶` for every `j ≥ 1` ([`TAIL_MIN_J`]; smaller `j` marches to the end); the inverse
+//!   square's two nearly coincident poles make it up to `1.2·10⁻⁵` at `j = 1`
+//!   (`tests/analytic_attenuation.rs`, `far_tail_step_is_accurate_at_the_edge_of_its_reach`). An end `b`
+//!   before `t_far` (an occluder) takes `∫_x^{t_far} − ∫_b^{t_far}` where the second is at most
+//!   half the first (else the march goes on).
 //!
 //! The 4-point rule on a cell whose nearest singularity is a cell length away (Bernstein ellipse
 //! `ρ = 3 + √8`) errs by about `ρ⁻⁸ ≈ 10⁻⁶` relative; `tests/analytic_attenuation.rs` holds the
@@ -37,7 +53,8 @@
 //!
 //! `j = 0` calls the unattenuated kernels themselves, so it is bit-identical to them and as fast.
 //! The eight-lane kernels (`lanes.rs`) have the same march in lanes (`lanes::*_attenuated`, a
-//! masked loop in which each lane grades, stops and caps its own cells by the rules here), which
+//! masked loop in which each lane grades, stops, caps its own cells and takes the far tail by the
+//! rules here), which
 //! the CPU backend uses; these functions are what they are tested against.
 
 use super::field::{
@@ -79,8 +96,8 @@ pub(super) const LAGUERRE_W: [f64; 8] = [
 
 /// The far tail `[x, t_far]` is taken in one Gauss–Laguerre step once the peak's complex
 /// singularities `t_c ± iε` are at least `reach(j) = max(1 + TAIL_REACH·j^{−2/3}, TAIL_REACH_MIN)`
-/// times `t_far − x` from `t_far` (the rule's error is then about `10⁻⁶` relative for every `j`;
-/// see this module's documentation).
+/// times `t_far − x` from `t_far` (the rule's error is then about `10⁻⁶` relative, up to
+/// `1.2·10⁻⁵` for the inverse square at `j = 1`; see this module's documentation).
 pub const TAIL_REACH: f64 = 2.0;
 
 /// The least reach of the far tail's rule (large `j`).
@@ -122,7 +139,9 @@ impl<R: Real> RayQuadratic<R> {
     /// `∫_{t0}^{min(t1, t_far)} (1 − t/t_far)^j dt / sqrt(Y² + H)` (faithful) or `/(Y² + H)`
     /// (inverse square): the piece integral of [`Self::integral`] with the distance attenuation
     /// of 002 eq. 3.23 (SPEC.md §1.4), 0 from the far point on. Graded 4-point Gauss–Legendre
-    /// cells weighted by the closed form (see this module's documentation, `energy/attenuated.rs`); `j = 0` (or NaN) is
+    /// cells weighted by the closed form, then one 8-point Gauss–Laguerre step over the far tail
+    /// once the peak is far enough from the far point (see this module's documentation,
+    /// `energy/attenuated.rs`); `j = 0` (or NaN) is
     /// [`Self::integral`] itself. Finite and in `[0, ENERGY_MAX]` for finite inputs; empty or
     /// NaN spans give 0.
     ///
