@@ -20,7 +20,7 @@
 //! lane by selects; the loop ends when no lane is active ([`Lane::bitmask`]), so a batch costs
 //! its slowest lane's cells (at most [`MAX_CELLS`]). Each lane takes the far tail in one
 //! Gauss–Laguerre step where the scalar march does (and is then done); a pass whose lanes mix
-//! the line and peak rules takes one power per node ([`Quad::attenuated`]). The powers, `sinh`, `tan`,
+//! the line and peak rules takes one power per node (`Quad::mean_g_mixed`). The powers, `sinh`, `tan`,
 //! `asinh` and `atan` are the lane polynomials of [`Lane`] (`exp(j·ln h)` for `h^j`), so each lane
 //! cuts the scalar march's cells up to rounding and agrees with it to about `10⁻⁵` relative
 //! (`tests/analytic_attenuation_lanes.rs`). `j = 0` (or NaN) runs the unattenuated kernels.
