@@ -327,3 +327,44 @@ fn finite_for_every_exponent() {
         }
     }
 }
+
+/// The far tail's one Gauss–Laguerre step at the edge of its reach: a sphere behind the eye at
+/// `reach(j)·t_far` from the far point (just inside), so the step covers the whole ray from its
+/// start, held to the `f64` reference at `2·10⁻⁵` relative for `j` from 1 (the least the step
+/// takes) to 64, narrow and wide peaks, both laws (measured: at most `1.2·10⁻⁵`, inverse square
+/// at `j = 1`; `2.2·10⁻⁶` faithful). A reach fixed at 1.5 would err by several `10⁻⁴` at `j = 1`
+/// (the rule's error on `e^{−u/(j+1)}` grows as `j` falls), which this would catch.
+#[test]
+fn far_tail_step_is_accurate_at_the_edge_of_its_reach() {
+    let mut worst = 0.0f64;
+    for law in LAWS {
+        for j in [1.0, 1.3, 2.0, 3.0, 5.0, 8.0, 16.0, 64.0] {
+            let reach = (1.0 + 2.0 * f64::powf(j, -2.0 / 3.0)).max(1.25);
+            for (far, miss) in [(1.0, 1e-3), (10.0, 0.3), (100.0, 5.0)] {
+                let (p, beam) = beam64(0.0);
+                let p = FieldParams { falloff: law, ..p };
+                // The centre (the origin) at `reach·far·(1 + 10⁻⁴) − far` behind the eye.
+                let eye = Vec3::new(reach * far * (1.0 + 1e-4) - far, miss, 0.0);
+                let (dir, t_far, t1) = match law {
+                    Falloff::Faithful => (Vec3::X * far, 1.0, 1.0),
+                    Falloff::InverseSquare => (Vec3::X, far, f64::INFINITY),
+                };
+                let case = Case { p, ray: Ray { origin: eye, dir }, t0: 0.0, t1, beam };
+                let att = Attenuation { j, t_far };
+                let r = reference(&case, Shape::Sphere, &att);
+                let v = attenuated(&case, Shape::Sphere, &att);
+                let e = rel(v, r);
+                assert!(e <= 2e-5, "{law:?} j {j} far {far} miss {miss}: {v:e} vs {r:e} (rel {e:e})");
+                let c32 = case.to_f32();
+                let v32 = attenuated(&c32, Shape::Sphere, &Attenuation { j: j as f32, t_far: t_far as f32 });
+                let e32 = rel(f64::from(v32), r);
+                assert!(
+                    e32 <= 1e-4,
+                    "{law:?} j {j} far {far} miss {miss}: f32 {v32:e} vs {r:e} (rel {e32:e})"
+                );
+                worst = worst.max(e);
+            }
+        }
+    }
+    println!("far tail at the edge of its reach: worst f64 relative error {worst:.2e}");
+}

@@ -315,6 +315,28 @@ fn att_mean_peak(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation
     return sum;
 }
 
+// Mirrors hadou_math::energy::TAIL_MIN_J, TAIL_REACH and TAIL_REACH_MIN.
+const ATT_TAIL_MIN_J: f32 = 1.0;
+const ATT_TAIL_REACH: f32 = 2.0;
+const ATT_TAIL_REACH_MIN: f32 = 1.25;
+
+// Mirrors RayQuadratic::tail: ∫_x^{t_far} g w dt by 8-point Gauss–Laguerre for span = t_far − x and
+// weight = span·g(x) (the density sampled at t = t_far − span·e^{−u/(j+1)}).
+fn att_tail(q: RayQuadratic, falloff: u32, tf: f32, span: f32, weight: f32, j: f32) -> f32 {
+    var us = array<f32, 8>(0.17027963230510093, 0.90370177679938, 2.251086629866131, 4.266700170287659,
+        7.0459054023934655, 10.758516010180996, 15.740678641278004, 22.863131736889265);
+    var ws = array<f32, 8>(0.36918858934163495, 0.4187867808143447, 0.17579498663717255,
+        0.033343492261215794, 0.0027945362352256834, 9.076508773358139e-5, 8.48574671627257e-7,
+        1.0480011748715153e-9);
+    let j1 = j + 1.0;
+    var sum = 0.0;
+    for (var i = 0; i < 8; i++) {
+        let t = tf - span * exp(-us[i] / j1);
+        sum += ws[i] * att_density(falloff, q.s * t + q.beta, q.h);
+    }
+    return weight / j1 * sum;
+}
+
 // Mirrors RayQuadratic::attenuated: ∫ (1 − t/t_far)^j w(t) dt over [t0, min(t1, t_far)] (002 eq.
 // 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded cells, each weighted by the closed form
 // (see the Rust module docs of hadou_math::energy::attenuated for the grading).
@@ -340,6 +362,16 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
         dmin = ATT_INNER_CELL * (sh / s);
     }
     let ratio = max(exp(-1.0 / att.j), 0.5);
+    // The far tail: where the peak's singularities are far from t_far (or there is no peak).
+    let tail_on = att.j >= ATT_TAIL_MIN_J;
+    var tail_reach = 3.0e38; // no peak: the tail from the start
+    if (has_peak) {
+        let dc = tf - tc;
+        let eps = sh / s;
+        let reach = max(1.0 + ATT_TAIL_REACH * pow(att.j, -2.0 / 3.0), ATT_TAIL_REACH_MIN);
+        tail_reach = sqrt(dc * dc + eps * eps) / reach;
+    }
+    let beyond = (tf - b) * att_factor(att, b);
     var x = a;
     var acc = 0.0;
     var used = 0.0;
@@ -347,6 +379,18 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
     loop {
         if (!(x < b)) {
             break;
+        }
+        if (tail_on && tf - x <= tail_reach) {
+            // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first (else march on).
+            let within = (tf - x) * att_factor(att, x);
+            if (beyond <= 0.5 * within) {
+                var tail = att_tail(q, falloff, tf, tf - x, within, att.j);
+                if (beyond > 0.0) {
+                    tail -= att_tail(q, falloff, tf, tf - b, beyond, att.j);
+                }
+                acc += max(tail, 0.0);
+                break;
+            }
         }
         let graded = min(b, tf - ratio * (tf - x));
         var y = graded;

@@ -26,7 +26,23 @@
 //!   of `t`'s floating-point values is approached by halving down to that spacing, its mass then
 //!   taken by the closed form over one step of it;
 //! - the march stops once the rest cannot add more than `10⁻⁵` of the sum: `g` falls along the
-//!   ray, so the rest is at most `g(x)·(I − Σ I_cell)`, `I` the unattenuated integral.
+//!   ray, so the rest is at most `g(x)·(I − Σ I_cell)`, `I` the unattenuated integral;
+//! - the far tail `[x, t_far]` is one step as soon as the peak is far from it: with
+//!   `h = 1 − t/t_far` and `u = (j + 1)·ln(h(x)/h(t))`, the attenuation times the measure is
+//!   exactly `(t_far − x)·g(x)/(j + 1)·e^{−u} du` (`g dt = −t_far h^j dh`), so
+//!   `∫_x^{t_far} g w dt = (t_far − x)·g(x)/(j + 1)·∫_0^∞ e^{−u} w(t(u)) du`,
+//!   `t(u) = t_far − (t_far − x)·e^{−u/(j+1)}`, which 8-point Gauss–Laguerre integrates from
+//!   eight densities (no power per node: `e^{−u_i/(j+1)}` is one set per call). The branch point
+//!   of `g` at `t_far` is in the weight, not the integrand; what is left, `w(t(u)) =
+//!   F(e^{−u/(j+1)})` with `F(ζ) = w(t_far − (t_far − x)ζ)`, has its singularities (the peak's
+//!   `t_c ± iε`) at `|ζ| = |t_far − t_c ∓ iε|/(t_far − x)`. Expanding `F` in powers of `ζ`, the
+//!   rule errs by about `Σ_k |ζ|^{−k}·E(k/(j + 1))`, `E(λ)` its error on `e^{−λu}`; taking the
+//!   step once `|ζ| ≥ reach(j) = max(1 + 2·j^{−2/3}, 1.25)` ([`TAIL_REACH`]) keeps that near
+//!   `10⁻⁶` for every `j ≥ 1` ([`TAIL_MIN_J`]; smaller `j` marches to the end); the inverse
+//!   square's two nearly coincident poles make it up to `1.2·10⁻⁵` at `j = 1`
+//!   (`tests/analytic_attenuation.rs`, `far_tail_step_is_accurate_at_the_edge_of_its_reach`). An end `b`
+//!   before `t_far` (an occluder) takes `∫_x^{t_far} − ∫_b^{t_far}` where the second is at most
+//!   half the first (else the march goes on).
 //!
 //! The 4-point rule on a cell whose nearest singularity is a cell length away (Bernstein ellipse
 //! `ρ = 3 + √8`) errs by about `ρ⁻⁸ ≈ 10⁻⁶` relative; `tests/analytic_attenuation.rs` holds the
@@ -37,7 +53,8 @@
 //!
 //! `j = 0` calls the unattenuated kernels themselves, so it is bit-identical to them and as fast.
 //! The eight-lane kernels (`lanes.rs`) have the same march in lanes (`lanes::*_attenuated`, a
-//! masked loop in which each lane grades, stops and caps its own cells by the rules here), which
+//! masked loop in which each lane grades, stops, caps its own cells and takes the far tail by the
+//! rules here), which
 //! the CPU backend uses; these functions are what they are tested against.
 
 use super::field::{
@@ -53,6 +70,48 @@ pub(super) const GL_X: [f64; 4] =
 /// Gauss–Legendre weights on `[0, 1]` (sum 1).
 pub(super) const GL_W: [f64; 4] =
     [0.173_927_422_568_726_93, 0.326_072_577_431_273_07, 0.326_072_577_431_273_07, 0.173_927_422_568_726_93];
+
+/// Gauss–Laguerre nodes (8 points, weight `e^{−u}` on `[0, ∞)`): the far tail's rule.
+pub(super) const LAGUERRE_X: [f64; 8] = [
+    0.170_279_632_305_100_93,
+    0.903_701_776_799_38,
+    2.251_086_629_866_131,
+    4.266_700_170_287_659,
+    7.045_905_402_393_465_5,
+    10.758_516_010_180_996,
+    15.740_678_641_278_004,
+    22.863_131_736_889_265,
+];
+/// Gauss–Laguerre weights (8 points, sum 1).
+pub(super) const LAGUERRE_W: [f64; 8] = [
+    0.369_188_589_341_634_95,
+    0.418_786_780_814_344_7,
+    0.175_794_986_637_172_55,
+    0.033_343_492_261_215_794,
+    0.002_794_536_235_225_683_4,
+    9.076_508_773_358_139e-5,
+    8.485_746_716_272_57e-7,
+    1.048_001_174_871_515_3e-9,
+];
+
+/// The far tail `[x, t_far]` is taken in one Gauss–Laguerre step once the peak's complex
+/// singularities `t_c ± iε` are at least `reach(j) = max(1 + TAIL_REACH·j^{−2/3}, TAIL_REACH_MIN)`
+/// times `t_far − x` from `t_far` (the rule's error is then about `10⁻⁶` relative, up to
+/// `1.2·10⁻⁵` for the inverse square at `j = 1`; see this module's documentation).
+pub const TAIL_REACH: f64 = 2.0;
+
+/// The least reach of the far tail's rule (large `j`).
+pub const TAIL_REACH_MIN: f64 = 1.25;
+
+/// `reach(j)` of [`TAIL_REACH`].
+#[inline(always)]
+pub(super) fn tail_reach<R: Real>(j: R) -> R {
+    (R::ONE + R::from_f64(TAIL_REACH) * j.powf(R::from_f64(-2.0 / 3.0))).max(R::from_f64(TAIL_REACH_MIN))
+}
+
+/// The far tail's rule is used only for `j` at least this (below, `e^{−u/(j+1)}` is too far from
+/// a low-degree polynomial in `u` for 8 nodes).
+pub const TAIL_MIN_J: f64 = 1.0;
 
 /// Most cells one piece is cut into; the rest of the span is then one last cell.
 pub const MAX_CELLS: u32 = 192;
@@ -80,7 +139,9 @@ impl<R: Real> RayQuadratic<R> {
     /// `∫_{t0}^{min(t1, t_far)} (1 − t/t_far)^j dt / sqrt(Y² + H)` (faithful) or `/(Y² + H)`
     /// (inverse square): the piece integral of [`Self::integral`] with the distance attenuation
     /// of 002 eq. 3.23 (SPEC.md §1.4), 0 from the far point on. Graded 4-point Gauss–Legendre
-    /// cells weighted by the closed form (see this module's documentation, `energy/attenuated.rs`); `j = 0` (or NaN) is
+    /// cells weighted by the closed form, then one 8-point Gauss–Laguerre step over the far tail
+    /// once the peak is far enough from the far point (see this module's documentation,
+    /// `energy/attenuated.rs`); `j = 0` (or NaN) is
     /// [`Self::integral`] itself. Finite and in `[0, ENERGY_MAX]` for finite inputs; empty or
     /// NaN spans give 0.
     ///
@@ -111,11 +172,33 @@ impl<R: Real> RayQuadratic<R> {
             if has_peak { (-self.beta / s, R::from_f64(INNER_CELL) * (sh / s)) } else { (R::ZERO, R::ZERO) };
         let q = (-R::ONE / att.j).exp().max(R::from_f64(0.5));
         let half = R::from_f64(0.5);
+        // The far tail: where the peak's singularities are far from t_far (or there is no peak).
+        let tail_on = att.j >= R::from_f64(TAIL_MIN_J);
+        let tail_reach = if has_peak {
+            let dc = tf - tc;
+            (dc * dc + (sh / s) * (sh / s)).sqrt() / tail_reach(att.j)
+        } else {
+            R::INFINITY
+        };
+        // (t_far − b)·g(b): what the tail beyond an end before t_far weighs (0 at t_far).
+        let beyond = (tf - b) * att.factor(b);
         let mut x = a;
         let mut acc = R::ZERO;
         let mut used = R::ZERO;
         let mut cells = 0;
         while x < b {
+            if tail_on && tf - x <= tail_reach {
+                // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first (else march on).
+                let within = (tf - x) * att.factor(x);
+                if beyond <= half * within {
+                    let mut tail = self.tail(falloff, tf, tf - x, within, att.j);
+                    if beyond > R::ZERO {
+                        tail -= self.tail(falloff, tf, tf - b, beyond, att.j);
+                    }
+                    acc += tail.max(R::ZERO);
+                    break;
+                }
+            }
             let graded = b.min(tf - q * (tf - x));
             let mut y = graded;
             let mut inner = false;
@@ -161,6 +244,21 @@ impl<R: Real> RayQuadratic<R> {
             }
         }
         acc.max(R::ZERO).min(R::from_f64(ENERGY_MAX))
+    }
+
+    /// `∫_x^{t_far} (1 − t/t_far)^j w(t) dt` by 8-point Gauss–Laguerre, for `span = t_far − x`
+    /// and `weight = span·g(x)`: with `u = (j + 1)·ln(h(x)/h(t))`, `h = 1 − t/t_far`, the
+    /// attenuation times the measure is exactly `weight/(j + 1)·e^{−u} du`, so the rule only
+    /// samples the density, at `t = t_far − span·e^{−u/(j+1)}` (8 nodes between `x` and `t_far`).
+    #[inline(always)]
+    fn tail(&self, falloff: Falloff, tf: R, span: R, weight: R, j: R) -> R {
+        let j1 = j + R::ONE;
+        let mut sum = R::ZERO;
+        for (&u, &wu) in LAGUERRE_X.iter().zip(LAGUERRE_W.iter()) {
+            let t = tf - span * (-R::from_f64(u) / j1).exp();
+            sum += R::from_f64(wu) * density(falloff, self.s * t + self.beta, self.h);
+        }
+        weight / j1 * sum
     }
 
     /// `g` averaged over `[x, y]` against `w`, with 4 Gauss–Legendre nodes uniform in `t`

@@ -18,7 +18,9 @@
 //! scalar march's grading (geometric towards `t_far` and away from the peak, the inner cell in
 //! `ψ = asinh(Y/√H)` or `θ = atan(Y/√H)`, the ulp step), early stop and cell cap applied per
 //! lane by selects; the loop ends when no lane is active ([`Lane::bitmask`]), so a batch costs
-//! its slowest lane's cells (at most [`MAX_CELLS`]). The powers, `sinh`, `tan`,
+//! its slowest lane's cells (at most [`MAX_CELLS`]). Each lane takes the far tail in one
+//! Gauss–Laguerre step where the scalar march does (and is then done); a pass whose lanes mix
+//! the line and peak rules takes one power per node (`Quad::mean_g_mixed`). The powers, `sinh`, `tan`,
 //! `asinh` and `atan` are the lane polynomials of [`Lane`] (`exp(j·ln h)` for `h^j`), so each lane
 //! cuts the scalar march's cells up to rounding and agrees with it to about `10⁻⁵` relative
 //! (`tests/analytic_attenuation_lanes.rs`). `j = 0` (or NaN) runs the unattenuated kernels.
@@ -26,7 +28,10 @@
 //! [`RayQuadratic`]: super::RayQuadratic
 //! [`RayQuadratic::attenuated`]: super::RayQuadratic::attenuated
 
-use super::attenuated::{GL_W, GL_X, INNER_CELL, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE};
+use super::attenuated::{
+    tail_reach, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
+    TAIL_MIN_J,
+};
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
 use crate::simd::{Lane, Outlined};
@@ -299,11 +304,43 @@ impl<L: Lane> Quad<L> {
         let half = k(0.5);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
+        // The far tail (the scalar march's): where the peak's singularities are far from t_far.
+        let tail_on = att.j >= TAIL_MIN_J as f32;
+        let (tail_reach, beyond, nodes) = if tail_on {
+            let dc = tf - tc;
+            let eps = sh / s;
+            let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
+            let j1 = att.j + 1.0;
+            let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
+            (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
+        } else {
+            (zero, zero, [zero; 8])
+        };
         let mut x = a;
         let mut acc = zero;
         let mut used = zero;
         let mut cells = zero;
         while active.bitmask() != 0 {
+            if tail_on {
+                let near = (tf - x).simd_le(tail_reach);
+                if (active & near).bitmask() != 0 {
+                    // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first.
+                    let within = (tf - x) * att.factor(x);
+                    let now = active & near & beyond.simd_le(k(0.5) * within);
+                    if now.bitmask() != 0 {
+                        let mut tail = self.tail(falloff, tf, tf - x, within, att.j, &nodes);
+                        if (now & beyond.simd_gt(zero)).bitmask() != 0 {
+                            let past = self.tail(falloff, tf, tf - b, beyond, att.j, &nodes);
+                            tail = tail - beyond.simd_gt(zero).select(past, zero);
+                        }
+                        acc += now.select(tail.max(zero), zero);
+                        active = active & !now;
+                        if active.bitmask() == 0 {
+                            break;
+                        }
+                    }
+                }
+            }
             let graded = b.min(tf - q * (tf - x));
             let capped = cells.simd_ge(last_cell);
             // Approaching the peak: halve the distance, down to the inner cell; inside it: to its
@@ -322,12 +359,14 @@ impl<L: Lane> Quad<L> {
             let nudged = nudged.simd_gt(x).select(nudged, b);
             let y = y.simd_gt(x).select(y, nudged);
             let i0 = self.integral(falloff, x, y);
-            let g_line =
-                if (active & !inner).bitmask() != 0 { self.mean_g_line(falloff, x, y, att) } else { zero };
-            let gbar = if (active & inner).bitmask() != 0 {
-                inner.select(self.mean_g_peak(falloff, x, y, att), g_line)
+            let any_line = (active & !inner).bitmask() != 0;
+            let any_inner = (active & inner).bitmask() != 0;
+            let gbar = if any_line && any_inner {
+                self.mean_g_mixed(falloff, x, y, att, inner)
+            } else if any_inner {
+                self.mean_g_peak(falloff, x, y, att)
             } else {
-                g_line
+                self.mean_g_line(falloff, x, y, att)
             };
             acc += active.select(i0 * gbar, zero);
             used += active.select(i0, zero);
@@ -338,6 +377,25 @@ impl<L: Lane> Quad<L> {
             active = active & x.simd_lt(b) & !done;
         }
         clamp_energy(live, acc)
+    }
+
+    /// The far tail `∫_x^{t_far} g w dt` by 8-point Gauss–Laguerre for `span = t_far − x` and
+    /// `weight = span·g(x)`, `nodes` the factors `e^{−u_i/(j+1)}` (the scalar `tail`).
+    #[inline(always)]
+    fn tail(&self, falloff: Falloff, tf: L, span: L, weight: L, j: f32, nodes: &[L; 8]) -> L {
+        let k = L::splat;
+        let mut sum = k(0.0);
+        for (e, &wu) in nodes.iter().zip(LAGUERRE_W.iter()) {
+            let t = tf - span * *e;
+            let yv = self.s * t + self.beta;
+            let r2 = yv * yv + self.h;
+            let density = match falloff {
+                Falloff::Faithful => k(1.0) / r2.sqrt(),
+                Falloff::InverseSquare => k(1.0) / r2,
+            };
+            sum += k(wu as f32) * density;
+        }
+        weight / k(j + 1.0) * sum
     }
 
     /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
@@ -366,6 +424,53 @@ impl<L: Lane> Quad<L> {
         }
         let ok = den.simd_gt(k(0.0)) & finite(den) & finite(num);
         ok.select(num / den, plain)
+    }
+
+    /// [`Self::mean_g_peak`] on the `inner` lanes and [`Self::mean_g_line`] on the others, with
+    /// one power per node: each lane's node positions are chosen first, then `g` is taken once
+    /// at them (a pass in which the lanes disagree would otherwise pay for both rules' powers).
+    #[inline(always)]
+    fn mean_g_mixed(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>, inner: L) -> L {
+        let k = L::splat;
+        let sh = self.h.sqrt();
+        let (yx, yy) = ((self.s * x + self.beta) / sh, (self.s * y + self.beta) / sh);
+        let (px, py) = match falloff {
+            Falloff::Faithful => (yx.asinh(), yy.asinh()),
+            Falloff::InverseSquare => (yx.atan(), yy.atan()),
+        };
+        let dt = y - x;
+        let mut num = k(0.0);
+        let mut den = k(0.0);
+        let mut plain = k(0.0);
+        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
+            let wi = k(wi as f32);
+            // The line rule's node and weight.
+            let t_line = x + k(xi as f32) * dt;
+            let yv = self.s * t_line + self.beta;
+            let r2 = yv * yv + self.h;
+            let density = match falloff {
+                Falloff::Faithful => k(1.0) / r2.sqrt(),
+                Falloff::InverseSquare => k(1.0) / r2,
+            };
+            // The peak rule's node.
+            let p = px + k(xi as f32) * (py - px);
+            let v = match falloff {
+                Falloff::Faithful => {
+                    let e = p.exp();
+                    k(0.5) * (e - k(1.0) / e)
+                }
+                Falloff::InverseSquare => p.tan(),
+            };
+            let t_peak = ((v * sh - self.beta) / self.s).max(x).min(y);
+            let g = att.factor(inner.select(t_peak, t_line));
+            let w = wi * density;
+            num += w * g;
+            den += w;
+            plain += wi * g;
+        }
+        let ok = den.simd_gt(k(0.0)) & finite(den) & finite(num);
+        // The peak rule's mean is the plain one at its nodes.
+        inner.select(plain, ok.select(num / den, plain))
     }
 
     /// `g` averaged over `[x, y]` against `w` on the inner cell around the peak, with 4
