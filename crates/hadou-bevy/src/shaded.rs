@@ -199,17 +199,17 @@ pub(crate) fn shade_models(
         };
         let mut e = commands.entity(entity);
         e.remove::<MeshMaterial3d<StandardMaterial>>().insert(MeshMaterial3d(handle));
-        let outline = match gltf_slot(&standard_material.0, shaded.slots.len()) {
-            Some(slot) => shaded.slots[slot].outline,
-            None => shaded.material.outline,
+        let look = match gltf_slot(&standard_material.0, shaded.slots.len()) {
+            Some(slot) => &shaded.slots[slot],
+            None => &shaded.material,
         };
-        if let Some(outline) = outline.filter(|o| o.width > 0.0) {
+        if let Some(outline) = HadouOutline::of(look, &shaded.light) {
             // The hull is drawn from the same mesh (skinned by the same joints: a sibling of the
             // mesh entity keeps its transform and skin).
             let mut hull = commands.spawn((
                 Name::new("outline"),
                 Mesh3d(mesh.0.clone()),
-                MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
+                MeshMaterial3d(outlines.add(outline)),
             ));
             match skinned {
                 Some(skin) => {

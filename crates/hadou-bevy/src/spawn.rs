@@ -201,11 +201,11 @@ pub fn spawn_object(
             MeshMaterial3d(handle),
             ChildOf(entity),
         ));
-        if let Some(outline) = material.outline.filter(|o| o.width > 0.0) {
+        if let Some(hull) = HadouOutline::of(material, light) {
             commands.spawn((
                 Name::new(format!("{} slot {slot} outline", object.name)),
                 Mesh3d(assets.meshes.add(outline_mesh(&object.mesh, slot))),
-                MeshMaterial3d(assets.outlines.add(HadouOutline::new(&outline))),
+                MeshMaterial3d(assets.outlines.add(hull)),
                 ChildOf(entity),
             ));
         }
