@@ -35,14 +35,14 @@ struct Split {
 #[derive(Component)]
 struct Second;
 
+/// What [`split`] reads of the spawned scene camera.
+type SceneCamera = (Entity, &'static mut Camera, &'static HadouCamera, &'static Projection);
+
 /// Puts the spawned scene camera into the left half and a second camera of the same settings
 /// into the right half.
 fn split(
     mut commands: Commands,
-    mut cameras: Query<
-        (Entity, &mut Camera, &HadouCamera, &Projection),
-        (Added<HadouCamera>, Without<Second>),
-    >,
+    mut cameras: Query<SceneCamera, (Added<HadouCamera>, Without<Second>)>,
     split: Res<Split>,
 ) {
     for (entity, mut camera, settings, projection) in &mut cameras {
