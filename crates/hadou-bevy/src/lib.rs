@@ -36,6 +36,8 @@ mod shaded;
 mod shadows;
 mod spawn;
 mod tone;
+#[cfg(feature = "gltf")]
+mod vrm;
 mod wave;
 
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
@@ -51,6 +53,8 @@ pub use shadows::{shadow_frame, shadow_mask, shadow_records, HadouShadows, PLANE
 pub use spawn::{
     scene_time, spawn_object, unsupported, HadouSceneRoot, ObjectAssets, SceneClock, SpawnedScene,
 };
+#[cfg(feature = "gltf")]
+pub use vrm::VrmLoader;
 pub use wave::{check_wave, rejection_message, HadouWave, WaveError, WaveRejected};
 
 use bevy::asset::io::file::FileAssetReader;
@@ -181,6 +185,14 @@ impl Plugin for HadouPlugin {
                 Core3d,
                 render::wave_pass.after(Core3dSystems::MainPass).before(Core3dSystems::EarlyPostProcess),
             );
+    }
+
+    fn finish(&self, app: &mut App) {
+        // After the glTF plugin's `finish`, which makes the loader's settings.
+        #[cfg(feature = "gltf")]
+        if app.is_plugin_added::<AssetPlugin>() {
+            vrm::register(app);
+        }
     }
 }
 

@@ -49,7 +49,9 @@ const LIGHT_DATA_HEADER: usize = 4;
 /// `m`, then `c + β·(look − c)` with the waves' looks weighted by `(ρᵢ/ρ_max)²` (the densities'
 /// dominance rule), glow, the feature texture) for the material's record, at the fragment's world
 /// point, normal, texture coordinates and vertex colour (quantised to 8 bits as hadou's G-buffer
-/// holds it). `lights`, `shading_data` and `polyline_point` are declared here in place of the
+/// holds it); an MToon material (VRMC_materials_mtoon 1.0, `hadou_math::mtoon`) through
+/// shading.wgsl's `mtoon_*` functions, its block in the material's texture buffer, seen from the
+/// view's own eye (`mtoon_eye`) and moved by the uniform's scene time (`mtoon_motion`). `lights`, `shading_data` and `polyline_point` are declared here in place of the
 /// wave pass's (`shading_bindings.wgsl`), `frame` is a private copy of what shading.wgsl reads
 /// of hadou's frame uniforms.
 const FRAGMENT: &str = r"
@@ -62,10 +64,11 @@ struct HadouSurface {
     model: u32,
     wave_blend: f32,
     shadow_mask: u32,
-    pad1: u32,
+    mtoon: u32,
     base_texture: vec4<u32>,
     feature_texture: vec4<u32>,
     ramp: GpuRamp,
+    time: f32,
 }
 @group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> surface: HadouSurface;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<storage, read> lights: array<GpuLight>;
@@ -81,6 +84,17 @@ fn shadow_word(o: u32) -> u32 {
 // No plane-shadow target in Bevy: plane shadows are drawn as maps (shadows.rs).
 fn plane_cast_at(pixel: vec2<u32>) -> u32 {
     return 0u;
+}
+
+// The eye of the view being drawn (Bevy's), not the block's.
+fn mtoon_eye(o: u32) -> vec3<f32> {
+    return view_bindings::view.world_position;
+}
+
+// The block holds `scroll` and `rotation` themselves (built at time 1): times the scene time here,
+// the same f32 products as hadou-cpu's.
+fn mtoon_motion(o: u32) -> vec3<f32> {
+    return mtoon_vec3(o + 18u) * surface.time;
 }
 
 fn polyline_point(offset: u32, i: u32) -> vec3<f32> {
@@ -126,7 +140,7 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     frame.plane_count = 0u;
     let m = GpuMaterial(
         surface.base_color.xyz, surface.model, surface.outline.xyz, surface.wave_blend,
-        surface.outline.w, surface.shadow_mask, 0u, 0u,
+        surface.outline.w, surface.shadow_mask, 0u, surface.mtoon,
         texture_record(surface.base_texture), texture_record(surface.feature_texture), surface.ramp);
     var uv = vec2<f32>(0.0);
 #ifdef VERTEX_UVS_A
@@ -154,7 +168,7 @@ pub(crate) fn shader_source() -> String {
     use hadou_gpu::shaders::{COMMON, ENERGY, SHADING, SHADOW_LOOKUP};
     let (energy, shading, shadows) = (constants(ENERGY), constants(SHADING), constants(SHADOW_LOOKUP));
     format!(
-        "#import bevy_pbr::forward_io::VertexOutput\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}\n{shadows}"
+        "#import bevy_pbr::forward_io::VertexOutput\n#import bevy_pbr::mesh_view_bindings as view_bindings\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}\n{shadows}"
     )
 }
 
@@ -178,8 +192,10 @@ pub struct HadouSurface {
     pub wave_blend: f32,
     /// Bit `s` set when the surface receives shadow `s` of [`crate::HadouShadows`]' frame.
     pub shadow_mask: u32,
-    /// Padding.
-    pub pad1: u32,
+    /// The word offset of the material's MToon block in its texture buffer (hadou-gpu's
+    /// `layout::mtoon_block`, built at time 1 so that its motion words hold the UV scroll and
+    /// rotation themselves); 0 = no MToon look.
+    pub mtoon: u32,
     /// The base-colour texture (`GpuTexture`: word offset in the material's texture buffer, width,
     /// height, sampling flags); offset 0 = none.
     pub base_texture: UVec4,
@@ -187,6 +203,8 @@ pub struct HadouSurface {
     pub feature_texture: UVec4,
     /// The toon ramp (read by `MODEL_TOON` only).
     pub ramp: HadouRamp,
+    /// The scene time in seconds the MToon UV animation is at ([`HadouMaterial::set_time`]).
+    pub time: f32,
 }
 
 /// A toon ramp (`hadou_math::toon::Ramp`, 000 §2.1, SPEC.md §2.1) in the layout of hadou-gpu's
@@ -244,10 +262,11 @@ impl HadouSurface {
             model: g.model,
             wave_blend: g.wave_blend,
             shadow_mask: 0,
-            pad1: 0,
+            mtoon: 0,
             base_texture: textures[0],
             feature_texture: textures[1],
             ramp: HadouRamp::from_gpu(&g.ramp),
+            time: 0.0,
         }
     }
 }
@@ -306,23 +325,28 @@ impl HadouMaterial {
     }
 
     /// As [`HadouMaterial::new`], with `material`'s base and feature textures (sampled as hadou
-    /// samples them: level 0, bilinear in linear light or nearest, its wrap modes) in a buffer of
-    /// their own added to `buffers`.
+    /// samples them: level 0, bilinear in linear light or nearest, its wrap modes) and its MToon
+    /// look (block and textures) in a buffer of their own added to `buffers`.
     pub fn with_textures(
         material: &hadou_scene::Material,
         light: &Light,
         buffers: &mut Assets<ShaderBuffer>,
     ) -> Self {
-        if material.base_texture.is_none() && material.feature_texture.is_none() {
+        if material.base_texture.is_none() && material.feature_texture.is_none() && material.mtoon.is_none() {
             return Self::new(material, light);
         }
         let mut data: Vec<u32> = layout::srgb_words().collect();
         let mut store = TextureStore::default();
         let base = store.texture(&mut data, &material.base_texture);
         let feature = store.texture(&mut data, &material.feature_texture);
+        // At time 1 the motion words are the scroll and rotation; the shader multiplies them by
+        // the uniform's time. The eye words are not read (the view's eye is).
+        let mtoon = layout::mtoon_block(material, 1.0, [0.0; 3], &mut data, &mut store);
         let textures = buffers.add(ShaderBuffer::new(bytes(&data), RenderAssetUsages::default()));
+        let mut surface = HadouSurface::new(material, light, [texture_words(base), texture_words(feature)]);
+        surface.mtoon = mtoon;
         HadouMaterial {
-            surface: HadouSurface::new(material, light, [texture_words(base), texture_words(feature)]),
+            surface,
             lights: WAVE_LIGHTS,
             light_data: WAVE_LIGHT_DATA,
             textures,
@@ -331,12 +355,25 @@ impl HadouMaterial {
         }
     }
 
-    /// Sets the uniform from `material` and `light`, keeping the textures and the shadow mask (e.g. when a track
+    /// The scene time `t` (seconds) for the MToon UV animation (`uvAnimationScrollXSpeedFactor`,
+    /// `…ScrollY…`, `…RotationSpeedFactor`, times `t` as hadou-cpu's `shading::mtoon_point` takes
+    /// them); false when nothing changed (no MToon look, or the same time).
+    pub fn set_time(&mut self, t: f32) -> bool {
+        if self.surface.mtoon == 0 || self.surface.time.to_bits() == t.to_bits() {
+            return false;
+        }
+        self.surface.time = t;
+        true
+    }
+
+    /// Sets the uniform from `material` and `light`, keeping the textures, the MToon block, the time and the shadow mask (e.g. when a track
     /// changes `wave_blend`); false when nothing changed.
     pub fn update(&mut self, material: &hadou_scene::Material, light: &Light) -> bool {
         let textures = [self.surface.base_texture, self.surface.feature_texture];
         let mut surface = HadouSurface::new(material, light, textures);
         surface.shadow_mask = self.surface.shadow_mask;
+        surface.mtoon = self.surface.mtoon;
+        surface.time = self.surface.time;
         let changed = surface != self.surface;
         self.surface = surface;
         changed

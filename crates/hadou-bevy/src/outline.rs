@@ -27,7 +27,7 @@ pub(crate) const SOURCE: &str = r"
 struct HadouOutlineUniform {
     color: vec4<f32>,
     width: f32,
-    pad0: u32,
+    mode: u32,
     pad1: u32,
     pad2: u32,
 }
@@ -63,7 +63,15 @@ fn vertex(v: Vertex) -> @builtin(position) vec4<f32> {
     }
     let forward = -normalize(view.world_from_view[2].xyz);
     let z = dot(base - view.world_position, forward);
-    return position_world_to_clip(base + u * (outline.width * abs(z)));
+    // hadou_scene::Material::hull_push: hadou's d·|z|; an MToon outline in world units w, or in
+    // screen mode 2·tan(fov/2)·w·|z| (w a fraction of the view's height).
+    var push = outline.width * abs(z);
+    if (outline.mode == 1u) {
+        push = outline.width;
+    } else if (outline.mode == 2u) {
+        push = 2.0 * outline.width * abs(z) / view.clip_from_view[1][1];
+    }
+    return position_world_to_clip(base + u * push);
 }
 
 @fragment
@@ -77,10 +85,12 @@ fn fragment() -> @location(0) vec4<f32> {
 pub struct HadouOutlineUniform {
     /// Linear RGB outline colour (`w` unused).
     pub color: Vec4,
-    /// `outline_width` `d`: the push along the normal per unit of view depth.
+    /// `outline_width` `d`: the push along the normal per unit of view depth; for an MToon
+    /// outline its `outlineWidthFactor` `w` ([`HadouOutline::of`]).
     pub width: f32,
-    /// Padding.
-    pub pad0: u32,
+    /// How `width` pushes (`hadou_scene::Material::hull_push`): 0 `d·|z|`, 1 MToon's world
+    /// mode `w`, 2 MToon's screen mode `2·tan(fov/2)·w·|z|`.
+    pub mode: u32,
     /// Padding.
     pub pad1: u32,
     /// Padding.
@@ -100,6 +110,22 @@ pub struct HadouOutline {
 }
 
 impl HadouOutline {
+    /// The outline of `material` under `light`, `None` without one (or of width 0): hadou's, or a
+    /// VRM material's MToon outline (`VRMC_materials_mtoon` "Outline": its width mode, and its
+    /// colour mixed with the light, `Material::outline_rgb`).
+    pub fn of(material: &hadou_scene::Material, light: &hadou_scene::Light) -> Option<Self> {
+        let outline = material.outline.filter(|o| o.width > 0.0)?;
+        let mut hull = HadouOutline::new(&outline);
+        let [r, g, b] = material.outline_rgb(light);
+        hull.outline.color = Vec4::new(r, g, b, 1.0);
+        hull.outline.mode = match material.mtoon.as_ref().map(|t| t.outline_mode) {
+            Some(hadou_scene::OutlineWidthMode::World) => 1,
+            Some(hadou_scene::OutlineWidthMode::Screen) => 2,
+            _ => 0,
+        };
+        Some(hull)
+    }
+
     /// The outline of `outline` (colour, width).
     pub fn new(outline: &hadou_scene::Outline) -> Self {
         let [r, g, b] = outline.color;
@@ -107,7 +133,7 @@ impl HadouOutline {
             outline: HadouOutlineUniform {
                 color: Vec4::new(r, g, b, 1.0),
                 width: outline.width,
-                pad0: 0,
+                mode: 0,
                 pad1: 0,
                 pad2: 0,
             },

@@ -24,8 +24,8 @@ pub(crate) struct ExtractedWaves(pub DrawnWaves);
 #[derive(Resource)]
 pub(crate) struct HadouRenderer(pub GpuBackend);
 
-/// Views already warned about (MSAA, a viewport not at the target's origin, a projection the
-/// pass cannot follow, a failed pass), so each is logged once.
+/// Views already warned about (invalid settings, a projection the pass cannot follow, a failed
+/// pass), so each is logged once.
 #[derive(Resource, Default)]
 pub(crate) struct Warned(HashSet<(Entity, &'static str)>);
 
@@ -104,12 +104,6 @@ pub(crate) fn wave_pass(
     if viewport.z == 0 || viewport.w == 0 {
         return; // a minimised window: nothing to draw into
     }
-    if viewport.x != 0 || viewport.y != 0 {
-        warned.once(entity, "viewport", || {
-            format!("hadou waves are not drawn into view {entity}: its viewport does not start at the target's corner")
-        });
-        return;
-    }
     let world_from_view = extracted.world_from_view.to_matrix();
     let Some(camera) = frame_camera(&world_from_view, &extracted.clip_from_view, settings.far) else {
         warned.once(entity, "projection", || {
@@ -137,6 +131,8 @@ pub(crate) fn wave_pass(
         // is the resolved image the post-processing reads.
         depth_samples: msaa.samples(),
         blend: OverlayBlend::Add,
+        // A viewport's corner (split screen, picture in picture): the frame is the viewport.
+        origin: [viewport.x, viewport.y],
     };
     if let Err(e) = renderer.0.encode_prepared_wave_overlay(&frame, prepared, ctx.command_encoder(), &overlay)
     {

@@ -36,12 +36,15 @@ pub struct HadouShaded {
     /// takes `slots[i]` as it is (its colours and textures already read from the file) instead
     /// of `material` times the `StandardMaterial`. Empty for a model of the game's own.
     pub slots: Vec<hadou_scene::Material>,
+    /// The scene time in seconds an MToon look's UV animation is at ([`HadouMaterial::set_time`]);
+    /// a spawned scene sets it every frame.
+    pub time: f32,
 }
 
 impl HadouShaded {
     /// `material` under `light` for every mesh, receiving the shadows of `shadow_mask`.
     pub fn new(material: hadou_scene::Material, light: hadou_scene::Light, shadow_mask: u32) -> Self {
-        HadouShaded { material, light, shadow_mask, slots: Vec::new() }
+        HadouShaded { material, light, shadow_mask, slots: Vec::new(), time: 0.0 }
     }
 }
 
@@ -144,10 +147,14 @@ pub(crate) fn shade_models(
         for ((_, standard_id), (standard_handle, handle)) in made.iter().filter(|((r, _), _)| *r == root) {
             let Some(source) = standard_materials.get(*standard_id) else { continue };
             let (look, _) = look_of(shaded, standard_handle, source);
-            let differs = materials.get(handle).is_some_and(|m| m.clone().update(&look, &shaded.light));
+            let differs = materials.get(handle).is_some_and(|m| {
+                let mut next = m.clone();
+                next.update(&look, &shaded.light) | next.set_time(shaded.time)
+            });
             if differs {
                 if let Some(mut m) = materials.get_mut(handle) {
                     m.update(&look, &shaded.light);
+                    m.set_time(shaded.time);
                 }
             }
         }
@@ -182,8 +189,9 @@ pub(crate) fn shade_models(
                         None => continue, // still loading
                     }
                 }
-                let material = HadouMaterial::with_textures(&look, &shaded.light, &mut buffers)
+                let mut material = HadouMaterial::with_textures(&look, &shaded.light, &mut buffers)
                     .with_shadow_mask(shaded.shadow_mask);
+                material.set_time(shaded.time);
                 let h = materials.add(material);
                 made.insert(key, (standard_material.0.clone(), h.clone()));
                 h
@@ -191,17 +199,17 @@ pub(crate) fn shade_models(
         };
         let mut e = commands.entity(entity);
         e.remove::<MeshMaterial3d<StandardMaterial>>().insert(MeshMaterial3d(handle));
-        let outline = match gltf_slot(&standard_material.0, shaded.slots.len()) {
-            Some(slot) => shaded.slots[slot].outline,
-            None => shaded.material.outline,
+        let look = match gltf_slot(&standard_material.0, shaded.slots.len()) {
+            Some(slot) => &shaded.slots[slot],
+            None => &shaded.material,
         };
-        if let Some(outline) = outline.filter(|o| o.width > 0.0) {
+        if let Some(outline) = HadouOutline::of(look, &shaded.light) {
             // The hull is drawn from the same mesh (skinned by the same joints: a sibling of the
             // mesh entity keeps its transform and skin).
             let mut hull = commands.spawn((
                 Name::new("outline"),
                 Mesh3d(mesh.0.clone()),
-                MeshMaterial3d(outlines.add(HadouOutline::new(&outline))),
+                MeshMaterial3d(outlines.add(outline)),
             ));
             match skinned {
                 Some(skin) => {

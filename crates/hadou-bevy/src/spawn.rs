@@ -201,11 +201,11 @@ pub fn spawn_object(
             MeshMaterial3d(handle),
             ChildOf(entity),
         ));
-        if let Some(outline) = material.outline.filter(|o| o.width > 0.0) {
+        if let Some(hull) = HadouOutline::of(material, light) {
             commands.spawn((
                 Name::new(format!("{} slot {slot} outline", object.name)),
                 Mesh3d(assets.meshes.add(outline_mesh(&object.mesh, slot))),
-                MeshMaterial3d(assets.outlines.add(HadouOutline::new(&outline))),
+                MeshMaterial3d(assets.outlines.add(hull)),
                 ChildOf(entity),
             ));
         }
@@ -296,6 +296,7 @@ pub(crate) fn spawn_scenes(
                 Some(path) => {
                     let shaded = HadouShaded {
                         slots: object.materials.clone(),
+                        time: frame.time,
                         ..HadouShaded::new(object.material(0).clone(), frame.light, mask)
                     };
                     let entity = commands
@@ -400,9 +401,11 @@ pub(crate) fn animate_scenes(
             }
             if let Ok(mut s) = shaded.get_mut(entity) {
                 // Only a changed look marks the component changed (its materials are updated).
-                if s.slots != object.materials || s.light != frame.light {
+                let moves = s.time != frame.time && object.materials.iter().any(|m| m.mtoon.is_some());
+                if s.slots != object.materials || s.light != frame.light || moves {
                     s.slots.clone_from(&object.materials);
                     s.light = frame.light;
+                    s.time = frame.time;
                 }
             }
             for (slot, handle) in handles.iter().enumerate() {
@@ -410,11 +413,12 @@ pub(crate) fn animate_scenes(
                 // Only a material whose uniform changes is marked changed (and uploaded again).
                 let changed = materials.get(handle).is_some_and(|m| {
                     let mut next = m.clone();
-                    next.update(material, &frame.light)
+                    next.update(material, &frame.light) | next.set_time(frame.time)
                 });
                 if changed {
                     if let Some(mut m) = materials.get_mut(handle) {
                         m.update(material, &frame.light);
+                        m.set_time(frame.time);
                     }
                 }
             }

@@ -52,6 +52,10 @@ pub struct OverlayTarget<'a> {
     pub depth_samples: u32,
     /// How to meet `color`'s contents.
     pub blend: OverlayBlend,
+    /// The pixel of `color` and `depth` where the frame's pixel (0, 0) is drawn: `[0, 0]` for a
+    /// frame the target's size, a viewport's corner otherwise (split screen, picture in picture).
+    /// The frame's `width × height` from there must lie inside both textures.
+    pub origin: [u32; 2],
 }
 
 impl Renderer {
@@ -147,8 +151,14 @@ impl Renderer {
                 DepthModel::Standard => DEPTH_STANDARD,
                 DepthModel::ReverseInfinite => DEPTH_REVERSE_INFINITE,
             };
-            let model =
-                OverlayUniforms { depth_model, near: frame.camera.near, far: frame.camera.far, _pad: 0 };
+            let model = OverlayUniforms {
+                depth_model,
+                near: frame.camera.near,
+                far: frame.camera.far,
+                _pad: 0,
+                origin: target.origin,
+                _pad2: [0; 2],
+            };
             let overlay = uniform("overlay depth model", bytemuck::bytes_of(&model));
             let waves = prepare::storage(d, "overlay waves", or_zeroed(waves, &[GpuWave::zeroed()]));
             let curves = upload_curves(d, curves);
@@ -160,7 +170,7 @@ impl Renderer {
                 curves: [&curves[0], &curves[1], &curves[2]],
             };
             let bind_group = pass.bind_group(d, &layout, &inputs, multisampled);
-            pass.encode(enc, &pipeline, target.color, size, &bind_group);
+            pass.encode(enc, &pipeline, target.color, target.origin, size, &bind_group);
         })
     }
 }

@@ -204,6 +204,7 @@ pub(crate) fn time_wave_overlay(
         depth_model: DepthModel::Standard,
         depth_samples: 1,
         blend: OverlayBlend::Add,
+        origin: [0, 0],
     };
     let once = |r: &mut Renderer| -> Result<f64, RenderError> {
         let start = Instant::now();

@@ -85,6 +85,7 @@ fn overlay_refused(gpu: &mut GpuBackend, frame: &Frame, samples: u32) -> String 
         depth_model: DepthModel::ReverseInfinite,
         depth_samples: samples,
         blend: OverlayBlend::Replace,
+        origin: [0, 0],
     };
     let mut enc = device.create_command_encoder(&Default::default());
     gpu.encode_wave_overlay(frame, &mut enc, &target).expect_err("refused on OpenGL").to_string()
@@ -116,13 +117,31 @@ fn overlay_with(
     samples: u32,
     prepared: bool,
 ) -> Vec<[f32; 4]> {
+    overlay_at(gpu, frame, depth, model, blend, clear, samples, prepared, [0, 0])
+}
+
+/// [`overlay_with`] into textures `origin` larger than the frame in each direction, the frame
+/// drawn at `origin` (a viewport's corner): the frame's pixels, read back from there.
+#[allow(clippy::too_many_arguments)]
+fn overlay_at(
+    gpu: &mut GpuBackend,
+    frame: &Frame,
+    depth: f32,
+    model: DepthModel,
+    blend: OverlayBlend,
+    clear: [f64; 4],
+    samples: u32,
+    prepared: bool,
+    origin: [u32; 2],
+) -> Vec<[f32; 4]> {
     let (w, h) = (frame.width, frame.height);
+    let (tw, th) = (w + origin[0], h + origin[1]);
     let device = gpu.device().clone();
     let queue = gpu.queue().clone();
     let texture = |format, usage, sample_count| {
         device.create_texture(&wgpu::TextureDescriptor {
             label: None,
-            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d { width: tw, height: th, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count,
             dimension: wgpu::TextureDimension::D2,
@@ -180,6 +199,7 @@ fn overlay_with(
         depth_model: model,
         depth_samples: samples,
         blend,
+        origin,
     };
     if prepared {
         let waves = hadou_gpu::layout::frame_waves(frame).expect("the frame's waves");
@@ -196,7 +216,10 @@ fn overlay_with(
         mapped_at_creation: false,
     });
     enc.copy_texture_to_buffer(
-        color.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            origin: wgpu::Origin3d { x: origin[0], y: origin[1], z: 0 },
+            ..color.as_image_copy()
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {
@@ -339,6 +362,7 @@ fn prepared_waves_draw_the_same_overlay() {
         depth_model: model,
         depth_samples: 1,
         blend,
+        origin: [0, 0],
     };
     let other = hadou_gpu::layout::frame_waves(&frame).expect("the other frame's waves");
     let mut enc = device.create_command_encoder(&Default::default());
@@ -367,4 +391,22 @@ fn targets(device: &wgpu::Device, frame: &Frame) -> (wgpu::TextureView, wgpu::Te
             .create_view(&Default::default())
     };
     (make(COLOR_FORMAT), make(wgpu::TextureFormat::Depth32Float))
+}
+
+/// A frame drawn into a viewport whose corner is not the target's (split screen, picture in
+/// picture: `OverlayTarget::origin`) gets the very pixels it gets at the target's corner, clipped
+/// at the same depth; on every backend.
+#[test]
+fn a_viewport_away_from_the_corner_draws_the_same_waves() {
+    let Some(mut gpu) = gpu_or_skip("wave overlay in a viewport") else { return };
+    let frame = kamehameha_frame(40, 24);
+    let (near, z) = (frame.camera.near, 12.5);
+    let clear = [0.0, 0.0, 0.0, 1.0];
+    let (model, blend) = (DepthModel::ReverseInfinite, OverlayBlend::Replace);
+    let corner = overlay_at(&mut gpu, &frame, near / z, model, blend, clear, 1, false, [0, 0]);
+    let moved = overlay_at(&mut gpu, &frame, near / z, model, blend, clear, 1, true, [13, 7]);
+    assert!(corner.iter().any(|p| p[0] > 0.0), "the overlay draws light");
+    // Not a picture that is the same everywhere: a shifted one would differ.
+    assert!(corner.iter().any(|p| p != &corner[0]));
+    assert_eq!(corner, moved, "the frame's pixels at (13, 7)");
 }

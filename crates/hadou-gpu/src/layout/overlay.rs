@@ -13,8 +13,12 @@ pub struct OverlayUniforms {
     pub near: f32,
     /// The camera's far plane (the standard model only).
     pub far: f32,
-    /// Padding to the uniform's 16-byte alignment.
+    /// Padding.
     pub _pad: u32,
+    /// The target's pixel where the frame's pixel (0, 0) is (a viewport's corner).
+    pub origin: [u32; 2],
+    /// Padding to the uniform's 16-byte alignment.
+    pub _pad2: [u32; 2],
 }
 
 /// Depth 0 at the near plane, 1 at the far plane (hadou's raster pass, most engines).

@@ -202,6 +202,7 @@ impl WaveOverlayPass {
         enc: &mut wgpu::CommandEncoder,
         pipeline: &wgpu::RenderPipeline,
         target: &wgpu::TextureView,
+        origin: [u32; 2],
         size: [u32; 2],
         bind_group: &wgpu::BindGroup,
     ) {
@@ -218,7 +219,7 @@ impl WaveOverlayPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_viewport(0.0, 0.0, size[0] as f32, size[1] as f32, 0.0, 1.0);
+        pass.set_viewport(origin[0] as f32, origin[1] as f32, size[0] as f32, size[1] as f32, 0.0, 1.0);
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.draw(0..3, 0..1);

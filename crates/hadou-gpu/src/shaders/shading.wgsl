@@ -282,7 +282,8 @@ fn mtoon_point(m: GpuMaterial, uv_in: vec2<f32>, vcolor: vec4<f32>) -> MtoonPoin
         let channel = min(shading_data[o + 21u], 3u);
         mask = mtoon_data(sample_texture(mask_t, uv_in)[channel], channel);
     }
-    let uv = mtoon_uv(uv_in, mask, vec2<f32>(mtoon_f32(o + 18u), mtoon_f32(o + 19u)), mtoon_f32(o + 20u));
+    let motion = mtoon_motion(o);
+    let uv = mtoon_uv(uv_in, mask, motion.xy, motion.z);
     var p: MtoonPoint;
     p.uv = uv;
     p.albedo = m.base_color * sample_texture(m.base_texture, uv).xyz * vcolor.xyz;
@@ -299,7 +300,7 @@ fn mtoon_point(m: GpuMaterial, uv_in: vec2<f32>, vcolor: vec4<f32>) -> MtoonPoin
 fn mtoon_own(o: u32, p: MtoonPoint, n: vec3<f32>, world: vec3<f32>) -> vec3<f32> {
     let sh = mtoon_shading(dot3(n, -frame.light_dir), p.shift, mtoon_f32(o + 3u));
     let direct = mtoon_lit(p.shade, p.albedo, sh, frame.light_color);
-    let v = normalize_or(mtoon_vec3(o + 24u) - world, n);
+    let v = normalize_or(mtoon_eye(o) - world, n);
     let para = mtoon_rim(dot3(n, v), mtoon_f32(o + 11u), mtoon_f32(o + 7u), mtoon_vec3(o + 4u));
     var cap = vec3<f32>(0.0);
     let cap_t = mtoon_texture(o, 3u);

@@ -3,8 +3,8 @@
 // depth buffer: per pixel exposure · Σ rgb·a·I (wave_energy.wgsl `waves_light`, the same light the
 // wave pass adds to the scene colour before its colour mapping), with no colour mapping, so an
 // engine blends it into its linear image (additively, before its own tone mapping and bloom).
-// Drawn as one full-screen triangle over a viewport the frame's size; fragment (x, y) is the
-// frame's pixel (x, y). Prepended by common.wgsl, energy.wgsl, curve.wgsl and wave_energy.wgsl
+// Drawn as one full-screen triangle over a viewport the frame's size at `overlay.origin`; fragment
+// (x, y) is the frame's pixel (x, y) − origin, and reads the depth buffer at (x, y). Prepended by common.wgsl, energy.wgsl, curve.wgsl and wave_energy.wgsl
 // (bindings 0–1 and 5–7, as in the wave pass).
 
 // The caller's depth buffer (a depth texture read as unfilterable float: GL has no textureLoad of
@@ -19,6 +19,9 @@ struct OverlayUniforms {
     near: f32,
     far: f32,
     _pad: u32,
+    // The target's pixel where the frame's pixel (0, 0) is (a viewport's corner).
+    origin: vec2<u32>,
+    _pad2: vec2<u32>,
 }
 @group(0) @binding(3) var<uniform> overlay: OverlayUniforms;
 
@@ -52,8 +55,8 @@ fn vs_overlay(@builtin(vertex_index) k: u32) -> @builtin(position) vec4<f32> {
 @fragment
 fn fs_overlay(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     load_frame();
-    let px = u32(position.x);
-    let py = u32(position.y);
+    let px = u32(position.x) - overlay.origin.x;
+    let py = u32(position.y) - overlay.origin.y;
     let dir = pixel_dir(frame, px, py);
     let z = view_depth(textureLoad(depth_texels, vec2<i32>(position.xy), 0).x);
     var surface = -1.0;
