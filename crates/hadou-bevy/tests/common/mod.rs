@@ -1,6 +1,8 @@
 //! Shared by the plugin's tests that draw: the adapter check and a Bevy app without a window.
 #![allow(dead_code)]
 
+pub mod picture;
+
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
 use bevy::render::RenderPlugin;
