@@ -70,7 +70,10 @@ pub fn picture_in(
 
     let shot: Arc<Mutex<Option<Image>>> = Arc::default();
     let mut drawn = 0;
+    let start = std::time::Instant::now();
+    let mut frames = 0;
     for _ in 0..2000 {
+        frames += 1;
         app.update();
         if app.world().get::<SpawnedScene>(root).is_some_and(|s| s.ready) {
             drawn += 1;
@@ -90,6 +93,7 @@ pub fn picture_in(
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    eprintln!("{file}: {frames} updates in {:.1} s until the screenshot", start.elapsed().as_secs_f64());
     let image = shot.lock().unwrap().take().expect("the screenshot came back");
     assert_eq!((image.width(), image.height()), (width, height));
     assert_eq!(image.texture_descriptor.format, TextureFormat::Rgba8UnormSrgb);
