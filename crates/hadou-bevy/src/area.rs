@@ -361,7 +361,8 @@ pub(crate) struct AreaWritten {
     record: Vec<u8>,
     capacity: (usize, usize),
     nodes: u64,
-    warned: Option<Entity>,
+    refused: Option<Entity>,
+    over_budget: Option<Entity>,
     warned_many: bool,
 }
 
@@ -432,8 +433,8 @@ pub(crate) fn update_area_light(
         let (bvh, refused) = match hadou_scene::check_trace_memory(tris.len() as u64) {
             Ok(()) => (Bvh::build(&tris), false),
             Err(e) => {
-                if let Some((entity, _, name)) = light.filter(|(e, _, _)| written.warned != Some(*e)) {
-                    written.warned = Some(entity);
+                if let Some((entity, _, name)) = light.filter(|(e, _, _)| written.refused != Some(*e)) {
+                    written.refused = Some(entity);
                     let what = area_rejection_message(
                         entity,
                         name,
@@ -448,8 +449,8 @@ pub(crate) fn update_area_light(
         let gpu_tris: Vec<GpuBvhTri> = bvh.tris.iter().map(GpuBvhTri::from).collect();
         if let Some((entity, l, name)) = light {
             let bound = fragment_loop_bound(l.shape, l.samples, nodes.len() as u64, gpu_tris.len() as u64);
-            if bound > LLVMPIPE_LOOP_BUDGET && written.warned != Some(entity) {
-                written.warned = Some(entity);
+            if bound > LLVMPIPE_LOOP_BUDGET && written.over_budget != Some(entity) {
+                written.over_budget = Some(entity);
                 let who = name.map_or_else(|| format!("{entity}"), |n| format!("{entity} (\"{n}\")"));
                 warn!(
                     "hadou area light {who}: a fragment's walk of its casters' {} triangles may take up to {bound} \

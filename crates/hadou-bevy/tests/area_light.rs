@@ -16,7 +16,8 @@ use bevy::render::storage::ShaderBuffer;
 use common::adapter_or_skip;
 use common::picture::{bevy_picture, difference, scenes};
 use hadou_bevy::{
-    check_area_light, AreaLightRejected, HadouAreaLight, HadouPlugin, AREA_DATA, AREA_NODES, AREA_TRIS,
+    area_rejection_message, check_area_light, AreaLightRejected, HadouAreaLight, HadouPlugin, AREA_DATA,
+    AREA_NODES, AREA_TRIS,
 };
 use hadou_math::soft::LampShape;
 use hadou_scene::{SoftResolve, DEFAULT_TRACE_SAMPLES};
@@ -104,6 +105,12 @@ fn each_bad_value_names_its_key() {
     assert_eq!(bad(&|l| l.target.y = f32::INFINITY), "target");
     assert_eq!(bad(&|l| l.target = l.position), "target");
     assert_eq!(bad(&|l| l.color.z = -1.0), "color");
+    let mut l = lamp(Vec::new());
+    l.samples = 0;
+    let entity = Entity::from_raw_u32(7).unwrap();
+    let line = area_rejection_message(entity, Some(&Name::new("lamp")), &check_area_light(&l).unwrap_err());
+    assert!(line.contains(&entity.to_string()) && line.contains("\"lamp\""), "{line}");
+    assert!(line.contains("`samples`") && line.contains("1..=1024"), "{line}");
     let mut edge = lamp(Vec::new());
     edge.samples = hadou_scene::MAX_TRACE_SAMPLES;
     edge.size = 3.7;
