@@ -9,9 +9,9 @@
 //! whenever one of them moves or changes, and uploaded into [`AREA_NODES`] and [`AREA_TRIS`];
 //! the lamp and its sample layout go to [`AREA_DATA`].
 
-use crate::material::HadouMaterial;
+use crate::material::{HadouMaterial, AREA_DATA, AREA_NODES, AREA_TRIS};
 use crate::outline::HadouOutline;
-use bevy::asset::{uuid_handle, RenderAssetUsages};
+use bevy::asset::RenderAssetUsages;
 use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
@@ -20,16 +20,6 @@ use bytemuck::{Pod, Zeroable};
 use hadou_gpu::layout::{GpuBvhNode, GpuBvhTri, TracedUniforms};
 use hadou_math::soft::{Bvh, LampPattern, LampShape, MAX_TRACE_SAMPLES};
 use hadou_math::Vec3f;
-
-/// The drawn `[area_light]`'s record every [`HadouMaterial`] binds: whether one is drawn, the
-/// lamp (shape, centre, axis, size, colour) and its sample layout (hadou-gpu's `TracedUniforms`).
-pub const AREA_DATA: Handle<ShaderBuffer> = uuid_handle!("6e8a0c2e-4a5b-4c7d-9e1f-3a5c7e9b1d25");
-/// The nodes of the casters' hierarchy (hadou-gpu's `GpuBvhNode`, `hadou_math::soft::BvhNode`'s
-/// bytes); every [`HadouMaterial`] binds it.
-pub const AREA_NODES: Handle<ShaderBuffer> = uuid_handle!("8a0c2e4a-6c7d-4e9f-8a1b-5c7e9b1d3f27");
-/// The triangles of the casters' hierarchy (hadou-gpu's `GpuBvhTri`); every [`HadouMaterial`]
-/// binds it.
-pub const AREA_TRIS: Handle<ShaderBuffer> = uuid_handle!("0c2e4a6c-8e9f-4a1b-9c3d-7e9b1d3f5a29");
 
 /// The largest magnitude of the lamp's and the target's coordinates (the scene reader's bound on
 /// every number without a tighter rule).

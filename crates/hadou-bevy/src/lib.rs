@@ -42,13 +42,13 @@ mod wave;
 
 pub use area::{
     area_rejection_message, check_area_light, fragment_loop_bound, AreaLightError, AreaLightRejected,
-    HadouAreaLight, AREA_COORD_MAX, AREA_DATA, AREA_NODES, AREA_TRIS, LLVMPIPE_LOOP_BUDGET,
+    HadouAreaLight, AREA_COORD_MAX, LLVMPIPE_LOOP_BUDGET,
 };
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
 pub use material::{
-    light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS,
-    NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
+    light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, AREA_DATA, AREA_NODES,
+    AREA_TRIS, MAX_WAVE_LIGHTS, NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
 };
 pub use mesh::{bevy_mesh, bevy_slot_mesh, outline_mesh, slot_indices_of};
 pub use outline::{HadouOutline, HadouOutlineUniform};

@@ -39,6 +39,17 @@ pub const SHADOW_MAPS: Handle<Image> = uuid_handle!("2b4d6f8a-0c1e-4f3a-9b5d-7e9
 /// `GpuShadowCast` and `FrameShadows::map_casts`).
 pub const SHADOW_DATA: Handle<ShaderBuffer> = uuid_handle!("4d6f8a0c-2e3a-4b5c-8d7e-9f1a3c5e7a23");
 
+/// The drawn [`crate::HadouAreaLight`]'s record every [`HadouMaterial`] binds (kept by the
+/// plugin): whether one is drawn, the lamp (shape, centre, axis, size, colour) and its sample
+/// layout (hadou-gpu's `TracedUniforms`).
+pub const AREA_DATA: Handle<ShaderBuffer> = uuid_handle!("6e8a0c2e-4a5b-4c7d-9e1f-3a5c7e9b1d25");
+/// The nodes of the casters' hierarchy (hadou-gpu's `GpuBvhNode`, `hadou_math::soft::BvhNode`'s
+/// bytes); every [`HadouMaterial`] binds it.
+pub const AREA_NODES: Handle<ShaderBuffer> = uuid_handle!("8a0c2e4a-6c7d-4e9f-8a1b-5c7e9b1d3f27");
+/// The triangles of the casters' hierarchy (hadou-gpu's `GpuBvhTri`); every [`HadouMaterial`]
+/// binds it.
+pub const AREA_TRIS: Handle<ShaderBuffer> = uuid_handle!("0c2e4a6c-8e9f-4a1b-9c3d-7e9b1d3f5a29");
+
 /// The most waves that light a surface (hadou-gpu's `MAX_LIGHTS` in shading.wgsl, hadou-scene's
 /// per-scene limit); past it the first by entity are used, and a warning says so once.
 pub const MAX_WAVE_LIGHTS: usize = 256;
@@ -326,13 +337,13 @@ pub struct HadouMaterial {
     /// The shadow records ([`SHADOW_DATA`], kept by the plugin).
     #[storage(5, read_only)]
     pub shadow_data: Handle<ShaderBuffer>,
-    /// The drawn [`crate::HadouAreaLight`] ([`crate::AREA_DATA`], kept by the plugin).
+    /// The drawn [`crate::HadouAreaLight`] ([`AREA_DATA`], kept by the plugin).
     #[storage(6, read_only)]
     pub area: Handle<ShaderBuffer>,
-    /// Its casters' hierarchy: nodes ([`crate::AREA_NODES`], kept by the plugin).
+    /// Its casters' hierarchy: nodes ([`AREA_NODES`], kept by the plugin).
     #[storage(7, read_only)]
     pub area_nodes: Handle<ShaderBuffer>,
-    /// And triangles ([`crate::AREA_TRIS`], kept by the plugin).
+    /// And triangles ([`AREA_TRIS`], kept by the plugin).
     #[storage(8, read_only)]
     pub area_tris: Handle<ShaderBuffer>,
 }
@@ -348,9 +359,9 @@ impl HadouMaterial {
             textures: NO_TEXTURES,
             shadow_maps: SHADOW_MAPS,
             shadow_data: SHADOW_DATA,
-            area: crate::area::AREA_DATA,
-            area_nodes: crate::area::AREA_NODES,
-            area_tris: crate::area::AREA_TRIS,
+            area: AREA_DATA,
+            area_nodes: AREA_NODES,
+            area_tris: AREA_TRIS,
         }
     }
 
@@ -384,9 +395,9 @@ impl HadouMaterial {
             textures,
             shadow_maps: SHADOW_MAPS,
             shadow_data: SHADOW_DATA,
-            area: crate::area::AREA_DATA,
-            area_nodes: crate::area::AREA_NODES,
-            area_tris: crate::area::AREA_TRIS,
+            area: AREA_DATA,
+            area_nodes: AREA_NODES,
+            area_tris: AREA_TRIS,
         }
     }
 
