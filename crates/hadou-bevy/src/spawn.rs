@@ -1,6 +1,7 @@
 //! Spawning a [`HadouScene`] asset: [`HadouSceneRoot`] names the scene; once it has loaded, its
-//! camera, light, objects and waves become entities under the root, and every frame the scene's
-//! tracks at the root's clock set the waves, the object transforms and the camera.
+//! camera, light, objects, waves and area light become entities under the root, and every frame
+//! the scene's tracks at the root's clock set the waves, the object transforms, the camera and
+//! the area light.
 
 use crate::area::HadouAreaLight;
 use crate::asset::HadouScene;
