@@ -7,9 +7,10 @@
 //! A camera's [`HadouCamera::mapping`] picks Bevy's tone mapping or hadou's own colour mapping
 //! ([`ViewMapping::Hadou`]: hadou-gpu's `map_faithful` / `map_filmic` on the HDR image, after
 //! bloom, in place of Bevy's tone mapping). [`HadouMaterial`] shades a mesh with hadou's Lambert
-//! or toon model under a hadou light. A hadou scene file (`.toml`) is a Bevy asset
+//! or toon model under a hadou light, and a [`HadouAreaLight`] adds a lamp's light and soft
+//! shadows (the share of the lamp each fragment sees past the casters' meshes). A hadou scene file (`.toml`) is a Bevy asset
 //! ([`HadouScene`]); a [`HadouSceneRoot`] spawns it (camera with the scene's colour mapping,
-//! light, objects with [`HadouMaterial`]s, waves) and plays its tracks.
+//! light, objects with [`HadouMaterial`]s, waves, area light) and plays its tracks.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -26,6 +27,7 @@
 //! }
 //! ```
 
+mod area;
 mod asset;
 mod camera;
 mod material;
@@ -40,11 +42,15 @@ mod tone;
 mod vrm;
 mod wave;
 
+pub use area::{
+    area_rejection_message, check_area_light, fragment_loop_bound, AreaLightError, AreaLightRejected,
+    HadouAreaLight, AREA_COORD_MAX, LLVMPIPE_LOOP_BUDGET,
+};
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
 pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
 pub use material::{
-    light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, MAX_WAVE_LIGHTS,
-    NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
+    light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, AREA_DATA, AREA_NODES,
+    AREA_TRIS, MAX_WAVE_LIGHTS, NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
 };
 pub use mesh::{bevy_mesh, bevy_slot_mesh, outline_mesh, slot_indices_of};
 pub use outline::{HadouOutline, HadouOutlineUniform};
@@ -87,10 +93,10 @@ impl Default for HadouPlugin {
 pub enum HadouSystems {
     /// Spawning loaded scenes and setting their entities from the tracks (`Update`).
     Scenes,
-    /// Checking changed waves (`PostUpdate`).
+    /// Checking changed waves and area lights (`PostUpdate`).
     CheckWaves,
-    /// Writing the waves as lights for the [`HadouMaterial`]s (`PostUpdate`, after
-    /// [`HadouSystems::CheckWaves`]).
+    /// Writing the waves as lights, the shadows and the area light for the [`HadouMaterial`]s
+    /// (`PostUpdate`, after [`HadouSystems::CheckWaves`]).
     Lights,
 }
 
@@ -112,6 +118,7 @@ impl Plugin for HadouPlugin {
                 app.init_asset::<ShaderBuffer>();
             }
             material::insert_buffers(&mut app.world_mut().resource_mut::<Assets<ShaderBuffer>>());
+            area::insert_buffers(&mut app.world_mut().resource_mut::<Assets<ShaderBuffer>>());
             if !app.world().contains_resource::<Assets<Image>>() {
                 app.init_asset::<Image>();
             }
@@ -120,6 +127,15 @@ impl Plugin for HadouPlugin {
                 shadows::insert_assets(&mut images, &mut world.resource_mut::<Assets<ShaderBuffer>>());
             });
             app.add_systems(PostUpdate, shadows::update_shadows.in_set(HadouSystems::Lights));
+            if app.world().contains_resource::<Assets<Mesh>>() {
+                app.add_systems(
+                    PostUpdate,
+                    area::update_area_light
+                        .in_set(HadouSystems::Lights)
+                        .after(HadouSystems::CheckWaves)
+                        .after(bevy::transform::TransformSystems::Propagate),
+                );
+            }
             if app.world().contains_resource::<Assets<StandardMaterial>>() {
                 app.add_systems(Update, shaded::shade_models);
             }
@@ -144,13 +160,16 @@ impl Plugin for HadouPlugin {
             }
         }
         app.init_resource::<wave::DrawnWaves>();
-        app.add_systems(PostUpdate, wave::check_changed_waves.in_set(HadouSystems::CheckWaves))
-            .add_systems(
-                PostUpdate,
-                wave::prepare_drawn_waves.after(HadouSystems::CheckWaves).before(HadouSystems::Lights),
-            )
-            .add_systems(PostUpdate, (camera::bind_depth, tone::apply_mapping))
-            .add_observer(tone::remove_mapping);
+        app.add_systems(
+            PostUpdate,
+            (wave::check_changed_waves, area::check_changed_area_lights).in_set(HadouSystems::CheckWaves),
+        )
+        .add_systems(
+            PostUpdate,
+            wave::prepare_drawn_waves.after(HadouSystems::CheckWaves).before(HadouSystems::Lights),
+        )
+        .add_systems(PostUpdate, (camera::bind_depth, tone::apply_mapping))
+        .add_observer(tone::remove_mapping);
         if !renders {
             return;
         }

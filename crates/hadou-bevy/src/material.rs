@@ -4,7 +4,9 @@
 //! base and feature textures), fed by Bevy's mesh vertex output. The waves' light records are the
 //! plugin's, shared by every material ([`WAVE_LIGHTS`], [`WAVE_LIGHT_DATA`], refreshed each frame
 //! from the [`crate::HadouWave`]s by [`update_wave_lights`]); a material's textures are in its
-//! own buffer ([`HadouMaterial::textures`]).
+//! own buffer ([`HadouMaterial::textures`]). The drawn [`crate::HadouAreaLight`] adds its light
+//! times the share of its lamp each fragment sees (hadou-gpu's `area_term` and soft_trace.wgsl's
+//! `pixel_visibility`; see `area.rs`).
 
 use crate::wave::DrawnWaves;
 use bevy::asset::{uuid_handle, RenderAssetUsages};
@@ -37,6 +39,17 @@ pub const SHADOW_MAPS: Handle<Image> = uuid_handle!("2b4d6f8a-0c1e-4f3a-9b5d-7e9
 /// `GpuShadowCast` and `FrameShadows::map_casts`).
 pub const SHADOW_DATA: Handle<ShaderBuffer> = uuid_handle!("4d6f8a0c-2e3a-4b5c-8d7e-9f1a3c5e7a23");
 
+/// The drawn [`crate::HadouAreaLight`]'s record every [`HadouMaterial`] binds (kept by the
+/// plugin): whether one is drawn, the lamp (shape, centre, axis, size, colour) and its sample
+/// layout (hadou-gpu's `TracedUniforms`).
+pub const AREA_DATA: Handle<ShaderBuffer> = uuid_handle!("6e8a0c2e-4a5b-4c7d-9e1f-3a5c7e9b1d25");
+/// The nodes of the casters' hierarchy (hadou-gpu's `GpuBvhNode`, `hadou_math::soft::BvhNode`'s
+/// bytes); every [`HadouMaterial`] binds it.
+pub const AREA_NODES: Handle<ShaderBuffer> = uuid_handle!("8a0c2e4a-6c7d-4e9f-8a1b-5c7e9b1d3f27");
+/// The triangles of the casters' hierarchy (hadou-gpu's `GpuBvhTri`); every [`HadouMaterial`]
+/// binds it.
+pub const AREA_TRIS: Handle<ShaderBuffer> = uuid_handle!("0c2e4a6c-8e9f-4a1b-9c3d-7e9b1d3f5a29");
+
 /// The most waves that light a surface (hadou-gpu's `MAX_LIGHTS` in shading.wgsl, hadou-scene's
 /// per-scene limit); past it the first by entity are used, and a warning says so once.
 pub const MAX_WAVE_LIGHTS: usize = 256;
@@ -51,9 +64,13 @@ const LIGHT_DATA_HEADER: usize = 4;
 /// point, normal, texture coordinates and vertex colour (quantised to 8 bits as hadou's G-buffer
 /// holds it); an MToon material (VRMC_materials_mtoon 1.0, `hadou_math::mtoon`) through
 /// shading.wgsl's `mtoon_*` functions, its block in the material's texture buffer, seen from the
-/// view's own eye (`mtoon_eye`) and moved by the uniform's scene time (`mtoon_motion`). `lights`, `shading_data` and `polyline_point` are declared here in place of the
-/// wave pass's (`shading_bindings.wgsl`), `frame` is a private copy of what shading.wgsl reads
-/// of hadou's frame uniforms.
+/// view's own eye (`mtoon_eye`) and moved by the uniform's scene time (`mtoon_motion`); then the
+/// shadows of its mask (`apply_shadows`) and the `[area_light]`'s term (`area_term`) times the
+/// share of the lamp the point sees (soft_trace.wgsl's `pixel_visibility`, where the term adds
+/// light). `lights`, `shading_data` and `polyline_point` are declared here in place of the wave
+/// pass's (`shading_bindings.wgsl`), `nodes`, `tris` and `traced` in place of soft_traced.wgsl's,
+/// `frame` is a private copy of what shading.wgsl and soft_trace.wgsl read of hadou's frame
+/// uniforms.
 const FRAGMENT: &str = r"
 struct HadouSurface {
     base_color: vec4<f32>,
@@ -76,6 +93,24 @@ struct HadouSurface {
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> shading_data: array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(4) var shadow_maps: texture_2d_array<f32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(5) var<storage, read> shadow_data: array<u32>;
+
+// The drawn `[area_light]` (area.rs `AreaRecord`, AREA_DATA): `drawn` 0 when there is none.
+struct HadouArea {
+    drawn: u32,
+    shape: u32,
+    size: f32,
+    pad: u32,
+    position: vec4<f32>,
+    axis: vec4<f32>,
+    color: vec4<f32>,
+    pattern: TracedUniforms,
+}
+@group(#{MATERIAL_BIND_GROUP}) @binding(6) var<storage, read> area: HadouArea;
+// The casters' hierarchy, read by soft_trace.wgsl's pixel_visibility (AREA_NODES, AREA_TRIS).
+@group(#{MATERIAL_BIND_GROUP}) @binding(7) var<storage, read> nodes: array<BvhNode>;
+@group(#{MATERIAL_BIND_GROUP}) @binding(8) var<storage, read> tris: array<BvhTri>;
+// soft_trace.wgsl's sample layout, copied from `area` when a fragment walks the hierarchy.
+var<private> traced: TracedUniforms;
 
 fn shadow_word(o: u32) -> u32 {
     return shadow_data[o];
@@ -110,7 +145,6 @@ struct HadouShadeFrame {
     any_glow: u32,
     area_position: vec3<f32>,
     area_color: vec3<f32>,
-    // The `[area_light]` is not drawn in Bevy: its lamp reads as the segment's.
     area_axis: vec3<f32>,
     area_size: f32,
     area_shape: u32,
@@ -151,8 +185,30 @@ fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
     color = unpack4x8unorm(pack4x8unorm(in.color));
 #endif
     let world = in.world_position.xyz;
-    let c = shade_surface(m, world, in.world_normal, uv, color);
-    return vec4<f32>(apply_shadows(c, m.shadow_mask, world, vec2<u32>(0u)), 1.0);
+    var c = apply_shadows(shade_surface(m, world, in.world_normal, uv, color), m.shadow_mask, world, vec2<u32>(0u));
+    if (area.drawn != 0u) {
+        // As hadou's wave pass: c + visibility · area term, saturated, after the hard shadows. The
+        // visibility is the traced resolve's (soft_traced.wgsl's cs_traced at this fragment's
+        // pixel): only where the term adds light (a point facing away counts 0 there too).
+        frame.area_position = area.position.xyz;
+        frame.area_axis = area.axis.xyz;
+        frame.area_color = area.color.xyz;
+        frame.area_size = area.size;
+        frame.area_shape = area.shape;
+        let t = area_term(m, world, in.world_normal, uv, color);
+        if (t.x > 0.0 || t.y > 0.0 || t.z > 0.0) {
+            traced = area.pattern;
+            let len = length3(in.world_normal);
+            var n = vec3<f32>(0.0);
+            if (len > 0.0 && len < 3.0e38) {
+                n = in.world_normal / len;
+            }
+            let r = world + n * (TRACE_BIAS * length3(world - frame.area_position));
+            let v = pixel_visibility(r, u32(in.position.x), u32(in.position.y));
+            c = vec3<f32>(energy_saturate(c.x + v * t.x), energy_saturate(c.y + v * t.y), energy_saturate(c.z + v * t.z));
+        }
+    }
+    return vec4<f32>(c, 1.0);
 }
 ";
 
@@ -162,13 +218,13 @@ fn constants(wgsl: &str) -> String {
 }
 
 /// The WGSL of [`HadouMaterial`]: Bevy's mesh vertex output, hadou-gpu's `common.wgsl`,
-/// `energy.wgsl`, `shading.wgsl` and `shadow_lookup.wgsl` (their switches as constants), then
-/// [`FRAGMENT`].
+/// `energy.wgsl`, [`FRAGMENT`], `shading.wgsl`, `shadow_lookup.wgsl` (their switches as constants)
+/// and `soft_trace.wgsl` (the traced resolve's per-pixel walk).
 pub(crate) fn shader_source() -> String {
-    use hadou_gpu::shaders::{COMMON, ENERGY, SHADING, SHADOW_LOOKUP};
+    use hadou_gpu::shaders::{COMMON, ENERGY, SHADING, SHADOW_LOOKUP, SOFT_TRACE};
     let (energy, shading, shadows) = (constants(ENERGY), constants(SHADING), constants(SHADOW_LOOKUP));
     format!(
-        "#import bevy_pbr::forward_io::VertexOutput\n#import bevy_pbr::mesh_view_bindings as view_bindings\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}\n{shadows}"
+        "#import bevy_pbr::forward_io::VertexOutput\n#import bevy_pbr::mesh_view_bindings as view_bindings\n{COMMON}\n{energy}\n{FRAGMENT}\n{shading}\n{shadows}\n{SOFT_TRACE}"
     )
 }
 
@@ -301,6 +357,15 @@ pub struct HadouMaterial {
     /// The shadow records ([`SHADOW_DATA`], kept by the plugin).
     #[storage(5, read_only)]
     pub shadow_data: Handle<ShaderBuffer>,
+    /// The drawn [`crate::HadouAreaLight`] ([`AREA_DATA`], kept by the plugin).
+    #[storage(6, read_only)]
+    pub area: Handle<ShaderBuffer>,
+    /// Its casters' hierarchy: nodes ([`AREA_NODES`], kept by the plugin).
+    #[storage(7, read_only)]
+    pub area_nodes: Handle<ShaderBuffer>,
+    /// And triangles ([`AREA_TRIS`], kept by the plugin).
+    #[storage(8, read_only)]
+    pub area_tris: Handle<ShaderBuffer>,
 }
 
 impl HadouMaterial {
@@ -314,6 +379,9 @@ impl HadouMaterial {
             textures: NO_TEXTURES,
             shadow_maps: SHADOW_MAPS,
             shadow_data: SHADOW_DATA,
+            area: AREA_DATA,
+            area_nodes: AREA_NODES,
+            area_tris: AREA_TRIS,
         }
     }
 
@@ -352,6 +420,9 @@ impl HadouMaterial {
             textures,
             shadow_maps: SHADOW_MAPS,
             shadow_data: SHADOW_DATA,
+            area: AREA_DATA,
+            area_nodes: AREA_NODES,
+            area_tris: AREA_TRIS,
         }
     }
 

@@ -1,7 +1,9 @@
 //! Spawning a [`HadouScene`] asset: [`HadouSceneRoot`] names the scene; once it has loaded, its
-//! camera, light, objects and waves become entities under the root, and every frame the scene's
-//! tracks at the root's clock set the waves, the object transforms and the camera.
+//! camera, light, objects, waves and area light become entities under the root, and every frame
+//! the scene's tracks at the root's clock set the waves, the object transforms, the camera and
+//! the area light.
 
+use crate::area::HadouAreaLight;
 use crate::asset::HadouScene;
 use crate::camera::{HadouCamera, ViewMapping};
 use crate::material::HadouMaterial;
@@ -62,6 +64,9 @@ pub struct SpawnedScene {
     pub materials: Vec<Vec<Handle<HadouMaterial>>>,
     /// One entity per `[[wave]]`.
     pub waves: Vec<Entity>,
+    /// The `[area_light]`'s entity ([`HadouAreaLight`], its casters the entities of the
+    /// light's caster objects), if the scene has one.
+    pub area_light: Option<Entity>,
     /// Every object is drawn with hadou's look: true at once for a scene of primitives; a scene
     /// with glTF objects is ready once Bevy has loaded each file (or failed to, with its error
     /// logged) and each of its meshes has been switched to its slot's `HadouMaterial`. Wait for
@@ -136,9 +141,6 @@ fn object_transform(object: &hadou_scene::Object) -> Transform {
 /// logged as one warning when a scene is spawned.
 pub fn unsupported(frame: &Frame) -> Vec<String> {
     let mut out = Vec::new();
-    if frame.area_light.is_some() {
-        out.push("the [area_light] (soft shadows)".into());
-    }
     if frame.bloom.is_some() {
         out.push("the [bloom] (glare)".into());
     }
@@ -324,6 +326,12 @@ pub(crate) fn spawn_scenes(
                     .id()
             })
             .collect();
+        let area_light = frame.area_light.as_ref().map(|light| {
+            let casters = light.casters.iter().filter_map(|&c| objects.get(c as usize).copied()).collect();
+            commands
+                .spawn((Name::new("area_light"), HadouAreaLight::from_scene(light, casters), ChildOf(root)))
+                .id()
+        });
         let ready = object_materials.iter().all(|m| !m.is_empty());
         commands.entity(root).insert(SpawnedScene {
             ready,
@@ -333,6 +341,7 @@ pub(crate) fn spawn_scenes(
             objects,
             materials: object_materials,
             waves,
+            area_light,
         });
     }
 }
@@ -378,6 +387,7 @@ pub(crate) fn animate_scenes(
     mut waves: Query<&mut HadouWave>,
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut shadows: ResMut<HadouShadows>,
+    mut area_lights: Query<&mut HadouAreaLight>,
 ) {
     for (root, mut spawned) in &mut roots {
         let Some(HadouScene(scene)) = scenes.get(&root.scene) else { continue };
@@ -426,6 +436,18 @@ pub(crate) fn animate_scenes(
         for (&entity, wave) in spawned.waves.iter().zip(&frame.waves) {
             if let Ok(mut w) = waves.get_mut(entity) {
                 w.wave = wave.clone();
+            }
+        }
+        if let (Some(light), Some(Ok(mut drawn))) =
+            (&frame.area_light, spawned.area_light.map(|e| area_lights.get_mut(e)))
+        {
+            // Only a moved or changed lamp marks the component changed (and is checked again).
+            let next = HadouAreaLight {
+                enabled: drawn.enabled,
+                ..HadouAreaLight::from_scene(light, drawn.casters.clone())
+            };
+            if next != *drawn {
+                *drawn = next;
             }
         }
         if !frame.shadows.is_empty() {

@@ -10,16 +10,9 @@
 mod common;
 
 use common::adapter_or_skip;
+use common::picture::{bevy_picture, difference, picture_in, scenes};
 
-use bevy::camera::RenderTarget;
-use bevy::image::Image;
-use bevy::prelude::*;
-use bevy::render::render_resource::TextureFormat;
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use hadou_bevy::{HadouCamera, HadouPlugin, HadouSceneRoot, SceneClock, SpawnedScene, ViewMapping};
-use hadou_math::shade::linear_to_srgb8;
-use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use hadou_bevy::ViewMapping;
 
 /// The largest mean absolute difference of the 8-bit RGB values accepted. Measured on Mesa's
 /// lavapipe: 0.001 for the toon scene, 0.06 for kamehameha with either mapping, 0.41 for the wave
@@ -27,108 +20,6 @@ use std::sync::{Arc, Mutex};
 /// same formulas shade and map both sides; the rest is rounding and rasterization at triangle
 /// edges).
 const MAX_MEAN: f64 = 2.0;
-
-fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
-
-/// The image every spawned scene camera renders into, and the mapping it is given instead of the
-/// scene's, if any.
-#[derive(Resource)]
-struct Target(Handle<Image>, Option<ViewMapping>, bevy::render::view::Msaa);
-
-fn into_image(
-    mut commands: Commands,
-    mut cameras: Query<(Entity, &mut HadouCamera), Added<HadouCamera>>,
-    target: Res<Target>,
-) {
-    for (camera, mut settings) in &mut cameras {
-        commands.entity(camera).insert((RenderTarget::Image(target.0.clone().into()), target.2));
-        if let Some(mapping) = target.1 {
-            settings.mapping = mapping;
-        }
-    }
-}
-
-/// The scene `file` at `time` drawn by Bevy into a `width × height` image (with `mapping`
-/// instead of the scene's colour mapping, if given): its sRGB bytes, 4 per pixel, and the spawned
-/// camera's mapping.
-fn bevy_picture(
-    file: &str,
-    time: f32,
-    size: (u32, u32),
-    mapping: Option<ViewMapping>,
-) -> (Vec<u8>, ViewMapping) {
-    picture_in(&scenes(), file, time, size, mapping, bevy::render::view::Msaa::Off)
-}
-
-/// [`bevy_picture`] of the scene `file` in the folder `root`.
-fn picture_in(
-    root: &Path,
-    file: &str,
-    time: f32,
-    (width, height): (u32, u32),
-    mapping: Option<ViewMapping>,
-    msaa: bevy::render::view::Msaa,
-) -> (Vec<u8>, ViewMapping) {
-    let root = root.canonicalize().expect("the scenes folder");
-    let mut app = App::new();
-    app.add_plugins(
-        common::windowless().set(AssetPlugin { file_path: root.display().to_string(), ..default() }),
-    )
-    .add_plugins(HadouPlugin { asset_root: root.clone() });
-    let image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
-    let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
-    app.insert_resource(Target(image.clone(), mapping, msaa)).add_systems(Update, into_image);
-    let scene = app.world().resource::<AssetServer>().load(file.to_string());
-    let root = app.world_mut().spawn(HadouSceneRoot { scene, clock: SceneClock::Frozen(time) }).id();
-    app.finish();
-    app.cleanup();
-
-    let shot: Arc<Mutex<Option<Image>>> = Arc::default();
-    let mut drawn = 0;
-    for _ in 0..2000 {
-        app.update();
-        if app.world().get::<SpawnedScene>(root).is_some_and(|s| s.ready) {
-            drawn += 1;
-        }
-        // A few frames after every object has hadou's look (glTF files load asynchronously),
-        // once the meshes and pipelines are ready.
-        if drawn == 5 {
-            let shot = shot.clone();
-            app.world_mut().spawn(Screenshot::image(image.clone())).observe(
-                move |captured: On<ScreenshotCaptured>| {
-                    *shot.lock().unwrap() = Some(captured.image.clone());
-                },
-            );
-        }
-        if shot.lock().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
-    let image = shot.lock().unwrap().take().expect("the screenshot came back");
-    assert_eq!((image.width(), image.height()), (width, height));
-    assert_eq!(image.texture_descriptor.format, TextureFormat::Rgba8UnormSrgb);
-    let camera = app.world().get::<SpawnedScene>(root).unwrap().camera;
-    let mapping = app.world().get::<HadouCamera>(camera).unwrap().mapping;
-    (image.data.expect("a captured image has its bytes"), mapping)
-}
-
-/// The mean and the largest absolute difference of the RGB bytes of `bevy` (4 per pixel) and
-/// hadou-cpu's `image` encoded as `hadou render` encodes it.
-fn difference(bevy: &[u8], image: &hadou_scene::Image) -> (f64, u8) {
-    assert_eq!(bevy.len(), image.color.len() * 4);
-    let (mut sum, mut max) = (0u64, 0u8);
-    for (b, c) in bevy.chunks_exact(4).zip(&image.color) {
-        for channel in 0..3 {
-            let d = b[channel].abs_diff(linear_to_srgb8(c[channel]));
-            sum += u64::from(d);
-            max = max.max(d);
-        }
-    }
-    (sum as f64 / (image.color.len() * 3) as f64, max)
-}
 
 #[test]
 fn kamehameha_in_bevy_is_the_picture_of_hadou_render() {

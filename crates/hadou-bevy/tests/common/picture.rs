@@ -1,9 +1,5 @@
-//! A scene file spawned by `HadouSceneRoot` and drawn by Bevy into an image, and its difference
-//! from hadou-cpu's render of the same frame, for the tests that hold Bevy's picture to
-//! `hadou render`'s.
-#![allow(dead_code)]
+//! Pictures of spawned scenes drawn by Bevy into images, and their difference from hadou-cpu's.
 
-use super::windowless;
 use bevy::camera::RenderTarget;
 use bevy::image::Image;
 use bevy::prelude::*;
@@ -14,13 +10,13 @@ use hadou_math::shade::linear_to_srgb8;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-/// The example scenes' folder.
+/// The repository's scenes folder.
 pub fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
 }
 
-/// The image every spawned scene camera renders into, the mapping it is given instead of the
-/// scene's, if any, and its multisampling.
+/// The image every spawned scene camera renders into, and the mapping it is given instead of the
+/// scene's, if any.
 #[derive(Resource)]
 struct Target(Handle<Image>, Option<ViewMapping>, bevy::render::view::Msaa);
 
@@ -37,9 +33,19 @@ fn into_image(
     }
 }
 
-/// The scene `file` in the folder `root` at `time`, drawn by Bevy into a `width × height` image
-/// (with `mapping` instead of the scene's colour mapping, if given, and the camera's `msaa`):
-/// its sRGB bytes, 4 per pixel, and the spawned camera's mapping.
+/// The scene `file` at `time` drawn by Bevy into a `width × height` image (with `mapping`
+/// instead of the scene's colour mapping, if given): its sRGB bytes, 4 per pixel, and the spawned
+/// camera's mapping.
+pub fn bevy_picture(
+    file: &str,
+    time: f32,
+    size: (u32, u32),
+    mapping: Option<ViewMapping>,
+) -> (Vec<u8>, ViewMapping) {
+    picture_in(&scenes(), file, time, size, mapping, bevy::render::view::Msaa::Off)
+}
+
+/// [`bevy_picture`] of the scene `file` in the folder `root`.
 pub fn picture_in(
     root: &Path,
     file: &str,
@@ -50,8 +56,10 @@ pub fn picture_in(
 ) -> (Vec<u8>, ViewMapping) {
     let root = root.canonicalize().expect("the scenes folder");
     let mut app = App::new();
-    app.add_plugins(windowless().set(AssetPlugin { file_path: root.display().to_string(), ..default() }))
-        .add_plugins(HadouPlugin { asset_root: root.clone() });
+    app.add_plugins(
+        super::windowless().set(AssetPlugin { file_path: root.display().to_string(), ..default() }),
+    )
+    .add_plugins(HadouPlugin { asset_root: root.clone() });
     let image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
     let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     app.insert_resource(Target(image.clone(), mapping, msaa)).add_systems(Update, into_image);
@@ -62,7 +70,10 @@ pub fn picture_in(
 
     let shot: Arc<Mutex<Option<Image>>> = Arc::default();
     let mut drawn = 0;
+    let start = std::time::Instant::now();
+    let mut frames = 0;
     for _ in 0..2000 {
+        frames += 1;
         app.update();
         if app.world().get::<SpawnedScene>(root).is_some_and(|s| s.ready) {
             drawn += 1;
@@ -82,6 +93,7 @@ pub fn picture_in(
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    eprintln!("{file}: {frames} updates in {:.1} s until the screenshot", start.elapsed().as_secs_f64());
     let image = shot.lock().unwrap().take().expect("the screenshot came back");
     assert_eq!((image.width(), image.height()), (width, height));
     assert_eq!(image.texture_descriptor.format, TextureFormat::Rgba8UnormSrgb);
