@@ -498,6 +498,8 @@ mod tests {
             ("near", offset_of!(crate::layout::OverlayUniforms, near)),
             ("far", offset_of!(crate::layout::OverlayUniforms, far)),
             ("_pad", offset_of!(crate::layout::OverlayUniforms, _pad)),
+            ("origin", offset_of!(crate::layout::OverlayUniforms, origin)),
+            ("_pad2", offset_of!(crate::layout::OverlayUniforms, _pad2)),
         ]
         .iter()
         .map(|&(n, o)| (n.to_string(), o as u32))

@@ -1,4 +1,4 @@
-//! The wave overlay's depth model (`OverlayUniforms`).
+//! The wave overlay's depth model and viewport corner (`OverlayUniforms`).
 
 use bytemuck::{Pod, Zeroable};
 
