@@ -28,7 +28,7 @@ const MAX_MEAN: f64 = 2.0;
 /// Both sides draw the scenes at this size (square, as the scenes' own 512²): on lavapipe every
 /// fragment walks the hierarchy alone, and `soft-plaster` at 512² takes 45–50 s a frame in Bevy
 /// on the 2-core machine, over a dozen frames a test.
-const SIZE: u32 = 160;
+const SIZE: u32 = 112;
 
 /// The scene `file` at `time` in Bevy against hadou-cpu's traced render of the same frame; and,
 /// so that the bound tells the shadows apart, against the same frame with the lamp casting no
