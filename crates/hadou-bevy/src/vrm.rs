@@ -4,13 +4,16 @@
 //! (MToon, spring bones, expressions) itself; Bevy's loader skips them.
 
 use bevy::asset::io::Reader;
+use bevy::asset::AsyncReadExt;
 use bevy::asset::{AssetLoader, LoadContext};
 use bevy::gltf::extensions::GltfExtensionHandlers;
 use bevy::gltf::{DefaultGltfImageSampler, Gltf, GltfError, GltfLoader, GltfLoaderSettings};
 use bevy::image::{CompressedImageFormatSupport, CompressedImageFormats};
 use bevy::prelude::*;
 
-/// Bevy's glTF loader under the `.vrm` extension: the same `Gltf` asset, labels and settings.
+/// Bevy's glTF loader under the `.vrm` extension: the same `Gltf` asset, labels and settings. A
+/// file whose MToon extension is broken (a key of the wrong type, a texture index out of range)
+/// is logged once as an error naming the file, the material and the key, and still loaded.
 #[derive(TypePath)]
 pub struct VrmLoader(pub GltfLoader);
 
@@ -25,7 +28,16 @@ impl AssetLoader for VrmLoader {
         settings: &GltfLoaderSettings,
         load_context: &mut LoadContext<'_>,
     ) -> Result<Gltf, GltfError> {
-        self.0.load(reader, settings, load_context).await
+        let mut bytes = Vec::new();
+        reader.read_to_end(&mut bytes).await?;
+        // hadou's check of the file's MToon materials (`hadou_scene::check_gltf_materials`, the
+        // error `hadou render` gives): a broken extension is one error naming the file, the
+        // material and the key; Bevy's loader reads the rest, and the materials are drawn without
+        // MToon (as every material of a `.vrm` Bevy loads itself is).
+        if let Err(why) = hadou_scene::check_gltf_materials(&bytes) {
+            error!("{}: {why}; its materials are drawn without MToon", load_context.path());
+        }
+        GltfLoader::load_gltf(&self.0, &bytes, load_context, settings).await
     }
 
     fn extensions(&self) -> &[&str] {

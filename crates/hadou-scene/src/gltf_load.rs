@@ -108,6 +108,18 @@ pub fn gltf_from_bytes_with_warnings(bytes: &[u8], dir: &Path) -> Result<(Mesh, 
     Ok((mesh, warnings))
 }
 
+/// Checks the material extensions hadou reads in glTF or GLB `bytes` (a VRM's MToon:
+/// `VRMC_materials_mtoon` 1.0 or VRM 0.x `materialProperties`; `extras.hadou.featureTexture`)
+/// without loading the file: the error [`gltf_from_bytes`] gives for them (naming the material and
+/// the key), for a file another loader reads (e.g. Bevy's glTF loader).
+pub fn check_gltf_materials(bytes: &[u8]) -> Result<(), String> {
+    let json = json_text(sniff(bytes)?)?;
+    check_json_size(&json)?;
+    let raw = raw_json(&json)?;
+    let textures = raw.get("textures").and_then(serde_json::Value::as_array).map_or(0, Vec::len);
+    crate::gltf_material::check_raw(&raw, textures)
+}
+
 /// The JSON text of the file: the `.gltf` itself or a `.glb`'s JSON chunk.
 fn json_text(body: &[u8]) -> Result<std::borrow::Cow<'_, [u8]>, String> {
     if body.starts_with(b"glTF") {

@@ -96,8 +96,8 @@ pub use frame::*;
 pub use gif_timing::{check_gif_size, gif_delay_cs, GIF_MAX_PIXELS, GIF_QUANT_SPEED};
 pub use gltf_anim::MAX_ANIMATION_VALUES;
 pub use gltf_load::{
-    gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf, load_gltf_rig, MAX_MORPH_DELTAS,
-    MAX_MORPH_TARGETS,
+    check_gltf_materials, gltf_from_bytes, gltf_from_bytes_with_warnings, load_gltf, load_gltf_rig,
+    MAX_MORPH_DELTAS, MAX_MORPH_TARGETS,
 };
 pub use gltf_vrma::load_vrma_clip;
 pub use image::{Image, Rgb8Image};

@@ -5,7 +5,9 @@
 mod common;
 
 use common::gltf::Builder;
-use hadou_scene::{encode_png, gltf_from_bytes, gltf_from_bytes_with_warnings, Mesh, OutlineWidthMode};
+use hadou_scene::{
+    check_gltf_materials, encode_png, gltf_from_bytes, gltf_from_bytes_with_warnings, Mesh, OutlineWidthMode,
+};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -247,9 +249,16 @@ fn wrong_types_give_located_messages() {
         ),
     ];
     for (ext, root, want) in cases {
-        let e = gltf_from_bytes(&file(json!([{"extensions": ext}]), root, &[]), Path::new(".")).unwrap_err();
+        let bytes = file(json!([{"extensions": ext}]), root, &[]);
+        let e = gltf_from_bytes(&bytes, Path::new(".")).unwrap_err();
         assert!(e.contains(want), "{e}\nwanted: {want}");
+        // The check another glTF loader runs (hadou-bevy's `.vrm` loader) gives the same message.
+        let checked = check_gltf_materials(&bytes).unwrap_err();
+        assert!(checked.contains(want), "{checked}\nwanted: {want}");
     }
+    // A good MToon material passes the check.
+    let good = json!([{"extensions": {"VRMC_materials_mtoon": {"shadingToonyFactor": 0.5}}}]);
+    check_gltf_materials(&file(good, json!({"VRMC_vrm": {}}), &["VRMC_vrm"])).unwrap();
 }
 
 /// Through a scene file, a `.vrm` with a wrong MToon type is an error at the object's `path`
