@@ -4,7 +4,6 @@
 //! (MToon, spring bones, expressions) itself; Bevy's loader skips them.
 
 use bevy::asset::io::Reader;
-use bevy::asset::AsyncReadExt;
 use bevy::asset::{AssetLoader, LoadContext};
 use bevy::gltf::extensions::GltfExtensionHandlers;
 use bevy::gltf::{DefaultGltfImageSampler, Gltf, GltfError, GltfLoader, GltfLoaderSettings};

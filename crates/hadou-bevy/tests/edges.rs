@@ -43,7 +43,7 @@ name = "box"
 model = "toon"
 base_color = [0.3, 0.45, 0.8]
 outline = true
-outline_width = 0.012
+outline_width = 0.03
 outline_color = [1.0, 0.0, 1.0]
 
 [[object]]

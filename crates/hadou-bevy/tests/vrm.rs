@@ -57,7 +57,7 @@ fn edit_glb(glb: &[u8], from: &str, to: &str) -> Vec<u8> {
     let json = std::str::from_utf8(&glb[20..20 + json_len]).unwrap();
     assert!(json.contains(from), "the file has `{from}`");
     let mut json = json.replacen(from, to, 1).into_bytes();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let rest = &glb[20 + json_len..];
