@@ -1,7 +1,8 @@
 //! Bad input: a `.vrm` whose MToon extension is broken (a key of the wrong type), loaded by Bevy's
 //! glTF loader under hadou's `VrmLoader`, gives one error log naming the file, the material and
 //! the key; the file still loads, its meshes are switched to hadou's shading without MToon, and
-//! the app runs on.
+//! the app runs on. Through a scene file, the scene is refused with the object's `file:line:col`
+//! and the key (as `hadou render` refuses it) and nothing is spawned.
 
 mod common;
 
@@ -12,7 +13,9 @@ use bevy::log::{BoxedLayer, LogPlugin};
 use bevy::prelude::*;
 use bevy::world_serialization::WorldAssetRoot;
 use common::adapter_or_skip;
-use hadou_bevy::{HadouMaterial, HadouPlugin, HadouShaded};
+use hadou_bevy::{
+    HadouMaterial, HadouPlugin, HadouScene, HadouSceneRoot, HadouShaded, SceneClock, SpawnedScene,
+};
 use std::path::Path;
 use std::sync::Mutex;
 
@@ -72,17 +75,58 @@ fn edit_glb(glb: &[u8], from: &str, to: &str) -> Vec<u8> {
     out
 }
 
+/// mtoon-ball.vrm with material 0's `shadingToonyFactor` a string instead of a number.
+fn broken_ball() -> Vec<u8> {
+    let ball =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets/mtoon-ball.vrm"))
+            .unwrap();
+    edit_glb(&ball, "\"shadingToonyFactor\":0.5", "\"shadingToonyFactor\":\"soft\"")
+}
+
+#[test]
+fn a_scene_with_a_broken_vrm_is_refused_at_the_objects_path() {
+    let dir = std::env::temp_dir().join(format!("hadou-bevy-vrm-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("broken.vrm"), broken_ball()).unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        "[[object]]\nname = \"avatar\"\nkind = \"gltf\"\npath = \"broken.vrm\"\n",
+    )
+    .unwrap();
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin { file_path: dir.display().to_string(), ..default() },
+        bevy::mesh::MeshPlugin,
+    ))
+    .add_plugins(HadouPlugin { asset_root: dir.clone() });
+    let handle: Handle<HadouScene> = app.world().resource::<AssetServer>().load("s.toml");
+    let root =
+        app.world_mut().spawn(HadouSceneRoot { scene: handle.clone(), clock: SceneClock::Running }).id();
+    let mut message = None;
+    for _ in 0..1000 {
+        app.update();
+        if let LoadState::Failed(e) = app.world().resource::<AssetServer>().load_state(&handle) {
+            message = Some(e.to_string());
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let message = message.expect("the scene fails to load");
+    assert!(message.contains("s.toml:4:8:"), "the object's path: {message}");
+    assert!(message.contains("material 0 (VRMC_materials_mtoon).shadingToonyFactor"), "the key: {message}");
+    app.update();
+    assert!(app.world().get::<SpawnedScene>(root).is_none(), "nothing spawned");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
 #[test]
 fn a_vrm_with_a_broken_mtoon_is_one_error_and_drawn_without_mtoon() {
     let test = "a_vrm_with_a_broken_mtoon_is_one_error_and_drawn_without_mtoon";
     if !adapter_or_skip(test) {
         return;
     }
-    let ball =
-        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets/mtoon-ball.vrm"))
-            .unwrap();
-    // Material 0's `shadingToonyFactor` a string instead of a number.
-    let broken = edit_glb(&ball, "\"shadingToonyFactor\":0.5", "\"shadingToonyFactor\":\"soft\"");
+    let broken = broken_ball();
     let dir = std::env::temp_dir().join(format!("hadou-bevy-vrm-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("broken.vrm"), &broken).unwrap();
@@ -127,7 +171,7 @@ fn a_vrm_with_a_broken_mtoon_is_one_error_and_drawn_without_mtoon() {
         app.update();
     }
     let errors = ERRORS.lock().unwrap().clone();
-    let ours: Vec<&String> = errors.iter().filter(|e| e.contains("MToon")).collect();
+    let ours: Vec<&String> = errors.iter().filter(|e| e.contains("drawn without MToon")).collect();
     assert_eq!(ours.len(), 1, "one error: {errors:?}");
     let message = ours[0];
     assert!(message.contains("broken.vrm"), "names the file: {message}");
