@@ -1,6 +1,8 @@
-//! An orthographic camera draws the waves along parallel rays against its own depth, and a camera
-//! whose projection or viewport is degenerate draws none, with one error log naming it and the
-//! key, while the app runs on.
+//! An orthographic camera draws the waves along parallel rays against its own depth, with MSAA
+//! off and with every sample count of 2, 4 and 8 the adapter supports (each camera into its own
+//! image, in one app), and a camera whose projection or viewport is degenerate draws none, with
+//! one error log naming it and the key, while the app runs on. Run it on each backend:
+//! `WGPU_BACKEND=vulkan` and `WGPU_BACKEND=gl` (Bevy reads it).
 //!
 //! The picture is held to a reference computed here, independently of the plugin's
 //! `frame_view`: per pixel the ray of `hadou_scene::CameraBasis::wave_ray` (002 eq. 3.12–3.13)
@@ -152,7 +154,8 @@ fn error_lines(_: &mut App) -> Option<BoxedLayer> {
 /// cannot follow.
 #[derive(Resource)]
 struct Cameras {
-    image: Handle<Image>,
+    /// Each orthographic camera's sample count and image (`Msaa::Off` first).
+    images: Vec<(u32, Handle<Image>)>,
     ortho: Entity,
     bad: Vec<(Entity, &'static str)>,
 }
@@ -161,19 +164,38 @@ fn hadou() -> HadouCamera {
     HadouCamera { far: FAR, mapping: ViewMapping::Hadou(ToneMode::Faithful), ..default() }
 }
 
+/// The MSAA sample counts above 1 that Bevy's adapter supports for its HDR target and depth
+/// buffer (of 2, 4 and 8), found once the render app is built.
+#[derive(Resource)]
+struct SampleCounts(Vec<u32>);
+
+fn msaa(samples: u32) -> Msaa {
+    match samples {
+        2 => Msaa::Sample2,
+        4 => Msaa::Sample4,
+        8 => Msaa::Sample8,
+        _ => Msaa::Off,
+    }
+}
+
 fn camera_bundle(image: &Handle<Image>, order: isize) -> impl Bundle {
+    camera_with_samples(image, order, 1)
+}
+
+fn camera_with_samples(image: &Handle<Image>, order: isize, samples: u32) -> impl Bundle {
     (
         Camera3d::default(),
         Camera { order, clear_color: ClearColorConfig::Custom(Color::BLACK), ..default() },
         RenderTarget::Image(image.clone().into()),
         bevy::camera::Hdr,
-        Msaa::Off,
+        msaa(samples),
         Transform::from_xyz(0.0, 0.0, EYE_Z).looking_at(Vec3::ZERO, Vec3::Y),
     )
 }
 
 fn setup(
     mut commands: Commands,
+    counts: Res<SampleCounts>,
     mut images: ResMut<Assets<Image>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
@@ -187,6 +209,15 @@ fn setup(
     };
     let ortho_camera =
         commands.spawn((camera_bundle(&image, 0), Projection::Orthographic(ortho.clone()), hadou())).id();
+    // The same view with each supported MSAA sample count, each into its own image: the waves
+    // clipped at the first sample of the multisampled depth buffer, added to the resolved image.
+    let mut targets = vec![(1, image)];
+    for (k, &samples) in counts.0.iter().enumerate() {
+        let target = images.add(Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None));
+        let camera = camera_with_samples(&target, 10 + k as isize, samples);
+        commands.spawn((camera, Projection::Orthographic(ortho.clone()), hadou()));
+        targets.push((samples, target));
+    }
     // The refused one draws into a spare image, after the orthographic camera: a near plane
     // beyond `HadouCamera::far`. (A NaN `fov`, a zero orthographic `scale` or a viewport of zero
     // size is refused the same way, `degenerate_projections_and_viewports_name_their_key`, but
@@ -195,7 +226,7 @@ fn setup(
     let bad_near = commands
         .spawn((Name::new("deep near"), camera_bundle(&spare, 1), Projection::Perspective(deep), hadou()))
         .id();
-    commands.insert_resource(Cameras { image, ortho: ortho_camera, bad: vec![(bad_near, "near")] });
+    commands.insert_resource(Cameras { images: targets, ortho: ortho_camera, bad: vec![(bad_near, "near")] });
     // The black quad over the left half (x < 0), facing the camera at z = QUAD_Z.
     commands.spawn((
         Mesh3d(meshes.add(Rectangle::new(2.0 * 4.0 * HALF_HEIGHT / 3.0, 4.0 * HALF_HEIGHT))),
@@ -212,8 +243,8 @@ fn setup(
 }
 
 #[test]
-fn an_orthographic_camera_draws_parallel_rays_and_degenerate_cameras_are_refused() {
-    let test = "an_orthographic_camera_draws_parallel_rays_and_degenerate_cameras_are_refused";
+fn orthographic_and_msaa_cameras_draw_against_their_depth_and_bad_ones_are_refused() {
+    let test = "orthographic_and_msaa_cameras_draw_against_their_depth_and_bad_ones_are_refused";
     if !adapter_or_skip(test) {
         return;
     }
@@ -224,42 +255,72 @@ fn an_orthographic_camera_draws_parallel_rays_and_degenerate_cameras_are_refused
         .add_systems(Startup, setup);
     app.finish();
     app.cleanup();
-    let shot: Arc<Mutex<Option<Image>>> = Arc::default();
+    let (backend, counts) = {
+        let adapter = &app.world().resource::<bevy::render::renderer::RenderAdapter>().0;
+        let supported = |format: TextureFormat, n: u32| {
+            adapter.get_texture_format_features(format).flags.sample_count_supported(n)
+        };
+        let counts: Vec<u32> = [2, 4, 8]
+            .into_iter()
+            .filter(|&n| {
+                supported(TextureFormat::Rgba16Float, n) && supported(TextureFormat::Depth32Float, n)
+            })
+            .collect();
+        (adapter.get_info().backend, counts)
+    };
+    eprintln!("{backend:?}: MSAA sample counts tested besides 1: {counts:?} (of 2, 4, 8)");
+    app.insert_resource(SampleCounts(counts));
+    type Shots = Arc<Mutex<Vec<Option<Image>>>>;
+    let shots: Shots = Arc::default();
     for frame in 0..400 {
         app.update();
         if frame == 3 {
-            let image = app.world().resource::<Cameras>().image.clone();
-            let shot = shot.clone();
-            app.world_mut().spawn(Screenshot::image(image)).observe(
-                move |captured: On<ScreenshotCaptured>| {
-                    *shot.lock().unwrap() = Some(captured.image.clone());
-                },
-            );
+            let images = app.world().resource::<Cameras>().images.clone();
+            *shots.lock().unwrap() = vec![None; images.len()];
+            for (k, (_, image)) in images.into_iter().enumerate() {
+                let shots = shots.clone();
+                app.world_mut().spawn(Screenshot::image(image)).observe(
+                    move |captured: On<ScreenshotCaptured>| {
+                        shots.lock().unwrap()[k] = Some(captured.image.clone());
+                    },
+                );
+            }
         }
-        if shot.lock().unwrap().is_some() {
+        if frame > 3 && shots.lock().unwrap().iter().all(Option::is_some) {
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
-    let shot = shot.lock().unwrap().take().expect("the screenshot came back: the app ran on");
-    let bytes = shot.data.expect("a captured image has its bytes");
+    let shots = std::mem::take(&mut *shots.lock().unwrap());
     let (clipped, open) = (reference(true), reference(false));
-    let (mean, largest) = difference(&bytes, &clipped);
-    let (unclipped, _) = difference(&bytes, &open);
     let brightest = clipped.iter().copied().max().unwrap_or(0);
-    eprintln!(
-        "orthographic {}×{}: mean {mean:.3} (largest {largest}) against the parallel rays, {unclipped:.3} against \
-         them unclipped; brightest reference byte {brightest}; {:.1} s",
-        SIZE.0,
-        SIZE.1,
-        start.elapsed().as_secs_f64()
-    );
     assert!(brightest > 128, "the reference waves are too faint to test anything ({brightest})");
-    assert!(mean <= MAX_MEAN, "orthographic view: mean {mean:.3} > {MAX_MEAN} (largest {largest})");
-    assert!(
-        unclipped > 4.0 * MAX_MEAN,
-        "the quad's depth did not clip the waves (mean {unclipped:.3} unclipped)"
-    );
+    let images = app.world().resource::<Cameras>().images.clone();
+    assert_eq!(shots.len(), images.len(), "the screenshots were taken: the app ran on");
+    for ((samples, _), shot) in images.iter().zip(shots) {
+        let shot = shot.expect("the screenshot came back: the app ran on");
+        let bytes = shot.data.expect("a captured image has its bytes");
+        let (mean, largest) = difference(&bytes, &clipped);
+        let (unclipped, _) = difference(&bytes, &open);
+        eprintln!(
+            "orthographic {}×{}, {samples} sample(s): mean {mean:.3} (largest {largest}) against the parallel rays, \
+             {unclipped:.3} against them unclipped; {:.1} s",
+            SIZE.0,
+            SIZE.1,
+            start.elapsed().as_secs_f64()
+        );
+        if *samples > 1 && backend == wgpu::Backend::Gl {
+            // Known bug (issue 45): OpenGL reads a multisampled depth buffer as empty, so an MSAA
+            // view on OpenGL gets no waves (a warning names it).
+            assert!(
+                mean > 4.0 * MAX_MEAN,
+                "{samples} samples on OpenGL drew the waves: issue 45 is fixed, update"
+            );
+            continue;
+        }
+        assert!(mean <= MAX_MEAN, "{samples} sample(s): mean {mean:.3} > {MAX_MEAN} (largest {largest})");
+        assert!(unclipped > 4.0 * MAX_MEAN, "{samples} sample(s): the quad's depth did not clip the waves");
+    }
 
     // The degenerate cameras: rejected with their key, one error line each naming the entity
     // and the key; the orthographic camera is not.

@@ -110,8 +110,11 @@ impl Renderer {
         self.ctx.check()?;
         prepare::validate_frame(frame)?;
         if target.depth_samples > 1 && self.ctx.info.backend == wgpu::Backend::Gl {
-            // Mesa's OpenGL (llvmpipe) reads a multisampled depth texture as if nothing were
-            // drawn (tests/overlay.rs): refused rather than drawn through the caller's surfaces.
+            // OpenGL reads a multisampled depth texture as if nothing were drawn (tests/overlay.rs):
+            // wgpu's GL backend creates a sampled multisampled texture with the target
+            // GL_TEXTURE_2D, so glTexStorage2DMultisample fails (GL_INVALID_ENUM, in its debug
+            // log) and the texture has no storage. Refused rather than drawn through the caller's
+            // surfaces.
             return Err(RenderError::Other(format!(
                 "the wave overlay cannot read a multisampled depth buffer ({} samples) on OpenGL; \
                  draw the view without MSAA",
