@@ -47,7 +47,10 @@ pub use area::{
     HadouAreaLight, AREA_COORD_MAX, LLVMPIPE_LOOP_BUDGET,
 };
 pub use asset::{parse_scene, HadouScene, HadouSceneLoadError, HadouSceneLoader};
-pub use camera::{frame_camera, HadouCamera, ViewMapping, EXPOSURE_MAX};
+pub use camera::{
+    camera_rejection_message, check_camera, frame_camera, frame_view, CameraError, CameraRejected,
+    HadouCamera, ViewMapping, EXPOSURE_MAX,
+};
 pub use material::{
     light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, AREA_DATA, AREA_NODES,
     AREA_TRIS, MAX_WAVE_LIGHTS, NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
@@ -168,7 +171,7 @@ impl Plugin for HadouPlugin {
             PostUpdate,
             wave::prepare_drawn_waves.after(HadouSystems::CheckWaves).before(HadouSystems::Lights),
         )
-        .add_systems(PostUpdate, (camera::bind_depth, tone::apply_mapping))
+        .add_systems(PostUpdate, (camera::bind_depth, camera::check_cameras, tone::apply_mapping))
         .add_observer(tone::remove_mapping);
         if !renders {
             return;

@@ -3,7 +3,7 @@
 //! [`HadouCamera`], a system of Bevy's `Core3d` schedule after the main passes and before
 //! post-processing (bloom, tone mapping), like Bevy's volumetric fog.
 
-use crate::camera::{frame_camera, HadouCamera};
+use crate::camera::{frame_view, HadouCamera};
 use crate::wave::DrawnWaves;
 use bevy::prelude::*;
 use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQueue, ViewQuery};
@@ -105,14 +105,16 @@ pub(crate) fn wave_pass(
         return; // a minimised window: nothing to draw into
     }
     let world_from_view = extracted.world_from_view.to_matrix();
-    let Some(camera) = frame_camera(&world_from_view, &extracted.clip_from_view, settings.far) else {
-        warned.once(entity, "projection", || {
-            format!(
-                "hadou waves are not drawn into view {entity}: it needs a perspective projection with 0 < near < \
-                 HadouCamera::far"
-            )
-        });
-        return;
+    let (camera, projection) = match frame_view(&world_from_view, &extracted.clip_from_view, settings.far) {
+        Ok(view) => view,
+        Err(why) => {
+            // The main world's `check_cameras` rejects the projections it can see; this is the
+            // view as extracted (its transform too).
+            warned.once(entity, "projection", || {
+                format!("hadou waves are not drawn into view {entity}: {why}")
+            });
+            return;
+        }
     };
     let prepared = match drawn.prepared.as_ref() {
         Ok(p) => p,
@@ -133,6 +135,8 @@ pub(crate) fn wave_pass(
         blend: OverlayBlend::Add,
         // A viewport's corner (split screen, picture in picture): the frame is the viewport.
         origin: [viewport.x, viewport.y],
+        // Perspective rays from the eye, or an orthographic view's parallel rays.
+        projection,
     };
     if let Err(e) = renderer.0.encode_prepared_wave_overlay(&frame, prepared, ctx.command_encoder(), &overlay)
     {

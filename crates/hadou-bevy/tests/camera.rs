@@ -1,10 +1,12 @@
-//! `frame_camera`: the hadou camera rebuilt from a Bevy view's matrices sees what the view sees.
+//! `frame_camera`, `frame_view`: the hadou camera and rays rebuilt from a Bevy view's matrices see
+//! what the view sees (perspective and orthographic).
 //! `HadouCamera::mapping`: hadou's colour mapping turns Bevy's tone mapping off on its camera.
 
-use bevy::camera::CameraProjection;
+use bevy::camera::{CameraProjection, ScalingMode};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use hadou_bevy::{frame_camera, HadouCamera, HadouPlugin, ViewMapping};
+use hadou_bevy::{frame_camera, frame_view, HadouCamera, HadouPlugin, ViewMapping};
+use hadou_gpu::OverlayProjection;
 use hadou_scene::ToneMode;
 
 #[test]
@@ -35,11 +37,37 @@ fn a_perspective_view_becomes_the_same_hadou_camera() {
 }
 
 #[test]
-fn an_orthographic_view_has_no_hadou_camera() {
-    let clip_from_view = OrthographicProjection::default_3d().get_clip_from_view();
-    assert!(frame_camera(&Mat4::IDENTITY, &clip_from_view, 100.0).is_none());
+fn an_orthographic_view_becomes_parallel_rays_from_its_near_plane() {
+    let mut projection = OrthographicProjection {
+        scaling_mode: ScalingMode::FixedVertical { viewport_height: 6.0 },
+        near: 0.5,
+        far: 100.0,
+        ..OrthographicProjection::default_3d()
+    };
+    projection.update(128.0, 96.0);
+    let clip_from_view = projection.get_clip_from_view();
+    let world_from_view =
+        Transform::from_xyz(1.0, 2.0, 10.0).looking_at(Vec3::new(1.0, 2.0, 0.0), Vec3::Y).to_matrix();
+    let (camera, rays) = frame_view(&world_from_view, &clip_from_view, 40.0).expect("an orthographic view");
+    let OverlayProjection::Orthographic { centre, right, up, depth_span } = rays else {
+        panic!("not orthographic: {rays:?}")
+    };
+    let close = |a: [f32; 3], b: [f32; 3]| a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-4);
+    // The near plane 0.5 in front of the eye; half-height 3, half-width 4 (4:3).
+    assert!(close(centre, [1.0, 2.0, 9.5]), "centre {centre:?}");
+    assert!(close(right, [4.0, 0.0, 0.0]) && close(up, [0.0, 3.0, 0.0]), "right {right:?}, up {up:?}");
+    assert!((depth_span - 99.5).abs() < 1e-3, "depth span {depth_span}");
+    let basis = camera.basis(128, 96);
+    assert!((basis.forward.z + 1.0).abs() < 1e-6, "forward {:?}", basis.forward);
+    assert_eq!(camera.far, 40.0);
+
+    // A perspective view is still its eye's camera; degenerate projections are refused.
     let clip_from_view = PerspectiveProjection::default().get_clip_from_view();
-    assert!(frame_camera(&Mat4::IDENTITY, &clip_from_view, 1e-4).is_none(), "far before near");
+    let (_, rays) = frame_view(&Mat4::IDENTITY, &clip_from_view, 100.0).unwrap();
+    assert_eq!(rays, OverlayProjection::Perspective);
+    assert!(frame_view(&Mat4::IDENTITY, &clip_from_view, 1e-4).is_err(), "far before near");
+    projection.update(0.0, 96.0);
+    assert!(frame_view(&Mat4::IDENTITY, &projection.get_clip_from_view(), 40.0).is_err(), "zero width");
 }
 
 #[test]

@@ -107,7 +107,7 @@ mod twins;
 mod window;
 
 pub use formats::{PRESENT_FORMAT, PRESENT_USAGE};
-pub use overlay::{DepthModel, OverlayBlend, OverlayTarget};
+pub use overlay::{DepthModel, OverlayBlend, OverlayProjection, OverlayTarget};
 pub use passes::present::PresentedFrame;
 pub use passes::soft::SOFT_BYTES_PER_PIXEL;
 pub use render::MAX_TILE;

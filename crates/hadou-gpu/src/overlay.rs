@@ -3,7 +3,10 @@
 //! owns, recorded into the caller's command encoder. The frame's objects, materials and shadows
 //! are not drawn: the caller's renderer draws its own scene and hadou adds the waves' light to it.
 
-use crate::layout::{self, FrameUniforms, GpuWave, OverlayUniforms, DEPTH_REVERSE_INFINITE, DEPTH_STANDARD};
+use crate::layout::{
+    self, FrameUniforms, GpuWave, OverlayUniforms, DEPTH_REVERSE_INFINITE, DEPTH_STANDARD,
+    PROJECTION_ORTHOGRAPHIC, PROJECTION_PERSPECTIVE,
+};
 use crate::passes::wave::WaveVariant;
 use crate::passes::wave_overlay::{OverlayInputs, WaveOverlayPass};
 use crate::prepare::{self, check_curves, or_zeroed, upload_curves};
@@ -34,6 +37,34 @@ pub enum OverlayBlend {
     Replace,
 }
 
+/// The rays the overlay integrates along, one per pixel (002 §3.3.3, eq. 3.12–3.13, with the
+/// frame camera's `far` as the far plane's distance in both).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OverlayProjection {
+    /// From the frame camera's eye through each pixel (`CameraBasis::wave_ray`); the depth buffer
+    /// is read by its [`DepthModel`].
+    Perspective,
+    /// Parallel rays along the frame camera's forward axis (an orthographic view), each starting
+    /// at its pixel's point on the view's near plane: `centre + right·ndc_x + up·ndc_y` for the
+    /// pixel centre's normalised device coordinates (x right, y up, −1..1 over the frame). The
+    /// span and the far point are those of `CameraBasis::wave_ray` for the direction `forward`
+    /// (|dir| = 1): the faithful falloff's `t ∈ [0, g]` along `forward·far`, the inverse square's
+    /// `t ∈ [0, d]`. The depth buffer runs linearly over `depth_span` from the near plane:
+    /// [`DepthModel::Standard`] 0 at the near plane and 1 at the far (cleared to 1),
+    /// [`DepthModel::ReverseInfinite`] read as reverse-Z, 1 at the near plane and 0 at the far
+    /// (cleared to 0: Bevy's orthographic projection).
+    Orthographic {
+        /// The world point on the near plane at the frame's centre.
+        centre: [f32; 3],
+        /// The world vector from `centre` to the near plane's point at NDC x = +1.
+        right: [f32; 3],
+        /// The world vector from `centre` to the near plane's point at NDC y = +1.
+        up: [f32; 3],
+        /// The distance from the near plane to the far plane of the depth buffer's range.
+        depth_span: f32,
+    },
+}
+
 /// Where [`crate::GpuBackend::encode_wave_overlay`] draws: views the caller owns, at least the
 /// frame's `width × height`, pixel (x, y) of the frame at texel (x, y).
 #[derive(Clone, Copy, Debug)]
@@ -56,6 +87,8 @@ pub struct OverlayTarget<'a> {
     /// frame the target's size, a viewport's corner otherwise (split screen, picture in picture).
     /// The frame's `width × height` from there must lie inside both textures.
     pub origin: [u32; 2],
+    /// The rays: the frame camera's perspective, or an orthographic view's parallel rays.
+    pub projection: OverlayProjection,
 }
 
 impl Renderer {
@@ -77,13 +110,25 @@ impl Renderer {
         self.ctx.check()?;
         prepare::validate_frame(frame)?;
         if target.depth_samples > 1 && self.ctx.info.backend == wgpu::Backend::Gl {
-            // Mesa's OpenGL (llvmpipe) reads a multisampled depth texture as if nothing were
-            // drawn (tests/overlay.rs): refused rather than drawn through the caller's surfaces.
+            // OpenGL reads a multisampled depth texture as if nothing were drawn (tests/overlay.rs):
+            // wgpu's GL backend creates a sampled multisampled texture with the target
+            // GL_TEXTURE_2D, so glTexStorage2DMultisample fails (GL_INVALID_ENUM, in its debug
+            // log) and the texture has no storage. Refused rather than drawn through the caller's
+            // surfaces.
             return Err(RenderError::Other(format!(
                 "the wave overlay cannot read a multisampled depth buffer ({} samples) on OpenGL; \
                  draw the view without MSAA",
                 target.depth_samples
             )));
+        }
+        if let OverlayProjection::Orthographic { centre, right, up, depth_span } = target.projection {
+            let finite = centre.iter().chain(&right).chain(&up).all(|c| c.is_finite());
+            if !(finite && depth_span.is_finite() && depth_span > 0.0) {
+                return Err(RenderError::Other(format!(
+                    "the wave overlay's orthographic projection must be finite with depth_span > 0, got \
+                     centre {centre:?}, right {right:?}, up {up:?}, depth_span {depth_span}"
+                )));
+            }
         }
         Ok(())
     }
@@ -151,13 +196,24 @@ impl Renderer {
                 DepthModel::Standard => DEPTH_STANDARD,
                 DepthModel::ReverseInfinite => DEPTH_REVERSE_INFINITE,
             };
+            let v4 = |v: [f32; 3]| [v[0], v[1], v[2], 0.0];
+            let (projection, centre, right, up, depth_span) = match target.projection {
+                OverlayProjection::Perspective => (PROJECTION_PERSPECTIVE, [0.0; 3], [0.0; 3], [0.0; 3], 0.0),
+                OverlayProjection::Orthographic { centre, right, up, depth_span } => {
+                    (PROJECTION_ORTHOGRAPHIC, centre, right, up, depth_span)
+                }
+            };
             let model = OverlayUniforms {
                 depth_model,
                 near: frame.camera.near,
                 far: frame.camera.far,
-                _pad: 0,
+                projection,
                 origin: target.origin,
-                _pad2: [0; 2],
+                depth_span,
+                _pad: 0,
+                ortho_centre: v4(centre),
+                ortho_right: v4(right),
+                ortho_up: v4(up),
             };
             let overlay = uniform("overlay depth model", bytemuck::bytes_of(&model));
             let waves = prepare::storage(d, "overlay waves", or_zeroed(waves, &[GpuWave::zeroed()]));

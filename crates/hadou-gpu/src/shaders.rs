@@ -497,9 +497,13 @@ mod tests {
             ("depth_model", offset_of!(crate::layout::OverlayUniforms, depth_model)),
             ("near", offset_of!(crate::layout::OverlayUniforms, near)),
             ("far", offset_of!(crate::layout::OverlayUniforms, far)),
-            ("_pad", offset_of!(crate::layout::OverlayUniforms, _pad)),
+            ("projection", offset_of!(crate::layout::OverlayUniforms, projection)),
             ("origin", offset_of!(crate::layout::OverlayUniforms, origin)),
-            ("_pad2", offset_of!(crate::layout::OverlayUniforms, _pad2)),
+            ("depth_span", offset_of!(crate::layout::OverlayUniforms, depth_span)),
+            ("_pad", offset_of!(crate::layout::OverlayUniforms, _pad)),
+            ("ortho_centre", offset_of!(crate::layout::OverlayUniforms, ortho_centre)),
+            ("ortho_right", offset_of!(crate::layout::OverlayUniforms, ortho_right)),
+            ("ortho_up", offset_of!(crate::layout::OverlayUniforms, ortho_up)),
         ]
         .iter()
         .map(|&(n, o)| (n.to_string(), o as u32))

@@ -205,6 +205,7 @@ pub(crate) fn time_wave_overlay(
         depth_samples: 1,
         blend: OverlayBlend::Add,
         origin: [0, 0],
+        projection: crate::OverlayProjection::Perspective,
     };
     let once = |r: &mut Renderer| -> Result<f64, RenderError> {
         let start = Instant::now();

@@ -13,7 +13,7 @@ mod common;
 
 use common::{gpu_or_skip, kamehameha_frame};
 use hadou_cpu::CpuBackend;
-use hadou_gpu::{DepthModel, GpuBackend, OverlayBlend, OverlayTarget};
+use hadou_gpu::{DepthModel, GpuBackend, OverlayBlend, OverlayProjection, OverlayTarget};
 use hadou_math::Mat4;
 use hadou_scene::{Backend, Frame, Mesh, Object};
 use std::sync::Arc;
@@ -86,6 +86,7 @@ fn overlay_refused(gpu: &mut GpuBackend, frame: &Frame, samples: u32) -> String 
         depth_samples: samples,
         blend: OverlayBlend::Replace,
         origin: [0, 0],
+        projection: OverlayProjection::Perspective,
     };
     let mut enc = device.create_command_encoder(&Default::default());
     gpu.encode_wave_overlay(frame, &mut enc, &target).expect_err("refused on OpenGL").to_string()
@@ -200,6 +201,7 @@ fn overlay_at(
         depth_samples: samples,
         blend,
         origin,
+        projection: OverlayProjection::Perspective,
     };
     if prepared {
         let waves = hadou_gpu::layout::frame_waves(frame).expect("the frame's waves");
@@ -363,6 +365,7 @@ fn prepared_waves_draw_the_same_overlay() {
         depth_samples: 1,
         blend,
         origin: [0, 0],
+        projection: OverlayProjection::Perspective,
     };
     let other = hadou_gpu::layout::frame_waves(&frame).expect("the other frame's waves");
     let mut enc = device.create_command_encoder(&Default::default());
