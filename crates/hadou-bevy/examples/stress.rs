@@ -6,7 +6,8 @@
 //! cargo run --manifest-path crates/hadou-bevy/Cargo.toml --example stress -- \
 //!     [--json] [--frames N] [--width W --height H] [--characters C] [--waves K]
 //! ```
-//! The load (defaults: 20 characters, 8 waves, 640×360, 30 frames a measurement): the character
+//! The load (defaults: 20 characters, 8 waves, 640×360, 30 frames a measurement, rounded up to
+//! whole blocks of five): the character
 //! of `scenes/light-brace.toml` (`assets/brace.glb`), loaded C times by Bevy's glTF loader, each
 //! playing the file's `brace` clip on repeat with Bevy's `AnimationPlayer`, character `i` at
 //! phase `i / C` of the clip, drawn with `HadouShaded` (the file's materials in hadou's look, with
