@@ -19,20 +19,18 @@
 //!
 //! The ratio `in Bevy / alone` is what the issue's bound (≤ 1.2) is about.
 
+mod common;
+
 use bevy::camera::RenderTarget;
 use bevy::image::Image;
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
-use bevy::render::renderer::RenderDevice;
-use bevy::render::{RenderApp, RenderPlugin};
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
+use common::{camera, json_string, median, whole_number, windowless_plugins, FrameClock};
 use hadou_bevy::{HadouCamera, HadouPlugin, HadouWave, ViewMapping};
 use hadou_gpu::GpuBackend;
 use hadou_scene::Frame;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
 struct Options {
     json: bool,
@@ -47,19 +45,12 @@ fn parse_args() -> Result<Options, String> {
     let mut o = Options { json: false, frames: 20, size: None, scenes: Vec::new() };
     let (mut width, mut height) = (None, None);
     let mut args = std::env::args().skip(1);
-    let number = |flag: &str, v: Option<String>| -> Result<u32, String> {
-        let v = v.ok_or(format!("{flag} needs a value"))?;
-        match v.parse::<u32>() {
-            Ok(n) if (1..=16384).contains(&n) => Ok(n),
-            _ => Err(format!("{flag}: `{v}` is not a whole number in 1..=16384")),
-        }
-    };
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--json" => o.json = true,
-            "--frames" => o.frames = number("--frames", args.next())?,
-            "--width" => width = Some(number("--width", args.next())?),
-            "--height" => height = Some(number("--height", args.next())?),
+            "--frames" => o.frames = whole_number("--frames", args.next())?,
+            "--width" => width = Some(whole_number("--width", args.next())?),
+            "--height" => height = Some(whole_number("--height", args.next())?),
             _ if arg.starts_with("--") => return Err(format!("unknown flag `{arg}`")),
             _ => {
                 let (file, t) = arg.rsplit_once('@').ok_or(format!("`{arg}`: give SCENE.toml@TIME"))?;
@@ -104,48 +95,12 @@ impl Row {
     }
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-/// The camera of `frame` as a Bevy transform and projection.
-fn camera(frame: &Frame) -> (Transform, Projection) {
-    let c = &frame.camera;
-    let v = |p: hadou_math::Vec3f| Vec3::new(p.x, p.y, p.z);
-    let transform = Transform::from_translation(v(c.position)).looking_at(v(c.target), v(c.up));
-    let projection = Projection::Perspective(PerspectiveProjection {
-        fov: c.fov_y_deg.to_radians(),
-        near: c.near,
-        far: c.far,
-        ..default()
-    });
-    (transform, projection)
-}
-
 /// Median frame times (ms) of a Bevy app drawing `frame`'s waves, with them on and off.
 fn time_in_bevy(frame: &Frame, frames: u32) -> (f64, f64) {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .build()
-            .disable::<WinitPlugin>()
-            // One app per scene; the first would own the global logger.
-            .disable::<bevy::log::LogPlugin>()
-            // Each frame rendered within its update, so that the wait below follows it.
-            .disable::<bevy::render::pipelined_rendering::PipelinedRenderingPlugin>()
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() }),
-    )
-    .add_plugins(HadouPlugin::default());
+    // One app per scene; the first would own the global logger.
+    app.add_plugins(windowless_plugins().disable::<bevy::log::LogPlugin>())
+        .add_plugins(HadouPlugin::default());
     let image = Image::new_target_texture(frame.width, frame.height, TextureFormat::Rgba8UnormSrgb, None);
     let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     let (transform, projection) = camera(frame);
@@ -166,13 +121,8 @@ fn time_in_bevy(frame: &Frame, frames: u32) -> (f64, f64) {
         frame.waves.iter().map(|w| app.world_mut().spawn(HadouWave::new(w.clone())).id()).collect();
     app.finish();
     app.cleanup();
-    let device = app.sub_app(RenderApp).world().resource::<RenderDevice>().wgpu_device().clone();
-    let frame_ms = |app: &mut App| {
-        let start = Instant::now();
-        app.update();
-        let _ = device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None });
-        start.elapsed().as_secs_f64() * 1e3
-    };
+    let clock = FrameClock::new(&app);
+    let frame_ms = |app: &mut App| clock.frame_ms(app);
     let set = |app: &mut App, on: bool| {
         for &w in &waves {
             app.world_mut().get_mut::<HadouWave>(w).unwrap().enabled = on;
@@ -195,20 +145,7 @@ fn time_in_bevy(frame: &Frame, frames: u32) -> (f64, f64) {
             off.push(frame_ms(&mut app));
         }
     }
-    (median(on), median(off))
-}
-
-fn json_string(s: &str) -> String {
-    let mut out = String::from("\"");
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out + "\""
+    (median(&on), median(&off))
 }
 
 fn main() -> ExitCode {
