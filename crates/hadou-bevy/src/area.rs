@@ -230,7 +230,7 @@ pub fn fragment_loop_bound(shape: LampShape, samples: u32, nodes: u64, tris: u64
 /// `GlobalTransform`, a skinned one posed by its joints (`Σ wᵢ · joint_globalᵢ · inverse_bindposeᵢ`,
 /// as Bevy's skinning does). Meshes not loaded yet, and triangles with an index out of range,
 /// are left out.
-fn caster_triangles(root: Entity, scene: &CasterScene, out: &mut Vec<[Vec3f; 3]>) {
+pub(crate) fn caster_triangles(root: Entity, scene: &CasterScene, out: &mut Vec<[Vec3f; 3]>) {
     let entities = std::iter::once(root).chain(scene.children.iter_descendants(root));
     for e in entities {
         let Ok((mesh, global, skin)) = scene.meshes.get(e) else { continue };
@@ -301,16 +301,17 @@ fn skinned(mesh: &Mesh, skin: &SkinnedMesh, scene: &CasterScene) -> Option<Vec<M
     Some(matrices)
 }
 
-/// What the casters' triangles are read from.
-struct CasterScene<'a, 'w, 's> {
-    children: &'a Query<'w, 's, &'static Children>,
-    meshes: &'a Query<'w, 's, CasterMesh, Without<MeshMaterial3d<HadouOutline>>>,
-    globals: &'a Query<'w, 's, &'static GlobalTransform>,
-    mesh_assets: &'a Assets<Mesh>,
-    bindposes: Option<&'a Assets<SkinnedMeshInverseBindposes>>,
+/// What the casters' triangles are read from (also the shadows' drawn poses, shadows.rs).
+pub(crate) struct CasterScene<'a, 'w, 's> {
+    pub(crate) children: &'a Query<'w, 's, &'static Children>,
+    pub(crate) meshes: &'a Query<'w, 's, CasterMesh, Without<MeshMaterial3d<HadouOutline>>>,
+    pub(crate) globals: &'a Query<'w, 's, &'static GlobalTransform>,
+    pub(crate) mesh_assets: &'a Assets<Mesh>,
+    pub(crate) bindposes: Option<&'a Assets<SkinnedMeshInverseBindposes>>,
 }
 
-type CasterMesh = (&'static Mesh3d, &'static GlobalTransform, Option<&'static SkinnedMesh>);
+/// A mesh a caster draws: its mesh, its transform and its skin, if skinned.
+pub(crate) type CasterMesh = (&'static Mesh3d, &'static GlobalTransform, Option<&'static SkinnedMesh>);
 
 /// What decides whether the casters' triangles changed: per caster mesh its entity, mesh, whether
 /// the mesh is loaded, its transform and its joints' transforms.

@@ -30,6 +30,9 @@
 mod area;
 mod asset;
 mod camera;
+#[cfg(feature = "gltf")]
+mod clips;
+mod drawn_pose;
 mod material;
 mod mesh;
 mod outline;
@@ -51,6 +54,9 @@ pub use camera::{
     camera_rejection_message, check_camera, frame_camera, frame_view, CameraError, CameraRejected,
     HadouCamera, ViewMapping, EXPOSURE_MAX,
 };
+#[cfg(feature = "gltf")]
+pub use clips::{clip_rejection_message, ClipRejected, HadouClip};
+pub use drawn_pose::triangles_mesh;
 pub use material::{
     light_records, prepared_light_records, HadouMaterial, HadouRamp, HadouSurface, AREA_DATA, AREA_NODES,
     AREA_TRIS, MAX_WAVE_LIGHTS, NO_TEXTURES, SHADOW_DATA, SHADOW_MAPS, WAVE_LIGHTS, WAVE_LIGHT_DATA,
@@ -142,6 +148,17 @@ impl Plugin for HadouPlugin {
             if app.world().contains_resource::<Assets<StandardMaterial>>() {
                 app.add_systems(Update, shaded::shade_models);
             }
+            if app.world().contains_resource::<Assets<Mesh>>() {
+                app.add_systems(
+                    PostUpdate,
+                    drawn_pose::shadows_from_drawn_poses
+                        .in_set(HadouSystems::Lights)
+                        .after(bevy::transform::TransformSystems::Propagate)
+                        .before(shadows::update_shadows),
+                );
+            }
+            #[cfg(feature = "gltf")]
+            app.add_systems(Update, clips::play_clips.after(HadouSystems::Scenes));
             app.add_systems(
                 PostUpdate,
                 material::update_wave_lights.in_set(HadouSystems::Lights).after(HadouSystems::CheckWaves),

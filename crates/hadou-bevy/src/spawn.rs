@@ -6,6 +6,8 @@
 use crate::area::HadouAreaLight;
 use crate::asset::HadouScene;
 use crate::camera::{HadouCamera, ViewMapping};
+#[cfg(feature = "gltf")]
+use crate::clips::{ClipPlayback, ClipRejected, HadouClip};
 use crate::material::HadouMaterial;
 use crate::mesh::{bevy_mesh, outline_mesh, slot_indices_of};
 use crate::outline::HadouOutline;
@@ -56,7 +58,8 @@ pub struct SpawnedScene {
     /// that has triangles (`Mesh3d`, `HadouMaterial`) and one per outlined slot
     /// (`HadouOutline`); a `kind = "gltf"` object is the file's scene loaded by Bevy's glTF
     /// loader (`WorldAssetRoot`, skinned and animated by Bevy) with [`crate::HadouShaded`]
-    /// giving each of its meshes its slot's look.
+    /// giving each of its meshes its slot's look, and a `HadouClip` (feature `gltf`) at the
+    /// scene's clip time when it plays an `animation`.
     pub objects: Vec<Entity>,
     /// Per object, the material of each slot (the object's materials in order), set from the
     /// scene every frame (tracks may change `wave_blend`, colours, the light); empty for a glTF
@@ -309,6 +312,9 @@ pub(crate) fn spawn_scenes(
                             shaded,
                         ))
                         .id();
+                    if let Some((name, time)) = scene.object_clip_at(i, frame.time) {
+                        commands.entity(entity).insert(HadouClip { name, time });
+                    }
                     (entity, Vec::new())
                 }
                 _ => spawn_object(&mut commands, &mut assets, object, &frame.light, mask),
@@ -388,11 +394,23 @@ pub(crate) fn animate_scenes(
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut shadows: ResMut<HadouShadows>,
     mut area_lights: Query<&mut HadouAreaLight>,
+    #[cfg(feature = "gltf")] mut clips: Query<&mut HadouClip>,
 ) {
     for (root, mut spawned) in &mut roots {
         let Some(HadouScene(scene)) = scenes.get(&root.scene) else { continue };
         spawned.elapsed += time.delta_secs();
         let frame = scene.at(scene_time(root.clock, spawned.elapsed, scene.duration()));
+        #[cfg(feature = "gltf")]
+        for (i, &entity) in spawned.objects.iter().enumerate() {
+            // The clip time of hadou-scene's rule (`animation_start`, `animation_speed`,
+            // `animation_loop`, `animation_time`), written only when it changes.
+            if let (Ok(mut clip), Some((_, t))) = (clips.get_mut(entity), scene.object_clip_at(i, frame.time))
+            {
+                if clip.time != t {
+                    clip.time = t;
+                }
+            }
+        }
         if let Ok(mut t) = transforms.get_mut(spawned.camera) {
             *t = camera_transform(&frame);
         }
@@ -459,6 +477,7 @@ pub(crate) fn animate_scenes(
 /// Sets [`SpawnedScene::ready`] once every glTF object's file has loaded (or failed to) and each
 /// of its meshes has its slot's [`HadouMaterial`].
 #[cfg(feature = "gltf")]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn mark_ready(
     mut roots: Query<&mut SpawnedScene>,
     models: Query<&WorldAssetRoot, With<HadouShaded>>,
@@ -466,12 +485,20 @@ pub(crate) fn mark_ready(
     standard: Query<(), With<MeshMaterial3d<StandardMaterial>>>,
     shaded: Query<(), With<MeshMaterial3d<HadouMaterial>>>,
     asset_server: Res<AssetServer>,
+    clips: Query<(Option<&ClipPlayback>, Has<ClipRejected>), With<HadouClip>>,
+    animation: Option<Res<Assets<bevy::animation::graph::AnimationGraph>>>,
 ) {
     for mut spawned in roots.iter_mut().filter(|s| !s.ready) {
         let ready = spawned.objects.iter().all(|&object| {
             let Ok(model) = models.get(object) else { return true };
             if asset_server.load_state(&model.0).is_failed() {
                 return true;
+            }
+            // A clip is bound to its player (or rejected) before the first posed frame.
+            if let Ok((playback, rejected)) = clips.get(object) {
+                if animation.is_some() && !rejected && !playback.is_some_and(ClipPlayback::is_bound) {
+                    return false;
+                }
             }
             let (mut switched, mut left) = (0, 0);
             for e in children.iter_descendants(object) {

@@ -50,10 +50,24 @@ pub fn picture_in(
     root: &Path,
     file: &str,
     time: f32,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     mapping: Option<ViewMapping>,
     msaa: bevy::render::view::Msaa,
 ) -> (Vec<u8>, ViewMapping) {
+    let (mut pictures, mapping) = pictures_in(root, file, &[time], size, mapping, msaa);
+    (pictures.remove(0), mapping)
+}
+
+/// [`picture_in`] at each of `times` in turn, drawn by one app (the root's clock is frozen at
+/// the next time once a picture has come back): the pictures, and the spawned camera's mapping.
+pub fn pictures_in(
+    root: &Path,
+    file: &str,
+    times: &[f32],
+    (width, height): (u32, u32),
+    mapping: Option<ViewMapping>,
+    msaa: bevy::render::view::Msaa,
+) -> (Vec<Vec<u8>>, ViewMapping) {
     let root = root.canonicalize().expect("the scenes folder");
     let mut app = App::new();
     app.add_plugins(
@@ -64,11 +78,12 @@ pub fn picture_in(
     let image = app.world_mut().resource_mut::<Assets<Image>>().add(image);
     app.insert_resource(Target(image.clone(), mapping, msaa)).add_systems(Update, into_image);
     let scene = app.world().resource::<AssetServer>().load(file.to_string());
-    let root = app.world_mut().spawn(HadouSceneRoot { scene, clock: SceneClock::Frozen(time) }).id();
+    let root = app.world_mut().spawn(HadouSceneRoot { scene, clock: SceneClock::Frozen(times[0]) }).id();
     app.finish();
     app.cleanup();
 
     let shot: Arc<Mutex<Option<Image>>> = Arc::default();
+    let mut pictures = Vec::with_capacity(times.len());
     let mut drawn = 0;
     let start = std::time::Instant::now();
     let mut frames = 0;
@@ -88,18 +103,25 @@ pub fn picture_in(
                 },
             );
         }
-        if shot.lock().unwrap().is_some() {
-            break;
+        if let Some(image) = shot.lock().unwrap().take() {
+            assert_eq!((image.width(), image.height()), (width, height));
+            assert_eq!(image.texture_descriptor.format, TextureFormat::Rgba8UnormSrgb);
+            pictures.push(image.data.expect("a captured image has its bytes"));
+            let Some(&next) = times.get(pictures.len()) else { break };
+            app.world_mut().get_mut::<HadouSceneRoot>(root).unwrap().clock = SceneClock::Frozen(next);
+            drawn = 0;
         }
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
-    eprintln!("{file}: {frames} updates in {:.1} s until the screenshot", start.elapsed().as_secs_f64());
-    let image = shot.lock().unwrap().take().expect("the screenshot came back");
-    assert_eq!((image.width(), image.height()), (width, height));
-    assert_eq!(image.texture_descriptor.format, TextureFormat::Rgba8UnormSrgb);
+    eprintln!(
+        "{file}: {frames} updates in {:.1} s until the last of {} screenshots",
+        start.elapsed().as_secs_f64(),
+        times.len()
+    );
+    assert_eq!(pictures.len(), times.len(), "every screenshot came back");
     let camera = app.world().get::<SpawnedScene>(root).unwrap().camera;
     let mapping = app.world().get::<HadouCamera>(camera).unwrap().mapping;
-    (image.data.expect("a captured image has its bytes"), mapping)
+    (pictures, mapping)
 }
 
 /// The mean and the largest absolute difference of the RGB bytes of `bevy` (4 per pixel) and
