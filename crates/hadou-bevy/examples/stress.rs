@@ -54,7 +54,7 @@ use hadou_bevy::{
     shadow_frame, shadow_mask, shadow_records, spawn_object, HadouCamera, HadouMaterial, HadouOutline,
     HadouPlugin, HadouShaded, HadouShadows, HadouWave, ObjectAssets, ViewMapping,
 };
-use hadou_gpu::{DepthModel, GpuBackend, OverlayBlend, OverlayTarget};
+use hadou_gpu::{DepthModel, GpuBackend, OverlayBlend, OverlayProjection, OverlayTarget};
 use hadou_math::{Mat4, Vec3f};
 use hadou_scene::{Frame, Shadow, ShadowLight, ShadowMethod, Wave, WaveShape};
 use std::collections::HashMap;
@@ -568,6 +568,7 @@ fn time_alone(backend: &mut GpuBackend, options: &Options, load: &Load) -> Resul
         depth_samples: 1,
         blend: OverlayBlend::Add,
         origin: [0, 0],
+        projection: OverlayProjection::Perspective,
     };
     let mut once = |frame: &Frame, waves: bool, shadows: bool| -> Result<f64, String> {
         let start = Instant::now();
