@@ -227,11 +227,32 @@ pub(crate) fn check_cameras(mut commands: Commands, cameras: Query<CameraToCheck
     }
 }
 
-/// Lets the wave pass read the depth buffer of every camera that gained a [`HadouCamera`].
-pub(crate) fn bind_depth(mut cameras: Query<&mut Camera3d, Added<HadouCamera>>) {
-    for mut camera in &mut cameras {
-        let usages = camera.depth_texture_usages.0 | TextureUsages::TEXTURE_BINDING.bits();
-        camera.depth_texture_usages = Camera3dDepthTextureUsage(usages);
+/// A camera that gained a [`HadouCamera`] or changed its `Msaa`.
+type DepthToBind = (&'static mut Camera3d, Option<&'static bevy::render::view::Msaa>);
+/// The cameras [`bind_depth`] looks at: those with a [`HadouCamera`] that is new or whose `Msaa`
+/// changed.
+type DepthChanged = (With<HadouCamera>, Or<(Added<HadouCamera>, Changed<bevy::render::view::Msaa>)>);
+
+/// Lets the wave pass read the depth buffer of every camera that gained a [`HadouCamera`], except
+/// a multisampled one on OpenGL: wgpu's GL backend creates a sampled multisampled texture with
+/// the target `GL_TEXTURE_2D`, so its storage fails (`GL_INVALID_ENUM` from
+/// `glTexStorage2DMultisample`) and Bevy's own passes draw into an incomplete framebuffer. Its
+/// depth stays a render attachment only (the wave pass refuses such a view with a warning).
+pub(crate) fn bind_depth(
+    mut cameras: Query<DepthToBind, DepthChanged>,
+    adapter: Option<Res<bevy::render::renderer::RenderAdapterInfo>>,
+) {
+    let gl = adapter.is_some_and(|a| a.0.backend == wgpu::Backend::Gl);
+    for (mut camera, msaa) in &mut cameras {
+        let bit = TextureUsages::TEXTURE_BINDING.bits();
+        let usages = if gl && msaa.is_some_and(|m| m.samples() > 1) {
+            camera.depth_texture_usages.0 & !bit
+        } else {
+            camera.depth_texture_usages.0 | bit
+        };
+        if usages != camera.depth_texture_usages.0 {
+            camera.depth_texture_usages = Camera3dDepthTextureUsage(usages);
+        }
     }
 }
 
