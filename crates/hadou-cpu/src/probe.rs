@@ -75,7 +75,7 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     // The probed row alone (the opaque pass decides each pixel independently), or every row when
     // the area light's penumbra search needs them.
     let mut opaque = OpaqueBuffers::default();
-    let oy0 = opaque_pass(frame, &setup, y as usize..y as usize + 1, &mut opaque);
+    let oy0 = opaque_pass(frame, &setup, 1, y as usize..y as usize + 1, &mut opaque);
     let i = (y as usize - oy0) * frame.width as usize + x as usize;
     let surface = opaque.surface[i];
     let mut light = [0.0f32; 3];

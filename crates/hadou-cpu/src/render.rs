@@ -457,7 +457,8 @@ impl<'a> DrawParts<'a> {
     /// and the [`RowSource`] that lights those rows from it.
     fn row_source(&self, rows: std::ops::Range<usize>, scratch: &'a mut OpaqueBuffers) -> RowSource<'a> {
         let DrawParts { frame, surfaces, setup, k, blank, simd } = *self;
-        let oy0 = if blank { 0 } else { opaque_pass(surfaces, setup, k * rows.start..k * rows.end, scratch) };
+        let oy0 =
+            if blank { 0 } else { opaque_pass(surfaces, setup, k, k * rows.start..k * rows.end, scratch) };
         RowSource {
             k,
             blank: blank.then(|| blank_color(surfaces.background, k)),
@@ -579,10 +580,13 @@ fn glare_rows(
 /// The opaque pass for the rows `rows`, with the area light's soft-shadowed light added (which
 /// needs the whole image: then every row is drawn) and the outlines closed where objects meet
 /// ([`edges::close_outlines`], which needs [`edges::frame_reach`]` + 1` rows beyond `rows`: those
-/// are drawn too). Returns the buffers' first row.
+/// are drawn too). `frame` is the frame the pass draws: with `k > 1` the sample frame, each image
+/// pixel `k × k` of its pixels (the soft stage's [`soft::SoftInput::grid`]). Returns the buffers'
+/// first row.
 pub(crate) fn opaque_pass(
     frame: &Frame,
     setup: &FrameSetup,
+    k: usize,
     rows: std::ops::Range<usize>,
     opaque: &mut OpaqueBuffers,
 ) -> usize {
@@ -601,6 +605,7 @@ pub(crate) fn opaque_pass(
         width: frame.width as usize,
         height: frame.height as usize,
         points: std::mem::take(&mut opaque.soft),
+        grid: k,
     };
     let vis = soft::visibility(frame, light, &input, light.resolve);
     opaque.color.par_iter_mut().zip(&input.points).zip(&vis).for_each(|((c, p), &v)| {

@@ -35,6 +35,10 @@ pub struct SoftInput {
     pub height: usize,
     /// Row-major, `None` for the background and outline hulls.
     pub points: Vec<Option<SoftPoint>>,
+    /// The anti-aliasing grid's edge `k`: the points are the sample frame's, each image pixel
+    /// `k × k` of them ([`hadou_scene::Frame::sample_frame`]); 1 for one point a pixel. Only the
+    /// traced resolve reads it ([`crate::traced::traced_grid`]).
+    pub grid: usize,
 }
 
 /// Runs the opaque pass of `frame` (which must have an `[area_light]`) and returns its visible
@@ -42,7 +46,12 @@ pub struct SoftInput {
 pub fn soft_input(frame: &Frame) -> Option<SoftInput> {
     frame.area_light.as_ref()?;
     let opaque = draw_opaque(frame, &FrameSetup::new(frame), 0..frame.height as usize);
-    Some(SoftInput { width: frame.width as usize, height: frame.height as usize, points: opaque.soft })
+    Some(SoftInput {
+        width: frame.width as usize,
+        height: frame.height as usize,
+        points: opaque.soft,
+        grid: 1,
+    })
 }
 
 /// A perspective depth map: the view depth of the nearest surface per texel, `+∞` where none.
@@ -141,7 +150,8 @@ pub fn classify(maps: &[SpotDepth; 2], input: &SoftInput) -> Vec<Class> {
 pub fn visibility(frame: &Frame, light: &AreaLight, input: &SoftInput, resolve: SoftResolve) -> Vec<f32> {
     let grid = match resolve {
         SoftResolve::Traced { samples } => {
-            return crate::traced::traced(frame, light, &input.points, input.width, samples)
+            let bvh = hadou_math::soft::Bvh::build(&crate::traced::caster_triangles(frame, &light.casters));
+            return crate::traced::traced_grid(&bvh, light, &input.points, input.width, samples, input.grid);
         }
         SoftResolve::Exact => None,
         SoftResolve::Faithful { n } => Some(n.max(1) as usize),

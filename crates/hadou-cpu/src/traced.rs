@@ -228,6 +228,141 @@ pub fn traced_with(
     out
 }
 
+/// Where a pixel's traced value settles its samples ([`traced_grid`]): the largest difference
+/// from a 4-neighbour's value (each from its pixel's mean point). Past it the visibility changes by
+/// more than an eighth across a pixel (a penumbra under about eight pixels wide: a contact
+/// shadow's edge), and the pixel's samples are traced one by one.
+pub const GRID_SPREAD: f32 = 0.125;
+
+/// Least cosine between two samples' normals for them to show one surface ([`grid_point`]).
+pub const GRID_NORMAL_COS: f32 = 0.98;
+
+/// [`traced_with`] over a sample frame whose image pixels are `k × k` points each (`width` is the
+/// sample frame's): one traced value per pixel where its samples agree, each sample traced where
+/// they may not. Two passes, each [`traced_with`]:
+///
+/// 1. **Pixels.** A pixel whose `k²` points all show one surface ([`grid_point`]: every point
+///    present, its normal within [`GRID_NORMAL_COS`] of the first's and on the first's tangent
+///    plane) is traced once, from its points' mean position and normal, lit or not (the image of
+///    the pixels, pixel `(x, y)` with its own [`pixel_offset`]).
+/// 2. **Samples.** A pixel is settled when it was traced in step 1 and each 4-neighbour traced
+///    there is within [`GRID_SPREAD`] of it: its samples all take its value (the box filter of a
+///    visibility that is linear across the pixel is its value at the mean point). Every other
+///    pixel's samples are traced one by one, as with one sample a pixel.
+///
+/// The decisions read only step 1's values, which depend only on the pixels' own points, so the
+/// result is deterministic and independent of the order of work, as [`traced_with`]'s. With
+/// `k = 1` (or a `width` that is not a multiple of `k`) it is [`traced_with`]. hadou-gpu's
+/// soft_traced.wgsl (`cs_traced_pixels`, then `cs_traced`) is the twin.
+pub fn traced_grid(
+    bvh: &Bvh,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+    k: usize,
+) -> Vec<f32> {
+    traced_grid_counted(bvh, light, points, width, samples, k).0
+}
+
+/// [`traced_grid`] and how many image pixels it settled in step 1 (each traced once), of how
+/// many.
+pub fn traced_grid_counted(
+    bvh: &Bvh,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+    k: usize,
+) -> (Vec<f32>, GridCount) {
+    let sh = points.len().checked_div(width).unwrap_or(0);
+    if k <= 1 || width % k != 0 || sh % k != 0 || width * sh != points.len() {
+        let pixels = points.iter().filter(|p| p.is_some()).count();
+        return (traced_with(bvh, light, points, width, samples), GridCount { pixels, settled: 0 });
+    }
+    let (w, h) = (width / k, sh / k);
+    let reps: Vec<Option<SoftPoint>> =
+        (0..w * h).into_par_iter().map(|i| grid_point(points, width, k, i % w, i / w)).collect();
+    let once = traced_with(bvh, light, &reps, w, samples);
+    let settled: Vec<bool> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            reps[i].is_some() && {
+                let v = once[i];
+                let near = |j: usize| reps[j].is_none() || (once[j] - v).abs() <= GRID_SPREAD;
+                (x == 0 || near(i - 1))
+                    && (x + 1 == w || near(i + 1))
+                    && (y == 0 || near(i - w))
+                    && (y + 1 == h || near(i + w))
+            }
+        })
+        .collect();
+    let pixel_of = |j: usize| (j / width / k) * w + (j % width) / k;
+    let rest: Vec<Option<SoftPoint>> =
+        points.par_iter().enumerate().map(|(j, p)| if settled[pixel_of(j)] { None } else { *p }).collect();
+    let mut out = traced_with(bvh, light, &rest, width, samples);
+    out.par_iter_mut().zip(points).enumerate().for_each(|(j, (o, p))| {
+        let i = pixel_of(j);
+        if settled[i] {
+            // A point the lamp adds nothing to stays 0, as [`traced_with`] gives it.
+            *o = if p.is_some_and(|p| lit_at_all(p.term)) { once[i] } else { 0.0 };
+        }
+    });
+    let drawn = (0..w * h)
+        .filter(|&i| {
+            (0..k * k).any(|s| points[(k * (i / w) + s / k) * width + k * (i % w) + s % k].is_some())
+        })
+        .count();
+    let count = GridCount { pixels: drawn, settled: settled.iter().filter(|&&s| s).count() };
+    (out, count)
+}
+
+/// What [`traced_grid_counted`] settled: of `pixels` image pixels with a visible point, `settled`
+/// took one traced value for all their samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GridCount {
+    /// Image pixels with a visible point (the points, when there is no grid).
+    pub pixels: usize,
+    /// Pixels traced once for all their samples.
+    pub settled: usize,
+}
+
+/// Pixel `(x, y)`'s one point when its `k × k` points of the sample frame (`width` wide) show one
+/// surface: every point present, each normal within [`GRID_NORMAL_COS`] of the first's (or all
+/// without one), each point within a quarter of its distance from the first of the first's
+/// tangent plane (no step between two surfaces that face the same way). The point is the mean of
+/// their positions and normals (normalised; the first's where the mean has no direction), with a
+/// term of 1 so that it is traced whether or not the lamp adds light there (the GPU's twin does
+/// not know the term); `None` otherwise.
+fn grid_point(points: &[Option<SoftPoint>], width: usize, k: usize, x: usize, y: usize) -> Option<SoftPoint> {
+    let first = points[k * y * width + k * x]?;
+    let n0 = first.normal;
+    let has_normal = n0.length_squared() > 0.0;
+    let (mut world, mut normal) = (Vec3f::splat(0.0), Vec3f::splat(0.0));
+    for j in 0..k {
+        for i in 0..k {
+            let p = points[(k * y + j) * width + k * x + i]?;
+            if (p.normal.length_squared() > 0.0) != has_normal {
+                return None;
+            }
+            if has_normal {
+                let d = p.world - first.world;
+                if p.normal.dot(n0) < GRID_NORMAL_COS * p.normal.length() * n0.length()
+                    || d.dot(n0).abs() > 0.25 * d.length() * n0.length()
+                {
+                    return None;
+                }
+            }
+            world = world + p.world;
+            normal = normal + p.normal;
+        }
+    }
+    let inv = 1.0 / (k * k) as f32;
+    let normal = if has_normal { normal.normalize_or(n0) } else { normal };
+    Some(SoftPoint { world: world * inv, normal, term: [1.0; 3] })
+}
+
 /// Whether an unshadowed term adds anything.
 #[inline]
 fn lit_at_all(term: [f32; 3]) -> bool {

@@ -441,7 +441,7 @@ impl Renderer {
                 self.submit_shadow_maps(frame, &prepared, None);
             }
             if frame.area_light.is_some() {
-                SoftTargets::ensure(&mut self.soft, &self.ctx, frame);
+                SoftTargets::ensure(&mut self.soft, &self.ctx, frame, grid);
             }
             prepared.groups = Some(self.tile_bind_groups(frame, &prepared));
             let soft = if frame.area_light.is_some() { self.draw_soft(frame, &prepared) } else { Ok(()) };

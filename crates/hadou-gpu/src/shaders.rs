@@ -456,7 +456,7 @@ mod tests {
     /// hadou-math's own (whose bytes are uploaded as they are).
     #[test]
     fn traced_structs_match_their_rust_definitions() {
-        use crate::layout::{GpuBvhNode, GpuBvhTri, TracedUniforms};
+        use crate::layout::{GpuBvhNode, GpuBvhTri, TracedGrid, TracedUniforms};
         use std::mem::{offset_of, size_of};
         let module = validate("soft traced module", &compose(SOFT_TRACED_PARTS));
         let field = |name: &str, offset: usize| (name.to_string(), offset as u32);
@@ -470,6 +470,14 @@ mod tests {
         ];
         assert_eq!((members, span as usize), (rust, size_of::<TracedUniforms>()));
         assert_eq!(size_of::<TracedUniforms>() / 16 * 4 - 4, hadou_math::soft::MAX_ROWS, "a weight a row");
+        let (members, span) = wgsl_layout(&module, "TracedGrid");
+        let rust = vec![
+            field("k", offset_of!(TracedGrid, k)),
+            field("pad0", offset_of!(TracedGrid, pad)),
+            field("pad1", offset_of!(TracedGrid, pad) + 4),
+            field("pad2", offset_of!(TracedGrid, pad) + 8),
+        ];
+        assert_eq!((members, span as usize), (rust, size_of::<TracedGrid>()));
         let (members, span) = wgsl_layout(&module, "BvhNode");
         let rust = vec![
             field("lo", offset_of!(GpuBvhNode, lo)),

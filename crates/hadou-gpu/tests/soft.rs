@@ -191,6 +191,65 @@ fn traced_resolve_matches_cpu() {
     assert!(partly > 1000, "only {partly} pixels in a penumbra");
 }
 
+/// With anti-aliasing (2 × 2 samples a pixel) the traced resolve traces one value per image pixel
+/// where the pixel's samples show one surface and its neighbours' values are near it, and each
+/// sample elsewhere (soft_traced.wgsl `cs_traced_pixels`, the twin of hadou-cpu's
+/// `traced::traced_grid`): the sample frame's visibility within `TRACED_STEP` of the CPU's at all
+/// but `TRACED_SHARE` of the lit samples, the frame's colours as the differential tests hold
+/// them, and most partly lit pixels' four samples one value (each traced alone, they would differ;
+/// a pixel in a penumbra narrower than about eight pixels is traced sample by sample).
+#[test]
+fn traced_resolve_with_anti_aliasing_traces_once_per_pixel_as_the_cpu() {
+    let Some(mut gpu) = gpu_or_skip("traced soft shadows, anti-aliased") else { return };
+    let scenes = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
+    for (name, t, shape) in [
+        ("soft-gradient.toml", 1.0, hadou_scene::LampShape::Disc),
+        ("soft-plaster.toml", 1.5, hadou_scene::LampShape::Disc),
+    ] {
+        let mut frame =
+            hadou_scene::Scene::load(format!("{scenes}{name}")).unwrap_or_else(|e| panic!("{e}")).at(t);
+        (frame.width, frame.height, frame.samples) = (96, 72, 4);
+        let light = frame.area_light.as_mut().expect("an area light");
+        light.shape = shape;
+        light.resolve = SoftResolve::Traced { samples: 256 };
+        let label = format!("{name} {shape:?}");
+        let (g, soft) = gpu.render_soft(&frame).unwrap_or_else(|e| panic!("{label}: GPU render failed: {e}"));
+        let (_, g_vis) = soft.expect("an area light");
+        let c =
+            CpuBackend::new().render(&frame).unwrap_or_else(|e| panic!("{label}: CPU render failed: {e}"));
+        let sampled = frame.sample_frame();
+        let light = sampled.area_light.as_ref().expect("an area light");
+        let mut input = soft_input(&sampled).expect("an area light");
+        input.grid = 2;
+        let c_vis = visibility(&sampled, light, &input, light.resolve);
+        assert_eq!(g_vis.len(), c_vis.len(), "{label}: the sample frame's visibility");
+        let lit = |i: usize| input.points[i].is_some_and(|p| p.term.iter().any(|&t| t > 0.0));
+        let lit_samples: Vec<usize> = (0..c_vis.len()).filter(|&i| lit(i)).collect();
+        let off = lit_samples.iter().filter(|&&i| (g_vis[i] - c_vis[i]).abs() > TRACED_STEP).count();
+        let sw = input.width;
+        let (mut partly, mut one_value) = (0, 0);
+        for y in 0..frame.height as usize {
+            for x in 0..frame.width as usize {
+                let s: Vec<usize> = (0..4).map(|k| (2 * y + k / 2) * sw + 2 * x + k % 2).collect();
+                if s.iter().all(|&i| lit(i)) && s.iter().all(|&i| g_vis[i] > 0.005 && g_vis[i] < 0.995) {
+                    partly += 1;
+                    one_value += usize::from(s.iter().all(|&i| g_vis[i].to_bits() == g_vis[s[0]].to_bits()));
+                }
+            }
+        }
+        let color_bad = colours_beyond(&g, &c);
+        eprintln!(
+            "{label}: {off} of {} lit samples off, {one_value} of {partly} partly lit pixels one value, \
+             {color_bad} colours beyond {COLOR_ABS}",
+            lit_samples.len()
+        );
+        assert!(off as f64 <= TRACED_SHARE * lit_samples.len() as f64, "{label}: {off} samples differ");
+        assert!(partly > 100 && one_value * 2 >= partly, "{label}: {one_value} of {partly}");
+        let n = g.color.len();
+        assert!(color_bad as f64 <= COLOR_SHARE * n as f64, "{label}: {color_bad} of {n} colours differ");
+    }
+}
+
 /// Outlines under an `[area_light]` (as in scenes/showcase.toml): the tile drawn right after the
 /// soft shadows' classification reuses the G-buffer that classification rasterized, and the
 /// outlines' edge pass must still run on it (without it a small frame of one tile lost its lamp

@@ -1,10 +1,13 @@
 //! Times the traced resolve of a soft scene for each lamp shape (hierarchy built once):
 //! `cargo run --release -p hadou --example traced_parts -- [SCENE] [SIZE] [SAMPLES]`, e.g.
 //! `scenes/soft-plaster.toml 512 256`, and a shape's name to time only that one. Prints each shape's median over 5 runs and the pixels
-//! that asked for work.
+//! that asked for work. With `HADOU_GRID=2` the points are the sample frame's of 2 × 2 samples a
+//! pixel (a `SIZE`² image, `(2·SIZE)`² points), each stage timed sample by sample
+//! (`traced_with`) and with one value per pixel where the samples agree (`traced_grid`), in
+//! turn.
 
 use hadou_cpu::soft::soft_input;
-use hadou_cpu::traced::traced_with;
+use hadou_cpu::traced::traced_grid_counted;
 use hadou_math::soft::{Bvh, LampShape};
 use hadou_scene::{caster_triangles, AreaLight, Scene};
 use std::time::Instant;
@@ -16,9 +19,10 @@ fn main() {
     let samples: u32 = args.next().and_then(|s| s.parse().ok()).unwrap_or(256);
     let only = args.next();
     let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let grid: usize = std::env::var("HADOU_GRID").ok().and_then(|s| s.parse().ok()).unwrap_or(1).max(1);
     let mut frame = scene.at(0.0);
-    frame.width = size;
-    frame.height = size;
+    frame.width = size * grid as u32;
+    frame.height = size * grid as u32;
     let light = frame.area_light.clone().expect("the scene has an [area_light]");
     let input = soft_input(&frame).expect("area light");
     let t = Instant::now();
@@ -32,16 +36,28 @@ fn main() {
             continue;
         }
         let lamp = AreaLight { shape, ..light.clone() };
-        let mut times: Vec<f64> = (0..6)
-            .map(|_| {
+        let kinds: &[usize] = if grid > 1 { &[1, grid] } else { &[1] };
+        let mut times = vec![Vec::new(); kinds.len()];
+        let mut counts = vec![None; kinds.len()];
+        for round in 0..6 {
+            for (slot, &k) in kinds.iter().enumerate() {
                 let t = Instant::now();
-                let v = traced_with(&bvh, &lamp, &input.points, input.width, samples);
+                let (v, count) = traced_grid_counted(&bvh, &lamp, &input.points, input.width, samples, k);
                 std::hint::black_box(v);
-                t.elapsed().as_secs_f64() * 1e3
-            })
-            .skip(1)
-            .collect();
-        times.sort_by(f64::total_cmp);
-        println!("{name:8} {:8.2} ms (fastest {:.2})", times[times.len() / 2], times[0]);
+                counts[slot] = Some(count);
+                if round > 0 {
+                    times[slot].push(t.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+        }
+        for ((t, &k), count) in times.iter_mut().zip(kinds).zip(&counts) {
+            t.sort_by(f64::total_cmp);
+            let how = if k == 1 { "each point" } else { "per pixel" };
+            let settled = match count {
+                Some(c) if k > 1 => format!(", {} of {} pixels traced once", c.settled, c.pixels),
+                _ => String::new(),
+            };
+            println!("{name:8} {how:10} {:8.2} ms (fastest {:.2}){settled}", t[t.len() / 2], t[0]);
+        }
     }
 }

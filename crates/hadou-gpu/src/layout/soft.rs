@@ -117,6 +117,18 @@ impl TracedUniforms {
     }
 }
 
+/// The traced resolve's sample grid (soft_traced.wgsl `TracedGrid`): with `k > 1` the soft
+/// buffers are the sample frame's, `k × k` points an image pixel, and one value is traced per pixel
+/// where its samples agree (hadou-cpu's `traced::traced_grid`). Keep in sync with `TracedGrid`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct TracedGrid {
+    /// The sample grid's edge `k` (1: one sample a pixel).
+    pub k: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 3],
+}
+
 /// One node of the traced resolve's hierarchy: `hadou_math::soft::BvhNode`'s bytes. Keep in sync
 /// with `BvhNode` in soft_traced.wgsl.
 #[repr(C)]

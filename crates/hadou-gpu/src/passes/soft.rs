@@ -18,7 +18,9 @@ use super::setup::{
 };
 use crate::device::GpuContext;
 use crate::formats::{MAP_FORMAT, SPOT_FORMAT};
-use crate::layout::{GpuBvhNode, GpuBvhTri, GpuCasterBox, GpuSpotMap, SoftUniforms, TracedUniforms};
+use crate::layout::{
+    GpuBvhNode, GpuBvhTri, GpuCasterBox, GpuSpotMap, SoftUniforms, TracedGrid, TracedUniforms,
+};
 use crate::meshes::MeshCache;
 use crate::shaders;
 use crate::timing::PassQueries;
@@ -51,14 +53,15 @@ pub(crate) const BINDINGS: [Binding; 14] = [
 ];
 
 /// The bindings of soft_traced.wgsl.
-pub(crate) const TRACED_BINDINGS: [Binding; 7] = [
+pub(crate) const TRACED_BINDINGS: [Binding; 8] = [
     Binding::new(0, "frame", Kind::Uniform, CS),
     Binding::new(1, "traced", Kind::Uniform, CS),
     Binding::new(2, "soft_world", Kind::Storage, CS),
-    Binding::new(3, "soft_normal", Kind::Storage, CS),
+    Binding::new(3, "soft_normal", Kind::StorageRw, CS),
     Binding::new(4, "visibility", Kind::StorageRw, CS),
     Binding::new(5, "nodes", Kind::Storage, CS),
     Binding::new(6, "tris", Kind::Storage, CS),
+    Binding::new(7, "grid", Kind::Uniform, CS),
 ];
 
 /// What soft.wgsl reads from a tile (the rest, [`BINDINGS`] 1, 4–9 and 11–13, is
@@ -157,10 +160,13 @@ pub(crate) struct SoftTargets {
     traced: Option<TracedBuffers>,
 }
 
-/// The traced resolve's buffers: its uniforms ([`TracedUniforms`]) and the hierarchy's nodes and
-/// triangles, with room for `capacity` of each.
+/// The traced resolve's buffers: its uniforms ([`TracedUniforms`], [`TracedGrid`]) and the
+/// hierarchy's nodes and triangles, with room for `capacity` of each.
 struct TracedBuffers {
     uniforms: wgpu::Buffer,
+    grid: wgpu::Buffer,
+    /// The sample grid's edge `k` this frame.
+    k: u32,
     nodes: wgpu::Buffer,
     tris: wgpu::Buffer,
     capacity: (u64, u64),
@@ -170,8 +176,9 @@ struct TracedBuffers {
 const FIT_BYTES: u64 = 32;
 
 impl SoftTargets {
-    /// Makes `soft` fit `frame` (which has an `[area_light]`) and writes its uniforms.
-    pub(crate) fn ensure(slot: &mut Option<SoftTargets>, ctx: &GpuContext, frame: &Frame) {
+    /// Makes `soft` fit `frame` (which has an `[area_light]`; with anti-aliasing the sample frame,
+    /// whose image pixels are `grid × grid` of its pixels) and writes its uniforms.
+    pub(crate) fn ensure(slot: &mut Option<SoftTargets>, ctx: &GpuContext, frame: &Frame, grid: u32) {
         let light = frame.area_light.as_ref().expect("an area light");
         let n = match light.resolve {
             SoftResolve::Exact | SoftResolve::Traced { .. } => 0,
@@ -231,7 +238,7 @@ impl SoftTargets {
         let keys = [empty.min, empty.max, empty.min, empty.max].concat();
         ctx.queue.write_buffer(&soft.fit, 0, bytemuck::cast_slice(&keys));
         if let Some(soft) = slot.as_mut() {
-            soft.write_traced(ctx, frame);
+            soft.write_traced(ctx, frame, grid);
         }
     }
 
@@ -258,8 +265,9 @@ impl SoftTargets {
 
     /// For a frame of the traced resolve: builds the hierarchy of the light's casters' world-space
     /// triangles (`hadou_math::soft::Bvh`, as hadou-cpu's `traced` does) and writes it and the
-    /// lamp's sample layout for soft_traced.wgsl, growing the buffers as needed.
-    pub(crate) fn write_traced(&mut self, ctx: &GpuContext, frame: &Frame) {
+    /// lamp's sample layout and the sample grid's edge `grid` for soft_traced.wgsl, growing the
+    /// buffers as needed.
+    pub(crate) fn write_traced(&mut self, ctx: &GpuContext, frame: &Frame, grid: u32) {
         let light = frame.area_light.as_ref().expect("an area light");
         let SoftResolve::Traced { samples } = light.resolve else { return };
         let bvh = Bvh::build(&hadou_scene::caster_triangles(frame, &light.casters));
@@ -284,15 +292,23 @@ impl SoftTargets {
                     std::mem::size_of::<TracedUniforms>() as u64,
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 ),
+                grid: buffer(
+                    "traced grid",
+                    std::mem::size_of::<TracedGrid>() as u64,
+                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                ),
+                k: 1,
                 nodes: buffer("traced hierarchy nodes", capacity.0 * BVH_NODE_BYTES, storage),
                 tris: buffer("traced hierarchy triangles", capacity.1 * BVH_TRI_BYTES, storage),
                 capacity,
             });
         }
-        let t = self.traced.as_ref().expect("made above");
+        let t = self.traced.as_mut().expect("made above");
         let pattern = LampPattern::new(light.shape, samples);
         let u = TracedUniforms::new(&pattern, nodes.len() as u32);
         ctx.queue.write_buffer(&t.uniforms, 0, bytemuck::bytes_of(&u));
+        t.k = grid.max(1);
+        ctx.queue.write_buffer(&t.grid, 0, bytemuck::bytes_of(&TracedGrid { k: t.k, pad: [0; 3] }));
         if !nodes.is_empty() {
             ctx.queue.write_buffer(&t.nodes, 0, bytemuck::cast_slice(&nodes));
             ctx.queue.write_buffer(&t.tris, 0, bytemuck::cast_slice(&tris));
@@ -341,8 +357,10 @@ struct SoftPipelines {
 
 /// The soft-shadow pipelines and bind group layouts.
 pub(crate) struct SoftPass {
-    /// The traced resolve (soft_traced.wgsl) and its layout.
+    /// The traced resolve (soft_traced.wgsl `cs_traced`, and `cs_traced_pixels` first with
+    /// anti-aliasing) and its layout.
     traced: wgpu::ComputePipeline,
+    traced_pixels: wgpu::ComputePipeline,
     traced_layout: wgpu::BindGroupLayout,
     /// The `[area_light]`'s maps (soft_map.wgsl).
     spot_map: wgpu::RenderPipeline,
@@ -398,7 +416,8 @@ impl SoftPass {
             let traced_layout = setup::bind_group_layout(d, "soft traced", &TRACED_BINDINGS);
             let traced_pl = setup::pipeline_layout(d, "soft traced", &traced_layout);
             let traced = setup::compute_pipeline(d, &traced_pl, &traced_module, "cs_traced");
-            Self { traced, traced_layout, spot_map, spot_map_layout, pipelines, layout }
+            let traced_pixels = setup::compute_pipeline(d, &traced_pl, &traced_module, "cs_traced_pixels");
+            Self { traced, traced_pixels, traced_layout, spot_map, spot_map_layout, pipelines, layout }
         })
     }
 
@@ -516,7 +535,8 @@ impl SoftPass {
         }
     }
 
-    /// Records the traced resolve over the whole image (`cs_traced`), once every tile's points are
+    /// Records the traced resolve over the whole image (`cs_traced`; with anti-aliasing
+    /// `cs_traced_pixels` first, one value per image pixel), once every tile's points are
     /// gathered and [`SoftTargets::write_traced`] has written the hierarchy; `uniforms` is the
     /// tiles' `layout::FrameUniforms` (any tile's: the image size and the light are the frame's).
     pub(crate) fn encode_traced(
@@ -536,8 +556,19 @@ impl SoftPass {
             targets.visibility.as_entire_binding(),
             t.nodes.as_entire_binding(),
             t.tris.as_entire_binding(),
+            t.grid.as_entire_binding(),
         ];
         let bg = setup::bind_group(device, "soft traced", &self.traced_layout, &TRACED_BINDINGS, resources);
+        if t.k > 1 {
+            // Its own pass: cs_traced reads what it writes.
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("soft traced pixels"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.traced_pixels);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups((frame.width / t.k).div_ceil(8), (frame.height / t.k).div_ceil(8), 1);
+        }
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("soft traced"),
             timestamp_writes: None,
