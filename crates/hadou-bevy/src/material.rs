@@ -590,3 +590,51 @@ pub(crate) fn update_wave_lights(
     }
     *written = LightsWritten { lights, data, capacity, warned: written.warned };
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The body of WGSL function `name` in `source` (up to its closing brace at the line start).
+    fn wgsl_function<'a>(source: &'a str, name: &str) -> &'a str {
+        let start = source.find(&format!("fn {name}(")).unwrap_or_else(|| panic!("no fn {name}"));
+        let end = source[start..].find("\n}\n").expect("the function's end") + start;
+        &source[start..end]
+    }
+
+    /// Issue 45 (a game's load): lavapipe compiled the material's whole fragment shader again for
+    /// every HadouMaterial drawn, every frame, because words of the uniform decide branches (Mesa's
+    /// uniform inlining). The uniform is read in `load_surface` only, every field of it copied
+    /// there through the zero, and the zero's array has a record whose size is not a power of two
+    /// (see `load_surface`: a power of two lets the driver fold the zero away).
+    #[test]
+    fn issue_45_the_uniform_is_read_only_through_the_hidden_copy() {
+        let source = shader_source();
+        let load = wgsl_function(&source, "load_surface");
+        assert_eq!(source.matches("surface_uniform").count(), 2, "the binding and load_surface's one read");
+        assert!(load.contains("let u = surface_uniform;"), "{load}");
+        assert!(load.contains("let zero = arrayLength(&lights) >> 31u;"), "{load}");
+        assert!(!std::mem::size_of::<GpuLight>().is_power_of_two(), "GpuLight's size folds the zero");
+        let fields = &FRAGMENT[FRAGMENT.find("struct HadouSurface {").expect("the struct")..];
+        let fields = &fields[..fields.find("\n}\n").expect("the struct's end")];
+        let names: Vec<&str> = fields
+            .lines()
+            .skip(1)
+            .filter_map(|l| l.trim().split(':').next().filter(|n| !n.is_empty()))
+            .collect();
+        assert_eq!(names.len(), 13, "{names:?}");
+        for name in names.iter().filter(|&&n| n != "ramp") {
+            assert!(load.contains(&format!("surface.{name} = ")), "`{name}` is not copied through the zero");
+            assert!(
+                load.contains(&format!("u.{name}, zero)")) || load.contains(&format!("u.{name} | ")),
+                "{name}"
+            );
+        }
+        for name in ["stops[i]", "count", "kind", "smoothing"] {
+            assert!(
+                load.contains(&format!("surface.ramp.{name} = ")),
+                "ramp.{name} is not copied through the zero"
+            );
+        }
+    }
+}

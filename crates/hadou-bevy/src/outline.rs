@@ -186,3 +186,20 @@ impl Material for HadouOutline {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 45 (a game's load): the words of the uniform that decide the hull's branches are read
+    /// once each, OR-ed with the instance index's top bit, so lavapipe does not compile the shader
+    /// again for every hull drawn (see `HadouMaterial`'s `load_surface`).
+    #[test]
+    fn issue_45_the_deciding_words_are_read_only_through_the_zero() {
+        assert!(SOURCE.contains("let zero = v.instance_index >> 31u;"));
+        assert_eq!(SOURCE.matches("outline.mode").count(), 1);
+        assert!(SOURCE.contains("let mode = outline.mode | zero;"));
+        assert_eq!(SOURCE.matches("outline.width").count(), 1);
+        assert!(SOURCE.contains("let width = bitcast<f32>(bitcast<u32>(outline.width) | zero);"));
+    }
+}
