@@ -87,7 +87,9 @@ struct HadouSurface {
     ramp: GpuRamp,
     time: f32,
 }
-@group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> surface: HadouSurface;
+@group(#{MATERIAL_BIND_GROUP}) @binding(0) var<uniform> surface_uniform: HadouSurface;
+// The uniform as the functions below read it: a private copy made by load_surface().
+var<private> surface: HadouSurface;
 @group(#{MATERIAL_BIND_GROUP}) @binding(1) var<storage, read> lights: array<GpuLight>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(2) var<storage, read> light_data: array<u32>;
 @group(#{MATERIAL_BIND_GROUP}) @binding(3) var<storage, read> shading_data: array<u32>;
@@ -156,12 +158,55 @@ struct HadouShadeFrame {
 }
 var<private> frame: HadouShadeFrame;
 
+fn hide1(v: f32, zero: u32) -> f32 {
+    return bitcast<f32>(bitcast<u32>(v) | zero);
+}
+
+fn hide4(v: vec4<f32>, zero: u32) -> vec4<f32> {
+    return bitcast<vec4<f32>>(bitcast<vec4<u32>>(v) | vec4<u32>(zero));
+}
+
+// Copies the uniform into `surface`, every word OR-ed with a zero the driver cannot fold: the top
+// bit of the number of wave lights (no buffer holds 2³¹ of them), as hadou-gpu's wave_energy.wgsl
+// `load_frame` does for the frame's uniforms. Mesa's lavapipe (22.3) folds up to four uniform
+// words that decide branches or loop counts into a large shader and compiles it again on every
+// bind of the material's group, with no cache of these variants: a whole compile of this shader
+// for every HadouMaterial drawn, every frame. Hidden, the values and branches are the same and the
+// pipeline's one compile serves every material and frame. The zero comes from `lights`, whose
+// record (208 bytes) is not a power of two: the length of an array of `u32` is the buffer's size
+// shifted right by 2, which the driver folds with the `>> 31` to a constant 0 (measured: hidden
+// with `light_data`'s length, every draw was still a compile).
+fn load_surface() {
+    let zero = arrayLength(&lights) >> 31u;
+    let u = surface_uniform;
+    surface.base_color = hide4(u.base_color, zero);
+    surface.light_direction = hide4(u.light_direction, zero);
+    surface.light_color = hide4(u.light_color, zero);
+    surface.ambient = hide4(u.ambient, zero);
+    surface.outline = hide4(u.outline, zero);
+    surface.model = u.model | zero;
+    surface.wave_blend = hide1(u.wave_blend, zero);
+    surface.shadow_mask = u.shadow_mask | zero;
+    surface.mtoon = u.mtoon | zero;
+    surface.base_texture = u.base_texture | vec4<u32>(zero);
+    surface.feature_texture = u.feature_texture | vec4<u32>(zero);
+    surface.ramp = u.ramp;
+    for (var i = 0u; i < 8u; i++) {
+        surface.ramp.stops[i] = hide4(u.ramp.stops[i], zero);
+    }
+    surface.ramp.count = u.ramp.count | zero;
+    surface.ramp.kind = u.ramp.kind | zero;
+    surface.ramp.smoothing = hide1(u.ramp.smoothing, zero);
+    surface.time = hide1(u.time, zero);
+}
+
 fn texture_record(t: vec4<u32>) -> GpuTexture {
     return GpuTexture(t.x, t.y, t.z, t.w);
 }
 
 @fragment
 fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+    load_surface();
     frame.light_dir = surface.light_direction.xyz;
     frame.light_color = surface.light_color.xyz;
     frame.ambient = surface.ambient.xyz;
@@ -544,4 +589,52 @@ pub(crate) fn update_wave_lights(
         for _ in materials.iter_mut() {}
     }
     *written = LightsWritten { lights, data, capacity, warned: written.warned };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The body of WGSL function `name` in `source` (up to its closing brace at the line start).
+    fn wgsl_function<'a>(source: &'a str, name: &str) -> &'a str {
+        let start = source.find(&format!("fn {name}(")).unwrap_or_else(|| panic!("no fn {name}"));
+        let end = source[start..].find("\n}\n").expect("the function's end") + start;
+        &source[start..end]
+    }
+
+    /// Issue 45 (a game's load): lavapipe compiled the material's whole fragment shader again for
+    /// every HadouMaterial drawn, every frame, because words of the uniform decide branches (Mesa's
+    /// uniform inlining). The uniform is read in `load_surface` only, every field of it copied
+    /// there through the zero, and the zero's array has a record whose size is not a power of two
+    /// (see `load_surface`: a power of two lets the driver fold the zero away).
+    #[test]
+    fn issue_45_the_uniform_is_read_only_through_the_hidden_copy() {
+        let source = shader_source();
+        let load = wgsl_function(&source, "load_surface");
+        assert_eq!(source.matches("surface_uniform").count(), 2, "the binding and load_surface's one read");
+        assert!(load.contains("let u = surface_uniform;"), "{load}");
+        assert!(load.contains("let zero = arrayLength(&lights) >> 31u;"), "{load}");
+        assert!(!std::mem::size_of::<GpuLight>().is_power_of_two(), "GpuLight's size folds the zero");
+        let fields = &FRAGMENT[FRAGMENT.find("struct HadouSurface {").expect("the struct")..];
+        let fields = &fields[..fields.find("\n}\n").expect("the struct's end")];
+        let names: Vec<&str> = fields
+            .lines()
+            .skip(1)
+            .filter_map(|l| l.trim().split(':').next().filter(|n| !n.is_empty()))
+            .collect();
+        assert_eq!(names.len(), 13, "{names:?}");
+        for name in names.iter().filter(|&&n| n != "ramp") {
+            assert!(load.contains(&format!("surface.{name} = ")), "`{name}` is not copied through the zero");
+            assert!(
+                load.contains(&format!("u.{name}, zero)")) || load.contains(&format!("u.{name} | ")),
+                "{name}"
+            );
+        }
+        for name in ["stops[i]", "count", "kind", "smoothing"] {
+            assert!(
+                load.contains(&format!("surface.ramp.{name} = ")),
+                "ramp.{name} is not copied through the zero"
+            );
+        }
+    }
 }

@@ -61,15 +61,21 @@ fn vertex(v: Vertex) -> @builtin(position) vec4<f32> {
     if (len > 0.0 && len < 3.0e38) {
         u = n / len;
     }
+    // The mode and width OR-ed with a zero the driver cannot fold (the top bit of the instance
+    // index: no draw holds 2³¹ instances), as HadouMaterial's `load_surface`: lavapipe would
+    // otherwise compile this shader again for every hull drawn (Mesa's uniform inlining).
+    let zero = v.instance_index >> 31u;
+    let mode = outline.mode | zero;
+    let width = bitcast<f32>(bitcast<u32>(outline.width) | zero);
     let forward = -normalize(view.world_from_view[2].xyz);
     let z = dot(base - view.world_position, forward);
     // hadou_scene::Material::hull_push: hadou's d·|z|; an MToon outline in world units w, or in
     // screen mode 2·tan(fov/2)·w·|z| (w a fraction of the view's height).
-    var push = outline.width * abs(z);
-    if (outline.mode == 1u) {
-        push = outline.width;
-    } else if (outline.mode == 2u) {
-        push = 2.0 * outline.width * abs(z) / view.clip_from_view[1][1];
+    var push = width * abs(z);
+    if (mode == 1u) {
+        push = width;
+    } else if (mode == 2u) {
+        push = 2.0 * width * abs(z) / view.clip_from_view[1][1];
     }
     return position_world_to_clip(base + u * push);
 }
@@ -178,5 +184,22 @@ impl Material for HadouOutline {
         descriptor.vertex.buffers = vec![buffer];
         descriptor.primitive.cull_mode = Some(Face::Front);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 45 (a game's load): the words of the uniform that decide the hull's branches are read
+    /// once each, OR-ed with the instance index's top bit, so lavapipe does not compile the shader
+    /// again for every hull drawn (see `HadouMaterial`'s `load_surface`).
+    #[test]
+    fn issue_45_the_deciding_words_are_read_only_through_the_zero() {
+        assert!(SOURCE.contains("let zero = v.instance_index >> 31u;"));
+        assert_eq!(SOURCE.matches("outline.mode").count(), 1);
+        assert!(SOURCE.contains("let mode = outline.mode | zero;"));
+        assert_eq!(SOURCE.matches("outline.width").count(), 1);
+        assert!(SOURCE.contains("let width = bitcast<f32>(bitcast<u32>(outline.width) | zero);"));
     }
 }
