@@ -234,14 +234,14 @@ pub fn traced_with(
 /// shadow's edge), and the pixel's samples are traced one by one.
 pub const GRID_SPREAD: f32 = 0.125;
 
-/// Least cosine between two samples' normals for them to show one surface ([`grid_point`]).
+/// Least cosine between two samples' normals for them to show one surface ([`traced_grid`] step 1).
 pub const GRID_NORMAL_COS: f32 = 0.98;
 
 /// [`traced_with`] over a sample frame whose image pixels are `k × k` points each (`width` is the
 /// sample frame's): one traced value per pixel where its samples agree, each sample traced where
 /// they may not. Two passes, each [`traced_with`]:
 ///
-/// 1. **Pixels.** A pixel whose `k²` points all show one surface ([`grid_point`]: every point
+/// 1. **Pixels.** A pixel whose `k²` points all show one surface (every point
 ///    present, its normal within [`GRID_NORMAL_COS`] of the first's and on the first's tangent
 ///    plane) is traced once, from its points' mean position and normal, lit or not (the image of
 ///    the pixels, pixel `(x, y)` with its own [`pixel_offset`]).
@@ -276,7 +276,7 @@ pub fn traced_grid_counted(
     k: usize,
 ) -> (Vec<f32>, GridCount) {
     let sh = points.len().checked_div(width).unwrap_or(0);
-    if k <= 1 || width % k != 0 || sh % k != 0 || width * sh != points.len() {
+    if k <= 1 || !width.is_multiple_of(k) || !sh.is_multiple_of(k) || width * sh != points.len() {
         let pixels = points.iter().filter(|p| p.is_some()).count();
         return (traced_with(bvh, light, points, width, samples), GridCount { pixels, settled: 0 });
     }
@@ -354,8 +354,8 @@ fn grid_point(points: &[Option<SoftPoint>], width: usize, k: usize, x: usize, y:
                     return None;
                 }
             }
-            world = world + p.world;
-            normal = normal + p.normal;
+            world += p.world;
+            normal += p.normal;
         }
     }
     let inv = 1.0 / (k * k) as f32;
