@@ -5,7 +5,7 @@
 //! upsample and the streak at level 1 (half the resolution), and the bilinear glare, the
 //! composite and the colour mapping in one pass over the band (eight pixels at a time).
 
-use hadou_math::bloom::{self, BloomParams, Plane, RowFill};
+use hadou_math::bloom::{self, BloomParams, Plane, PlanePool, RowFill};
 use hadou_math::shade;
 use hadou_math::simd::{dispatch, Lane, SimdPath, WithLanes};
 use hadou_scene::{Frame, ToneMode};
@@ -58,7 +58,7 @@ pub(crate) fn source_rows(frame: &Frame, params: &BloomParams, band: Range<usize
 
 /// The band `band` of `linear` (which holds [`source_rows`]) with the glare added and the frame's
 /// colour mapping applied, into `color` (`band.len()` rows); the glare's levels on the vector
-/// path `simd`. After the glare's plane at level 1 ([`bloom::lanes::try_glare_plane`]), each row
+/// path `simd`, its planes from `pool` (and given back to it). After the glare's plane at level 1 ([`bloom::lanes::try_glare_plane`]), each row
 /// of the band is read once: its bilinear glare, the composite and the mapping in one pass.
 pub(crate) fn glare_and_map(
     frame: &Frame,
@@ -67,14 +67,16 @@ pub(crate) fn glare_and_map(
     band: Range<usize>,
     color: &mut [[f32; 4]],
     simd: SimdPath,
+    pool: &mut PlanePool,
 ) -> Result<(), hadou_scene::RenderError> {
-    let g =
-        bloom::lanes::try_glare_plane(simd, params, linear, band.clone(), &Parallel).map_err(|bytes| {
+    let g = bloom::lanes::try_glare_plane_in(simd, params, linear, band.clone(), &Parallel, pool).map_err(
+        |bytes| {
             hadou_scene::RenderError::Memory(format!(
                 "the glare's planes need {:.2} GB that could not be allocated",
                 bytes as f64 / 1e9
             ))
-        })?;
+        },
+    )?;
     let mode = frame.color_mapping.mode;
     let w = linear.width;
     color.par_chunks_mut(w.max(1)).enumerate().for_each_init(Vec::new, |row, (r, out)| {
@@ -86,6 +88,7 @@ pub(crate) fn glare_and_map(
         }
         dispatch(simd, MapRow { mode, linear: row, out });
     });
+    pool.give(g);
     Ok(())
 }
 

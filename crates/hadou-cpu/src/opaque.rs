@@ -50,6 +50,8 @@ pub(crate) struct OpaqueBuffers {
     pub edge: Vec<EdgeTexel>,
     /// A `[bloom]` frame's linear colour, kept from frame to frame (not the opaque pass's).
     pub glare_linear: Vec<[f32; 3]>,
+    /// The glare's planes, kept from frame to frame (not the opaque pass's).
+    pub glare_planes: hadou_math::bloom::PlanePool,
 }
 
 /// A drawn pixel as the edge pass reads it (the GPU's G-buffer holds the same).

@@ -489,6 +489,18 @@ fn try_grow<T>(v: &mut Vec<T>, n: usize, what: &str) -> Result<(), RenderError> 
     v.try_reserve_exact(n).map_err(|_| out_of_memory(n * std::mem::size_of::<T>(), what))
 }
 
+/// `v` sized to `n` elements, its allocation grown fallibly where it is short; the elements it
+/// already holds are kept as they are (for buffers of which every element is written next).
+fn try_size<T: Clone>(v: &mut Vec<T>, n: usize, fill: T, what: &str) -> Result<(), RenderError> {
+    if v.len() >= n {
+        v.truncate(n);
+        return Ok(());
+    }
+    v.try_reserve_exact(n - v.len()).map_err(|_| out_of_memory(n * std::mem::size_of::<T>(), what))?;
+    v.resize(n, fill);
+    Ok(())
+}
+
 fn out_of_memory(bytes: usize, what: &str) -> RenderError {
     RenderError::Memory(format!("{what} needs {:.2} GB that could not be allocated", bytes as f64 / 1e9))
 }
@@ -513,19 +525,16 @@ fn glare_rows(
     let w = frame.width as usize;
     let n = w * band.len();
     (img.width, img.height) = (frame.width, band.len() as u32);
+    // Sized only: every element is written below (the energy and depth by the wave pass, the
+    // colour by the glare's mapping).
     for (v, what) in [(&mut img.energy, "the band's energy"), (&mut img.depth, "the band's depth")] {
-        v.clear();
-        try_grow(v, n, what)?;
-        v.resize(n, 0.0);
+        try_size(v, n, 0.0, what)?;
     }
-    img.color.clear();
-    try_grow(&mut img.color, n, "the band's colour")?;
-    img.color.resize(n, [0.0; 4]);
-    // The linear colour in the buffer the last frame left (no fresh pages to fault in).
+    try_size(&mut img.color, n, [0.0; 4], "the band's colour")?;
+    // The linear colour in the buffer the last frame left (no fresh pages to fault in), every row
+    // written by the wave pass.
     let mut data = std::mem::take(&mut scratch.glare_linear);
-    data.clear();
-    try_grow(&mut data, w * src.len(), "the glare's linear colour")?;
-    data.resize(w * src.len(), [0.0; 3]);
+    try_size(&mut data, w * src.len(), [0.0; 3], "the glare's linear colour")?;
     let mut linear =
         hadou_math::bloom::Plane { width: w, height: frame.height as usize, rows: src.clone(), data };
     // With an area light the opaque pass draws every row whatever it is asked: one chunk.
@@ -572,7 +581,7 @@ fn glare_rows(
         wave_ms += ms(opaque_done, waves_done);
         t = waves_done;
     }
-    bloom::glare_and_map(frame, params, &linear, band, &mut img.color, simd)?;
+    bloom::glare_and_map(frame, params, &linear, band, &mut img.color, simd, &mut scratch.glare_planes)?;
     scratch.glare_linear = linear.data;
     Ok(PassTimes { opaque_ms, wave_ms, color_ms: ms(t, Instant::now()) })
 }

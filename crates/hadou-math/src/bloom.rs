@@ -142,6 +142,26 @@ impl Plane {
         Ok(Plane { width, height, rows, data })
     }
 
+    /// A window like [`Plane::try_new`]'s with `pool`'s texels where it has a buffer large
+    /// enough (see [`PlanePool`]), without fresh pages to fault in and **not zeroed**: its texels
+    /// are what the buffer last held, so the caller writes every one (as [`RowFill`] does).
+    pub fn try_new_in(
+        pool: &mut PlanePool,
+        width: usize,
+        height: usize,
+        rows: Range<usize>,
+    ) -> Result<Self, usize> {
+        let n = width.saturating_mul(rows.len());
+        let mut data = pool.take(n);
+        if data.len() >= n {
+            data.truncate(n);
+        } else {
+            data.try_reserve_exact(n - data.len()).map_err(|_| n.saturating_mul(12))?;
+            data.resize(n, [0.0; 3]);
+        }
+        Ok(Plane { width, height, rows, data })
+    }
+
     /// Texel `(x, y)` of the level, both clamped to its edge; `y` (after clamping) must be held.
     #[inline]
     pub fn at(&self, x: isize, y: isize) -> [f32; 3] {
@@ -339,6 +359,37 @@ impl Plan {
 pub fn source_rows(params: &BloomParams, width: usize, height: usize, band: Range<usize>) -> Range<usize> {
     let n = levels(params.radius * height as f32);
     Plan::new(width, height, n, band).source
+}
+
+/// The texel buffers of planes a glare no longer needs, kept for the next ones
+/// ([`Plane::try_new_in`], [`PlanePool::give`]): a renderer that keeps one from frame to frame
+/// allocates its glare's planes once, not every frame (fresh pages cost more than the filters on
+/// them). Every texel of a glare's plane is written before it is read, so a pool changes no result
+/// (`tests/bloom.rs` runs the chain on a pool of poisoned buffers).
+#[derive(Debug, Default)]
+pub struct PlanePool {
+    free: Vec<Vec<[f32; 3]>>,
+}
+
+impl PlanePool {
+    /// The free buffer that holds `n` texels with the least to spare, else the largest (which
+    /// grows), else a new one; its texels as they were.
+    fn take(&mut self, n: usize) -> Vec<[f32; 3]> {
+        let cap = |i: &usize| self.free[*i].capacity();
+        let fits = (0..self.free.len()).filter(|i| cap(i) >= n).min_by_key(cap);
+        let pick = fits.or_else(|| (0..self.free.len()).max_by_key(cap));
+        pick.map(|i| self.free.swap_remove(i)).unwrap_or_default()
+    }
+
+    /// Keeps `plane`'s texel buffer for a later plane.
+    pub fn give(&mut self, plane: Plane) {
+        self.free.push(plane.data);
+    }
+
+    /// The bytes the kept buffers hold.
+    pub fn bytes(&self) -> usize {
+        self.free.iter().map(|v| v.capacity() * std::mem::size_of::<[f32; 3]>()).sum()
+    }
 }
 
 /// How the chain fills a plane's rows: one row at a time here ([`Sequential`]), in parallel in a

@@ -4,8 +4,8 @@
 //! lanes (`bloom::lanes`) equal to the texel-by-texel kernels bit for bit on every vector path.
 
 use hadou_math::bloom::{
-    down_row, glare, lanes, levels, prefilter, try_glare, up_row, BloomParams, Plan, Plane, Sequential,
-    BLOOM_CLAMP,
+    down_row, glare, lanes, levels, prefilter, try_glare, up_row, BloomParams, Plan, Plane, PlanePool,
+    Sequential, BLOOM_CLAMP,
 };
 use hadou_math::rng::Rng;
 use hadou_math::simd::SimdPath;
@@ -239,4 +239,39 @@ fn lanes_equal_the_texel_kernels_bit_for_bit() {
             }
         }
     }
+}
+
+/// A pool's buffers are reused without being cleared ([`PlanePool`]): the glare drawn from a pool
+/// whose buffers hold NaN, and then from the buffers the earlier glares (of other sizes, bands and
+/// parameters) left in it, is the glare drawn from fresh planes, bit for bit.
+#[test]
+fn a_pool_of_stale_buffers_changes_no_texel() {
+    let mut rng = Rng(45);
+    let mut pool = PlanePool::default();
+    for n in [1usize, 40, 900, 5000] {
+        pool.give(Plane { width: n, height: 1, rows: 0..1, data: vec![[f32::NAN; 3]; n] });
+    }
+    let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+    for (case, &(w, h)) in [(70, 70), (9, 17), (64, 33), (31, 40), (70, 70), (3, 5)].iter().enumerate() {
+        let vals: Vec<[f32; 3]> = (0..w * h)
+            .map(|_| [rng.range_f32(0.0, 8.0), rng.range_f32(0.0, 3.0), rng.range_f32(0.0, 20.0)])
+            .collect();
+        let src = plane(w, h, |x, y| vals[y * w + x]);
+        for p in [params(), BloomParams { radius: 1.0, streak: 0.0, ..params() }] {
+            let a = rng.below(h);
+            let b = a + 1 + rng.below(h - a);
+            for path in SimdPath::supported() {
+                let fresh = lanes::try_glare_plane(path, &p, &src, a..b, &Sequential).unwrap();
+                let pooled = lanes::try_glare_plane_in(path, &p, &src, a..b, &Sequential, &mut pool).unwrap();
+                assert_eq!(
+                    bits(&pooled.data),
+                    bits(&fresh.data),
+                    "case {case} {w}×{h} rows {a}..{b} on {path}"
+                );
+                // Its own plane back too, stale for the next glare.
+                pool.give(pooled);
+            }
+        }
+    }
+    assert!(pool.bytes() > 0);
 }

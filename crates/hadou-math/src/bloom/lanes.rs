@@ -22,7 +22,9 @@
 //! split once (no prefiltered plane); a renderer then reads each output row once for the tap, the
 //! composite and its colour mapping.
 
-use super::{bilinear, composite, half, levels, tent, BloomParams, Plan, Plane, RowFill, BLUR, MAX_LEVELS};
+use super::{
+    bilinear, composite, half, levels, tent, BloomParams, Plan, Plane, PlanePool, RowFill, BLUR, MAX_LEVELS,
+};
 use crate::simd::{dispatch, Lane, SimdPath, WithLanes};
 
 /// The downsample's weights in its order of summation (see [`super::down_row`]).
@@ -196,6 +198,8 @@ struct Scratch {
     pre: Vec<[f32; 3]>,
     /// The prefiltered rows of a block of level 1, each split into even and odd padded texels.
     block: Vec<Vec<f32>>,
+    /// The 2×2 box rows of a block of level 1 (every box row its rows share, made once).
+    boxes: Vec<Vec<f32>>,
 }
 
 thread_local! {
@@ -214,16 +218,38 @@ fn with_scratch<R>(rows: usize, f: impl FnOnce(&mut Scratch) -> R) -> R {
 }
 
 /// `row`'s texels padded by clamping, split: `even[m] = row[clamp(2m − 2)]`,
-/// `odd[m] = row[clamp(2m − 1)]` for `m < count` (flat, three floats a texel).
+/// `odd[m] = row[clamp(2m − 1)]` for `m < count` (flat, three floats a texel). The texels whose
+/// index needs no clamping are copied pair by pair, the few at either end one by one.
 fn split(row: &[[f32; 3]], count: usize, even: &mut Vec<f32>, odd: &mut Vec<f32>) {
     let last = row.len() as isize - 1;
     even.resize(3 * count, 0.0);
     odd.resize(3 * count, 0.0);
+    if count == 0 {
+        return;
+    }
     let (ev, od) = (even.as_chunks_mut::<3>().0, odd.as_chunks_mut::<3>().0);
-    for (m, (e, o)) in ev.iter_mut().zip(od.iter_mut()).enumerate() {
+    // m in 1..=inner reads the pair row[2m − 2], row[2m − 1] unclamped.
+    let inner = (row.len() / 2).min(count.saturating_sub(1));
+    let (pairs, _) = row.as_chunks::<2>();
+    for ((e, o), p) in ev[1..=inner].iter_mut().zip(od[1..=inner].iter_mut()).zip(&pairs[..inner]) {
+        *e = p[0];
+        *o = p[1];
+    }
+    for m in std::iter::once(0).chain(inner + 1..count) {
         let x = 2 * m as isize;
-        *e = row[(x - 2).clamp(0, last) as usize];
-        *o = row[(x - 1).clamp(0, last) as usize];
+        ev[m] = row[(x - 2).clamp(0, last) as usize];
+        od[m] = row[(x - 1).clamp(0, last) as usize];
+    }
+}
+
+/// `out[2j] = even[j]`, `out[2j + 1] = odd[j]` (`even` holds `⌈n/2⌉` texels, `odd` `⌊n/2⌋`).
+fn interleave(even: &[[f32; 3]], odd: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    let (pairs, tail) = out.as_chunks_mut::<2>();
+    for ((p, e), o) in pairs.iter_mut().zip(even).zip(odd) {
+        *p = [*e, *o];
+    }
+    if let Some(t) = tail.first_mut() {
+        *t = even[pairs.len()];
     }
 }
 
@@ -231,8 +257,14 @@ fn split(row: &[[f32; 3]], count: usize, even: &mut Vec<f32>, odd: &mut Vec<f32>
 fn pad(row: &[[f32; 3]], count: usize, out: &mut Vec<f32>) {
     let last = row.len() as isize - 1;
     out.resize(3 * count, 0.0);
-    for (m, o) in out.as_chunks_mut::<3>().0.iter_mut().enumerate() {
-        *o = row[(m as isize - 2).clamp(0, last) as usize];
+    let o = out.as_chunks_mut::<3>().0;
+    // m in 2..2 + inner reads row[m − 2] unclamped.
+    let inner = row.len().min(count.saturating_sub(2));
+    if inner > 0 {
+        o[2..2 + inner].copy_from_slice(&row[..inner]);
+    }
+    for m in (0..2.min(count)).chain(2 + inner..count) {
+        o[m] = row[(m as isize - 2).clamp(0, last) as usize];
     }
 }
 
@@ -315,16 +347,24 @@ fn tent_h(path: SimdPath, low: &[[f32; 3]], base: BaseIn, out: &mut [[f32; 3]], 
     ho.resize(3 * no, 0.0);
     taps(path, [&q[..]; 4], [0, 1, 2, 3], we, be, he);
     taps(path, [&q[..]; 4], [1, 2, 3, 4], wo, bo, ho);
-    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = if i % 2 == 0 { he[i / 2] } else { ho[i / 2] };
-    }
+    interleave(he.as_chunks::<3>().0, ho.as_chunks::<3>().0, out);
 }
 
 /// The horizontal sums of the tent over `low` (every row it holds) at the width `width` of the
 /// level above: row `y` of the result is `tent_h` of `low`'s row `y`.
 pub fn up_plane(path: SimdPath, low: &Plane, width: usize, fill: &dyn RowFill) -> Result<Plane, usize> {
-    let mut h = Plane::try_new(width, low.height, low.rows.clone())?;
+    up_plane_in(path, low, width, fill, &mut PlanePool::default())
+}
+
+/// [`up_plane`] into a plane from `pool`.
+fn up_plane_in(
+    path: SimdPath,
+    low: &Plane,
+    width: usize,
+    fill: &dyn RowFill,
+    pool: &mut PlanePool,
+) -> Result<Plane, usize> {
+    let mut h = Plane::try_new_in(pool, width, low.height, low.rows.clone())?;
     fill.fill(&mut h, &|y, row| {
         with_scratch(5, |s| tent_h(path, low.row(y), BaseIn::None, row, &mut s.rows[..5]))
     });
@@ -488,28 +528,27 @@ fn upsample_row_in(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]], s:
     ho.resize(3 * no, 0.0);
     taps(path, [&q[..]; 2], [1, 2], bilinear(0).1, None, he);
     taps(path, [&q[..]; 2], [2, 3], bilinear(1).1, None, ho);
-    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = if i % 2 == 0 { he[i / 2] } else { ho[i / 2] };
-    }
+    interleave(he.as_chunks::<3>().0, ho.as_chunks::<3>().0, out);
 }
 
 /// Level-1 rows a block of [`first_level`] makes at once: the prefiltered rows it reads (two per
 /// row and four more) are made and split once for the block.
 const BLOCK: usize = 8;
 
-/// `D₁` and the streak's `D₁ʰ` for the level-1 rows `rows`, straight from the linear image `src`
-/// (which holds the rows they read): the prefiltered rows `2·rows.start − 2 … 2·rows.end + 1`
-/// (clamped) each made once ([`prefilter_row`]) and split, then for each row `y` [`down_row`] of
-/// them into `d1`, and (`s1` not empty) `down_row_h` of the pair `(0 + ½·T(2y)) + ½·T(2y + 1)`
-/// into `s1` (the split of the pair is the pair of the splits, texel for texel): the planes of the
-/// prefilter, [`super::down_row`], [`super::pair_row`] and [`super::down_row_h`], bit for bit.
+/// The downsample's rows `rows` of the level below `src` (which holds the rows they read) in a
+/// block: the source rows `2·rows.start − 2 … 2·rows.end + 1` (clamped) each split once (with
+/// `prefilter = Some((threshold, soft_knee))` prefiltered first, [`prefilter_row`]), every 2×2 box
+/// row the block's rows share made once, then for each row `y` the thirteen taps of
+/// [`down_row`] into `d1`, and (`s1` not empty) `down_row_h` of the pair `(0 + ½·T(2y)) + ½·T(2y
+/// + 1)` into `s1` (the split of the pair is the pair of the splits, texel for texel): with the
+/// prefilter `D₁` and the streak's `D₁ʰ` straight from the linear image, without it a level of
+/// the pyramid; the planes of the prefilter, [`super::down_row`], [`super::pair_row`] and
+/// [`super::down_row_h`], bit for bit.
 #[allow(clippy::too_many_arguments)]
 fn first_level(
     path: SimdPath,
     src: &Plane,
-    threshold: f32,
-    soft_knee: f32,
+    prefilter: Option<(f32, f32)>,
     rows: std::ops::Range<usize>,
     d1: &mut [[f32; 3]],
     s1: &mut [[f32; 3]],
@@ -521,35 +560,48 @@ fn first_level(
     let clamp = |y: isize| y.clamp(0, last) as usize;
     let ta = clamp(2 * rows.start as isize - 2);
     let tb = clamp(2 * rows.end as isize + 1);
-    let Scratch { rows: work, pre, block, .. } = s;
+    let Scratch { rows: work, pre, block, boxes, .. } = s;
     let n = tb + 1 - ta;
     if block.len() < 2 * n {
         block.resize_with(2 * n, Vec::new);
     }
     pre.resize(src.width, [0.0; 3]);
     for (i, y) in (ta..=tb).enumerate() {
-        prefilter_row(path, src.row(y), threshold, soft_knee, pre);
         let (e, o) = block[2 * i..2 * i + 2].split_at_mut(1);
-        split(pre, count, &mut e[0], &mut o[0]);
+        match prefilter {
+            Some((threshold, soft_knee)) => {
+                prefilter_row(path, src.row(y), threshold, soft_knee, pre);
+                split(pre, count, &mut e[0], &mut o[0]);
+            }
+            None => split(src.row(y), count, &mut e[0], &mut o[0]),
+        }
     }
-    let (boxes, pair) = work.split_at_mut(5);
+    // The box rows: row y's five are those at the (unclamped) source rows s = 2y − 2 + k,
+    // k = 0 … 4, each the box of the source rows clamp(s) and clamp(s + 1): even-x boxes for even
+    // s, odd-x ones for odd s. Neighbouring rows share three of their five, so each is made once
+    // for the block, from `s0 = 2·rows.start − 2` on.
+    let s0 = 2 * rows.start as isize - 2;
+    let nb = 2 * rows.len() + 3;
+    if boxes.len() < nb {
+        boxes.resize_with(nb, Vec::new);
+    }
+    let m = 3 * (wo + 2);
+    for (b, bx) in boxes[..nb].iter_mut().enumerate() {
+        let sy = s0 + b as isize;
+        let (i0, i1) = (2 * (clamp(sy) - ta), 2 * (clamp(sy + 1) - ta));
+        let (e0, o0, e1, o1) = (&block[i0], &block[i0 + 1], &block[i1], &block[i1 + 1]);
+        bx.resize(m, 0.0);
+        let srcs: [&[f32]; 4] = if b % 2 == 0 {
+            [&e0[..m], &o0[..m], &e1[..m], &o1[..m]]
+        } else {
+            [&o0[..m], &e0[3..3 + m], &o1[..m], &e1[3..3 + m]]
+        };
+        dispatch(path, BoxSum { srcs, out: bx });
+    }
+    let pair = work;
     for (r, y) in rows.clone().enumerate() {
         let at = |dy: isize| 2 * (clamp(2 * y as isize - 2 + dy) - ta);
-        // The six source rows 2y−2 … 2y+3, split: (even, odd) of row 2y − 2 + r at `at(r)`.
-        for (k, bx) in boxes.iter_mut().enumerate() {
-            let (i0, i1) = (at(k as isize), at(k as isize + 1));
-            let (e0, o0, e1, o1) = (&block[i0], &block[i0 + 1], &block[i1], &block[i1 + 1]);
-            let m = 3 * (wo + 2);
-            bx.resize(m, 0.0);
-            let srcs: [&[f32]; 4] = if k % 2 == 0 {
-                [&e0[..m], &o0[..m], &e1[..m], &o1[..m]]
-            } else {
-                [&o0[..m], &e0[3..3 + m], &o1[..m], &e1[3..3 + m]]
-            };
-            dispatch(path, BoxSum { srcs, out: bx });
-        }
-        let [be0, bo1, be2, bo3, be4] =
-            [&boxes[0], &boxes[1], &boxes[2], &boxes[3], &boxes[4]].map(|v| &v[..]);
+        let [be0, bo1, be2, bo3, be4] = std::array::from_fn(|k| &boxes[2 * r + k][..]);
         taps(
             path,
             [be2, bo1, bo1, bo3, bo3, be0, be2, be2, be4, be0, be0, be4, be4],
@@ -611,6 +663,20 @@ pub fn try_glare_plane(
     band: std::ops::Range<usize>,
     fill: &dyn RowFill,
 ) -> Result<Plane, usize> {
+    try_glare_plane_in(path, params, src, band, fill, &mut PlanePool::default())
+}
+
+/// [`try_glare_plane`] with its planes from `pool`, and every plane but the one it returns given
+/// back to it (the caller may give that one back too once it is read): the same plane, bit for
+/// bit.
+pub fn try_glare_plane_in(
+    path: SimdPath,
+    params: &BloomParams,
+    src: &Plane,
+    band: std::ops::Range<usize>,
+    fill: &dyn RowFill,
+    pool: &mut PlanePool,
+) -> Result<Plane, usize> {
     let (w, h) = (src.width, src.height);
     let n = levels(params.radius * h as f32);
     let plan = Plan::new(w, h, n, band.clone());
@@ -618,34 +684,39 @@ pub fn try_glare_plane(
     let (kb, ks) = super::weights(params, h);
     let l1 = &plan.levels[0];
     // D₁ and the streak's D₁ʰ in one pass over the linear image.
-    let mut d1 = Plane::try_new(l1.width, l1.height, l1.down.clone())?;
-    let mut s1 = if ks > 0.0 { Some(Plane::try_new(l1.width, l1.height, l1.down.clone())?) } else { None };
+    let mut d1 = Plane::try_new_in(pool, l1.width, l1.height, l1.down.clone())?;
+    let mut s1 =
+        if ks > 0.0 { Some(Plane::try_new_in(pool, l1.width, l1.height, l1.down.clone())?) } else { None };
     fill.fill_blocks(&mut d1, s1.as_mut(), BLOCK, &|rows, d, s| {
-        with_scratch(7, |scratch| first_level(path, src, th, kn, rows, d, s, scratch))
+        with_scratch(7, |scratch| first_level(path, src, Some((th, kn)), rows, d, s, scratch))
     });
     let mut downs: Vec<Plane> = Vec::with_capacity(plan.levels.len());
     downs.push(d1);
     for l in &plan.levels[1..] {
-        let mut d = Plane::try_new(l.width, l.height, l.down.clone())?;
+        let mut d = Plane::try_new_in(pool, l.width, l.height, l.down.clone())?;
         let prev = downs.last().expect("D₁");
-        fill.fill(&mut d, &|y, row| down_row(path, prev, y, row));
+        fill.fill_blocks(&mut d, None, BLOCK, &|rows, d, _| {
+            with_scratch(7, |scratch| first_level(path, prev, None, rows, d, &mut [], scratch))
+        });
         downs.push(d);
     }
     let mut u = downs.pop().unwrap_or_default();
     while let Some(d) = downs.pop() {
         let l = &plan.levels[downs.len()];
-        let hs = up_plane(path, &u, l.width, fill)?;
-        let mut next = Plane::try_new(l.width, l.height, l.up.clone())?;
+        let hs = up_plane_in(path, &u, l.width, fill, pool)?;
+        let mut next = Plane::try_new_in(pool, l.width, l.height, l.up.clone())?;
         fill.fill(&mut next, &|y, row| up_row(path, &hs, y, Some(d.row(y)), row));
-        u = next;
+        pool.give(hs);
+        pool.give(d);
+        pool.give(std::mem::replace(&mut u, next));
     }
-    let mut hb = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+    let mut hb = Plane::try_new_in(pool, l1.width, l1.height, l1.up.clone())?;
     fill.fill(&mut hb, &|y, row| blur_row_h(path, u.row(y), row));
-    drop(u);
+    pool.give(u);
     let hs = match s1 {
         Some(s1) => {
             let ns = levels(params.streak_length * h as f32);
-            let mut hs = Plane::try_new(l1.width, l1.height, l1.up.clone())?;
+            let mut hs = Plane::try_new_in(pool, l1.width, l1.height, l1.up.clone())?;
             fill.fill(&mut hs, &|y, row| {
                 with_scratch(5, |s| {
                     let Scratch { rows, levels, .. } = s;
@@ -653,11 +724,16 @@ pub fn try_glare_plane(
                     blur_row_h_in(path, &levels[0], row, &mut rows[0]);
                 })
             });
+            pool.give(s1);
             Some(hs)
         }
         None => None,
     };
-    let mut g = Plane::try_new(l1.width, l1.height, super::bilinear_rows(&band, l1.height))?;
+    let mut g = Plane::try_new_in(pool, l1.width, l1.height, super::bilinear_rows(&band, l1.height))?;
     fill.fill(&mut g, &|y, row| glare_row(path, &hb, hs.as_ref(), y, kb, ks, row));
+    pool.give(hb);
+    if let Some(hs) = hs {
+        pool.give(hs);
+    }
     Ok(g)
 }
