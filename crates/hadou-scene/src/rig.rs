@@ -152,7 +152,7 @@ pub struct Rig {
 pub struct NodePose {
     /// Per node, its local translation, rotation (unit quaternion `[x, y, z, w]`) and scale
     /// (glTF 2.0 §3.5.3: `L = T·R·S`); `None` for a node given by a `matrix`, which keeps it.
-    pub locals: Vec<Option<([f32; 3], [f32; 4], [f32; 3])>>,
+    pub locals: Vec<Option<Trs>>,
     /// Per node, the morph weights of its mesh (glTF 2.0 §3.7.2.2, expressions added); empty for
     /// a node without morph targets.
     pub weights: Vec<Vec<f32>>,
@@ -426,8 +426,8 @@ impl Rig {
     }
 }
 
-/// A node's translation, rotation (unit quaternion) and scale.
-pub(crate) type Trs = ([f32; 3], [f32; 4], [f32; 3]);
+/// A node's translation, rotation (unit quaternion `[x, y, z, w]`) and scale (glTF 2.0 §3.5.3).
+pub type Trs = ([f32; 3], [f32; 4], [f32; 3]);
 
 /// What posing every vertex of one part shares.
 struct PartSetup<'a> {
