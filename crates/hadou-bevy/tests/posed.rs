@@ -1,9 +1,10 @@
 //! Characters posed by hadou-scene in Bevy ([`HadouPose`]): `scenes/showcase.toml`'s VRM character
 //! (a VRM Animation clip, spring bones blown by the beam's wind) is drawn by Bevy as `hadou render`
 //! draws it at two times of its motion (mean absolute 8-bit difference ≤ [`MAX_MEAN`] each, the
-//! pose of one time held apart from the other's by more than [`MIN_MOVED_MEAN`]), and bad input is one clear error: an expression
-//! the file lacks or a broken `.vrma` fails the scene's load with `file:line:col`, a pose that does
-//! not fit its file is one error naming the entity and `path`, the character at rest.
+//! pose of one time held apart from the other's by more than [`MIN_MOVED_MEAN`]), and bad input is
+//! one clear error: an expression the file lacks or a broken `.vrma` fails the scene's load with
+//! `file:line:col`, a pose that does not fit its file is one error naming the entity and `path`,
+//! the character at rest, and a pose's values that are not finite leave their node at rest.
 
 mod common;
 
@@ -203,6 +204,17 @@ fn a_pose_that_does_not_fit_its_file_is_an_error_and_the_character_stays_at_rest
     let posed = spawn("posed", Some(pose.clone()));
     let wrong = spawn("wrong", Some(short));
     let still = spawn("still", None);
+    // A node the pose moves given values that are not finite: that node keeps its rest.
+    let (_, rig) = hadou_scene::load_gltf_rig(&root.join("assets/showcase.vrm")).unwrap();
+    let rest_pose = rig.unwrap().node_locals(&hadou_scene::PoseInput::default());
+    let moved =
+        (0..pose.locals.len()).find(|&i| pose.locals[i] != rest_pose.locals[i]).expect("a node moves");
+    let mut broken = pose.clone();
+    broken.locals[moved] = Some(([f32::NAN; 3], [f32::INFINITY; 4], [f32::NAN; 3]));
+    for w in &mut broken.weights {
+        w.iter_mut().for_each(|x| *x = f32::NAN);
+    }
+    let not_finite = spawn("not finite", Some(broken));
     let mut rejected = None;
     for _ in 0..1000 {
         app.update();
@@ -226,6 +238,20 @@ fn a_pose_that_does_not_fit_its_file_is_an_error_and_the_character_stays_at_rest
     let rest = nodes(app.world_mut(), still);
     assert!(!rest.is_empty());
     assert_eq!(nodes(app.world_mut(), wrong), rest, "a rejected pose leaves the character at rest");
+    let (kept, drawn) = (nodes(app.world_mut(), not_finite), nodes(app.world_mut(), posed));
+    assert!(
+        kept.iter().all(|(_, t, r)| t.is_finite() && r.is_finite()),
+        "no value that is not finite is drawn"
+    );
+    let differ: Vec<_> = kept.iter().zip(&drawn).zip(&rest).filter(|((k, d), _)| k != d).collect();
+    assert!(!differ.is_empty(), "the node given values that are not finite is not posed");
+    assert!(differ.iter().all(|((k, _), r)| k == r), "it keeps its rest: {differ:?}");
+    let weights = app
+        .world_mut()
+        .query::<&bevy::mesh::morph::MorphWeights>()
+        .iter(app.world())
+        .all(|w| w.weights().iter().all(|x| x.is_finite()));
+    assert!(weights, "no morph weight that is not finite");
     let drawn = nodes(app.world_mut(), posed);
     assert_ne!(drawn, rest, "the pose at 1.8 s moves the character");
     // Every node of the pose has hadou's local transform.
