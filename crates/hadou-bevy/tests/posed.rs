@@ -4,7 +4,8 @@
 //! pose of one time held apart from the other's by more than [`MIN_MOVED_MEAN`]), and bad input is
 //! one clear error: an expression the file lacks or a broken `.vrma` fails the scene's load with
 //! `file:line:col`, a pose that does not fit its file is one error naming the entity and `path`,
-//! the character at rest, and a pose's values that are not finite leave their node at rest.
+//! the character at rest, and a pose's values that are not finite leave their node at rest; the
+//! pose's morph weights reach the meshes' `MorphWeights`.
 
 mod common;
 
@@ -215,6 +216,14 @@ fn a_pose_that_does_not_fit_its_file_is_an_error_and_the_character_stays_at_rest
         w.iter_mut().for_each(|x| *x = f32::NAN);
     }
     let not_finite = spawn("not finite", Some(broken));
+    // Morph weights (expressions) reach the meshes' `MorphWeights`.
+    let mut weighted = pose.clone();
+    for w in &mut weighted.weights {
+        w.iter_mut().for_each(|x| *x = 0.25);
+    }
+    let morphs = weighted.weights.iter().filter(|w| !w.is_empty()).count();
+    assert!(morphs > 0, "showcase.vrm has morph targets");
+    let weighted = spawn("weighted", Some(weighted));
     let mut rejected = None;
     for _ in 0..1000 {
         app.update();
@@ -252,6 +261,17 @@ fn a_pose_that_does_not_fit_its_file_is_an_error_and_the_character_stays_at_rest
         .iter(app.world())
         .all(|w| w.weights().iter().all(|x| x.is_finite()));
     assert!(weights, "no morph weight that is not finite");
+    let below: Vec<Entity> = app.world().get::<Children>(weighted).into_iter().flatten().copied().collect();
+    let mut set = 0;
+    let mut stack = below;
+    while let Some(e) = stack.pop() {
+        if let Some(w) = app.world().get::<bevy::mesh::morph::MorphWeights>(e) {
+            assert!(w.weights().iter().all(|&x| x == 0.25), "{:?}", w.weights());
+            set += 1;
+        }
+        stack.extend(app.world().get::<Children>(e).into_iter().flatten().copied());
+    }
+    assert_eq!(set, morphs, "every node with morph targets has the pose's weights");
     let drawn = nodes(app.world_mut(), posed);
     assert_ne!(drawn, rest, "the pose at 1.8 s moves the character");
     // Every node of the pose has hadou's local transform.
