@@ -36,6 +36,8 @@ mod drawn_pose;
 mod material;
 mod mesh;
 mod outline;
+#[cfg(feature = "gltf")]
+mod pose;
 mod render;
 mod shaded;
 mod shadows;
@@ -63,6 +65,8 @@ pub use material::{
 };
 pub use mesh::{bevy_mesh, bevy_slot_mesh, outline_mesh, slot_indices_of};
 pub use outline::{HadouOutline, HadouOutlineUniform};
+#[cfg(feature = "gltf")]
+pub use pose::{pose_rejection_message, HadouPose, PoseRejected};
 pub use shaded::{hadou_texture, HadouShaded};
 pub use shadows::{shadow_frame, shadow_mask, shadow_records, HadouShadows, PLANE_MAP_SIZE};
 pub use spawn::{
@@ -159,6 +163,8 @@ impl Plugin for HadouPlugin {
             }
             #[cfg(feature = "gltf")]
             app.add_systems(Update, clips::play_clips.after(HadouSystems::Scenes));
+            #[cfg(feature = "gltf")]
+            app.add_systems(Update, pose::apply_poses.after(HadouSystems::Scenes));
             app.add_systems(
                 PostUpdate,
                 material::update_wave_lights.in_set(HadouSystems::Lights).after(HadouSystems::CheckWaves),

@@ -11,6 +11,8 @@ use crate::clips::{ClipPlayback, ClipRejected, HadouClip};
 use crate::material::HadouMaterial;
 use crate::mesh::{bevy_mesh, outline_mesh, slot_indices_of};
 use crate::outline::HadouOutline;
+#[cfg(feature = "gltf")]
+use crate::pose::{HadouPose, PoseBinding, PoseRejected};
 use crate::shaded::HadouShaded;
 use crate::shadows::{shadow_mask, HadouShadows};
 use crate::wave::HadouWave;
@@ -59,7 +61,9 @@ pub struct SpawnedScene {
     /// (`HadouOutline`); a `kind = "gltf"` object is the file's scene loaded by Bevy's glTF
     /// loader (`WorldAssetRoot`, skinned and animated by Bevy) with [`crate::HadouShaded`]
     /// giving each of its meshes its slot's look, and a `HadouClip` (feature `gltf`) at the
-    /// scene's clip time when it plays an `animation`.
+    /// scene's clip time when it plays an `animation`, or a `HadouPose` (feature `gltf`) of
+    /// hadou-scene's pose of its nodes when hadou poses it beyond a clip of its file (a VRMA
+    /// `animation_file`, `expressions`, spring bones, `look_at`).
     pub objects: Vec<Entity>,
     /// Per object, the material of each slot (the object's materials in order), set from the
     /// scene every frame (tracks may change `wave_blend`, colours, the light); empty for a glTF
@@ -312,7 +316,12 @@ pub(crate) fn spawn_scenes(
                             shaded,
                         ))
                         .id();
-                    if let Some((name, time)) = scene.object_clip_at(i, frame.time) {
+                    if scene.object_posed_by_hadou(i) {
+                        // Posed by hadou-scene (a VRMA clip, expressions, spring bones, a gaze):
+                        // its nodes are set from the pose, and no clip of the file is played.
+                        let pose = scene.object_node_pose_at(i, frame.time).unwrap_or_default();
+                        commands.entity(entity).insert(HadouPose(pose));
+                    } else if let Some((name, time)) = scene.object_clip_at(i, frame.time) {
                         commands.entity(entity).insert(HadouClip { name, time });
                     }
                     (entity, Vec::new())
@@ -395,6 +404,7 @@ pub(crate) fn animate_scenes(
     mut shadows: ResMut<HadouShadows>,
     mut area_lights: Query<&mut HadouAreaLight>,
     #[cfg(feature = "gltf")] mut clips: Query<&mut HadouClip>,
+    #[cfg(feature = "gltf")] mut poses: Query<&mut HadouPose>,
 ) {
     for (root, mut spawned) in &mut roots {
         let Some(HadouScene(scene)) = scenes.get(&root.scene) else { continue };
@@ -408,6 +418,14 @@ pub(crate) fn animate_scenes(
             {
                 if clip.time != t {
                     clip.time = t;
+                }
+            }
+            // hadou-scene's pose of the nodes at this time, written only when it changes.
+            if let Ok(mut pose) = poses.get_mut(entity) {
+                if let Some(next) = scene.object_node_pose_at(i, frame.time) {
+                    if pose.0 != next {
+                        pose.0 = next;
+                    }
                 }
             }
         }
@@ -487,6 +505,7 @@ pub(crate) fn mark_ready(
     asset_server: Res<AssetServer>,
     clips: Query<(Option<&ClipPlayback>, Has<ClipRejected>), With<HadouClip>>,
     animation: Option<Res<Assets<bevy::animation::graph::AnimationGraph>>>,
+    poses: Query<(Option<&PoseBinding>, Has<PoseRejected>), With<HadouPose>>,
 ) {
     for mut spawned in roots.iter_mut().filter(|s| !s.ready) {
         let ready = spawned.objects.iter().all(|&object| {
@@ -497,6 +516,12 @@ pub(crate) fn mark_ready(
             // A clip is bound to its player (or rejected) before the first posed frame.
             if let Ok((playback, rejected)) = clips.get(object) {
                 if animation.is_some() && !rejected && !playback.is_some_and(ClipPlayback::is_bound) {
+                    return false;
+                }
+            }
+            // hadou's pose is bound to the nodes (or rejected) before the first posed frame.
+            if let Ok((binding, rejected)) = poses.get(object) {
+                if !rejected && !binding.is_some_and(PoseBinding::is_bound) {
                     return false;
                 }
             }

@@ -108,7 +108,7 @@ pub use limits::{
     GLARE_MAX_PIXELS, MAX_IMAGE_EDGE, MAX_KEY_CHECKS, MAX_MATERIAL_SLOTS, MAX_SKINNED_NODES, MAX_SKIN_JOINTS,
     MAX_TRIANGLES, MAX_VERTICES, PIXEL_WORK_MAX, TRACE_MAX_BYTES,
 };
-pub use rig::{clip_time, clip_wrap, Clip, Expression, PoseInput, Rig, VrmVersion};
+pub use rig::{clip_time, clip_wrap, Clip, Expression, NodePose, PoseInput, Rig, Trs, VrmVersion};
 pub use scene::Scene;
 pub use shadow::{
     Shadow, ShadowCast, ShadowLight, ShadowMethod, MAX_MAPS, MAX_MAP_SIZE, MAX_MAP_TEXELS, MAX_SHADOWS,

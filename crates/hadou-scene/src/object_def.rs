@@ -360,7 +360,8 @@ fn parse_motion(
         });
         expressions = true;
     }
-    Ok(Some(Motion { clip, looping, pinned, expressions }))
+    let retargeted = t.get("animation_file").is_some();
+    Ok(Some(Motion { clip, looping, pinned, expressions, retargeted }))
 }
 
 /// Resolves an asset path `rel` written at `span` of `t`: relative to the scene file and inside

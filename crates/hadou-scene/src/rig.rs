@@ -145,6 +145,19 @@ pub struct Rig {
     pub(crate) look_at: Option<crate::look_at::LookAt>,
 }
 
+/// The pose of a character's glTF nodes ([`Rig::node_locals`], [`crate::Scene::object_node_pose_at`]):
+/// per node of the file (the file's node order), its local transform and the morph weights of
+/// its mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NodePose {
+    /// Per node, its local translation, rotation (unit quaternion `[x, y, z, w]`) and scale
+    /// (glTF 2.0 §3.5.3: `L = T·R·S`); `None` for a node given by a `matrix`, which keeps it.
+    pub locals: Vec<Option<Trs>>,
+    /// Per node, the morph weights of its mesh (glTF 2.0 §3.7.2.2, expressions added); empty for
+    /// a node without morph targets.
+    pub weights: Vec<Vec<f32>>,
+}
+
 /// What to pose: a clip at a time, and expression weights.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PoseInput<'a> {
@@ -202,6 +215,16 @@ impl Rig {
     /// The file's spring bones, if it has any.
     pub fn springs(&self) -> Option<&crate::spring_bones::SpringBones> {
         self.springs.as_ref()
+    }
+
+    /// Every glTF node's local transform and morph weights under `input` (steps 1 and 3 of the
+    /// module's notes before the product `G(node) = G(parent) · L(node)`): what a renderer that
+    /// keeps the file's own node hierarchy (Bevy's glTF scene) sets on its nodes so that its
+    /// skinning draws the pose [`Rig::pose`] gives. The rig's `base` (VRM 0.x's half turn above
+    /// the root nodes) is not in it.
+    pub fn node_locals(&self, input: &PoseInput<'_>) -> NodePose {
+        let (locals, weights) = self.sample_locals(input);
+        NodePose { locals, weights }
     }
 
     /// Every node's global matrix and morph weights for `input`.
@@ -403,8 +426,8 @@ impl Rig {
     }
 }
 
-/// A node's translation, rotation (unit quaternion) and scale.
-pub(crate) type Trs = ([f32; 3], [f32; 4], [f32; 3]);
+/// A node's translation, rotation (unit quaternion `[x, y, z, w]`) and scale (glTF 2.0 §3.5.3).
+pub type Trs = ([f32; 3], [f32; 4], [f32; 3]);
 
 /// What posing every vertex of one part shares.
 struct PartSetup<'a> {

@@ -12,7 +12,7 @@ use crate::frame::{
 };
 use crate::materials::{build_material, MaterialDef, ObjectMaterials};
 use crate::params::ParamSet;
-use crate::rig::{clip_time, clip_wrap, Clip, PoseInput, Rig};
+use crate::rig::{clip_time, clip_wrap, Clip, NodePose, PoseInput, Rig};
 use crate::shadow_def::{build_shadow, ShadowDef};
 use crate::wave_kind::{CurveKind, WaveKind};
 use hadou_math::curve::{CurveFrame, CurveShape, CurveWave, Integrator, Reduction};
@@ -99,6 +99,30 @@ pub(crate) struct Motion {
     /// It gives `expressions` (the parameter `expressions`, one weight per expression of the
     /// file, in the file's order).
     pub expressions: bool,
+    /// The clip is a VRM Animation (`animation_file`) retargeted onto the file, not one of its
+    /// own clips.
+    pub retargeted: bool,
+}
+
+/// What poses an object at one time (`Scene::pose_parts`).
+struct PoseParts<'a> {
+    clip: Option<&'a Clip>,
+    clip_t: f32,
+    expressions: Vec<(usize, f32)>,
+    rotations: Vec<(usize, [f32; 4])>,
+}
+
+impl PoseParts<'_> {
+    /// The rig's input for this pose.
+    fn input(&self) -> PoseInput<'_> {
+        PoseInput {
+            clip: self.clip,
+            time: self.clip_t,
+            expressions: &self.expressions,
+            rotations: &self.rotations,
+            skip_weights: false,
+        }
+    }
 }
 
 impl ObjectDef {
@@ -442,26 +466,59 @@ impl Scene {
         })
     }
 
-    /// Object `o`'s mesh at scene time `time`: its rest mesh, or the pose its clip and expressions
-    /// give (cached for the last pose asked for).
-    fn posed_mesh(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Arc<Mesh> {
-        let Some(rig) = &o.rig else { return o.mesh.clone() };
+    /// What poses object `o` at scene time `time`: its clip, the clip time, its expressions
+    /// (`expressions`, the gaze's) and its nodes' replaced rotations (spring bones, gaze); `None`
+    /// when nothing moves it (its rest pose).
+    fn pose_parts<'a>(&self, o: &'a ObjectDef, vals: &[f32], time: f32) -> Option<PoseParts<'a>> {
+        let rig = o.rig.as_ref()?;
         let springs = o.spring && rig.springs.is_some();
         if o.motion.is_none() && !springs && o.look_at.is_none() {
-            return o.mesh.clone();
+            return None;
         }
         let clip_t = self.clip_time_of(o, vals, time).unwrap_or(0.0);
-        let expressions: Vec<(usize, f32)> = if o.motion.as_ref().is_some_and(|m| m.expressions) {
+        let mut expressions: Vec<(usize, f32)> = if o.motion.as_ref().is_some_and(|m| m.expressions) {
             o.params.raw(vals, "expressions").iter().copied().enumerate().filter(|e| e.1 != 0.0).collect()
         } else {
             Vec::new()
         };
-        let mut expressions = expressions;
         let mut rotations = if springs { self.spring_rotations(o, rig, time) } else { Vec::new() };
         self.add_gaze(o, rig, vals, clip_t, &mut rotations, &mut expressions);
-        let key: Vec<u32> = std::iter::once(clip_t.to_bits())
-            .chain(expressions.iter().map(|e| e.1.to_bits()))
-            .chain(rotations.iter().flat_map(|(_, r)| r.map(f32::to_bits)))
+        let clip = o.motion.as_ref().and_then(|m| m.clip.as_deref());
+        Some(PoseParts { clip, clip_t, expressions, rotations })
+    }
+
+    /// Whether hadou poses object `index` with more than a clip of its own glTF file: a VRM
+    /// Animation (`animation_file`), `expressions`, spring bones or a gaze (`look_at`). Such an
+    /// object's pose is [`Scene::object_node_pose_at`]; a file clip alone is
+    /// [`Scene::object_clip_at`].
+    pub fn object_posed_by_hadou(&self, index: usize) -> bool {
+        let Some(o) = self.objects.get(index) else { return false };
+        let Some(rig) = o.rig.as_ref() else { return false };
+        let retargeted = o.motion.as_ref().is_some_and(|m| m.retargeted);
+        let expressions = o.motion.as_ref().is_some_and(|m| m.expressions);
+        retargeted || expressions || (o.spring && rig.springs.is_some()) || o.look_at.is_some()
+    }
+
+    /// The pose of object `index`'s glTF nodes at scene time `time`, from the same clip, clip
+    /// time, expressions and spring-bone and gaze rotations as the mesh [`Scene::at`] draws
+    /// ([`crate::Rig::node_locals`]); `None` for an object without a glTF character or one that
+    /// nothing moves.
+    pub fn object_node_pose_at(&self, index: usize, time: f32) -> Option<NodePose> {
+        let o = self.objects.get(index)?;
+        let vals = self.values_at(time);
+        let parts = self.pose_parts(o, &vals, time)?;
+        Some(o.rig.as_ref()?.node_locals(&parts.input()))
+    }
+
+    /// Object `o`'s mesh at scene time `time`: its rest mesh, or the pose its clip and expressions
+    /// give (cached for the last pose asked for).
+    fn posed_mesh(&self, o: &ObjectDef, vals: &[f32], time: f32) -> Arc<Mesh> {
+        let (Some(rig), Some(parts)) = (&o.rig, self.pose_parts(o, vals, time)) else {
+            return o.mesh.clone();
+        };
+        let key: Vec<u32> = std::iter::once(parts.clip_t.to_bits())
+            .chain(parts.expressions.iter().map(|e| e.1.to_bits()))
+            .chain(parts.rotations.iter().flat_map(|(_, r)| r.map(f32::to_bits)))
             .collect();
         if let Ok(cache) = o.pose_cache.lock() {
             if let Some((k, m)) = cache.as_ref() {
@@ -470,15 +527,7 @@ impl Scene {
                 }
             }
         }
-        let clip = o.motion.as_ref().and_then(|m| m.clip.as_deref());
-        let input = PoseInput {
-            clip,
-            time: clip_t,
-            expressions: &expressions,
-            rotations: &rotations,
-            skip_weights: false,
-        };
-        let mesh = Arc::new(rig.pose(&o.mesh, &input));
+        let mesh = Arc::new(rig.pose(&o.mesh, &parts.input()));
         if let Ok(mut cache) = o.pose_cache.lock() {
             *cache = Some((key, mesh.clone()));
         }

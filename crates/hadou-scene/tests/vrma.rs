@@ -213,3 +213,66 @@ fn issue_41_a_warning_never_carries_a_files_control_characters() {
     }
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// `Scene::object_node_pose_at` (what the Bevy plugin sets on the file's own nodes): its node
+/// locals, composed parent first (glTF 2.0 §3.5.3, `G(node) = G(parent) · L(node)`), are the
+/// node globals hadou skins the VRMA-posed mesh by (`Rig::node_globals` of the same clip and clip
+/// time); they move with the scene time, and only an object posed beyond a file clip has them.
+#[test]
+fn a_scenes_node_pose_composes_to_the_globals_its_mesh_is_posed_by() {
+    let d = std::env::temp_dir().join(format!("hadou-vrma-nodes-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    for f in ["brace.vrm", "brace.vrma"] {
+        std::fs::copy(asset(f), d.join(f)).unwrap();
+    }
+    let text = "[camera]\nposition = [0, 1, 6]\ntarget = [0, 1, 0]\n\n[[object]]\nname = \"who\"\nkind = \"gltf\"\n\
+                path = \"brace.vrm\"\nanimation_file = \"brace.vrma\"\nspring = false\n\n[[object]]\nname = \"floor\"\n\
+                kind = \"plane\"\n";
+    std::fs::write(d.join("scene.toml"), text).unwrap();
+    let scene = Scene::load(d.join("scene.toml")).unwrap();
+    assert!(scene.object_posed_by_hadou(0) && !scene.object_posed_by_hadou(1));
+    assert!(scene.object_node_pose_at(1, 0.9).is_none(), "a plane has no nodes");
+    let (_, rig) = load_gltf_rig(&asset("brace.vrm")).unwrap();
+    let rig = rig.unwrap();
+    let (clip, _) = load_vrma_clip(&asset("brace.vrma"), &rig, None).unwrap();
+    let json = Gltf::open(&asset("brace.vrm")).json;
+    let nodes = json["nodes"].as_array().unwrap();
+    let mut parent = vec![None; nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        for c in n["children"].as_array().into_iter().flatten() {
+            parent[c.as_u64().unwrap() as usize] = Some(i);
+        }
+    }
+    let mut poses = Vec::new();
+    for t in [0.3f32, 0.9] {
+        let pose = scene.object_node_pose_at(0, t).expect("a VRMA-posed character has a node pose");
+        assert_eq!((pose.locals.len(), pose.weights.len()), (nodes.len(), nodes.len()));
+        let want = rig.node_globals(&PoseInput { clip: Some(&clip), time: t, ..Default::default() });
+        let mut got: Vec<Option<Mat4>> = vec![None; nodes.len()];
+        // Parents before children: repeat until every node is placed.
+        while got.iter().any(Option::is_none) {
+            for i in 0..nodes.len() {
+                let (t_, r, s) = pose.locals[i].expect("brace.vrm's nodes are TRS");
+                let local = hadou_math::keyframes::trs_matrix(t_, r, s);
+                got[i] = match parent[i] {
+                    None => Some(local),
+                    Some(p) => got[p].map(|g| g * local),
+                };
+            }
+        }
+        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+            for (a, b) in g.unwrap().cols.iter().flatten().zip(w.cols.iter().flatten()) {
+                assert!((a - b).abs() < 1e-5, "node {i} at {t}: {g:?} vs {w:?}");
+            }
+        }
+        poses.push(pose);
+    }
+    assert_ne!(poses[0], poses[1], "the clip moves the nodes between 0.3 s and 0.9 s");
+    // A file clip alone is played by the file's own clip (`object_clip_at`), not posed by hadou.
+    let brace =
+        Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-brace.toml")).unwrap();
+    assert!(!brace.object_posed_by_hadou(0));
+    let showcase =
+        Scene::load(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/showcase.toml")).unwrap();
+    assert!(showcase.object_posed_by_hadou(0), "a VRMA clip and spring bones");
+}
