@@ -29,6 +29,9 @@ impl RowFill for Parallel {
     }
 
     fn fill_blocks(&self, a: &mut Plane, b: Option<&mut Plane>, block: usize, f: &bloom::BlockFn<'_>) {
+        if a.data.len() < SMALL_PLANE {
+            return bloom::Sequential.fill_blocks(a, b, block, f);
+        }
         let (y0, wa, block) = (a.rows.start, a.width, block.max(1));
         let rows = |i: usize, len: usize| y0 + i * block..y0 + i * block + len / wa;
         match b {
