@@ -12,6 +12,8 @@
 use crate::material::{HadouMaterial, AREA_DATA, AREA_NODES, AREA_TRIS};
 use crate::outline::HadouOutline;
 use bevy::asset::RenderAssetUsages;
+use bevy::ecs::system::SystemParam;
+use bevy::mesh::morph::{MeshMorphWeights, MorphWeights};
 use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
@@ -233,21 +235,22 @@ pub fn fragment_loop_bound(shape: LampShape, samples: u32, nodes: u64, tris: u64
 pub(crate) fn caster_triangles(root: Entity, scene: &CasterScene, out: &mut Vec<[Vec3f; 3]>) {
     let entities = std::iter::once(root).chain(scene.children.iter_descendants(root));
     for e in entities {
-        let Ok((mesh, global, skin)) = scene.meshes.get(e) else { continue };
+        let Ok((mesh, global, skin, morph)) = scene.meshes.get(e) else { continue };
         let Some(mesh) = scene.mesh_assets.get(&mesh.0) else { continue };
-        let Some(VertexAttributeValues::Float32x3(positions)) = mesh.attribute(Mesh::ATTRIBUTE_POSITION)
+        // A mesh whose data went to the render world only (`RenderAssetUsages::RENDER_WORLD`)
+        // has nothing to read here and casts nothing.
+        let Ok(Some(VertexAttributeValues::Float32x3(positions))) =
+            mesh.try_attribute_option(Mesh::ATTRIBUTE_POSITION)
         else {
             continue;
         };
+        let Ok(indices) = mesh.try_indices_option() else { continue };
+        let positions = morphed(mesh, positions, morph.and_then(|m| morph_weights(m, scene)));
         let world: Vec<Vec3> = match skin.and_then(|s| skinned(mesh, s, scene)) {
-            Some(matrices) => positions
-                .iter()
-                .zip(matrices)
-                .map(|(p, m)| m.transform_point3(Vec3::from_array(*p)))
-                .collect(),
+            Some(matrices) => positions.iter().zip(matrices).map(|(p, m)| m.transform_point3(*p)).collect(),
             None => {
                 let m = global.affine();
-                positions.iter().map(|p| m.transform_point3(Vec3::from_array(*p))).collect()
+                positions.iter().map(|p| m.transform_point3(*p)).collect()
             }
         };
         let corner = |i: usize| world.get(i).map(|v| Vec3f::new(v.x, v.y, v.z));
@@ -256,7 +259,7 @@ pub(crate) fn caster_triangles(root: Entity, scene: &CasterScene, out: &mut Vec<
                 out.push([a, b, c]);
             }
         };
-        match mesh.indices() {
+        match indices {
             Some(indices) => {
                 let all: Vec<usize> = indices.iter().collect();
                 for t in all.chunks_exact(3) {
@@ -272,21 +275,57 @@ pub(crate) fn caster_triangles(root: Entity, scene: &CasterScene, out: &mut Vec<
     }
 }
 
+/// The weights a mesh's morph targets are blended by, as Bevy's morphing reads them: its own
+/// (`MeshMorphWeights::Value`) or those of the entity it refers to (a glTF node's
+/// `MorphWeights`); `None` when that entity has none.
+fn morph_weights<'a>(morph: &'a MeshMorphWeights, scene: &'a CasterScene) -> Option<&'a [f32]> {
+    match morph {
+        MeshMorphWeights::Value { weights } => Some(weights),
+        MeshMorphWeights::Reference(e) => scene.weights.get(*e).ok().map(MorphWeights::weights),
+    }
+}
+
+/// The mesh's vertex positions with its morph targets blended in before skinning, as Bevy's
+/// morphing does (glTF 2.0 §3.7.2.2: `p + Σ wₖ·Δpₖ`, the targets' displacements stored target
+/// after target). Weights that are not finite, and targets past the weights or the mesh's data,
+/// add nothing.
+fn morphed(mesh: &Mesh, positions: &[[f32; 3]], weights: Option<&[f32]>) -> Vec<Vec3> {
+    let mut out: Vec<Vec3> = positions.iter().map(|p| Vec3::from_array(*p)).collect();
+    let (Some(weights), Some(targets)) = (weights, mesh.try_morph_targets().ok()) else { return out };
+    let n = out.len();
+    if n == 0 {
+        return out;
+    }
+    for (w, target) in weights.iter().zip(targets.chunks_exact(n)) {
+        if *w == 0.0 || !w.is_finite() {
+            continue;
+        }
+        for (p, d) in out.iter_mut().zip(target) {
+            *p += *w * d.position;
+        }
+    }
+    out
+}
+
 /// Each vertex's skinning matrix of a skinned `mesh`, or `None` when the mesh has no joint
 /// attributes or its joints or inverse bind poses are not there yet (it is then placed by its
 /// `GlobalTransform`).
 fn skinned(mesh: &Mesh, skin: &SkinnedMesh, scene: &CasterScene) -> Option<Vec<Mat4>> {
-    let bindposes = scene.bindposes?.get(&skin.inverse_bindposes)?;
+    let bindposes = scene.bindposes.as_deref()?.get(&skin.inverse_bindposes)?;
     let joints: Vec<Mat4> = skin
         .joints
         .iter()
         .zip(bindposes.iter())
         .map(|(&j, ibp)| scene.globals.get(j).ok().map(|g| g.to_matrix() * *ibp))
         .collect::<Option<_>>()?;
-    let Some(VertexAttributeValues::Uint16x4(index)) = mesh.attribute(Mesh::ATTRIBUTE_JOINT_INDEX) else {
+    let Ok(Some(VertexAttributeValues::Uint16x4(index))) =
+        mesh.try_attribute_option(Mesh::ATTRIBUTE_JOINT_INDEX)
+    else {
         return None;
     };
-    let Some(VertexAttributeValues::Float32x4(weight)) = mesh.attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT) else {
+    let Ok(Some(VertexAttributeValues::Float32x4(weight))) =
+        mesh.try_attribute_option(Mesh::ATTRIBUTE_JOINT_WEIGHT)
+    else {
         return None;
     };
     let matrices = index
@@ -301,20 +340,31 @@ fn skinned(mesh: &Mesh, skin: &SkinnedMesh, scene: &CasterScene) -> Option<Vec<M
     Some(matrices)
 }
 
-/// What the casters' triangles are read from (also the shadows' drawn poses, shadows.rs).
-pub(crate) struct CasterScene<'a, 'w, 's> {
-    pub(crate) children: &'a Query<'w, 's, &'static Children>,
-    pub(crate) meshes: &'a Query<'w, 's, CasterMesh, Without<MeshMaterial3d<HadouOutline>>>,
-    pub(crate) globals: &'a Query<'w, 's, &'static GlobalTransform>,
-    pub(crate) mesh_assets: &'a Assets<Mesh>,
-    pub(crate) bindposes: Option<&'a Assets<SkinnedMeshInverseBindposes>>,
+/// What the casters' triangles are read from (also the shadows' drawn poses, drawn_pose.rs): the
+/// hierarchy, the meshes Bevy draws (outline hulls left out), their transforms, their morph
+/// weights (`MeshMorphWeights`, a glTF mesh's referring to its node's `MorphWeights`) and the
+/// skins' inverse bind poses.
+#[derive(SystemParam)]
+pub(crate) struct CasterScene<'w, 's> {
+    children: Query<'w, 's, &'static Children>,
+    meshes: Query<'w, 's, CasterMesh, Without<MeshMaterial3d<HadouOutline>>>,
+    globals: Query<'w, 's, &'static GlobalTransform>,
+    weights: Query<'w, 's, &'static MorphWeights>,
+    mesh_assets: Res<'w, Assets<Mesh>>,
+    bindposes: Option<Res<'w, Assets<SkinnedMeshInverseBindposes>>>,
 }
 
-/// A mesh a caster draws: its mesh, its transform and its skin, if skinned.
-pub(crate) type CasterMesh = (&'static Mesh3d, &'static GlobalTransform, Option<&'static SkinnedMesh>);
+/// A mesh a caster draws: its mesh, its transform, its skin if skinned and its morph weights if
+/// it has morph targets.
+pub(crate) type CasterMesh = (
+    &'static Mesh3d,
+    &'static GlobalTransform,
+    Option<&'static SkinnedMesh>,
+    Option<&'static MeshMorphWeights>,
+);
 
-/// What decides whether the casters' triangles changed: per caster mesh its entity, mesh, whether
-/// the mesh is loaded, its transform and its joints' transforms.
+/// What decides whether the casters' triangles changed: per caster mesh its entity, its morph
+/// weights, mesh, whether the mesh is loaded, its transform and its joints' transforms.
 fn caster_key(casters: &[Entity], scene: &CasterScene) -> Vec<u64> {
     let mut key = Vec::new();
     let bits = |m: Mat4, key: &mut Vec<u64>| {
@@ -327,8 +377,11 @@ fn caster_key(casters: &[Entity], scene: &CasterScene) -> Vec<u64> {
     for &root in casters {
         key.push(root.to_bits());
         for e in std::iter::once(root).chain(scene.children.iter_descendants(root)) {
-            let Ok((mesh, global, skin)) = scene.meshes.get(e) else { continue };
+            let Ok((mesh, global, skin, morph)) = scene.meshes.get(e) else { continue };
             key.push(e.to_bits());
+            if let Some(weights) = morph.and_then(|m| morph_weights(m, scene)) {
+                key.extend(weights.iter().map(|w| u64::from(w.to_bits())));
+            }
             let id = mesh.0.id();
             let mut h = std::hash::DefaultHasher::new();
             std::hash::Hash::hash(&id, &mut h);
@@ -384,11 +437,7 @@ const MIN_TRIS: usize = 64;
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn update_area_light(
     lights: Query<(Entity, &HadouAreaLight, Option<&Name>), Without<AreaLightRejected>>,
-    children: Query<&'static Children>,
-    meshes: Query<CasterMesh, Without<MeshMaterial3d<HadouOutline>>>,
-    globals: Query<&'static GlobalTransform>,
-    mesh_assets: Res<Assets<Mesh>>,
-    bindposes: Option<Res<Assets<SkinnedMeshInverseBindposes>>>,
+    scene: CasterScene,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut materials: ResMut<Assets<HadouMaterial>>,
     mut written: Local<AreaWritten>,
@@ -404,13 +453,6 @@ pub(crate) fn update_area_light(
         );
     }
     let light = drawn.first().copied();
-    let scene = CasterScene {
-        children: &children,
-        meshes: &meshes,
-        globals: &globals,
-        mesh_assets: &mesh_assets,
-        bindposes: bindposes.as_deref(),
-    };
     let mut key = light.map_or_else(Vec::new, |(_, l, _)| caster_key(&l.casters, &scene));
     key.push(light.map_or(u64::MAX, |(e, _, _)| e.to_bits()));
     let mut resized = false;

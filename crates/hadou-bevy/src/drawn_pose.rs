@@ -8,11 +8,9 @@
 //! follow the clip Bevy plays, or a joint a game turns, rather than hadou's own reading of the
 //! file.
 
-use crate::area::{caster_triangles, CasterMesh, CasterScene};
-use crate::outline::HadouOutline;
+use crate::area::{caster_triangles, CasterScene};
 use crate::shaded::HadouShaded;
 use crate::shadows::HadouShadows;
-use bevy::mesh::skinning::SkinnedMeshInverseBindposes;
 use bevy::prelude::*;
 use hadou_math::Vec3f;
 use std::sync::Arc;
@@ -37,26 +35,14 @@ pub fn triangles_mesh(tris: &[[Vec3f; 3]]) -> hadou_scene::Mesh {
 /// module's notes); a model none of whose meshes has loaded keeps the frame's mesh. `PostUpdate`,
 /// after Bevy's animation, skinning joints and transform propagation, before the shadows'
 /// records are written.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn shadows_from_drawn_poses(
     mut shadows: ResMut<HadouShadows>,
     models: Query<(Entity, &Name), With<HadouShaded>>,
-    children: Query<&'static Children>,
-    meshes: Query<CasterMesh, Without<MeshMaterial3d<HadouOutline>>>,
-    globals: Query<&'static GlobalTransform>,
-    mesh_assets: Res<Assets<Mesh>>,
-    bindposes: Option<Res<Assets<SkinnedMeshInverseBindposes>>>,
+    scene: CasterScene,
 ) {
     if models.is_empty() || shadows.frame.is_none() {
         return;
     }
-    let scene = CasterScene {
-        children: &children,
-        meshes: &meshes,
-        globals: &globals,
-        mesh_assets: &mesh_assets,
-        bindposes: bindposes.as_deref(),
-    };
     let mut models: Vec<_> = models.iter().collect();
     models.sort_by_key(|(e, _)| *e);
     let Some(frame) = shadows.frame.as_mut() else { return };

@@ -2,6 +2,7 @@
 //! sun's shadow-map silhouette of a character Bevy poses at a clip time is held to `hadou render`'s
 //! at the same time (IoU of the shadowed ground pixels ≥ [`MIN_IOU`]), another clip time moves it,
 //! and a clip the file lacks is one error naming the entity and `animation`, the character at rest.
+//! A mesh's morph targets, blended by Bevy, shape its shadow as they shape `hadou render`'s.
 
 mod common;
 
@@ -65,9 +66,10 @@ color = [0.0, 0.0, 0.0]
 opacity = 1.0
 "#;
 
-/// The folder of the test scene, with the character's file beside it.
-fn scene_folder() -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("hadou-bevy-drawn-pose-{}", std::process::id()));
+/// The folder of the test scene (one for each `test`, as tests run in parallel), with the
+/// character's file beside it.
+fn scene_folder(test: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("hadou-bevy-{test}-{}", std::process::id()));
     std::fs::create_dir_all(dir.join("assets")).unwrap();
     std::fs::copy(scenes().join("assets/brace.glb"), dir.join("assets/brace.glb")).unwrap();
     std::fs::write(dir.join("pose.toml"), SCENE).unwrap();
@@ -117,7 +119,7 @@ fn the_shadow_is_cast_by_the_pose_bevy_draws() {
     if !adapter_or_skip(test) {
         return;
     }
-    let dir = scene_folder();
+    let dir = scene_folder(test);
     let scene = hadou_scene::Scene::load(dir.join("pose.toml")).unwrap();
     let (braced, rest) = (1.6, 0.0);
     let size = (scene.width(), scene.height());
@@ -219,4 +221,105 @@ fn a_clip_the_file_lacks_is_an_error_and_the_character_stays_at_rest() {
     assert!(!rest.is_empty());
     assert_eq!(joints(app.world_mut(), wrong), rest, "a rejected clip leaves the character at rest");
     assert_ne!(joints(app.world_mut(), played), rest, "the `brace` clip at 1.2 s poses the character");
+}
+
+/// A glTF binary of one mesh: a plate 0.2 × 1.6 × 0.8 standing on the ground at the origin
+/// (24 vertices, flat faces) with one morph target that moves its top face by `(0, 0, 1)` (the
+/// plate leans sideways to the sun), blended by the mesh's default weight `weight`.
+fn plate_glb(weight: f32) -> Vec<u8> {
+    let (x, y, z) = (0.1f32, 1.6f32, 0.4f32);
+    let faces: [([f32; 3], [[f32; 3]; 4]); 6] = [
+        ([1.0, 0.0, 0.0], [[x, 0.0, -z], [x, y, -z], [x, y, z], [x, 0.0, z]]),
+        ([-1.0, 0.0, 0.0], [[-x, 0.0, z], [-x, y, z], [-x, y, -z], [-x, 0.0, -z]]),
+        ([0.0, 1.0, 0.0], [[-x, y, -z], [-x, y, z], [x, y, z], [x, y, -z]]),
+        ([0.0, -1.0, 0.0], [[-x, 0.0, z], [-x, 0.0, -z], [x, 0.0, -z], [x, 0.0, z]]),
+        ([0.0, 0.0, 1.0], [[x, 0.0, z], [x, y, z], [-x, y, z], [-x, 0.0, z]]),
+        ([0.0, 0.0, -1.0], [[-x, 0.0, -z], [-x, y, -z], [x, y, -z], [x, 0.0, -z]]),
+    ];
+    let (mut pos, mut nor, mut lean, mut idx) = (Vec::new(), Vec::new(), Vec::new(), Vec::<u16>::new());
+    for (n, quad) in faces {
+        let base = pos.len() as u16;
+        for p in quad {
+            pos.push(p);
+            nor.push(n);
+            lean.push(if p[1] > 0.0 { [0.0, 0.0, 1.0] } else { [0.0; 3] });
+        }
+        idx.extend([0, 1, 2, 0, 2, 3].map(|i| base + i));
+    }
+    let floats = |v: &[[f32; 3]]| v.iter().flatten().flat_map(|f| f.to_le_bytes()).collect::<Vec<u8>>();
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    for part in
+        [floats(&pos), floats(&nor), floats(&lean), idx.iter().flat_map(|i| i.to_le_bytes()).collect()]
+    {
+        views.push(format!(r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#, bin.len(), part.len()));
+        bin.extend(part);
+        bin.resize(bin.len().next_multiple_of(4), 0);
+    }
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"name":"plate"}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":1}},"indices":3,"targets":[{{"POSITION":2}}]}}],"weights":[{weight}]}}],
+"accessors":[
+{{"bufferView":0,"componentType":5126,"count":24,"type":"VEC3","min":[{nx},0,{nz}],"max":[{x},{y},{z}]}},
+{{"bufferView":1,"componentType":5126,"count":24,"type":"VEC3"}},
+{{"bufferView":2,"componentType":5126,"count":24,"type":"VEC3","min":[0,0,0],"max":[0,0,1]}},
+{{"bufferView":3,"componentType":5123,"count":36,"type":"SCALAR"}}],
+"bufferViews":[{}],"buffers":[{{"byteLength":{}}}]}}"#,
+        views.join(","),
+        bin.len(),
+        nx = -x,
+        nz = -z,
+    );
+    let mut json = json.into_bytes();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(bin);
+    glb
+}
+
+#[test]
+fn the_shadow_is_cast_by_the_morph_targets_bevy_draws() {
+    let test = "the_shadow_is_cast_by_the_morph_targets_bevy_draws";
+    if !adapter_or_skip(test) {
+        return;
+    }
+    let dir = scene_folder(test);
+    std::fs::write(dir.join("assets/leaning.glb"), plate_glb(1.0)).unwrap();
+    std::fs::write(dir.join("assets/upright.glb"), plate_glb(0.0)).unwrap();
+    let plate = |file: &str| {
+        let text = SCENE
+            .replace("assets/brace.glb", &format!("assets/{file}"))
+            .replace("animation = \"brace\"\nanimation_loop = false\n", "");
+        let name = format!("{file}.toml");
+        std::fs::write(dir.join(&name), text).unwrap();
+        name
+    };
+    let (leaning, upright) = (plate("leaning.glb"), plate("upright.glb"));
+    let scene = hadou_scene::Scene::load(dir.join(&leaning)).unwrap();
+    let size = (scene.width(), scene.height());
+    let (hadou_leaning, unshadowed) = hadou_pictures(&scene, 0.0);
+    let (hadou_upright, _) = hadou_pictures(&hadou_scene::Scene::load(dir.join(&upright)).unwrap(), 0.0);
+    let (bevy, _) = pictures_in(&dir, &leaning, &[0.0], size, None, bevy::render::view::Msaa::Off);
+    let _ = std::fs::remove_dir_all(&dir);
+    let reference = silhouette(&hadou_leaning, &unshadowed);
+    let count = reference.iter().filter(|s| **s).count();
+    assert!(count > 300, "the test's shadow covers {count} pixels: too few to compare");
+    let drawn = silhouette(&bevy[0], &unshadowed);
+    let same = iou(&drawn, &reference);
+    // The plate without its morph: what the shadow was before the morph targets were applied.
+    let unmorphed = iou(&drawn, &silhouette(&hadou_upright, &unshadowed));
+    eprintln!("leaning plate: {count} shadowed pixels, IoU {same:.3} against hadou render, {unmorphed:.3} against the upright plate's");
+    assert!(same >= MIN_IOU, "Bevy's shadow of the morphed plate is not hadou's: IoU {same:.3} < {MIN_IOU}");
+    assert!(
+        unmorphed <= MAX_MOVED_IOU,
+        "the morph must move the shadow: IoU {unmorphed:.3} > {MAX_MOVED_IOU}"
+    );
 }
