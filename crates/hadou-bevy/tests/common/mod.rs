@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod picture;
+pub mod split;
 
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
