@@ -18,6 +18,10 @@
 //! wave's stylized shadow (000 §2.4, θ = 60°, every character onto the ground, maps of
 //! [`WAVE_MAP`]²), set in `HadouShadows` each frame. Simulated time advances 1/30 s a frame.
 //!
+//! The camera has Bevy's depth prepass (`DepthPrepass`), as a game drawing many characters in
+//! materials with many lights would: each pixel's material is then shaded once, not once for
+//! every character drawn over it; `--no-prepass` measures without it.
+//!
 //! Measured, each frame an `App::update` followed by a wait for Bevy's device to go idle (wall
 //! clock), in blocks of five frames (after one that lets the change land) alternating between:
 //! - **hadou**: all of the above;
@@ -34,7 +38,12 @@
 //! device (`GpuBackend::new`) drawing each measured frame's shadow maps
 //! (`encode_shadow_maps_into`) and wave pass (`encode_wave_overlay`, `Rgba16Float` colour, a
 //! cleared reverse-Z depth buffer), one submission waited for a frame (median). The ratio
-//! `in Bevy / alone` is what issue 45's bound (≤ 1.2) is about.
+//! `in Bevy / alone` is what issue 45's bound (≤ 1.2) is about. The passes alone lack what the
+//! waves and shadows cost in the shading of the characters and the ground (their light and the
+//! shadows' lookups), which the figure in Bevy holds; so the same work is also timed in whole
+//! frames: hadou-gpu rendering each measured frame (one sample, characters, ground, waves and
+//! shadows; `Backend::render`, read back) against the same frame without its waves and shadows,
+//! the difference of the medians (`whole frames`, and `in Bevy / whole frames`).
 
 mod common;
 
@@ -56,7 +65,7 @@ use hadou_bevy::{
 };
 use hadou_gpu::{DepthModel, GpuBackend, OverlayBlend, OverlayProjection, OverlayTarget};
 use hadou_math::{Mat4, Vec3f};
-use hadou_scene::{Frame, Shadow, ShadowLight, ShadowMethod, Wave, WaveShape};
+use hadou_scene::{Backend, Frame, Shadow, ShadowLight, ShadowMethod, Wave, WaveShape};
 use std::collections::HashMap;
 use std::path::Path;
 use std::process::ExitCode;
@@ -85,7 +94,8 @@ const ROW: u32 = 5;
 /// Updates allowed for the characters to load and take hadou's look before giving up.
 const LOAD_UPDATES: u32 = 1200;
 
-const USAGE: &str = "usage: stress [--json] [--frames N] [--width W --height H] [--characters C] [--waves K]";
+const USAGE: &str =
+    "usage: stress [--json] [--frames N] [--width W --height H] [--characters C] [--waves K] [--no-prepass]";
 
 #[derive(Clone, Debug)]
 struct Options {
@@ -94,10 +104,13 @@ struct Options {
     size: (u32, u32),
     characters: u32,
     waves: u32,
+    /// Bevy's depth prepass on the camera (the default; `--no-prepass` leaves it off).
+    prepass: bool,
 }
 
 fn parse_args() -> Result<Options, String> {
-    let mut o = Options { json: false, frames: 30, size: (640, 360), characters: 20, waves: 8 };
+    let mut o =
+        Options { json: false, frames: 30, size: (640, 360), characters: 20, waves: 8, prepass: true };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -107,6 +120,7 @@ fn parse_args() -> Result<Options, String> {
             "--height" => o.size.1 = whole_number("--height", args.next())?,
             "--characters" => o.characters = whole_number("--characters", args.next())?,
             "--waves" => o.waves = whole_number("--waves", args.next())?,
+            "--no-prepass" => o.prepass = false,
             _ => return Err(format!("unknown argument `{arg}`")),
         }
     }
@@ -273,20 +287,29 @@ fn setup(
     let image = Image::new_target_texture(frame.width, frame.height, TextureFormat::Rgba8UnormSrgb, None);
     let (transform, projection) = camera(&frame);
     let c = frame.background;
-    commands.spawn((
-        Camera3d::default(),
-        Camera { clear_color: ClearColorConfig::Custom(Color::linear_rgb(c[0], c[1], c[2])), ..default() },
-        RenderTarget::Image(images.add(image).into()),
-        bevy::camera::Hdr,
-        bevy::render::view::Msaa::Off,
-        HadouCamera {
-            exposure: frame.color_mapping.exposure,
-            far: frame.camera.far,
-            mapping: ViewMapping::Hadou(frame.color_mapping.mode),
-        },
-        transform,
-        projection,
-    ));
+    let view = commands
+        .spawn((
+            Camera3d::default(),
+            Camera {
+                clear_color: ClearColorConfig::Custom(Color::linear_rgb(c[0], c[1], c[2])),
+                ..default()
+            },
+            RenderTarget::Image(images.add(image).into()),
+            bevy::camera::Hdr,
+            bevy::render::view::Msaa::Off,
+            HadouCamera {
+                exposure: frame.color_mapping.exposure,
+                far: frame.camera.far,
+                mapping: ViewMapping::Hadou(frame.color_mapping.mode),
+            },
+            transform,
+            projection,
+        ))
+        .id();
+    if stress.options.prepass {
+        // Bevy shades each pixel once: the depth of every opaque mesh first, then the materials.
+        commands.entity(view).insert(bevy::core_pipeline::prepass::DepthPrepass);
+    }
     // Bevy's light, for the `StandardMaterial`s of the "Bevy only" frames.
     let l = frame.light.direction;
     commands.spawn((
@@ -412,6 +435,9 @@ struct Report {
     alone: Vec<f64>,
     alone_waves: Vec<f64>,
     alone_shadows: Vec<f64>,
+    /// hadou-gpu's whole frames with the waves and shadows, and without.
+    whole: Vec<f64>,
+    whole_off: Vec<f64>,
 }
 
 impl Report {
@@ -425,6 +451,15 @@ impl Report {
 
     fn ratio(&self) -> f64 {
         self.in_bevy_ms() / median(&self.alone)
+    }
+
+    /// What the waves and shadows add to hadou-gpu's whole frame.
+    fn whole_ms(&self) -> f64 {
+        median(&self.whole) - median(&self.whole_off)
+    }
+
+    fn whole_ratio(&self) -> f64 {
+        self.in_bevy_ms() / self.whole_ms()
     }
 }
 
@@ -596,6 +631,28 @@ fn time_alone(backend: &mut GpuBackend, options: &Options, load: &Load) -> Resul
     Ok(times)
 }
 
+/// Times hadou-gpu's whole frames of the load (one sample, no glare, read back), with the waves
+/// and shadows and without them, alternating frame by frame after one warm-up of each.
+fn time_whole(backend: &mut GpuBackend, options: &Options, load: &Load) -> Result<[Vec<f64>; 2], String> {
+    let mut times: [Vec<f64>; 2] = Default::default();
+    for f in 0..=options.frames {
+        let mut frame = load.at(options, (f + 1) as f32 * FRAME_SECONDS);
+        frame.samples = 1;
+        frame.bloom = None;
+        let mut off = frame.clone();
+        off.waves.clear();
+        off.shadows.clear();
+        for (i, frame) in [frame, off].iter().enumerate() {
+            let start = Instant::now();
+            backend.render(frame).map_err(|e| e.to_string())?;
+            if f > 0 {
+                times[i].push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    Ok(times)
+}
+
 fn profile() -> &'static str {
     if cfg!(debug_assertions) {
         "dev"
@@ -610,12 +667,14 @@ fn print_report(options: &Options, r: &Report) {
         let stats =
             |v: &[f64]| format!("{{\"median_ms\":{:.4},\"p90_ms\":{:.4}}}", median(v), quantile(v, 0.9));
         println!(
-            "{{\"adapter\":{},\"profile\":{},\"width\":{w},\"height\":{h},\"characters\":{},\"waves\":{},\
+            "{{\"adapter\":{},\"profile\":{},\"prepass\":{},\"width\":{w},\"height\":{h},\"characters\":{},\"waves\":{},\
              \"frames\":{},\"frame\":{},\"passes_off\":{},\"bevy_only\":{},\"hadou_share\":{:.4},\
              \"passes_in_bevy_ms\":{:.4},\"passes_alone_ms\":{:.4},\"waves_alone_ms\":{:.4},\
-             \"shadow_maps_alone_ms\":{:.4},\"ratio\":{:.4}}}",
+             \"shadow_maps_alone_ms\":{:.4},\"ratio\":{:.4},\"whole_frame\":{},\"whole_frame_off\":{},\
+             \"passes_whole_ms\":{:.4},\"whole_ratio\":{:.4}}}",
             json_string(&r.adapter),
             json_string(profile()),
+            options.prepass,
             options.characters,
             options.waves,
             r.frames,
@@ -628,13 +687,18 @@ fn print_report(options: &Options, r: &Report) {
             median(&r.alone_waves),
             median(&r.alone_shadows),
             r.ratio(),
+            stats(&r.whole),
+            stats(&r.whole_off),
+            r.whole_ms(),
+            r.whole_ratio(),
         );
         return;
     }
     println!(
-        "stress: {} characters, {} waves, shadows on, {w}×{h}, adapter {}, {} profile, {} frames a row",
+        "stress: {} characters, {} waves, shadows on, {w}×{h}, depth prepass {}, adapter {}, {} profile, {} frames a row",
         options.characters,
         options.waves,
+        if options.prepass { "on" } else { "off" },
         r.adapter,
         profile(),
         r.frames
@@ -654,6 +718,14 @@ fn print_report(options: &Options, r: &Report) {
         median(&r.alone_shadows)
     );
     println!("{:<34} {:>10.2}", "in Bevy / alone", r.ratio());
+    println!(
+        "{:<34} {:>10.2}   (hadou-gpu frame {:.2}, without waves and shadows {:.2})",
+        "waves and shadows, whole frames (ms)",
+        r.whole_ms(),
+        median(&r.whole),
+        median(&r.whole_off)
+    );
+    println!("{:<34} {:>10.2}", "in Bevy / whole frames", r.whole_ratio());
 }
 
 fn main() -> ExitCode {
@@ -671,6 +743,10 @@ fn main() -> ExitCode {
             eprintln!("timing hadou's passes alone…");
         }
         let [alone, alone_waves, alone_shadows] = time_alone(&mut backend, &options, &load)?;
+        if !options.json {
+            eprintln!("timing hadou-gpu's whole frames…");
+        }
+        let [whole, whole_off] = time_whole(&mut backend, &options, &load)?;
         let adapter = backend.adapter_name().to_string();
         drop(backend);
         if !options.json {
@@ -678,7 +754,18 @@ fn main() -> ExitCode {
         }
         let [hadou, passes_off, bevy_only] = time_in_bevy(&options, load)?;
         let frames = hadou.len();
-        Ok(Report { adapter, frames, hadou, passes_off, bevy_only, alone, alone_waves, alone_shadows })
+        Ok(Report {
+            adapter,
+            frames,
+            hadou,
+            passes_off,
+            bevy_only,
+            alone,
+            alone_waves,
+            alone_shadows,
+            whole,
+            whole_off,
+        })
     };
     let report = match run() {
         Ok(r) => r,
