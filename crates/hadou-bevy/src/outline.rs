@@ -4,13 +4,22 @@
 //! culled, so only the hull's back faces show around the silhouette, in the outline colour. The
 //! twin of hadou-gpu's `vs_hull` (raster.wgsl) and hadou-cpu's `opaque::project_all`. A skinned
 //! mesh's hull is skinned as Bevy skins the mesh.
+//!
+//! Under a camera with Bevy's depth and normal prepasses (`DepthPrepass`, `NormalPrepass`; a
+//! spawned scene's camera has both) the outline is closed where objects meet, as hadou's edge
+//! pass closes it (hadou-gpu's `edges.wgsl`, 000 §2.3): the hull is drawn after the opaque meshes
+//! without a depth test, and a fragment is kept where the hull is in front of the surface in the
+//! prepass depth or where the hull vertex's source point (the object's edge) is not behind that
+//! surface's plane (its normal from the normal prepass), so the line where a character stands on
+//! the ground, whose hull is buried in the ground, is drawn. Without the prepasses the hull is
+//! depth-tested as before.
 
 use bevy::asset::uuid_handle;
 use bevy::mesh::MeshVertexBufferLayoutRef;
-use bevy::pbr::{Material, MaterialPipeline, MaterialPipelineKey};
+use bevy::pbr::{Material, MaterialPipeline, MaterialPipelineKey, MeshPipelineKey};
 use bevy::prelude::*;
 use bevy::render::render_resource::{
-    AsBindGroup, Face, RenderPipelineDescriptor, ShaderType, SpecializedMeshPipelineError,
+    AsBindGroup, CompareFunction, Face, RenderPipelineDescriptor, ShaderType, SpecializedMeshPipelineError,
 };
 use bevy::shader::ShaderRef;
 
@@ -21,8 +30,11 @@ pub(crate) const SHADER: Handle<Shader> = uuid_handle!("3f6b8d0a-2c4e-4a6f-9b1d-
 pub(crate) const SOURCE: &str = r"
 #import bevy_pbr::mesh_functions
 #import bevy_pbr::skinning
-#import bevy_pbr::view_transformations::position_world_to_clip
+#import bevy_pbr::view_transformations::{position_world_to_clip, position_ndc_to_world, frag_coord_to_ndc}
 #import bevy_pbr::mesh_view_bindings::view
+#ifdef HADOU_CLOSED_OUTLINE
+#import bevy_pbr::prepass_utils
+#endif
 
 struct HadouOutlineUniform {
     color: vec4<f32>,
@@ -43,10 +55,17 @@ struct Vertex {
 #endif
 }
 
+struct Hull {
+    @builtin(position) clip: vec4<f32>,
+    // The vertex before the push: the point of the object's own surface the hull fragment stands
+    // for (the edge pixel q of hadou's edge pass).
+    @location(0) source: vec3<f32>,
+}
+
 // The hull vertex (000 §2.3): R' = R + d·|R_z|·U, U the unit world outline normal, R_z the view
 // depth of the vertex (hadou-gpu's vs_hull).
 @vertex
-fn vertex(v: Vertex) -> @builtin(position) vec4<f32> {
+fn vertex(v: Vertex) -> Hull {
 #ifdef SKINNED
     // A skinned mesh (Bevy's joints, as Bevy's own mesh shader skins it).
     let world_from_local = skinning::skin_model(v.joint_indices, v.joint_weights, v.instance_index);
@@ -77,13 +96,70 @@ fn vertex(v: Vertex) -> @builtin(position) vec4<f32> {
     } else if (mode == 2u) {
         push = 2.0 * width * abs(z) / view.clip_from_view[1][1];
     }
-    return position_world_to_clip(base + u * push);
+    return Hull(position_world_to_clip(base + u * push), base);
 }
 
+#ifdef HADOU_CLOSED_OUTLINE
+// Mirrors hadou_math::outline::IN_FRONT_MARGIN.
+const IN_FRONT_MARGIN: f32 = 1.0e-3;
+
+// hadou_math::outline::in_front (hadou-gpu's edges.wgsl) with its margin turned around: whether
+// the point q = eye + q_dist·q_dir is not behind the surface through p = eye + p_dist·p_dir with
+// normal p_normal (flipped to face the eye) by more than IN_FRONT_MARGIN of p's distance. hadou's
+// edge pixel q is a visible surface point a fraction of a pixel above the surface it closes onto,
+// so it must be in front by the margin; a hull's source point where an object stands on another
+// lies on that surface's plane itself (the box's bottom face on the ground), so it may be on it
+// within the margin.
+fn not_behind(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f32>, q_dist: f32) -> bool {
+    let len = length(p_normal);
+    var n = -p_dir;
+    if (len > 0.0 && len < 3.0e38) {
+        n = p_normal / len;
+    }
+    if (dot(n, p_dir) > 0.0) {
+        n = -n;
+    }
+    let num = p_dist * dot(n, p_dir);
+    let den = dot(n, q_dir);
+    return q_dist * den > num * (1.0 + IN_FRONT_MARGIN);
+}
+
+struct Closed {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+// The closed outline (000 §2.3, hadou's edge pass): the hull is drawn after the opaque meshes
+// without a depth test, and a fragment is kept where the hull is in front of the surface the
+// depth prepass holds there (the inverted hull's own rule) or where its source point, the
+// object's edge, is not behind that surface (hadou-gpu's edges.wgsl rule, `not_behind` the
+// surface at p, its normal from the normal prepass; the hull's push is the edge's reach), so the
+// line stays closed where the hull is buried in the ground or in another object. It keeps the
+// nearer depth of the two.
+@fragment
+fn fragment(in: Hull, @builtin(sample_index) sample_index: u32) -> Closed {
+    let surface = prepass_utils::prepass_depth(in.clip, sample_index);
+    var keep = in.clip.z >= surface;
+    if (!keep) {
+        let p = position_ndc_to_world(vec3<f32>(frag_coord_to_ndc(in.clip).xy, surface));
+        let n = prepass_utils::prepass_normal(in.clip, sample_index);
+        let pv = p - view.world_position;
+        let qv = in.source - view.world_position;
+        let pd = length(pv);
+        let qd = length(qv);
+        keep = pd > 0.0 && qd > 0.0 && not_behind(n, pv / pd, pd, qv / qd, qd);
+    }
+    if (!keep) {
+        discard;
+    }
+    return Closed(vec4<f32>(outline.color.xyz, 1.0), max(in.clip.z, surface));
+}
+#else
 @fragment
 fn fragment() -> @location(0) vec4<f32> {
     return vec4<f32>(outline.color.xyz, 1.0);
 }
+#endif
 ";
 
 /// The outline's colour and width, as the shader reads them.
@@ -106,8 +182,10 @@ pub struct HadouOutlineUniform {
 /// hadou's inverted-hull outline of a mesh (a `[[material]]`'s `outline`, `outline_color`,
 /// `outline_width`): put it with the same mesh as the shaded entity (whose `NORMAL`s may be
 /// replaced by outline normals, averaged per position, so the hull stays closed at hard edges:
-/// [`crate::outline_mesh`]). Writes its colour into the HDR target, depth-tested like any opaque
-/// mesh; no shadows or prepass.
+/// [`crate::outline_mesh`]). Writes its colour and depth into the view after the opaque meshes
+/// (Bevy's transparent phase, no blending), depth-tested, or closed where objects meet when the
+/// camera has the depth and normal prepasses (see the module's notes); casts no shadows and has
+/// no prepass of its own.
 #[derive(Asset, TypePath, AsBindGroup, Clone, Debug, PartialEq)]
 pub struct HadouOutline {
     /// The uniform.
@@ -160,6 +238,12 @@ impl Material for HadouOutline {
         false
     }
 
+    /// Drawn after the opaque meshes (Bevy's transparent phase), replacing the colour and writing
+    /// depth (see `specialize`), so that a closed outline sees every surface's prepass depth.
+    fn alpha_mode(&self) -> AlphaMode {
+        AlphaMode::Blend
+    }
+
     fn enable_shadows() -> bool {
         false
     }
@@ -168,7 +252,7 @@ impl Material for HadouOutline {
         _pipeline: &MaterialPipeline,
         descriptor: &mut RenderPipelineDescriptor,
         layout: &MeshVertexBufferLayoutRef,
-        _key: MaterialPipelineKey<Self>,
+        key: MaterialPipelineKey<Self>,
     ) -> Result<(), SpecializedMeshPipelineError> {
         let mut attributes = vec![
             Mesh::ATTRIBUTE_POSITION.at_shader_location(0),
@@ -183,6 +267,26 @@ impl Material for HadouOutline {
         let buffer = layout.0.get_layout(&attributes)?;
         descriptor.vertex.buffers = vec![buffer];
         descriptor.primitive.cull_mode = Some(Face::Front);
+        // An opaque colour: the outline replaces what is drawn, and writes its depth.
+        if let Some(fragment) = descriptor.fragment.as_mut() {
+            for target in fragment.targets.iter_mut().flatten() {
+                target.blend = None;
+            }
+        }
+        let closed = key.mesh_key.contains(MeshPipelineKey::DEPTH_PREPASS | MeshPipelineKey::NORMAL_PREPASS);
+        if let Some(depth) = descriptor.depth_stencil.as_mut() {
+            depth.depth_write_enabled = Some(true);
+            if closed {
+                // The test is the fragment's own (the hull, or its edge, in front of the surface).
+                depth.depth_compare = Some(CompareFunction::Always);
+            }
+        }
+        if closed {
+            descriptor.vertex.shader_defs.push("HADOU_CLOSED_OUTLINE".into());
+            if let Some(fragment) = descriptor.fragment.as_mut() {
+                fragment.shader_defs.push("HADOU_CLOSED_OUTLINE".into());
+            }
+        }
         Ok(())
     }
 }

@@ -255,6 +255,10 @@ pub(crate) fn spawn_scenes(
                 Camera { clear_color: ClearColorConfig::Custom(linear(frame.background)), ..default() },
                 bevy::camera::Hdr,
                 bevy::render::view::Msaa::Off,
+                // The prepass depth and normals close the outlines where objects meet
+                // (`HadouOutline`).
+                bevy::core_pipeline::prepass::DepthPrepass,
+                bevy::core_pipeline::prepass::NormalPrepass,
                 bevy::camera::Exposure { ev100: 0.0 },
                 AmbientLight {
                     color: linear(frame.light.ambient),

@@ -2,8 +2,11 @@
 //! outlined in a colour nothing else has. hadou's edge pass (hadou-gpu's `edges.wgsl`, hadou-cpu's
 //! `edges.rs`, 000 §2.3) closes the box's outline along the line where it meets the ground: the
 //! hull is buried in the ground there, and the ground pixels within the hull's reach on screen
-//! behind the box's border take the outline colour. Bevy draws the inverted hulls only, so that
-//! line stays open: issue 45, held here as a known bug until the edge pass runs in Bevy.
+//! behind the box's border take the outline colour. In Bevy the hull closes it by the same rule
+//! (`HadouOutline` under a camera with the depth and normal prepasses, as a spawned scene's has:
+//! a hull fragment is kept where its edge point is in front of the surface the prepass holds),
+//! so every pixel of hadou's outline is Bevy's too, and Bevy draws few outline pixels hadou does
+//! not (issue 45).
 
 mod common;
 
@@ -61,14 +64,21 @@ size = [8.0, 8.0]
 material = "ground"
 "#;
 
+/// The most outline pixels Bevy may draw away from hadou's outline (a pixel of the hull's edge
+/// rasterized otherwise).
+const MAX_EXTRA: usize = 4;
+
+/// The largest mean absolute difference of the 8-bit RGB values (the parity bound).
+const MAX_MEAN: f64 = 0.5;
+
 /// Whether an sRGB pixel shows the outline's magenta.
 fn magenta([r, g, b]: [u8; 3]) -> bool {
     r > 180 && b > 180 && g < 80
 }
 
 #[test]
-fn issue_45_bevy_leaves_the_outline_open_where_the_box_meets_the_ground() {
-    let test = "issue_45_bevy_leaves_the_outline_open_where_the_box_meets_the_ground";
+fn the_outline_is_closed_where_the_box_meets_the_ground_as_hadou_closes_it() {
+    let test = "the_outline_is_closed_where_the_box_meets_the_ground_as_hadou_closes_it";
     if !adapter_or_skip(test) {
         return;
     }
@@ -119,10 +129,30 @@ fn issue_45_bevy_leaves_the_outline_open_where_the_box_meets_the_ground() {
         open.len(),
         start.elapsed().as_secs_f64()
     );
-    // Issue 45 (known bug): the outline is open along the contact line in Bevy. When Bevy runs
-    // hadou's edge pass, these pixels are drawn and this assertion is to be turned around
-    // (`open` empty, the mean ≤ 2).
-    assert!(open.len() >= 8, "issue 45: the contact line is open in Bevy ({} pixels)", open.len());
-    assert!(lower * 10 >= open.len() * 8, "the open pixels lie along the bottom: {open:?}");
+    // Outline pixels of Bevy's that hadou does not draw (nor a 4-neighbour of them).
+    let near_hadou = |x: usize, y: usize| {
+        let at = |x: usize, y: usize| hadou[y * w + x];
+        at(x, y)
+            || (x > 0 && at(x - 1, y))
+            || (x + 1 < w && at(x + 1, y))
+            || (y > 0 && at(x, y - 1))
+            || (y + 1 < h && at(x, y + 1))
+    };
+    let extra = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| drawn[y * w + x] && !near_hadou(x, y))
+        .count();
+    eprintln!("{extra} outline pixels of Bevy's picture away from hadou's outline");
+    // Issue 45: the contact line is closed in Bevy as hadou closes it (it was open: 89 pixels,
+    // mean 0.91, with the hulls alone).
+    assert!(
+        open.is_empty(),
+        "the outline is open in Bevy where hadou closes it: {open:?} ({lower} along the bottom)"
+    );
+    assert!(
+        extra <= MAX_EXTRA,
+        "{extra} outline pixels in Bevy away from hadou's outline (at most {MAX_EXTRA})"
+    );
+    assert!(mean <= MAX_MEAN, "box on the ground: mean {mean:.3} > {MAX_MEAN}");
     std::fs::remove_dir_all(&dir).ok();
 }
