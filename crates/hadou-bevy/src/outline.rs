@@ -6,13 +6,17 @@
 //! mesh's hull is skinned as Bevy skins the mesh.
 //!
 //! Under a camera with Bevy's depth and normal prepasses (`DepthPrepass`, `NormalPrepass`; a
-//! spawned scene's camera has both) the outline is closed where objects meet, as hadou's edge
-//! pass closes it (hadou-gpu's `edges.wgsl`, 000 §2.3): the hull is drawn after the opaque meshes
-//! without a depth test, and a fragment is kept where the hull is in front of the surface in the
-//! prepass depth or where the hull vertex's source point (the object's edge) is not behind that
-//! surface's plane (its normal from the normal prepass), so the line where a character stands on
-//! the ground, whose hull is buried in the ground, is drawn. Without the prepasses the hull is
-//! depth-tested as before.
+//! spawned scene's camera has both) the outline is also closed where objects meet, as hadou's
+//! edge pass closes it (hadou-gpu's `edges.wgsl`, 000 §2.3): a second hull entity with
+//! `closing = true` ([`HadouOutline::closing`]) is drawn after the opaque meshes without a depth
+//! test and keeps only the fragments where its hull is buried in the surface the prepass holds
+//! (the ones the first, depth-tested hull loses) and its source point, the object's edge, is in
+//! front of that surface's plane (its normal from the normal prepass) and within `CLOSE_REACH`
+//! (3) hull widths of it, so the line where a character stands on the ground is drawn. Without
+//! the prepasses the closing hull draws nothing. Bevy's prepass holds no object ids, so where
+//! hadou's edge pass closes onto other objects only, the closing hull takes any surface that
+//! near the edge (a part of the same object farther away, such as hair behind a face's rim, is
+//! left alone).
 
 use bevy::asset::uuid_handle;
 use bevy::mesh::MeshVertexBufferLayoutRef;
@@ -32,8 +36,10 @@ pub(crate) const SOURCE: &str = r"
 #import bevy_pbr::skinning
 #import bevy_pbr::view_transformations::{position_world_to_clip, position_ndc_to_world, frag_coord_to_ndc}
 #import bevy_pbr::mesh_view_bindings::view
-#ifdef HADOU_CLOSED_OUTLINE
+#ifdef HADOU_CLOSING
+#ifndef HADOU_NO_PREPASS
 #import bevy_pbr::prepass_utils
+#endif
 #endif
 
 struct HadouOutlineUniform {
@@ -60,6 +66,10 @@ struct Hull {
     // The vertex before the push: the point of the object's own surface the hull fragment stands
     // for (the edge pixel q of hadou's edge pass).
     @location(0) source: vec3<f32>,
+    // Its unit world outline normal.
+    @location(1) normal: vec3<f32>,
+    // How far it was pushed (world units).
+    @location(2) push: f32,
 }
 
 // The hull vertex (000 §2.3): R' = R + d·|R_z|·U, U the unit world outline normal, R_z the view
@@ -96,21 +106,21 @@ fn vertex(v: Vertex) -> Hull {
     } else if (mode == 2u) {
         push = 2.0 * width * abs(z) / view.clip_from_view[1][1];
     }
-    return Hull(position_world_to_clip(base + u * push), base);
+    return Hull(position_world_to_clip(base + u * push), base, u, push);
 }
 
-#ifdef HADOU_CLOSED_OUTLINE
+#ifdef HADOU_CLOSING
+// How far from the edge point, in hull widths, a surface the outline closes onto may be.
+const CLOSE_REACH: f32 = 3.0;
 // Mirrors hadou_math::outline::IN_FRONT_MARGIN.
 const IN_FRONT_MARGIN: f32 = 1.0e-3;
 
-// hadou_math::outline::in_front (hadou-gpu's edges.wgsl) with its margin turned around: whether
-// the point q = eye + q_dist·q_dir is not behind the surface through p = eye + p_dist·p_dir with
-// normal p_normal (flipped to face the eye) by more than IN_FRONT_MARGIN of p's distance. hadou's
-// edge pixel q is a visible surface point a fraction of a pixel above the surface it closes onto,
-// so it must be in front by the margin; a hull's source point where an object stands on another
-// lies on that surface's plane itself (the box's bottom face on the ground), so it may be on it
-// within the margin.
-fn not_behind(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f32>, q_dist: f32) -> bool {
+// Twin of hadou_math::outline::in_front (hadou-gpu's edges.wgsl) with the margin a parameter:
+// whether the point q = eye + q_dist·q_dir lies in front of the surface through
+// p = eye + p_dist·p_dir with normal p_normal (flipped to face the eye) by `margin` of p's
+// distance (hadou's in_front: margin = IN_FRONT_MARGIN; a negative margin lets q lie that far
+// behind).
+fn in_front(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f32>, q_dist: f32, margin: f32) -> bool {
     let len = length(p_normal);
     var n = -p_dir;
     if (len > 0.0 && len < 3.0e38) {
@@ -121,38 +131,52 @@ fn not_behind(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f3
     }
     let num = p_dist * dot(n, p_dir);
     let den = dot(n, q_dir);
-    return q_dist * den > num * (1.0 + IN_FRONT_MARGIN);
+    return q_dist * den > num * (1.0 - margin);
 }
 
-struct Closed {
-    @location(0) color: vec4<f32>,
-    @builtin(frag_depth) depth: f32,
-}
-
-// The closed outline (000 §2.3, hadou's edge pass): the hull is drawn after the opaque meshes
-// without a depth test, and a fragment is kept where the hull is in front of the surface the
-// depth prepass holds there (the inverted hull's own rule) or where its source point, the
-// object's edge, is not behind that surface (hadou-gpu's edges.wgsl rule, `not_behind` the
-// surface at p, its normal from the normal prepass; the hull's push is the edge's reach), so the
-// line stays closed where the hull is buried in the ground or in another object. It keeps the
-// nearer depth of the two.
+// The closing hull (000 §2.3, hadou's edge pass): drawn after the opaque meshes without a depth
+// test; a fragment is kept where the hull is buried in the surface the depth prepass holds (the
+// depth-tested hull lost it) and its source point, the object's edge, is in front of that surface
+// (hadou-gpu's edges.wgsl rule, `in_front` of the surface at p, its normal from the normal
+// prepass; the hull's push is the edge's reach), so the line stays closed where the hull is
+// buried in the ground or in another object. The surface keeps its depth.
 @fragment
-fn fragment(in: Hull, @builtin(sample_index) sample_index: u32) -> Closed {
+fn fragment(in: Hull, @builtin(sample_index) sample_index: u32) -> @location(0) vec4<f32> {
+#ifdef HADOU_NO_PREPASS
+    discard;
+    return vec4<f32>(0.0);
+#else
     let surface = prepass_utils::prepass_depth(in.clip, sample_index);
-    var keep = in.clip.z >= surface;
-    if (!keep) {
+    // Reverse-Z: the hull at or behind a surface drawn there (0 is nothing drawn).
+    var keep = surface > 0.0 && in.clip.z <= surface;
+    if (keep) {
         let p = position_ndc_to_world(vec3<f32>(frag_coord_to_ndc(in.clip).xy, surface));
         let n = prepass_utils::prepass_normal(in.clip, sample_index);
         let pv = p - view.world_position;
         let qv = in.source - view.world_position;
         let pd = length(pv);
         let qd = length(qv);
-        keep = pd > 0.0 && qd > 0.0 && not_behind(n, pv / pd, pd, qv / qd, qd);
+        // hadou's edge pixel q is a visible point a fraction of a pixel above the surface it
+        // closes onto, so it must be in front by the margin. A hull's source point where an
+        // object stands on another lies on that surface's plane itself (the box's bottom face on
+        // the ground), so where the two face each other (the outline normal against the
+        // surface's) it may lie on the plane within the margin.
+        var margin = IN_FRONT_MARGIN;
+        if (dot(n, in.normal) < 0.0) {
+            margin = -IN_FRONT_MARGIN;
+        }
+        // Only a surface the edge touches: within CLOSE_REACH hull widths of it (hadou's edge
+        // pass closes onto another object's pixels within the hull's reach on screen; without
+        // object ids, this keeps a part of the same object far behind its edge, e.g. hair
+        // behind a face seen at its rim, from taking the line).
+        let near = length(in.source - p) <= CLOSE_REACH * in.push;
+        keep = near && pd > 0.0 && qd > 0.0 && in_front(n, pv / pd, pd, qv / qd, qd, margin);
     }
     if (!keep) {
         discard;
     }
-    return Closed(vec4<f32>(outline.color.xyz, 1.0), max(in.clip.z, surface));
+    return vec4<f32>(outline.color.xyz, 1.0);
+#endif
 }
 #else
 @fragment
@@ -182,15 +206,30 @@ pub struct HadouOutlineUniform {
 /// hadou's inverted-hull outline of a mesh (a `[[material]]`'s `outline`, `outline_color`,
 /// `outline_width`): put it with the same mesh as the shaded entity (whose `NORMAL`s may be
 /// replaced by outline normals, averaged per position, so the hull stays closed at hard edges:
-/// [`crate::outline_mesh`]). Writes its colour and depth into the view after the opaque meshes
-/// (Bevy's transparent phase, no blending), depth-tested, or closed where objects meet when the
-/// camera has the depth and normal prepasses (see the module's notes); casts no shadows and has
-/// no prepass of its own.
+/// [`crate::outline_mesh`]). Writes its colour into the HDR target, depth-tested like any opaque
+/// mesh; no shadows or prepass. Put its [`HadouOutline::closing`] hull over the same mesh too to
+/// close the outline where objects meet (under a camera with the depth and normal prepasses).
 #[derive(Asset, TypePath, AsBindGroup, Clone, Debug, PartialEq)]
+#[bind_group_data(HadouOutlineKey)]
 pub struct HadouOutline {
     /// The uniform.
     #[uniform(0)]
     pub outline: HadouOutlineUniform,
+    /// The closing hull of an outline ([`HadouOutline::closing`]): drawn after the opaque meshes,
+    /// only where the outline closes onto another surface (see the module's notes).
+    pub closing: bool,
+}
+
+/// What selects [`HadouOutline`]'s pipeline: whether it is the closing hull.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct HadouOutlineKey {
+    closing: bool,
+}
+
+impl From<&HadouOutline> for HadouOutlineKey {
+    fn from(outline: &HadouOutline) -> Self {
+        HadouOutlineKey { closing: outline.closing }
+    }
 }
 
 impl HadouOutline {
@@ -221,7 +260,14 @@ impl HadouOutline {
                 pad1: 0,
                 pad2: 0,
             },
+            closing: false,
         }
+    }
+
+    /// The closing hull of this outline: the same colour and width, drawn where the outline
+    /// closes onto another surface (the module's notes).
+    pub fn closing(&self) -> Self {
+        HadouOutline { closing: true, ..self.clone() }
     }
 }
 
@@ -238,10 +284,14 @@ impl Material for HadouOutline {
         false
     }
 
-    /// Drawn after the opaque meshes (Bevy's transparent phase), replacing the colour and writing
-    /// depth (see `specialize`), so that a closed outline sees every surface's prepass depth.
+    /// The closing hull is drawn after the opaque meshes (Bevy's transparent phase, without
+    /// blending: see `specialize`), when the prepass holds every surface.
     fn alpha_mode(&self) -> AlphaMode {
-        AlphaMode::Blend
+        if self.closing {
+            AlphaMode::Blend
+        } else {
+            AlphaMode::Opaque
+        }
     }
 
     fn enable_shadows() -> bool {
@@ -267,24 +317,22 @@ impl Material for HadouOutline {
         let buffer = layout.0.get_layout(&attributes)?;
         descriptor.vertex.buffers = vec![buffer];
         descriptor.primitive.cull_mode = Some(Face::Front);
-        // An opaque colour: the outline replaces what is drawn, and writes its depth.
-        if let Some(fragment) = descriptor.fragment.as_mut() {
-            for target in fragment.targets.iter_mut().flatten() {
-                target.blend = None;
-            }
-        }
-        let closed = key.mesh_key.contains(MeshPipelineKey::DEPTH_PREPASS | MeshPipelineKey::NORMAL_PREPASS);
-        if let Some(depth) = descriptor.depth_stencil.as_mut() {
-            depth.depth_write_enabled = Some(true);
-            if closed {
-                // The test is the fragment's own (the hull, or its edge, in front of the surface).
-                depth.depth_compare = Some(CompareFunction::Always);
-            }
-        }
-        if closed {
-            descriptor.vertex.shader_defs.push("HADOU_CLOSED_OUTLINE".into());
+        if key.bind_group_data.closing {
+            // An opaque colour over what is drawn; the surface keeps its depth; the test is the
+            // fragment's own.
             if let Some(fragment) = descriptor.fragment.as_mut() {
-                fragment.shader_defs.push("HADOU_CLOSED_OUTLINE".into());
+                for target in fragment.targets.iter_mut().flatten() {
+                    target.blend = None;
+                }
+                fragment.shader_defs.push("HADOU_CLOSING".into());
+                let prepass = MeshPipelineKey::DEPTH_PREPASS | MeshPipelineKey::NORMAL_PREPASS;
+                if !key.mesh_key.contains(prepass) {
+                    fragment.shader_defs.push("HADOU_NO_PREPASS".into());
+                }
+            }
+            if let Some(depth) = descriptor.depth_stencil.as_mut() {
+                depth.depth_write_enabled = Some(false);
+                depth.depth_compare = Some(CompareFunction::Always);
             }
         }
         Ok(())

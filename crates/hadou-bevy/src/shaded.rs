@@ -204,26 +204,28 @@ pub(crate) fn shade_models(
             None => &shaded.material,
         };
         if let Some(outline) = HadouOutline::of(look, &shaded.light) {
-            // The hull is drawn from the same mesh (skinned by the same joints: a sibling of the
-            // mesh entity keeps its transform and skin).
-            let mut hull = commands.spawn((
-                Name::new("outline"),
-                Mesh3d(mesh.0.clone()),
-                MeshMaterial3d(outlines.add(outline)),
-            ));
-            match skinned {
-                Some(skin) => {
-                    // Skinned bounds move with the joints; the hull is never culled.
-                    hull.insert((skin.clone(), bevy::camera::visibility::NoFrustumCulling));
-                    if let Ok(parent) = parents.get(entity) {
-                        hull.insert((
-                            ChildOf(parent.parent()),
-                            transforms.get(entity).copied().unwrap_or_default(),
-                        ));
+            // The hull and its closing hull are drawn from the same mesh (skinned by the same
+            // joints: a sibling of the mesh entity keeps its transform and skin).
+            for outline in [outline.closing(), outline] {
+                let mut hull = commands.spawn((
+                    Name::new("outline"),
+                    Mesh3d(mesh.0.clone()),
+                    MeshMaterial3d(outlines.add(outline)),
+                ));
+                match skinned {
+                    Some(skin) => {
+                        // Skinned bounds move with the joints; the hull is never culled.
+                        hull.insert((skin.clone(), bevy::camera::visibility::NoFrustumCulling));
+                        if let Ok(parent) = parents.get(entity) {
+                            hull.insert((
+                                ChildOf(parent.parent()),
+                                transforms.get(entity).copied().unwrap_or_default(),
+                            ));
+                        }
                     }
-                }
-                None => {
-                    hull.insert(ChildOf(entity));
+                    None => {
+                        hull.insert(ChildOf(entity));
+                    }
                 }
             }
         }

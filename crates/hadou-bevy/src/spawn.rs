@@ -211,12 +211,16 @@ pub fn spawn_object(
             ChildOf(entity),
         ));
         if let Some(hull) = HadouOutline::of(material, light) {
-            commands.spawn((
-                Name::new(format!("{} slot {slot} outline", object.name)),
-                Mesh3d(assets.meshes.add(outline_mesh(&object.mesh, slot))),
-                MeshMaterial3d(assets.outlines.add(hull)),
-                ChildOf(entity),
-            ));
+            // The hull, and its closing hull where the outline meets another surface.
+            let mesh = assets.meshes.add(outline_mesh(&object.mesh, slot));
+            for (name, hull) in [("outline closing", hull.closing()), ("outline", hull)] {
+                commands.spawn((
+                    Name::new(format!("{} slot {slot} {name}", object.name)),
+                    Mesh3d(mesh.clone()),
+                    MeshMaterial3d(assets.outlines.add(hull)),
+                    ChildOf(entity),
+                ));
+            }
         }
     }
     (entity, handles)
@@ -256,7 +260,7 @@ pub(crate) fn spawn_scenes(
                 bevy::camera::Hdr,
                 bevy::render::view::Msaa::Off,
                 // The prepass depth and normals close the outlines where objects meet
-                // (`HadouOutline`).
+                // (`HadouOutline::closing`).
                 bevy::core_pipeline::prepass::DepthPrepass,
                 bevy::core_pipeline::prepass::NormalPrepass,
                 bevy::camera::Exposure { ev100: 0.0 },

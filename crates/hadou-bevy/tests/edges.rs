@@ -2,11 +2,11 @@
 //! outlined in a colour nothing else has. hadou's edge pass (hadou-gpu's `edges.wgsl`, hadou-cpu's
 //! `edges.rs`, 000 §2.3) closes the box's outline along the line where it meets the ground: the
 //! hull is buried in the ground there, and the ground pixels within the hull's reach on screen
-//! behind the box's border take the outline colour. In Bevy the hull closes it by the same rule
-//! (`HadouOutline` under a camera with the depth and normal prepasses, as a spawned scene's has:
-//! a hull fragment is kept where its edge point is in front of the surface the prepass holds),
-//! so every pixel of hadou's outline is Bevy's too, and Bevy draws few outline pixels hadou does
-//! not (issue 45).
+//! behind the box's border take the outline colour. In Bevy the closing hull closes it by the
+//! same rule (`HadouOutline::closing` under a camera with the depth and normal prepasses, as a
+//! spawned scene's has: a fragment of the buried hull is kept where its edge point is in front of
+//! the surface the prepass holds), so every pixel of hadou's outline is Bevy's too, and Bevy
+//! draws few outline pixels hadou does not (issue 45).
 
 mod common;
 

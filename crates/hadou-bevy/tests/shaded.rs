@@ -89,7 +89,7 @@ fn a_character_loaded_by_bevy_takes_hadous_shading_with_one_component() {
         .query_filtered::<Has<bevy::mesh::skinning::SkinnedMesh>, With<MeshMaterial3d<hadou_bevy::HadouOutline>>>()
         .iter(world)
         .collect();
-    assert_eq!(hulls.len(), shaded.len(), "every mesh gets its outline hull");
+    assert_eq!(hulls.len(), 2 * shaded.len(), "every mesh gets its outline hull and closing hull");
     assert!(hulls.iter().all(|&skinned| skinned), "the hulls of the skinned hero are skinned by its joints");
     // The hulls are drawn (skinned, front faces culled): magenta pixels at the silhouette. Bevy
     // compiles the pipelines in the background (a cold shader cache on a software adapter can take
