@@ -113,6 +113,16 @@ pub(super) fn tail_reach<R: Real>(j: R) -> R {
 /// a low-degree polynomial in `u` for 8 nodes).
 pub const TAIL_MIN_J: f64 = 1.0;
 
+/// A far-graded cell spans `FAR_STEP/(j + 1)` in `u = −ln(1 − t/t_far)`: on it the weight
+/// `e^{−(j+1)u}` of the u rule varies by `e^{−FAR_STEP}`, which 4 Gauss–Legendre nodes integrate
+/// to about `5.6·10⁻¹⁰·FAR_STEP⁸` relative.
+pub const FAR_STEP: f64 = 1.125;
+
+/// A cell shorter than `RESOLVED_CELL·ε·|x|` (`ε` the type's epsilon) is weighted by the closed
+/// form, as the inner cell is: its nodes are not resolved well enough in `t` to sample a density
+/// whose peak may sit one rounding step away.
+pub const RESOLVED_CELL: f64 = 4096.0;
+
 /// Most cells one piece is cut into; the rest of the span is then one last cell.
 pub const MAX_CELLS: u32 = 192;
 
@@ -124,6 +134,19 @@ pub const PEAK_RANGE: f64 = 1e20;
 
 /// Half-width of the inner cell around the peak, in units of the peak's half-width `ε = √H/s`.
 pub const INNER_CELL: f64 = 1.0;
+
+/// `e^v − 1` without the cancellation of `exp(v) − 1` near 0 (Kahan's `(u − 1)·v/ln u`, `u = e^v`).
+#[inline(always)]
+fn exp_m1<R: Real>(v: R) -> R {
+    let u = v.exp();
+    if u == R::ONE {
+        v
+    } else if (u - R::ONE).abs() < R::from_f64(0.5) {
+        (u - R::ONE) * v / u.ln()
+    } else {
+        u - R::ONE
+    }
+}
 
 /// `(Y² + H)^{-1/2}` or `(Y² + H)^{-1}`.
 #[inline(always)]
@@ -170,7 +193,8 @@ impl<R: Real> RayQuadratic<R> {
         let has_peak = s > R::ZERO && sh <= s * range && self.beta.abs() <= s * range;
         let (tc, dmin) =
             if has_peak { (-self.beta / s, R::from_f64(INNER_CELL) * (sh / s)) } else { (R::ZERO, R::ZERO) };
-        let q = (-R::ONE / att.j).exp().max(R::from_f64(0.5));
+        // A far-graded cell spans FAR_STEP/(j + 1) in u = −ln(1 − t/t_far): t_far − t falls by q.
+        let q = (-R::from_f64(FAR_STEP) / (att.j + R::ONE)).exp();
         let half = R::from_f64(0.5);
         // The far tail: where the peak's singularities are far from t_far (or there is no peak).
         let tail_on = att.j >= R::from_f64(TAIL_MIN_J);
@@ -183,15 +207,18 @@ impl<R: Real> RayQuadratic<R> {
         // (t_far − b)·g(b): what the tail beyond an end before t_far weighs (0 at t_far).
         let beyond = (tf - b) * att.factor(b);
         let mut x = a;
+        // g(x), carried from cell to cell.
+        let mut g = att.factor(a);
         let mut acc = R::ZERO;
         let mut used = R::ZERO;
         let mut cells = 0;
         while x < b {
-            if tail_on && tf - x <= tail_reach {
+            let span = tf - x;
+            if tail_on && span <= tail_reach {
                 // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first (else march on).
-                let within = (tf - x) * att.factor(x);
+                let within = span * g;
                 if beyond <= half * within {
-                    let mut tail = self.tail(falloff, tf, tf - x, within, att.j);
+                    let mut tail = self.tail(falloff, tf, span, within, att.j);
                     if beyond > R::ZERO {
                         tail -= self.tail(falloff, tf, tf - b, beyond, att.j);
                     }
@@ -199,11 +226,13 @@ impl<R: Real> RayQuadratic<R> {
                     break;
                 }
             }
-            let graded = b.min(tf - q * (tf - x));
+            let graded = b.min(tf - q * span);
             let mut y = graded;
             let mut inner = false;
+            let mut whole = false;
             if cells + 1 >= MAX_CELLS {
                 y = b;
+                whole = true;
             } else if has_peak {
                 if x < tc - dmin {
                     // Approaching the peak: halve the distance, down to the inner cell.
@@ -212,8 +241,10 @@ impl<R: Real> RayQuadratic<R> {
                     y = y.min(tc + dmin);
                     inner = true;
                 } else {
-                    // Leaving it: double the distance.
-                    y = y.min(x + (x - tc).max(dmin));
+                    // Leaving it: at most the distance m to the peak, in u (t_far − y ≥
+                    // span²/(span + m)).
+                    let m = (x - tc).max(dmin);
+                    y = y.min(x + span * m / (span + m));
                 }
             }
             let advances = y > x; // false for NaN too
@@ -225,20 +256,34 @@ impl<R: Real> RayQuadratic<R> {
                 if y <= x {
                     y = b;
                 }
+                whole = true;
             }
-            let i0 = self.integral(falloff, x, y);
-            let gbar = if inner {
-                self.mean_g_peak(falloff, x, y, att)
+            // h(y)/h(x) = e^{−Δu}, in (0, 1) on a cell of the u rule.
+            let r = (tf - y) / span;
+            // A cell too short for its nodes to be told apart from its ends (next to a peak
+            // narrower than the rounding of t) takes its mass from the closed form.
+            let fine = y - x <= R::from_f64(RESOLVED_CELL) * R::EPSILON * x.abs();
+            if inner || whole || fine || !(r > R::ZERO) {
+                let i0 = self.integral(falloff, x, y);
+                let gbar = if inner {
+                    self.mean_g_peak(falloff, x, y, att)
+                } else {
+                    self.mean_g_line(falloff, x, y, att)
+                };
+                acc += i0 * gbar;
+                used += i0;
+                g = att.factor(y);
             } else {
-                self.mean_g_line(falloff, x, y, att)
-            };
-            acc += i0 * gbar;
-            used += i0;
+                let (piece, mass) = self.cell_u(falloff, x, y, span, att.j);
+                acc += g * piece;
+                used += mass;
+                g = att.factor(y);
+            }
             cells += 1;
             x = y;
             if x < b {
                 let rest = (total - used).max(R::ZERO);
-                if att.factor(x) * rest <= R::from_f64(REST_TOLERANCE) * acc {
+                if g * rest <= R::from_f64(REST_TOLERANCE) * acc {
                     break;
                 }
             }
@@ -259,6 +304,29 @@ impl<R: Real> RayQuadratic<R> {
             sum += R::from_f64(wu) * density(falloff, self.s * t + self.beta, self.h);
         }
         weight / j1 * sum
+    }
+
+    /// One cell `[x, y]` of the u rule, `r = (t_far − y)/(t_far − x) = e^{−Δu}`, `span = t_far − x`:
+    /// `(∫ g w dt / g(x), ∫ w dt)` by 4 Gauss–Legendre nodes uniform in `u = −ln(1 − t/t_far)`,
+    /// in which `g dt = g(x)·span·e^{−(j+1)(u − u_x)} du` exactly (002 eq. 3.23, SPEC.md §1.4):
+    /// the nodes are `t_i = t_far − span·r^{ξ_i}`, the weights `W_i·Δu·span·r^{(j+1)ξ_i}` (and
+    /// `r^{ξ_i}` for the unattenuated mass), so no power of `h` is taken at a node.
+    #[inline(always)]
+    fn cell_u(&self, falloff: Falloff, x: R, y: R, span: R, j: R) -> (R, R) {
+        let lr = (-(y - x) / span).ln_1p(); // −Δu
+        let j1 = j + R::ONE;
+        let mut num = R::ZERO;
+        let mut den = R::ZERO;
+        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
+            let em1 = exp_m1(R::from_f64(xi) * lr);
+            let e = R::ONE + em1;
+            let t = x - span * em1;
+            let w = R::from_f64(wi) * density(falloff, self.s * t + self.beta, self.h);
+            num += w * (j1 * R::from_f64(xi) * lr).exp();
+            den += w * e;
+        }
+        let scale = -lr * span;
+        (scale * num, scale * den)
     }
 
     /// `g` averaged over `[x, y]` against `w`, with 4 Gauss–Legendre nodes uniform in `t`

@@ -29,8 +29,8 @@
 //! [`RayQuadratic::attenuated`]: super::RayQuadratic::attenuated
 
 use super::attenuated::{
-    tail_reach, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
-    TAIL_MIN_J,
+    tail_reach, FAR_STEP, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE,
+    RESOLVED_CELL, REST_TOLERANCE, TAIL_MIN_J,
 };
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
@@ -299,8 +299,21 @@ impl<L: Lane> Quad<L> {
         let has_peak = s.simd_gt(zero) & sh.simd_le(range) & self.beta.max(-self.beta).simd_le(range);
         let tc = has_peak.select(-self.beta / s, zero);
         let dmin = has_peak.select(k(INNER_CELL as f32) * (sh / s), zero);
-        // The same ratio as the scalar march (the maths library's exp, once per wave).
-        let q = k((-1.0f32 / att.j).exp().max(0.5));
+        // The scalar march's far grading (the maths library's exp, once per wave): a cell of
+        // FAR_STEP/(j + 1) in u = −ln(1 − t/t_far), whose u rule has the same nodes and weights on
+        // every such cell (`t_far − span·e_i`, weights `W_i·e^{−FAR_STEP·ξ_i}` and `W_i·e_i`).
+        let j1 = att.j + 1.0;
+        let step_u = (FAR_STEP as f32) / j1;
+        let q0 = (-step_u).exp();
+        let q = k(q0);
+        let q_j = k((-step_u * att.j).exp());
+        let step_f64 = FAR_STEP / (f64::from(att.j) + 1.0);
+        // 1 − e^{−ξ_i·Δu}: the nodes' fractions of t_far − x.
+        let far_c = GL_X.map(|xi| k(-(-xi * step_f64).exp_m1() as f32));
+        let far_num =
+            std::array::from_fn::<L, 4, _>(|i| k((GL_W[i] * (-FAR_STEP * GL_X[i]).exp() * step_f64) as f32));
+        let far_den =
+            std::array::from_fn::<L, 4, _>(|i| k((GL_W[i] * (-GL_X[i] * step_f64).exp() * step_f64) as f32));
         let half = k(0.5);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
@@ -310,25 +323,27 @@ impl<L: Lane> Quad<L> {
             let dc = tf - tc;
             let eps = sh / s;
             let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
-            let j1 = att.j + 1.0;
             let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
             (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
         } else {
             (zero, zero, [zero; 8])
         };
         let mut x = a;
+        // g(x), carried from cell to cell.
+        let mut g = att.factor(a);
         let mut acc = zero;
         let mut used = zero;
         let mut cells = zero;
         while active.bitmask() != 0 {
+            let span = tf - x;
             if tail_on {
-                let near = (tf - x).simd_le(tail_reach);
+                let near = span.simd_le(tail_reach);
                 if (active & near).bitmask() != 0 {
                     // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first.
-                    let within = (tf - x) * att.factor(x);
+                    let within = span * g;
                     let now = active & near & beyond.simd_le(k(0.5) * within);
                     if now.bitmask() != 0 {
-                        let mut tail = self.tail(falloff, tf, tf - x, within, att.j, &nodes);
+                        let mut tail = self.tail(falloff, tf, span, within, att.j, &nodes);
                         if (now & beyond.simd_gt(zero)).bitmask() != 0 {
                             let past = self.tail(falloff, tf, tf - b, beyond, att.j, &nodes);
                             tail = tail - beyond.simd_gt(zero).select(past, zero);
@@ -341,15 +356,17 @@ impl<L: Lane> Quad<L> {
                     }
                 }
             }
-            let graded = b.min(tf - q * (tf - x));
+            let far_y = tf - q * span;
+            let graded = b.min(far_y);
             let capped = cells.simd_ge(last_cell);
             // Approaching the peak: halve the distance, down to the inner cell; inside it: to its
-            // end; leaving it: double the distance.
+            // end; leaving it: at most the distance m to the peak, in u.
             let before = x.simd_lt(tc - dmin);
             let within = x.simd_lt(tc + dmin);
+            let m = (x - tc).max(dmin);
             let y_before = graded.min((tc - (tc - x) * half).min(tc - dmin));
             let y_within = graded.min(tc + dmin);
-            let y_after = graded.min(x + (x - tc).max(dmin));
+            let y_after = graded.min(x + span * m / (span + m));
             let y_peak = before.select(y_before, within.select(y_within, y_after));
             let y = capped.select(b, has_peak.select(y_peak, graded));
             let inner = has_peak & !capped & !before & within;
@@ -357,23 +374,59 @@ impl<L: Lane> Quad<L> {
             let step = (x.max(-x) * k(2.0 * f32::EPSILON)).max(k(f32::MIN_POSITIVE));
             let nudged = (x + step).min(b);
             let nudged = nudged.simd_gt(x).select(nudged, b);
-            let y = y.simd_gt(x).select(y, nudged);
-            let i0 = self.integral(falloff, x, y);
-            let any_line = (active & !inner).bitmask() != 0;
-            let any_inner = (active & inner).bitmask() != 0;
-            let gbar = if any_line && any_inner {
-                self.mean_g_mixed(falloff, x, y, att, inner)
-            } else if any_inner {
-                self.mean_g_peak(falloff, x, y, att)
+            let advances = y.simd_gt(x);
+            let y = advances.select(y, nudged);
+            // h(y)/h(x) = e^{−Δu}; the cells of the closed form: inner, capped, nudged, or r = 0.
+            let r = (tf - y) / span;
+            // A cell too short for its nodes to be resolved takes the closed form (the scalar's).
+            let fine = (y - x).simd_le(k(RESOLVED_CELL as f32 * f32::EPSILON) * x.max(-x));
+            let closed = inner | capped | !advances | fine | !r.simd_gt(zero);
+            let far = !closed & y.simd_ge(far_y);
+            let (piece, mass, g_next) = if (active & !far).bitmask() == 0 {
+                // Every lane on a far-graded cell: the wave's nodes and weights.
+                let mut num = zero;
+                let mut den = zero;
+                for i in 0..4 {
+                    let w = self.density(falloff, x + span * far_c[i]);
+                    num += far_num[i] * w;
+                    den += far_den[i] * w;
+                }
+                (g * (span * num), span * den, g * q_j)
             } else {
-                self.mean_g_line(falloff, x, y, att)
+                let mut piece = zero;
+                let mut mass = zero;
+                let mut g_next = g;
+                if (active & !closed).bitmask() != 0 {
+                    let d = closed.select(k(1.0) - q, (y - x) / span);
+                    let (p, w, rj) = self.cell_u(falloff, x, span, d, att.j);
+                    piece = g * p;
+                    mass = w;
+                    g_next = g * rj;
+                }
+                if (active & closed).bitmask() != 0 {
+                    let i0 = self.integral(falloff, x, y);
+                    let any_line = (active & closed & !inner).bitmask() != 0;
+                    let any_inner = (active & inner).bitmask() != 0;
+                    let gbar = if any_line && any_inner {
+                        self.mean_g_mixed(falloff, x, y, att, inner)
+                    } else if any_inner {
+                        self.mean_g_peak(falloff, x, y, att)
+                    } else {
+                        self.mean_g_line(falloff, x, y, att)
+                    };
+                    piece = closed.select(i0 * gbar, piece);
+                    mass = closed.select(i0, mass);
+                    g_next = closed.select(att.factor(y), g_next);
+                }
+                (piece, mass, g_next)
             };
-            acc += active.select(i0 * gbar, zero);
-            used += active.select(i0, zero);
+            acc += active.select(piece, zero);
+            used += active.select(mass, zero);
             cells += active.select(k(1.0), zero);
             x = active.select(y, x);
+            g = active.select(g_next, g);
             let rest = (total - used).max(zero);
-            let done = (att.factor(x) * rest).simd_le(tolerance * acc);
+            let done = (g * rest).simd_le(tolerance * acc);
             active = active & x.simd_lt(b) & !done;
         }
         clamp_energy(live, acc)
@@ -396,6 +449,38 @@ impl<L: Lane> Quad<L> {
             sum += k(wu as f32) * density;
         }
         weight / k(j + 1.0) * sum
+    }
+
+    /// `(Y² + H)^{-1/2}` or `(Y² + H)^{-1}` at `t` per lane.
+    #[inline(always)]
+    fn density(&self, falloff: Falloff, t: L) -> L {
+        let yv = self.s * t + self.beta;
+        let r2 = yv * yv + self.h;
+        match falloff {
+            Falloff::Faithful => L::splat(1.0) / r2.sqrt(),
+            Falloff::InverseSquare => L::splat(1.0) / r2,
+        }
+    }
+
+    /// One cell `[x, x + d·span]` of the u rule per lane, `span = t_far − x`, `d` in `(0, 1)`:
+    /// `(∫ g w dt / g(x), ∫ w dt, (1 − d)^j)`, the scalar `cell_u` (`ln(1 − d) = −Δu` as
+    /// `ln(u)·(−d)/(u − 1)`, `u = 1 − d`, exact where `u` rounds; nodes `x − span·expm1(−ξ_i·Δu)`,
+    /// weights `W_i·Δu·span·e^{−(j+1)ξ_iΔu}` and `W_i·Δu·span·e^{−ξ_iΔu}`).
+    #[inline(always)]
+    fn cell_u(&self, falloff: Falloff, x: L, span: L, d: L, j: f32) -> (L, L, L) {
+        let k = L::splat;
+        let u = k(1.0) - d;
+        let lr = u.simd_lt(k(1.0)).select(u.ln() * -d / (u - k(1.0)), -d);
+        let mut num = k(0.0);
+        let mut den = k(0.0);
+        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
+            let em1 = exp_m1(k(xi as f32) * lr);
+            let w = k(wi as f32) * self.density(falloff, x - span * em1);
+            num += w * (k((j + 1.0) * xi as f32) * lr).exp();
+            den += w * (k(1.0) + em1);
+        }
+        let scale = -lr * span;
+        (scale * num, scale * den, (k(j) * lr).exp())
     }
 
     /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
@@ -502,6 +587,23 @@ impl<L: Lane> Quad<L> {
         }
         sum
     }
+}
+
+/// `e^v − 1` per lane for `v ≤ 0`: the degree-8 Taylor polynomial on `v > −½` (relative error
+/// below `10⁻⁸` there, where `exp(v) − 1` would cancel), `exp(v) − 1` below.
+#[inline(always)]
+fn exp_m1<L: Lane>(v: L) -> L {
+    let k = L::splat;
+    let small = v.simd_gt(k(-0.5));
+    let mut p = k(1.0);
+    for n in (2..=8).rev() {
+        p = (v * k(1.0 / n as f32)).mul_add(p, k(1.0));
+    }
+    let poly = v * p;
+    if (!small).bitmask() == 0 {
+        return poly;
+    }
+    small.select(poly, v.exp() - k(1.0))
 }
 
 /// [`Quad::attenuated`]'s march as a body for [`Lane::outlined`].
