@@ -19,8 +19,14 @@
 //! `ψ = asinh(Y/√H)` or `θ = atan(Y/√H)`, the ulp step), early stop and cell cap applied per
 //! lane by selects; the loop ends when no lane is active ([`Lane::bitmask`]), so a batch costs
 //! its slowest lane's cells (at most [`MAX_CELLS`]). Each lane takes the far tail in one
-//! Gauss–Laguerre step where the scalar march does (and is then done); a pass whose lanes mix
-//! the line and peak rules takes one power per node (`Quad::mean_g_mixed`). The powers, `sinh`, `tan`,
+//! Gauss–Laguerre step where the scalar march does (and is then done). A pass in which every
+//! active lane is on a cell graded towards `t_far` (its span in `u = −ln(1 − t/t_far)` is then
+//! the wave's `FAR_STEP/(j + 1)`) takes nodes and weights computed once per wave: four densities
+//! and no transcendental function; other cells of the `u` rule take one `ln`, two `expm1` (a
+//! polynomial) and three `exp` for their four nodes (`Quad::cell_u`, the nodes being symmetric);
+//! a lane on the inner cell takes its mass from the `ψ` or `θ` span the rule already has, and only
+//! a pass with a degenerate cell (capped, an ulp step, unresolved) evaluates the closed form and
+//! mixes the line and peak rules with one power per node (`Quad::mean_g_mixed`). The powers, `sinh`, `tan`,
 //! `asinh` and `atan` are the lane polynomials of [`Lane`] (`exp(j·ln h)` for `h^j`), so each lane
 //! cuts the scalar march's cells up to rounding and agrees with it to about `10⁻⁵` relative
 //! (`tests/analytic_attenuation_lanes.rs`). `j = 0` (or NaN) runs the unattenuated kernels.
@@ -380,7 +386,8 @@ impl<L: Lane> Quad<L> {
             let r = (tf - y) / span;
             // A cell too short for its nodes to be resolved takes the closed form (the scalar's).
             let fine = (y - x).simd_le(k(RESOLVED_CELL as f32 * f32::EPSILON) * x.max(-x));
-            let closed = inner | capped | !advances | fine | !r.simd_gt(zero);
+            let odd = capped | !advances | fine | !r.simd_gt(zero);
+            let closed = inner | odd;
             let far = !closed & y.simd_ge(far_y);
             let (piece, mass, g_next) = if (active & !far).bitmask() == 0 {
                 // Every lane on a far-graded cell: the wave's nodes and weights.
@@ -403,14 +410,22 @@ impl<L: Lane> Quad<L> {
                     mass = w;
                     g_next = g * rj;
                 }
-                if (active & closed).bitmask() != 0 {
+                if (active & odd).bitmask() == 0 {
+                    if (active & inner).bitmask() != 0 {
+                        // Inner lanes only: their mass is Δψ/s or Δθ/(s·√H), which the rule has.
+                        let (gbar, i0) = self.mean_g_peak(falloff, x, y, att);
+                        piece = inner.select(i0 * gbar, piece);
+                        mass = inner.select(i0, mass);
+                        g_next = inner.select(att.factor(y), g_next);
+                    }
+                } else {
                     let i0 = self.integral(falloff, x, y);
                     let any_line = (active & closed & !inner).bitmask() != 0;
                     let any_inner = (active & inner).bitmask() != 0;
                     let gbar = if any_line && any_inner {
                         self.mean_g_mixed(falloff, x, y, att, inner)
                     } else if any_inner {
-                        self.mean_g_peak(falloff, x, y, att)
+                        self.mean_g_peak(falloff, x, y, att).0
                     } else {
                         self.mean_g_line(falloff, x, y, att)
                     };
@@ -469,18 +484,31 @@ impl<L: Lane> Quad<L> {
     #[inline(always)]
     fn cell_u(&self, falloff: Falloff, x: L, span: L, d: L, j: f32) -> (L, L, L) {
         let k = L::splat;
-        let u = k(1.0) - d;
-        let lr = u.simd_lt(k(1.0)).select(u.ln() * -d / (u - k(1.0)), -d);
+        let one = k(1.0);
+        let u = one - d;
+        let lr = u.simd_lt(one).select(u.ln() * -d / (u - one), -d);
+        // The nodes are symmetric (ξ₄ = 1 − ξ₁, ξ₃ = 1 − ξ₂): e^{−ξ₄Δu} = r/e^{−ξ₁Δu}, so two
+        // expm1 and three exponentials serve the four nodes (|(j + 1)·Δu| ≤ FAR_STEP here, so
+        // nothing underflows).
+        let em1_1 = exp_m1(k(GL_X[0] as f32) * lr);
+        let em1_2 = exp_m1(k(GL_X[1] as f32) * lr);
+        let em1_3 = (-d - em1_2) / (one + em1_2);
+        let em1_4 = (-d - em1_1) / (one + em1_1);
+        let z = k(j + 1.0) * lr;
+        let p1 = (k(GL_X[0] as f32) * z).exp();
+        let p2 = (k(GL_X[1] as f32) * z).exp();
+        let whole = z.exp();
+        let em1 = [em1_1, em1_2, em1_3, em1_4];
+        let pw = [p1, p2, whole / p2, whole / p1];
         let mut num = k(0.0);
         let mut den = k(0.0);
-        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
-            let em1 = exp_m1(k(xi as f32) * lr);
-            let w = k(wi as f32) * self.density(falloff, x - span * em1);
-            num += w * (k((j + 1.0) * xi as f32) * lr).exp();
-            den += w * (k(1.0) + em1);
+        for i in 0..4 {
+            let w = k(GL_W[i] as f32) * self.density(falloff, x - span * em1[i]);
+            num += w * pw[i];
+            den += w * (one + em1[i]);
         }
         let scale = -lr * span;
-        (scale * num, scale * den, (k(j) * lr).exp())
+        (scale * num, scale * den, whole / u)
     }
 
     /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
@@ -564,7 +592,7 @@ impl<L: Lane> Quad<L> {
     /// scalar `mean_g_peak`. Lanes without a peak (`s = 0`) give garbage, which the caller
     /// selects away; node positions are clamped to `[x, y]` (a NaN one to `x`).
     #[inline(always)]
-    fn mean_g_peak(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> L {
+    fn mean_g_peak(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> (L, L) {
         let k = L::splat;
         let sh = self.h.sqrt();
         let (yx, yy) = ((self.s * x + self.beta) / sh, (self.s * y + self.beta) / sh);
@@ -585,7 +613,11 @@ impl<L: Lane> Quad<L> {
             let t = ((v * sh - self.beta) / self.s).max(x).min(y);
             sum += k(wi as f32) * att.factor(t);
         }
-        sum
+        let mass = match falloff {
+            Falloff::Faithful => (py - px) / self.s,
+            Falloff::InverseSquare => (py - px) / (self.s * sh),
+        };
+        (sum, mass)
     }
 }
 
