@@ -308,18 +308,12 @@ impl<L: Lane> Quad<L> {
         // The scalar march's far grading (the maths library's exp, once per wave): a cell of
         // FAR_STEP/(j + 1) in u = −ln(1 − t/t_far), whose u rule has the same nodes and weights on
         // every such cell (`t_far − span·e_i`, weights `W_i·e^{−FAR_STEP·ξ_i}` and `W_i·e_i`).
-        let j1 = att.j + 1.0;
-        let step_u = (FAR_STEP as f32) / j1;
-        let q0 = (-step_u).exp();
-        let q = k(q0);
-        let q_j = k((-step_u * att.j).exp());
-        let step_f64 = FAR_STEP / (f64::from(att.j) + 1.0);
-        // 1 − e^{−ξ_i·Δu}: the nodes' fractions of t_far − x.
-        let far_c = GL_X.map(|xi| k(-(-xi * step_f64).exp_m1() as f32));
-        let far_num =
-            std::array::from_fn::<L, 4, _>(|i| k((GL_W[i] * (-FAR_STEP * GL_X[i]).exp() * step_f64) as f32));
-        let far_den =
-            std::array::from_fn::<L, 4, _>(|i| k((GL_W[i] * (-GL_X[i] * step_f64).exp() * step_f64) as f32));
+        let wave = WaveConstants::of(att.j);
+        let q = k(wave.q);
+        let q_j = k(wave.q_j);
+        let far_c = wave.far_c.map(k);
+        let far_num = wave.far_num.map(k);
+        let far_den = wave.far_den.map(k);
         let half = k(0.5);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
@@ -328,8 +322,8 @@ impl<L: Lane> Quad<L> {
         let (tail_reach, beyond, nodes) = if tail_on {
             let dc = tf - tc;
             let eps = sh / s;
-            let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
-            let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
+            let far = (dc * dc + eps * eps).sqrt() / k(wave.reach);
+            let nodes = wave.laguerre.map(k);
             (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
         } else {
             (zero, zero, [zero; 8])
@@ -618,6 +612,60 @@ impl<L: Lane> Quad<L> {
             Falloff::InverseSquare => (py - px) / (self.s * sh),
         };
         (sum, mass)
+    }
+}
+
+/// What the march needs of the wave's exponent `j` alone, taken once per thread and `j` (the
+/// maths library's `exp`, `expm1` and `powf`; a wave's batches share `j`): the far grading's
+/// ratio `q = e^{−FAR_STEP/(j+1)}` and `q^j`, the far-graded cell's node fractions `1 −
+/// e^{−ξ_iΔu}` and weights, the far tail's reach and its Gauss–Laguerre factors `e^{−u_i/(j+1)}`.
+#[derive(Clone, Copy)]
+struct WaveConstants {
+    j: f32,
+    q: f32,
+    q_j: f32,
+    far_c: [f32; 4],
+    far_num: [f32; 4],
+    far_den: [f32; 4],
+    reach: f32,
+    laguerre: [f32; 8],
+}
+
+impl WaveConstants {
+    /// The constants of `j`, from this thread's last ones where `j` is the same.
+    #[inline(always)]
+    fn of(j: f32) -> Self {
+        thread_local! {
+            static LAST: std::cell::Cell<Option<WaveConstants>> = const { std::cell::Cell::new(None) };
+        }
+        LAST.with(|last| match last.get() {
+            Some(w) if w.j.to_bits() == j.to_bits() => w,
+            _ => {
+                let w = Self::new(j);
+                last.set(Some(w));
+                w
+            }
+        })
+    }
+
+    #[inline(never)]
+    #[cold]
+    fn new(j: f32) -> Self {
+        let j1 = j + 1.0;
+        let step_u = (FAR_STEP as f32) / j1;
+        let step = FAR_STEP / (f64::from(j) + 1.0);
+        Self {
+            j,
+            // The scalar march's ratio (the maths library's exp, in f32).
+            q: (-step_u).exp(),
+            q_j: (-step_u * j).exp(),
+            // 1 − e^{−ξ_i·Δu}: the nodes' fractions of t_far − x.
+            far_c: GL_X.map(|xi| -(-xi * step).exp_m1() as f32),
+            far_num: std::array::from_fn(|i| (GL_W[i] * (-FAR_STEP * GL_X[i]).exp() * step) as f32),
+            far_den: std::array::from_fn(|i| (GL_W[i] * (-GL_X[i] * step).exp() * step) as f32),
+            reach: tail_reach(j),
+            laguerre: LAGUERRE_X.map(|u| (-(u as f32) / j1).exp()),
+        }
     }
 }
 
