@@ -248,10 +248,8 @@ fn att_factor(att: Attenuation, t: f32) -> f32 {
     return 0.0;
 }
 
-// Mirrors hadou_math::energy::MAX_CELLS, REST_TOLERANCE, INNER_CELL, FAR_STEP and RESOLVED_CELL.
+// Mirrors hadou_math::energy::MAX_CELLS, REST_TOLERANCE and INNER_CELL.
 const ATT_MAX_CELLS: u32 = 192u;
-const ATT_FAR_STEP: f32 = 1.125;
-const ATT_RESOLVED_CELL: f32 = 4096.0;
 const ATT_REST_TOLERANCE: f32 = 1.0e-5;
 const ATT_INNER_CELL: f32 = 1.0;
 // Mirrors hadou_math::energy::PEAK_RANGE.
@@ -317,44 +315,6 @@ fn att_mean_peak(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation
     return sum;
 }
 
-// e^v − 1 for v ≤ 0 (the eight-lane `exp_m1`): the degree-8 Taylor polynomial above −½, where
-// exp(v) − 1 would cancel.
-fn att_expm1(v: f32) -> f32 {
-    if (v > -0.5) {
-        var p = 1.0;
-        for (var n = 8; n >= 2; n--) {
-            p = 1.0 + v / f32(n) * p;
-        }
-        return v * p;
-    }
-    return exp(v) - 1.0;
-}
-
-// Mirrors RayQuadratic::cell_u: one cell [x, y] of the u rule (span = t_far − x), (∫ g w dt / g(x),
-// ∫ w dt) by 4 Gauss–Legendre nodes uniform in u = −ln(1 − t/t_far), where g dt is
-// g(x)·span·e^{−(j+1)(u − u_x)} du exactly (002 eq. 3.23, SPEC.md §1.4).
-fn att_cell_u(q: RayQuadratic, falloff: u32, x: f32, y: f32, span: f32, j: f32) -> vec2<f32> {
-    var xs = array<f32, 4>(0.06943184420297371, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263);
-    var ws = array<f32, 4>(0.17392742256872693, 0.32607257743127307, 0.32607257743127307, 0.17392742256872693);
-    // ln(1 − d) = −Δu as ln(u)·(−d)/(u − 1), exact where u = 1 − d rounds.
-    let d = (y - x) / span;
-    let u = 1.0 - d;
-    var lr = -d;
-    if (u < 1.0) {
-        lr = log(u) * -d / (u - 1.0);
-    }
-    var num = 0.0;
-    var den = 0.0;
-    for (var i = 0; i < 4; i++) {
-        let em1 = att_expm1(xs[i] * lr);
-        let w = ws[i] * att_density(falloff, q.s * (x - span * em1) + q.beta, q.h);
-        num += w * exp((j + 1.0) * xs[i] * lr);
-        den += w * (1.0 + em1);
-    }
-    let scale = -lr * span;
-    return vec2<f32>(scale * num, scale * den);
-}
-
 // Mirrors hadou_math::energy::TAIL_MIN_J, TAIL_REACH and TAIL_REACH_MIN.
 const ATT_TAIL_MIN_J: f32 = 1.0;
 const ATT_TAIL_REACH: f32 = 2.0;
@@ -378,9 +338,8 @@ fn att_tail(q: RayQuadratic, falloff: u32, tf: f32, span: f32, weight: f32, j: f
 }
 
 // Mirrors RayQuadratic::attenuated: ∫ (1 − t/t_far)^j w(t) dt over [t0, min(t1, t_far)] (002 eq.
-// 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded cells, uniform in u = −ln(1 − t/t_far)
-// or, on the inner and degenerate cells, weighted by the closed form (see the Rust module docs of
-// hadou_math::energy::attenuated for the grading).
+// 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded cells, each weighted by the closed form
+// (see the Rust module docs of hadou_math::energy::attenuated for the grading).
 fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuation) -> f32 {
     let tf = att.t_far;
     let a = max(t0, -T_LIMIT);
@@ -402,8 +361,7 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
         tc = -q.beta / s;
         dmin = ATT_INNER_CELL * (sh / s);
     }
-    // A far-graded cell spans FAR_STEP/(j + 1) in u = −ln(1 − t/t_far).
-    let ratio = exp(-ATT_FAR_STEP / (att.j + 1.0));
+    let ratio = max(exp(-1.0 / att.j), 0.5);
     // The far tail: where the peak's singularities are far from t_far (or there is no peak).
     let tail_on = att.j >= ATT_TAIL_MIN_J;
     var tail_reach = 3.0e38; // no peak: the tail from the start
@@ -415,7 +373,6 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
     }
     let beyond = (tf - b) * att_factor(att, b);
     var x = a;
-    var g = att_factor(att, a);
     var acc = 0.0;
     var used = 0.0;
     var cells = 0u;
@@ -423,12 +380,11 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
         if (!(x < b)) {
             break;
         }
-        let span = tf - x;
-        if (tail_on && span <= tail_reach) {
+        if (tail_on && tf - x <= tail_reach) {
             // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first (else march on).
-            let within = span * g;
+            let within = (tf - x) * att_factor(att, x);
             if (beyond <= 0.5 * within) {
-                var tail = att_tail(q, falloff, tf, span, within, att.j);
+                var tail = att_tail(q, falloff, tf, tf - x, within, att.j);
                 if (beyond > 0.0) {
                     tail -= att_tail(q, falloff, tf, tf - b, beyond, att.j);
                 }
@@ -436,13 +392,11 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
                 break;
             }
         }
-        let graded = min(b, tf - ratio * span);
+        let graded = min(b, tf - ratio * (tf - x));
         var y = graded;
         var inner = false;
-        var whole = false;
         if (cells + 1u >= ATT_MAX_CELLS) {
             y = b;
-            whole = true;
         } else if (has_peak) {
             if (x < tc - dmin) {
                 y = min(y, min(tc - (tc - x) * 0.5, tc - dmin));
@@ -450,9 +404,7 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
                 y = min(y, tc + dmin);
                 inner = true;
             } else {
-                // Leaving it: at most the distance m to the peak, in u.
-                let m = max(x - tc, dmin);
-                y = min(y, x + span * m / (span + m));
+                y = min(y, x + max(x - tc, dmin));
             }
         }
         if (!(y > x)) {
@@ -461,32 +413,21 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
             if (!(y > x)) {
                 y = b;
             }
-            whole = true;
         }
-        // The closed form weights the inner, capped, nudged and unresolved cells and one reaching
-        // t_far; the others take the u rule.
-        let fine = y - x <= ATT_RESOLVED_CELL * F32_EPSILON * abs(x);
-        if (inner || whole || fine || !((tf - y) / span > 0.0)) {
-            let i0 = rq_integral(q, falloff, x, y);
-            var gbar = 0.0;
-            if (inner) {
-                gbar = att_mean_peak(q, falloff, x, y, att);
-            } else {
-                gbar = att_mean_line(q, falloff, x, y, att);
-            }
-            acc += i0 * gbar;
-            used += i0;
+        let i0 = rq_integral(q, falloff, x, y);
+        var gbar = 0.0;
+        if (inner) {
+            gbar = att_mean_peak(q, falloff, x, y, att);
         } else {
-            let cell = att_cell_u(q, falloff, x, y, span, att.j);
-            acc += g * cell.x;
-            used += cell.y;
+            gbar = att_mean_line(q, falloff, x, y, att);
         }
-        g = att_factor(att, y);
+        acc += i0 * gbar;
+        used += i0;
         cells += 1u;
         x = y;
         if (x < b) {
             let rest = max(total - used, 0.0);
-            if (g * rest <= ATT_REST_TOLERANCE * acc) {
+            if (att_factor(att, x) * rest <= ATT_REST_TOLERANCE * acc) {
                 break;
             }
         }

@@ -10,37 +10,23 @@
 //! `j`, with a branch point there for non-integer `j`. No closed form covers real `j`, and the
 //! polynomial expansion of `(1 − t/t_far)^j` for integer `j` cancels catastrophically in `f32`
 //! for `j` beyond a few, so [`RayQuadratic::attenuated`] integrates by 4-point Gauss–Legendre on
-//! graded cells in the variable `u = −ln h`, `h = 1 − t/t_far`, in which the attenuation is an
-//! exponential: `g dt = t_far·e^{−(j+1)u} du`. On a cell `[x, y]` with `span = t_far − x` and
-//! `Δu = −ln(1 − (y − x)/span)`, `∫ g w dt = g(x)·span·Δu·∫_0^1 e^{−(j+1)Δu·ξ} w(t(ξ)) dξ`,
-//! `t(ξ) = x − span·expm1(−ξΔu)`, so the rule's nodes and weights need one `ln_1p` per cell and
-//! exponentials of known arguments, no power of `h` at a node, and `g(x)` is carried from cell
-//! to cell; `w` is sampled at the nodes and `∫ w dt` (what the early stop counts) comes from the
-//! same nodes:
+//! graded cells, each cell's weight `∫w` taken from the exact closed form and the rule only
+//! averaging `g` against it (`A = Σ_cells I_cell·ḡ_cell`; exact wherever `g` is constant):
 //!
-//! - cells shrink geometrically towards `t_far`: each spans at most `Δu = FAR_STEP/(j + 1)`
-//!   ([`FAR_STEP`]), so the weight `e^{−(j+1)Δu·ξ}` varies by at most `e^{−FAR_STEP}` on a cell
-//!   (4 nodes integrate it to `5.6·10⁻¹⁰·FAR_STEP⁸`), and `g`'s branch point is at `u = ∞`.
-//!   Such a cell's nodes and weights depend only on `j`: the eight-lane march takes them once
-//!   per wave (on the benchmark's sphere rays, 40 % of its passes have every lane on one);
-//! - cells grow geometrically away from the peak, so that `w`'s complex poles `t_c ± iε` stay a
-//!   cell length away in the rule's variable (Bernstein ellipse `ρ ≥ 3 + √8`): approaching,
-//!   `t_c − t` halves per cell (in `u` the cell is then no longer than in `t` relative to its
-//!   distance to the pole, `ln` being concave); leaving, a cell at distance `m = max(t − t_c, ε)`
-//!   spans `Δu ≤ ln(1 + m/span)`, the pole's distance in `u` (`t_far − y ≥ span²/(span + m)`);
-//!   the `t`-rule's doubling (`y = x + m`) gives up to 1.7× longer cells in `u` than their
-//!   distance, and raised the worst `f64` error of `tests/analytic_attenuation.rs` to `8.6·10⁻⁵`;
+//! - cells shrink geometrically towards `t_far`: `t_far − t` falls by `q = max(e^{−1/j}, ½)` per
+//!   cell, so `g` changes by at most a factor `e` on one and its branch point stays a cell length
+//!   away;
+//! - cells grow geometrically away from the peak: a cell at distance `d > ε` from `t_c` spans at
+//!   most `d` (ratio 2), so `w`'s complex poles `t_c ± iε` also stay a cell length away. On such
+//!   a cell `g` is averaged with the weights `W_i·w(t_i)` at nodes uniform in `t`;
 //! - the inner cell `|t − t_c| ≤ ε` is integrated in the variable in which `w dt` is uniform,
 //!   `ψ = asinh(Y/√H)` (faithful) or `θ = atan(Y/√H)` (inverse square; `|θ| ≤ π/4` keeps the
 //!   poles of `t(θ) ∝ tan θ` twice the cell's half-width away), so the peak itself needs no
-//!   refinement however narrow it is (`H` down to `H_FLOOR`); its weight `∫w` is the closed form
-//!   and the rule only averages `g` against it (`I_cell·ḡ_cell`). A peak narrower than the
-//!   spacing of `t`'s floating-point values is approached by halving down to that spacing, its
-//!   mass then taken by the closed form over one step of it; so is every cell shorter than
-//!   [`RESOLVED_CELL`] steps of `t` (whose nodes would round onto such a peak), the capped last
-//!   cell and a cell that reaches `t_far`;
+//!   refinement however narrow it is (`H` down to `H_FLOOR`). A peak narrower than the spacing
+//!   of `t`'s floating-point values is approached by halving down to that spacing, its mass then
+//!   taken by the closed form over one step of it;
 //! - the march stops once the rest cannot add more than `10⁻⁵` of the sum: `g` falls along the
-//!   ray, so the rest is at most `g(x)·(I − Σ ∫_cell w)`, `I` the unattenuated integral;
+//!   ray, so the rest is at most `g(x)·(I − Σ I_cell)`, `I` the unattenuated integral;
 //! - the far tail `[x, t_far]` is one step as soon as the peak is far from it: with
 //!   `h = 1 − t/t_far` and `u = (j + 1)·ln(h(x)/h(t))`, the attenuation times the measure is
 //!   exactly `(t_far − x)·g(x)/(j + 1)·e^{−u} du` (`g dt = −t_far h^j dh`), so
@@ -59,11 +45,8 @@
 //!   half the first (else the march goes on).
 //!
 //! The 4-point rule on a cell whose nearest singularity is a cell length away (Bernstein ellipse
-//! `ρ = 3 + √8`) errs by about `ρ⁻⁸ ≈ 10⁻⁶` relative; the weight `e^{−(j+1)Δu·ξ}` grows on that
-//! ellipse by up to `e^{FAR_STEP·(ρ + 1/ρ)/4}`, which is why `FAR_STEP` stays near 1 (at 1.3 the
-//! worst error of the inverse square rose from `1.9·10⁻⁵` to `3.8·10⁻⁵`, at 2 to `7.9·10⁻⁵`);
-//! `tests/analytic_attenuation.rs` holds the result to an `f64` adaptive quadrature of the
-//! densities written from their definitions
+//! `ρ = 3 + √8`) errs by about `ρ⁻⁸ ≈ 10⁻⁶` relative; `tests/analytic_attenuation.rs` holds the
+//! result to an `f64` adaptive quadrature of the densities written from their definitions
 //! (p99 relative error ≤ 10⁻³ in `f32` over random rays and degenerate ones). A ray through a
 //! centre with `r_c = 0` needs about `2·log₂(span/ε)` cells; the march is capped at
 //! [`MAX_CELLS`] (the rest is then one last cell).
@@ -130,17 +113,6 @@ pub(super) fn tail_reach<R: Real>(j: R) -> R {
 /// a low-degree polynomial in `u` for 8 nodes).
 pub const TAIL_MIN_J: f64 = 1.0;
 
-/// A cell spans at most `FAR_STEP/(j + 1)` in `u = −ln(1 − t/t_far)` (the grading towards
-/// `t_far`; see this module's documentation): on it the rule's weight `e^{−(j+1)u}` (002 eq.
-/// 3.23, SPEC.md §1.4) varies by at most `e^{−FAR_STEP}`. At `j = 8` the cells are those of the
-/// earlier grading in `t` (`t_far − t` falling by `e^{−1/j}`).
-pub const FAR_STEP: f64 = 1.125;
-
-/// A cell shorter than `RESOLVED_CELL·ε·|x|` (`ε` the type's epsilon) is weighted by the closed
-/// form, as the inner cell is: its nodes are not resolved well enough in `t` to sample a density
-/// whose peak may sit one rounding step away.
-pub const RESOLVED_CELL: f64 = 4096.0;
-
 /// Most cells one piece is cut into; the rest of the span is then one last cell.
 pub const MAX_CELLS: u32 = 192;
 
@@ -152,19 +124,6 @@ pub const PEAK_RANGE: f64 = 1e20;
 
 /// Half-width of the inner cell around the peak, in units of the peak's half-width `ε = √H/s`.
 pub const INNER_CELL: f64 = 1.0;
-
-/// `e^v − 1` without the cancellation of `exp(v) − 1` near 0 (Kahan's `(u − 1)·v/ln u`, `u = e^v`).
-#[inline(always)]
-fn exp_m1<R: Real>(v: R) -> R {
-    let u = v.exp();
-    if u == R::ONE {
-        v
-    } else if (u - R::ONE).abs() < R::from_f64(0.5) {
-        (u - R::ONE) * v / u.ln()
-    } else {
-        u - R::ONE
-    }
-}
 
 /// `(Y² + H)^{-1/2}` or `(Y² + H)^{-1}`.
 #[inline(always)]
@@ -180,8 +139,7 @@ impl<R: Real> RayQuadratic<R> {
     /// `∫_{t0}^{min(t1, t_far)} (1 − t/t_far)^j dt / sqrt(Y² + H)` (faithful) or `/(Y² + H)`
     /// (inverse square): the piece integral of [`Self::integral`] with the distance attenuation
     /// of 002 eq. 3.23 (SPEC.md §1.4), 0 from the far point on. Graded 4-point Gauss–Legendre
-    /// cells uniform in `u = −ln(1 − t/t_far)` (the inner cell around the peak weighted by the
-    /// closed form), then one 8-point Gauss–Laguerre step over the far tail
+    /// cells weighted by the closed form, then one 8-point Gauss–Laguerre step over the far tail
     /// once the peak is far enough from the far point (see this module's documentation,
     /// `energy/attenuated.rs`); `j = 0` (or NaN) is
     /// [`Self::integral`] itself. Finite and in `[0, ENERGY_MAX]` for finite inputs; empty or
@@ -212,8 +170,7 @@ impl<R: Real> RayQuadratic<R> {
         let has_peak = s > R::ZERO && sh <= s * range && self.beta.abs() <= s * range;
         let (tc, dmin) =
             if has_peak { (-self.beta / s, R::from_f64(INNER_CELL) * (sh / s)) } else { (R::ZERO, R::ZERO) };
-        // A far-graded cell spans FAR_STEP/(j + 1) in u = −ln(1 − t/t_far): t_far − t falls by q.
-        let q = (-R::from_f64(FAR_STEP) / (att.j + R::ONE)).exp();
+        let q = (-R::ONE / att.j).exp().max(R::from_f64(0.5));
         let half = R::from_f64(0.5);
         // The far tail: where the peak's singularities are far from t_far (or there is no peak).
         let tail_on = att.j >= R::from_f64(TAIL_MIN_J);
@@ -226,18 +183,15 @@ impl<R: Real> RayQuadratic<R> {
         // (t_far − b)·g(b): what the tail beyond an end before t_far weighs (0 at t_far).
         let beyond = (tf - b) * att.factor(b);
         let mut x = a;
-        // g(x), carried from cell to cell.
-        let mut g = att.factor(a);
         let mut acc = R::ZERO;
         let mut used = R::ZERO;
         let mut cells = 0;
         while x < b {
-            let span = tf - x;
-            if tail_on && span <= tail_reach {
+            if tail_on && tf - x <= tail_reach {
                 // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first (else march on).
-                let within = span * g;
+                let within = (tf - x) * att.factor(x);
                 if beyond <= half * within {
-                    let mut tail = self.tail(falloff, tf, span, within, att.j);
+                    let mut tail = self.tail(falloff, tf, tf - x, within, att.j);
                     if beyond > R::ZERO {
                         tail -= self.tail(falloff, tf, tf - b, beyond, att.j);
                     }
@@ -245,13 +199,11 @@ impl<R: Real> RayQuadratic<R> {
                     break;
                 }
             }
-            let graded = b.min(tf - q * span);
+            let graded = b.min(tf - q * (tf - x));
             let mut y = graded;
             let mut inner = false;
-            let mut whole = false;
             if cells + 1 >= MAX_CELLS {
                 y = b;
-                whole = true;
             } else if has_peak {
                 if x < tc - dmin {
                     // Approaching the peak: halve the distance, down to the inner cell.
@@ -260,10 +212,8 @@ impl<R: Real> RayQuadratic<R> {
                     y = y.min(tc + dmin);
                     inner = true;
                 } else {
-                    // Leaving it: at most the distance m to the peak, in u (t_far − y ≥
-                    // span²/(span + m)).
-                    let m = (x - tc).max(dmin);
-                    y = y.min(x + span * m / (span + m));
+                    // Leaving it: double the distance.
+                    y = y.min(x + (x - tc).max(dmin));
                 }
             }
             let advances = y > x; // false for NaN too
@@ -275,35 +225,20 @@ impl<R: Real> RayQuadratic<R> {
                 if y <= x {
                     y = b;
                 }
-                whole = true;
             }
-            // h(y)/h(x) = e^{−Δu}, in (0, 1) on a cell of the u rule.
-            // (false where it is not, or NaN).
-            let in_range = (tf - y) / span > R::ZERO;
-            // A cell too short for its nodes to be told apart from its ends (next to a peak
-            // narrower than the rounding of t) takes its mass from the closed form.
-            let fine = y - x <= R::from_f64(RESOLVED_CELL) * R::EPSILON * x.abs();
-            if inner || whole || fine || !in_range {
-                let i0 = self.integral(falloff, x, y);
-                let gbar = if inner {
-                    self.mean_g_peak(falloff, x, y, att)
-                } else {
-                    self.mean_g_line(falloff, x, y, att)
-                };
-                acc += i0 * gbar;
-                used += i0;
-                g = att.factor(y);
+            let i0 = self.integral(falloff, x, y);
+            let gbar = if inner {
+                self.mean_g_peak(falloff, x, y, att)
             } else {
-                let (piece, mass) = self.cell_u(falloff, x, y, span, att.j);
-                acc += g * piece;
-                used += mass;
-                g = att.factor(y);
-            }
+                self.mean_g_line(falloff, x, y, att)
+            };
+            acc += i0 * gbar;
+            used += i0;
             cells += 1;
             x = y;
             if x < b {
                 let rest = (total - used).max(R::ZERO);
-                if g * rest <= R::from_f64(REST_TOLERANCE) * acc {
+                if att.factor(x) * rest <= R::from_f64(REST_TOLERANCE) * acc {
                     break;
                 }
             }
@@ -324,30 +259,6 @@ impl<R: Real> RayQuadratic<R> {
             sum += R::from_f64(wu) * density(falloff, self.s * t + self.beta, self.h);
         }
         weight / j1 * sum
-    }
-
-    /// One cell `[x, y]` of the u rule, `span = t_far − x`, `Δu = −ln_1p(−(y − x)/span)`:
-    /// `(∫ g w dt / g(x), ∫ w dt)` by 4 Gauss–Legendre nodes uniform in `u = −ln(1 − t/t_far)`,
-    /// in which `g dt = g(x)·span·e^{−(j+1)(u − u_x)} du` exactly (002 eq. 3.23, SPEC.md §1.4):
-    /// the nodes are `t_i = x − span·expm1(−ξ_iΔu)` (no cancellation however short the cell),
-    /// the weights `W_i·Δu·span·e^{−(j+1)ξ_iΔu}` (and `e^{−ξ_iΔu}` for the unattenuated mass), so
-    /// no power of `h` is taken at a node.
-    #[inline(always)]
-    fn cell_u(&self, falloff: Falloff, x: R, y: R, span: R, j: R) -> (R, R) {
-        let lr = (-(y - x) / span).ln_1p(); // −Δu
-        let j1 = j + R::ONE;
-        let mut num = R::ZERO;
-        let mut den = R::ZERO;
-        for (&xi, &wi) in GL_X.iter().zip(GL_W.iter()) {
-            let em1 = exp_m1(R::from_f64(xi) * lr);
-            let e = R::ONE + em1;
-            let t = x - span * em1;
-            let w = R::from_f64(wi) * density(falloff, self.s * t + self.beta, self.h);
-            num += w * (j1 * R::from_f64(xi) * lr).exp();
-            den += w * e;
-        }
-        let scale = -lr * span;
-        (scale * num, scale * den)
     }
 
     /// `g` averaged over `[x, y]` against `w`, with 4 Gauss–Legendre nodes uniform in `t`

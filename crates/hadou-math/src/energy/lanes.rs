@@ -19,14 +19,8 @@
 //! `ψ = asinh(Y/√H)` or `θ = atan(Y/√H)`, the ulp step), early stop and cell cap applied per
 //! lane by selects; the loop ends when no lane is active ([`Lane::bitmask`]), so a batch costs
 //! its slowest lane's cells (at most [`MAX_CELLS`]). Each lane takes the far tail in one
-//! Gauss–Laguerre step where the scalar march does (and is then done). A pass in which every
-//! active lane is on a cell graded towards `t_far` (its span in `u = −ln(1 − t/t_far)` is then
-//! the wave's `FAR_STEP/(j + 1)`) takes nodes and weights computed once per wave: four densities
-//! and no transcendental function; other cells of the `u` rule take one `ln`, two `expm1` (a
-//! polynomial) and three `exp` for their four nodes (`Quad::cell_u`, the nodes being symmetric);
-//! a lane on the inner cell takes its mass from the `ψ` or `θ` span the rule already has, and only
-//! a pass with a degenerate cell (capped, an ulp step, unresolved) evaluates the closed form and
-//! mixes the line and peak rules with one power per node (`Quad::mean_g_mixed`). The powers, `sinh`, `tan`,
+//! Gauss–Laguerre step where the scalar march does (and is then done); a pass whose lanes mix
+//! the line and peak rules takes one power per node (`Quad::mean_g_mixed`). The powers, `sinh`, `tan`,
 //! `asinh` and `atan` are the lane polynomials of [`Lane`] (`exp(j·ln h)` for `h^j`), so each lane
 //! cuts the scalar march's cells up to rounding and agrees with it to about `10⁻⁵` relative
 //! (`tests/analytic_attenuation_lanes.rs`). `j = 0` (or NaN) runs the unattenuated kernels.
@@ -35,8 +29,8 @@
 //! [`RayQuadratic::attenuated`]: super::RayQuadratic::attenuated
 
 use super::attenuated::{
-    tail_reach, FAR_STEP, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE,
-    RESOLVED_CELL, REST_TOLERANCE, TAIL_MIN_J,
+    tail_reach, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
+    TAIL_MIN_J,
 };
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
@@ -305,15 +299,8 @@ impl<L: Lane> Quad<L> {
         let has_peak = s.simd_gt(zero) & sh.simd_le(range) & self.beta.max(-self.beta).simd_le(range);
         let tc = has_peak.select(-self.beta / s, zero);
         let dmin = has_peak.select(k(INNER_CELL as f32) * (sh / s), zero);
-        // The scalar march's far grading (the maths library's exp, once per wave): a cell of
-        // FAR_STEP/(j + 1) in u = −ln(1 − t/t_far), whose u rule has the same nodes and weights on
-        // every such cell (`t_far − span·e_i`, weights `W_i·e^{−FAR_STEP·ξ_i}` and `W_i·e_i`).
-        let wave = WaveConstants::of(att.j);
-        let q = k(wave.q);
-        let q_j = k(wave.q_j);
-        let far_c = wave.far_c.map(k);
-        let far_num = wave.far_num.map(k);
-        let far_den = wave.far_den.map(k);
+        // The same ratio as the scalar march (the maths library's exp, once per wave).
+        let q = k((-1.0f32 / att.j).exp().max(0.5));
         let half = k(0.5);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
@@ -322,28 +309,26 @@ impl<L: Lane> Quad<L> {
         let (tail_reach, beyond, nodes) = if tail_on {
             let dc = tf - tc;
             let eps = sh / s;
-            let far = (dc * dc + eps * eps).sqrt() / k(wave.reach);
-            let nodes = wave.laguerre.map(k);
+            let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
+            let j1 = att.j + 1.0;
+            let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
             (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
         } else {
             (zero, zero, [zero; 8])
         };
         let mut x = a;
-        // g(x), carried from cell to cell.
-        let mut g = att.factor(a);
         let mut acc = zero;
         let mut used = zero;
         let mut cells = zero;
         while active.bitmask() != 0 {
-            let span = tf - x;
             if tail_on {
-                let near = span.simd_le(tail_reach);
+                let near = (tf - x).simd_le(tail_reach);
                 if (active & near).bitmask() != 0 {
                     // ∫_x^{t_far} − ∫_b^{t_far}, the second at most half the first.
-                    let within = span * g;
+                    let within = (tf - x) * att.factor(x);
                     let now = active & near & beyond.simd_le(k(0.5) * within);
                     if now.bitmask() != 0 {
-                        let mut tail = self.tail(falloff, tf, span, within, att.j, &nodes);
+                        let mut tail = self.tail(falloff, tf, tf - x, within, att.j, &nodes);
                         if (now & beyond.simd_gt(zero)).bitmask() != 0 {
                             let past = self.tail(falloff, tf, tf - b, beyond, att.j, &nodes);
                             tail = tail - beyond.simd_gt(zero).select(past, zero);
@@ -356,17 +341,15 @@ impl<L: Lane> Quad<L> {
                     }
                 }
             }
-            let far_y = tf - q * span;
-            let graded = b.min(far_y);
+            let graded = b.min(tf - q * (tf - x));
             let capped = cells.simd_ge(last_cell);
             // Approaching the peak: halve the distance, down to the inner cell; inside it: to its
-            // end; leaving it: at most the distance m to the peak, in u.
+            // end; leaving it: double the distance.
             let before = x.simd_lt(tc - dmin);
             let within = x.simd_lt(tc + dmin);
-            let m = (x - tc).max(dmin);
             let y_before = graded.min((tc - (tc - x) * half).min(tc - dmin));
             let y_within = graded.min(tc + dmin);
-            let y_after = graded.min(x + span * m / (span + m));
+            let y_after = graded.min(x + (x - tc).max(dmin));
             let y_peak = before.select(y_before, within.select(y_within, y_after));
             let y = capped.select(b, has_peak.select(y_peak, graded));
             let inner = has_peak & !capped & !before & within;
@@ -374,68 +357,23 @@ impl<L: Lane> Quad<L> {
             let step = (x.max(-x) * k(2.0 * f32::EPSILON)).max(k(f32::MIN_POSITIVE));
             let nudged = (x + step).min(b);
             let nudged = nudged.simd_gt(x).select(nudged, b);
-            let advances = y.simd_gt(x);
-            let y = advances.select(y, nudged);
-            // h(y)/h(x) = e^{−Δu}; the cells of the closed form: inner, capped, nudged, or r = 0.
-            let r = (tf - y) / span;
-            // A cell too short for its nodes to be resolved takes the closed form (the scalar's).
-            let fine = (y - x).simd_le(k(RESOLVED_CELL as f32 * f32::EPSILON) * x.max(-x));
-            let odd = capped | !advances | fine | !r.simd_gt(zero);
-            let closed = inner | odd;
-            let far = !closed & y.simd_ge(far_y);
-            let (piece, mass, g_next) = if (active & !far).bitmask() == 0 {
-                // Every lane on a far-graded cell: the wave's nodes and weights.
-                let mut num = zero;
-                let mut den = zero;
-                for i in 0..4 {
-                    let w = self.density(falloff, x + span * far_c[i]);
-                    num += far_num[i] * w;
-                    den += far_den[i] * w;
-                }
-                (g * (span * num), span * den, g * q_j)
+            let y = y.simd_gt(x).select(y, nudged);
+            let i0 = self.integral(falloff, x, y);
+            let any_line = (active & !inner).bitmask() != 0;
+            let any_inner = (active & inner).bitmask() != 0;
+            let gbar = if any_line && any_inner {
+                self.mean_g_mixed(falloff, x, y, att, inner)
+            } else if any_inner {
+                self.mean_g_peak(falloff, x, y, att)
             } else {
-                let mut piece = zero;
-                let mut mass = zero;
-                let mut g_next = g;
-                if (active & !closed).bitmask() != 0 {
-                    let d = closed.select(k(1.0) - q, (y - x) / span);
-                    let (p, w, rj) = self.cell_u(falloff, x, span, d, att.j);
-                    piece = g * p;
-                    mass = w;
-                    g_next = g * rj;
-                }
-                if (active & odd).bitmask() == 0 {
-                    if (active & inner).bitmask() != 0 {
-                        // Inner lanes only: their mass is Δψ/s or Δθ/(s·√H), which the rule has.
-                        let (gbar, i0) = self.mean_g_peak(falloff, x, y, att);
-                        piece = inner.select(i0 * gbar, piece);
-                        mass = inner.select(i0, mass);
-                        g_next = inner.select(att.factor(y), g_next);
-                    }
-                } else {
-                    let i0 = self.integral(falloff, x, y);
-                    let any_line = (active & closed & !inner).bitmask() != 0;
-                    let any_inner = (active & inner).bitmask() != 0;
-                    let gbar = if any_line && any_inner {
-                        self.mean_g_mixed(falloff, x, y, att, inner)
-                    } else if any_inner {
-                        self.mean_g_peak(falloff, x, y, att).0
-                    } else {
-                        self.mean_g_line(falloff, x, y, att)
-                    };
-                    piece = closed.select(i0 * gbar, piece);
-                    mass = closed.select(i0, mass);
-                    g_next = closed.select(att.factor(y), g_next);
-                }
-                (piece, mass, g_next)
+                self.mean_g_line(falloff, x, y, att)
             };
-            acc += active.select(piece, zero);
-            used += active.select(mass, zero);
+            acc += active.select(i0 * gbar, zero);
+            used += active.select(i0, zero);
             cells += active.select(k(1.0), zero);
             x = active.select(y, x);
-            g = active.select(g_next, g);
             let rest = (total - used).max(zero);
-            let done = (g * rest).simd_le(tolerance * acc);
+            let done = (att.factor(x) * rest).simd_le(tolerance * acc);
             active = active & x.simd_lt(b) & !done;
         }
         clamp_energy(live, acc)
@@ -458,51 +396,6 @@ impl<L: Lane> Quad<L> {
             sum += k(wu as f32) * density;
         }
         weight / k(j + 1.0) * sum
-    }
-
-    /// `(Y² + H)^{-1/2}` or `(Y² + H)^{-1}` at `t` per lane.
-    #[inline(always)]
-    fn density(&self, falloff: Falloff, t: L) -> L {
-        let yv = self.s * t + self.beta;
-        let r2 = yv * yv + self.h;
-        match falloff {
-            Falloff::Faithful => L::splat(1.0) / r2.sqrt(),
-            Falloff::InverseSquare => L::splat(1.0) / r2,
-        }
-    }
-
-    /// One cell `[x, x + d·span]` of the u rule per lane, `span = t_far − x`, `d` in `(0, 1)`:
-    /// `(∫ g w dt / g(x), ∫ w dt, (1 − d)^j)`, the scalar `cell_u` (`ln(1 − d) = −Δu` as
-    /// `ln(u)·(−d)/(u − 1)`, `u = 1 − d`, exact where `u` rounds; nodes `x − span·expm1(−ξ_i·Δu)`,
-    /// weights `W_i·Δu·span·e^{−(j+1)ξ_iΔu}` and `W_i·Δu·span·e^{−ξ_iΔu}`).
-    #[inline(always)]
-    fn cell_u(&self, falloff: Falloff, x: L, span: L, d: L, j: f32) -> (L, L, L) {
-        let k = L::splat;
-        let one = k(1.0);
-        let u = one - d;
-        let lr = u.simd_lt(one).select(u.ln() * -d / (u - one), -d);
-        // The nodes are symmetric (ξ₄ = 1 − ξ₁, ξ₃ = 1 − ξ₂): e^{−ξ₄Δu} = r/e^{−ξ₁Δu}, so two
-        // expm1 and three exponentials serve the four nodes (|(j + 1)·Δu| ≤ FAR_STEP here, so
-        // nothing underflows).
-        let em1_1 = exp_m1(k(GL_X[0] as f32) * lr);
-        let em1_2 = exp_m1(k(GL_X[1] as f32) * lr);
-        let em1_3 = (-d - em1_2) / (one + em1_2);
-        let em1_4 = (-d - em1_1) / (one + em1_1);
-        let z = k(j + 1.0) * lr;
-        let p1 = (k(GL_X[0] as f32) * z).exp();
-        let p2 = (k(GL_X[1] as f32) * z).exp();
-        let whole = z.exp();
-        let em1 = [em1_1, em1_2, em1_3, em1_4];
-        let pw = [p1, p2, whole / p2, whole / p1];
-        let mut num = k(0.0);
-        let mut den = k(0.0);
-        for i in 0..4 {
-            let w = k(GL_W[i] as f32) * self.density(falloff, x - span * em1[i]);
-            num += w * pw[i];
-            den += w * (one + em1[i]);
-        }
-        let scale = -lr * span;
-        (scale * num, scale * den, whole / u)
     }
 
     /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
@@ -586,7 +479,7 @@ impl<L: Lane> Quad<L> {
     /// scalar `mean_g_peak`. Lanes without a peak (`s = 0`) give garbage, which the caller
     /// selects away; node positions are clamped to `[x, y]` (a NaN one to `x`).
     #[inline(always)]
-    fn mean_g_peak(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> (L, L) {
+    fn mean_g_peak(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> L {
         let k = L::splat;
         let sh = self.h.sqrt();
         let (yx, yy) = ((self.s * x + self.beta) / sh, (self.s * y + self.beta) / sh);
@@ -607,83 +500,8 @@ impl<L: Lane> Quad<L> {
             let t = ((v * sh - self.beta) / self.s).max(x).min(y);
             sum += k(wi as f32) * att.factor(t);
         }
-        let mass = match falloff {
-            Falloff::Faithful => (py - px) / self.s,
-            Falloff::InverseSquare => (py - px) / (self.s * sh),
-        };
-        (sum, mass)
+        sum
     }
-}
-
-/// What the march needs of the wave's exponent `j` alone, taken once per thread and `j` (the
-/// maths library's `exp`, `expm1` and `powf`; a wave's batches share `j`): the far grading's
-/// ratio `q = e^{−FAR_STEP/(j+1)}` and `q^j`, the far-graded cell's node fractions `1 −
-/// e^{−ξ_iΔu}` and weights, the far tail's reach and its Gauss–Laguerre factors `e^{−u_i/(j+1)}`.
-#[derive(Clone, Copy)]
-struct WaveConstants {
-    j: f32,
-    q: f32,
-    q_j: f32,
-    far_c: [f32; 4],
-    far_num: [f32; 4],
-    far_den: [f32; 4],
-    reach: f32,
-    laguerre: [f32; 8],
-}
-
-impl WaveConstants {
-    /// The constants of `j`, from this thread's last ones where `j` is the same.
-    #[inline(always)]
-    fn of(j: f32) -> Self {
-        thread_local! {
-            static LAST: std::cell::Cell<Option<WaveConstants>> = const { std::cell::Cell::new(None) };
-        }
-        LAST.with(|last| match last.get() {
-            Some(w) if w.j.to_bits() == j.to_bits() => w,
-            _ => {
-                let w = Self::new(j);
-                last.set(Some(w));
-                w
-            }
-        })
-    }
-
-    #[inline(never)]
-    #[cold]
-    fn new(j: f32) -> Self {
-        let j1 = j + 1.0;
-        let step_u = (FAR_STEP as f32) / j1;
-        let step = FAR_STEP / (f64::from(j) + 1.0);
-        Self {
-            j,
-            // The scalar march's ratio (the maths library's exp, in f32).
-            q: (-step_u).exp(),
-            q_j: (-step_u * j).exp(),
-            // 1 − e^{−ξ_i·Δu}: the nodes' fractions of t_far − x.
-            far_c: GL_X.map(|xi| -(-xi * step).exp_m1() as f32),
-            far_num: std::array::from_fn(|i| (GL_W[i] * (-FAR_STEP * GL_X[i]).exp() * step) as f32),
-            far_den: std::array::from_fn(|i| (GL_W[i] * (-GL_X[i] * step).exp() * step) as f32),
-            reach: tail_reach(j),
-            laguerre: LAGUERRE_X.map(|u| (-(u as f32) / j1).exp()),
-        }
-    }
-}
-
-/// `e^v − 1` per lane for `v ≤ 0`: the degree-8 Taylor polynomial on `v > −½` (relative error
-/// below `10⁻⁸` there, where `exp(v) − 1` would cancel), `exp(v) − 1` below.
-#[inline(always)]
-fn exp_m1<L: Lane>(v: L) -> L {
-    let k = L::splat;
-    let small = v.simd_gt(k(-0.5));
-    let mut p = k(1.0);
-    for n in (2..=8).rev() {
-        p = (v * k(1.0 / n as f32)).mul_add(p, k(1.0));
-    }
-    let poly = v * p;
-    if (!small).bitmask() == 0 {
-        return poly;
-    }
-    small.select(poly, v.exp() - k(1.0))
 }
 
 /// [`Quad::attenuated`]'s march as a body for [`Lane::outlined`].
