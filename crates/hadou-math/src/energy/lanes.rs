@@ -300,8 +300,7 @@ impl<L: Lane> Quad<L> {
         let tc = has_peak.select(-self.beta / s, zero);
         let dmin = has_peak.select(k(INNER_CELL as f32) * (sh / s), zero);
         // The same ratio as the scalar march (the maths library's exp, once per wave).
-        let wave = WaveConstants::of(att.j);
-        let q = k(wave.q);
+        let q = k((-1.0f32 / att.j).exp().max(0.5));
         let half = k(0.5);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
@@ -310,8 +309,9 @@ impl<L: Lane> Quad<L> {
         let (tail_reach, beyond, nodes) = if tail_on {
             let dc = tf - tc;
             let eps = sh / s;
-            let far = (dc * dc + eps * eps).sqrt() / k(wave.reach);
-            let nodes = wave.laguerre.map(k);
+            let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
+            let j1 = att.j + 1.0;
+            let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
             (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
         } else {
             (zero, zero, [zero; 8])
@@ -501,49 +501,6 @@ impl<L: Lane> Quad<L> {
             sum += k(wi as f32) * att.factor(t);
         }
         sum
-    }
-}
-
-/// What the march needs of the wave's exponent `j` alone, taken once per thread and `j` rather
-/// than once per piece and batch (ten calls of the maths library's `exp` and `powf`; a wave's
-/// batches share `j`): the grading ratio `q = max(e^{−1/j}, ½)` of the scalar march, the far
-/// tail's `reach(j)` and its Gauss–Laguerre factors `e^{−u_i/(j+1)}`, each computed as before.
-#[derive(Clone, Copy)]
-struct WaveConstants {
-    j: f32,
-    q: f32,
-    reach: f32,
-    laguerre: [f32; 8],
-}
-
-impl WaveConstants {
-    /// The constants of `j`, from this thread's last ones where `j` is the same (bit for bit).
-    #[inline(always)]
-    fn of(j: f32) -> Self {
-        thread_local! {
-            static LAST: std::cell::Cell<Option<WaveConstants>> = const { std::cell::Cell::new(None) };
-        }
-        LAST.with(|last| match last.get() {
-            Some(w) if w.j.to_bits() == j.to_bits() => w,
-            _ => {
-                let w = Self::new(j);
-                last.set(Some(w));
-                w
-            }
-        })
-    }
-
-    #[inline(never)]
-    #[cold]
-    fn new(j: f32) -> Self {
-        let j1 = j + 1.0;
-        Self {
-            j,
-            // The same ratio as the scalar march (the maths library's exp).
-            q: (-1.0f32 / j).exp().max(0.5),
-            reach: tail_reach(j),
-            laguerre: LAGUERRE_X.map(|u| (-(u as f32) / j1).exp()),
-        }
     }
 }
 
