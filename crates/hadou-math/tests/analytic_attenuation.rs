@@ -9,7 +9,7 @@ mod analytic_common;
 use analytic_common::*;
 use hadou_math::energy::{
     beam_energy_attenuated, capsule_energy_attenuated, cylinder_energy_attenuated, sphere_energy_attenuated,
-    Attenuation, BeamField, CapsuleField, Falloff, FieldParams, Ray,
+    Attenuation, BeamField, CapsuleField, Falloff, FieldParams, Ray, TAIL_REACH, TAIL_REACH_MIN,
 };
 use hadou_math::{Real, Vec3, Vec3d};
 
@@ -339,7 +339,7 @@ fn far_tail_step_is_accurate_at_the_edge_of_its_reach() {
     let mut worst = 0.0f64;
     for law in LAWS {
         for j in [1.0, 1.3, 2.0, 3.0, 5.0, 8.0, 16.0, 64.0] {
-            let reach = (1.0 + 2.0 * f64::powf(j, -2.0 / 3.0)).max(1.25);
+            let reach = (1.0 + TAIL_REACH * f64::powf(j, -2.0 / 3.0)).max(TAIL_REACH_MIN);
             for (far, miss) in [(1.0, 1e-3), (10.0, 0.3), (100.0, 5.0)] {
                 let (p, beam) = beam64(0.0);
                 let p = FieldParams { falloff: law, ..p };
