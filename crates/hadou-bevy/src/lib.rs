@@ -210,7 +210,10 @@ impl Plugin for HadouPlugin {
                 )
                 .expect("a shader under a fixed handle can be inserted");
             shaders
-                .insert(&outline::SHADER, Shader::from_wgsl(outline::SOURCE, "hadou_bevy/outline.wgsl"))
+                .insert(
+                    &outline::SHADER,
+                    Shader::from_wgsl(outline::shader_source(), "hadou_bevy/outline.wgsl"),
+                )
                 .expect("a shader under a fixed handle can be inserted");
         }
         app.add_plugins((

@@ -30,8 +30,8 @@ use bevy::shader::ShaderRef;
 /// The shader of [`HadouOutline`] (vertex and fragment), inserted at start-up.
 pub(crate) const SHADER: Handle<Shader> = uuid_handle!("3f6b8d0a-2c4e-4a6f-9b1d-3e5f7a9c1b19");
 
-/// The WGSL of [`HadouOutline`].
-pub(crate) const SOURCE: &str = r"
+/// The imports of [`HadouOutline`]'s WGSL.
+const IMPORTS: &str = r"
 #import bevy_pbr::mesh_functions
 #import bevy_pbr::skinning
 #import bevy_pbr::view_transformations::{position_world_to_clip, position_ndc_to_world, frag_coord_to_ndc}
@@ -42,7 +42,10 @@ pub(crate) const SOURCE: &str = r"
 #endif
 #endif
 
-struct HadouOutlineUniform {
+";
+
+/// [`HadouOutline`]'s own WGSL, after hadou-gpu's `common.wgsl`.
+pub(crate) const SOURCE: &str = r"struct HadouOutlineUniform {
     color: vec4<f32>,
     width: f32,
     mode: u32,
@@ -115,29 +118,10 @@ const CLOSE_REACH: f32 = 3.0;
 // Mirrors hadou_math::outline::IN_FRONT_MARGIN.
 const IN_FRONT_MARGIN: f32 = 1.0e-3;
 
-// Twin of hadou_math::outline::in_front (hadou-gpu's edges.wgsl) with the margin a parameter:
-// whether the point q = eye + q_dist·q_dir lies in front of the surface through
-// p = eye + p_dist·p_dir with normal p_normal (flipped to face the eye) by `margin` of p's
-// distance (hadou's in_front: margin = IN_FRONT_MARGIN; a negative margin lets q lie that far
-// behind).
-fn in_front(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f32>, q_dist: f32, margin: f32) -> bool {
-    let len = length(p_normal);
-    var n = -p_dir;
-    if (len > 0.0 && len < 3.0e38) {
-        n = p_normal / len;
-    }
-    if (dot(n, p_dir) > 0.0) {
-        n = -n;
-    }
-    let num = p_dist * dot(n, p_dir);
-    let den = dot(n, q_dir);
-    return q_dist * den > num * (1.0 - margin);
-}
-
 // The closing hull (000 §2.3, hadou's edge pass): drawn after the opaque meshes without a depth
 // test; a fragment is kept where the hull is buried in the surface the depth prepass holds (the
 // depth-tested hull lost it) and its source point, the object's edge, is in front of that surface
-// (hadou-gpu's edges.wgsl rule, `in_front` of the surface at p, its normal from the normal
+// (hadou-gpu's edges.wgsl rule, common.wgsl's `in_front_by` the surface at p, its normal from the normal
 // prepass; the hull's push is the edge's reach), so the line stays closed where the hull is
 // buried in the ground or in another object. The surface keeps its depth.
 @fragment
@@ -170,7 +154,7 @@ fn fragment(in: Hull, @builtin(sample_index) sample_index: u32) -> @location(0) 
         // object ids, this keeps a part of the same object far behind its edge, e.g. hair
         // behind a face seen at its rim, from taking the line).
         let near = length(in.source - p) <= CLOSE_REACH * in.push;
-        keep = near && pd > 0.0 && qd > 0.0 && in_front(n, pv / pd, pd, qv / qd, qd, margin);
+        keep = near && pd > 0.0 && qd > 0.0 && in_front_by(n, pv / pd, pd, qv / qd, qd, margin);
     }
     if (!keep) {
         discard;
@@ -185,6 +169,12 @@ fn fragment() -> @location(0) vec4<f32> {
 }
 #endif
 ";
+
+/// The WGSL of [`HadouOutline`]: Bevy's imports, hadou-gpu's `common.wgsl` (`in_front_by`, the
+/// edge pass's rule) and [`SOURCE`].
+pub(crate) fn shader_source() -> String {
+    format!("{IMPORTS}\n{}\n{SOURCE}", hadou_gpu::shaders::COMMON)
+}
 
 /// The outline's colour and width, as the shader reads them.
 #[derive(Clone, Copy, Debug, PartialEq, ShaderType)]

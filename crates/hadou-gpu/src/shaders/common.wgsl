@@ -23,6 +23,26 @@ fn length3(a: vec3<f32>) -> f32 {
     return sqrt(dot3(a, a));
 }
 
+// hadou_math::outline::in_front with the margin a parameter (edges.wgsl's `in_front` passes
+// IN_FRONT_MARGIN; hadou-bevy's closing hull lets an edge lying on the surface count): whether the
+// point q = eye + q_dist·q_dir lies in front of the plane through p = eye + p_dist·p_dir with
+// normal p_normal (any length; zero: the plane facing the eye), turned to face the eye, by
+// `margin` of p's distance along q's ray (a negative margin lets q lie that far behind). A ray
+// missing the plane counts as in front, without a division.
+fn in_front_by(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f32>, q_dist: f32, margin: f32) -> bool {
+    let len = length3(p_normal);
+    var n = -p_dir;
+    if (len > 0.0 && len < 3.0e38) {
+        n = p_normal / len;
+    }
+    if (dot3(n, p_dir) > 0.0) {
+        n = -n;
+    }
+    let num = p_dist * dot3(n, p_dir);
+    let den = dot3(n, q_dir);
+    return q_dist * den > num * (1.0 - margin);
+}
+
 // Keep in sync with layout/ `FrameUniforms`.
 struct FrameUniforms {
     eye: vec3<f32>,

@@ -59,19 +59,9 @@ fn material_hull_pixels(width: f32, z: f32) -> f32 {
     return hull_pixels(d, frame.tan_half_fov, frame.image_size.y);
 }
 
-// Twin of hadou_math::outline::in_front.
+// Twin of hadou_math::outline::in_front (common.wgsl's `in_front_by` at hadou's margin).
 fn in_front(p_normal: vec3<f32>, p_dir: vec3<f32>, p_dist: f32, q_dir: vec3<f32>, q_dist: f32) -> bool {
-    let len = length3(p_normal);
-    var n = -p_dir;
-    if (len > 0.0 && len < 3.0e38) {
-        n = p_normal / len;
-    }
-    if (dot3(n, p_dir) > 0.0) {
-        n = -n;
-    }
-    let num = p_dist * dot3(n, p_dir);
-    let den = dot3(n, q_dir);
-    return q_dist * den > num * (1.0 - IN_FRONT_MARGIN);
+    return in_front_by(p_normal, p_dir, p_dist, q_dir, q_dist, IN_FRONT_MARGIN);
 }
 
 // The object (+ 1) whose surface tile pixel `p` shows; 0 for the background, a hull, or a pixel
