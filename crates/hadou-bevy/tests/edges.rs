@@ -71,6 +71,17 @@ const MAX_EXTRA: usize = 4;
 /// The largest mean absolute difference of the 8-bit RGB values (the parity bound).
 const MAX_MEAN: f64 = 0.5;
 
+/// Whether pixel `(x, y)` of the `w`-wide `mask` or one of its 4-neighbours is set.
+fn near(mask: &[bool], w: usize, x: usize, y: usize) -> bool {
+    let h = mask.len() / w;
+    let at = |x: usize, y: usize| mask[y * w + x];
+    at(x, y)
+        || (x > 0 && at(x - 1, y))
+        || (x + 1 < w && at(x + 1, y))
+        || (y > 0 && at(x, y - 1))
+        || (y + 1 < h && at(x, y + 1))
+}
+
 /// Whether an sRGB pixel shows the outline's magenta.
 fn magenta([r, g, b]: [u8; 3]) -> bool {
     r > 180 && b > 180 && g < 80
@@ -107,17 +118,9 @@ fn the_outline_is_closed_where_the_box_meets_the_ground_as_hadou_closes_it() {
     // The pixels hadou's edge pass paints that Bevy leaves open: hadou's outline pixels Bevy
     // shows as something else (neither pixel nor a 4-neighbour of it magenta in Bevy's picture,
     // so that a hull edge a pixel apart does not count).
-    let near_drawn = |x: usize, y: usize| {
-        let at = |x: usize, y: usize| drawn[y * w + x];
-        at(x, y)
-            || (x > 0 && at(x - 1, y))
-            || (x + 1 < w && at(x + 1, y))
-            || (y > 0 && at(x, y - 1))
-            || (y + 1 < h && at(x, y + 1))
-    };
     let open: Vec<(usize, usize)> = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .filter(|&(x, y)| hadou[y * w + x] && !near_drawn(x, y))
+        .filter(|&(x, y)| hadou[y * w + x] && !near(&drawn, w, x, y))
         .collect();
     // Where they lie: the lower part of the box's outline on screen (the contact line).
     let rows: Vec<usize> = (0..h).filter(|&y| (0..w).any(|x| hadou[y * w + x])).collect();
@@ -130,17 +133,9 @@ fn the_outline_is_closed_where_the_box_meets_the_ground_as_hadou_closes_it() {
         start.elapsed().as_secs_f64()
     );
     // Outline pixels of Bevy's that hadou does not draw (nor a 4-neighbour of them).
-    let near_hadou = |x: usize, y: usize| {
-        let at = |x: usize, y: usize| hadou[y * w + x];
-        at(x, y)
-            || (x > 0 && at(x - 1, y))
-            || (x + 1 < w && at(x + 1, y))
-            || (y > 0 && at(x, y - 1))
-            || (y + 1 < h && at(x, y + 1))
-    };
     let extra = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .filter(|&(x, y)| drawn[y * w + x] && !near_hadou(x, y))
+        .filter(|&(x, y)| drawn[y * w + x] && !near(&hadou, w, x, y))
         .count();
     eprintln!("{extra} outline pixels of Bevy's picture away from hadou's outline");
     // Issue 45: the contact line is closed in Bevy as hadou closes it (it was open: 89 pixels,
