@@ -248,6 +248,16 @@ fn att_factor(att: Attenuation, t: f32) -> f32 {
     return 0.0;
 }
 
+// Mirrors attenuated.rs GL_X and GL_W: 8-point Gauss–Legendre on [0, 1].
+const ATT_GL_X = array<f32, 8>(0.019855071751231884, 0.10166676129318664, 0.2372337950418355,
+    0.4082826787521751, 0.591717321247825, 0.7627662049581645, 0.8983332387068134, 0.9801449282487681);
+const ATT_GL_W = array<f32, 8>(0.05061426814518813, 0.11119051722668724, 0.15685332293894363,
+    0.181341891689181, 0.181341891689181, 0.15685332293894363, 0.11119051722668724, 0.05061426814518813);
+// Mirrors hadou_math::energy::FAR_GRADE, FAR_RATIO_MIN, APPROACH_RATIO and LEAVE_GROWTH.
+const ATT_FAR_GRADE: f32 = 4.0;
+const ATT_FAR_RATIO_MIN: f32 = 0.25;
+const ATT_APPROACH_RATIO: f32 = 0.2;
+const ATT_LEAVE_GROWTH: f32 = 4.0;
 // Mirrors hadou_math::energy::MAX_CELLS, REST_TOLERANCE and INNER_CELL.
 const ATT_MAX_CELLS: u32 = 192u;
 const ATT_REST_TOLERANCE: f32 = 1.0e-5;
@@ -264,16 +274,16 @@ fn att_density(falloff: u32, y: f32, h: f32) -> f32 {
     return 1.0 / r2;
 }
 
-// Mirrors RayQuadratic::mean_g_line: g averaged over [x, y] against w, 4 Gauss–Legendre nodes
+// Mirrors RayQuadratic::mean_g_line: g averaged over [x, y] against w, 8 Gauss–Legendre nodes
 // uniform in t.
 fn att_mean_line(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation) -> f32 {
-    var xs = array<f32, 4>(0.06943184420297371, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263);
-    var ws = array<f32, 4>(0.17392742256872693, 0.32607257743127307, 0.32607257743127307, 0.17392742256872693);
+    var xs = ATT_GL_X;
+    var ws = ATT_GL_W;
     let dt = y - x;
     var num = 0.0;
     var den = 0.0;
     var plain = 0.0;
-    for (var i = 0; i < 4; i++) {
+    for (var i = 0; i < 8; i++) {
         let t = x + xs[i] * dt;
         let g = att_factor(att, t);
         let w = ws[i] * att_density(falloff, q.s * t + q.beta, q.h);
@@ -288,10 +298,10 @@ fn att_mean_line(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation
 }
 
 // Mirrors RayQuadratic::mean_g_peak: g averaged over the inner cell [x, y] around the peak (s > 0),
-// 4 Gauss–Legendre nodes uniform in ψ = asinh(Y/√H) (faithful) or θ = atan(Y/√H).
+// 8 Gauss–Legendre nodes uniform in ψ = asinh(Y/√H) (faithful) or θ = atan(Y/√H).
 fn att_mean_peak(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation) -> f32 {
-    var xs = array<f32, 4>(0.06943184420297371, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263);
-    var ws = array<f32, 4>(0.17392742256872693, 0.32607257743127307, 0.32607257743127307, 0.17392742256872693);
+    var xs = ATT_GL_X;
+    var ws = ATT_GL_W;
     let sh = sqrt(q.h);
     let yx = (q.s * x + q.beta) / sh;
     let yy = (q.s * y + q.beta) / sh;
@@ -302,7 +312,7 @@ fn att_mean_peak(q: RayQuadratic, falloff: u32, x: f32, y: f32, att: Attenuation
         py = asinh(yy);
     }
     var sum = 0.0;
-    for (var i = 0; i < 4; i++) {
+    for (var i = 0; i < 8; i++) {
         let p = px + xs[i] * (py - px);
         var v = tan(p);
         if (falloff == FALLOFF_FAITHFUL) {
@@ -338,7 +348,7 @@ fn att_tail(q: RayQuadratic, falloff: u32, tf: f32, span: f32, weight: f32, j: f
 }
 
 // Mirrors RayQuadratic::attenuated: ∫ (1 − t/t_far)^j w(t) dt over [t0, min(t1, t_far)] (002 eq.
-// 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded cells, each weighted by the closed form
+// 3.23, SPEC.md §1.4) by 8-point Gauss–Legendre on graded cells, each weighted by the closed form
 // (see the Rust module docs of hadou_math::energy::attenuated for the grading).
 fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuation) -> f32 {
     let tf = att.t_far;
@@ -361,7 +371,7 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
         tc = -q.beta / s;
         dmin = ATT_INNER_CELL * (sh / s);
     }
-    let ratio = max(exp(-1.0 / att.j), 0.5);
+    let ratio = max(exp(-ATT_FAR_GRADE / att.j), ATT_FAR_RATIO_MIN);
     // The far tail: where the peak's singularities are far from t_far (or there is no peak).
     let tail_on = att.j >= ATT_TAIL_MIN_J;
     var tail_reach = 3.0e38; // no peak: the tail from the start
@@ -399,12 +409,12 @@ fn rq_attenuated(q: RayQuadratic, falloff: u32, t0: f32, t1: f32, att: Attenuati
             y = b;
         } else if (has_peak) {
             if (x < tc - dmin) {
-                y = min(y, min(tc - (tc - x) * 0.5, tc - dmin));
+                y = min(y, min(tc - (tc - x) * ATT_APPROACH_RATIO, tc - dmin));
             } else if (x < tc + dmin) {
                 y = min(y, tc + dmin);
                 inner = true;
             } else {
-                y = min(y, x + max(x - tc, dmin));
+                y = min(y, x + ATT_LEAVE_GROWTH * max(x - tc, dmin));
             }
         }
         if (!(y > x)) {

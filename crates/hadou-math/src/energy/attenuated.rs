@@ -9,16 +9,18 @@
 //! `t_c = −β/s` with half-width `ε = √H/s`; `g` falls from 1 to 0 at `t_far`, steeply for large
 //! `j`, with a branch point there for non-integer `j`. No closed form covers real `j`, and the
 //! polynomial expansion of `(1 − t/t_far)^j` for integer `j` cancels catastrophically in `f32`
-//! for `j` beyond a few, so [`RayQuadratic::attenuated`] integrates by 4-point Gauss–Legendre on
+//! for `j` beyond a few, so [`RayQuadratic::attenuated`] integrates by 8-point Gauss–Legendre on
 //! graded cells, each cell's weight `∫w` taken from the exact closed form and the rule only
 //! averaging `g` against it (`A = Σ_cells I_cell·ḡ_cell`; exact wherever `g` is constant):
 //!
-//! - cells shrink geometrically towards `t_far`: `t_far − t` falls by `q = max(e^{−1/j}, ½)` per
-//!   cell, so `g` changes by at most a factor `e` on one and its branch point stays a cell length
-//!   away;
-//! - cells grow geometrically away from the peak: a cell at distance `d > ε` from `t_c` spans at
-//!   most `d` (ratio 2), so `w`'s complex poles `t_c ± iε` also stay a cell length away. On such
-//!   a cell `g` is averaged with the weights `W_i·w(t_i)` at nodes uniform in `t`;
+//! - cells shrink geometrically towards `t_far`: `t_far − t` falls by `q = max(e^{−4/j}, ¼)` per
+//!   cell ([`FAR_GRADE`], [`FAR_RATIO_MIN`]), so `g` changes by at most a factor `e⁴` on one and
+//!   its branch point stays a third of a cell length away;
+//! - cells grow geometrically away from the peak: a cell leaving it at distance `d > ε` from
+//!   `t_c` spans at most `4·d` ([`LEAVE_GROWTH`]), one approaching it ends at a fifth of the
+//!   distance left ([`APPROACH_RATIO`]), so `w`'s complex poles `t_c ± iε` stay a quarter of a
+//!   cell length away. On such a cell `g` is averaged with the weights `W_i·w(t_i)` at nodes
+//!   uniform in `t`;
 //! - the inner cell `|t − t_c| ≤ ε` is integrated in the variable in which `w dt` is uniform,
 //!   `ψ = asinh(Y/√H)` (faithful) or `θ = atan(Y/√H)` (inverse square; `|θ| ≤ π/4` keeps the
 //!   poles of `t(θ) ∝ tan θ` twice the cell's half-width away), so the peak itself needs no
@@ -44,8 +46,11 @@
 //!   before `t_far` (an occluder) takes `∫_x^{t_far} − ∫_b^{t_far}` where the second is at most
 //!   half the first (else the march goes on).
 //!
-//! The 4-point rule on a cell whose nearest singularity is a cell length away (Bernstein ellipse
-//! `ρ = 3 + √8`) errs by about `ρ⁻⁸ ≈ 10⁻⁶` relative; `tests/analytic_attenuation.rs` holds the
+//! The 8-point rule on a cell whose nearest singularity is a quarter of a cell length away
+//! (Bernstein ellipse `ρ = 1.5 + √1.25 ≈ 2.6`) errs by about `ρ⁻¹⁶ ≈ 2·10⁻⁷` relative, times
+//! what `g` grows by on that ellipse (at most `e⁴` more); the grading of the 4-point rule it
+//! replaced (ratio 2 from the peak, `e` per cell towards `t_far`) took about twice as many cells
+//! for the same error (docs/benchmarks.md, "Eight nodes on longer cells"); `tests/analytic_attenuation.rs` holds the
 //! result to an `f64` adaptive quadrature of the densities written from their definitions
 //! (p99 relative error ≤ 10⁻³ in `f32` over random rays and degenerate ones). A ray through a
 //! centre with `r_c = 0` needs about `2·log₂(span/ε)` cells; the march is capped at
@@ -64,12 +69,42 @@ use super::integral::{capsule_parts, cylinder_quadratic, sphere_quadratic};
 use super::kernel::{saturate, scaled, RayQuadratic, ENERGY_MAX, T_LIMIT};
 use crate::Real;
 
-/// Gauss–Legendre nodes on `[0, 1]` (4 points).
-pub(super) const GL_X: [f64; 4] =
-    [0.069_431_844_202_973_71, 0.330_009_478_207_571_9, 0.669_990_521_792_428_1, 0.930_568_155_797_026_3];
-/// Gauss–Legendre weights on `[0, 1]` (sum 1).
-pub(super) const GL_W: [f64; 4] =
-    [0.173_927_422_568_726_93, 0.326_072_577_431_273_07, 0.326_072_577_431_273_07, 0.173_927_422_568_726_93];
+/// Gauss–Legendre nodes on `[0, 1]` (8 points).
+pub(super) const GL_X: [f64; 8] = [
+    0.019_855_071_751_231_884,
+    0.101_666_761_293_186_64,
+    0.237_233_795_041_835_5,
+    0.408_282_678_752_175_1,
+    0.591_717_321_247_825,
+    0.762_766_204_958_164_5,
+    0.898_333_238_706_813_4,
+    0.980_144_928_248_768_1,
+];
+/// Gauss–Legendre weights on `[0, 1]` (8 points, sum 1).
+pub(super) const GL_W: [f64; 8] = [
+    0.050_614_268_145_188_13,
+    0.111_190_517_226_687_24,
+    0.156_853_322_938_943_63,
+    0.181_341_891_689_181,
+    0.181_341_891_689_181,
+    0.156_853_322_938_943_63,
+    0.111_190_517_226_687_24,
+    0.050_614_268_145_188_13,
+];
+
+/// Cells towards `t_far` shrink `t_far − t` by `e^{−FAR_GRADE/j}`: `g` changes by at most
+/// `e^{FAR_GRADE}` on one.
+pub const FAR_GRADE: f64 = 4.0;
+
+/// The least ratio of `t_far − t` from one cell's start to its end (small `j`), so that `t_far`,
+/// a branch point of `g` for non-integer `j`, stays a third of a cell length away.
+pub const FAR_RATIO_MIN: f64 = 0.25;
+
+/// A cell approaching the peak ends at this fraction of its distance `t_c − x` from the peak.
+pub const APPROACH_RATIO: f64 = 0.2;
+
+/// A cell leaving the peak at distance `d` spans at most `LEAVE_GROWTH·d`.
+pub const LEAVE_GROWTH: f64 = 4.0;
 
 /// Gauss–Laguerre nodes (8 points, weight `e^{−u}` on `[0, ∞)`): the far tail's rule.
 pub(super) const LAGUERRE_X: [f64; 8] = [
@@ -138,7 +173,7 @@ fn density<R: Real>(falloff: Falloff, y: R, h: R) -> R {
 impl<R: Real> RayQuadratic<R> {
     /// `∫_{t0}^{min(t1, t_far)} (1 − t/t_far)^j dt / sqrt(Y² + H)` (faithful) or `/(Y² + H)`
     /// (inverse square): the piece integral of [`Self::integral`] with the distance attenuation
-    /// of 002 eq. 3.23 (SPEC.md §1.4), 0 from the far point on. Graded 4-point Gauss–Legendre
+    /// of 002 eq. 3.23 (SPEC.md §1.4), 0 from the far point on. Graded 8-point Gauss–Legendre
     /// cells weighted by the closed form, then one 8-point Gauss–Laguerre step over the far tail
     /// once the peak is far enough from the far point (see this module's documentation,
     /// `energy/attenuated.rs`); `j = 0` (or NaN) is
@@ -170,8 +205,10 @@ impl<R: Real> RayQuadratic<R> {
         let has_peak = s > R::ZERO && sh <= s * range && self.beta.abs() <= s * range;
         let (tc, dmin) =
             if has_peak { (-self.beta / s, R::from_f64(INNER_CELL) * (sh / s)) } else { (R::ZERO, R::ZERO) };
-        let q = (-R::ONE / att.j).exp().max(R::from_f64(0.5));
+        let q = (-R::from_f64(FAR_GRADE) / att.j).exp().max(R::from_f64(FAR_RATIO_MIN));
         let half = R::from_f64(0.5);
+        let approach = R::from_f64(APPROACH_RATIO);
+        let leave = R::from_f64(LEAVE_GROWTH);
         // The far tail: where the peak's singularities are far from t_far (or there is no peak).
         let tail_on = att.j >= R::from_f64(TAIL_MIN_J);
         let tail_reach = if has_peak {
@@ -206,14 +243,14 @@ impl<R: Real> RayQuadratic<R> {
                 y = b;
             } else if has_peak {
                 if x < tc - dmin {
-                    // Approaching the peak: halve the distance, down to the inner cell.
-                    y = y.min((tc - (tc - x) * half).min(tc - dmin));
+                    // Approaching the peak: a fifth of the distance left, down to the inner cell.
+                    y = y.min((tc - (tc - x) * approach).min(tc - dmin));
                 } else if x < tc + dmin {
                     y = y.min(tc + dmin);
                     inner = true;
                 } else {
-                    // Leaving it: double the distance.
-                    y = y.min(x + (x - tc).max(dmin));
+                    // Leaving it: the distance times five.
+                    y = y.min(x + leave * (x - tc).max(dmin));
                 }
             }
             let advances = y > x; // false for NaN too
@@ -261,7 +298,7 @@ impl<R: Real> RayQuadratic<R> {
         weight / j1 * sum
     }
 
-    /// `g` averaged over `[x, y]` against `w`, with 4 Gauss–Legendre nodes uniform in `t`
+    /// `g` averaged over `[x, y]` against `w`, with 8 Gauss–Legendre nodes uniform in `t`
     /// (`Σ W_i·w(t_i)·g(t_i) / Σ W_i·w(t_i)`); the plain mean of `g` where the weights underflow.
     #[inline(always)]
     fn mean_g_line(&self, falloff: Falloff, x: R, y: R, att: &Attenuation<R>) -> R {
@@ -284,7 +321,7 @@ impl<R: Real> RayQuadratic<R> {
         }
     }
 
-    /// `g` averaged over `[x, y]` against `w` on the inner cell around the peak (`s > 0`), with 4
+    /// `g` averaged over `[x, y]` against `w` on the inner cell around the peak (`s > 0`), with 8
     /// Gauss–Legendre nodes uniform in `ψ = asinh(Y/√H)` (faithful) or `θ = atan(Y/√H)`
     /// (inverse square), the variables in which `w dt` is uniform.
     #[inline(always)]

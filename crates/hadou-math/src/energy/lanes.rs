@@ -29,8 +29,8 @@
 //! [`RayQuadratic::attenuated`]: super::RayQuadratic::attenuated
 
 use super::attenuated::{
-    tail_reach, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
-    TAIL_MIN_J,
+    tail_reach, APPROACH_RATIO, FAR_GRADE, FAR_RATIO_MIN, GL_W, GL_X, INNER_CELL, LAGUERRE_W, LAGUERRE_X,
+    LEAVE_GROWTH, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE, TAIL_MIN_J,
 };
 use super::field::{BeamField, CapsuleField, CylinderField, Falloff, FieldParams, SphereField};
 use super::kernel::{ENERGY_MAX, ENERGY_SATURATION, H_FLOOR, T_LIMIT};
@@ -256,7 +256,7 @@ impl<L: Lane> Outlined<L> for Integral<L> {
 
 impl<L: Lane> Quad<L> {
     /// The scalar [`super::RayQuadratic::attenuated`] on eight rays: `∫_{t0}^{min(t1, t_far)}
-    /// (1 − t/t_far)^j w(t) dt` (002 eq. 3.23, SPEC.md §1.4) by 4-point Gauss–Legendre on graded
+    /// (1 − t/t_far)^j w(t) dt` (002 eq. 3.23, SPEC.md §1.4) by 8-point Gauss–Legendre on graded
     /// cells weighted by the closed form, as one masked loop (see the [module docs](self)). Each
     /// lane cuts the scalar march's cells: the same grading, ulp step, early stop
     /// ([`REST_TOLERANCE`](super::REST_TOLERANCE)) and cap ([`MAX_CELLS`](super::MAX_CELLS));
@@ -300,8 +300,9 @@ impl<L: Lane> Quad<L> {
         let tc = has_peak.select(-self.beta / s, zero);
         let dmin = has_peak.select(k(INNER_CELL as f32) * (sh / s), zero);
         // The same ratio as the scalar march (the maths library's exp, once per wave).
-        let q = k((-1.0f32 / att.j).exp().max(0.5));
-        let half = k(0.5);
+        let q = k((-(FAR_GRADE as f32) / att.j).exp().max(FAR_RATIO_MIN as f32));
+        let approach = k(APPROACH_RATIO as f32);
+        let leave = k(LEAVE_GROWTH as f32);
         let last_cell = k((MAX_CELLS - 1) as f32);
         let tolerance = k(REST_TOLERANCE as f32);
         // The far tail (the scalar march's): where the peak's singularities are far from t_far.
@@ -343,13 +344,13 @@ impl<L: Lane> Quad<L> {
             }
             let graded = b.min(tf - q * (tf - x));
             let capped = cells.simd_ge(last_cell);
-            // Approaching the peak: halve the distance, down to the inner cell; inside it: to its
-            // end; leaving it: double the distance.
+            // Approaching the peak: a fifth of the distance left, down to the inner cell; inside
+            // it: to its end; leaving it: the distance times five.
             let before = x.simd_lt(tc - dmin);
             let within = x.simd_lt(tc + dmin);
-            let y_before = graded.min((tc - (tc - x) * half).min(tc - dmin));
+            let y_before = graded.min((tc - (tc - x) * approach).min(tc - dmin));
             let y_within = graded.min(tc + dmin);
-            let y_after = graded.min(x + (x - tc).max(dmin));
+            let y_after = graded.min(x + leave * (x - tc).max(dmin));
             let y_peak = before.select(y_before, within.select(y_within, y_after));
             let y = capped.select(b, has_peak.select(y_peak, graded));
             let inner = has_peak & !capped & !before & within;
@@ -398,7 +399,7 @@ impl<L: Lane> Quad<L> {
         weight / k(j + 1.0) * sum
     }
 
-    /// `g` averaged over `[x, y]` against `w` with 4 Gauss–Legendre nodes uniform in `t`, the
+    /// `g` averaged over `[x, y]` against `w` with 8 Gauss–Legendre nodes uniform in `t`, the
     /// plain mean of `g` where the weights underflow (the scalar `mean_g_line`).
     #[inline(always)]
     fn mean_g_line(&self, falloff: Falloff, x: L, y: L, att: &AttenuationLanes<L>) -> L {
