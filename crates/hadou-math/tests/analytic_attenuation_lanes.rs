@@ -28,7 +28,8 @@ const REL: f64 = 1e-4;
 /// Absolute allowance, as a fraction of the lane's unattenuated energy.
 const FLOOR: f64 = 1e-9;
 
-const JS: [f32; 6] = [0.5, 2.0, 2.7, 8.0, 16.0, 64.0];
+/// Exponents: integers up to `INTEGER_J_MAX` (powers by squaring) and others (`exp(j·ln h)`).
+const JS: [f32; 7] = [0.5, 2.0, 2.7, 8.0, 16.0, 64.0, 96.0];
 const LAWS: [Falloff; 2] = [Falloff::Faithful, Falloff::InverseSquare];
 
 /// One ray of a batch: direction, span and far point (the origin is the batch's).

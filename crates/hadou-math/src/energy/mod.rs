@@ -70,8 +70,8 @@ pub mod lanes;
 
 pub use attenuated::{
     beam_energy_attenuated, capsule_energy_attenuated, cylinder_energy_attenuated, sphere_energy_attenuated,
-    APPROACH_RATIO, FAR_GRADE, FAR_RATIO_MIN, INNER_CELL, LEAVE_GROWTH, MAX_CELLS, PEAK_RANGE, REST_TOLERANCE,
-    TAIL_MIN_J, TAIL_REACH, TAIL_REACH_MIN,
+    APPROACH_RATIO, FAR_GRADE, FAR_RATIO_MIN, INNER_CELL, LEAVE_GROWTH, MAX_CELLS, PEAK_RANGE,
+    REST_TOLERANCE, TAIL_MIN_J, TAIL_REACH, TAIL_REACH_MIN,
 };
 pub use field::{
     Attenuation, BeamField, CapsuleField, CylinderField, Falloff, FieldParams, Ray, SphereField,
