@@ -50,10 +50,11 @@
 //! (Bernstein ellipse `ρ = 1.5 + √1.25 ≈ 2.6`) errs by about `ρ⁻¹⁶ ≈ 2·10⁻⁷` relative, times
 //! what `g` grows by on that ellipse (at most `e⁴` more); the grading of the 4-point rule it
 //! replaced (ratio 2 from the peak, `e` per cell towards `t_far`) took about twice as many cells
-//! for the same error (docs/benchmarks.md, "Eight nodes on longer cells"); `tests/analytic_attenuation.rs` holds the
-//! result to an `f64` adaptive quadrature of the densities written from their definitions
-//! (p99 relative error ≤ 10⁻³ in `f32` over random rays and degenerate ones). A ray through a
-//! centre with `r_c = 0` needs about `2·log₂(span/ε)` cells; the march is capped at
+//! for the same error (docs/benchmarks.md, "Eight nodes on longer cells").
+//! `tests/analytic_attenuation.rs` holds the result to an `f64` adaptive quadrature of the
+//! densities written from their definitions (p99 relative error ≤ 10⁻³ in `f32` over random
+//! rays and degenerate ones). A ray through a
+//! centre with `r_c = 0` needs about `2·log₅(span/ε)` cells; the march is capped at
 //! [`MAX_CELLS`] (the rest is then one last cell).
 //!
 //! `j = 0` calls the unattenuated kernels themselves, so it is bit-identical to them and as fast.
