@@ -386,13 +386,13 @@ fn attenuated_lanes<L: Lane>(
     rays: &PixelRays<L>,
     valid: usize,
 ) -> L {
-    let att = lanes::AttenuationLanes {
-        j: wave.attenuation,
-        t_far: match p.falloff {
+    let att = lanes::AttenuationLanes::new(
+        wave.attenuation,
+        match p.falloff {
             Falloff::Faithful => L::splat(1.0),
             Falloff::InverseSquare => rays.far_dist,
         },
-    };
+    );
     let mut ray = *ray;
     if valid < LANES {
         let lane = L::from_array(std::array::from_fn(|i| i as f32));

@@ -107,7 +107,7 @@ impl WithLanes for Kernel<'_> {
             t0: L::from_array(self.rays.map(|r| r.t0)),
             t1: L::from_array(self.rays.map(|r| r.t1)),
         };
-        let att = AttenuationLanes { j: self.j, t_far: L::from_array(self.rays.map(|r| r.t_far)) };
+        let att = AttenuationLanes::new(self.j, L::from_array(self.rays.map(|r| r.t_far)));
         let p = self.p;
         let e = if self.attenuated {
             match self.shape {

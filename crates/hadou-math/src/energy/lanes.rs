@@ -300,8 +300,8 @@ impl<L: Lane> Quad<L> {
         let has_peak = s.simd_gt(zero) & sh.simd_le(range) & self.beta.max(-self.beta).simd_le(range);
         let tc = has_peak.select(-self.beta / s, zero);
         let dmin = has_peak.select(k(INNER_CELL as f32) * (sh / s), zero);
-        // The same ratio as the scalar march (the maths library's exp, once per wave).
-        let q = k((-(FAR_GRADE as f32) / att.j).exp().max(FAR_RATIO_MIN as f32));
+        // The same ratio as the scalar march (taken once with the attenuation: `MarchConstants`).
+        let q = k(att.march.q);
         let approach = k(APPROACH_RATIO as f32);
         let leave = k(LEAVE_GROWTH as f32);
         let last_cell = k((MAX_CELLS - 1) as f32);
@@ -311,9 +311,8 @@ impl<L: Lane> Quad<L> {
         let (tail_reach, beyond, nodes) = if tail_on {
             let dc = tf - tc;
             let eps = sh / s;
-            let far = (dc * dc + eps * eps).sqrt() / k(tail_reach(att.j));
-            let j1 = att.j + 1.0;
-            let nodes = LAGUERRE_X.map(|u| k((-(u as f32) / j1).exp()));
+            let far = (dc * dc + eps * eps).sqrt() / k(att.march.reach);
+            let nodes = att.march.nodes.map(k);
             (has_peak.select(far, k(f32::INFINITY)), (tf - b) * att.factor(b), nodes)
         } else {
             (zero, zero, [zero; 8])
@@ -529,18 +528,64 @@ pub const INTEGER_J_MAX: f32 = 64.0;
 /// The distance attenuation `(1 − t/t_far)^j` of 002 eq. 3.23 (SPEC.md §1.4) on eight rays:
 /// [`super::Attenuation`] with one exponent for the batch (a wave's) and each ray's own far point
 /// (`t_far` is 1 for every faithful ray, the far point's distance along each inverse-square ray).
+/// Built by [`Self::new`], which also takes the march's constants that depend on `j` alone (its
+/// ratio towards `t_far`, the far tail's reach and nodes: about ten `exp` that each of a bulged
+/// beam's five pieces would otherwise take again).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AttenuationLanes<L = Lanes> {
     /// Exponent `j ≥ 0` (0: none), shared by the lanes.
-    pub j: f32,
+    j: f32,
     /// Each ray's far-point parameter (`> 0`).
     pub t_far: L,
+    /// What the march takes from `j` alone.
+    march: MarchConstants,
+}
+
+/// The constants of [`Quad::march`] that depend on `j` alone, formed as the scalar march forms
+/// them (so each lane still cuts the scalar march's cells).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct MarchConstants {
+    /// `t_far − t` falls by this per cell graded towards `t_far`.
+    q: f32,
+    /// The far tail's `reach(j)`.
+    reach: f32,
+    /// The far tail's nodes `e^{−u_i/(j+1)}` (zero below [`TAIL_MIN_J`]).
+    nodes: [f32; 8],
+}
+
+impl MarchConstants {
+    fn new(j: f32) -> Self {
+        if j.is_nan() || j <= 0.0 {
+            return Self { q: 0.0, reach: 0.0, nodes: [0.0; 8] };
+        }
+        let j1 = j + 1.0;
+        Self {
+            q: (-(FAR_GRADE as f32) / j).exp().max(FAR_RATIO_MIN as f32),
+            reach: tail_reach(j),
+            nodes: if j >= TAIL_MIN_J as f32 {
+                LAGUERRE_X.map(|u| (-(u as f32) / j1).exp())
+            } else {
+                [0.0; 8]
+            },
+        }
+    }
 }
 
 impl<L: Lane> AttenuationLanes<L> {
+    /// The attenuation with exponent `j` (`≥ 0`, 0: none) and each lane's far point `t_far`.
+    pub fn new(j: f32, t_far: L) -> Self {
+        Self { j, t_far, march: MarchConstants::new(j) }
+    }
+
     /// No attenuation (`j = 0`).
     pub fn none() -> Self {
-        Self { j: 0.0, t_far: L::splat(1.0) }
+        Self::new(0.0, L::splat(1.0))
+    }
+
+    /// The exponent `j`.
+    #[inline(always)]
+    pub fn j(&self) -> f32 {
+        self.j
     }
 
     /// Whether it changes anything (`j > 0`; false for NaN).
