@@ -6,7 +6,7 @@
 //! 1. **Tiles.** The image is cut into [`TILE`]² tiles. A tile's receivers (each visible point
 //!    moved off its surface by [`TRACE_BIAS`] of its distance to `L`) fit in a ball; every ray
 //!    from one of them to the lamp (inside the ball of radius `l` around `L`) lies in the tapered
-//!    capsule between the two balls ([`capsule_hits`]). The hierarchy is walked once per tile
+//!    capsule between the two balls ([`hadou_math::soft::capsule_hits`]). The hierarchy is walked once per tile
 //!    with that capsule, a triangle whose plane leaves both balls on one side
 //!    ([`hadou_math::soft::BvhTri::one_side`]) dropped: no triangle kept, and every pixel of the tile sees the whole
 //!    lamp without a single ray (most of the image); up to [`TILE_TRIS`], and each pixel tests
@@ -28,8 +28,9 @@
 use crate::opaque::SoftPoint;
 use crate::winding::TileCasters;
 use hadou_math::soft::{
-    capsule_hits, lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, segment_triangle_distance,
-    Bvh, BvhTri, LampFrame, LampPattern, LampShape, Topology, MASK_WORDS, TRACE_BIAS, T_MIN,
+    lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, segment_plane_margin,
+    segment_triangle_distance, Bvh, BvhTri, Capsule, LampFrame, LampPattern, LampShape, SegmentWedge,
+    Topology, MASK_WORDS, TRACE_BIAS, T_MIN,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame};
@@ -139,43 +140,56 @@ pub fn traced_with(
         return out;
     }
     let topo = Topology::of(bvh);
+    let extent = bvh_extent(bvh);
     out.par_chunks_mut(w * TILE).enumerate().for_each(|(ty, band)| {
         let y0 = ty * TILE;
         let rows = band.len() / w;
         let mut ids: Vec<u32> = Vec::with_capacity(TILE_TRIS);
         let mut casters = TileCasters::default();
         let mut cands: Vec<Cand> = Vec::new();
+        let mut receivers: Vec<Vec3f> = Vec::with_capacity(TILE * TILE);
         let cap = if lamp.shape == LampShape::Segment { SEGMENT_TILE_TRIS } else { TILE_TRIS };
         for x0 in (0..w).step_by(TILE) {
             let x1 = (x0 + TILE).min(w);
             // The tile's receivers and their ball.
             let (mut lo, mut hi) = (Vec3f::splat(f32::INFINITY), Vec3f::splat(f32::NEG_INFINITY));
-            let mut any = false;
+            receivers.clear();
             for y in y0..y0 + rows {
                 for x in x0..x1 {
                     if let Some(p) = points[y * w + x].filter(|p| lit_at_all(p.term)) {
                         let r = receiver(p.world, p.normal, lamp.centre);
                         lo = lo.min(r);
                         hi = hi.max(r);
-                        any = true;
+                        receivers.push(r);
                     }
                 }
             }
-            if !any {
+            if receivers.is_empty() {
                 continue;
             }
             let (tc, tr) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+            // The segment's receivers see it only within the wedge of their planes through it.
+            let wedge = (lamp.shape == LampShape::Segment)
+                .then(|| {
+                    let reach =
+                        [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z].iter().fold(0.0f32, |m, v| m.max(v.abs()));
+                    let margin = segment_plane_margin(Vec3f::splat(reach), extent);
+                    SegmentWedge::around(lamp.centre, lamp.axis, &receivers, margin)
+                })
+                .flatten();
             ids.clear();
             let mut overflow = false;
+            let capsule = Capsule::new(tc, tr, lamp.centre, lamp.size);
             bvh.walk(
                 |node| {
                     let (c, r) = node.ball();
-                    capsule_hits(tc, tr, lamp.centre, lamp.size, c, r)
+                    capsule.hits(c, r) && !wedge.is_some_and(|wg| wg.misses_box(node.lo, node.hi))
                 },
                 |i, t| {
                     // Outside the straight capsule of the larger radius around the axis from the
                     // tile's centre to `L`, which holds the tapered one.
-                    if t.one_side(tc, tr, lamp.centre, lamp.size)
+                    if wedge.is_some_and(|wg| wg.misses(&t.corners()))
+                        || t.one_side(tc, tr, lamp.centre, lamp.size)
                         || segment_triangle_distance(tc, lamp.centre, &t.corners()) > tr.max(lamp.size)
                     {
                         return true;
@@ -210,12 +224,12 @@ pub fn traced_with(
                     }
                     let r = receiver(p.world, p.normal, lamp.centre);
                     *o = if overflow {
-                        pixel(bvh, &lamp, &pat, r, x as u32, y as u32)
+                        pixel(bvh, &lamp, &pat, r, x as u32, y as u32, extent)
                     } else {
                         let o = pixel_offset(x as u32, y as u32);
                         match lamp.frame(r) {
                             Some(f) if lamp.shape == LampShape::Segment => {
-                                by_triangles(&cands, &f, &pat, o, &lamp)
+                                by_triangles(&cands, &f, &pat, o, &lamp, extent)
                             }
                             Some(f) => casters.visibility(bvh, &f, &pat, o, lamp.centre, lamp.size),
                             None => 1.0,
@@ -363,6 +377,12 @@ fn grid_point(points: &[Option<SoftPoint>], width: usize, k: usize, x: usize, y:
     Some(SoftPoint { world: world * inv, normal, term: [1.0; 3] })
 }
 
+/// The largest coordinate magnitude of the hierarchy's triangles (its root box's), for
+/// [`segment_plane_margin`]; 0 without triangles.
+fn bvh_extent(bvh: &Bvh) -> f32 {
+    bvh.nodes.first().map_or(0.0, |n| n.lo.iter().chain(&n.hi).fold(0.0f32, |m, v| m.max(v.abs())))
+}
+
 /// Whether an unshadowed term adds anything.
 #[inline]
 fn lit_at_all(term: [f32; 3]) -> bool {
@@ -373,12 +393,18 @@ fn lit_at_all(term: [f32; 3]) -> bool {
 /// ([`occlude`] each, in the mask), stopping once every sample is hidden: what the segment lamp
 /// uses, whose plane runs through the casters its axis points at (so that most of them reach
 /// past it and are clipped whatever the method) and whose single row makes each triangle cheap.
-fn by_triangles(cands: &[Cand], f: &LampFrame, pat: &LampPattern, o: f32, lamp: &Lamp) -> f32 {
+///
+/// A triangle wholly on one side of the plane through the receiver and the segment is skipped
+/// first ([`LampFrame::beside_segment_plane`], three products): most of a tile's candidates are.
+fn by_triangles(cands: &[Cand], f: &LampFrame, pat: &LampPattern, o: f32, lamp: &Lamp, extent: f32) -> f32 {
     let r = f.origin;
+    let margin = segment_plane_margin(r, extent);
+    let capsule = Capsule::new(r, 0.0, lamp.centre, lamp.size);
     let mut mask = [0u32; MASK_WORDS];
     for c in cands {
-        if !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
-            && capsule_hits(r, 0.0, lamp.centre, lamp.size, c.centre, c.radius)
+        if !f.beside_segment_plane(&c.corners, margin)
+            && !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
+            && capsule.hits(c.centre, c.radius)
         {
             occlude(f, pat, o, &c.corners, &mut mask);
             if mask_full(&mask, pat) {
@@ -391,18 +417,26 @@ fn by_triangles(cands: &[Cand], f: &LampFrame, pat: &LampPattern, o: f32, lamp: 
 
 /// One pixel's visibility from the receiver `r` at global pixel `(x, y)` by a walk of the
 /// whole hierarchy (a tile with more than [`TILE_TRIS`] candidates), triangle by triangle.
-fn pixel(bvh: &Bvh, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32) -> f32 {
+///
+/// For the segment lamp, a node or triangle wholly on one side of the plane through the receiver
+/// and the segment is skipped first ([`LampFrame::box_beside_segment_plane`]).
+fn pixel(bvh: &Bvh, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32, extent: f32) -> f32 {
     let Some(f) = lamp.frame(r) else { return 1.0 };
     let o = pixel_offset(x, y);
+    let segment = lamp.shape == LampShape::Segment;
+    let margin = segment_plane_margin(r, extent);
+    let capsule = Capsule::new(r, 0.0, lamp.centre, lamp.size);
     let mut mask = [0u32; MASK_WORDS];
     // `Bvh::walk`, with a node test that reads the mask the leaves write.
     let mut i = 0usize;
     while i < bvh.nodes.len() {
         let node = &bvh.nodes[i];
         let (c, rc) = node.ball();
-        if !(capsule_hits(r, 0.0, lamp.centre, lamp.size, c, rc)
-            && f.box_may_hide(node.lo, node.hi, pat, o, &mask))
-        {
+        if segment && f.box_beside_segment_plane(node.lo, node.hi, margin) {
+            i = node.skip as usize;
+            continue;
+        }
+        if !(capsule.hits(c, rc) && f.box_may_hide(node.lo, node.hi, pat, o, &mask)) {
             i = node.skip as usize;
             continue;
         }
@@ -410,8 +444,10 @@ fn pixel(bvh: &Bvh, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32) ->
             None => i += 1,
             Some(range) => {
                 for t in &bvh.tris[range] {
-                    if !t.one_side(r, 0.0, lamp.centre, lamp.size) {
-                        occlude(&f, pat, o, &t.corners(), &mut mask);
+                    let corners = t.corners();
+                    let beside = segment && f.beside_segment_plane(&corners, margin);
+                    if !beside && !t.one_side(r, 0.0, lamp.centre, lamp.size) {
+                        occlude(&f, pat, o, &corners, &mut mask);
                         if mask_full(&mask, pat) {
                             return 0.0;
                         }

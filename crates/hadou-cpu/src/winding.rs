@@ -22,7 +22,7 @@
 //! few edges are projected, which is what makes a detailed caster cheap.
 
 use hadou_math::soft::{
-    capsule_hits, occlude, row_offset, Bvh, LampFrame, LampPattern, Topology, MASK_WORDS, NO_TRI, T_MIN,
+    occlude, row_offset, Bvh, Capsule, LampFrame, LampPattern, Topology, MASK_WORDS, NO_TRI, T_MIN,
 };
 use hadou_math::Vec3f;
 use std::collections::HashMap;
@@ -169,7 +169,7 @@ impl TileCasters {
     /// The visibility of the lamp `f` (layout `pat`, first-row offset `o`) from its origin, the
     /// tile's candidates being every triangle that can hide part of it; `lamp_centre` and
     /// `lamp_size` give the ball that holds the lamp, which a clipped triangle must come near
-    /// ([`capsule_hits`], [`hadou_math::soft::BvhTri::one_side`]) before it is projected.
+    /// ([`hadou_math::soft::capsule_hits`], [`hadou_math::soft::BvhTri::one_side`]) before it is projected.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn visibility(
         &mut self,
@@ -198,6 +198,7 @@ impl TileCasters {
         let mut mask = [0u32; MASK_WORDS];
         let mut masked = false;
         spill.clear();
+        let capsule = Capsule::new(p, 0.0, lamp_centre, lamp_size);
         for (i, (t, w)) in tris.iter().zip(w.iter_mut()).enumerate() {
             let i = i as u32;
             let s = match t.fixed {
@@ -219,7 +220,7 @@ impl TileCasters {
             // Its edges with counted neighbours are outline now, even where the tile dropped them.
             spill.push(i);
             let corners = t.v.map(|v| verts[v as usize]);
-            let near = |c: Vec3f, rc: f32| capsule_hits(p, 0.0, lamp_centre, lamp_size, c, rc);
+            let near = |c: Vec3f, rc: f32| capsule.hits(c, rc);
             if hs.iter().any(|&h| h > 0.0)
                 && hs.iter().any(|&h| h < top)
                 && (!bvh.tris[t.global as usize].one_side(p, 0.0, lamp_centre, lamp_size)

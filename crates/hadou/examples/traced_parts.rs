@@ -4,7 +4,8 @@
 //! that asked for work. With `HADOU_GRID=2` the points are the sample frame's of 2 × 2 samples a
 //! pixel (a `SIZE`² image, `(2·SIZE)`² points), each stage timed sample by sample
 //! (`traced_with`) and with one value per pixel where the samples agree (`traced_grid`), in
-//! turn.
+//! turn. Each line ends with a hash of the values' bits, to tell whether a change to the resolve
+//! kept its images.
 
 use hadou_cpu::soft::soft_input;
 use hadou_cpu::traced::traced_grid_counted;
@@ -39,25 +40,33 @@ fn main() {
         let kinds: &[usize] = if grid > 1 { &[1, grid] } else { &[1] };
         let mut times = vec![Vec::new(); kinds.len()];
         let mut counts = vec![None; kinds.len()];
+        let mut hashes = vec![0u64; kinds.len()];
         for round in 0..6 {
             for (slot, &k) in kinds.iter().enumerate() {
                 let t = Instant::now();
                 let (v, count) = traced_grid_counted(&bvh, &lamp, &input.points, input.width, samples, k);
-                std::hint::black_box(v);
+                // FNV-1a over the values' bits.
+                hashes[slot] = v.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
+                    (h ^ u64::from(x.to_bits())).wrapping_mul(0x0000_0100_0000_01b3)
+                });
                 counts[slot] = Some(count);
                 if round > 0 {
                     times[slot].push(t.elapsed().as_secs_f64() * 1e3);
                 }
             }
         }
-        for ((t, &k), count) in times.iter_mut().zip(kinds).zip(&counts) {
+        for (((t, &k), count), hash) in times.iter_mut().zip(kinds).zip(&counts).zip(&hashes) {
             t.sort_by(f64::total_cmp);
             let how = if k == 1 { "each point" } else { "per pixel" };
             let settled = match count {
                 Some(c) if k > 1 => format!(", {} of {} pixels traced once", c.settled, c.pixels),
                 _ => String::new(),
             };
-            println!("{name:8} {how:10} {:8.2} ms (fastest {:.2}){settled}", t[t.len() / 2], t[0]);
+            println!(
+                "{name:8} {how:10} {:8.2} ms (fastest {:.2}){settled}, bits {hash:016x}",
+                t[t.len() / 2],
+                t[0]
+            );
         }
     }
 }

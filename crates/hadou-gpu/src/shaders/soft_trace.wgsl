@@ -36,6 +36,8 @@ struct BvhTri {
 const MASK_WORDS: u32 = 32u;
 const T_MIN: f32 = 1e-5;
 const TRACE_BIAS: f32 = 1e-3;
+// hadou_math::soft::SEGMENT_PLANE_MARGIN.
+const SEGMENT_PLANE_MARGIN: f32 = 1e-4;
 
 // A pixel's mask of hidden samples (bit k: sample k % per_row of row k / per_row), a function
 // variable of the caller's passed by pointer (MASK_WORDS words).
@@ -212,6 +214,29 @@ fn box_may_hide(f: LampFrame, lo: vec3<f32>, hi: vec3<f32>, disc: bool) -> bool 
     box_corner(f, vec3<f32>(hi.x, hi.y, hi.z), &e, &state);
     let ylim = select(0.0, 1.0, disc);
     return state.y != 0u || (state.x < 8u && !(e.x > 1.0 || e.y < -1.0 || e.z > ylim || e.w < -ylim));
+}
+
+// Twin of hadou_math::soft::segment_plane_margin for the receiver p, `extent` the largest
+// coordinate magnitude of the hierarchy's root box.
+fn segment_plane_margin(p: vec3<f32>, extent: f32) -> f32 {
+    return SEGMENT_PLANE_MARGIN * (max(max(abs(p.x), abs(p.y)), abs(p.z)) + extent);
+}
+
+// Twin of hadou_math::soft::LampFrame::box_beside_segment_plane: the box lo..hi wholly beyond
+// `margin` on one side of the plane through the receiver and the segment.
+fn box_beside_segment_plane(f: LampFrame, lo: vec3<f32>, hi: vec3<f32>, margin: f32) -> bool {
+    let c = (lo + hi) * 0.5;
+    let e = (hi - lo) * 0.5;
+    let reach = e.x * abs(f.v.x) + e.y * abs(f.v.y) + e.z * abs(f.v.z);
+    return abs(dot3(f.v, c - f.origin)) > reach + margin;
+}
+
+// Twin of hadou_math::soft::LampFrame::beside_segment_plane for a triangle's three corners.
+fn tri_beside_segment_plane(f: LampFrame, t: BvhTri, margin: f32) -> bool {
+    let da = dot3(f.v, t.a.xyz - f.origin);
+    let db = dot3(f.v, t.b.xyz - f.origin);
+    let dc = dot3(f.v, t.c.xyz - f.origin);
+    return min(min(da, db), dc) > margin || max(max(da, db), dc) < -margin;
 }
 
 // Twin of hadou_math::soft::BvhTri::one_side with a receiver ball of radius 0 at p and the lamp's
@@ -495,6 +520,16 @@ fn pixel_visibility(r: vec3<f32>, x: u32, y: u32) -> f32 {
     // loops over a polygon's corners of a constant count (unrolled), the containment test skipped
     // where it cannot hold (trace_twins.rs wgsl_trace_walk_matches_the_cpu holds the walk to the
     // CPU's). The walk itself, one iteration a node, and the rows a triangle crosses remain.
+    // The segment: what lies wholly on one side of the plane through r and the segment hides
+    // nothing (hadou-cpu's traced::pixel, the same test first).
+    let segment = frame.area_shape == LAMP_SEGMENT;
+    var extent = 0.0;
+    if (traced.node_count > 0u) {
+        let root = nodes[0];
+        let m = max(abs(root.lo), abs(root.hi));
+        extent = max(max(m.x, m.y), m.z);
+    }
+    let margin = segment_plane_margin(r, extent);
     var i = 0u;
     var full = false;
     var hidden = 0u;
@@ -504,7 +539,8 @@ fn pixel_visibility(r: vec3<f32>, x: u32, y: u32) -> f32 {
         let centre = (node.lo + node.hi) * 0.5;
         let radius = length3(node.hi - node.lo) * 0.5;
         let count = node.tris & 15u;
-        if (!(capsule_hits(r, 0.0, l, size, centre, radius) && box_may_hide(f, node.lo, node.hi, disc))) {
+        if ((segment && box_beside_segment_plane(f, node.lo, node.hi, margin))
+            || !(capsule_hits(r, 0.0, l, size, centre, radius) && box_may_hide(f, node.lo, node.hi, disc))) {
             i = node.skip;
         } else if (count == 0u) {
             i += 1u;
@@ -513,7 +549,7 @@ fn pixel_visibility(r: vec3<f32>, x: u32, y: u32) -> f32 {
             var k = first;
             while (k < first + count && !full) {
                 let t = tris[k];
-                if (!one_side(t, r, l, size)) {
+                if (!(segment && tri_beside_segment_plane(f, t, margin)) && !one_side(t, r, l, size)) {
                     hidden += occlude(f, o, t, &mask);
                     full = hidden >= all;
                 }

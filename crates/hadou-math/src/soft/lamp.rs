@@ -43,6 +43,87 @@ pub const T_MIN: f32 = 1e-5;
 /// it looks at the lamp (its own surface's facets do not shade it beyond that).
 pub const TRACE_BIAS: f32 = 1e-3;
 
+/// Relative margin of [`LampFrame::beside_segment_plane`]: a thousand times what the clip and the
+/// projection of [`occlude`] can round by (a few `f32` ulps of the coordinates, `6·10⁻⁸` each).
+pub const SEGMENT_PLANE_MARGIN: f32 = 1e-4;
+
+/// The margin [`LampFrame::beside_segment_plane`] takes for a receiver `p` among casters whose
+/// coordinates are at most `extent` in magnitude: [`SEGMENT_PLANE_MARGIN`] of the largest
+/// coordinate either can have, so that a point it calls beside the plane is beside it after any
+/// rounding of [`occlude`] too.
+#[inline]
+pub fn segment_plane_margin(p: Vec3f, extent: f32) -> f32 {
+    SEGMENT_PLANE_MARGIN * (p.x.abs().max(p.y.abs()).max(p.z.abs()) + extent)
+}
+
+/// The wedge around a segment lamp's line that holds the planes through it and each receiver of a
+/// tile (hadou's own): every sample ray of a receiver lies in the half-plane bounded by the line
+/// that holds the receiver, so a triangle or box wholly outside the wedge hides nothing from any
+/// of the tile's receivers, and the traced resolve drops it from the tile's candidates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SegmentWedge {
+    /// A point of the line (the lamp's centre).
+    at: Vec3f,
+    /// The two bounding planes' normals through `at`, each towards the wedge.
+    lo: Vec3f,
+    hi: Vec3f,
+    /// [`segment_plane_margin`] of the tile.
+    margin: f32,
+}
+
+impl SegmentWedge {
+    /// The wedge around the line through `centre` along the unit `axis` that holds the receivers
+    /// `pts`, with the margin `margin`; `None` where it would be half a turn wide or more, a
+    /// receiver lies on the line, or a value is not finite (no wedge: keep every candidate).
+    pub fn around(centre: Vec3f, axis: Vec3f, pts: &[Vec3f], margin: f32) -> Option<SegmentWedge> {
+        let off = |p: Vec3f| {
+            let q = p - centre;
+            q - axis * q.dot(axis)
+        };
+        let d0 = off(*pts.first()?).try_normalize()?;
+        let e2 = axis.cross(d0);
+        let (mut a0, mut a1) = (0.0f32, 0.0f32);
+        for &p in pts {
+            let q = off(p);
+            if q.length_squared() <= 0.0 {
+                return None;
+            }
+            let a = q.dot(e2).atan2(q.dot(d0));
+            a0 = a0.min(a);
+            a1 = a1.max(a);
+        }
+        // Well short of half a turn, so that the planes bound a convex wedge.
+        let narrow = a1 - a0 < 0.9 * std::f32::consts::PI;
+        if !narrow || !margin.is_finite() {
+            return None;
+        }
+        // The plane at angle `a` holds `d0·cos a + e2·sin a`; its normal towards larger angles.
+        let normal = |a: f32| e2 * a.cos() - d0 * a.sin();
+        Some(SegmentWedge { at: centre, lo: normal(a0), hi: -normal(a1), margin })
+    }
+
+    /// Whether every point of `pts` lies farther than the margin outside one bounding plane.
+    #[inline]
+    pub fn misses(&self, pts: &[Vec3f]) -> bool {
+        let (mut lo, mut hi) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
+        for &c in pts {
+            let q = c - self.at;
+            lo = lo.max(self.lo.dot(q));
+            hi = hi.max(self.hi.dot(q));
+        }
+        lo < -self.margin || hi < -self.margin
+    }
+
+    /// [`SegmentWedge::misses`] for the box `lo..hi`.
+    #[inline]
+    pub fn misses_box(&self, lo: [f32; 3], hi: [f32; 3]) -> bool {
+        let c = Vec3f::new(lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]) * 0.5 - self.at;
+        let e = Vec3f::new(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) * 0.5;
+        let reach = |n: Vec3f| e.x * n.x.abs() + e.y * n.y.abs() + e.z * n.z.abs();
+        self.lo.dot(c) + reach(self.lo) < -self.margin || self.hi.dot(c) + reach(self.hi) < -self.margin
+    }
+}
+
 /// The lamp as seen from one receiver: the plane it is sampled in and the receiver's height
 /// above it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,6 +189,33 @@ pub fn lamp_frame(shape: LampShape, l: Vec3f, axis: Vec3f, size: f32, p: Vec3f) 
 }
 
 impl LampFrame {
+    /// For the segment lamp: whether every point of `pts` lies farther than `margin` on one side
+    /// of the plane through the receiver and the segment (normal `v`), the plane every sample's
+    /// ray lies in. Such a triangle or box hides no sample (its clipped projection misses the
+    /// row `y = 0` that [`occlude`] fills), so the traced resolve skips it before clipping
+    /// (hadou's own). `margin` covers the rounding of [`occlude`]'s clip and projection
+    /// ([`segment_plane_margin`]); `false` where unsure (NaN).
+    #[inline]
+    pub fn beside_segment_plane(&self, pts: &[Vec3f], margin: f32) -> bool {
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for &c in pts {
+            let d = self.v.dot(c - self.origin);
+            lo = lo.min(d);
+            hi = hi.max(d);
+        }
+        lo > margin || hi < -margin
+    }
+
+    /// [`LampFrame::beside_segment_plane`] for the box `lo..hi`: its centre's distance to the
+    /// plane beyond its half-extent's reach along `v` and `margin`.
+    #[inline]
+    pub fn box_beside_segment_plane(&self, lo: [f32; 3], hi: [f32; 3], margin: f32) -> bool {
+        let c = Vec3f::new(lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]) * 0.5;
+        let e = Vec3f::new(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) * 0.5;
+        let reach = e.x * self.v.x.abs() + e.y * self.v.y.abs() + e.z * self.v.z.abs();
+        (self.v.dot(c - self.origin)).abs() > reach + margin
+    }
+
     /// Whether anything inside the box `lo..hi` can hide a sample of the lamp (layout `pat`,
     /// first-row offset `o`) that `mask` does not hide yet: `false` when every corner lies beyond
     /// the lamp's plane, or when every corner lies between the planes and the bounding rectangle
@@ -635,6 +743,78 @@ mod tests {
             }
         }
         assert!(skipped > 300 && kept > 300, "{skipped} skipped, {kept} kept");
+    }
+
+    /// The segment's plane tests drop only what hides nothing: a triangle or box said to lie
+    /// beside the plane through the receiver and the segment, or outside a tile's wedge, sets no
+    /// sample in [`occlude`], for triangles anywhere and for triangles skimming the plane (within
+    /// a few margins of it, far from the world's origin too); and they do drop most triangles.
+    #[test]
+    fn what_the_segment_planes_drop_hides_nothing() {
+        let mut s = 0x5e6_3e47u32;
+        let mut r = move || {
+            s = hash32(s.wrapping_add(0x9e37_79b9));
+            (s >> 8) as f32 / 16_777_216.0
+        };
+        let (mut dropped, mut kept, mut wedge_dropped, mut box_dropped) = (0, 0, 0, 0);
+        for case in 0..6000 {
+            // Far from the origin in a third of the cases (coordinates of about 1000).
+            let shift = if case % 3 == 0 { Vec3f::new(1000.0, 20.0, -700.0) } else { Vec3f::ZERO };
+            let l = Vec3f::new(0.0, 4.0, 0.0) + shift;
+            let axis = Vec3f::new(r() - 0.5, 1.0, r() - 0.5).normalize_or(Vec3f::Y);
+            // A tile of receivers: a few points close together.
+            let base = Vec3f::new(r() * 4.0 - 2.0, r() * 0.5, r() * 4.0 - 2.0) + shift;
+            let tile: Vec<Vec3f> =
+                (0..4).map(|_| base + Vec3f::new(r() - 0.5, r() - 0.5, r() - 0.5) * 0.1).collect();
+            let extent = 1010.0;
+            let reach = tile.iter().flat_map(|p| [p.x, p.y, p.z]).fold(0.0f32, |m, v| m.max(v.abs()));
+            let margin = segment_plane_margin(Vec3f::splat(reach), extent);
+            let wedge = SegmentWedge::around(l, axis, &tile, margin);
+            let pat = LampPattern::new(LampShape::Segment, 256);
+            let c = Vec3f::new(r() * 2.0 - 1.0, 0.5 + r() * 3.0, r() * 2.0 - 1.0) + shift;
+            let mut tri = [0, 1, 2].map(|_| c + Vec3f::new(r() - 0.5, r() - 0.5, r() - 0.5) * 1.2);
+            for (k, &p) in tile.iter().enumerate() {
+                let Some(f) = lamp_frame(LampShape::Segment, l, axis, 0.6, p) else { continue };
+                let m = segment_plane_margin(p, extent);
+                if case % 2 == 1 && k == 0 {
+                    // Skim the plane: every corner a few margins from it, on one side.
+                    for v in &mut tri {
+                        let d = f.v.dot(*v - p);
+                        *v += f.v * (-d + m * (1.5 + 3.0 * r()));
+                    }
+                }
+                let o = pixel_offset(case as u32, k as u32);
+                let mut mask = [0u32; MASK_WORDS];
+                occlude(&f, &pat, o, &tri, &mut mask);
+                let hides = mask.iter().any(|&w| w != 0);
+                if f.beside_segment_plane(&tri, m) {
+                    dropped += 1;
+                    assert!(!hides, "case {case}: a triangle beside the plane hid a sample");
+                } else {
+                    kept += 1;
+                }
+                let (lo, hi) = (tri[0].min(tri[1]).min(tri[2]), tri[0].max(tri[1]).max(tri[2]));
+                if f.box_beside_segment_plane(lo.to_array(), hi.to_array(), m) {
+                    box_dropped += 1;
+                    assert!(!hides, "case {case}: a triangle in a box beside the plane hid a sample");
+                }
+                if let Some(wg) = wedge {
+                    if wg.misses(&tri) {
+                        wedge_dropped += 1;
+                        assert!(!hides, "case {case}: a triangle outside the wedge hid a sample");
+                    }
+                    if wg.misses_box(lo.to_array(), hi.to_array()) {
+                        assert!(!hides, "case {case}: a triangle in a box outside the wedge hid a sample");
+                    }
+                }
+            }
+        }
+        eprintln!("{dropped} dropped, {kept} kept, {wedge_dropped} outside wedges, {box_dropped} boxes");
+        assert!(dropped > 2 * kept / 3 && kept > 2000, "{dropped} dropped, {kept} kept");
+        assert!(
+            wedge_dropped > 2000 && box_dropped > 2000,
+            "{wedge_dropped} outside wedges, {box_dropped} boxes"
+        );
     }
 
     #[test]
