@@ -156,13 +156,22 @@ pub(crate) fn draw_opaque_into(
                     col.fill(frame.background);
                     return;
                 }
-                let mut zbuf = vec![f32::INFINITY; rows * w];
-                let mut tri_id = vec![u32::MAX; rows * w];
+                // The band's own buffers, kept by the thread from band to band and frame to frame
+                // (fresh ones, over a megabyte a band at 1024 wide, cost their pages' faults and
+                // clearing each time); taken out while in use, so a band the thread runs meanwhile
+                // gets fresh ones.
+                let mut scratch = BAND_SCRATCH.take();
+                let BandScratch { zbuf, tri_id, visible, best } = &mut scratch;
+                zbuf.clear();
+                zbuf.resize(rows * w, f32::INFINITY);
+                tri_id.clear();
+                tri_id.resize(rows * w, u32::MAX);
                 for ti in mine() {
-                    raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, &mut zbuf, &mut tri_id);
+                    raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
                 }
                 // The visible surface of every pixel.
-                let mut visible: Vec<Option<shading::Surface>> = vec![None; rows * w];
+                visible.clear();
+                visible.resize(rows * w, None);
                 for r in 0..rows {
                     for x in 0..w {
                         let i = r * w + x;
@@ -191,7 +200,8 @@ pub(crate) fn draw_opaque_into(
                     }
                 }
                 // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
-                let mut best = vec![NO_SHADOW; rows * w];
+                best.clear();
+                best.resize(rows * w, NO_SHADOW);
                 let receiver = |i: usize| {
                     let t = tris.get(tri_id[i] as usize)?;
                     (!t.hull).then_some(t.object)
@@ -239,8 +249,23 @@ pub(crate) fn draw_opaque_into(
                         }
                     }
                 }
+                BAND_SCRATCH.set(scratch);
             });
     }
+}
+
+/// A band's depth, triangle, visible-surface and shadow buffers ([`draw_opaque_into`]).
+#[derive(Default)]
+struct BandScratch {
+    zbuf: Vec<f32>,
+    tri_id: Vec<u32>,
+    visible: Vec<Option<shading::Surface>>,
+    best: Vec<crate::shadows::Choice>,
+}
+
+thread_local! {
+    /// Each thread's [`BandScratch`], kept from band to band.
+    static BAND_SCRATCH: std::cell::Cell<BandScratch> = std::cell::Cell::new(BandScratch::default());
 }
 
 /// The objects' triangles and then their outline hulls, projected by the camera.

@@ -131,6 +131,20 @@ pub fn traced_with(
     width: usize,
     samples: u32,
 ) -> Vec<f32> {
+    traced_where(bvh, light, points, width, samples, |_| true)
+}
+
+/// [`traced_with`] of the points `points[i]` for which `wanted(i)` holds, as if every other were
+/// `None` (0 there), without a copy of the points.
+fn traced_where(
+    bvh: &Bvh,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    width: usize,
+    samples: u32,
+    wanted: impl Fn(usize) -> bool + Sync,
+) -> Vec<f32> {
+    let point = |i: usize| if wanted(i) { points[i] } else { None };
     let w = width;
     let h = points.len().checked_div(w).unwrap_or(0);
     let lamp = Lamp::of(light);
@@ -156,7 +170,7 @@ pub fn traced_with(
             receivers.clear();
             for y in y0..y0 + rows {
                 for x in x0..x1 {
-                    if let Some(p) = points[y * w + x].filter(|p| lit_at_all(p.term)) {
+                    if let Some(p) = point(y * w + x).filter(|p| lit_at_all(p.term)) {
                         let r = receiver(p.world, p.normal, lamp.centre);
                         lo = lo.min(r);
                         hi = hi.max(r);
@@ -212,7 +226,7 @@ pub fn traced_with(
             }
             for y in y0..y0 + rows {
                 for x in x0..x1 {
-                    let Some(p) = points[y * w + x] else { continue };
+                    let Some(p) = point(y * w + x) else { continue };
                     let o = &mut band[(y - y0) * w + x];
                     if !lit_at_all(p.term) {
                         *o = 0.0;
@@ -313,9 +327,7 @@ pub fn traced_grid_counted(
         })
         .collect();
     let pixel_of = |j: usize| (j / width / k) * w + (j % width) / k;
-    let rest: Vec<Option<SoftPoint>> =
-        points.par_iter().enumerate().map(|(j, p)| if settled[pixel_of(j)] { None } else { *p }).collect();
-    let mut out = traced_with(bvh, light, &rest, width, samples);
+    let mut out = traced_where(bvh, light, points, width, samples, |j| !settled[pixel_of(j)]);
     out.par_iter_mut().zip(points).enumerate().for_each(|(j, (o, p))| {
         let i = pixel_of(j);
         if settled[i] {
