@@ -31,17 +31,23 @@ fn unit_dir(basis: &CameraBasis, frame: &Frame, x: usize, y: usize) -> Vec3f {
     d / d.length()
 }
 
-/// An edge pixel of an outlined object.
+/// An edge pixel of an outlined object, with what the pixels that take its outline read of it
+/// (copied, so that bands can write their own rows while others still read their edges).
 #[derive(Clone, Copy)]
 struct Edge {
     x: u32,
     /// Its reach in pixels, squared.
     reach2: f32,
     object: u32,
+    /// The material slot of its surface.
+    material: u32,
     distance: f32,
-    /// Index of its pixel in the buffers.
-    index: usize,
+    /// The unit ray through it.
+    dir: Vec3f,
 }
+
+/// Rows of the image one task of the edge pass decides.
+const EDGE_BAND: usize = 16;
 
 /// Runs the edge pass over `out`, which holds the rows from `first_row` on. Rows within
 /// [`frame_reach`]` + 1` of either end of the buffers (unless at the image's edge) see only part
@@ -75,8 +81,8 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 if code == 0 {
                     continue;
                 }
-                let z =
-                    surface[i].unwrap_or(0.0) * unit_dir(basis, frame, x, r + first_row).dot(basis.forward);
+                let dir = unit_dir(basis, frame, x, r + first_row);
+                let z = surface[i].unwrap_or(0.0) * dir.dot(basis.forward);
                 let px = hull_px(o, material, z);
                 let rp = reach_pixels(px, code);
                 if rp.is_nan() || rp <= 0.0 {
@@ -90,7 +96,7 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                     || (r + 1 < h && differs(i + w));
                 if on_edge {
                     let distance = surface[i].unwrap_or(0.0);
-                    row.push(Edge { x: x as u32, reach2: rp * rp, object: o, distance, index: i });
+                    row.push(Edge { x: x as u32, reach2: rp * rp, object: o, material, distance, dir });
                 }
             }
             row
@@ -99,93 +105,73 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     if edges.iter().all(|r| r.is_empty()) {
         return;
     }
-    // Each pixel's winning edge pixel, if any: row by row, only the pixels within the search
-    // window of some edge pixel searched (a difference array over the window's rows marks them).
-    // Per row of edge pixels, the one object they all belong to (`None`: several, or none): a
-    // pixel of that object skips the row, whose edges can only be its own.
-    let sole: Vec<Option<u32>> = edges
-        .iter()
-        .map(|row| {
-            let first = row.first()?.object;
-            row.iter().all(|e| e.object == first).then_some(first)
-        })
-        .collect();
-    let (surface_ro, edge_ro, edges_ro, sole) = (&*surface, &*edge, &edges, &sole);
-    let owner = &owner;
-    let wins: Vec<Option<usize>> = (0..h)
-        .into_par_iter()
-        .flat_map_iter(|r| {
-            let (surface, edge, edges) = (surface_ro, edge_ro, edges_ro);
-            let lo = r.saturating_sub(reach);
-            let hi = (r + reach + 1).min(h);
-            let mut near = vec![0i32; w + 1];
-            for row in &edges[lo..hi] {
-                for e in row {
-                    near[(e.x as usize).saturating_sub(reach)] += 1;
-                    near[(e.x as usize + reach + 1).min(w)] -= 1;
+    // Each pixel's winning edge pixel, if any, band by band: every edge pixel within the search
+    // window of the band's rows visits the pixels of its window in the band (a scatter: the
+    // window's pixels far outnumber the edge pixels that reach them), in row-major order, so that
+    // of equally near edge pixels the first in row-major order wins.
+    let edges = &edges;
+    color
+        .par_chunks_mut(EDGE_BAND * w)
+        .zip(surface.par_chunks(EDGE_BAND * w))
+        .zip(object.par_chunks_mut(EDGE_BAND * w))
+        .zip(shadow.par_chunks_mut(EDGE_BAND * w))
+        .zip(edge.par_chunks_mut(EDGE_BAND * w))
+        .enumerate()
+        .for_each(|(band, ((((color, surface), object), shadow), edge))| {
+            let y0 = band * EDGE_BAND;
+            let rows = surface.len() / w;
+            let owner = |i: usize| match (surface[i], edge[i].hull) {
+                (Some(_), false) => object[i],
+                _ => None,
+            };
+            // Per pixel: the winning edge's eye distance and (row, index in its row).
+            let mut best: Vec<Option<(f32, u32, u32)>> = vec![None; rows * w];
+            let mut any = false;
+            for (rr, row) in edges.iter().enumerate().take(y0 + rows + reach).skip(y0.saturating_sub(reach)) {
+                // The band's rows within the window of the edge pixels of row `rr`.
+                let r_lo = rr.saturating_sub(reach).max(y0);
+                let r_hi = (rr + reach + 1).min(y0 + rows);
+                for (k, e) in row.iter().enumerate() {
+                    let ex = e.x as usize;
+                    let (x_lo, x_hi) = (ex.saturating_sub(reach), (ex + reach + 1).min(w));
+                    for r in r_lo..r_hi {
+                        let dy = r as f32 - rr as f32;
+                        for x in x_lo..x_hi {
+                            let dx = x as f32 - ex as f32;
+                            if dx * dx + dy * dy > e.reach2 {
+                                continue;
+                            }
+                            let i = (r - y0) * w + x;
+                            let Some(b) = owner(i) else { continue };
+                            if b == e.object || best[i].is_some_and(|(d, _, _)| e.distance >= d) {
+                                continue;
+                            }
+                            let p_dir = unit_dir(basis, frame, x, first_row + r);
+                            let p_dist = surface[i].unwrap_or(0.0);
+                            if in_front(edge[i].normal, p_dir, p_dist, e.dir, e.distance) {
+                                best[i] = Some((e.distance, rr as u32, k as u32));
+                                any = true;
+                            }
+                        }
+                    }
                 }
             }
-            let mut count = 0;
-            let near: Vec<bool> = near[..w]
-                .iter()
-                .map(|d| {
-                    count += d;
-                    count > 0
-                })
-                .collect();
-            (0..w).map(move |x| {
-                let i = r * w + x;
-                if !near[x] {
-                    return None;
+            if !any {
+                return;
+            }
+            for (i, win) in best.into_iter().enumerate() {
+                let Some((_, rr, k)) = win else { continue };
+                let e = &edges[rr as usize][k as usize];
+                let mat = frame.objects[e.object as usize].material(e.material);
+                if mat.outline.is_some() {
+                    color[i] = mat.outline_rgb(&frame.light);
+                    shadow[i] = None;
+                    // The pixel now shows that object's outline, as a hull pixel of it would (the
+                    // GPU's edge pass writes its material word | HULL_BIT): what the probe names
+                    // and what the anti-aliased resolve compares.
+                    object[i] = Some(e.object);
+                    edge[i] = EdgeTexel { material: e.material, hull: true, reach: 0, ..edge[i] };
                 }
-                let b = owner(i)?;
-                let y = first_row + r;
-                let p_dir = unit_dir(basis, frame, x, y);
-                let p_dist = surface[i].unwrap_or(0.0);
-                let p_normal = edge[i].normal;
-                let mut best: Option<(f32, usize)> = None;
-                for (rr, row) in edges.iter().enumerate().take(hi).skip(lo) {
-                    if sole[rr] == Some(b) {
-                        continue;
-                    }
-                    let dy = rr as f32 - r as f32;
-                    let start = row.partition_point(|e| (e.x as usize) + reach < x);
-                    for e in &row[start..] {
-                        if e.x as usize > x + reach {
-                            break;
-                        }
-                        if e.object == b {
-                            continue;
-                        }
-                        let dx = e.x as f32 - x as f32;
-                        if dx * dx + dy * dy > e.reach2 {
-                            continue;
-                        }
-                        if best.is_some_and(|(d, _)| e.distance >= d) {
-                            continue;
-                        }
-                        let q_dir = unit_dir(basis, frame, e.x as usize, first_row + rr);
-                        if in_front(p_normal, p_dir, p_dist, q_dir, e.distance) {
-                            best = Some((e.distance, e.index));
-                        }
-                    }
-                }
-                best.map(|(_, q)| q)
-            })
-        })
-        .collect();
-    for (i, win) in wins.into_iter().enumerate() {
-        let Some(q) = win else { continue };
-        let (Some(o), m) = (object[q], edge[q].material) else { continue };
-        let mat = frame.objects[o as usize].material(m);
-        if mat.outline.is_some() {
-            color[i] = mat.outline_rgb(&frame.light);
-            shadow[i] = None;
-            // The pixel now shows that object's outline, as a hull pixel of it would (the GPU's
-            // edge pass writes its material word | HULL_BIT): what the probe names and what
-            // the anti-aliased resolve compares.
-            object[i] = Some(o);
-            edge[i] = EdgeTexel { material: m, hull: true, reach: 0, ..edge[i] };
-        }
-    }
+            }
+        });
 }
