@@ -28,4 +28,7 @@ mod waves;
 mod winding;
 
 pub use probe::{probe, Probe, WaveProbe};
-pub use render::{render, render_rows, render_rows_glare_chunked, render_timed, CpuBackend, PassTimes};
+pub use render::{
+    render, render_every_sample_shaded, render_rows, render_rows_glare_chunked, render_timed, CpuBackend,
+    PassTimes,
+};

@@ -52,7 +52,42 @@ pub(crate) struct OpaqueBuffers {
     pub glare_linear: Vec<[f32; 3]>,
     /// The glare's planes, kept from frame to frame (not the opaque pass's).
     pub glare_planes: hadou_math::bloom::PlanePool,
+    /// With `k × k` samples a pixel: what shading once per pixel and surface keeps between the
+    /// bands and the refinement ([`ShadedOnce`]); empty otherwise.
+    pub once: ShadedOnce,
 }
+
+/// Anti-aliasing at the price of multisampling (issue 44): where all `k × k` samples of a pixel
+/// show one triangle (not an outline hull), the surface is shaded once, at the pixel's centre,
+/// and every sample takes that colour (its own hard shadow, soft-shadow term, depth and edge data
+/// stay per sample); coverage and depth stay per sample. Where the shading changes across the
+/// pixel — a toon band's, a texture's or a wave light's edge — the centre colour differs from a
+/// neighbouring pixel's of the same object and material by more than [`ONCE_CONTRAST`], and the
+/// pixel is shaded sample by sample after all ([`refine`]), as every pixel was before. The
+/// decision reads only pixels whose samples are drawn exactly as in the whole frame, so bands
+/// still equal the whole frame bit for bit.
+#[derive(Default)]
+pub(crate) struct ShadedOnce {
+    /// Per pixel of the drawn rows: the shaded colour at its centre where its samples share one
+    /// triangle (before the hard shadows), NaN elsewhere.
+    centre: Vec<[f32; 3]>,
+    /// Per pixel: that triangle (`u32::MAX`: none).
+    tri: Vec<u32>,
+    /// Per sample: the plane shadows' choice (for the samples a refinement shades again).
+    best: Vec<crate::shadows::Choice>,
+    /// Shade every sample instead (the tests' reference).
+    pub every_sample: bool,
+}
+
+/// A band's share of [`ShadedOnce`]: its pixels' centre colours and triangles, its samples'
+/// plane-shadow choices.
+type OnceBand<'a> = (&'a mut [[f32; 3]], &'a mut [u32], &'a mut [crate::shadows::Choice]);
+
+/// The largest difference between the centre colours of neighbouring pixels of one object and
+/// material (per channel, of the square roots of the linear values: about sRGB's steps) that
+/// still counts as smooth shading ([`ShadedOnce`]): below it the pixel keeps its one shade, whose
+/// box-filtered mean over the samples it then differs from by at most about half this step.
+pub(crate) const ONCE_CONTRAST: f32 = 1.0 / 255.0;
 
 /// A drawn pixel as the edge pass reads it (the GPU's G-buffer holds the same).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -78,15 +113,18 @@ pub(crate) struct EdgeTexel {
 /// whose map shadows it.
 pub(crate) fn draw_opaque(frame: &Frame, setup: &FrameSetup, rows: std::ops::Range<usize>) -> OpaqueBuffers {
     let mut out = OpaqueBuffers::default();
-    draw_opaque_into(frame, setup, rows, &mut out);
+    draw_opaque_into(frame, setup, 1, rows, &mut out);
     out
 }
 
 /// [`draw_opaque`] into `out`, reusing its buffers' allocations from an earlier frame. Bands of
 /// rows that no triangle or shadow touches are filled with the background without further work.
+/// `frame` is a sample frame of `grid × grid` samples a pixel (1: none); with 2 or 4, and `rows`
+/// on whole pixels, surfaces are shaded once per pixel where they can be ([`ShadedOnce`]).
 pub(crate) fn draw_opaque_into(
     frame: &Frame,
     setup: &FrameSetup,
+    grid: usize,
     rows: std::ops::Range<usize>,
     out: &mut OpaqueBuffers,
 ) {
@@ -97,7 +135,14 @@ pub(crate) fn draw_opaque_into(
     let far = frame.camera.far;
     let bands = Bands::new(&tris, frame.height as usize, &rows);
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
-    let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge, .. } = out;
+    let k = grid.max(1);
+    let once = k > 1
+        && !out.once.every_sample
+        && BAND.is_multiple_of(k)
+        && rows.start.is_multiple_of(k)
+        && rows.len().is_multiple_of(k)
+        && (frame.width as usize).is_multiple_of(k);
+    let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge, once: kept, .. } = out;
     // Sized only: every band clears its own rows below, the bands in parallel (a frame of waves
     // alone pays for these writes, some 50 bytes a pixel, on every thread rather than one).
     color.resize(w * h, [0.0f32; 3]);
@@ -111,6 +156,23 @@ pub(crate) fn draw_opaque_into(
     if w * h == 0 {
         return;
     }
+    // Without shading once every band gets empty slices.
+    let (centre, once_tri, once_best) = (&mut kept.centre, &mut kept.tri, &mut kept.best);
+    let pixels = if once { w * h / (k * k) } else { 0 };
+    centre.resize(pixels, [0.0; 3]);
+    once_tri.resize(pixels, u32::MAX);
+    once_best.resize(if once { w * h } else { 0 }, NO_SHADOW);
+    let band_pixels = BAND * w / (k * k);
+    let mut once_chunks: Vec<OnceBand<'_>> = if once {
+        centre
+            .chunks_mut(band_pixels)
+            .zip(once_tri.chunks_mut(band_pixels))
+            .zip(once_best.chunks_mut(BAND * w))
+            .map(|((a, b), c)| (a, b, c))
+            .collect()
+    } else {
+        (0..h.div_ceil(BAND)).map(|_| Default::default()).collect()
+    };
     // Without an area light every band gets an empty slice.
     let mut soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
         soft.chunks_mut(BAND * w).collect()
@@ -126,12 +188,13 @@ pub(crate) fn draw_opaque_into(
         .zip(object.chunks_mut(batch_px))
         .zip(shadow.chunks_mut(batch_px))
         .zip(edge.chunks_mut(batch_px));
-    for (k, ((((color, surface), object), shadow), edge)) in batches.enumerate() {
-        let first = k * BATCH;
+    for (n, ((((color, surface), object), shadow), edge)) in batches.enumerate() {
+        let first = n * BATCH;
         let count = color.len().div_ceil(BAND * w);
         let list = bands.batch(first, count);
         let shadow_list = shadow_bands.batch(first, count);
         let soft_batch: Vec<&mut [Option<SoftPoint>]> = soft_chunks.drain(..count).collect();
+        let once_batch: Vec<_> = once_chunks.drain(..count).collect();
         color
             .par_chunks_mut(BAND * w)
             .zip(surface.par_chunks_mut(BAND * w))
@@ -139,8 +202,9 @@ pub(crate) fn draw_opaque_into(
             .zip(shadow.par_chunks_mut(BAND * w))
             .zip(edge.par_chunks_mut(BAND * w))
             .zip(soft_batch.into_par_iter())
+            .zip(once_batch.into_par_iter())
             .enumerate()
-            .for_each(|(j, (((((col, surf), obj), shad), edg), soft))| {
+            .for_each(|(j, ((((((col, surf), obj), shad), edg), soft), (centre, once_tri, once_best)))| {
                 let b = first + j;
                 let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
                 let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
@@ -151,6 +215,8 @@ pub(crate) fn draw_opaque_into(
                 shad.fill(None);
                 edg.fill(EdgeTexel::default());
                 soft.fill(None);
+                centre.fill([f32::NAN; 3]);
+                once_tri.fill(u32::MAX);
                 if mine().next().is_none() && mine_shadows().next().is_none() {
                     // Nothing drawn here.
                     col.fill(frame.background);
@@ -222,6 +288,30 @@ pub(crate) fn draw_opaque_into(
                         );
                     });
                 }
+                if once {
+                    // Each pixel whose samples share one triangle, shaded once at its centre.
+                    let (pw, ph) = (w / k, rows / k);
+                    for py in 0..ph {
+                        for px in 0..pw {
+                            let i0 = py * k * w + px * k;
+                            let t0 = tri_id[i0];
+                            let shared = t0 != u32::MAX
+                                && !tris[t0 as usize].hull
+                                && (0..k)
+                                    .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
+                            if shared {
+                                let t = &tris[t0 as usize];
+                                let material = frame.objects[t.object as usize].material(t.material);
+                                let half = k as f32 / 2.0;
+                                let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
+                                let (s, _) = interpolate(t, cx, cy);
+                                centre[py * pw + px] = shading::shade(frame, lights, material, &s);
+                                once_tri[py * pw + px] = t0;
+                            }
+                        }
+                    }
+                    once_best.copy_from_slice(best);
+                }
                 for r in 0..rows {
                     for x in 0..w {
                         let i = r * w + x;
@@ -231,7 +321,9 @@ pub(crate) fn draw_opaque_into(
                         };
                         let t = &tris[tri_id[i] as usize];
                         let material = frame.objects[t.object as usize].material(t.material);
+                        let p = (r / k) * (w / k) + x / k;
                         let c = match (t.hull, material.outline) {
+                            _ if once && once_tri[p] != u32::MAX => centre[p],
                             (true, Some(_)) => material.outline_rgb(&frame.light),
                             _ => shading::shade(frame, lights, material, s),
                         };
@@ -252,6 +344,63 @@ pub(crate) fn draw_opaque_into(
                 BAND_SCRATCH.set(scratch);
             });
     }
+    if once {
+        refine(frame, setup, &tris, k, rows.start, color, shadow, kept);
+    }
+}
+
+/// Shades sample by sample the pixels of [`ShadedOnce`] whose centre colour differs from a
+/// neighbouring pixel's of the same object and material by more than [`ONCE_CONTRAST`] (in
+/// either direction, so both sides of a band's edge), exactly as the samples of any other pixel
+/// are shaded. `color` and `shadow` hold the drawn sample rows from `y0`.
+#[allow(clippy::too_many_arguments)]
+fn refine(
+    frame: &Frame,
+    setup: &FrameSetup,
+    tris: &Tris,
+    k: usize,
+    y0: usize,
+    color: &mut [[f32; 3]],
+    shadow: &mut [Option<u32>],
+    kept: &ShadedOnce,
+) {
+    let w = frame.width as usize;
+    let (pw, ph) = (w / k, color.len() / (w * k));
+    let ShadedOnce { centre, tri, best, .. } = kept;
+    let key = |p: usize| tris.get(tri[p] as usize).map(|t| (t.object, t.material));
+    let rough = |a: [f32; 3], b: [f32; 3]| {
+        (0..3).any(|c| (a[c].max(0.0).sqrt() - b[c].max(0.0).sqrt()).abs() > ONCE_CONTRAST)
+    };
+    color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).enumerate().for_each(
+        |(py, (col, shad))| {
+            for px in 0..pw {
+                let p = py * pw + px;
+                let Some(me) = key(p) else { continue };
+                let mut edge = false;
+                for qy in py.saturating_sub(1)..(py + 2).min(ph) {
+                    for qx in px.saturating_sub(1)..(px + 2).min(pw) {
+                        let q = qy * pw + qx;
+                        edge |= q != p && key(q) == Some(me) && rough(centre[p], centre[q]);
+                    }
+                }
+                if !edge {
+                    continue;
+                }
+                let t = &tris[tri[p] as usize];
+                let material = frame.objects[t.object as usize].material(t.material);
+                for j in 0..k {
+                    let sy = y0 + py * k + j;
+                    for x in px * k..px * k + k {
+                        let i = j * w + x;
+                        let (s, _) = interpolate(t, x as f32 + 0.5, sy as f32 + 0.5);
+                        let c = shading::shade(frame, &setup.lights, material, &s);
+                        (col[i], shad[i]) =
+                            setup.shadows.resolve(frame, t.object, s.world, best[(py * k + j) * w + x], c);
+                    }
+                }
+            }
+        },
+    );
 }
 
 /// A band's depth, triangle, visible-surface and shadow buffers ([`draw_opaque_into`]).

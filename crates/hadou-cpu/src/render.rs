@@ -178,6 +178,20 @@ pub fn render_rows_glare_chunked(frame: &Frame, rows: std::ops::Range<u32>, chun
     img
 }
 
+/// Renders `frame` with every sample of every pixel shaded (the anti-aliased frame as it was
+/// before surfaces were shaded once per pixel, [`crate::opaque::ShadedOnce`]), for the tests that
+/// hold the two to a tolerance.
+#[doc(hidden)]
+pub fn render_every_sample_shaded(frame: &Frame) -> Image {
+    let mut img = Image::new(frame.width, frame.height);
+    let mut scratch = OpaqueBuffers::default();
+    scratch.once.every_sample = true;
+    let times =
+        render_with(frame, 0..frame.height, &mut scratch, Target::Float(&mut img), SimdPath::current());
+    expect_memory(times);
+    img
+}
+
 /// [`render_with`], a `[bloom]`'s opaque pass in chunks of `chunk_samples` samples.
 fn render_chunked(
     frame: &Frame,
@@ -602,14 +616,16 @@ pub(crate) fn opaque_pass(
     let Some(light) = &frame.area_light else {
         let margin = edges::frame_reach(frame) as usize + 1;
         let h = frame.height as usize;
+        // On whole pixels (multiples of `k` samples), for shading once per pixel.
+        let margin = margin.next_multiple_of(k);
         let drawn =
             rows.start.saturating_sub(margin).min(rows.start)..(rows.end + margin).min(h).max(rows.end);
         let y0 = drawn.start;
-        draw_opaque_into(frame, setup, drawn, opaque);
+        draw_opaque_into(frame, setup, k, drawn, opaque);
         edges::close_outlines(frame, &setup.basis, y0, opaque);
         return y0;
     };
-    draw_opaque_into(frame, setup, 0..frame.height as usize, opaque);
+    draw_opaque_into(frame, setup, k, 0..frame.height as usize, opaque);
     let input = soft::SoftInput {
         width: frame.width as usize,
         height: frame.height as usize,

@@ -1,8 +1,10 @@
 //! Anti-aliasing (`[image] samples`, `Frame::grid`, `Frame::sample_frame`): each pixel is the
 //! box-filtered mean of a `k × k` grid of samples of its surfaces; the waves are integrated once
-//! per pixel wherever its samples show one surface; bands of rows are the whole frame's rows.
+//! per pixel wherever its samples show one surface; bands of rows are the whole frame's rows; a
+//! surface is shaded once per pixel where its shading is smooth across it, and the picture stays
+//! within issue 44's tolerance of every sample shaded.
 
-use hadou_cpu::{render, render_rows};
+use hadou_cpu::{render, render_every_sample_shaded, render_rows};
 use hadou_math::energy::{CapsuleField, Falloff};
 use hadou_math::toon::{Ramp, RampKind};
 use hadou_math::{Mat4, Vec3, Vec3f};
@@ -169,4 +171,42 @@ fn the_grid_follows_the_samples_and_the_soft_shadow_limit() {
     assert_eq!(Frame { samples: 16, ..f.clone() }.sample_grid().edge(), 4);
     // A count that is not a square (only code can set one) draws one sample.
     assert_eq!(Frame { samples: 2, ..f.clone() }.sample_grid().edge(), 1);
+}
+
+/// The 8-bit codes of `img` (mapped colour in `[0, 1]`).
+fn bytes(img: &Image) -> Vec<i32> {
+    img.color.iter().flat_map(|c| c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as i32)).collect()
+}
+
+/// Issue 44, point 1: shading a surface once per pixel where it is smooth across the pixel (and
+/// sample by sample where a band's, a texture's or a wave light's edge crosses it) keeps every
+/// example scene, at 4 and 16 samples, within the issue's tolerance of the frame with every
+/// sample shaded: mean absolute difference ≤ 1 and 99.9th percentile ≤ 8 on 8-bit codes.
+#[test]
+fn shading_once_per_pixel_stays_within_tolerance_of_every_sample_shaded() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut paths: Vec<_> = std::fs::read_dir(dir)
+        .expect("scenes/")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    paths.sort();
+    let mut differing = 0;
+    for path in &paths {
+        let scene = hadou_scene::Scene::load(path).unwrap_or_else(|e| panic!("{e}"));
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        for samples in [4, 16] {
+            let mut frame = scene.at(scene.duration() * 0.6);
+            (frame.width, frame.height, frame.samples) = (160, 120, samples);
+            let (once, every) = (bytes(&render(&frame)), bytes(&render_every_sample_shaded(&frame)));
+            let mut d: Vec<i32> = once.iter().zip(&every).map(|(a, b)| (a - b).abs()).collect();
+            let mean = d.iter().sum::<i32>() as f64 / d.len() as f64;
+            d.sort_unstable();
+            let p999 = d[(d.len() - 1) * 999 / 1000];
+            differing += usize::from(d[d.len() - 1] > 0);
+            assert!(mean <= 1.0 && p999 <= 8, "{name}, {samples} samples: mean {mean:.3}, p99.9 {p999}");
+        }
+    }
+    // The rule is in force: some scene's pixels are shaded once (and so differ in their last bits).
+    assert!(differing > 0, "no scene changed: the frames were all shaded sample by sample");
 }
