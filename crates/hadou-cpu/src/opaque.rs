@@ -75,6 +75,9 @@ pub(crate) struct ShadedOnce {
     tri: Vec<u32>,
     /// Per sample: the plane shadows' choice (for the samples a refinement shades again).
     best: Vec<crate::shadows::Choice>,
+    /// Per pixel, for the refinement's comparisons: the square roots of the centre colour and the
+    /// object and material slot (`u64::MAX`: not shaded once).
+    probe: Vec<([f32; 3], u64)>,
     /// Shade every sample instead (the tests' reference).
     pub every_sample: bool,
 }
@@ -362,25 +365,32 @@ fn refine(
     y0: usize,
     color: &mut [[f32; 3]],
     shadow: &mut [Option<u32>],
-    kept: &ShadedOnce,
+    kept: &mut ShadedOnce,
 ) {
     let w = frame.width as usize;
     let (pw, ph) = (w / k, color.len() / (w * k));
-    let ShadedOnce { centre, tri, best, .. } = kept;
-    let key = |p: usize| tris.get(tri[p] as usize).map(|t| (t.object, t.material));
-    let rough = |a: [f32; 3], b: [f32; 3]| {
-        (0..3).any(|c| (a[c].max(0.0).sqrt() - b[c].max(0.0).sqrt()).abs() > ONCE_CONTRAST)
-    };
+    let ShadedOnce { centre, tri, best, probe, .. } = kept;
+    probe.clear();
+    probe.resize(centre.len(), ([0.0; 3], u64::MAX));
+    probe.par_iter_mut().zip(&*centre).zip(&*tri).for_each(|((p, c), &t)| {
+        if let Some(t) = tris.get(t as usize) {
+            *p = (c.map(|v| v.max(0.0).sqrt()), (u64::from(t.object) << 32) | u64::from(t.material));
+        }
+    });
+    let (probe, tri, best) = (&*probe, &*tri, &*best);
     color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).enumerate().for_each(
         |(py, (col, shad))| {
             for px in 0..pw {
                 let p = py * pw + px;
-                let Some(me) = key(p) else { continue };
+                let (a, me) = probe[p];
+                if me == u64::MAX {
+                    continue;
+                }
                 let mut edge = false;
                 for qy in py.saturating_sub(1)..(py + 2).min(ph) {
-                    for qx in px.saturating_sub(1)..(px + 2).min(pw) {
-                        let q = qy * pw + qx;
-                        edge |= q != p && key(q) == Some(me) && rough(centre[p], centre[q]);
+                    for (b, key) in &probe[qy * pw + px.saturating_sub(1)..qy * pw + (px + 2).min(pw)] {
+                        // (The pixel itself differs from itself by nothing.)
+                        edge |= *key == me && (0..3).any(|c| (a[c] - b[c]).abs() > ONCE_CONTRAST);
                     }
                 }
                 if !edge {
