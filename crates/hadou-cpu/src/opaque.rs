@@ -75,16 +75,19 @@ pub(crate) struct ShadedOnce {
     tri: Vec<u32>,
     /// Per sample: the plane shadows' choice (for the samples a refinement shades again).
     best: Vec<crate::shadows::Choice>,
-    /// Per pixel, for the refinement's comparisons: the square roots of the centre colour and the
-    /// object and material slot (`u64::MAX`: not shaded once).
-    probe: Vec<([f32; 3], u64)>,
+    /// Per pixel, for the refinement's comparisons ([`Probe`]).
+    probe: Vec<Probe>,
     /// Shade every sample instead (the tests' reference).
     pub every_sample: bool,
 }
 
 /// A band's share of [`ShadedOnce`]: its pixels' centre colours and triangles, its samples'
 /// plane-shadow choices.
-type OnceBand<'a> = (&'a mut [[f32; 3]], &'a mut [u32], &'a mut [crate::shadows::Choice]);
+type OnceBand<'a> = (&'a mut [[f32; 3]], &'a mut [u32], &'a mut [crate::shadows::Choice], &'a mut [Probe]);
+
+/// A pixel as the refinement compares it with its neighbours: the square roots of its centre
+/// colour, and its object and material slot (`u64::MAX`: not shaded once).
+type Probe = ([f32; 3], u64);
 
 /// The largest difference between the centre colours of neighbouring pixels of one object and
 /// material (per channel, of the square roots of the linear values: about sRGB's steps) that
@@ -160,18 +163,21 @@ pub(crate) fn draw_opaque_into(
         return;
     }
     // Without shading once every band gets empty slices.
-    let (centre, once_tri, once_best) = (&mut kept.centre, &mut kept.tri, &mut kept.best);
+    let (centre, once_tri, once_best, probe) =
+        (&mut kept.centre, &mut kept.tri, &mut kept.best, &mut kept.probe);
     let pixels = if once { w * h / (k * k) } else { 0 };
     centre.resize(pixels, [0.0; 3]);
     once_tri.resize(pixels, u32::MAX);
     once_best.resize(if once { w * h } else { 0 }, NO_SHADOW);
+    probe.resize(pixels, ([0.0; 3], u64::MAX));
     let band_pixels = BAND * w / (k * k);
     let mut once_chunks: Vec<OnceBand<'_>> = if once {
         centre
             .chunks_mut(band_pixels)
             .zip(once_tri.chunks_mut(band_pixels))
             .zip(once_best.chunks_mut(BAND * w))
-            .map(|((a, b), c)| (a, b, c))
+            .zip(probe.chunks_mut(band_pixels))
+            .map(|(((a, b), c), d)| (a, b, c, d))
             .collect()
     } else {
         (0..h.div_ceil(BAND)).map(|_| Default::default()).collect()
@@ -207,145 +213,153 @@ pub(crate) fn draw_opaque_into(
             .zip(soft_batch.into_par_iter())
             .zip(once_batch.into_par_iter())
             .enumerate()
-            .for_each(|(j, ((((((col, surf), obj), shad), edg), soft), (centre, once_tri, once_best)))| {
-                let b = first + j;
-                let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
-                let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
-                let y_start = rows.start + b * BAND;
-                let rows = col.len() / w;
-                surf.fill(None);
-                obj.fill(None);
-                shad.fill(None);
-                edg.fill(EdgeTexel::default());
-                soft.fill(None);
-                centre.fill([f32::NAN; 3]);
-                once_tri.fill(u32::MAX);
-                if mine().next().is_none() && mine_shadows().next().is_none() {
-                    // Nothing drawn here.
-                    col.fill(frame.background);
-                    return;
-                }
-                // The band's own buffers, kept by the thread from band to band and frame to frame
-                // (fresh ones, over a megabyte a band at 1024 wide, cost their pages' faults and
-                // clearing each time); taken out while in use, so a band the thread runs meanwhile
-                // gets fresh ones.
-                let mut scratch = BAND_SCRATCH.take();
-                let BandScratch { zbuf, tri_id, visible, best } = &mut scratch;
-                zbuf.clear();
-                zbuf.resize(rows * w, f32::INFINITY);
-                tri_id.clear();
-                tri_id.resize(rows * w, u32::MAX);
-                for ti in mine() {
-                    raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
-                }
-                // The visible surface of every pixel.
-                visible.clear();
-                visible.resize(rows * w, None);
-                for r in 0..rows {
-                    for x in 0..w {
-                        let i = r * w + x;
-                        if tri_id[i] == u32::MAX {
-                            continue;
-                        }
-                        let py = (y_start + r) as f32;
-                        let t = &tris[tri_id[i] as usize];
-                        let (s, outline_dir) = interpolate(t, x as f32 + 0.5, py + 0.5);
-                        let d = (s.world - basis.eye).length();
-                        surf[i] = Some(if d.is_finite() { d } else { 0.0 });
-                        obj[i] = Some(t.object);
-                        let outlined = !t.hull
-                            && frame.objects[t.object as usize]
-                                .material(t.material)
-                                .outline
-                                .is_some_and(|o| o.width > 0.0);
-                        let reach = if outlined {
-                            let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
-                            outline::reach_code(outline_dir, dir)
-                        } else {
-                            0
-                        };
-                        edg[i] = EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
-                        visible[i] = Some(s);
+            .for_each(
+                |(j, ((((((col, surf), obj), shad), edg), soft), (centre, once_tri, once_best, probe)))| {
+                    let b = first + j;
+                    let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
+                    let mine_shadows =
+                        || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
+                    let y_start = rows.start + b * BAND;
+                    let rows = col.len() / w;
+                    surf.fill(None);
+                    obj.fill(None);
+                    shad.fill(None);
+                    edg.fill(EdgeTexel::default());
+                    soft.fill(None);
+                    centre.fill([f32::NAN; 3]);
+                    once_tri.fill(u32::MAX);
+                    probe.fill(([0.0; 3], u64::MAX));
+                    if mine().next().is_none() && mine_shadows().next().is_none() {
+                        // Nothing drawn here.
+                        col.fill(frame.background);
+                        return;
                     }
-                }
-                // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
-                best.clear();
-                best.resize(rows * w, NO_SHADOW);
-                let receiver = |i: usize| {
-                    let t = tris.get(tri_id[i] as usize)?;
-                    (!t.hull).then_some(t.object)
-                };
-                for si in mine_shadows() {
-                    let st = &shadow_tris[si as usize];
-                    cover(st, y_start, rows, w, |i, bary| {
-                        let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
-                        let t = perspective(st, bary, |k| st.uv[k][0]);
-                        shadows.plane_candidate(
-                            frame,
-                            st.object,
-                            o,
-                            t,
-                            s.world,
-                            surf[i].unwrap_or(0.0),
-                            &mut best[i],
-                        );
-                    });
-                }
-                if once {
-                    // Each pixel whose samples share one triangle, shaded once at its centre.
-                    let (pw, ph) = (w / k, rows / k);
-                    for py in 0..ph {
-                        for px in 0..pw {
-                            let i0 = py * k * w + px * k;
-                            let t0 = tri_id[i0];
-                            let shared = t0 != u32::MAX
-                                && !tris[t0 as usize].hull
-                                && (0..k)
-                                    .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
-                            if shared {
-                                let t = &tris[t0 as usize];
-                                let material = frame.objects[t.object as usize].material(t.material);
-                                let half = k as f32 / 2.0;
-                                let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
-                                let (s, _) = interpolate(t, cx, cy);
-                                centre[py * pw + px] = shading::shade(frame, lights, material, &s);
-                                once_tri[py * pw + px] = t0;
+                    // The band's own buffers, kept by the thread from band to band and frame to frame
+                    // (fresh ones, over a megabyte a band at 1024 wide, cost their pages' faults and
+                    // clearing each time); taken out while in use, so a band the thread runs meanwhile
+                    // gets fresh ones.
+                    let mut scratch = BAND_SCRATCH.take();
+                    let BandScratch { zbuf, tri_id, visible, best } = &mut scratch;
+                    zbuf.clear();
+                    zbuf.resize(rows * w, f32::INFINITY);
+                    tri_id.clear();
+                    tri_id.resize(rows * w, u32::MAX);
+                    for ti in mine() {
+                        raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
+                    }
+                    // The visible surface of every pixel.
+                    visible.clear();
+                    visible.resize(rows * w, None);
+                    for r in 0..rows {
+                        for x in 0..w {
+                            let i = r * w + x;
+                            if tri_id[i] == u32::MAX {
+                                continue;
+                            }
+                            let py = (y_start + r) as f32;
+                            let t = &tris[tri_id[i] as usize];
+                            let (s, outline_dir) = interpolate(t, x as f32 + 0.5, py + 0.5);
+                            let d = (s.world - basis.eye).length();
+                            surf[i] = Some(if d.is_finite() { d } else { 0.0 });
+                            obj[i] = Some(t.object);
+                            let outlined = !t.hull
+                                && frame.objects[t.object as usize]
+                                    .material(t.material)
+                                    .outline
+                                    .is_some_and(|o| o.width > 0.0);
+                            let reach = if outlined {
+                                let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
+                                outline::reach_code(outline_dir, dir)
+                            } else {
+                                0
+                            };
+                            edg[i] =
+                                EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
+                            visible[i] = Some(s);
+                        }
+                    }
+                    // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
+                    best.clear();
+                    best.resize(rows * w, NO_SHADOW);
+                    let receiver = |i: usize| {
+                        let t = tris.get(tri_id[i] as usize)?;
+                        (!t.hull).then_some(t.object)
+                    };
+                    for si in mine_shadows() {
+                        let st = &shadow_tris[si as usize];
+                        cover(st, y_start, rows, w, |i, bary| {
+                            let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
+                            let t = perspective(st, bary, |k| st.uv[k][0]);
+                            shadows.plane_candidate(
+                                frame,
+                                st.object,
+                                o,
+                                t,
+                                s.world,
+                                surf[i].unwrap_or(0.0),
+                                &mut best[i],
+                            );
+                        });
+                    }
+                    if once {
+                        // Each pixel whose samples share one triangle, shaded once at its centre.
+                        let (pw, ph) = (w / k, rows / k);
+                        for py in 0..ph {
+                            for px in 0..pw {
+                                let i0 = py * k * w + px * k;
+                                let t0 = tri_id[i0];
+                                let shared = t0 != u32::MAX
+                                    && !tris[t0 as usize].hull
+                                    && (0..k)
+                                        .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
+                                if shared {
+                                    let t = &tris[t0 as usize];
+                                    let material = frame.objects[t.object as usize].material(t.material);
+                                    let half = k as f32 / 2.0;
+                                    let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
+                                    let (s, _) = interpolate(t, cx, cy);
+                                    let c = shading::shade(frame, lights, material, &s);
+                                    centre[py * pw + px] = c;
+                                    once_tri[py * pw + px] = t0;
+                                    let key = (u64::from(t.object) << 32) | u64::from(t.material);
+                                    probe[py * pw + px] = (c.map(|v| v.max(0.0).sqrt()), key);
+                                }
+                            }
+                        }
+                        once_best.copy_from_slice(best);
+                    }
+                    for r in 0..rows {
+                        for x in 0..w {
+                            let i = r * w + x;
+                            let Some(s) = visible[i].as_ref() else {
+                                col[i] = frame.background;
+                                continue;
+                            };
+                            let t = &tris[tri_id[i] as usize];
+                            let material = frame.objects[t.object as usize].material(t.material);
+                            let p = (r / k) * (w / k) + x / k;
+                            let c = match (t.hull, material.outline) {
+                                _ if once && once_tri[p] != u32::MAX => centre[p],
+                                (true, Some(_)) => material.outline_rgb(&frame.light),
+                                _ => shading::shade(frame, lights, material, s),
+                            };
+                            if t.hull {
+                                col[i] = c;
+                            } else {
+                                (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
+                                if let Some(al) = area {
+                                    soft[i] = Some(SoftPoint {
+                                        world: s.world,
+                                        normal: s.normal.normalize_or(Vec3f::ZERO),
+                                        term: shading::area_term(al, material, s, frame.time),
+                                    });
+                                }
                             }
                         }
                     }
-                    once_best.copy_from_slice(best);
-                }
-                for r in 0..rows {
-                    for x in 0..w {
-                        let i = r * w + x;
-                        let Some(s) = visible[i].as_ref() else {
-                            col[i] = frame.background;
-                            continue;
-                        };
-                        let t = &tris[tri_id[i] as usize];
-                        let material = frame.objects[t.object as usize].material(t.material);
-                        let p = (r / k) * (w / k) + x / k;
-                        let c = match (t.hull, material.outline) {
-                            _ if once && once_tri[p] != u32::MAX => centre[p],
-                            (true, Some(_)) => material.outline_rgb(&frame.light),
-                            _ => shading::shade(frame, lights, material, s),
-                        };
-                        if t.hull {
-                            col[i] = c;
-                        } else {
-                            (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
-                            if let Some(al) = area {
-                                soft[i] = Some(SoftPoint {
-                                    world: s.world,
-                                    normal: s.normal.normalize_or(Vec3f::ZERO),
-                                    term: shading::area_term(al, material, s, frame.time),
-                                });
-                            }
-                        }
-                    }
-                }
-                BAND_SCRATCH.set(scratch);
-            });
+                    BAND_SCRATCH.set(scratch);
+                },
+            );
     }
     if once {
         refine(frame, setup, &tris, k, rows.start, color, shadow, kept);
@@ -365,19 +379,11 @@ fn refine(
     y0: usize,
     color: &mut [[f32; 3]],
     shadow: &mut [Option<u32>],
-    kept: &mut ShadedOnce,
+    kept: &ShadedOnce,
 ) {
     let w = frame.width as usize;
     let (pw, ph) = (w / k, color.len() / (w * k));
-    let ShadedOnce { centre, tri, best, probe, .. } = kept;
-    probe.clear();
-    probe.resize(centre.len(), ([0.0; 3], u64::MAX));
-    probe.par_iter_mut().zip(&*centre).zip(&*tri).for_each(|((p, c), &t)| {
-        if let Some(t) = tris.get(t as usize) {
-            *p = (c.map(|v| v.max(0.0).sqrt()), (u64::from(t.object) << 32) | u64::from(t.material));
-        }
-    });
-    let (probe, tri, best) = (&*probe, &*tri, &*best);
+    let ShadedOnce { tri, best, probe, .. } = kept;
     color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).enumerate().for_each(
         |(py, (col, shad))| {
             for px in 0..pw {
@@ -390,7 +396,8 @@ fn refine(
                 for qy in py.saturating_sub(1)..(py + 2).min(ph) {
                     for (b, key) in &probe[qy * pw + px.saturating_sub(1)..qy * pw + (px + 2).min(pw)] {
                         // (The pixel itself differs from itself by nothing.)
-                        edge |= *key == me && (0..3).any(|c| (a[c] - b[c]).abs() > ONCE_CONTRAST);
+                        let step = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).max((a[2] - b[2]).abs());
+                        edge |= (*key == me) & (step > ONCE_CONTRAST);
                     }
                 }
                 if !edge {
