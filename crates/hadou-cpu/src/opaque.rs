@@ -77,6 +77,8 @@ pub(crate) struct ShadedOnce {
     best: Vec<crate::shadows::Choice>,
     /// Per pixel, for the refinement's comparisons ([`Probe`]).
     probe: Vec<Probe>,
+    /// Per pixel: which of its pairs with its neighbours differ ([`PAIR_E`] and the rest).
+    pairs: Vec<u8>,
     /// Shade every sample instead (the tests' reference).
     pub every_sample: bool,
 }
@@ -221,19 +223,22 @@ pub(crate) fn draw_opaque_into(
                         || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
                     let y_start = rows.start + b * BAND;
                     let rows = col.len() / w;
-                    surf.fill(None);
-                    obj.fill(None);
-                    shad.fill(None);
-                    edg.fill(EdgeTexel::default());
-                    soft.fill(None);
-                    centre.fill([f32::NAN; 3]);
-                    once_tri.fill(u32::MAX);
-                    probe.fill(([0.0; 3], u64::MAX));
                     if mine().next().is_none() && mine_shadows().next().is_none() {
                         // Nothing drawn here.
                         col.fill(frame.background);
+                        surf.fill(None);
+                        obj.fill(None);
+                        shad.fill(None);
+                        edg.fill(EdgeTexel::default());
+                        soft.fill(None);
+                        centre.fill([f32::NAN; 3]);
+                        once_tri.fill(u32::MAX);
+                        probe.fill(([0.0; 3], u64::MAX));
                         return;
                     }
+                    // Otherwise every sample's and pixel's entry is written once below (a frame
+                    // at 4 samples moves some 200 bytes a sample through these buffers: a clear
+                    // before the writes would add half as much again).
                     // The band's own buffers, kept by the thread from band to band and frame to frame
                     // (fresh ones, over a megabyte a band at 1024 wide, cost their pages' faults and
                     // clearing each time); taken out while in use, so a band the thread runs meanwhile
@@ -247,18 +252,48 @@ pub(crate) fn draw_opaque_into(
                     for ti in mine() {
                         raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
                     }
-                    // The visible surface of every pixel.
-                    visible.clear();
+                    // Shading once: the pixels whose samples all show one triangle (not a hull).
+                    let (pw, ph) = (w / k, rows / k);
+                    if once {
+                        for py in 0..ph {
+                            for px in 0..pw {
+                                let i0 = py * k * w + px * k;
+                                let t0 = tri_id[i0];
+                                let shared = t0 != u32::MAX
+                                    && !tris[t0 as usize].hull
+                                    && (0..k)
+                                        .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
+                                once_tri[py * pw + px] = if shared { t0 } else { u32::MAX };
+                            }
+                        }
+                    }
+                    // The visible surface of every pixel (every entry written: stale ones from
+                    // an earlier band are overwritten). A sample of a pixel shaded once needs
+                    // only its geometry, unless the area light shades it.
+                    let lean = once && area.is_none();
                     visible.resize(rows * w, None);
                     for r in 0..rows {
+                        let prow = (r / k) * pw;
+                        let (mut px, mut sub) = (0, 0);
                         for x in 0..w {
                             let i = r * w + x;
+                            let lean_here = lean && once_tri[prow + px] != u32::MAX;
+                            sub += 1;
+                            if sub == k {
+                                (px, sub) = (px + 1, 0);
+                            }
                             if tri_id[i] == u32::MAX {
+                                (surf[i], obj[i], edg[i], visible[i]) =
+                                    (None, None, EdgeTexel::default(), None);
                                 continue;
                             }
                             let py = (y_start + r) as f32;
                             let t = &tris[tri_id[i] as usize];
-                            let (s, outline_dir) = interpolate(t, x as f32 + 0.5, py + 0.5);
+                            let (s, outline_dir) = if lean_here {
+                                interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
+                            } else {
+                                interpolate(t, x as f32 + 0.5, py + 0.5)
+                            };
                             let d = (s.world - basis.eye).length();
                             surf[i] = Some(if d.is_finite() { d } else { 0.0 });
                             obj[i] = Some(t.object);
@@ -303,16 +338,10 @@ pub(crate) fn draw_opaque_into(
                     }
                     if once {
                         // Each pixel whose samples share one triangle, shaded once at its centre.
-                        let (pw, ph) = (w / k, rows / k);
                         for py in 0..ph {
                             for px in 0..pw {
-                                let i0 = py * k * w + px * k;
-                                let t0 = tri_id[i0];
-                                let shared = t0 != u32::MAX
-                                    && !tris[t0 as usize].hull
-                                    && (0..k)
-                                        .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
-                                if shared {
+                                let t0 = once_tri[py * pw + px];
+                                if t0 != u32::MAX {
                                     let t = &tris[t0 as usize];
                                     let material = frame.objects[t.object as usize].material(t.material);
                                     let half = k as f32 / 2.0;
@@ -320,31 +349,45 @@ pub(crate) fn draw_opaque_into(
                                     let (s, _) = interpolate(t, cx, cy);
                                     let c = shading::shade(frame, lights, material, &s);
                                     centre[py * pw + px] = c;
-                                    once_tri[py * pw + px] = t0;
                                     let key = (u64::from(t.object) << 32) | u64::from(t.material);
                                     probe[py * pw + px] = (c.map(|v| v.max(0.0).sqrt()), key);
+                                } else {
+                                    centre[py * pw + px] = [f32::NAN; 3];
+                                    probe[py * pw + px] = ([0.0; 3], u64::MAX);
                                 }
                             }
                         }
                         once_best.copy_from_slice(best);
                     }
                     for r in 0..rows {
+                        let prow = (r / k) * pw;
+                        let (mut px, mut sub) = (0, 0);
                         for x in 0..w {
                             let i = r * w + x;
+                            let p = prow + px;
+                            sub += 1;
+                            if sub == k {
+                                (px, sub) = (px + 1, 0);
+                            }
                             let Some(s) = visible[i].as_ref() else {
-                                col[i] = frame.background;
+                                (col[i], shad[i]) = (frame.background, None);
+                                if area.is_some() {
+                                    soft[i] = None;
+                                }
                                 continue;
                             };
                             let t = &tris[tri_id[i] as usize];
                             let material = frame.objects[t.object as usize].material(t.material);
-                            let p = (r / k) * (w / k) + x / k;
                             let c = match (t.hull, material.outline) {
                                 _ if once && once_tri[p] != u32::MAX => centre[p],
                                 (true, Some(_)) => material.outline_rgb(&frame.light),
                                 _ => shading::shade(frame, lights, material, s),
                             };
                             if t.hull {
-                                col[i] = c;
+                                (col[i], shad[i]) = (c, None);
+                                if area.is_some() {
+                                    soft[i] = None;
+                                }
                             } else {
                                 (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
                                 if let Some(al) = area {
@@ -379,26 +422,49 @@ fn refine(
     y0: usize,
     color: &mut [[f32; 3]],
     shadow: &mut [Option<u32>],
-    kept: &ShadedOnce,
+    kept: &mut ShadedOnce,
 ) {
     let w = frame.width as usize;
     let (pw, ph) = (w / k, color.len() / (w * k));
-    let ShadedOnce { tri, best, probe, .. } = kept;
+    let ShadedOnce { tri, best, probe, pairs, .. } = kept;
+    // Each neighbouring pair compared once (the step is symmetric): a pixel's bits say which of
+    // its pairs to the east, south, south-east and south-west differ.
+    pairs.resize(pw * ph, 0);
+    pairs.par_chunks_mut(pw).enumerate().for_each(|(py, bits)| {
+        let row = &probe[py * pw..py * pw + pw];
+        let below = probe.get((py + 1) * pw..(py + 2) * pw);
+        for (px, bit) in bits.iter_mut().enumerate() {
+            let a = &row[px];
+            let mut b = 0;
+            if px + 1 < pw {
+                b |= u8::from(differs(a, &row[px + 1])) * PAIR_E;
+            }
+            if let Some(below) = below {
+                b |= u8::from(differs(a, &below[px])) * PAIR_S;
+                if px + 1 < pw {
+                    b |= u8::from(differs(a, &below[px + 1])) * PAIR_SE;
+                }
+                if px > 0 {
+                    b |= u8::from(differs(a, &below[px - 1])) * PAIR_SW;
+                }
+            }
+            *bit = b;
+        }
+    });
+    let pairs = &pairs[..];
     color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).enumerate().for_each(
         |(py, (col, shad))| {
+            let row = &pairs[py * pw..py * pw + pw];
+            let above = py.checked_sub(1).map(|a| &pairs[a * pw..a * pw + pw]);
             for px in 0..pw {
                 let p = py * pw + px;
-                let (a, me) = probe[p];
-                if me == u64::MAX {
-                    continue;
-                }
-                let mut edge = false;
-                for qy in py.saturating_sub(1)..(py + 2).min(ph) {
-                    for (b, key) in &probe[qy * pw + px.saturating_sub(1)..qy * pw + (px + 2).min(pw)] {
-                        // (The pixel itself differs from itself by nothing.)
-                        let step = (a[0] - b[0]).abs().max((a[1] - b[1]).abs()).max((a[2] - b[2]).abs());
-                        edge |= (*key == me) & (step > ONCE_CONTRAST);
-                    }
+                // The pixel's eight neighbours: its own four pairs, its west neighbour's east,
+                // and the row above's pairs that reach down to it.
+                let mut edge = row[px] != 0 || (px > 0 && row[px - 1] & PAIR_E != 0);
+                if let Some(above) = above {
+                    edge |= above[px] & PAIR_S != 0
+                        || (px > 0 && above[px - 1] & PAIR_SE != 0)
+                        || (px + 1 < pw && above[px + 1] & PAIR_SW != 0);
                 }
                 if !edge {
                     continue;
@@ -418,6 +484,23 @@ fn refine(
             }
         },
     );
+}
+
+/// The bits of [`ShadedOnce::pairs`]: a pixel's pair with its east, south, south-east and
+/// south-west neighbour differs.
+const PAIR_E: u8 = 1;
+const PAIR_S: u8 = 2;
+const PAIR_SE: u8 = 4;
+const PAIR_SW: u8 = 8;
+
+/// Whether two neighbouring pixels were both shaded once, show the same object and material, and
+/// differ in a channel by more than [`ONCE_CONTRAST`] (a NaN channel counts as no difference).
+#[inline]
+fn differs((a, ka): &Probe, (b, kb): &Probe) -> bool {
+    let step = ((a[0] - b[0]).abs() > ONCE_CONTRAST)
+        | ((a[1] - b[1]).abs() > ONCE_CONTRAST)
+        | ((a[2] - b[2]).abs() > ONCE_CONTRAST);
+    (ka == kb) & (*ka != u64::MAX) & step
 }
 
 /// A band's depth, triangle, visible-surface and shadow buffers ([`draw_opaque_into`]).
@@ -536,6 +619,13 @@ fn raster_tri(
 /// Perspective-correct surface attributes at screen point `(px, py)`, and the interpolated outline
 /// direction there.
 fn interpolate(t: &ScreenTri, px: f32, py: f32) -> (shading::Surface, Vec3f) {
+    interpolate_with::<true>(t, px, py)
+}
+
+/// [`interpolate`], with `FULL` false only the geometry: the texture coordinates and colour are
+/// left zero (a sample of a pixel shaded once reads neither); the rest bit for bit the same.
+#[inline(always)]
+fn interpolate_with<const FULL: bool>(t: &ScreenTri, px: f32, py: f32) -> (shading::Surface, Vec3f) {
     let area = edge(t.sx[0], t.sy[0], t.sx[1], t.sy[1], t.sx[2], t.sy[2]);
     let b = [
         edge(t.sx[1], t.sy[1], t.sx[2], t.sy[2], px, py) / area,
@@ -547,9 +637,14 @@ fn interpolate(t: &ScreenTri, px: f32, py: f32) -> (shading::Surface, Vec3f) {
     let wts = wts.map(|v| v / s);
     let world = t.world[0] * wts[0] + t.world[1] * wts[1] + t.world[2] * wts[2];
     let normal = t.normal[0] * wts[0] + t.normal[1] * wts[1] + t.normal[2] * wts[2];
-    let uv = std::array::from_fn(|k| t.uv[0][k] * wts[0] + t.uv[1][k] * wts[1] + t.uv[2][k] * wts[2]);
-    let color =
-        std::array::from_fn(|k| t.color[0][k] * wts[0] + t.color[1][k] * wts[1] + t.color[2][k] * wts[2]);
+    let (uv, color) = if FULL {
+        (
+            std::array::from_fn(|k| t.uv[0][k] * wts[0] + t.uv[1][k] * wts[1] + t.uv[2][k] * wts[2]),
+            std::array::from_fn(|k| t.color[0][k] * wts[0] + t.color[1][k] * wts[1] + t.color[2][k] * wts[2]),
+        )
+    } else {
+        ([0.0; 2], [0.0; 4])
+    };
     let outline = t.outline[0] * wts[0] + t.outline[1] * wts[1] + t.outline[2] * wts[2];
     (shading::Surface { world, normal, uv, color }, outline)
 }
