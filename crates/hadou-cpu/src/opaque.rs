@@ -142,6 +142,18 @@ pub(crate) fn draw_opaque_into(
     let shadow_tris = if shadows.any_plane() { shadows.plane_tris(frame, basis) } else { Tris::default() };
     let far = frame.camera.far;
     let bands = Bands::new(&tris, frame.height as usize, &rows);
+    // Per triangle: whether its samples carry the outline's reach (an outlined material's
+    // surface, not its hull).
+    let outlined: Vec<bool> = tris
+        .iter()
+        .map(|t| {
+            !t.hull
+                && frame.objects[t.object as usize]
+                    .material(t.material)
+                    .outline
+                    .is_some_and(|o| o.width > 0.0)
+        })
+        .collect();
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
     let k = grid.max(1);
     let once = k > 1
@@ -244,7 +256,7 @@ pub(crate) fn draw_opaque_into(
                     // clearing each time); taken out while in use, so a band the thread runs meanwhile
                     // gets fresh ones.
                     let mut scratch = BAND_SCRATCH.take();
-                    let BandScratch { zbuf, tri_id, visible, best } = &mut scratch;
+                    let BandScratch { zbuf, tri_id, world, surfaces, best } = &mut scratch;
                     zbuf.clear();
                     zbuf.resize(rows * w, f32::INFINITY);
                     tri_id.clear();
@@ -267,42 +279,35 @@ pub(crate) fn draw_opaque_into(
                             }
                         }
                     }
-                    // The visible surface of every pixel (every entry written: stale ones from
-                    // an earlier band are overwritten). A sample of a pixel shaded once needs
-                    // only its geometry, unless the area light shades it.
-                    let lean = once && area.is_none();
-                    visible.resize(rows * w, None);
+                    // The visible point of every sample: its world position here, its normal in
+                    // the edge data (every entry written where a triangle is drawn; the rest is
+                    // never read). Where most samples take their pixel's one shade, only this
+                    // geometry: the few shaded one by one interpolate again, bit for bit the same
+                    // (a frame at 4 samples moves some 200 bytes a sample through its buffers,
+                    // and a whole surface a sample would add a quarter as much again). Where
+                    // every sample is shaded (one sample a pixel, or the area light's term), the
+                    // whole surface, kept.
+                    let keep = !once || area.is_some();
+                    world.resize(rows * w, Vec3f::ZERO);
+                    surfaces.resize(if keep { rows * w } else { 0 }, shading::Surface::default());
                     for r in 0..rows {
-                        let prow = (r / k) * pw;
-                        let (mut px, mut sub) = (0, 0);
                         for x in 0..w {
                             let i = r * w + x;
-                            let lean_here = lean && once_tri[prow + px] != u32::MAX;
-                            sub += 1;
-                            if sub == k {
-                                (px, sub) = (px + 1, 0);
-                            }
                             if tri_id[i] == u32::MAX {
-                                (surf[i], obj[i], edg[i], visible[i]) =
-                                    (None, None, EdgeTexel::default(), None);
+                                (surf[i], obj[i], edg[i]) = (None, None, EdgeTexel::default());
                                 continue;
                             }
                             let py = (y_start + r) as f32;
                             let t = &tris[tri_id[i] as usize];
-                            let (s, outline_dir) = if lean_here {
-                                interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
-                            } else {
+                            let (s, outline_dir) = if keep {
                                 interpolate(t, x as f32 + 0.5, py + 0.5)
+                            } else {
+                                interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
                             };
                             let d = (s.world - basis.eye).length();
                             surf[i] = Some(if d.is_finite() { d } else { 0.0 });
                             obj[i] = Some(t.object);
-                            let outlined = !t.hull
-                                && frame.objects[t.object as usize]
-                                    .material(t.material)
-                                    .outline
-                                    .is_some_and(|o| o.width > 0.0);
-                            let reach = if outlined {
+                            let reach = if outlined[tri_id[i] as usize] {
                                 let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
                                 outline::reach_code(outline_dir, dir)
                             } else {
@@ -310,7 +315,10 @@ pub(crate) fn draw_opaque_into(
                             };
                             edg[i] =
                                 EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
-                            visible[i] = Some(s);
+                            world[i] = s.world;
+                            if keep {
+                                surfaces[i] = s;
+                            }
                         }
                     }
                     // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
@@ -323,14 +331,14 @@ pub(crate) fn draw_opaque_into(
                     for si in mine_shadows() {
                         let st = &shadow_tris[si as usize];
                         cover(st, y_start, rows, w, |i, bary| {
-                            let (Some(o), Some(s)) = (receiver(i), visible[i].as_ref()) else { return };
+                            let Some(o) = receiver(i) else { return };
                             let t = perspective(st, bary, |k| st.uv[k][0]);
                             shadows.plane_candidate(
                                 frame,
                                 st.object,
                                 o,
                                 t,
-                                s.world,
+                                world[i],
                                 surf[i].unwrap_or(0.0),
                                 &mut best[i],
                             );
@@ -369,19 +377,26 @@ pub(crate) fn draw_opaque_into(
                             if sub == k {
                                 (px, sub) = (px + 1, 0);
                             }
-                            let Some(s) = visible[i].as_ref() else {
+                            let Some(t) = tris.get(tri_id[i] as usize) else {
                                 (col[i], shad[i]) = (frame.background, None);
                                 if area.is_some() {
                                     soft[i] = None;
                                 }
                                 continue;
                             };
-                            let t = &tris[tri_id[i] as usize];
                             let material = frame.objects[t.object as usize].material(t.material);
+                            // The whole surface where something shades it.
+                            let surface = || {
+                                if keep {
+                                    surfaces[i]
+                                } else {
+                                    interpolate(t, x as f32 + 0.5, (y_start + r) as f32 + 0.5).0
+                                }
+                            };
                             let c = match (t.hull, material.outline) {
                                 _ if once && once_tri[p] != u32::MAX => centre[p],
                                 (true, Some(_)) => material.outline_rgb(&frame.light),
-                                _ => shading::shade(frame, lights, material, s),
+                                _ => shading::shade(frame, lights, material, &surface()),
                             };
                             if t.hull {
                                 (col[i], shad[i]) = (c, None);
@@ -389,12 +404,12 @@ pub(crate) fn draw_opaque_into(
                                     soft[i] = None;
                                 }
                             } else {
-                                (col[i], shad[i]) = shadows.resolve(frame, t.object, s.world, best[i], c);
+                                (col[i], shad[i]) = shadows.resolve(frame, t.object, world[i], best[i], c);
                                 if let Some(al) = area {
                                     soft[i] = Some(SoftPoint {
-                                        world: s.world,
-                                        normal: s.normal.normalize_or(Vec3f::ZERO),
-                                        term: shading::area_term(al, material, s, frame.time),
+                                        world: world[i],
+                                        normal: edg[i].normal.normalize_or(Vec3f::ZERO),
+                                        term: shading::area_term(al, material, &surface(), frame.time),
                                     });
                                 }
                             }
@@ -508,7 +523,8 @@ fn differs((a, ka): &Probe, (b, kb): &Probe) -> bool {
 struct BandScratch {
     zbuf: Vec<f32>,
     tri_id: Vec<u32>,
-    visible: Vec<Option<shading::Surface>>,
+    world: Vec<Vec3f>,
+    surfaces: Vec<shading::Surface>,
     best: Vec<crate::shadows::Choice>,
 }
 

@@ -11,7 +11,7 @@ use hadou_math::{shade as tone, Vec3f};
 use hadou_scene::{AreaLight, Frame, LampShape, LightLine, Material, Mtoon, ShadingModel};
 
 /// The interpolated attributes of a visible surface point.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Surface {
     /// World position.
     pub world: Vec3f,
