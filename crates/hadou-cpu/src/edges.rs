@@ -81,6 +81,16 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 if code == 0 {
                     continue;
                 }
+                // Neighbours outside the buffers count as the same object. (Tested first: most
+                // pixels of an outlined surface are not on its edge.)
+                let differs = |j: usize| owner(j) != Some(o);
+                let on_edge = (x > 0 && differs(i - 1))
+                    || (x + 1 < w && differs(i + 1))
+                    || (r > 0 && differs(i - w))
+                    || (r + 1 < h && differs(i + w));
+                if !on_edge {
+                    continue;
+                }
                 let dir = unit_dir(basis, frame, x, r + first_row);
                 let z = surface[i].unwrap_or(0.0) * dir.dot(basis.forward);
                 let px = hull_px(o, material, z);
@@ -88,16 +98,8 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 if rp.is_nan() || rp <= 0.0 {
                     continue;
                 }
-                // Neighbours outside the buffers count as the same object.
-                let differs = |j: usize| owner(j) != Some(o);
-                let on_edge = (x > 0 && differs(i - 1))
-                    || (x + 1 < w && differs(i + 1))
-                    || (r > 0 && differs(i - w))
-                    || (r + 1 < h && differs(i + w));
-                if on_edge {
-                    let distance = surface[i].unwrap_or(0.0);
-                    row.push(Edge { x: x as u32, reach2: rp * rp, object: o, material, distance, dir });
-                }
+                let distance = surface[i].unwrap_or(0.0);
+                row.push(Edge { x: x as u32, reach2: rp * rp, object: o, material, distance, dir });
             }
             row
         })

@@ -165,7 +165,9 @@ impl DepthMap {
     fn shadows(&self, p: Vec3f) -> bool {
         let [s, t, d] = self.frame.to_map(p);
         let n = self.size as f32;
-        let (x, y) = ((s * n).floor(), ((1.0 - t) * n).floor());
+        // `⌊v⌋` lies in `0..n` exactly when `v` does (`n` whole; NaN in neither), so the texel is
+        // the truncation's (without a call to `floorf` on targets without SSE4.1).
+        let (x, y) = (s * n, (1.0 - t) * n);
         if !(x >= 0.0 && y >= 0.0 && x < n && y < n) {
             return false;
         }

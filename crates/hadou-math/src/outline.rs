@@ -58,8 +58,9 @@ pub fn reach_code(outline: Vec3f, view: Vec3f) -> u32 {
     if !s.is_finite() {
         return 0;
     }
-    let q = (s.min(1.0) * REACH_STEPS as f32 + 0.5).floor();
-    q as u32
+    // At least ½, so the conversion's truncation is the floor (without a call to `floorf` on
+    // targets without SSE4.1).
+    (s.min(1.0) * REACH_STEPS as f32 + 0.5) as u32
 }
 
 /// The contact outline's radius in pixels for an edge pixel whose hull is `hull_px` wide
