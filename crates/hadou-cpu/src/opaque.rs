@@ -107,7 +107,8 @@ pub(crate) struct EdgeTexel {
     /// An outline hull fragment.
     pub hull: bool,
     /// The hull's reach across the view ray here (`hadou_math::outline::reach_code`; 0 for hulls
-    /// and materials without an outline).
+    /// and materials without an outline, and where the edge pass does not read it: wherever the
+    /// four neighbours show the same triangle, so none can be another object's).
     pub reach: u32,
 }
 
@@ -307,7 +308,18 @@ pub(crate) fn draw_opaque_into(
                             let d = (s.world - basis.eye).length();
                             surf[i] = Some(if d.is_finite() { d } else { 0.0 });
                             obj[i] = Some(t.object);
-                            let reach = if outlined[tri_id[i] as usize] {
+                            // The edge pass reads the reach only where a neighbour shows another
+                            // object (or none): not where all four show this triangle.
+                            let ti = tri_id[i];
+                            let inside = x > 0
+                                && x + 1 < w
+                                && r > 0
+                                && r + 1 < rows
+                                && tri_id[i - 1] == ti
+                                && tri_id[i + 1] == ti
+                                && tri_id[i - w] == ti
+                                && tri_id[i + w] == ti;
+                            let reach = if outlined[ti as usize] && !inside {
                                 let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
                                 outline::reach_code(outline_dir, dir)
                             } else {
