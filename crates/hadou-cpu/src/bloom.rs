@@ -85,10 +85,7 @@ pub(crate) fn glare_and_map(
     color.par_chunks_mut(w.max(1)).enumerate().for_each_init(Vec::new, |row, (r, out)| {
         let y = band.start + r;
         row.resize(w, [0.0; 3]);
-        bloom::lanes::upsample_row(simd, &g, y, row);
-        for (o, c) in row.iter_mut().zip(linear.row(y)) {
-            *o = bloom::composite(*c, *o);
-        }
+        bloom::lanes::upsample_composite_row(simd, &g, y, linear.row(y), row);
         dispatch(simd, MapRow { mode, linear: row, out });
     });
     pool.give(g);

@@ -241,6 +241,51 @@ fn lanes_equal_the_texel_kernels_bit_for_bit() {
     }
 }
 
+/// A picture mostly below the knee (where the lanes skip the soft threshold's arithmetic, eight
+/// texels at a time): runs of dark texels, some with a negative zero or a negative channel, next
+/// to bright, infinite and NaN ones, for knees from none to the whole threshold, whole and in
+/// bands, on every path the machine has: the texel kernels' bits.
+#[test]
+fn dark_runs_keep_the_texel_kernels_bits() {
+    let mut rng = Rng(46);
+    let (w, h) = (83, 37);
+    let vals: Vec<[f32; 3]> = (0..w * h)
+        .map(|i| {
+            let dark = [rng.range_f32(0.0, 0.45), rng.range_f32(0.0, 0.45), rng.range_f32(0.0, 0.45)];
+            match (i / 16 % 5, rng.below(40)) {
+                (0, _) => [rng.range_f32(0.0, 4.0), rng.range_f32(0.0, 2.0), rng.range_f32(0.0, 6.0)],
+                (_, 0) => [-0.0, dark[1], dark[2]],
+                (_, 1) => [dark[0], -2.0, dark[2]],
+                (_, 2) => [f32::NAN, dark[1], dark[2]],
+                (_, 3) => [dark[0], dark[1], f32::INFINITY],
+                (_, 4) => [0.0, -0.0, 0.0],
+                (_, 5) => [dark[0], 0.9999, dark[2]],
+                _ => dark,
+            }
+        })
+        .collect();
+    let src = plane(w, h, |x, y| vals[y * w + x]);
+    let bits = |v: &[[f32; 3]]| v.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+    for (threshold, soft_knee) in [(1.0, 0.5), (1.0, 0.0), (0.5, 1.0), (0.45, 0.1), (0.0, 0.5), (2.0, 0.75)] {
+        let p = BloomParams { threshold, soft_knee, ..params() };
+        let reference = try_glare(&p, &src, 0..h, &Sequential).unwrap();
+        for path in SimdPath::supported() {
+            let whole = lanes::try_glare(path, &p, &src, 0..h, &Sequential).unwrap();
+            assert_eq!(
+                bits(&whole.data),
+                bits(&reference.data),
+                "threshold {threshold} knee {soft_knee} on {path}"
+            );
+            let band = lanes::try_glare(path, &p, &src, 5..21, &Sequential).unwrap();
+            assert_eq!(
+                bits(&band.data),
+                bits(&reference.data[5 * w..21 * w]),
+                "band, {threshold} {soft_knee} on {path}"
+            );
+        }
+    }
+}
+
 /// A pool's buffers are reused without being cleared ([`PlanePool`]): the glare drawn from a pool
 /// whose buffers hold NaN, and then from the buffers the earlier glares (of other sizes, bands and
 /// parameters) left in it, is the glare drawn from fresh planes, bit for bit.

@@ -19,8 +19,10 @@
 //!
 //! [`try_glare_plane`] makes the prefilter, the first downsample and the streak's first level in
 //! one pass over the linear image, in blocks of level-1 rows whose prefiltered rows are made and
-//! split once (no prefiltered plane); a renderer then reads each output row once for the tap, the
-//! composite and its colour mapping.
+//! split once (no prefiltered plane: each texel's soft threshold is written straight to its even
+//! or odd slot, and eight texels all below the knee, where the threshold gives `+0` exactly, skip
+//! its arithmetic); a renderer then reads each output row once for the tap, the composite
+//! ([`upsample_composite_row`]) and its colour mapping.
 
 use super::{
     bilinear, composite, half, levels, tent, BloomParams, Plan, Plane, PlanePool, RowFill, BLUR, MAX_LEVELS,
@@ -51,28 +53,34 @@ impl<const N: usize> WithLanes for WeightedSum<'_, N> {
         for (l, &w) in ws.iter_mut().zip(&self.w) {
             *l = L::splat(w);
         }
-        let lane = load::<L>;
-        let mut k = 0;
-        while k + 8 <= n {
+        // Every slice cut to `n` and seen as blocks of eight, so the loop's reads need no bounds
+        // checks.
+        let srcs: [&[f32]; N] = self.srcs.map(|s| &s[..n]);
+        let blocks: [&[[f32; 8]]; N] = srcs.map(|s| s.as_chunks::<8>().0);
+        let base = self.base.map(|b| &b[..n]);
+        let base_blocks = base.map(|b| b.as_chunks::<8>().0);
+        let (out, tail) = self.out.as_chunks_mut::<8>();
+        let m = out.len();
+        for c in 0..m {
             let mut acc = L::splat(0.0);
-            for (&w, s) in ws.iter().zip(&self.srcs) {
-                acc += w * lane(s, k);
+            for t in 0..N {
+                acc += ws[t] * L::from_array(blocks[t][c]);
             }
-            if let Some(b) = self.base {
-                acc += lane(b, k);
+            if let Some(b) = base_blocks {
+                acc += L::from_array(b[c]);
             }
-            self.out[k..k + 8].copy_from_slice(&acc.to_array());
-            k += 8;
+            out[c] = acc.to_array();
         }
-        for k in k..n {
+        for (i, o) in tail.iter_mut().enumerate() {
+            let k = 8 * m + i;
             let mut acc = 0.0f32;
-            for (&w, s) in self.w.iter().zip(&self.srcs) {
+            for (&w, s) in self.w.iter().zip(&srcs) {
                 acc += w * s[k];
             }
-            if let Some(b) = self.base {
+            if let Some(b) = base {
                 acc += b[k];
             }
-            self.out[k] = acc;
+            *o = acc;
         }
     }
 }
@@ -118,44 +126,92 @@ struct PrefilterRow<'a> {
     soft_knee: f32,
 }
 
+/// The soft threshold's constants as lanes: `threshold`, the knee `k = threshold·soft_knee`, `2k`,
+/// `4k` (and `k` itself, whose sign picks the knee).
+struct Knee<L> {
+    k: f32,
+    th: L,
+    lk: L,
+    l2k: L,
+    l4k: L,
+}
+
+impl<L: Lane> Knee<L> {
+    #[inline(always)]
+    fn new(threshold: f32, soft_knee: f32) -> Self {
+        let k = threshold * soft_knee;
+        Knee { k, th: L::splat(threshold), lk: L::splat(k), l2k: L::splat(2.0 * k), l4k: L::splat(4.0 * k) }
+    }
+
+    /// [`super::prefilter`] of eight texels (`s`), as three channel arrays: the same comparisons,
+    /// selects and arithmetic per lane, so the same bits.
+    #[inline(always)]
+    fn eight(&self, s: &[[f32; 3]]) -> [[f32; 8]; 3] {
+        let (zero, max, clamp) = (L::splat(0.0), L::splat(f32::MAX), L::splat(super::BLOOM_CLAMP));
+        let mut ch = [zero; 3];
+        for (c, lane) in ch.iter_mut().enumerate() {
+            let mut a = [0.0f32; 8];
+            for j in 0..8 {
+                a[j] = s[j][c];
+            }
+            // NaN → 0, then clamped to [0, f32::MAX] as `f32::clamp` does.
+            let v = L::from_array(a);
+            let v = v.simd_lt(zero).select(zero, v);
+            let v = v.simd_gt(max).select(max, v);
+            *lane = v.is_nan().select(zero, v);
+        }
+        let b = ch[0].max(ch[1]).max(ch[2]);
+        let q = if self.k > 0.0 {
+            let x = (b - self.th) + self.lk;
+            let x = x.simd_lt(zero).select(zero, x);
+            let x = x.simd_gt(self.l2k).select(self.l2k, x);
+            x * x / self.l4k
+        } else {
+            zero
+        };
+        let w = q.max(b - self.th) / b;
+        let dark = b.simd_le(zero);
+        let mut r = [[0.0f32; 8]; 3];
+        for c in 0..3 {
+            r[c] = dark.select(zero, (ch[c] * w).min(clamp)).to_array();
+        }
+        r
+    }
+}
+
+impl<L: Lane> Knee<L> {
+    /// Whether all eight texels `s` are below the knee, where the soft threshold gives exactly
+    /// `+0` in every channel: each channel `v`, negative ones read as 0, has `(v − threshold) + k
+    /// ≤ 0` and `v − threshold < 0` (so `q = +0` and `max(q, b − threshold) = +0` whatever the
+    /// channel that makes `b`: rounding keeps both monotonic) and no sign bit (a `−0` channel
+    /// would give `−0`); NaN and infinite channels fail the tests.
+    #[inline(always)]
+    fn dark(&self, s: &[[f32; 3]]) -> bool {
+        let zero = L::splat(0.0);
+        let (flat, _) = s.as_flattened().as_chunks::<8>();
+        let mut dark = true;
+        for &a in &flat[..3] {
+            let v = L::from_array(a);
+            let v = v.simd_lt(zero).select(zero, v);
+            let below = v - self.th;
+            dark &= (below + self.lk).simd_le(zero).bitmask() == 0xff
+                && below.simd_lt(zero).bitmask() == 0xff
+                && v.is_sign_negative().bitmask() == 0;
+        }
+        dark
+    }
+}
+
 impl WithLanes for PrefilterRow<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lane>(self) {
         let (th, kn) = (self.threshold, self.soft_knee);
-        let k = th * kn;
-        let (zero, max, clamp) = (L::splat(0.0), L::splat(f32::MAX), L::splat(super::BLOOM_CLAMP));
-        let (lth, lk, l2k, l4k) = (L::splat(th), L::splat(k), L::splat(2.0 * k), L::splat(4.0 * k));
+        let knee = Knee::<L>::new(th, kn);
         let mut src = self.src.chunks_exact(8);
         let mut out = self.out.chunks_exact_mut(8);
         for (s, o) in (&mut src).zip(&mut out) {
-            let mut ch = [zero; 3];
-            for (c, lane) in ch.iter_mut().enumerate() {
-                let mut a = [0.0f32; 8];
-                for j in 0..8 {
-                    a[j] = s[j][c];
-                }
-                // NaN → 0, then clamped to [0, f32::MAX] as `f32::clamp` does.
-                let v = L::from_array(a);
-                let v = v.simd_lt(zero).select(zero, v);
-                let v = v.simd_gt(max).select(max, v);
-                *lane = v.is_nan().select(zero, v);
-            }
-            let b = ch[0].max(ch[1]).max(ch[2]);
-            let q = if k > 0.0 {
-                let x = (b - lth) + lk;
-                let x = x.simd_lt(zero).select(zero, x);
-                let x = x.simd_gt(l2k).select(l2k, x);
-                x * x / l4k
-            } else {
-                zero
-            };
-            let w = q.max(b - lth) / b;
-            let dark = b.simd_le(zero);
-            let mut r = [[0.0f32; 8]; 3];
-            for c in 0..3 {
-                r[c] = dark.select(zero, (ch[c] * w).min(clamp)).to_array();
-            }
+            let r = knee.eight(s);
             for j in 0..8 {
                 o[j] = [r[0][j], r[1][j], r[2][j]];
             }
@@ -163,6 +219,79 @@ impl WithLanes for PrefilterRow<'_> {
         for (s, o) in src.remainder().iter().zip(out.into_remainder()) {
             *o = super::prefilter(*s, th, kn);
         }
+    }
+}
+
+/// [`split`] of [`super::prefilter`] of a row, without the prefiltered row in between: each
+/// texel's eight-lane soft threshold written straight to its even or odd slot.
+struct PrefilterSplit<'a> {
+    src: &'a [[f32; 3]],
+    even: &'a mut [[f32; 3]],
+    odd: &'a mut [[f32; 3]],
+    threshold: f32,
+    soft_knee: f32,
+}
+
+impl WithLanes for PrefilterSplit<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lane>(self) {
+        let (th, kn) = (self.threshold, self.soft_knee);
+        let knee = Knee::<L>::new(th, kn);
+        let (ev, od) = (self.even, self.odd);
+        // Texel 2p goes to even[p + 1] and texel 2p + 1 to odd[p + 1] (split's unclamped slots).
+        let (ev, od) = (&mut ev[1..], &mut od[1..]);
+        let mut src = self.src.chunks_exact(8);
+        for (c, s) in (&mut src).enumerate() {
+            let p0 = 4 * c;
+            // Most of a picture lies below the knee: nothing to gather, weigh and scatter.
+            if knee.dark(s) {
+                ev[p0..p0 + 4].fill([0.0; 3]);
+                od[p0..p0 + 4].fill([0.0; 3]);
+                continue;
+            }
+            let r = knee.eight(s);
+            // Whole blocks of four pairs fit (the caller sizes the halves to the row).
+            for (i, (e, o)) in ev[p0..p0 + 4].iter_mut().zip(&mut od[p0..p0 + 4]).enumerate() {
+                *e = [r[0][2 * i], r[1][2 * i], r[2][2 * i]];
+                *o = [r[0][2 * i + 1], r[1][2 * i + 1], r[2][2 * i + 1]];
+            }
+        }
+        let x0 = self.src.len() - src.remainder().len();
+        for (i, s) in src.remainder().iter().enumerate() {
+            let (x, t) = (x0 + i, super::prefilter(*s, th, kn));
+            match x % 2 {
+                0 => ev[x / 2] = t,
+                _ => od[x / 2] = t,
+            }
+        }
+    }
+}
+
+/// [`split`] of the prefiltered `row` (`count` texels a half): `even[m] = T(row[clamp(2m − 2)])`,
+/// `odd[m] = T(row[clamp(2m − 1)])`, `T` [`super::prefilter`], in lanes; `count` is at least
+/// `row.len()/2 + 2` ([`first_level`]'s rows), so every texel of the row has its slot.
+fn prefilter_split(
+    path: SimdPath,
+    row: &[[f32; 3]],
+    count: usize,
+    (threshold, soft_knee): (f32, f32),
+    even: &mut Vec<f32>,
+    odd: &mut Vec<f32>,
+) {
+    debug_assert!(count >= row.len() / 2 + 2, "{count} slots for {} texels", row.len());
+    even.resize(3 * count, 0.0);
+    odd.resize(3 * count, 0.0);
+    let (ev, od) = (even.as_chunks_mut::<3>().0, odd.as_chunks_mut::<3>().0);
+    dispatch(path, PrefilterSplit { src: row, even: &mut *ev, odd: &mut *od, threshold, soft_knee });
+    // The clamped slots: m = 0 reads texel 0, m past the row's end its last texel.
+    let (first, last) = (row[0], row[row.len() - 1]);
+    let (first, last) =
+        (super::prefilter(first, threshold, soft_knee), super::prefilter(last, threshold, soft_knee));
+    (ev[0], od[0]) = (first, first);
+    let inner = row.len() / 2;
+    for m in inner + 1..count {
+        (ev[m], od[m]) = (last, last);
     }
 }
 
@@ -194,8 +323,6 @@ struct Scratch {
     rows: Vec<Vec<f32>>,
     /// The streak's levels.
     levels: Vec<Vec<[f32; 3]>>,
-    /// A prefiltered row.
-    pre: Vec<[f32; 3]>,
     /// The prefiltered rows of a block of level 1, each split into even and odd padded texels.
     block: Vec<Vec<f32>>,
     /// The 2×2 box rows of a block of level 1 (every box row its rows share, made once).
@@ -250,6 +377,39 @@ fn interleave(even: &[[f32; 3]], odd: &[[f32; 3]], out: &mut [[f32; 3]]) {
     }
     if let Some(t) = tail.first_mut() {
         *t = even[pairs.len()];
+    }
+}
+
+/// `b + t` per channel.
+#[inline(always)]
+fn add3(b: [f32; 3], t: [f32; 3]) -> [f32; 3] {
+    [b[0] + t[0], b[1] + t[1], b[2] + t[2]]
+}
+
+/// [`interleave`] added to a base: `out[i] = base[i] + t[i]`, `t` the interleaved row (`base`
+/// `None`: what `out` holds). The sum the lanes would make with the base as a last tap, `t + b`,
+/// is the same float (addition commutes), without the base split into even and odd texels.
+fn interleave_add(even: &[[f32; 3]], odd: &[[f32; 3]], base: Option<&[[f32; 3]]>, out: &mut [[f32; 3]]) {
+    let (pairs, tail) = out.as_chunks_mut::<2>();
+    let n = pairs.len();
+    match base {
+        None => {
+            for ((p, e), o) in pairs.iter_mut().zip(even).zip(odd) {
+                *p = [add3(p[0], *e), add3(p[1], *o)];
+            }
+            if let Some(t) = tail.first_mut() {
+                *t = add3(*t, even[n]);
+            }
+        }
+        Some(b) => {
+            let (bp, bt) = b.as_chunks::<2>();
+            for (((p, e), o), b) in pairs.iter_mut().zip(even).zip(odd).zip(bp) {
+                *p = [add3(b[0], *e), add3(b[1], *o)];
+            }
+            if let Some(t) = tail.first_mut() {
+                *t = add3(bt[0], even[n]);
+            }
+        }
     }
 }
 
@@ -317,37 +477,36 @@ fn down_row_in(path: SimdPath, src: &Plane, y: usize, out: &mut [[f32; 3]], s: &
 const SHORT: usize = 16;
 
 /// What [`tent_h`] adds to the tent.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum BaseIn {
+#[derive(Clone, Copy)]
+enum BaseIn<'a> {
     /// Nothing.
     None,
     /// The texels `out` holds when it is called.
     Out,
+    /// These texels (as many as `out`).
+    Row(&'a [[f32; 3]]),
 }
 
 /// The horizontal half of the tent: `low` (one row) to `out` (`out.len()` texels, the level
 /// above's width), each high texel `i` the sum of the four taps of [`tent`]`(i)`, plus the base
-/// ([`BaseIn`]). `s` holds five rows.
+/// ([`BaseIn`]). `s` holds at least three rows.
 fn tent_h(path: SimdPath, low: &[[f32; 3]], base: BaseIn, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
     let wh = out.len();
     let (ne, no) = (wh.div_ceil(2), wh / 2);
-    let [q, he, ho, be, bo] = s else { unreachable!("five rows") };
+    let [q, he, ho, ..] = s else { unreachable!("three rows") };
     pad(low, ne + 4, q);
     // Even i = 2j reads low j−2 … j+1 = q[j … j+3]; odd i = 2j+1 reads j−1 … j+2 = q[j+1 … j+4].
     let (we, wo) = (tent(0).1, tent(1).1);
-    let (be, bo) = match base {
-        BaseIn::Out => {
-            // The base's even and odd texels: split's e[m + 1] = b[2m], o[m + 1] = b[2m + 1].
-            split(out, ne + 1, be, bo);
-            (Some(&be[3..3 + 3 * ne]), Some(&bo[3..3 + 3 * no]))
-        }
-        BaseIn::None => (None, None),
-    };
     he.resize(3 * ne, 0.0);
     ho.resize(3 * no, 0.0);
-    taps(path, [&q[..]; 4], [0, 1, 2, 3], we, be, he);
-    taps(path, [&q[..]; 4], [1, 2, 3, 4], wo, bo, ho);
-    interleave(he.as_chunks::<3>().0, ho.as_chunks::<3>().0, out);
+    taps(path, [&q[..]; 4], [0, 1, 2, 3], we, None, he);
+    taps(path, [&q[..]; 4], [1, 2, 3, 4], wo, None, ho);
+    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
+    match base {
+        BaseIn::None => interleave(he, ho, out),
+        BaseIn::Out => interleave_add(he, ho, None, out),
+        BaseIn::Row(b) => interleave_add(he, ho, Some(b), out),
+    }
 }
 
 /// The horizontal sums of the tent over `low` (every row it holds) at the width `width` of the
@@ -421,7 +580,7 @@ fn streak_row_in(
         down_row_h_in(path, t, &mut d1, &mut rows[..2]);
     }
     levels[0] = d1;
-    streak_levels(path, n, rows, levels);
+    streak_levels(path, None, n, rows, levels);
 }
 
 /// The streak's chain from its first level `d1` (`D₁ʰ`) with `n` levels, leaving `U₁ʰ` in
@@ -433,25 +592,30 @@ fn streak_from_first(
     rows: &mut [Vec<f32>],
     levels: &mut Vec<Vec<[f32; 3]>>,
 ) {
-    if levels.is_empty() {
-        levels.push(Vec::new());
-    }
-    levels[0].clear();
-    levels[0].extend_from_slice(d1);
-    streak_levels(path, n, rows, levels);
+    streak_levels(path, Some(d1), n, rows, levels);
 }
 
-/// Levels `D₂ʰ … D_nʰ` from `levels[0]` (`D₁ʰ`), then `U_kʰ` over them, `U₁ʰ` in `levels[0]`.
-fn streak_levels(path: SimdPath, n: u32, rows: &mut [Vec<f32>], levels: &mut Vec<Vec<[f32; 3]>>) {
+/// Levels `D₂ʰ … D_nʰ` from `D₁ʰ` (`first`, or `None`: what `levels[0]` holds), then `U_kʰ`
+/// over them, `U₁ʰ` in `levels[0]`.
+fn streak_levels(
+    path: SimdPath,
+    first: Option<&[[f32; 3]]>,
+    n: u32,
+    rows: &mut [Vec<f32>],
+    levels: &mut Vec<Vec<[f32; 3]>>,
+) {
     let n = n.clamp(1, MAX_LEVELS) as usize;
     if levels.len() < n {
         levels.resize_with(n, Vec::new);
     }
-    let mut len = levels[0].len();
+    let mut len = first.map_or(levels[0].len(), <[_]>::len);
     for k in 1..n {
         len = half(len);
         let (done, rest) = levels.split_at_mut(k);
-        let src: &[[f32; 3]] = &done[k - 1];
+        let src: &[[f32; 3]] = match first {
+            Some(d1) if k == 1 => d1,
+            _ => &done[k - 1],
+        };
         rest[0].resize(len, [0.0; 3]);
         if src.len() < SHORT {
             super::down_row_h(src, &mut rest[0]);
@@ -459,17 +623,30 @@ fn streak_levels(path: SimdPath, n: u32, rows: &mut [Vec<f32>], levels: &mut Vec
             down_row_h_in(path, src, &mut rest[0], &mut rows[..2]);
         }
     }
-    // U_N = D_N; U_k = D_k + up(U_{k+1}), over D_k in place.
+    // U_N = D_N; U_k = D_k + up(U_{k+1}), over D_k in place (U₁ʰ from `first` into levels[0]).
     for k in (0..n - 1).rev() {
         let (lo, hi) = levels.split_at_mut(k + 1);
         let (d, u) = (&mut lo[k], &hi[0]);
-        if d.len() < SHORT {
-            let mut base = [[0.0f32; 3]; SHORT];
-            base[..d.len()].copy_from_slice(d);
-            super::up_row_h(u, Some(&base[..d.len()]), d);
-        } else {
-            tent_h(path, u, BaseIn::Out, d, rows);
+        match first {
+            Some(d1) if k == 0 => {
+                d.resize(d1.len(), [0.0; 3]);
+                if d1.len() < SHORT {
+                    super::up_row_h(u, Some(d1), d);
+                } else {
+                    tent_h(path, u, BaseIn::Row(d1), d, rows);
+                }
+            }
+            _ if d.len() < SHORT => {
+                let mut base = [[0.0f32; 3]; SHORT];
+                base[..d.len()].copy_from_slice(d);
+                super::up_row_h(u, Some(&base[..d.len()]), d);
+            }
+            _ => tent_h(path, u, BaseIn::Out, d, rows),
         }
+    }
+    if let (Some(d1), 1) = (first, n) {
+        levels[0].clear();
+        levels[0].extend_from_slice(d1);
     }
 }
 
@@ -508,10 +685,29 @@ pub fn glare_row(
 
 /// [`super::upsample_row`] in lanes: row `y` of the full-resolution glare from `g`.
 pub fn upsample_row(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]]) {
-    with_scratch(4, |s| upsample_row_in(path, g, y, out, &mut s.rows[..4]));
+    with_scratch(4, |s| upsample_row_in(path, g, y, None, out, &mut s.rows[..4]));
 }
 
-fn upsample_row_in(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]], s: &mut [Vec<f32>]) {
+/// [`upsample_row`] composited over the linear row `linear` ([`super::composite`]): row `y` of the
+/// glared linear colour, without the glare's own row in between.
+pub fn upsample_composite_row(
+    path: SimdPath,
+    g: &Plane,
+    y: usize,
+    linear: &[[f32; 3]],
+    out: &mut [[f32; 3]],
+) {
+    with_scratch(4, |s| upsample_row_in(path, g, y, Some(linear), out, &mut s.rows[..4]));
+}
+
+fn upsample_row_in(
+    path: SimdPath,
+    g: &Plane,
+    y: usize,
+    linear: Option<&[[f32; 3]]>,
+    out: &mut [[f32; 3]],
+    s: &mut [Vec<f32>],
+) {
     let [v, q, he, ho] = s else { unreachable!("four rows") };
     let (y0, wy) = bilinear(y);
     let last = g.height as isize - 1;
@@ -528,7 +724,21 @@ fn upsample_row_in(path: SimdPath, g: &Plane, y: usize, out: &mut [[f32; 3]], s:
     ho.resize(3 * no, 0.0);
     taps(path, [&q[..]; 2], [1, 2], bilinear(0).1, None, he);
     taps(path, [&q[..]; 2], [2, 3], bilinear(1).1, None, ho);
-    interleave(he.as_chunks::<3>().0, ho.as_chunks::<3>().0, out);
+    let (he, ho) = (he.as_chunks::<3>().0, ho.as_chunks::<3>().0);
+    match linear {
+        None => interleave(he, ho, out),
+        Some(c) => {
+            // composite(c, g) = min(c + g, f32::MAX) per channel.
+            let (pairs, tail) = out.as_chunks_mut::<2>();
+            let (cp, ct) = c.as_chunks::<2>();
+            for (((p, e), o), c) in pairs.iter_mut().zip(he).zip(ho).zip(cp) {
+                *p = [composite(c[0], *e), composite(c[1], *o)];
+            }
+            if let Some(t) = tail.first_mut() {
+                *t = composite(ct[0], he[pairs.len()]);
+            }
+        }
+    }
 }
 
 /// Level-1 rows a block of [`first_level`] makes at once: the prefiltered rows it reads (two per
@@ -560,19 +770,15 @@ fn first_level(
     let clamp = |y: isize| y.clamp(0, last) as usize;
     let ta = clamp(2 * rows.start as isize - 2);
     let tb = clamp(2 * rows.end as isize + 1);
-    let Scratch { rows: work, pre, block, boxes, .. } = s;
+    let Scratch { rows: work, block, boxes, .. } = s;
     let n = tb + 1 - ta;
     if block.len() < 2 * n {
         block.resize_with(2 * n, Vec::new);
     }
-    pre.resize(src.width, [0.0; 3]);
     for (i, y) in (ta..=tb).enumerate() {
         let (e, o) = block[2 * i..2 * i + 2].split_at_mut(1);
         match prefilter {
-            Some((threshold, soft_knee)) => {
-                prefilter_row(path, src.row(y), threshold, soft_knee, pre);
-                split(pre, count, &mut e[0], &mut o[0]);
-            }
+            Some(knee) => prefilter_split(path, src.row(y), count, knee, &mut e[0], &mut o[0]),
             None => split(src.row(y), count, &mut e[0], &mut o[0]),
         }
     }
@@ -643,12 +849,7 @@ pub fn try_glare(
 ) -> Result<Plane, usize> {
     let g = try_glare_plane(path, params, src, band.clone(), fill)?;
     let mut out = Plane::try_new(src.width, src.height, band)?;
-    fill.fill(&mut out, &|y, row| {
-        upsample_row(path, &g, y, row);
-        for (o, c) in row.iter_mut().zip(src.row(y)) {
-            *o = composite(*c, *o);
-        }
-    });
+    fill.fill(&mut out, &|y, row| upsample_composite_row(path, &g, y, src.row(y), row));
     Ok(out)
 }
 
