@@ -373,12 +373,14 @@ pub struct PlanePool {
 
 impl PlanePool {
     /// The free buffer that already holds `n` texels with the least to spare (nothing to fill in),
-    /// else the one that holds the most (the least to fill in; it grows), else a new one; its
-    /// texels as they were.
+    /// else the one with room for `n` with the least room (its texels filled in up to `n`, no
+    /// fresh pages), else the largest (which grows), else a new one; its texels as they were.
     fn take(&mut self, n: usize) -> Vec<[f32; 3]> {
         let len = |i: &usize| self.free[*i].len();
+        let cap = |i: &usize| self.free[*i].capacity();
         let held = (0..self.free.len()).filter(|i| len(i) >= n).min_by_key(len);
-        let pick = held.or_else(|| (0..self.free.len()).max_by_key(len));
+        let fits = || (0..self.free.len()).filter(|i| cap(i) >= n).min_by_key(cap);
+        let pick = held.or_else(fits).or_else(|| (0..self.free.len()).max_by_key(cap));
         pick.map(|i| self.free.swap_remove(i)).unwrap_or_default()
     }
 
