@@ -233,15 +233,18 @@ struct PrefilterSplit<'a> {
 }
 
 impl WithLanes for PrefilterSplit<'_> {
-    type Output = ();
+    /// Whether every texel's soft threshold is `+0` (each run of eight below the knee, the
+    /// remainder's values `+0`).
+    type Output = bool;
     #[inline(always)]
-    fn run<L: Lane>(self) {
+    fn run<L: Lane>(self) -> bool {
         let (th, kn) = (self.threshold, self.soft_knee);
         let knee = Knee::<L>::new(th, kn);
         let (ev, od) = (self.even, self.odd);
         // Texel 2p goes to even[p + 1] and texel 2p + 1 to odd[p + 1] (split's unclamped slots).
         let (ev, od) = (&mut ev[1..], &mut od[1..]);
         let mut src = self.src.chunks_exact(8);
+        let mut zero = true;
         for (c, s) in (&mut src).enumerate() {
             let p0 = 4 * c;
             // Most of a picture lies below the knee: nothing to gather, weigh and scatter.
@@ -250,6 +253,7 @@ impl WithLanes for PrefilterSplit<'_> {
                 od[p0..p0 + 4].fill([0.0; 3]);
                 continue;
             }
+            zero = false;
             let r = knee.eight(s);
             // Whole blocks of four pairs fit (the caller sizes the halves to the row).
             for (i, (e, o)) in ev[p0..p0 + 4].iter_mut().zip(&mut od[p0..p0 + 4]).enumerate() {
@@ -260,17 +264,26 @@ impl WithLanes for PrefilterSplit<'_> {
         let x0 = self.src.len() - src.remainder().len();
         for (i, s) in src.remainder().iter().enumerate() {
             let (x, t) = (x0 + i, super::prefilter(*s, th, kn));
+            zero &= is_plus_zero(t);
             match x % 2 {
                 0 => ev[x / 2] = t,
                 _ => od[x / 2] = t,
             }
         }
+        zero
     }
+}
+
+/// Whether every channel of `t` is `+0` (bit for bit).
+#[inline]
+fn is_plus_zero(t: [f32; 3]) -> bool {
+    t.iter().all(|v| v.to_bits() == 0)
 }
 
 /// [`split`] of the prefiltered `row` (`count` texels a half): `even[m] = T(row[clamp(2m − 2)])`,
 /// `odd[m] = T(row[clamp(2m − 1)])`, `T` [`super::prefilter`], in lanes; `count` is at least
-/// `row.len()/2 + 2` ([`first_level`]'s rows), so every texel of the row has its slot.
+/// `row.len()/2 + 2` ([`first_level`]'s rows), so every texel of the row has its slot. Returns
+/// whether every slot is `+0`: then every sum over the row is `+0` too.
 fn prefilter_split(
     path: SimdPath,
     row: &[[f32; 3]],
@@ -278,12 +291,13 @@ fn prefilter_split(
     (threshold, soft_knee): (f32, f32),
     even: &mut Vec<f32>,
     odd: &mut Vec<f32>,
-) {
+) -> bool {
     debug_assert!(count >= row.len() / 2 + 2, "{count} slots for {} texels", row.len());
     even.resize(3 * count, 0.0);
     odd.resize(3 * count, 0.0);
     let (ev, od) = (even.as_chunks_mut::<3>().0, odd.as_chunks_mut::<3>().0);
-    dispatch(path, PrefilterSplit { src: row, even: &mut *ev, odd: &mut *od, threshold, soft_knee });
+    let zero =
+        dispatch(path, PrefilterSplit { src: row, even: &mut *ev, odd: &mut *od, threshold, soft_knee });
     // The clamped slots: m = 0 reads texel 0, m past the row's end its last texel.
     let (first, last) = (row[0], row[row.len() - 1]);
     let (first, last) =
@@ -293,6 +307,7 @@ fn prefilter_split(
     for m in inner + 1..count {
         (ev[m], od[m]) = (last, last);
     }
+    zero && is_plus_zero(first) && is_plus_zero(last)
 }
 
 /// [`super::prefilter`] of every texel of `src` into `out`, in lanes.
@@ -327,6 +342,8 @@ struct Scratch {
     block: Vec<Vec<f32>>,
     /// The 2×2 box rows of a block of level 1 (every box row its rows share, made once).
     boxes: Vec<Vec<f32>>,
+    /// Which of the block's source rows are `+0` in every slot once prefiltered.
+    zero: Vec<bool>,
 }
 
 thread_local! {
@@ -770,17 +787,29 @@ fn first_level(
     let clamp = |y: isize| y.clamp(0, last) as usize;
     let ta = clamp(2 * rows.start as isize - 2);
     let tb = clamp(2 * rows.end as isize + 1);
-    let Scratch { rows: work, block, boxes, .. } = s;
+    let Scratch { rows: work, block, boxes, zero, .. } = s;
     let n = tb + 1 - ta;
     if block.len() < 2 * n {
         block.resize_with(2 * n, Vec::new);
     }
+    zero.clear();
     for (i, y) in (ta..=tb).enumerate() {
         let (e, o) = block[2 * i..2 * i + 2].split_at_mut(1);
-        match prefilter {
+        zero.push(match prefilter {
             Some(knee) => prefilter_split(path, src.row(y), count, knee, &mut e[0], &mut o[0]),
-            None => split(src.row(y), count, &mut e[0], &mut o[0]),
-        }
+            None => {
+                split(src.row(y), count, &mut e[0], &mut o[0]);
+                false
+            }
+        });
+    }
+    // Where every source row a level-1 row reads is `+0` (a dark stretch of the picture), its
+    // `D₁` and `D₁ʰ` are `+0` too: every box, tap and pair sum of `+0` starts from `+0` and adds
+    // `+0`. A block of such rows makes no box rows at all.
+    if zero.iter().all(|&z| z) {
+        d1.fill([0.0; 3]);
+        s1.fill([0.0; 3]);
+        return;
     }
     // The box rows: row y's five are those at the (unclamped) source rows s = 2y − 2 + k,
     // k = 0 … 4, each the box of the source rows clamp(s) and clamp(s + 1): even-x boxes for even
@@ -807,6 +836,13 @@ fn first_level(
     let pair = work;
     for (r, y) in rows.clone().enumerate() {
         let at = |dy: isize| 2 * (clamp(2 * y as isize - 2 + dy) - ta);
+        if (0..6).all(|dy| zero[at(dy) / 2]) {
+            d1[r * wo..(r + 1) * wo].fill([0.0; 3]);
+            if !s1.is_empty() {
+                s1[r * wo..(r + 1) * wo].fill([0.0; 3]);
+            }
+            continue;
+        }
         let [be0, bo1, be2, bo3, be4] = std::array::from_fn(|k| &boxes[2 * r + k][..]);
         taps(
             path,
