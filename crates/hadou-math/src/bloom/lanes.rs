@@ -955,6 +955,12 @@ pub fn try_glare_plane_in(
             let ns = levels(params.streak_length * h as f32);
             let mut hs = Plane::try_new_in(pool, l1.width, l1.height, l1.up.clone())?;
             fill.fill(&mut hs, &|y, row| {
+                // A row of `D₁ʰ` that is `+0` throughout (a dark stretch: see `first_level`) has a
+                // streak of `+0`: every level's sums and the blur start from `+0` and add `+0`.
+                if s1.row(y).iter().all(|t| is_plus_zero(*t)) {
+                    row.fill([0.0; 3]);
+                    return;
+                }
                 with_scratch(5, |s| {
                     let Scratch { rows, levels, .. } = s;
                     streak_from_first(path, s1.row(y), ns, &mut rows[..5], levels);
