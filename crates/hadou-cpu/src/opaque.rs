@@ -59,8 +59,9 @@ pub(crate) struct OpaqueBuffers {
 
 /// Anti-aliasing at the price of multisampling (issue 44): where all `k × k` samples of a pixel
 /// show one triangle (not an outline hull), the surface is shaded once, at the pixel's centre,
-/// and every sample takes that colour (its own hard shadow, soft-shadow term, depth and edge data
-/// stay per sample); coverage and depth stay per sample. Where the shading changes across the
+/// and every sample takes that colour and, with an `[area_light]`, that unshadowed lamp term (its
+/// own hard shadow, soft-shadow visibility, depth and edge data stay per sample); coverage and
+/// depth stay per sample. Where the shading changes across the
 /// pixel — a toon band's, a texture's or a wave light's edge — the centre colour differs from a
 /// neighbouring pixel's of the same object and material by more than [`ONCE_CONTRAST`], and the
 /// pixel is shaded sample by sample after all ([`refine`]), as every pixel was before. The
@@ -73,6 +74,10 @@ pub(crate) struct ShadedOnce {
     centre: Vec<[f32; 3]>,
     /// Per pixel: that triangle (`u32::MAX`: none).
     tri: Vec<u32>,
+    /// With an `[area_light]`, per pixel: what the lamp adds at its centre where its samples
+    /// share one triangle (`shading::area_term`; every sample takes it, as it takes the centre
+    /// colour); empty without one.
+    term: Vec<[f32; 3]>,
     /// Per sample: the plane shadows' choice (for the samples a refinement shades again).
     best: Vec<crate::shadows::Choice>,
     /// Per pixel, for the refinement's comparisons ([`Probe`]).
@@ -83,13 +88,20 @@ pub(crate) struct ShadedOnce {
     pub every_sample: bool,
 }
 
-/// A band's share of [`ShadedOnce`]: its pixels' centre colours and triangles, its samples'
-/// plane-shadow choices.
-type OnceBand<'a> = (&'a mut [[f32; 3]], &'a mut [u32], &'a mut [crate::shadows::Choice], &'a mut [Probe]);
+/// A band's share of [`ShadedOnce`]: its pixels' centre colours, triangles and area-light terms,
+/// its samples' plane-shadow choices.
+struct OnceBand<'a> {
+    centre: &'a mut [[f32; 3]],
+    tri: &'a mut [u32],
+    term: &'a mut [[f32; 3]],
+    best: &'a mut [crate::shadows::Choice],
+    probe: &'a mut [Probe],
+}
 
 /// A pixel as the refinement compares it with its neighbours: the square roots of its centre
-/// colour, and its object and material slot (`u64::MAX`: not shaded once).
-type Probe = ([f32; 3], u64);
+/// colour and of its area-light term (zero without an `[area_light]`), and its object and
+/// material slot (`u64::MAX`: not shaded once).
+type Probe = ([f32; 6], u64);
 
 /// The largest difference between the centre colours of neighbouring pixels of one object and
 /// material (per channel, of the square roots of the linear values: about sRGB's steps) that
@@ -178,24 +190,34 @@ pub(crate) fn draw_opaque_into(
         return;
     }
     // Without shading once every band gets empty slices.
-    let (centre, once_tri, once_best, probe) =
-        (&mut kept.centre, &mut kept.tri, &mut kept.best, &mut kept.probe);
+    let (centre, once_tri, once_term, once_best, probe) =
+        (&mut kept.centre, &mut kept.tri, &mut kept.term, &mut kept.best, &mut kept.probe);
     let pixels = if once { w * h / (k * k) } else { 0 };
     centre.resize(pixels, [0.0; 3]);
     once_tri.resize(pixels, u32::MAX);
+    once_term.resize(if area.is_some() { pixels } else { 0 }, [0.0; 3]);
     once_best.resize(if once { w * h } else { 0 }, NO_SHADOW);
-    probe.resize(pixels, ([0.0; 3], u64::MAX));
+    probe.resize(pixels, ([0.0; 6], u64::MAX));
     let band_pixels = BAND * w / (k * k);
     let mut once_chunks: Vec<OnceBand<'_>> = if once {
+        let mut terms = once_term.chunks_mut(band_pixels);
         centre
             .chunks_mut(band_pixels)
             .zip(once_tri.chunks_mut(band_pixels))
             .zip(once_best.chunks_mut(BAND * w))
             .zip(probe.chunks_mut(band_pixels))
-            .map(|(((a, b), c), d)| (a, b, c, d))
+            .map(|(((centre, tri), best), probe)| OnceBand {
+                centre,
+                tri,
+                term: terms.next().unwrap_or_default(),
+                best,
+                probe,
+            })
             .collect()
     } else {
-        (0..h.div_ceil(BAND)).map(|_| Default::default()).collect()
+        (0..h.div_ceil(BAND))
+            .map(|_| OnceBand { centre: &mut [], tri: &mut [], term: &mut [], best: &mut [], probe: &mut [] })
+            .collect()
     };
     // Without an area light every band gets an empty slice.
     let mut soft_chunks: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
@@ -228,218 +250,231 @@ pub(crate) fn draw_opaque_into(
             .zip(soft_batch.into_par_iter())
             .zip(once_batch.into_par_iter())
             .enumerate()
-            .for_each(
-                |(j, ((((((col, surf), obj), shad), edg), soft), (centre, once_tri, once_best, probe)))| {
-                    let b = first + j;
-                    let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
-                    let mine_shadows =
-                        || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
-                    let y_start = rows.start + b * BAND;
-                    let rows = col.len() / w;
-                    if mine().next().is_none() && mine_shadows().next().is_none() {
-                        // Nothing drawn here.
-                        col.fill(frame.background);
-                        surf.fill(None);
-                        obj.fill(None);
-                        shad.fill(None);
-                        edg.fill(EdgeTexel::default());
-                        soft.fill(None);
-                        centre.fill([f32::NAN; 3]);
-                        once_tri.fill(u32::MAX);
-                        probe.fill(([0.0; 3], u64::MAX));
-                        return;
-                    }
-                    // Otherwise every sample's and pixel's entry is written once below (a frame
-                    // at 4 samples moves some 200 bytes a sample through these buffers: a clear
-                    // before the writes would add half as much again).
-                    // The band's own buffers, kept by the thread from band to band and frame to frame
-                    // (fresh ones, over a megabyte a band at 1024 wide, cost their pages' faults and
-                    // clearing each time); taken out while in use, so a band the thread runs meanwhile
-                    // gets fresh ones.
-                    let mut scratch = BAND_SCRATCH.take();
-                    let BandScratch { zbuf, tri_id, world, surfaces, best } = &mut scratch;
-                    zbuf.clear();
-                    zbuf.resize(rows * w, f32::INFINITY);
-                    tri_id.clear();
-                    tri_id.resize(rows * w, u32::MAX);
-                    for ti in mine() {
-                        raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
-                    }
-                    // Shading once: the pixels whose samples all show one triangle (not a hull).
-                    let (pw, ph) = (w / k, rows / k);
-                    if once {
-                        for py in 0..ph {
-                            for px in 0..pw {
-                                let i0 = py * k * w + px * k;
-                                let t0 = tri_id[i0];
-                                let shared = t0 != u32::MAX
-                                    && !tris[t0 as usize].hull
-                                    && (0..k)
-                                        .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
-                                once_tri[py * pw + px] = if shared { t0 } else { u32::MAX };
-                            }
+            .for_each(|(j, ((((((col, surf), obj), shad), edg), soft), once_band))| {
+                let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, probe } = once_band;
+                let b = first + j;
+                let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
+                let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
+                let y_start = rows.start + b * BAND;
+                let rows = col.len() / w;
+                if mine().next().is_none() && mine_shadows().next().is_none() {
+                    // Nothing drawn here.
+                    col.fill(frame.background);
+                    surf.fill(None);
+                    obj.fill(None);
+                    shad.fill(None);
+                    edg.fill(EdgeTexel::default());
+                    soft.fill(None);
+                    centre.fill([f32::NAN; 3]);
+                    once_tri.fill(u32::MAX);
+                    probe.fill(([0.0; 6], u64::MAX));
+                    return;
+                }
+                // Otherwise every sample's and pixel's entry is written once below (a frame
+                // at 4 samples moves some 200 bytes a sample through these buffers: a clear
+                // before the writes would add half as much again).
+                // The band's own buffers, kept by the thread from band to band and frame to frame
+                // (fresh ones, over a megabyte a band at 1024 wide, cost their pages' faults and
+                // clearing each time); taken out while in use, so a band the thread runs meanwhile
+                // gets fresh ones.
+                let mut scratch = BAND_SCRATCH.take();
+                let BandScratch { zbuf, tri_id, world, surfaces, best } = &mut scratch;
+                zbuf.clear();
+                zbuf.resize(rows * w, f32::INFINITY);
+                tri_id.clear();
+                tri_id.resize(rows * w, u32::MAX);
+                for ti in mine() {
+                    raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
+                }
+                // Shading once: the pixels whose samples all show one triangle (not a hull).
+                let (pw, ph) = (w / k, rows / k);
+                if once {
+                    for py in 0..ph {
+                        for px in 0..pw {
+                            let i0 = py * k * w + px * k;
+                            let t0 = tri_id[i0];
+                            let shared = t0 != u32::MAX
+                                && !tris[t0 as usize].hull
+                                && (0..k)
+                                    .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
+                            once_tri[py * pw + px] = if shared { t0 } else { u32::MAX };
                         }
                     }
-                    // The visible point of every sample: its world position here, its normal in
-                    // the edge data (every entry written where a triangle is drawn; the rest is
-                    // never read). Where most samples take their pixel's one shade, only this
-                    // geometry: the few shaded one by one interpolate again, bit for bit the same
-                    // (a frame at 4 samples moves some 200 bytes a sample through its buffers,
-                    // and a whole surface a sample would add a quarter as much again). Where
-                    // every sample is shaded (one sample a pixel, or the area light's term), the
-                    // whole surface, kept.
-                    let keep = !once || area.is_some();
-                    world.resize(rows * w, Vec3f::ZERO);
-                    surfaces.resize(if keep { rows * w } else { 0 }, shading::Surface::default());
-                    for r in 0..rows {
-                        for x in 0..w {
-                            let i = r * w + x;
-                            if tri_id[i] == u32::MAX {
-                                (surf[i], obj[i], edg[i]) = (None, None, EdgeTexel::default());
-                                continue;
-                            }
-                            let py = (y_start + r) as f32;
-                            let t = &tris[tri_id[i] as usize];
-                            let (s, outline_dir) = if keep {
-                                interpolate(t, x as f32 + 0.5, py + 0.5)
-                            } else {
-                                interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
-                            };
-                            let d = (s.world - basis.eye).length();
-                            surf[i] = Some(if d.is_finite() { d } else { 0.0 });
-                            obj[i] = Some(t.object);
-                            // The edge pass reads the reach only where a neighbour shows another
-                            // object (or none): not where all four show this triangle.
-                            let ti = tri_id[i];
-                            let inside = x > 0
-                                && x + 1 < w
-                                && r > 0
-                                && r + 1 < rows
-                                && tri_id[i - 1] == ti
-                                && tri_id[i + 1] == ti
-                                && tri_id[i - w] == ti
-                                && tri_id[i + w] == ti;
-                            let reach = if outlined[ti as usize] && !inside {
-                                let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
-                                outline::reach_code(outline_dir, dir)
-                            } else {
-                                0
-                            };
-                            edg[i] =
-                                EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
-                            world[i] = s.world;
-                            if keep {
-                                surfaces[i] = s;
-                            }
+                }
+                // The visible point of every sample: its world position here, its normal in
+                // the edge data (every entry written where a triangle is drawn; the rest is
+                // never read). Where most samples take their pixel's one shade, only this
+                // geometry: the few shaded one by one interpolate again, bit for bit the same
+                // (a frame at 4 samples moves some 200 bytes a sample through its buffers,
+                // and a whole surface a sample would add a quarter as much again). Where
+                // every sample is shaded (one sample a pixel), the whole surface, kept.
+                let keep = !once;
+                world.resize(rows * w, Vec3f::ZERO);
+                surfaces.resize(if keep { rows * w } else { 0 }, shading::Surface::default());
+                for r in 0..rows {
+                    for x in 0..w {
+                        let i = r * w + x;
+                        if tri_id[i] == u32::MAX {
+                            (surf[i], obj[i], edg[i]) = (None, None, EdgeTexel::default());
+                            continue;
+                        }
+                        let py = (y_start + r) as f32;
+                        let t = &tris[tri_id[i] as usize];
+                        let (s, outline_dir) = if keep {
+                            interpolate(t, x as f32 + 0.5, py + 0.5)
+                        } else {
+                            interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
+                        };
+                        let d = (s.world - basis.eye).length();
+                        surf[i] = Some(if d.is_finite() { d } else { 0.0 });
+                        obj[i] = Some(t.object);
+                        // The edge pass reads the reach only where a neighbour shows another
+                        // object (or none): not where all four show this triangle.
+                        let ti = tri_id[i];
+                        let inside = x > 0
+                            && x + 1 < w
+                            && r > 0
+                            && r + 1 < rows
+                            && tri_id[i - 1] == ti
+                            && tri_id[i + 1] == ti
+                            && tri_id[i - w] == ti
+                            && tri_id[i + w] == ti;
+                        let reach = if outlined[ti as usize] && !inside {
+                            let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
+                            outline::reach_code(outline_dir, dir)
+                        } else {
+                            0
+                        };
+                        edg[i] = EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
+                        world[i] = s.world;
+                        if keep {
+                            surfaces[i] = s;
                         }
                     }
-                    // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
-                    best.clear();
-                    best.resize(rows * w, NO_SHADOW);
-                    let receiver = |i: usize| {
-                        let t = tris.get(tri_id[i] as usize)?;
-                        (!t.hull).then_some(t.object)
-                    };
-                    for si in mine_shadows() {
-                        let st = &shadow_tris[si as usize];
-                        cover(st, y_start, rows, w, |i, bary| {
-                            let Some(o) = receiver(i) else { return };
-                            let t = perspective(st, bary, |k| st.uv[k][0]);
-                            shadows.plane_candidate(
-                                frame,
-                                st.object,
-                                o,
-                                t,
-                                world[i],
-                                surf[i].unwrap_or(0.0),
-                                &mut best[i],
-                            );
-                        });
-                    }
-                    if once {
-                        // Each pixel whose samples share one triangle, shaded once at its centre.
-                        for py in 0..ph {
-                            for px in 0..pw {
-                                let t0 = once_tri[py * pw + px];
-                                if t0 != u32::MAX {
-                                    let t = &tris[t0 as usize];
-                                    let material = frame.objects[t.object as usize].material(t.material);
-                                    let half = k as f32 / 2.0;
-                                    let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
-                                    let (s, _) = interpolate(t, cx, cy);
-                                    let c = shading::shade(frame, lights, material, &s);
-                                    centre[py * pw + px] = c;
-                                    let key = (u64::from(t.object) << 32) | u64::from(t.material);
-                                    probe[py * pw + px] = (c.map(|v| v.max(0.0).sqrt()), key);
-                                } else {
-                                    centre[py * pw + px] = [f32::NAN; 3];
-                                    probe[py * pw + px] = ([0.0; 3], u64::MAX);
+                }
+                // Shadows: the receiver pixels each cast darkens, the largest opacity winning.
+                best.clear();
+                best.resize(rows * w, NO_SHADOW);
+                let receiver = |i: usize| {
+                    let t = tris.get(tri_id[i] as usize)?;
+                    (!t.hull).then_some(t.object)
+                };
+                for si in mine_shadows() {
+                    let st = &shadow_tris[si as usize];
+                    cover(st, y_start, rows, w, |i, bary| {
+                        let Some(o) = receiver(i) else { return };
+                        let t = perspective(st, bary, |k| st.uv[k][0]);
+                        shadows.plane_candidate(
+                            frame,
+                            st.object,
+                            o,
+                            t,
+                            world[i],
+                            surf[i].unwrap_or(0.0),
+                            &mut best[i],
+                        );
+                    });
+                }
+                if once {
+                    // Each pixel whose samples share one triangle, shaded once at its centre.
+                    for py in 0..ph {
+                        for px in 0..pw {
+                            let t0 = once_tri[py * pw + px];
+                            if t0 != u32::MAX {
+                                let t = &tris[t0 as usize];
+                                let material = frame.objects[t.object as usize].material(t.material);
+                                let half = k as f32 / 2.0;
+                                let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
+                                let (s, _) = interpolate(t, cx, cy);
+                                let c = shading::shade(frame, lights, material, &s);
+                                centre[py * pw + px] = c;
+                                let key = (u64::from(t.object) << 32) | u64::from(t.material);
+                                let root = |v: f32| v.max(0.0).sqrt();
+                                let mut seen = [0.0; 6];
+                                seen[..3].copy_from_slice(&c.map(root));
+                                if let Some(al) = area {
+                                    let a = shading::area_term(al, material, &s, frame.time);
+                                    once_term[py * pw + px] = a;
+                                    seen[3..].copy_from_slice(&a.map(root));
                                 }
+                                probe[py * pw + px] = (seen, key);
+                            } else {
+                                centre[py * pw + px] = [f32::NAN; 3];
+                                probe[py * pw + px] = ([0.0; 6], u64::MAX);
                             }
                         }
-                        once_best.copy_from_slice(best);
                     }
-                    for r in 0..rows {
-                        let prow = (r / k) * pw;
-                        let (mut px, mut sub) = (0, 0);
-                        for x in 0..w {
-                            let i = r * w + x;
-                            let p = prow + px;
-                            sub += 1;
-                            if sub == k {
-                                (px, sub) = (px + 1, 0);
+                    once_best.copy_from_slice(best);
+                }
+                for r in 0..rows {
+                    let prow = (r / k) * pw;
+                    let (mut px, mut sub) = (0, 0);
+                    for x in 0..w {
+                        let i = r * w + x;
+                        let p = prow + px;
+                        sub += 1;
+                        if sub == k {
+                            (px, sub) = (px + 1, 0);
+                        }
+                        let Some(t) = tris.get(tri_id[i] as usize) else {
+                            (col[i], shad[i]) = (frame.background, None);
+                            if area.is_some() {
+                                soft[i] = None;
                             }
-                            let Some(t) = tris.get(tri_id[i] as usize) else {
-                                (col[i], shad[i]) = (frame.background, None);
-                                if area.is_some() {
-                                    soft[i] = None;
-                                }
-                                continue;
-                            };
-                            let material = frame.objects[t.object as usize].material(t.material);
-                            // The whole surface where something shades it.
-                            let surface = || {
+                            continue;
+                        };
+                        let material = frame.objects[t.object as usize].material(t.material);
+                        let shared = once && once_tri[p] != u32::MAX;
+                        // The whole surface where something shades it (interpolated once).
+                        let mut whole = None;
+                        let mut surface = || {
+                            *whole.get_or_insert_with(|| {
                                 if keep {
                                     surfaces[i]
                                 } else {
                                     interpolate(t, x as f32 + 0.5, (y_start + r) as f32 + 0.5).0
                                 }
-                            };
-                            let c = match (t.hull, material.outline) {
-                                _ if once && once_tri[p] != u32::MAX => centre[p],
-                                (true, Some(_)) => material.outline_rgb(&frame.light),
-                                _ => shading::shade(frame, lights, material, &surface()),
-                            };
-                            if t.hull {
-                                (col[i], shad[i]) = (c, None);
-                                if area.is_some() {
-                                    soft[i] = None;
-                                }
-                            } else {
-                                (col[i], shad[i]) = shadows.resolve(frame, t.object, world[i], best[i], c);
-                                if let Some(al) = area {
-                                    soft[i] = Some(SoftPoint {
-                                        world: world[i],
-                                        normal: edg[i].normal.normalize_or(Vec3f::ZERO),
-                                        term: shading::area_term(al, material, &surface(), frame.time),
-                                    });
-                                }
+                            })
+                        };
+                        let c = match (t.hull, material.outline) {
+                            _ if shared => centre[p],
+                            (true, Some(_)) => material.outline_rgb(&frame.light),
+                            _ => shading::shade(frame, lights, material, &surface()),
+                        };
+                        if t.hull {
+                            (col[i], shad[i]) = (c, None);
+                            if area.is_some() {
+                                soft[i] = None;
+                            }
+                        } else {
+                            (col[i], shad[i]) = shadows.resolve(frame, t.object, world[i], best[i], c);
+                            if let Some(al) = area {
+                                soft[i] = Some(SoftPoint {
+                                    world: world[i],
+                                    normal: edg[i].normal.normalize_or(Vec3f::ZERO),
+                                    term: if shared {
+                                        once_term[p]
+                                    } else {
+                                        shading::area_term(al, material, &surface(), frame.time)
+                                    },
+                                });
                             }
                         }
                     }
-                    BAND_SCRATCH.set(scratch);
-                },
-            );
+                }
+                BAND_SCRATCH.set(scratch);
+            });
     }
     if once {
-        refine(frame, setup, &tris, k, rows.start, color, shadow, kept);
+        refine(frame, setup, &tris, k, rows.start, color, shadow, soft, kept);
     }
 }
 
 /// Shades sample by sample the pixels of [`ShadedOnce`] whose centre colour differs from a
 /// neighbouring pixel's of the same object and material by more than [`ONCE_CONTRAST`] (in
 /// either direction, so both sides of a band's edge), exactly as the samples of any other pixel
-/// are shaded. `color` and `shadow` hold the drawn sample rows from `y0`.
+/// are shaded (with an `[area_light]`, its term too). `color`, `shadow` and `soft` (empty without
+/// an area light) hold the drawn sample rows from `y0`.
 #[allow(clippy::too_many_arguments)]
 fn refine(
     frame: &Frame,
@@ -449,6 +484,7 @@ fn refine(
     y0: usize,
     color: &mut [[f32; 3]],
     shadow: &mut [Option<u32>],
+    soft: &mut [Option<SoftPoint>],
     kept: &mut ShadedOnce,
 ) {
     let w = frame.width as usize;
@@ -479,8 +515,15 @@ fn refine(
         }
     });
     let pairs = &pairs[..];
-    color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).enumerate().for_each(
-        |(py, (col, shad))| {
+    let area = frame.area_light.as_ref();
+    // Without an area light every pixel row gets an empty slice.
+    let soft_rows: Vec<&mut [Option<SoftPoint>]> = if area.is_some() {
+        soft.chunks_mut(k * w).collect()
+    } else {
+        (0..ph).map(|_| Default::default()).collect()
+    };
+    color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).zip(soft_rows).enumerate().for_each(
+        |(py, ((col, shad), soft))| {
             let row = &pairs[py * pw..py * pw + pw];
             let above = py.checked_sub(1).map(|a| &pairs[a * pw..a * pw + pw]);
             for px in 0..pw {
@@ -506,6 +549,9 @@ fn refine(
                         let c = shading::shade(frame, &setup.lights, material, &s);
                         (col[i], shad[i]) =
                             setup.shadows.resolve(frame, t.object, s.world, best[(py * k + j) * w + x], c);
+                        if let (Some(al), Some(Some(p))) = (area, soft.get_mut(i)) {
+                            p.term = shading::area_term(al, material, &s, frame.time);
+                        }
                     }
                 }
             }
@@ -521,12 +567,11 @@ const PAIR_SE: u8 = 4;
 const PAIR_SW: u8 = 8;
 
 /// Whether two neighbouring pixels were both shaded once, show the same object and material, and
-/// differ in a channel by more than [`ONCE_CONTRAST`] (a NaN channel counts as no difference).
+/// differ in a channel of the colour or of the area-light term by more than [`ONCE_CONTRAST`] (a
+/// NaN channel counts as no difference).
 #[inline]
 fn differs((a, ka): &Probe, (b, kb): &Probe) -> bool {
-    let step = ((a[0] - b[0]).abs() > ONCE_CONTRAST)
-        | ((a[1] - b[1]).abs() > ONCE_CONTRAST)
-        | ((a[2] - b[2]).abs() > ONCE_CONTRAST);
+    let step = a.iter().zip(b).fold(false, |d, (a, b)| d | ((a - b).abs() > ONCE_CONTRAST));
     (ka == kb) & (*ka != u64::MAX) & step
 }
 

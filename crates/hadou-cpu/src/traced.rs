@@ -326,13 +326,25 @@ pub fn traced_grid_counted(
             }
         })
         .collect();
-    let pixel_of = |j: usize| (j / width / k) * w + (j % width) / k;
-    let mut out = traced_where(bvh, light, points, width, samples, |j| !settled[pixel_of(j)]);
-    out.par_iter_mut().zip(points).enumerate().for_each(|(j, (o, p))| {
-        let i = pixel_of(j);
-        if settled[i] {
-            // A point the lamp adds nothing to stays 0, as [`traced_with`] gives it.
-            *o = if p.is_some_and(|p| lit_at_all(p.term)) { once[i] } else { 0.0 };
+    // Each point's pixel's verdict, spread row by row (no division per point).
+    let mut settled_at = vec![false; points.len()];
+    settled_at.par_chunks_mut(width).enumerate().for_each(|(sy, row)| {
+        let py = sy / k;
+        for (px, cell) in row.chunks_mut(k).enumerate() {
+            cell.fill(settled[py * w + px]);
+        }
+    });
+    let mut out = traced_where(bvh, light, points, width, samples, |j| !settled_at[j]);
+    out.par_chunks_mut(width).zip(points.par_chunks(width)).enumerate().for_each(|(sy, (o, p))| {
+        let py = sy / k;
+        for (px, (o, p)) in o.chunks_mut(k).zip(p.chunks(k)).enumerate() {
+            let i = py * w + px;
+            if settled[i] {
+                for (o, p) in o.iter_mut().zip(p) {
+                    // A point the lamp adds nothing to stays 0, as [`traced_with`] gives it.
+                    *o = if p.is_some_and(|p| lit_at_all(p.term)) { once[i] } else { 0.0 };
+                }
+            }
         }
     });
     let drawn = (0..w * h)
