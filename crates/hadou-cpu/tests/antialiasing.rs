@@ -210,3 +210,33 @@ fn shading_once_per_pixel_stays_within_tolerance_of_every_sample_shaded() {
     // The rule is in force: some scene's pixels are shaded once (and so differ in their last bits).
     assert!(differing > 0, "no scene changed: the frames were all shaded sample by sample");
 }
+
+/// Issue 44, point 1, with an `[area_light]`: a pixel shaded once takes the lamp's unshadowed
+/// light at its centre too, and the refinement compares that light as it compares the colour. The
+/// floor of `soft-gradient` made a hard two-band toon surface is lit evenly by the scene's own
+/// light (a flat floor: one colour everywhere) but banded by the lamp (its `N·l̂` changes across
+/// the floor), so only the lamp's light shows the band's edge: shaded once without that
+/// comparison, its edge pixels would take one band or the other whole (tens of 8-bit codes off).
+#[test]
+fn the_lamps_own_bands_are_refined_like_the_colours() {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/soft-gradient.toml");
+    let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut frame = scene.at(0.0);
+    (frame.width, frame.height, frame.samples) = (160, 120, 4);
+    let floor = frame.objects.iter_mut().find(|o| o.name == "floor").expect("the floor");
+    floor.materials[0] = Material {
+        model: hadou_scene::ShadingModel::Toon,
+        ramp: Ramp {
+            kind: RampKind::Bands { smoothing: 0.0 },
+            stops: vec![(-1.0, [0.2, 0.2, 0.2]), (0.55, [1.0, 1.0, 1.0])],
+        },
+        ..Material::diffuse([0.8, 0.8, 0.8])
+    };
+    let (once, every) = (bytes(&render(&frame)), bytes(&render_every_sample_shaded(&frame)));
+    let largest = once.iter().zip(&every).map(|(a, b)| (a - b).abs()).max().unwrap_or(0);
+    // Both of the lamp's bands are on the floor in view (the upper one saturates the code).
+    let upper = every.chunks(3).filter(|c| c[0] >= 245).count();
+    let lower = every.chunks(3).filter(|c| (200..235).contains(&c[0])).count();
+    assert!(upper > 2000 && lower > 2000, "the lamp's band edge is not in view: {upper} and {lower} pixels");
+    assert!(largest <= 2, "the lamp's band edge shaded once: {largest} codes from every sample shaded");
+}
