@@ -76,11 +76,13 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
             let mut row = Vec::new();
             for x in 0..w {
                 let i = r * w + x;
+                // (The reach tested first: it is 0 for hulls, the background and every pixel of a
+                // surface without an outline or not on its edge.)
                 let EdgeTexel { material, reach: code, .. } = edge[i];
-                let Some(o) = owner(i) else { continue };
                 if code == 0 {
                     continue;
                 }
+                let Some(o) = owner(i) else { continue };
                 // Neighbours outside the buffers count as the same object. (Tested first: most
                 // pixels of an outlined surface are not on its edge.)
                 let differs = |j: usize| owner(j) != Some(o);
@@ -126,10 +128,17 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 (Some(_), false) => object[i],
                 _ => None,
             };
-            // Per pixel: the winning edge's eye distance and (row, index in its row).
-            let mut best: Vec<Option<(f32, u32, u32)>> = vec![None; rows * w];
-            let mut any = false;
-            for (rr, row) in edges.iter().enumerate().take(y0 + rows + reach).skip(y0.saturating_sub(reach)) {
+            let window = || edges.iter().enumerate().take(y0 + rows + reach).skip(y0.saturating_sub(reach));
+            if window().all(|(_, row)| row.is_empty()) {
+                return;
+            }
+            // Per pixel: the winning edge's eye distance and (row, index in its row); kept by the
+            // thread from band to band (all `None` between bands: only the pixels listed in
+            // `touched` are set, and reset after), since most of a band's pixels are never reached.
+            let mut scratch = EDGE_SCRATCH.take();
+            let (best, touched) = &mut scratch;
+            best.resize(rows * w, None);
+            for (rr, row) in window() {
                 // The band's rows within the window of the edge pixels of row `rr`.
                 let r_lo = rr.saturating_sub(reach).max(y0);
                 let r_hi = (rr + reach + 1).min(y0 + rows);
@@ -151,18 +160,18 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                             let p_dir = unit_dir(basis, frame, x, first_row + r);
                             let p_dist = surface[i].unwrap_or(0.0);
                             if in_front(edge[i].normal, p_dir, p_dist, e.dir, e.distance) {
+                                if best[i].is_none() {
+                                    touched.push(i as u32);
+                                }
                                 best[i] = Some((e.distance, rr as u32, k as u32));
-                                any = true;
                             }
                         }
                     }
                 }
             }
-            if !any {
-                return;
-            }
-            for (i, win) in best.into_iter().enumerate() {
-                let Some((_, rr, k)) = win else { continue };
+            for &i in touched.iter() {
+                let i = i as usize;
+                let Some((_, rr, k)) = best[i].take() else { continue };
                 let e = &edges[rr as usize][k as usize];
                 let mat = frame.objects[e.object as usize].material(e.material);
                 if mat.outline.is_some() {
@@ -175,5 +184,15 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                     edge[i] = EdgeTexel { material: e.material, hull: true, reach: 0, ..edge[i] };
                 }
             }
+            touched.clear();
+            EDGE_SCRATCH.set(scratch);
         });
+}
+
+/// The per-pixel winners of the edge pass's bands and the pixels they set.
+type EdgeScratch = (Vec<Option<(f32, u32, u32)>>, Vec<u32>);
+
+thread_local! {
+    /// Each thread's [`EdgeScratch`], kept from band to band (its winners all `None` between).
+    static EDGE_SCRATCH: std::cell::Cell<EdgeScratch> = const { std::cell::Cell::new((Vec::new(), Vec::new())) };
 }

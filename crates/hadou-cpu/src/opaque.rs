@@ -61,7 +61,11 @@ pub(crate) struct OpaqueBuffers {
 /// show one triangle (not an outline hull), the surface is shaded once, at the pixel's centre,
 /// and every sample takes that colour and, with an `[area_light]`, that unshadowed lamp term (its
 /// own hard shadow, soft-shadow visibility, depth and edge data stay per sample); coverage and
-/// depth stay per sample. Where the shading changes across the
+/// depth stay per sample. In a frame without hard or soft shadows, whose samples need no visible
+/// point of their own, such a pixel's samples also take the centre's surface (its normal, for the
+/// edge pass) without an interpolation of their own: a sample's eye distance is its view depth
+/// from the raster times its ray's length (so the waves' clipping and the outlines' depth tests
+/// keep each sample's depth), and the outline's reach stays the sample's own. Where the shading changes across the
 /// pixel — a toon band's, a texture's or a wave light's edge — the centre colour differs from a
 /// neighbouring pixel's of the same object and material by more than [`ONCE_CONTRAST`], and the
 /// pixel is shaded sample by sample after all ([`refine`]), as every pixel was before. The
@@ -169,7 +173,14 @@ pub(crate) fn draw_opaque_into(
         .collect();
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
     let k = grid.max(1);
+    // `x / k` as a shift where shading once (k is 2 or 4 there): a division a sample costs more
+    // than the rest of what a sample of a pixel shaded once does.
+    let k_shift = k.trailing_zeros();
+    // Whether a sample needs its own visible point (its hard shadows or soft shadows are its
+    // own); otherwise a sample of a pixel shaded once takes its pixel's centre geometry too.
+    let point_per_sample = frame.area_light.is_some() || shadows.any();
     let once = k > 1
+        && k.is_power_of_two()
         && !out.once.every_sample
         && BAND.is_multiple_of(k)
         && rows.start.is_multiple_of(k)
@@ -278,7 +289,7 @@ pub(crate) fn draw_opaque_into(
                 // clearing each time); taken out while in use, so a band the thread runs meanwhile
                 // gets fresh ones.
                 let mut scratch = BAND_SCRATCH.take();
-                let BandScratch { zbuf, tri_id, world, surfaces, best } = &mut scratch;
+                let BandScratch { zbuf, tri_id, world, surfaces, best, centres } = &mut scratch;
                 zbuf.clear();
                 zbuf.resize(rows * w, f32::INFINITY);
                 tri_id.clear();
@@ -286,8 +297,10 @@ pub(crate) fn draw_opaque_into(
                 for ti in mine() {
                     raster_tri(&tris[ti as usize], ti, y_start, rows, w, far, zbuf, tri_id);
                 }
-                // Shading once: the pixels whose samples all show one triangle (not a hull).
+                // Shading once: the pixels whose samples all show one triangle (not a hull), and
+                // their surfaces at their centres.
                 let (pw, ph) = (w / k, rows / k);
+                centres.resize(if once { pw * ph } else { 0 }, (shading::Surface::default(), [0.0; 4]));
                 if once {
                     for py in 0..ph {
                         for px in 0..pw {
@@ -298,6 +311,19 @@ pub(crate) fn draw_opaque_into(
                                 && (0..k)
                                     .all(|j| tri_id[i0 + j * w..i0 + j * w + k].iter().all(|&t| t == t0));
                             once_tri[py * pw + px] = if shared { t0 } else { u32::MAX };
+                            if shared {
+                                let half = k as f32 / 2.0;
+                                let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
+                                let (s, _) = interpolate(&tris[t0 as usize], cx, cy);
+                                // The triangle's plane in view axes, through the centre's point:
+                                // its normal `n` and `n·(C − eye)`.
+                                let [a, b, c] = tris[t0 as usize].world;
+                                let n = (b - a).cross(c - a);
+                                let to = s.world - basis.eye;
+                                let plane =
+                                    [n.dot(basis.right), n.dot(basis.up), n.dot(basis.forward), n.dot(to)];
+                                centres[py * pw + px] = (s, plane);
+                            }
                         }
                     }
                 }
@@ -311,7 +337,14 @@ pub(crate) fn draw_opaque_into(
                 let keep = !once;
                 world.resize(rows * w, Vec3f::ZERO);
                 surfaces.resize(if keep { rows * w } else { 0 }, shading::Surface::default());
+                // A sample's ray direction is `forward + ax·right + ay·up`
+                // (`CameraBasis::pixel_dir`), `ax` by column and `ay` by row: it meets the plane
+                // `n·(P − eye) = q` at eye distance `q·√(1 + ax² + ay²) / (n·dir)`.
+                let (sx, sy) = (basis.tan_half_fov * basis.aspect, basis.tan_half_fov);
+                let ray_x = |x: usize| (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * sx;
                 for r in 0..rows {
+                    let prow = (r / k) * pw;
+                    let ay = (1.0 - 2.0 * ((y_start + r) as f32 + 0.5) / frame.height as f32) * sy;
                     for x in 0..w {
                         let i = r * w + x;
                         if tri_id[i] == u32::MAX {
@@ -320,13 +353,31 @@ pub(crate) fn draw_opaque_into(
                         }
                         let py = (y_start + r) as f32;
                         let t = &tris[tri_id[i] as usize];
-                        let (s, outline_dir) = if keep {
-                            interpolate(t, x as f32 + 0.5, py + 0.5)
+                        // A sample of a pixel shaded once whose point is not its own takes the
+                        // centre's (multisampling's rule: one surface a pixel, coverage and
+                        // depth order per sample); the outline's reach below stays its own.
+                        let centred = (once && !point_per_sample)
+                            .then(|| prow + (x >> k_shift))
+                            .filter(|&p| once_tri[p] != u32::MAX)
+                            .map(|p| &centres[p]);
+                        let (s, d) = if let Some(&(s, [nx, ny, nz, q])) = centred {
+                            // (Its raster depth times its ray's length where the plane is seen
+                            // edge-on: less exact far from a huge triangle's vertices.)
+                            let ax = ray_x(x);
+                            let len = (1.0 + ax * ax + ay * ay).sqrt();
+                            let d = q * len / (nz + nx * ax + ny * ay);
+                            let d = if d.is_finite() && d > 0.0 { d } else { zbuf[i] * len };
+                            (s, if d.is_finite() { d } else { 0.0 })
                         } else {
-                            interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
+                            let (s, _) = if keep {
+                                interpolate(t, x as f32 + 0.5, py + 0.5)
+                            } else {
+                                interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
+                            };
+                            let d = (s.world - basis.eye).length();
+                            (s, if d.is_finite() { d } else { 0.0 })
                         };
-                        let d = (s.world - basis.eye).length();
-                        surf[i] = Some(if d.is_finite() { d } else { 0.0 });
+                        surf[i] = Some(d);
                         obj[i] = Some(t.object);
                         // The edge pass reads the reach only where a neighbour shows another
                         // object (or none): not where all four show this triangle.
@@ -340,13 +391,17 @@ pub(crate) fn draw_opaque_into(
                             && tri_id[i - w] == ti
                             && tri_id[i + w] == ti;
                         let reach = if outlined[ti as usize] && !inside {
+                            let (_, outline_dir) = interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5);
                             let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
                             outline::reach_code(outline_dir, dir)
                         } else {
                             0
                         };
                         edg[i] = EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
-                        world[i] = s.world;
+                        if centred.is_none() {
+                            // (A centred sample's point is read by nothing: it has no shadows.)
+                            world[i] = s.world;
+                        }
                         if keep {
                             surfaces[i] = s;
                         }
@@ -383,9 +438,7 @@ pub(crate) fn draw_opaque_into(
                             if t0 != u32::MAX {
                                 let t = &tris[t0 as usize];
                                 let material = frame.objects[t.object as usize].material(t.material);
-                                let half = k as f32 / 2.0;
-                                let (cx, cy) = ((k * px) as f32 + half, (y_start + k * py) as f32 + half);
-                                let (s, _) = interpolate(t, cx, cy);
+                                let s = centres[py * pw + px].0;
                                 let c = shading::shade(frame, lights, material, &s);
                                 centre[py * pw + px] = c;
                                 let key = (u64::from(t.object) << 32) | u64::from(t.material);
@@ -416,6 +469,12 @@ pub(crate) fn draw_opaque_into(
                         if sub == k {
                             (px, sub) = (px + 1, 0);
                         }
+                        let shared = once && once_tri[p] != u32::MAX;
+                        if shared && !point_per_sample {
+                            // Its pixel's one shade, and no shadow of its own.
+                            (col[i], shad[i]) = (centre[p], None);
+                            continue;
+                        }
                         let Some(t) = tris.get(tri_id[i] as usize) else {
                             (col[i], shad[i]) = (frame.background, None);
                             if area.is_some() {
@@ -424,7 +483,6 @@ pub(crate) fn draw_opaque_into(
                             continue;
                         };
                         let material = frame.objects[t.object as usize].material(t.material);
-                        let shared = once && once_tri[p] != u32::MAX;
                         // The whole surface where something shades it (interpolated once).
                         let mut whole = None;
                         let mut surface = || {
@@ -571,8 +629,12 @@ const PAIR_SW: u8 = 8;
 /// NaN channel counts as no difference).
 #[inline]
 fn differs((a, ka): &Probe, (b, kb): &Probe) -> bool {
-    let step = a.iter().zip(b).fold(false, |d, (a, b)| d | ((a - b).abs() > ONCE_CONTRAST));
-    (ka == kb) & (*ka != u64::MAX) & step
+    // (The keys first: neighbours of other objects or materials need no channel compared.)
+    if ka != kb || *ka == u64::MAX {
+        return false;
+    }
+    let step = a.iter().zip(b).fold(0.0f32, |d, (a, b)| d.max((a - b).abs()));
+    step > ONCE_CONTRAST
 }
 
 /// A band's depth, triangle, visible-surface and shadow buffers ([`draw_opaque_into`]).
@@ -583,6 +645,9 @@ struct BandScratch {
     world: Vec<Vec3f>,
     surfaces: Vec<shading::Surface>,
     best: Vec<crate::shadows::Choice>,
+    /// Per pixel shaded once: its surface at its centre, and its triangle's plane through that
+    /// point in view axes (the normal's right, up and forward components, and `n·(C − eye)`).
+    centres: Vec<(shading::Surface, [f32; 4])>,
 }
 
 thread_local! {

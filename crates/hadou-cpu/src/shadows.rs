@@ -55,6 +55,11 @@ impl ShadowCasts {
         ShadowCasts { casts, maps }
     }
 
+    /// Whether the frame casts any hard shadow.
+    pub(crate) fn any(&self) -> bool {
+        !self.casts.is_empty()
+    }
+
     /// Whether any cast projects onto a plane.
     pub(crate) fn any_plane(&self) -> bool {
         self.maps.iter().any(Option::is_none)

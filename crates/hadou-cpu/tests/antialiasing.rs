@@ -181,7 +181,12 @@ fn bytes(img: &Image) -> Vec<i32> {
 /// Issue 44, point 1: shading a surface once per pixel where it is smooth across the pixel (and
 /// sample by sample where a band's, a texture's or a wave light's edge crosses it) keeps every
 /// example scene, at 4 and 16 samples, within the issue's tolerance of the frame with every
-/// sample shaded: mean absolute difference ≤ 1 and 99.9th percentile ≤ 8 on 8-bit codes.
+/// sample shaded: mean absolute difference ≤ 1 and 99.9th percentile ≤ 8 on 8-bit codes. Each
+/// sample keeps its own eye distance (where nothing shadows, a pixel shaded once gives its samples
+/// its centre's surface, but their distances from their own depths and rays): the pixels' depths,
+/// which the waves are clipped at, within 1e-4 of the frame with every sample shaded (relative;
+/// the CPU–GPU differential allows 1e-3) but for at most 0.1 % of them (a pixel whose samples'
+/// spread in depth sits at `SAMPLE_DEPTH_SPREAD` may turn from their mean to their nearest).
 #[test]
 fn shading_once_per_pixel_stays_within_tolerance_of_every_sample_shaded() {
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
@@ -198,7 +203,15 @@ fn shading_once_per_pixel_stays_within_tolerance_of_every_sample_shaded() {
         for samples in [4, 16] {
             let mut frame = scene.at(scene.duration() * 0.6);
             (frame.width, frame.height, frame.samples) = (160, 120, samples);
-            let (once, every) = (bytes(&render(&frame)), bytes(&render_every_sample_shaded(&frame)));
+            let (once, every) = (render(&frame), render_every_sample_shaded(&frame));
+            let off = once
+                .depth
+                .iter()
+                .zip(&every.depth)
+                .filter(|(a, b)| (*a - *b).abs() > 1e-4 * a.abs().max(b.abs()).max(1e-6))
+                .count();
+            assert!(off * 1000 <= once.depth.len(), "{name}, {samples} samples: {off} pixels' depths moved");
+            let (once, every) = (bytes(&once), bytes(&every));
             let mut d: Vec<i32> = once.iter().zip(&every).map(|(a, b)| (a - b).abs()).collect();
             let mean = d.iter().sum::<i32>() as f64 / d.len() as f64;
             d.sort_unstable();
