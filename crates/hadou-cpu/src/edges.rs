@@ -12,7 +12,7 @@
 //! of several, the nearest `q` to the eye wins, ties to the first in row-major order. The GPU's
 //! `shaders/edges.wgsl` is the twin.
 
-use crate::opaque::{EdgeTexel, OpaqueBuffers};
+use crate::opaque::{OpaqueBuffers, HULL, NONE};
 use hadou_math::outline::{in_front, reach_pixels, reach_window};
 use hadou_math::Vec3f;
 use hadou_scene::{CameraBasis, Frame};
@@ -63,10 +63,10 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     let hull_px = |o: u32, m: u32, z: f32| {
         frame.objects[o as usize].material(m).hull_pixels(z, basis.tan_half_fov, frame.height)
     };
-    let OpaqueBuffers { color, surface, object, shadow, edge, .. } = out;
+    let OpaqueBuffers { color, surface, object, shadow, normal, material, reach: reaches, .. } = out;
     // A surface pixel's object (hulls and the background: none).
-    let owner = |i: usize| match (surface[i], edge[i].hull) {
-        (Some(_), false) => object[i],
+    let owner = |i: usize| match (surface[i].is_finite(), material[i] & HULL != 0) {
+        (true, false) if object[i] != NONE => Some(object[i]),
         _ => None,
     };
     // Each row's edge pixels, in order of x.
@@ -78,10 +78,11 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 let i = r * w + x;
                 // (The reach tested first: it is 0 for hulls, the background and every pixel of a
                 // surface without an outline or not on its edge.)
-                let EdgeTexel { material, reach: code, .. } = edge[i];
+                let code = u32::from(reaches[i]);
                 if code == 0 {
                     continue;
                 }
+                let material = material[i];
                 let Some(o) = owner(i) else { continue };
                 // Neighbours outside the buffers count as the same object. (Tested first: most
                 // pixels of an outlined surface are not on its edge.)
@@ -94,13 +95,13 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                     continue;
                 }
                 let dir = unit_dir(basis, frame, x, r + first_row);
-                let z = surface[i].unwrap_or(0.0) * dir.dot(basis.forward);
+                let z = surface[i] * dir.dot(basis.forward);
                 let px = hull_px(o, material, z);
                 let rp = reach_pixels(px, code);
                 if rp.is_nan() || rp <= 0.0 {
                     continue;
                 }
-                let distance = surface[i].unwrap_or(0.0);
+                let distance = surface[i];
                 row.push(Edge { x: x as u32, reach2: rp * rp, object: o, material, distance, dir });
             }
             row
@@ -119,13 +120,15 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
         .zip(surface.par_chunks(EDGE_BAND * w))
         .zip(object.par_chunks_mut(EDGE_BAND * w))
         .zip(shadow.par_chunks_mut(EDGE_BAND * w))
-        .zip(edge.par_chunks_mut(EDGE_BAND * w))
+        .zip(normal.par_chunks(EDGE_BAND * w))
+        .zip(material.par_chunks_mut(EDGE_BAND * w))
+        .zip(reaches.par_chunks_mut(EDGE_BAND * w))
         .enumerate()
-        .for_each(|(band, ((((color, surface), object), shadow), edge))| {
+        .for_each(|(band, ((((((color, surface), object), shadow), normal), material), reaches))| {
             let y0 = band * EDGE_BAND;
             let rows = surface.len() / w;
-            let owner = |i: usize| match (surface[i], edge[i].hull) {
-                (Some(_), false) => object[i],
+            let owner = |i: usize| match (surface[i].is_finite(), material[i] & HULL != 0) {
+                (true, false) if object[i] != NONE => Some(object[i]),
                 _ => None,
             };
             let window = || edges.iter().enumerate().take(y0 + rows + reach).skip(y0.saturating_sub(reach));
@@ -158,8 +161,8 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                                 continue;
                             }
                             let p_dir = unit_dir(basis, frame, x, first_row + r);
-                            let p_dist = surface[i].unwrap_or(0.0);
-                            if in_front(edge[i].normal, p_dir, p_dist, e.dir, e.distance) {
+                            let p_dist = surface[i];
+                            if in_front(normal[i], p_dir, p_dist, e.dir, e.distance) {
                                 if best[i].is_none() {
                                     touched.push(i as u32);
                                 }
@@ -176,12 +179,12 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
                 let mat = frame.objects[e.object as usize].material(e.material);
                 if mat.outline.is_some() {
                     color[i] = mat.outline_rgb(&frame.light);
-                    shadow[i] = None;
+                    shadow[i] = NONE;
                     // The pixel now shows that object's outline, as a hull pixel of it would (the
                     // GPU's edge pass writes its material word | HULL_BIT): what the probe names
                     // and what the anti-aliased resolve compares.
-                    object[i] = Some(e.object);
-                    edge[i] = EdgeTexel { material: e.material, hull: true, reach: 0, ..edge[i] };
+                    object[i] = e.object;
+                    (material[i], reaches[i]) = (e.material | HULL, 0);
                 }
             }
             touched.clear();

@@ -34,20 +34,34 @@ pub struct SoftPoint {
 pub(crate) struct OpaqueBuffers {
     /// Shaded linear RGB, background where nothing is drawn.
     pub color: Vec<[f32; 3]>,
-    /// Eye distance to the visible surface, `None` where nothing is drawn.
-    pub surface: Vec<Option<f32>>,
-    /// Index into `frame.objects` of the visible object, if any.
-    pub object: Vec<Option<u32>>,
-    /// Index into `frame.shadows` of the shadow the pixel takes, if any.
-    pub shadow: Vec<Option<u32>>,
+    /// Eye distance to the visible surface (finite), `+∞` where nothing is drawn (as the wave
+    /// pass reads it).
+    pub surface: Vec<f32>,
+    /// Index into `frame.objects` of the visible object, [`NONE`] where nothing is drawn (four
+    /// bytes a sample, not an `Option`'s eight: a frame at 4 samples a pixel writes and reads
+    /// these buffers sample by sample).
+    pub object: Vec<u32>,
+    /// Index into `frame.shadows` of the shadow the pixel takes, [`NONE`] where none.
+    pub shadow: Vec<u32>,
     /// With an `[area_light]`: each pixel's visible point for the soft shadows (`None` for the
     /// background and outline hulls); empty without one.
     pub soft: Vec<Option<SoftPoint>>,
     /// The soft-shadow visibility per pixel once resolved (empty before, and without an area
     /// light).
     pub visibility: Vec<f32>,
-    /// What the edge pass ([`crate::edges`]) reads of each drawn pixel.
-    pub edge: Vec<EdgeTexel>,
+    /// What the edge pass ([`crate::edges`]) and the anti-aliased resolve read of each drawn
+    /// pixel (the GPU's G-buffer holds the same), in three planes so that each reader touches
+    /// only the bytes it needs (a frame at 4 samples a pixel scans them sample by sample): the
+    /// interpolated world normal (not unit; zero where the surface has none) …
+    pub normal: Vec<Vec3f>,
+    /// … the material slot of the visible triangle's object, with [`HULL`] set for an outline
+    /// hull fragment (0 where nothing is drawn) …
+    pub material: Vec<u32>,
+    /// … and the hull's reach across the view ray (`hadou_math::outline::reach_code`, at most
+    /// `REACH_STEPS` = 255): 0 for hulls, the background and materials without an outline, and
+    /// where the edge pass does not read it (wherever the four neighbours show surfaces of the
+    /// same object).
+    pub reach: Vec<u8>,
     /// A `[bloom]` frame's linear colour, kept from frame to frame (not the opaque pass's).
     pub glare_linear: Vec<[f32; 3]>,
     /// The glare's planes, kept from frame to frame (not the opaque pass's).
@@ -113,20 +127,12 @@ type Probe = ([f32; 6], u64);
 /// box-filtered mean over the samples it then differs from by at most about half this step.
 pub(crate) const ONCE_CONTRAST: f32 = 1.0 / 255.0;
 
-/// A drawn pixel as the edge pass reads it (the GPU's G-buffer holds the same).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct EdgeTexel {
-    /// The interpolated world normal (not unit; zero where the surface has none).
-    pub normal: Vec3f,
-    /// The material slot of the visible triangle's object.
-    pub material: u32,
-    /// An outline hull fragment.
-    pub hull: bool,
-    /// The hull's reach across the view ray here (`hadou_math::outline::reach_code`; 0 for hulls
-    /// and materials without an outline, and where the edge pass does not read it: wherever the
-    /// four neighbours show the same triangle, so none can be another object's).
-    pub reach: u32,
-}
+/// No object or shadow ([`OpaqueBuffers::object`], [`OpaqueBuffers::shadow`]).
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// The bit of [`OpaqueBuffers::material`] that marks an outline hull fragment (or a pixel the
+/// edge pass closed an outline over; material slots are far below it).
+pub(crate) const HULL: u32 = 1 << 31;
 
 /// Runs the opaque pass over the frame's rows `rows` (0 = top); the buffers hold those rows only.
 /// Every pixel is decided by the triangles covering it alone, so a pixel's result does not depend
@@ -171,6 +177,9 @@ pub(crate) fn draw_opaque_into(
                     .is_some_and(|o| o.width > 0.0)
         })
         .collect();
+    // Per triangle: the object whose surface it is (`u32::MAX` for a hull), as the edge pass's
+    // owners name them.
+    let owner: Vec<u32> = tris.iter().map(|t| if t.hull { u32::MAX } else { t.object }).collect();
     let shadow_bands = Bands::new(&shadow_tris, frame.height as usize, &rows);
     let k = grid.max(1);
     // `x / k` as a shift where shading once (k is 2 or 4 there): a division a sample costs more
@@ -186,14 +195,28 @@ pub(crate) fn draw_opaque_into(
         && rows.start.is_multiple_of(k)
         && rows.len().is_multiple_of(k)
         && (frame.width as usize).is_multiple_of(k);
-    let OpaqueBuffers { color, surface, object, shadow, soft, visibility, edge, once: kept, .. } = out;
+    let OpaqueBuffers {
+        color,
+        surface,
+        object,
+        shadow,
+        soft,
+        visibility,
+        normal,
+        material,
+        reach,
+        once: kept,
+        ..
+    } = out;
     // Sized only: every band clears its own rows below, the bands in parallel (a frame of waves
     // alone pays for these writes, some 50 bytes a pixel, on every thread rather than one).
     color.resize(w * h, [0.0f32; 3]);
-    surface.resize(w * h, None);
-    object.resize(w * h, None);
-    shadow.resize(w * h, None);
-    edge.resize(w * h, EdgeTexel::default());
+    surface.resize(w * h, f32::INFINITY);
+    object.resize(w * h, NONE);
+    shadow.resize(w * h, NONE);
+    normal.resize(w * h, Vec3f::ZERO);
+    material.resize(w * h, 0);
+    reach.resize(w * h, 0);
     visibility.clear();
     let area = frame.area_light.as_ref();
     soft.resize(if area.is_some() { w * h } else { 0 }, None);
@@ -244,8 +267,10 @@ pub(crate) fn draw_opaque_into(
         .zip(surface.chunks_mut(batch_px))
         .zip(object.chunks_mut(batch_px))
         .zip(shadow.chunks_mut(batch_px))
-        .zip(edge.chunks_mut(batch_px));
-    for (n, ((((color, surface), object), shadow), edge)) in batches.enumerate() {
+        .zip(normal.chunks_mut(batch_px))
+        .zip(material.chunks_mut(batch_px))
+        .zip(reach.chunks_mut(batch_px));
+    for (n, ((((((color, surface), object), shadow), normal), material), reach)) in batches.enumerate() {
         let first = n * BATCH;
         let count = color.len().div_ceil(BAND * w);
         let list = bands.batch(first, count);
@@ -257,11 +282,13 @@ pub(crate) fn draw_opaque_into(
             .zip(surface.par_chunks_mut(BAND * w))
             .zip(object.par_chunks_mut(BAND * w))
             .zip(shadow.par_chunks_mut(BAND * w))
-            .zip(edge.par_chunks_mut(BAND * w))
+            .zip(normal.par_chunks_mut(BAND * w))
+            .zip(material.par_chunks_mut(BAND * w))
+            .zip(reach.par_chunks_mut(BAND * w))
             .zip(soft_batch.into_par_iter())
             .zip(once_batch.into_par_iter())
             .enumerate()
-            .for_each(|(j, ((((((col, surf), obj), shad), edg), soft), once_band))| {
+            .for_each(|(j, ((((((((col, surf), obj), shad), nrm), mat), rch), soft), once_band))| {
                 let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, probe } = once_band;
                 let b = first + j;
                 let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
@@ -271,10 +298,12 @@ pub(crate) fn draw_opaque_into(
                 if mine().next().is_none() && mine_shadows().next().is_none() {
                     // Nothing drawn here.
                     col.fill(frame.background);
-                    surf.fill(None);
-                    obj.fill(None);
-                    shad.fill(None);
-                    edg.fill(EdgeTexel::default());
+                    surf.fill(f32::INFINITY);
+                    obj.fill(NONE);
+                    shad.fill(NONE);
+                    nrm.fill(Vec3f::ZERO);
+                    mat.fill(0);
+                    rch.fill(0);
                     soft.fill(None);
                     centre.fill([f32::NAN; 3]);
                     once_tri.fill(u32::MAX);
@@ -342,66 +371,90 @@ pub(crate) fn draw_opaque_into(
                 // `n·(P − eye) = q` at eye distance `q·√(1 + ax² + ay²) / (n·dir)`.
                 let (sx, sy) = (basis.tan_half_fov * basis.aspect, basis.tan_half_fov);
                 let ray_x = |x: usize| (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * sx;
+                // The outline's reach of sample `i` (column `x`, band row `r`) of triangle `ti`;
+                // the edge pass reads it only where a neighbour shows another object (or none):
+                // not where all four show a surface of this one.
+                let reach_of = |i: usize, x: usize, r: usize, ti: u32| {
+                    if !outlined[ti as usize] {
+                        return 0;
+                    }
+                    // A neighbour of the same surface: the same triangle, or another of the same
+                    // object that is not a hull (what the edge pass's owners compare).
+                    let o = owner[ti as usize];
+                    let same = |j: usize| tri_id[j] == ti || owner.get(tri_id[j] as usize) == Some(&o);
+                    let inside = x > 0 && x + 1 < w && r > 0 && r + 1 < rows && {
+                        same(i - 1) && same(i + 1) && same(i - w) && same(i + w)
+                    };
+                    if inside {
+                        return 0;
+                    }
+                    let py = (y_start + r) as f32;
+                    let (_, outline_dir) =
+                        interpolate_with::<false>(&tris[ti as usize], x as f32 + 0.5, py + 0.5);
+                    let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
+                    // (At most `REACH_STEPS`, 255.)
+                    outline::reach_code(outline_dir, dir).min(255) as u8
+                };
+                // Whether a sample of a pixel shaded once takes the centre's surface rather than
+                // a point of its own (multisampling's rule: one surface a pixel, coverage and
+                // depth order per sample); the outline's reach stays its own.
+                let centring = once && !point_per_sample;
                 for r in 0..rows {
                     let prow = (r / k) * pw;
                     let ay = (1.0 - 2.0 * ((y_start + r) as f32 + 0.5) / frame.height as f32) * sy;
-                    for x in 0..w {
+                    let py = (y_start + r) as f32;
+                    let mut x = 0;
+                    while x < w {
                         let i = r * w + x;
-                        if tri_id[i] == u32::MAX {
-                            (surf[i], obj[i], edg[i]) = (None, None, EdgeTexel::default());
+                        if centring && once_tri[prow + (x >> k_shift)] != u32::MAX {
+                            // The pixel's `k` samples of this row at once (`x` is on the pixel's
+                            // first column: the other columns of a shared pixel never come here).
+                            let p = prow + (x >> k_shift);
+                            let ti = once_tri[p];
+                            let t = &tris[ti as usize];
+                            let (ref c, [nx, ny, nz, q]) = centres[p];
+                            for x in x..x + k {
+                                let i = r * w + x;
+                                // Where its ray meets the triangle's plane (its raster depth
+                                // times its ray's length where the plane is seen edge-on: less
+                                // exact far from a huge triangle's vertices).
+                                let ax = ray_x(x);
+                                let len = (1.0 + ax * ax + ay * ay).sqrt();
+                                let d = q * len / (nz + nx * ax + ny * ay);
+                                let d = if d.is_finite() && d > 0.0 { d } else { zbuf[i] * len };
+                                // (The point itself is read by nothing: such a frame has no
+                                // shadows.)
+                                surf[i] = if d.is_finite() { d } else { 0.0 };
+                                obj[i] = t.object;
+                                rch[i] = reach_of(i, x, r, ti);
+                                nrm[i] = c.normal;
+                                // (Never a hull: shared pixels show a surface.)
+                                mat[i] = t.material;
+                            }
+                            x += k;
                             continue;
                         }
-                        let py = (y_start + r) as f32;
-                        let t = &tris[tri_id[i] as usize];
-                        // A sample of a pixel shaded once whose point is not its own takes the
-                        // centre's (multisampling's rule: one surface a pixel, coverage and
-                        // depth order per sample); the outline's reach below stays its own.
-                        let centred = (once && !point_per_sample)
-                            .then(|| prow + (x >> k_shift))
-                            .filter(|&p| once_tri[p] != u32::MAX)
-                            .map(|p| &centres[p]);
-                        let (s, d) = if let Some(&(s, [nx, ny, nz, q])) = centred {
-                            // (Its raster depth times its ray's length where the plane is seen
-                            // edge-on: less exact far from a huge triangle's vertices.)
-                            let ax = ray_x(x);
-                            let len = (1.0 + ax * ax + ay * ay).sqrt();
-                            let d = q * len / (nz + nx * ax + ny * ay);
-                            let d = if d.is_finite() && d > 0.0 { d } else { zbuf[i] * len };
-                            (s, if d.is_finite() { d } else { 0.0 })
-                        } else {
-                            let (s, _) = if keep {
-                                interpolate(t, x as f32 + 0.5, py + 0.5)
-                            } else {
-                                interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
-                            };
-                            let d = (s.world - basis.eye).length();
-                            (s, if d.is_finite() { d } else { 0.0 })
-                        };
-                        surf[i] = Some(d);
-                        obj[i] = Some(t.object);
-                        // The edge pass reads the reach only where a neighbour shows another
-                        // object (or none): not where all four show this triangle.
+                        x += 1;
+                        let x = x - 1;
                         let ti = tri_id[i];
-                        let inside = x > 0
-                            && x + 1 < w
-                            && r > 0
-                            && r + 1 < rows
-                            && tri_id[i - 1] == ti
-                            && tri_id[i + 1] == ti
-                            && tri_id[i - w] == ti
-                            && tri_id[i + w] == ti;
-                        let reach = if outlined[ti as usize] && !inside {
-                            let (_, outline_dir) = interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5);
-                            let dir = basis.pixel_dir(x as f32, py, frame.width, frame.height);
-                            outline::reach_code(outline_dir, dir)
-                        } else {
-                            0
-                        };
-                        edg[i] = EdgeTexel { normal: s.normal, material: t.material, hull: t.hull, reach };
-                        if centred.is_none() {
-                            // (A centred sample's point is read by nothing: it has no shadows.)
-                            world[i] = s.world;
+                        if ti == u32::MAX {
+                            (surf[i], obj[i], nrm[i], mat[i], rch[i]) =
+                                (f32::INFINITY, NONE, Vec3f::ZERO, 0, 0);
+                            continue;
                         }
+                        let t = &tris[ti as usize];
+                        let (s, _) = if keep {
+                            interpolate(t, x as f32 + 0.5, py + 0.5)
+                        } else {
+                            interpolate_with::<false>(t, x as f32 + 0.5, py + 0.5)
+                        };
+                        let d = (s.world - basis.eye).length();
+                        surf[i] = if d.is_finite() { d } else { 0.0 };
+                        obj[i] = t.object;
+                        rch[i] = reach_of(i, x, r, ti);
+                        nrm[i] = s.normal;
+                        mat[i] = t.material | if t.hull { HULL } else { 0 };
+                        world[i] = s.world;
                         if keep {
                             surfaces[i] = s;
                         }
@@ -419,15 +472,7 @@ pub(crate) fn draw_opaque_into(
                     cover(st, y_start, rows, w, |i, bary| {
                         let Some(o) = receiver(i) else { return };
                         let t = perspective(st, bary, |k| st.uv[k][0]);
-                        shadows.plane_candidate(
-                            frame,
-                            st.object,
-                            o,
-                            t,
-                            world[i],
-                            surf[i].unwrap_or(0.0),
-                            &mut best[i],
-                        );
+                        shadows.plane_candidate(frame, st.object, o, t, world[i], surf[i], &mut best[i]);
                     });
                 }
                 if once {
@@ -461,22 +506,24 @@ pub(crate) fn draw_opaque_into(
                 }
                 for r in 0..rows {
                     let prow = (r / k) * pw;
-                    let (mut px, mut sub) = (0, 0);
-                    for x in 0..w {
+                    let mut x = 0;
+                    while x < w {
                         let i = r * w + x;
-                        let p = prow + px;
-                        sub += 1;
-                        if sub == k {
-                            (px, sub) = (px + 1, 0);
-                        }
+                        // (Pixels are `k` = 2 or 4 columns wide where shading once.)
+                        let p = if once { prow + (x >> k_shift) } else { 0 };
                         let shared = once && once_tri[p] != u32::MAX;
-                        if shared && !point_per_sample {
-                            // Its pixel's one shade, and no shadow of its own.
-                            (col[i], shad[i]) = (centre[p], None);
+                        if shared && centring {
+                            // Its pixel's one shade, and no shadow of its own: the pixel's `k`
+                            // samples of this row at once (`x` is on its first column).
+                            col[i..i + k].fill(centre[p]);
+                            shad[i..i + k].fill(NONE);
+                            x += k;
                             continue;
                         }
+                        x += 1;
+                        let x = x - 1;
                         let Some(t) = tris.get(tri_id[i] as usize) else {
-                            (col[i], shad[i]) = (frame.background, None);
+                            (col[i], shad[i]) = (frame.background, NONE);
                             if area.is_some() {
                                 soft[i] = None;
                             }
@@ -500,16 +547,17 @@ pub(crate) fn draw_opaque_into(
                             _ => shading::shade(frame, lights, material, &surface()),
                         };
                         if t.hull {
-                            (col[i], shad[i]) = (c, None);
+                            (col[i], shad[i]) = (c, NONE);
                             if area.is_some() {
                                 soft[i] = None;
                             }
                         } else {
-                            (col[i], shad[i]) = shadows.resolve(frame, t.object, world[i], best[i], c);
+                            let (c, si) = shadows.resolve(frame, t.object, world[i], best[i], c);
+                            (col[i], shad[i]) = (c, si.unwrap_or(NONE));
                             if let Some(al) = area {
                                 soft[i] = Some(SoftPoint {
                                     world: world[i],
-                                    normal: edg[i].normal.normalize_or(Vec3f::ZERO),
+                                    normal: nrm[i].normalize_or(Vec3f::ZERO),
                                     term: if shared {
                                         once_term[p]
                                     } else {
@@ -541,7 +589,7 @@ fn refine(
     k: usize,
     y0: usize,
     color: &mut [[f32; 3]],
-    shadow: &mut [Option<u32>],
+    shadow: &mut [u32],
     soft: &mut [Option<SoftPoint>],
     kept: &mut ShadedOnce,
 ) {
@@ -605,8 +653,9 @@ fn refine(
                         let i = j * w + x;
                         let (s, _) = interpolate(t, x as f32 + 0.5, sy as f32 + 0.5);
                         let c = shading::shade(frame, &setup.lights, material, &s);
-                        (col[i], shad[i]) =
+                        let (c, si) =
                             setup.shadows.resolve(frame, t.object, s.world, best[(py * k + j) * w + x], c);
+                        (col[i], shad[i]) = (c, si.unwrap_or(NONE));
                         if let (Some(al), Some(Some(p))) = (area, soft.get_mut(i)) {
                             p.term = shading::area_term(al, material, &s, frame.time);
                         }

@@ -2,7 +2,7 @@
 //! same set-up, opaque pass and batched wave code as the render, so it reports exactly what the
 //! render drew.
 
-use crate::opaque::OpaqueBuffers;
+use crate::opaque::{OpaqueBuffers, NONE};
 use crate::render::opaque_pass;
 use crate::setup::FrameSetup;
 use crate::waves::{self, WavePass};
@@ -77,7 +77,7 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
     let mut opaque = OpaqueBuffers::default();
     let oy0 = opaque_pass(frame, &setup, 1, y as usize..y as usize + 1, &mut opaque);
     let i = (y as usize - oy0) * frame.width as usize + x as usize;
-    let surface = opaque.surface[i];
+    let surface = Some(opaque.surface[i]).filter(|d| d.is_finite());
     let mut light = [0.0f32; 3];
     let mut out = Vec::new();
     let pass = WavePass::new(frame, &setup.basis, &setup.curves);
@@ -92,8 +92,8 @@ pub fn probe(frame: &Frame, x: u32, y: u32) -> Option<Probe> {
         waves: out,
         color: waves::compose(frame, opaque.color[i], light),
         depth,
-        object: opaque.object[i].map(|o| frame.objects[o as usize].name.clone()),
-        shadow: opaque.shadow[i].map(|s| frame.shadows[s as usize].name.clone()),
-        soft: opaque.visibility.get(i).copied().filter(|_| surface.is_some() && opaque.object[i].is_some()),
+        object: frame.objects.get(opaque.object[i] as usize).map(|o| o.name.clone()),
+        shadow: frame.shadows.get(opaque.shadow[i] as usize).map(|s| s.name.clone()),
+        soft: opaque.visibility.get(i).copied().filter(|_| surface.is_some() && opaque.object[i] != NONE),
     })
 }

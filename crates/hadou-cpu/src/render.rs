@@ -311,7 +311,7 @@ fn render_chunked(
 struct RowBuffers {
     light: Vec<BatchLight>,
     scene: Vec<[f32; 3]>,
-    surface: Vec<Option<f32>>,
+    surface: Vec<f32>,
     edges: Vec<usize>,
 }
 
@@ -351,7 +351,7 @@ impl RowSource<'_> {
             let RowBuffers { light, scene, surface, .. } = bufs;
             if surface.len() != w || scene.len() != w || scene.first() != Some(&bg) {
                 surface.clear();
-                surface.resize(w, None);
+                surface.resize(w, f32::INFINITY);
                 scene.clear();
                 scene.resize(w, bg);
             }
@@ -384,7 +384,8 @@ impl RowSource<'_> {
                         *ck += v * inv;
                     }
                     same &= sample_key(o, idx) == key0;
-                    if let Some(d) = o.surface[idx] {
+                    let d = o.surface[idx];
+                    if d.is_finite() {
                         (lo, hi, sum) = (lo.min(d), hi.max(d), sum + d);
                     }
                 }
@@ -392,7 +393,7 @@ impl RowSource<'_> {
             scene.push(c.map(hadou_math::energy::saturate));
             let drawn = key0.is_some();
             let agree = same && (!drawn || hi - lo <= hadou_scene::SAMPLE_DEPTH_SPREAD * lo);
-            surface.push(drawn.then_some(sum * inv));
+            surface.push(if drawn { sum * inv } else { f32::INFINITY });
             if !agree {
                 edges.push(x);
             }
@@ -447,10 +448,13 @@ fn blank_color(background: [f32; 3], k: usize) -> [f32; 3] {
 /// slot and whether it is an outline (a hull, or a pixel the edge pass closed an outline over,
 /// which takes that object and slot); `None` where nothing is drawn. The GPU's wave pass compares
 /// the G-buffer's material word the same way.
-fn sample_key(o: &OpaqueBuffers, i: usize) -> Option<(u32, u32, bool)> {
-    o.surface[i]?;
-    let e = &o.edge[i];
-    Some((o.object[i]?, e.material, e.hull))
+fn sample_key(o: &OpaqueBuffers, i: usize) -> Option<(u32, u32)> {
+    if !o.surface[i].is_finite() {
+        return None;
+    }
+    // (The material word carries the outline state: `opaque::HULL`.)
+    let object = o.object[i];
+    (object != crate::opaque::NONE).then_some((object, o.material[i]))
 }
 
 /// What a frame's rows are drawn from: the frame, the frame its opaque pass draws, the set-up,

@@ -235,24 +235,20 @@ impl<'a> WavePass<'a> {
         dispatch(self.simd, PixelEnergies { pass: self, x, py, surface: surface.unwrap_or(f32::INFINITY) })
     }
 
-    /// The wave pass over one row: `out[k]` gets batch `k`'s light (pixels `8k ..`).
-    pub(crate) fn row_light(&self, py: f32, surface: &[Option<f32>], out: &mut Vec<BatchLight>) {
+    /// The wave pass over one row, clipped at the visible surfaces `surface` (`+∞` where nothing
+    /// is drawn): `out[k]` gets batch `k`'s light (pixels `8k ..`).
+    pub(crate) fn row_light(&self, py: f32, surface: &[f32], out: &mut Vec<BatchLight>) {
         dispatch(self.simd, RowLight { pass: self, py, surface, out });
     }
 
     /// [`WavePass::row_light`] on lanes `L`.
     #[inline(always)]
-    fn row_light_lanes<L: Lane>(&self, py: f32, surface: &[Option<f32>], out: &mut Vec<BatchLight>) {
+    fn row_light_lanes<L: Lane>(&self, py: f32, surface: &[f32], out: &mut Vec<BatchLight>) {
         out.clear();
         for x0 in (0..surface.len()).step_by(LANES) {
             let n = LANES.min(surface.len() - x0);
-            let s = L::from_array(std::array::from_fn(|i| {
-                if i < n {
-                    surface[x0 + i].unwrap_or(f32::INFINITY)
-                } else {
-                    f32::INFINITY
-                }
-            }));
+            let s =
+                L::from_array(std::array::from_fn(|i| if i < n { surface[x0 + i] } else { f32::INFINITY }));
             let mut acc = LightSum { colors: &self.colors, light: [L::splat(0.0); 3], total: L::splat(0.0) };
             let depth = self.energies(x0, py, s, n, &mut acc);
             let [r, g, b] = acc.light;
@@ -273,7 +269,7 @@ impl<'a> WavePass<'a> {
         &self,
         x0: usize,
         py: f32,
-        surface: &[Option<f32>],
+        surface: &[f32],
         weight: f32,
     ) -> ([f32; 3], f32, f32) {
         dispatch(self.simd, SamplesLight { pass: self, x0, py, surface, weight })
@@ -285,12 +281,12 @@ impl<'a> WavePass<'a> {
         &self,
         x0: usize,
         py: f32,
-        surface: &[Option<f32>],
+        surface: &[f32],
         weight: f32,
     ) -> ([f32; 3], f32, f32) {
         let n = surface.len().min(LANES);
         let s = L::from_array(std::array::from_fn(|i| {
-            surface.get(i).filter(|_| i < n).copied().flatten().unwrap_or(f32::INFINITY)
+            surface.get(i).filter(|_| i < n).copied().unwrap_or(f32::INFINITY)
         }));
         let mut acc = WeightedSum { colors: &self.colors, n, weight, light: [0.0; 3], total: 0.0 };
         let depth = self.energies(x0, py, s, n, &mut acc);
@@ -491,7 +487,7 @@ impl Rays {
 struct RowLight<'p, 'a> {
     pass: &'p WavePass<'a>,
     py: f32,
-    surface: &'p [Option<f32>],
+    surface: &'p [f32],
     out: &'p mut Vec<BatchLight>,
 }
 
@@ -526,7 +522,7 @@ struct SamplesLight<'p, 'a> {
     pass: &'p WavePass<'a>,
     x0: usize,
     py: f32,
-    surface: &'p [Option<f32>],
+    surface: &'p [f32],
     weight: f32,
 }
 
