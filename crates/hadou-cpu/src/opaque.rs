@@ -318,7 +318,7 @@ pub(crate) fn draw_opaque_into(
                 // clearing each time); taken out while in use, so a band the thread runs meanwhile
                 // gets fresh ones.
                 let mut scratch = BAND_SCRATCH.take();
-                let BandScratch { zbuf, tri_id, world, surfaces, best, centres } = &mut scratch;
+                let BandScratch { zbuf, tri_id, world, surfaces, best, centres, columns } = &mut scratch;
                 zbuf.clear();
                 zbuf.resize(rows * w, f32::INFINITY);
                 tri_id.clear();
@@ -370,7 +370,14 @@ pub(crate) fn draw_opaque_into(
                 // (`CameraBasis::pixel_dir`), `ax` by column and `ay` by row: it meets the plane
                 // `n·(P − eye) = q` at eye distance `q·√(1 + ax² + ay²) / (n·dir)`.
                 let (sx, sy) = (basis.tan_half_fov * basis.aspect, basis.tan_half_fov);
-                let ray_x = |x: usize| (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * sx;
+                // Per column: `ax` and `1 + ax²` (the sum below adds `ay²` to the latter).
+                columns.clear();
+                if once && !point_per_sample {
+                    columns.extend((0..w).map(|x| {
+                        let ax = (2.0 * (x as f32 + 0.5) / w as f32 - 1.0) * sx;
+                        (ax, 1.0 + ax * ax)
+                    }));
+                }
                 // The outline's reach of sample `i` (column `x`, band row `r`) of triangle `ti`;
                 // the edge pass reads it only where a neighbour shows another object (or none):
                 // not where all four show a surface of this one.
@@ -402,6 +409,7 @@ pub(crate) fn draw_opaque_into(
                 for r in 0..rows {
                     let prow = (r / k) * pw;
                     let ay = (1.0 - 2.0 * ((y_start + r) as f32 + 0.5) / frame.height as f32) * sy;
+                    let ay2 = ay * ay;
                     let py = (y_start + r) as f32;
                     let mut x = 0;
                     while x < w {
@@ -418,8 +426,8 @@ pub(crate) fn draw_opaque_into(
                                 // Where its ray meets the triangle's plane (its raster depth
                                 // times its ray's length where the plane is seen edge-on: less
                                 // exact far from a huge triangle's vertices).
-                                let ax = ray_x(x);
-                                let len = (1.0 + ax * ax + ay * ay).sqrt();
+                                let (ax, ax2) = columns[x];
+                                let len = (ax2 + ay2).sqrt();
                                 let d = q * len / (nz + nx * ax + ny * ay);
                                 let d = if d.is_finite() && d > 0.0 { d } else { zbuf[i] * len };
                                 // (The point itself is read by nothing: such a frame has no
@@ -697,6 +705,8 @@ struct BandScratch {
     /// Per pixel shaded once: its surface at its centre, and its triangle's plane through that
     /// point in view axes (the normal's right, up and forward components, and `n·(C − eye)`).
     centres: Vec<(shading::Surface, [f32; 4])>,
+    /// Per sample column: its ray's `ax` and `1 + ax²`.
+    columns: Vec<(f32, f32)>,
 }
 
 thread_local! {
