@@ -421,12 +421,11 @@ pub(crate) fn draw_opaque_into(
                             let ti = once_tri[p];
                             let t = &tris[ti as usize];
                             let (ref c, [nx, ny, nz, q]) = centres[p];
-                            for x in x..x + k {
+                            for (x, &(ax, ax2)) in columns.iter().enumerate().skip(x).take(k) {
                                 let i = r * w + x;
                                 // Where its ray meets the triangle's plane (its raster depth
                                 // times its ray's length where the plane is seen edge-on: less
                                 // exact far from a huge triangle's vertices).
-                                let (ax, ax2) = columns[x];
                                 let len = (ax2 + ay2).sqrt();
                                 let d = q * len / (nz + nx * ax + ny * ay);
                                 let d = if d.is_finite() && d > 0.0 { d } else { zbuf[i] * len };
