@@ -416,9 +416,15 @@ pub(crate) fn cover(
     let inv_area = 1.0 / edges[0].at(f64::from(t.sx[0]), f64::from(t.sy[0]));
     // How far the rows' spans below may stray from the edge tests, in pixels: a few units of f64
     // rounding of coordinates as large as the triangle's (a vertex far off screen makes them
-    // large), so the spans are widened by that much and never miss a pixel the tests accept.
+    // large), so the spans are widened by that much and never miss a pixel the tests accept. An
+    // edge function's rounding is about 2⁻⁵² of the coordinates' square, and an edge crossing a
+    // row has a height of at least one f32 unit of its coordinates (2⁻²⁴ of them), so its
+    // crossing moves by at most some 10⁻⁸ of the coordinates (3·10⁻⁵ pixels on a 2048-sample
+    // row): `magnitude·10⁻⁸` plus a sixteenth of a pixel. (Every pixel tested is a pixel whose
+    // three edge functions are evaluated, so the margin is paid on every row of every
+    // triangle; it was 1.5 pixels a side.)
     let magnitude = [xmin, xmax, ylo, yhi].iter().fold(1.0f64, |m, &c| m.max(f64::from(c).abs()));
-    let slack = 1.5 + magnitude * 1e-9;
+    let slack = 1.0 / 16.0 + magnitude * 1e-8;
     // Only the rows whose centres may lie within [ylo, yhi] (the test below still decides).
     let r0 = ((ylo - 0.5).ceil() - y_start as f32 - 1.0).max(0.0) as usize;
     let r1 = ((yhi - 0.5).floor() - y_start as f32 + 2.0).clamp(0.0, rows as f32) as usize;
@@ -561,6 +567,57 @@ mod tests {
             }
         }
         tris
+    }
+
+    /// `cover`'s rows test only a span about the row's crossing of the triangle (widened by a
+    /// margin): it must reach exactly the pixels of the whole bounding box whose three edge
+    /// tests pass, also for edges nearly parallel to the rows and vertices far off screen.
+    #[test]
+    fn row_spans_miss_no_pixel_the_edge_tests_accept() {
+        let mut rng = Rng(0x7370_616e_7321_2121);
+        let (w, h) = (160, 120);
+        for case in 0..4000 {
+            let far = [1.0e2f32, 1.0e4, 1.0e6, 1.0e7][case % 4];
+            let mut p =
+                |spread: f32| [(rng.unit() as f32 - 0.3) * spread, (rng.unit() as f32 - 0.3) * spread];
+            let (a, mut b, c) = (p(w as f32), p(w as f32), p(far));
+            if case % 3 == 0 {
+                // An edge within a fraction of a pixel of horizontal.
+                b[1] = a[1] + (rng.unit() as f32 - 0.5) * 1e-3;
+            }
+            let t = ScreenTri::flat([a[0], b[0], c[0]], [a[1], b[1], c[1]]);
+            let mut reached = vec![false; w * h];
+            cover(&t, 0, h, w, |i, _| reached[i] = true);
+            let area = f64::from(edge(a[0], a[1], b[0], b[1], c[0], c[1]));
+            if area == 0.0 || !area.is_finite() {
+                assert!(!reached.contains(&true), "case {case}: a degenerate triangle covers nothing");
+                continue;
+            }
+            let sign = area.signum() as f32;
+            let edges = [
+                CanonicalEdge::new(b, c, sign),
+                CanonicalEdge::new(c, a, sign),
+                CanonicalEdge::new(a, b, sign),
+            ];
+            let (lo, hi) = ([a, b, c].map(|v| v[0]), [a, b, c].map(|v| v[1]));
+            let (xmin, xmax) =
+                (lo.iter().copied().fold(f32::MAX, f32::min), lo.iter().copied().fold(f32::MIN, f32::max));
+            let (ymin, ymax) =
+                (hi.iter().copied().fold(f32::MAX, f32::min), hi.iter().copied().fold(f32::MIN, f32::max));
+            for y in 0..h {
+                for x in 0..w {
+                    let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                    let boxed = px >= xmin - 0.5 && px <= xmax + 0.5 && py >= ymin && py <= ymax;
+                    let (pxd, pyd) = (f64::from(px), f64::from(py));
+                    let accepted = boxed && edges.iter().all(|e| e.inside(e.at(pxd, pyd)));
+                    assert_eq!(
+                        reached[y * w + x],
+                        accepted,
+                        "case {case}: pixel ({x}, {y}) of {a:?} {b:?} {c:?}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
