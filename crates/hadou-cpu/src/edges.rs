@@ -12,7 +12,7 @@
 //! of several, the nearest `q` to the eye wins, ties to the first in row-major order. The GPU's
 //! `shaders/edges.wgsl` is the twin.
 
-use crate::opaque::{OpaqueBuffers, HULL, NONE};
+use crate::opaque::{expand, OpaqueBuffers, HULL, NONE};
 use hadou_math::outline::{in_front, reach_pixels, reach_window};
 use hadou_math::Vec3f;
 use hadou_scene::{CameraBasis, Frame};
@@ -63,7 +63,7 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     let hull_px = |o: u32, m: u32, z: f32| {
         frame.objects[o as usize].material(m).hull_pixels(z, basis.tan_half_fov, frame.height)
     };
-    let OpaqueBuffers { color, surface, object, shadow, normal, material, reach: reaches, .. } = out;
+    let OpaqueBuffers { color, surface, object, shadow, normal, material, reach: reaches, once, .. } = out;
     // A surface pixel's object (hulls and the background: none).
     let owner = |i: usize| match (surface[i].is_finite(), material[i] & HULL != 0) {
         (true, false) if object[i] != NONE => Some(object[i]),
@@ -115,6 +115,16 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
     // window's pixels far outnumber the edge pixels that reach them), in row-major order, so that
     // of equally near edge pixels the first in row-major order wins.
     let edges = &edges;
+    // Pixels whose samples take their centre colour unwritten (`ShadedOnce::centred`): a band's
+    // `EDGE_BAND / grid` rows of them (every band gets an empty slice where none is marked).
+    let grid = once.grid.max(1);
+    let pw = w / grid;
+    let marks: Vec<&mut [bool]> = if once.centred.is_empty() {
+        (0..h.div_ceil(EDGE_BAND)).map(|_| Default::default()).collect()
+    } else {
+        once.centred.chunks_mut(EDGE_BAND / grid * pw).collect()
+    };
+    let centre = &once.centre;
     color
         .par_chunks_mut(EDGE_BAND * w)
         .zip(surface.par_chunks(EDGE_BAND * w))
@@ -123,73 +133,93 @@ pub(crate) fn close_outlines(frame: &Frame, basis: &CameraBasis, first_row: usiz
         .zip(normal.par_chunks(EDGE_BAND * w))
         .zip(material.par_chunks_mut(EDGE_BAND * w))
         .zip(reaches.par_chunks_mut(EDGE_BAND * w))
+        .zip(marks)
         .enumerate()
-        .for_each(|(band, ((((((color, surface), object), shadow), normal), material), reaches))| {
-            let y0 = band * EDGE_BAND;
-            let rows = surface.len() / w;
-            let owner = |i: usize| match (surface[i].is_finite(), material[i] & HULL != 0) {
-                (true, false) if object[i] != NONE => Some(object[i]),
-                _ => None,
-            };
-            let window = || edges.iter().enumerate().take(y0 + rows + reach).skip(y0.saturating_sub(reach));
-            if window().all(|(_, row)| row.is_empty()) {
-                return;
-            }
-            // Per pixel: the winning edge's eye distance and (row, index in its row); kept by the
-            // thread from band to band (all `None` between bands: only the pixels listed in
-            // `touched` are set, and reset after), since most of a band's pixels are never reached.
-            let mut scratch = EDGE_SCRATCH.take();
-            let (best, touched) = &mut scratch;
-            best.resize(rows * w, None);
-            for (rr, row) in window() {
-                // The band's rows within the window of the edge pixels of row `rr`.
-                let r_lo = rr.saturating_sub(reach).max(y0);
-                let r_hi = (rr + reach + 1).min(y0 + rows);
-                for (k, e) in row.iter().enumerate() {
-                    let ex = e.x as usize;
-                    let (x_lo, x_hi) = (ex.saturating_sub(reach), (ex + reach + 1).min(w));
-                    for r in r_lo..r_hi {
-                        let dy = r as f32 - rr as f32;
-                        for x in x_lo..x_hi {
-                            let dx = x as f32 - ex as f32;
-                            if dx * dx + dy * dy > e.reach2 {
-                                continue;
-                            }
-                            let i = (r - y0) * w + x;
-                            let Some(b) = owner(i) else { continue };
-                            if b == e.object || best[i].is_some_and(|(d, _, _)| e.distance >= d) {
-                                continue;
-                            }
-                            let p_dir = unit_dir(basis, frame, x, first_row + r);
-                            let p_dist = surface[i];
-                            if in_front(normal[i], p_dir, p_dist, e.dir, e.distance) {
-                                if best[i].is_none() {
-                                    touched.push(i as u32);
+        .for_each(
+            |(band, (((((((color, surface), object), shadow), normal), material), reaches), marks))| {
+                let y0 = band * EDGE_BAND;
+                let rows = surface.len() / w;
+                let owner = |i: usize| match (surface[i].is_finite(), material[i] & HULL != 0) {
+                    (true, false) if object[i] != NONE => Some(object[i]),
+                    _ => None,
+                };
+                let window =
+                    || edges.iter().enumerate().take(y0 + rows + reach).skip(y0.saturating_sub(reach));
+                if window().all(|(_, row)| row.is_empty()) {
+                    return;
+                }
+                // Per pixel: the winning edge's eye distance and (row, index in its row); kept by the
+                // thread from band to band (all `None` between bands: only the pixels listed in
+                // `touched` are set, and reset after), since most of a band's pixels are never reached.
+                let mut scratch = EDGE_SCRATCH.take();
+                let (best, touched) = &mut scratch;
+                best.resize(rows * w, None);
+                for (rr, row) in window() {
+                    // The band's rows within the window of the edge pixels of row `rr`.
+                    let r_lo = rr.saturating_sub(reach).max(y0);
+                    let r_hi = (rr + reach + 1).min(y0 + rows);
+                    for (k, e) in row.iter().enumerate() {
+                        let ex = e.x as usize;
+                        let (x_lo, x_hi) = (ex.saturating_sub(reach), (ex + reach + 1).min(w));
+                        for r in r_lo..r_hi {
+                            let dy = r as f32 - rr as f32;
+                            for x in x_lo..x_hi {
+                                let dx = x as f32 - ex as f32;
+                                if dx * dx + dy * dy > e.reach2 {
+                                    continue;
                                 }
-                                best[i] = Some((e.distance, rr as u32, k as u32));
+                                let i = (r - y0) * w + x;
+                                let Some(b) = owner(i) else { continue };
+                                if b == e.object || best[i].is_some_and(|(d, _, _)| e.distance >= d) {
+                                    continue;
+                                }
+                                let p_dir = unit_dir(basis, frame, x, first_row + r);
+                                let p_dist = surface[i];
+                                if in_front(normal[i], p_dir, p_dist, e.dir, e.distance) {
+                                    if best[i].is_none() {
+                                        touched.push(i as u32);
+                                    }
+                                    best[i] = Some((e.distance, rr as u32, k as u32));
+                                }
                             }
                         }
                     }
                 }
-            }
-            for &i in touched.iter() {
-                let i = i as usize;
-                let Some((_, rr, k)) = best[i].take() else { continue };
-                let e = &edges[rr as usize][k as usize];
-                let mat = frame.objects[e.object as usize].material(e.material);
-                if mat.outline.is_some() {
-                    color[i] = mat.outline_rgb(&frame.light);
-                    shadow[i] = NONE;
-                    // The pixel now shows that object's outline, as a hull pixel of it would (the
-                    // GPU's edge pass writes its material word | HULL_BIT): what the probe names
-                    // and what the anti-aliased resolve compares.
-                    object[i] = e.object;
-                    (material[i], reaches[i]) = (e.material | HULL, 0);
+                for &i in touched.iter() {
+                    let i = i as usize;
+                    let Some((_, rr, k)) = best[i].take() else { continue };
+                    let e = &edges[rr as usize][k as usize];
+                    let mat = frame.objects[e.object as usize].material(e.material);
+                    if mat.outline.is_some() {
+                        // The sample's pixel's samples written first where they are not.
+                        if !marks.is_empty() {
+                            let (pr, px) = (i / w / grid, i % w / grid);
+                            let p = pr * pw + px;
+                            let rows = pr * grid * w..(pr + 1) * grid * w;
+                            let c = centre[band * (EDGE_BAND / grid) * pw + p];
+                            expand(
+                                &mut marks[p],
+                                c,
+                                grid,
+                                w,
+                                px,
+                                &mut color[rows.clone()],
+                                &mut shadow[rows],
+                            );
+                        }
+                        color[i] = mat.outline_rgb(&frame.light);
+                        shadow[i] = NONE;
+                        // The pixel now shows that object's outline, as a hull pixel of it would (the
+                        // GPU's edge pass writes its material word | HULL_BIT): what the probe names
+                        // and what the anti-aliased resolve compares.
+                        object[i] = e.object;
+                        (material[i], reaches[i]) = (e.material | HULL, 0);
+                    }
                 }
-            }
-            touched.clear();
-            EDGE_SCRATCH.set(scratch);
-        });
+                touched.clear();
+                EDGE_SCRATCH.set(scratch);
+            },
+        );
 }
 
 /// The per-pixel winners of the edge pass's bands and the pixels they set.
@@ -198,4 +228,60 @@ type EdgeScratch = (Vec<Option<(f32, u32, u32)>>, Vec<u32>);
 thread_local! {
     /// Each thread's [`EdgeScratch`], kept from band to band (its winners all `None` between).
     static EDGE_SCRATCH: std::cell::Cell<EdgeScratch> = const { std::cell::Cell::new((Vec::new(), Vec::new())) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::opaque::draw_opaque_into;
+    use crate::setup::FrameSetup;
+
+    /// Issue 44, point 1: a pixel shaded once whose samples take its centre colour unwritten
+    /// (`ShadedOnce::centred`) has its samples written before the edge pass closes an outline
+    /// over one of them: the closed sample shows the outline, its neighbours in the pixel the
+    /// centre colour, and the pixel is no longer marked (the resolve reads its samples).
+    #[test]
+    fn outlines_closed_over_centred_pixels_write_their_samples() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-from-front.toml");
+        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mut frame = scene.at(1.2);
+        (frame.width, frame.height, frame.samples) = (160, 120, 4);
+        let sampled = frame.sample_frame();
+        let setup = FrameSetup::new(&sampled);
+        let mut out = OpaqueBuffers::default();
+        let h = sampled.height as usize;
+        draw_opaque_into(&sampled, &setup, 2, 0..h, &mut out);
+        let (material, marked, centre) =
+            (out.material.clone(), out.once.centred.clone(), out.once.centre.clone());
+        assert!(marked.iter().filter(|&&m| m).count() > 1000, "few pixels centred");
+        close_outlines(&sampled, &setup.basis, 0, &mut out);
+        let w = sampled.width as usize;
+        let pw = w / 2;
+        let (mut closed, mut written) = (0, 0);
+        for i in 0..w * h {
+            if out.material[i] == material[i] || out.material[i] & HULL == 0 {
+                continue;
+            }
+            let p = i / w / 2 * pw + i % w / 2;
+            let o = &sampled.objects[out.object[i] as usize];
+            let outline = o.material(out.material[i] & !HULL).outline_rgb(&sampled.light);
+            assert_eq!(out.color[i], outline, "sample {i}: not the outline's colour");
+            assert!(!out.once.centred[p], "pixel {p}: still marked after its sample {i} was closed");
+            closed += 1;
+            if !marked[p] {
+                continue;
+            }
+            // Its pixel's other samples, untouched by the pass, hold the centre colour.
+            let (r0, x0) = (i / w / 2 * 2, i % w / 2 * 2);
+            for j in [r0 * w + x0, r0 * w + x0 + 1, (r0 + 1) * w + x0, (r0 + 1) * w + x0 + 1] {
+                if out.material[j] == material[j] {
+                    assert_eq!(out.color[j], centre[p], "sample {j} of pixel {p}");
+                    assert_eq!(out.shadow[j], NONE, "sample {j} of pixel {p}");
+                    written += 1;
+                }
+            }
+        }
+        assert!(closed > 0 && written > 0, "{closed} samples closed, {written} centred samples written");
+    }
 }

@@ -32,7 +32,8 @@ pub struct SoftPoint {
 /// What the opaque pass leaves per pixel.
 #[derive(Default)]
 pub(crate) struct OpaqueBuffers {
-    /// Shaded linear RGB, background where nothing is drawn.
+    /// Shaded linear RGB, background where nothing is drawn. Not written for the samples of a
+    /// pixel [`ShadedOnce::centred`] marks (their colour is [`ShadedOnce::centred_color`]).
     pub color: Vec<[f32; 3]>,
     /// Eye distance to the visible surface (finite), `+∞` where nothing is drawn (as the wave
     /// pass reads it).
@@ -41,7 +42,8 @@ pub(crate) struct OpaqueBuffers {
     /// bytes a sample, not an `Option`'s eight: a frame at 4 samples a pixel writes and reads
     /// these buffers sample by sample).
     pub object: Vec<u32>,
-    /// Index into `frame.shadows` of the shadow the pixel takes, [`NONE`] where none.
+    /// Index into `frame.shadows` of the shadow the pixel takes, [`NONE`] where none (and, not
+    /// written, for the samples of a pixel [`ShadedOnce::centred`] marks).
     pub shadow: Vec<u32>,
     /// With an `[area_light]`: each pixel's visible point for the soft shadows (`None` for the
     /// background and outline hulls); empty without one.
@@ -89,21 +91,63 @@ pub(crate) struct OpaqueBuffers {
 pub(crate) struct ShadedOnce {
     /// Per pixel of the drawn rows: the shaded colour at its centre where its samples share one
     /// triangle (before the hard shadows), NaN elsewhere.
-    centre: Vec<[f32; 3]>,
+    pub(crate) centre: Vec<[f32; 3]>,
     /// Per pixel: that triangle (`u32::MAX`: none).
     tri: Vec<u32>,
     /// With an `[area_light]`, per pixel: what the lamp adds at its centre where its samples
     /// share one triangle (`shading::area_term`; every sample takes it, as it takes the centre
     /// colour); empty without one.
     term: Vec<[f32; 3]>,
-    /// Per sample: the plane shadows' choice (for the samples a refinement shades again).
+    /// Per sample: the plane shadows' choice (for the samples a refinement shades again); empty
+    /// in a frame without plane shadows, where every choice is [`NO_SHADOW`].
     best: Vec<crate::shadows::Choice>,
+    /// Per pixel: its samples all take its centre colour and no shadow, and their entries of
+    /// [`OpaqueBuffers::color`] and [`OpaqueBuffers::shadow`] are not written (some 16 bytes a
+    /// sample that the resolve would read back only to sum four equal values). Set where the
+    /// samples of a pixel shaded once take its centre's surface too (a frame without shadows);
+    /// cleared, once the samples are written after all, by the refinement and by the edge pass
+    /// ([`ShadedOnce::expand`]). Empty where no pixel is shaded once.
+    pub(crate) centred: Vec<bool>,
+    /// The samples' grid edge `k` of the pixels above (1 where none is shaded once).
+    pub(crate) grid: usize,
     /// Per pixel, for the refinement's comparisons ([`Probe`]).
     probe: Vec<Probe>,
     /// Per pixel: which of its pairs with its neighbours differ ([`PAIR_E`] and the rest).
     pairs: Vec<u8>,
     /// Shade every sample instead (the tests' reference).
     pub every_sample: bool,
+}
+
+impl ShadedOnce {
+    /// The colour of every sample of pixel `p` (of a frame's drawn rows), where
+    /// [`ShadedOnce::centred`] marks it; `None` where its samples hold their own.
+    #[inline]
+    pub(crate) fn centred_color(&self, p: usize) -> Option<[f32; 3]> {
+        self.centred.get(p).copied().unwrap_or(false).then(|| self.centre[p])
+    }
+}
+
+/// Writes the centre colour and no shadow into every sample of pixel `px` (column) of a row of
+/// pixels marked [`ShadedOnce::centred`], and clears the mark: the samples then hold their own
+/// entries, which the caller may change one by one. `color` and `shadow` hold the pixel row's
+/// `k` sample rows of width `w`; nothing happens where the pixel is not marked.
+pub(crate) fn expand(
+    centred: &mut bool,
+    centre: [f32; 3],
+    k: usize,
+    w: usize,
+    px: usize,
+    color: &mut [[f32; 3]],
+    shadow: &mut [u32],
+) {
+    if !std::mem::take(centred) {
+        return;
+    }
+    for j in 0..k {
+        let i = j * w + px * k;
+        color[i..i + k].fill(centre);
+        shadow[i..i + k].fill(NONE);
+    }
 }
 
 /// A band's share of [`ShadedOnce`]: its pixels' centre colours, triangles and area-light terms,
@@ -114,6 +158,7 @@ struct OnceBand<'a> {
     term: &'a mut [[f32; 3]],
     best: &'a mut [crate::shadows::Choice],
     probe: &'a mut [Probe],
+    centred: &'a mut [bool],
 }
 
 /// A pixel as the refinement compares it with its neighbours: the square roots of its centre
@@ -224,33 +269,51 @@ pub(crate) fn draw_opaque_into(
         return;
     }
     // Without shading once every band gets empty slices.
-    let (centre, once_tri, once_term, once_best, probe) =
-        (&mut kept.centre, &mut kept.tri, &mut kept.term, &mut kept.best, &mut kept.probe);
+    let (centre, once_tri, once_term, once_best, probe, centred) =
+        (&mut kept.centre, &mut kept.tri, &mut kept.term, &mut kept.best, &mut kept.probe, &mut kept.centred);
     let pixels = if once { w * h / (k * k) } else { 0 };
     centre.resize(pixels, [0.0; 3]);
     once_tri.resize(pixels, u32::MAX);
     once_term.resize(if area.is_some() { pixels } else { 0 }, [0.0; 3]);
-    once_best.resize(if once { w * h } else { 0 }, NO_SHADOW);
+    // (Without plane shadows every sample's choice is `NO_SHADOW`: nothing kept.)
+    let plane_shadows = shadow_tris.get(0).is_some();
+    once_best.resize(if once && plane_shadows { w * h } else { 0 }, NO_SHADOW);
     probe.resize(pixels, ([0.0; 6], u64::MAX));
+    // Whether a sample of a pixel shaded once takes the centre's surface rather than a point of
+    // its own (multisampling's rule: one surface a pixel, coverage and depth order per sample);
+    // the outline's reach stays its own.
+    let centring = once && !point_per_sample;
+    centred.clear();
+    centred.resize(if centring { pixels } else { 0 }, false);
+    kept.grid = if once { k } else { 1 };
     let band_pixels = BAND * w / (k * k);
     let mut once_chunks: Vec<OnceBand<'_>> = if once {
         let mut terms = once_term.chunks_mut(band_pixels);
+        let mut bests = once_best.chunks_mut(BAND * w);
+        let mut marks = centred.chunks_mut(band_pixels);
         centre
             .chunks_mut(band_pixels)
             .zip(once_tri.chunks_mut(band_pixels))
-            .zip(once_best.chunks_mut(BAND * w))
             .zip(probe.chunks_mut(band_pixels))
-            .map(|(((centre, tri), best), probe)| OnceBand {
+            .map(|((centre, tri), probe)| OnceBand {
                 centre,
                 tri,
                 term: terms.next().unwrap_or_default(),
-                best,
+                best: bests.next().unwrap_or_default(),
                 probe,
+                centred: marks.next().unwrap_or_default(),
             })
             .collect()
     } else {
         (0..h.div_ceil(BAND))
-            .map(|_| OnceBand { centre: &mut [], tri: &mut [], term: &mut [], best: &mut [], probe: &mut [] })
+            .map(|_| OnceBand {
+                centre: &mut [],
+                tri: &mut [],
+                term: &mut [],
+                best: &mut [],
+                probe: &mut [],
+                centred: &mut [],
+            })
             .collect()
     };
     // Without an area light every band gets an empty slice.
@@ -289,7 +352,8 @@ pub(crate) fn draw_opaque_into(
             .zip(once_batch.into_par_iter())
             .enumerate()
             .for_each(|(j, ((((((((col, surf), obj), shad), nrm), mat), rch), soft), once_band))| {
-                let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, probe } = once_band;
+                let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, probe, centred } =
+                    once_band;
                 let b = first + j;
                 let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
                 let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
@@ -308,6 +372,7 @@ pub(crate) fn draw_opaque_into(
                     centre.fill([f32::NAN; 3]);
                     once_tri.fill(u32::MAX);
                     probe.fill(([0.0; 6], u64::MAX));
+                    centred.fill(false);
                     return;
                 }
                 // Otherwise every sample's and pixel's entry is written once below (a frame
@@ -402,10 +467,6 @@ pub(crate) fn draw_opaque_into(
                     // (At most `REACH_STEPS`, 255.)
                     outline::reach_code(outline_dir, dir).min(255) as u8
                 };
-                // Whether a sample of a pixel shaded once takes the centre's surface rather than
-                // a point of its own (multisampling's rule: one surface a pixel, coverage and
-                // depth order per sample); the outline's reach stays its own.
-                let centring = once && !point_per_sample;
                 for r in 0..rows {
                     let prow = (r / k) * pw;
                     let ay = (1.0 - 2.0 * ((y_start + r) as f32 + 0.5) / frame.height as f32) * sy;
@@ -509,7 +570,9 @@ pub(crate) fn draw_opaque_into(
                             }
                         }
                     }
-                    once_best.copy_from_slice(best);
+                    if plane_shadows {
+                        once_best.copy_from_slice(best);
+                    }
                 }
                 for r in 0..rows {
                     let prow = (r / k) * pw;
@@ -520,12 +583,15 @@ pub(crate) fn draw_opaque_into(
                         let p = if once { prow + (x >> k_shift) } else { 0 };
                         let shared = once && once_tri[p] != u32::MAX;
                         if shared && centring {
-                            // Its pixel's one shade, and no shadow of its own: the pixel's `k`
-                            // samples of this row at once (`x` is on its first column).
-                            col[i..i + k].fill(centre[p]);
-                            shad[i..i + k].fill(NONE);
+                            // Its pixel's one shade, and no shadow of its own: marked, its
+                            // samples' colour and shadow left unwritten (`ShadedOnce::centred`;
+                            // `x` is on the pixel's first column).
+                            centred[p] = true;
                             x += k;
                             continue;
+                        }
+                        if centring {
+                            centred[p] = false;
                         }
                         x += 1;
                         let x = x - 1;
@@ -602,7 +668,7 @@ fn refine(
 ) {
     let w = frame.width as usize;
     let (pw, ph) = (w / k, color.len() / (w * k));
-    let ShadedOnce { tri, best, probe, pairs, .. } = kept;
+    let ShadedOnce { tri, best, probe, pairs, centred, .. } = kept;
     // Each neighbouring pair compared once (the step is symmetric): a pixel's bits say which of
     // its pairs to the east, south, south-east and south-west differ.
     pairs.resize(pw * ph, 0);
@@ -635,8 +701,20 @@ fn refine(
     } else {
         (0..ph).map(|_| Default::default()).collect()
     };
-    color.par_chunks_mut(k * w).zip(shadow.par_chunks_mut(k * w)).zip(soft_rows).enumerate().for_each(
-        |(py, ((col, shad), soft))| {
+    // Where no pixel is centred, every pixel row gets an empty slice.
+    let centred_rows: Vec<&mut [bool]> = if centred.is_empty() {
+        (0..ph).map(|_| Default::default()).collect()
+    } else {
+        centred.chunks_mut(pw).collect()
+    };
+    let best = &best[..];
+    color
+        .par_chunks_mut(k * w)
+        .zip(shadow.par_chunks_mut(k * w))
+        .zip(soft_rows)
+        .zip(centred_rows)
+        .enumerate()
+        .for_each(|(py, (((col, shad), soft), centred))| {
             let row = &pairs[py * pw..py * pw + pw];
             let above = py.checked_sub(1).map(|a| &pairs[a * pw..a * pw + pw]);
             for px in 0..pw {
@@ -654,14 +732,18 @@ fn refine(
                 }
                 let t = &tris[tri[p] as usize];
                 let material = frame.objects[t.object as usize].material(t.material);
+                // Every sample written below.
+                if let Some(c) = centred.get_mut(px) {
+                    *c = false;
+                }
                 for j in 0..k {
                     let sy = y0 + py * k + j;
                     for x in px * k..px * k + k {
                         let i = j * w + x;
                         let (s, _) = interpolate(t, x as f32 + 0.5, sy as f32 + 0.5);
                         let c = shading::shade(frame, &setup.lights, material, &s);
-                        let (c, si) =
-                            setup.shadows.resolve(frame, t.object, s.world, best[(py * k + j) * w + x], c);
+                        let choice = best.get((py * k + j) * w + x).copied().unwrap_or(NO_SHADOW);
+                        let (c, si) = setup.shadows.resolve(frame, t.object, s.world, choice, c);
                         (col[i], shad[i]) = (c, si.unwrap_or(NONE));
                         if let (Some(al), Some(Some(p))) = (area, soft.get_mut(i)) {
                             p.term = shading::area_term(al, material, &s, frame.time);
@@ -669,8 +751,7 @@ fn refine(
                     }
                 }
             }
-        },
-    );
+        });
 }
 
 /// The bits of [`ShadedOnce::pairs`]: a pixel's pair with its east, south, south-east and
@@ -689,8 +770,9 @@ fn differs((a, ka): &Probe, (b, kb): &Probe) -> bool {
     if ka != kb || *ka == u64::MAX {
         return false;
     }
-    let step = a.iter().zip(b).fold(0.0f32, |d, (a, b)| d.max((a - b).abs()));
-    step > ONCE_CONTRAST
+    // (Any channel past the step: the same as the largest past it, without a NaN-aware maximum
+    // a channel.)
+    a.iter().zip(b).fold(false, |d, (a, b)| d | ((a - b).abs() > ONCE_CONTRAST))
 }
 
 /// A band's depth, triangle, visible-surface and shadow buffers ([`draw_opaque_into`]).
@@ -843,4 +925,48 @@ fn interpolate_with<const FULL: bool>(t: &ScreenTri, px: f32, py: f32) -> (shadi
     };
     let outline = t.outline[0] * wts[0] + t.outline[1] * wts[1] + t.outline[2] * wts[2];
     (shading::Surface { world, normal, uv, color }, outline)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 44, point 1: the refinement writes every sample of the pixels it shades sample by
+    /// sample, so none of them stays marked [`ShadedOnce::centred`] (the resolve would read the
+    /// centre colour and drop the band's edge); the rest of the pixels shaded once stay marked.
+    #[test]
+    fn refined_pixels_are_not_left_centred() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-from-front.toml");
+        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let mut frame = scene.at(1.2);
+        (frame.width, frame.height, frame.samples) = (160, 120, 4);
+        let sampled = frame.sample_frame();
+        let setup = FrameSetup::new(&sampled);
+        let mut out = OpaqueBuffers::default();
+        draw_opaque_into(&sampled, &setup, 2, 0..sampled.height as usize, &mut out);
+        let ShadedOnce { tri, pairs, centred, .. } = &out.once;
+        let (pw, ph) = (frame.width as usize, frame.height as usize);
+        let (mut refined, mut kept) = (0, 0);
+        for py in 0..ph {
+            for px in 0..pw {
+                let p = py * pw + px;
+                let bit = |x: usize, y: usize, b: u8| pairs[y * pw + x] & b != 0;
+                let edge = pairs[p] != 0
+                    || (px > 0 && bit(px - 1, py, PAIR_E))
+                    || (py > 0
+                        && (bit(px, py - 1, PAIR_S)
+                            || (px > 0 && bit(px - 1, py - 1, PAIR_SE))
+                            || (px + 1 < pw && bit(px + 1, py - 1, PAIR_SW))));
+                if edge {
+                    assert!(!centred[p], "pixel ({px}, {py}) refined but still centred");
+                    refined += 1;
+                } else if tri[p] != u32::MAX {
+                    assert!(centred[p], "pixel ({px}, {py}) shaded once but not centred");
+                    kept += 1;
+                }
+            }
+        }
+        assert!(refined > 0 && kept > 1000, "{refined} pixels refined, {kept} centred");
+    }
 }
