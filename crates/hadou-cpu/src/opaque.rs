@@ -110,8 +110,13 @@ pub(crate) struct ShadedOnce {
     pub(crate) centred: Vec<bool>,
     /// The samples' grid edge `k` of the pixels above (1 where none is shaded once).
     pub(crate) grid: usize,
-    /// Per pixel, for the refinement's comparisons ([`Probe`]).
-    probe: Vec<Probe>,
+    /// Per pixel, for the refinement's comparisons: its object and material slot
+    /// (`(object << 32) | slot`; `u64::MAX`: not shaded once) …
+    keys: Vec<u64>,
+    /// … and the square roots of its centre colour's channels and, with an `[area_light]`, of its
+    /// area-light term's: [`probe_channels`] planes a pixel row, each a row of pixels (so that
+    /// the comparisons run along rows in lanes).
+    seen: Vec<f32>,
     /// Per pixel: which of its pairs with its neighbours differ ([`PAIR_E`] and the rest).
     pairs: Vec<u8>,
     /// Shade every sample instead (the tests' reference).
@@ -157,14 +162,20 @@ struct OnceBand<'a> {
     tri: &'a mut [u32],
     term: &'a mut [[f32; 3]],
     best: &'a mut [crate::shadows::Choice],
-    probe: &'a mut [Probe],
+    keys: &'a mut [u64],
+    seen: &'a mut [f32],
     centred: &'a mut [bool],
 }
 
-/// A pixel as the refinement compares it with its neighbours: the square roots of its centre
-/// colour and of its area-light term (zero without an `[area_light]`), and its object and
-/// material slot (`u64::MAX`: not shaded once).
-type Probe = ([f32; 6], u64);
+/// The channels [`ShadedOnce::seen`] holds a pixel: the centre colour's three, and the
+/// area-light term's three with an `[area_light]`.
+fn probe_channels(frame: &Frame) -> usize {
+    if frame.area_light.is_some() {
+        6
+    } else {
+        3
+    }
+}
 
 /// The largest difference between the centre colours of neighbouring pixels of one object and
 /// material (per channel, of the square roots of the linear values: about sRGB's steps) that
@@ -269,8 +280,16 @@ pub(crate) fn draw_opaque_into(
         return;
     }
     // Without shading once every band gets empty slices.
-    let (centre, once_tri, once_term, once_best, probe, centred) =
-        (&mut kept.centre, &mut kept.tri, &mut kept.term, &mut kept.best, &mut kept.probe, &mut kept.centred);
+    let (centre, once_tri, once_term, once_best, keys, seen, centred) = (
+        &mut kept.centre,
+        &mut kept.tri,
+        &mut kept.term,
+        &mut kept.best,
+        &mut kept.keys,
+        &mut kept.seen,
+        &mut kept.centred,
+    );
+    let channels = probe_channels(frame);
     let pixels = if once { w * h / (k * k) } else { 0 };
     centre.resize(pixels, [0.0; 3]);
     once_tri.resize(pixels, u32::MAX);
@@ -278,7 +297,8 @@ pub(crate) fn draw_opaque_into(
     // (Without plane shadows every sample's choice is `NO_SHADOW`: nothing kept.)
     let plane_shadows = shadow_tris.get(0).is_some();
     once_best.resize(if once && plane_shadows { w * h } else { 0 }, NO_SHADOW);
-    probe.resize(pixels, ([0.0; 6], u64::MAX));
+    keys.resize(pixels, u64::MAX);
+    seen.resize(pixels * channels, 0.0);
     // Whether a sample of a pixel shaded once takes the centre's surface rather than a point of
     // its own (multisampling's rule: one surface a pixel, coverage and depth order per sample);
     // the outline's reach stays its own.
@@ -294,13 +314,15 @@ pub(crate) fn draw_opaque_into(
         centre
             .chunks_mut(band_pixels)
             .zip(once_tri.chunks_mut(band_pixels))
-            .zip(probe.chunks_mut(band_pixels))
-            .map(|((centre, tri), probe)| OnceBand {
+            .zip(keys.chunks_mut(band_pixels))
+            .zip(seen.chunks_mut(band_pixels * channels))
+            .map(|(((centre, tri), keys), seen)| OnceBand {
                 centre,
                 tri,
                 term: terms.next().unwrap_or_default(),
                 best: bests.next().unwrap_or_default(),
-                probe,
+                keys,
+                seen,
                 centred: marks.next().unwrap_or_default(),
             })
             .collect()
@@ -311,7 +333,8 @@ pub(crate) fn draw_opaque_into(
                 tri: &mut [],
                 term: &mut [],
                 best: &mut [],
-                probe: &mut [],
+                keys: &mut [],
+                seen: &mut [],
                 centred: &mut [],
             })
             .collect()
@@ -352,7 +375,7 @@ pub(crate) fn draw_opaque_into(
             .zip(once_batch.into_par_iter())
             .enumerate()
             .for_each(|(j, ((((((((col, surf), obj), shad), nrm), mat), rch), soft), once_band))| {
-                let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, probe, centred } =
+                let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, keys, seen, centred } =
                     once_band;
                 let b = first + j;
                 let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
@@ -371,7 +394,8 @@ pub(crate) fn draw_opaque_into(
                     soft.fill(None);
                     centre.fill([f32::NAN; 3]);
                     once_tri.fill(u32::MAX);
-                    probe.fill(([0.0; 6], u64::MAX));
+                    keys.fill(u64::MAX);
+                    seen.fill(0.0);
                     centred.fill(false);
                     return;
                 }
@@ -554,19 +578,24 @@ pub(crate) fn draw_opaque_into(
                                 let s = centres[py * pw + px].0;
                                 let c = shading::shade(frame, lights, material, &s);
                                 centre[py * pw + px] = c;
-                                let key = (u64::from(t.object) << 32) | u64::from(t.material);
+                                keys[py * pw + px] = (u64::from(t.object) << 32) | u64::from(t.material);
                                 let root = |v: f32| v.max(0.0).sqrt();
-                                let mut seen = [0.0; 6];
-                                seen[..3].copy_from_slice(&c.map(root));
+                                for (ch, v) in c.into_iter().enumerate() {
+                                    seen[(py * channels + ch) * pw + px] = root(v);
+                                }
                                 if let Some(al) = area {
                                     let a = shading::area_term(al, material, &s, frame.time);
                                     once_term[py * pw + px] = a;
-                                    seen[3..].copy_from_slice(&a.map(root));
+                                    for (ch, v) in a.into_iter().enumerate() {
+                                        seen[(py * channels + 3 + ch) * pw + px] = root(v);
+                                    }
                                 }
-                                probe[py * pw + px] = (seen, key);
                             } else {
                                 centre[py * pw + px] = [f32::NAN; 3];
-                                probe[py * pw + px] = ([0.0; 6], u64::MAX);
+                                keys[py * pw + px] = u64::MAX;
+                                for ch in 0..channels {
+                                    seen[(py * channels + ch) * pw + px] = 0.0;
+                                }
                             }
                         }
                     }
@@ -668,29 +697,40 @@ fn refine(
 ) {
     let w = frame.width as usize;
     let (pw, ph) = (w / k, color.len() / (w * k));
-    let ShadedOnce { tri, best, probe, pairs, centred, .. } = kept;
+    let ShadedOnce { tri, best, keys, seen, pairs, centred, .. } = kept;
+    let channels = probe_channels(frame);
     // Each neighbouring pair compared once (the step is symmetric): a pixel's bits say which of
     // its pairs to the east, south, south-east and south-west differ.
     pairs.resize(pw * ph, 0);
     pairs.par_chunks_mut(pw).enumerate().for_each(|(py, bits)| {
-        let row = &probe[py * pw..py * pw + pw];
-        let below = probe.get((py + 1) * pw..(py + 2) * pw);
+        let plane = |y: usize, ch: usize| &seen[(y * channels + ch) * pw..(y * channels + ch + 1) * pw];
+        let below = py + 1 < ph;
+        // Channel by channel along the row (in lanes), whether a pair's step is past the
+        // contrast (a NaN channel: no step); then only pairs of the same key kept.
+        bits.fill(0);
+        let step = |a: f32, b: f32, bit: u8| u8::from((a - b).abs() > ONCE_CONTRAST) * bit;
+        for ch in 0..channels {
+            let a = plane(py, ch);
+            for ((bit, &x), &y) in bits.iter_mut().zip(a).zip(&a[1..]) {
+                *bit |= step(x, y, PAIR_E);
+            }
+            if below {
+                let b = plane(py + 1, ch);
+                for ((bit, &x), &y) in bits.iter_mut().zip(a).zip(b) {
+                    *bit |= step(x, y, PAIR_S);
+                }
+                for ((bit, &x), &y) in bits.iter_mut().zip(a).zip(&b[1..]) {
+                    *bit |= step(x, y, PAIR_SE);
+                }
+                for ((bit, &x), &y) in bits[1..].iter_mut().zip(&a[1..]).zip(b) {
+                    *bit |= step(x, y, PAIR_SW);
+                }
+            }
+        }
+        let row = &keys[py * pw..py * pw + pw];
+        let next = keys.get((py + 1) * pw..(py + 2) * pw);
         for (px, bit) in bits.iter_mut().enumerate() {
-            let a = &row[px];
-            let mut b = 0;
-            if px + 1 < pw {
-                b |= u8::from(differs(a, &row[px + 1])) * PAIR_E;
-            }
-            if let Some(below) = below {
-                b |= u8::from(differs(a, &below[px])) * PAIR_S;
-                if px + 1 < pw {
-                    b |= u8::from(differs(a, &below[px + 1])) * PAIR_SE;
-                }
-                if px > 0 {
-                    b |= u8::from(differs(a, &below[px - 1])) * PAIR_SW;
-                }
-            }
-            *bit = b;
+            *bit &= same_keys(row, next, px);
         }
     });
     let pairs = &pairs[..];
@@ -761,18 +801,25 @@ const PAIR_S: u8 = 2;
 const PAIR_SE: u8 = 4;
 const PAIR_SW: u8 = 8;
 
-/// Whether two neighbouring pixels were both shaded once, show the same object and material, and
-/// differ in a channel of the colour or of the area-light term by more than [`ONCE_CONTRAST`] (a
-/// NaN channel counts as no difference).
+/// The pair bits of pixel `px` of a row of [`ShadedOnce::keys`] (`next`: the row below, if any)
+/// whose two pixels were both shaded once and show the same object and material: only those
+/// pairs are compared (a pair differs where a channel of the colour or of the area-light term
+/// steps by more than [`ONCE_CONTRAST`]).
 #[inline]
-fn differs((a, ka): &Probe, (b, kb): &Probe) -> bool {
-    // (The keys first: neighbours of other objects or materials need no channel compared.)
-    if ka != kb || *ka == u64::MAX {
-        return false;
+fn same_keys(row: &[u64], next: Option<&[u64]>, px: usize) -> u8 {
+    let k = row[px];
+    if k == u64::MAX {
+        return 0;
     }
-    // (Any channel past the step: the same as the largest past it, without a NaN-aware maximum
-    // a channel.)
-    a.iter().zip(b).fold(false, |d, (a, b)| d | ((a - b).abs() > ONCE_CONTRAST))
+    let is = |v: Option<&u64>, bit: u8| u8::from(v == Some(&k)) * bit;
+    let mut bits = is(row.get(px + 1), PAIR_E);
+    if let Some(next) = next {
+        bits |= is(next.get(px), PAIR_S) | is(next.get(px + 1), PAIR_SE);
+        if px > 0 {
+            bits |= is(next.get(px - 1), PAIR_SW);
+        }
+    }
+    bits
 }
 
 /// A band's depth, triangle, visible-surface and shadow buffers ([`draw_opaque_into`]).
