@@ -33,7 +33,7 @@ pub struct SoftPoint {
 #[derive(Default)]
 pub(crate) struct OpaqueBuffers {
     /// Shaded linear RGB, background where nothing is drawn. Not written for the samples of a
-    /// pixel [`ShadedOnce::centred`] marks (their colour is [`ShadedOnce::centred_color`]).
+    /// pixel [`ShadedOnce::centred`] marks (their colour is the pixel's [`ShadedOnce::centre`]).
     pub color: Vec<[f32; 3]>,
     /// Eye distance to the visible surface (finite), `+∞` where nothing is drawn (as the wave
     /// pass reads it).
@@ -121,15 +121,6 @@ pub(crate) struct ShadedOnce {
     pairs: Vec<u8>,
     /// Shade every sample instead (the tests' reference).
     pub every_sample: bool,
-}
-
-impl ShadedOnce {
-    /// The colour of every sample of pixel `p` (of a frame's drawn rows), where
-    /// [`ShadedOnce::centred`] marks it; `None` where its samples hold their own.
-    #[inline]
-    pub(crate) fn centred_color(&self, p: usize) -> Option<[f32; 3]> {
-        self.centred.get(p).copied().unwrap_or(false).then(|| self.centre[p])
-    }
 }
 
 /// Writes the centre colour and no shadow into every sample of pixel `px` (column) of a row of

@@ -372,6 +372,9 @@ impl CanonicalEdge {
     }
 }
 
+/// Pixels whose edge values [`cover`] computes together.
+const RUN: usize = 8;
+
 /// Calls `f(i, b)` for every pixel centre of the rows `y_start..y_start + rows` (`i` indexing a
 /// `rows × w` buffer) that `t` covers under the top-left rule, with the screen-space barycentric
 /// weights `b` of the centre. Degenerate (zero-area or non-finite) triangles cover nothing.
@@ -459,14 +462,27 @@ pub(crate) fn cover(
         if xe < xs as f64 {
             continue;
         }
-        for x in xs..=xe as usize {
-            let px = x as f64 + 0.5;
-            let e = [edges[0].at(px, pyd), edges[1].at(px, pyd), edges[2].at(px, pyd)];
-            if !(edges[0].inside(e[0]) && edges[1].inside(e[1]) && edges[2].inside(e[2])) {
-                continue;
+        // In runs of `RUN` pixels: the three edge values of a run first, the same products on
+        // the same numbers (so the same bits) but in lanes, then the tests and the calls.
+        let end = xe as usize + 1;
+        let mut x = xs;
+        while x < end {
+            let n = (end - x).min(RUN);
+            let px0 = x as f64 + 0.5;
+            let mut e = [[0.0f64; RUN]; 3];
+            for (edge, e) in edges.iter().zip(&mut e) {
+                for (l, v) in e.iter_mut().enumerate() {
+                    // (`x + l` and its half are exact in f64: the same `px` as one at a time.)
+                    *v = edge.at(px0 + l as f64, pyd);
+                }
             }
-            let b = e.map(|e| (e * inv_area) as f32);
-            f(r * w + x, b);
+            for l in 0..n {
+                let v = [e[0][l], e[1][l], e[2][l]];
+                if edges[0].inside(v[0]) && edges[1].inside(v[1]) && edges[2].inside(v[2]) {
+                    f(r * w + x + l, v.map(|e| (e * inv_area) as f32));
+                }
+            }
+            x += RUN;
         }
     }
 }

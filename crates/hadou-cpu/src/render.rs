@@ -371,17 +371,18 @@ impl RowSource<'_> {
         surface.clear();
         edges.clear();
         let inv = 1.0 / (k * k) as f32;
-        // The pixel row's first entry in the per-pixel buffers of shading once.
+        // The pixel row's marks of shading once (`ShadedOnce::centred`), where there are any.
         let prow = (k * y - self.oy0) / k * w;
+        let centred = o.once.centred.get(prow..prow + w);
         for x in 0..w {
             let mut c = [0.0f32; 3];
             let (mut lo, mut hi, mut sum) = (f32::INFINITY, 0.0f32, 0.0f32);
             let first = (k * y - self.oy0) * sw + k * x;
-            let key0 = sample_key(o, first);
-            let mut same = true;
-            if let Some(centre) = o.once.centred_color(prow + x) {
-                // Every sample of the pixel takes its centre's colour and surface (their colour
-                // unwritten; `ShadedOnce::centred`): the same sums without reading them back.
+            if centred.is_some_and(|m| m[x]) {
+                // Every sample of the pixel shows one surface of an object (so it is drawn and
+                // the samples agree but for their spread in depth), in its centre's colour (left
+                // unwritten): the same sums without reading the samples' colours and keys.
+                let centre = o.once.centre[prow + x];
                 for j in 0..k {
                     for i in 0..k {
                         for (ck, v) in c.iter_mut().zip(centre) {
@@ -393,18 +394,26 @@ impl RowSource<'_> {
                         }
                     }
                 }
-            } else {
-                for j in 0..k {
-                    for i in 0..k {
-                        let idx = first + j * sw + i;
-                        for (ck, v) in c.iter_mut().zip(o.color[idx]) {
-                            *ck += v * inv;
-                        }
-                        same &= sample_key(o, idx) == key0;
-                        let d = o.surface[idx];
-                        if d.is_finite() {
-                            (lo, hi, sum) = (lo.min(d), hi.max(d), sum + d);
-                        }
+                scene.push(c.map(hadou_math::energy::saturate));
+                surface.push(sum * inv);
+                let agree = hi - lo <= hadou_scene::SAMPLE_DEPTH_SPREAD * lo;
+                if !agree {
+                    edges.push(x);
+                }
+                continue;
+            }
+            let key0 = sample_key(o, first);
+            let mut same = true;
+            for j in 0..k {
+                for i in 0..k {
+                    let idx = first + j * sw + i;
+                    for (ck, v) in c.iter_mut().zip(o.color[idx]) {
+                        *ck += v * inv;
+                    }
+                    same &= sample_key(o, idx) == key0;
+                    let d = o.surface[idx];
+                    if d.is_finite() {
+                        (lo, hi, sum) = (lo.min(d), hi.max(d), sum + d);
                     }
                 }
             }
