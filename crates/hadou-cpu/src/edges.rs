@@ -233,7 +233,7 @@ thread_local! {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::opaque::draw_opaque_into;
+    use crate::opaque::light_from_front_drawn;
     use crate::setup::FrameSetup;
 
     /// Issue 44, point 1: a pixel shaded once whose samples take its centre colour unwritten
@@ -242,16 +242,9 @@ mod tests {
     /// centre colour, and the pixel is no longer marked (the resolve reads its samples).
     #[test]
     fn outlines_closed_over_centred_pixels_write_their_samples() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-from-front.toml");
-        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let mut frame = scene.at(1.2);
-        (frame.width, frame.height, frame.samples) = (160, 120, 4);
-        let sampled = frame.sample_frame();
+        let (_, sampled, mut out) = light_from_front_drawn();
         let setup = FrameSetup::new(&sampled);
-        let mut out = OpaqueBuffers::default();
         let h = sampled.height as usize;
-        draw_opaque_into(&sampled, &setup, 2, 0..h, &mut out);
         let (material, marked, centre) =
             (out.material.clone(), out.once.centred.clone(), out.once.centre.clone());
         assert!(marked.iter().filter(|&&m| m).count() > 1000, "few pixels centred");

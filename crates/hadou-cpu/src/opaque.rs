@@ -965,6 +965,20 @@ fn interpolate_with<const FULL: bool>(t: &ScreenTri, px: f32, py: f32) -> (shadi
     (shading::Surface { world, normal, uv, color }, outline)
 }
 
+/// `scenes/light-from-front.toml` at t = 1.2 s, 160 × 120 pixels of 2 × 2 samples: the image
+/// frame, its sample frame, and the sample frame's opaque pass (without the edge pass).
+#[cfg(test)]
+pub(crate) fn light_from_front_drawn() -> (Frame, Frame, OpaqueBuffers) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-from-front.toml");
+    let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let mut frame = scene.at(1.2);
+    (frame.width, frame.height, frame.samples) = (160, 120, 4);
+    let sampled = frame.sample_frame();
+    let mut out = OpaqueBuffers::default();
+    draw_opaque_into(&sampled, &FrameSetup::new(&sampled), 2, 0..sampled.height as usize, &mut out);
+    (frame, sampled, out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -974,15 +988,7 @@ mod tests {
     /// centre colour and drop the band's edge); the rest of the pixels shaded once stay marked.
     #[test]
     fn refined_pixels_are_not_left_centred() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/light-from-front.toml");
-        let scene = hadou_scene::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-        let mut frame = scene.at(1.2);
-        (frame.width, frame.height, frame.samples) = (160, 120, 4);
-        let sampled = frame.sample_frame();
-        let setup = FrameSetup::new(&sampled);
-        let mut out = OpaqueBuffers::default();
-        draw_opaque_into(&sampled, &setup, 2, 0..sampled.height as usize, &mut out);
+        let (frame, _, out) = light_from_front_drawn();
         let ShadedOnce { tri, pairs, centred, .. } = &out.once;
         let (pw, ph) = (frame.width as usize, frame.height as usize);
         let (mut refined, mut kept) = (0, 0);
