@@ -15,8 +15,10 @@
 //! 2. **Pixels.** A pixel's own capsule (radius 0 at its point) and [`hadou_math::soft::BvhTri::one_side`] pick the
 //!    triangles that can hide part of its lamp; each sets the samples it hides in the pixel's mask
 //!    ([`hadou_math::soft::occlude`]: clipped, projected onto the lamp's plane, each row of samples
-//!    solved exactly); the walk stops once every sample is hidden (umbra). The visibility is the
-//!    mask's weighted share of clear samples ([`mask_visibility`]).
+//!    solved exactly; for the segment [`hadou_math::soft::occlude_segment`], the triangle's chord
+//!    across the plane of the receiver and the segment, which needs no side or capsule test
+//!    first); the walk stops once every sample is hidden (umbra). The visibility is the mask's
+//!    weighted share of clear samples ([`mask_visibility`]).
 //! 3. **Determinism.** A pixel's samples depend only on its global coordinates
 //!    ([`pixel_offset`]), and the mask's OR does not depend on the order of the triangles, so the
 //!    same frame gives the same bits, banded or whole, on any number of threads.
@@ -28,9 +30,9 @@
 use crate::opaque::SoftPoint;
 use crate::winding::TileCasters;
 use hadou_math::soft::{
-    lamp_frame, mask_full, mask_visibility, occlude, pixel_offset, segment_plane_margin,
-    segment_triangle_distance, Bvh, BvhTri, Capsule, LampFrame, LampPattern, LampShape, SegmentWedge,
-    Topology, MASK_WORDS, TRACE_BIAS, T_MIN,
+    lamp_frame, mask_full, mask_visibility, occlude, occlude_segment, pixel_offset, segment_plane_margin,
+    segment_triangle_distance, Bvh, Capsule, LampFrame, LampPattern, LampShape, SegmentWedge, Topology,
+    MASK_WORDS, TRACE_BIAS, T_MIN,
 };
 use hadou_math::{Vec3, Vec3f};
 use hadou_scene::{AreaLight, Frame};
@@ -40,8 +42,9 @@ use rayon::prelude::*;
 pub const TILE: usize = 8;
 /// Most triangles a tile keeps for its pixels (more: each pixel walks the hierarchy).
 pub const TILE_TRIS: usize = 4096;
-/// The same for the segment lamp, whose pixels test the triangles one by one.
-pub const SEGMENT_TILE_TRIS: usize = 128;
+/// The same for the segment lamp, whose pixels take the triangles' chords one by one (each
+/// three products where it misses the pixel's plane).
+pub const SEGMENT_TILE_TRIS: usize = 512;
 
 /// The world-space triangles of the objects `casters` of `frame` (what the two maps draw,
 /// [`crate::soft::SpotDepth::render`]): [`hadou_scene::caster_triangles`], which the GPU backend
@@ -91,24 +94,6 @@ impl Lamp {
     }
 }
 
-/// A triangle with its bounding ball, for the segment's per-pixel tests.
-#[derive(Clone, Copy)]
-struct Cand {
-    tri: BvhTri,
-    corners: [Vec3f; 3],
-    centre: Vec3f,
-    radius: f32,
-}
-
-impl Cand {
-    fn new(tri: &BvhTri) -> Cand {
-        let corners = tri.corners();
-        let centre = (corners[0] + corners[1] + corners[2]) * (1.0 / 3.0);
-        let radius = corners.iter().map(|v| (*v - centre).length()).fold(0.0f32, f32::max);
-        Cand { tri: *tri, corners, centre, radius }
-    }
-}
-
 /// The traced visibility of every pixel of an image `width` pixels wide whose visible points are
 /// `points` (row-major, `None` for none: a [`crate::soft::SoftInput`]'s) under `light` with
 /// `samples` lamp samples a pixel (see the module notes); 0 where no point is.
@@ -131,11 +116,12 @@ pub fn traced_with(
     width: usize,
     samples: u32,
 ) -> Vec<f32> {
-    traced_where(bvh, light, points, width, samples, |_| true)
+    traced_where(bvh, light, points, width, samples, |_| true, |_, _| true)
 }
 
 /// [`traced_with`] of the points `points[i]` for which `wanted(i)` holds, as if every other were
-/// `None` (0 there), without a copy of the points.
+/// `None` (0 there), without a copy of the points. `tile(tx, ty)` false says that tile `(tx, ty)`
+/// (columns `TILE·tx..`, rows `TILE·ty..`) has no wanted point: it is skipped unread.
 fn traced_where(
     bvh: &Bvh,
     light: &AreaLight,
@@ -143,6 +129,7 @@ fn traced_where(
     width: usize,
     samples: u32,
     wanted: impl Fn(usize) -> bool + Sync,
+    tile: impl Fn(usize, usize) -> bool + Sync,
 ) -> Vec<f32> {
     let point = |i: usize| if wanted(i) { points[i] } else { None };
     let w = width;
@@ -160,10 +147,13 @@ fn traced_where(
         let rows = band.len() / w;
         let mut ids: Vec<u32> = Vec::with_capacity(TILE_TRIS);
         let mut casters = TileCasters::default();
-        let mut cands: Vec<Cand> = Vec::new();
+        let mut cands: Vec<[Vec3f; 3]> = Vec::new();
         let mut receivers: Vec<Vec3f> = Vec::with_capacity(TILE * TILE);
         let cap = if lamp.shape == LampShape::Segment { SEGMENT_TILE_TRIS } else { TILE_TRIS };
         for x0 in (0..w).step_by(TILE) {
+            if !tile(x0 / TILE, ty) {
+                continue;
+            }
             let x1 = (x0 + TILE).min(w);
             // The tile's receivers and their ball.
             let (mut lo, mut hi) = (Vec3f::splat(f32::INFINITY), Vec3f::splat(f32::NEG_INFINITY));
@@ -219,7 +209,7 @@ fn traced_where(
             if !ids.is_empty() && !overflow {
                 if lamp.shape == LampShape::Segment {
                     cands.clear();
-                    cands.extend(ids.iter().map(|&i| Cand::new(&bvh.tris[i as usize])));
+                    cands.extend(ids.iter().map(|&i| bvh.tris[i as usize].corners()));
                 } else {
                     casters.set(bvh, &topo, &ids, tc, tr);
                 }
@@ -242,9 +232,7 @@ fn traced_where(
                     } else {
                         let o = pixel_offset(x as u32, y as u32);
                         match lamp.frame(r) {
-                            Some(f) if lamp.shape == LampShape::Segment => {
-                                by_triangles(&cands, &f, &pat, o, &lamp, extent)
-                            }
+                            Some(f) if lamp.shape == LampShape::Segment => by_triangles(&cands, &f, &pat, o),
                             Some(f) => casters.visibility(bvh, &f, &pat, o, lamp.centre, lamp.size),
                             None => 1.0,
                         }
@@ -309,8 +297,21 @@ pub fn traced_grid_counted(
         return (traced_with(bvh, light, points, width, samples), GridCount { pixels, settled: 0 });
     }
     let (w, h) = (width / k, sh / k);
-    let reps: Vec<Option<SoftPoint>> =
-        (0..w * h).into_par_iter().map(|i| grid_point(points, width, k, i % w, i / w)).collect();
+    // Step 1's points, and how many pixels show anything, row by row.
+    let mut reps: Vec<Option<SoftPoint>> = vec![None; w * h];
+    let drawn: usize = reps
+        .par_chunks_mut(w)
+        .enumerate()
+        .map(|(py, row)| {
+            let mut drawn = 0;
+            for (px, rep) in row.iter_mut().enumerate() {
+                *rep = grid_point(points, width, k, px, py);
+                let any = || (0..k * k).any(|s| points[(k * py + s / k) * width + k * px + s % k].is_some());
+                drawn += usize::from(rep.is_some() || any());
+            }
+            drawn
+        })
+        .sum();
     let once = traced_with(bvh, light, &reps, w, samples);
     let settled: Vec<bool> = (0..w * h)
         .into_par_iter()
@@ -334,7 +335,21 @@ pub fn traced_grid_counted(
             cell.fill(settled[py * w + px]);
         }
     });
-    let mut out = traced_where(bvh, light, points, width, samples, |j| !settled_at[j]);
+    // The sample frame's tiles that hold a pixel left to trace sample by sample.
+    let (tw, th) = (width.div_ceil(TILE), sh.div_ceil(TILE));
+    let mut open = vec![false; tw * th];
+    for (i, &s) in settled.iter().enumerate() {
+        if !s {
+            let (sx, sy) = (k * (i % w), k * (i / w));
+            for ty in sy / TILE..=(sy + k - 1) / TILE {
+                for tx in sx / TILE..=(sx + k - 1) / TILE {
+                    open[ty * tw + tx] = true;
+                }
+            }
+        }
+    }
+    let mut out =
+        traced_where(bvh, light, points, width, samples, |j| !settled_at[j], |tx, ty| open[ty * tw + tx]);
     out.par_chunks_mut(width).zip(points.par_chunks(width)).enumerate().for_each(|(sy, (o, p))| {
         let py = sy / k;
         for (px, (o, p)) in o.chunks_mut(k).zip(p.chunks(k)).enumerate() {
@@ -347,11 +362,6 @@ pub fn traced_grid_counted(
             }
         }
     });
-    let drawn = (0..w * h)
-        .filter(|&i| {
-            (0..k * k).any(|s| points[(k * (i / w) + s / k) * width + k * (i % w) + s % k].is_some())
-        })
-        .count();
     let count = GridCount { pixels: drawn, settled: settled.iter().filter(|&&s| s).count() };
     (out, count)
 }
@@ -413,27 +423,17 @@ fn lit_at_all(term: [f32; 3]) -> bool {
     term.iter().any(|&t| t > 0.0)
 }
 
-/// One pixel's visibility from its lamp frame `f` by the tile's candidates one by one
-/// ([`occlude`] each, in the mask), stopping once every sample is hidden: what the segment lamp
-/// uses, whose plane runs through the casters its axis points at (so that most of them reach
-/// past it and are clipped whatever the method) and whose single row makes each triangle cheap.
-///
-/// A triangle wholly on one side of the plane through the receiver and the segment is skipped
-/// first ([`LampFrame::beside_segment_plane`], three products): most of a tile's candidates are.
-fn by_triangles(cands: &[Cand], f: &LampFrame, pat: &LampPattern, o: f32, lamp: &Lamp, extent: f32) -> f32 {
-    let r = f.origin;
-    let margin = segment_plane_margin(r, extent);
-    let capsule = Capsule::new(r, 0.0, lamp.centre, lamp.size);
+/// One pixel's visibility from its lamp frame `f` (a segment's) by the tile's candidates one by
+/// one ([`occlude_segment`] each, in the mask), stopping once every sample is hidden: what the
+/// segment lamp uses, whose plane runs through the casters its axis points at and whose chords
+/// make each triangle cheap. A triangle wholly on one side of the plane through the receiver and
+/// the segment costs [`occlude_segment`] three products: most of a tile's candidates are.
+fn by_triangles(cands: &[[Vec3f; 3]], f: &LampFrame, pat: &LampPattern, o: f32) -> f32 {
     let mut mask = [0u32; MASK_WORDS];
     for c in cands {
-        if !f.beside_segment_plane(&c.corners, margin)
-            && !c.tri.one_side(r, 0.0, lamp.centre, lamp.size)
-            && capsule.hits(c.centre, c.radius)
-        {
-            occlude(f, pat, o, &c.corners, &mut mask);
-            if mask_full(&mask, pat) {
-                return 0.0;
-            }
+        occlude_segment(f, pat, o, c, &mut mask);
+        if mask_full(&mask, pat) {
+            return 0.0;
         }
     }
     mask_visibility(&mask, pat)
@@ -442,8 +442,9 @@ fn by_triangles(cands: &[Cand], f: &LampFrame, pat: &LampPattern, o: f32, lamp: 
 /// One pixel's visibility from the receiver `r` at global pixel `(x, y)` by a walk of the
 /// whole hierarchy (a tile with more than [`TILE_TRIS`] candidates), triangle by triangle.
 ///
-/// For the segment lamp, a node or triangle wholly on one side of the plane through the receiver
-/// and the segment is skipped first ([`LampFrame::box_beside_segment_plane`]).
+/// For the segment lamp, a node wholly on one side of the plane through the receiver and the
+/// segment is skipped first ([`LampFrame::box_beside_segment_plane`]), and each triangle's chord
+/// taken ([`occlude_segment`]).
 fn pixel(bvh: &Bvh, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32, extent: f32) -> f32 {
     let Some(f) = lamp.frame(r) else { return 1.0 };
     let o = pixel_offset(x, y);
@@ -469,12 +470,16 @@ fn pixel(bvh: &Bvh, lamp: &Lamp, pat: &LampPattern, r: Vec3f, x: u32, y: u32, ex
             Some(range) => {
                 for t in &bvh.tris[range] {
                     let corners = t.corners();
-                    let beside = segment && f.beside_segment_plane(&corners, margin);
-                    if !beside && !t.one_side(r, 0.0, lamp.centre, lamp.size) {
+                    // The segment's chord does in three products what the side test would.
+                    if segment {
+                        occlude_segment(&f, pat, o, &corners, &mut mask);
+                    } else if !t.one_side(r, 0.0, lamp.centre, lamp.size) {
                         occlude(&f, pat, o, &corners, &mut mask);
-                        if mask_full(&mask, pat) {
-                            return 0.0;
-                        }
+                    } else {
+                        continue;
+                    }
+                    if mask_full(&mask, pat) {
+                        return 0.0;
                     }
                 }
                 i = node.skip as usize;

@@ -210,13 +210,16 @@ fn the_traced_example_scenes_render_true_to_their_lamp() {
 }
 
 /// The outline count of the tiles (`hadou_cpu::traced`'s module notes) gives every receiver the
-/// visibility the triangles give one by one ([`occlude`] over the whole hierarchy), on the plaster
+/// visibility the triangles give one by one ([`occlude`] over the whole hierarchy, the segment's
+/// chords by [`occlude_segment`]), on the plaster
 /// cast (a figure of many pieces and a wall: closed and open parts, triangles reaching past the
 /// lamp's plane) for each lamp shape: within one sample a row, and equal at nearly every receiver.
 #[test]
 fn the_outline_count_equals_the_triangles_one_by_one() {
     use hadou_cpu::traced::{receiver, traced_with, Lamp};
-    use hadou_math::soft::{mask_visibility, occlude, pixel_offset, Bvh, LampPattern, MASK_WORDS};
+    use hadou_math::soft::{
+        mask_visibility, occlude, occlude_segment, pixel_offset, Bvh, LampPattern, MASK_WORDS,
+    };
     let frame = example("soft-plaster.toml", 1.5, 96);
     for shape in SHAPES {
         let (f, light) = with_shape(&frame, shape);
@@ -232,7 +235,12 @@ fn the_outline_count_equals_the_triangles_one_by_one() {
             let o = pixel_offset((i % input.width) as u32, (i / input.width) as u32);
             let mut mask = [0u32; MASK_WORDS];
             for t in &bvh.tris {
-                occlude(&fr, &pat, o, &t.corners(), &mut mask);
+                // The segment's chords ([`occlude_segment`]), the other shapes' clipped polygons.
+                if shape == LampShape::Segment {
+                    occlude_segment(&fr, &pat, o, &t.corners(), &mut mask);
+                } else {
+                    occlude(&fr, &pat, o, &t.corners(), &mut mask);
+                }
             }
             let want = mask_visibility(&mask, &pat);
             n += 1;

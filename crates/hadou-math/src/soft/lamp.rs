@@ -580,6 +580,85 @@ pub fn occlude(f: &LampFrame, pat: &LampPattern, o: f32, tri: &[Vec3f; 3], mask:
     }
 }
 
+/// [`occlude`] for the segment lamp, in the plane that holds the receiver and the segment
+/// (hadou's own): every sample ray lies in that plane (normal `v`), so the samples a triangle
+/// hides are those its chord across the plane hides, and that chord's projection from the
+/// receiver onto the segment's line is one interval. The triangle meets the plane in at most two
+/// points (where its edges cross it, or its corners on it); the chord between them, in the
+/// plane's coordinates `(u·(X − L), h)`, is clipped to `0 ≤ h ≤ (1 − T_MIN)·height` and its two
+/// ends projected from the receiver as [`occlude`] projects a corner. The same set as
+/// [`occlude`]'s row `y = 0` of the projected polygon, from a few products instead of two clips
+/// of the whole triangle and up to five projections; the two agree but for samples within
+/// rounding of an interval's end. A triangle lying in the plane (every corner on it) is handed to
+/// [`occlude`]. `f` must be a segment's frame ([`lamp_frame`] with [`LampShape::Segment`]).
+pub fn occlude_segment(
+    f: &LampFrame,
+    pat: &LampPattern,
+    o: f32,
+    tri: &[Vec3f; 3],
+    mask: &mut [u32; MASK_WORDS],
+) {
+    let d = tri.map(|c| f.v.dot(c - f.origin));
+    // Wholly on one side of the plane (most of a pixel's candidates): nothing to do.
+    if (d[0] > 0.0 && d[1] > 0.0 && d[2] > 0.0) || (d[0] < 0.0 && d[1] < 0.0 && d[2] < 0.0) {
+        return;
+    }
+    let ah = tri.map(|c| {
+        let e = c - f.centre;
+        (f.u.dot(e), f.n.dot(e))
+    });
+    // The triangle's points on the plane: at most two, or three when it lies in it.
+    let mut pts = [(0.0f32, 0.0f32); 3];
+    let mut np = 0;
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if d[i] == 0.0 {
+            pts[np] = ah[i];
+            np += 1;
+        }
+        if (d[i] < 0.0 && d[j] > 0.0) || (d[i] > 0.0 && d[j] < 0.0) {
+            let t = d[i] / (d[i] - d[j]);
+            pts[np] = (ah[i].0 + (ah[j].0 - ah[i].0) * t, ah[i].1 + (ah[j].1 - ah[i].1) * t);
+            np += 1;
+        }
+    }
+    match np {
+        0 => return,
+        3 => return occlude(f, pat, o, tri, mask),
+        _ => {}
+    }
+    let hp = f.height;
+    let top = hp * (1.0 - T_MIN);
+    let (mut p, mut q) = (pts[0], pts[np - 1]);
+    // Clip the chord to h ≥ 0, then to h ≤ top (a crossing point takes the bound's h exactly).
+    for (bound, below) in [(0.0f32, false), (top, true)] {
+        let out = |h: f32| if below { h > bound } else { h < bound };
+        match (out(p.1), out(q.1)) {
+            (true, true) => return,
+            (false, false) => {}
+            (po, _) => {
+                let t = (p.1 - bound) / (p.1 - q.1);
+                let x = (p.0 + (q.0 - p.0) * t, bound);
+                if po {
+                    p = x;
+                } else {
+                    q = x;
+                }
+            }
+        }
+    }
+    let ar = f.u.dot(f.origin - f.centre);
+    let inv_r = 1.0 / f.radius;
+    let project = |(a, h): (f32, f32)| {
+        let s = hp / (hp - h).max(hp * T_MIN);
+        (ar + (a - ar) * s) * inv_r
+    };
+    let (xp, xq) = (project(p), project(q));
+    if let Some((a, b)) = pat.samples_within(o, 0, 1.0, xp.min(xq), xp.max(xq)) {
+        set_bits(mask, a, b);
+    }
+}
+
 /// The world point of sample `i` of row `j` of the lamp `f` (for tests and the GPU's ray-by-ray
 /// comparison): `centre + radius·(x·u + y·v)` with `x = −c + (i + oⱼ)·2c/per_row`.
 pub fn sample_point(f: &LampFrame, pat: &LampPattern, o: f32, j: u32, i: u32) -> Vec3f {
@@ -699,6 +778,50 @@ mod tests {
         }
         // Samples within rounding of a triangle's edge may differ.
         assert!(total > 10_000 && agree as f64 >= 0.999 * total as f64, "{agree} of {total}");
+    }
+
+    #[test]
+    fn the_segments_chord_hides_what_the_rays_meet() {
+        // occlude_segment against the rays and against occlude, on triangles that cross the
+        // segment's plane near and far from the receiver, some reaching past the lamp or behind
+        // the receiver, some large (whose clipped polygon's edges run nearly along the row).
+        let mut s = 0x0bad_5eedu32;
+        let mut r = move || {
+            s = hash32(s.wrapping_add(0x9e37_79b9));
+            (s >> 8) as f32 / 16_777_216.0
+        };
+        let (mut total, mut chord_off, mut clip_off, mut hidden) = (0u64, 0u64, 0u64, 0u64);
+        for case in 0..1500 {
+            let l = Vec3f::new(0.3, 4.0, -0.2);
+            let axis = Vec3f::new(0.1, 1.0, 0.2).normalize_or(Vec3f::Y);
+            let p = Vec3f::new(r() * 4.0 - 2.0, r() * 0.5, r() * 4.0 - 2.0);
+            let Some(f) = lamp_frame(LampShape::Segment, l, axis, 0.8, p) else { continue };
+            let pat = LampPattern::new(LampShape::Segment, [64, 256, 1000][case % 3]);
+            // About a point of the plane through p and the segment, between them or a little
+            // beyond either.
+            let t = r() * 1.3 - 0.15;
+            let on = p + (l + axis * (r() * 2.4 - 1.2) - p) * t;
+            let size = [0.05, 0.4, 3.0][(case / 3) % 3];
+            let tri = [0, 1, 2].map(|_| on + Vec3f::new(r() - 0.5, r() - 0.5, r() - 0.5) * size);
+            let o = pixel_offset(case as u32, 7);
+            let (mut clip, mut chord) = ([0u32; MASK_WORDS], [0u32; MASK_WORDS]);
+            occlude(&f, &pat, o, &tri, &mut clip);
+            occlude_segment(&f, &pat, o, &tri, &mut chord);
+            for i in 0..pat.samples() {
+                let y = sample_point(&f, &pat, o, 0, i);
+                let ray = hits(p, y - p, &tri).is_some_and(|t| (T_MIN..=1.0).contains(&t));
+                let bit = |m: &[u32; MASK_WORDS]| m[(i / 32) as usize] >> (i % 32) & 1 == 1;
+                total += 1;
+                hidden += u64::from(ray);
+                chord_off += u64::from(bit(&chord) != ray);
+                clip_off += u64::from(bit(&clip) != ray);
+            }
+        }
+        assert!(hidden * 20 > total, "the cases hide samples: {hidden} of {total}");
+        // Only samples within rounding of a ray's grazing an edge differ from the rays (the
+        // clipped polygon, whose edges may run nearly along the row, misses a few more).
+        assert!(chord_off * 100_000 <= total, "{chord_off} of {total} samples differ from the rays");
+        assert!(chord_off <= clip_off, "chord {chord_off}, clipped polygon {clip_off}");
     }
 
     #[test]
