@@ -1,6 +1,6 @@
 //! The WGSL twin test of the traced resolve's per-pixel work (`shaders/soft_trace.wgsl`): random
 //! receivers, lamps of every shape and triangles, each case's samples hidden by one triangle
-//! (`occlude`, and `occlude_segment` for the segment) and the hierarchy's tests (`capsule_hits`, `one_side`, `box_may_hide`) computed on
+//! (`occlude`) and the hierarchy's tests (`capsule_hits`, `one_side`, `box_may_hide`) computed on
 //! the GPU and by hadou-math, compared case by case.
 
 use crate::layout::{FrameUniforms, GpuBvhNode, GpuBvhTri, TracedUniforms};
@@ -8,8 +8,8 @@ use crate::shaders::{compose, COMMON, SOFT_TRACE};
 use crate::twin_kernel::Rng;
 use bytemuck::{Pod, Zeroable};
 use hadou_math::soft::{
-    capsule_hits, lamp_frame, mask_visibility, occlude, occlude_segment, pixel_offset, BvhTri, LampPattern,
-    LampShape, MASK_WORDS,
+    capsule_hits, lamp_frame, mask_visibility, occlude, pixel_offset, BvhTri, LampPattern, LampShape,
+    MASK_WORDS,
 };
 use hadou_math::Vec3f;
 
@@ -28,9 +28,8 @@ struct Case {
     tri: GpuBvhTri,
 }
 
-/// Per case, five results: the hidden samples' count, the visibility, `capsule_hits` of the box's
-/// ball and `box_may_hide` of the box (1 or 0), `one_side` of the triangle, and for the segment
-/// the count `occlude_segment` hides (−1 for the other shapes).
+/// Per case, four results: the hidden samples' count, the visibility, `capsule_hits` of the box's
+/// ball and `box_may_hide` of the box (1 or 0), `one_side` of the triangle.
 const KERNEL: &str = r#"
 var<private> frame: FrameUniforms;
 var<private> traced: TracedUniforms;
@@ -71,16 +70,7 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
     var hidden = -1.0;
     var vis = -1.0;
     var boxes = 0.0;
-    var chord = -1.0;
     if (f.ok) {
-        if (c.words.x == LAMP_SEGMENT) {
-            var m2: Mask;
-            for (var w = 0u; w < MASK_WORDS; w++) {
-                m2[w] = 0u;
-            }
-            occlude_segment(f, pixel_offset(c.words.z, c.words.w), c.tri, &m2);
-            chord = f32(count_bits(&m2, 0u, samples()));
-        }
         occlude(f, pixel_offset(c.words.z, c.words.w), c.tri, &mask);
         hidden = f32(count_bits(&mask, 0u, samples()));
         vis = mask_visibility(&mask);
@@ -93,11 +83,10 @@ fn twin_main(@builtin(global_invocation_id) id: vec3<u32>) {
             boxes += 2.0;
         }
     }
-    results[5u * id.x] = hidden;
-    results[5u * id.x + 1u] = vis;
-    results[5u * id.x + 2u] = boxes;
-    results[5u * id.x + 3u] = select(0.0, 1.0, one_side(c.tri, c.receiver.xyz, c.centre.xyz, c.centre.w));
-    results[5u * id.x + 4u] = chord;
+    results[4u * id.x] = hidden;
+    results[4u * id.x + 1u] = vis;
+    results[4u * id.x + 2u] = boxes;
+    results[4u * id.x + 3u] = select(0.0, 1.0, one_side(c.tri, c.receiver.xyz, c.centre.xyz, c.centre.w));
 }
 "#;
 
@@ -149,11 +138,6 @@ fn wgsl_trace_functions_match_their_rust_twins() {
             let mut mask = [0u32; MASK_WORDS];
             occlude(&f, &pattern, pixel_offset(x, y), &tri.corners(), &mut mask);
             let hidden: u32 = mask.iter().map(|w| w.count_ones()).sum();
-            let chord = (shape == LampShape::Segment).then(|| {
-                let mut mask = [0u32; MASK_WORDS];
-                occlude_segment(&f, &pattern, pixel_offset(x, y), &tri.corners(), &mut mask);
-                mask.iter().map(|w| w.count_ones()).sum::<u32>()
-            });
             let centre_box = (lo + hi) * 0.5;
             let radius = (hi - lo).length() * 0.5;
             let boxes = u32::from(capsule_hits(receiver, 0.0, centre, size, centre_box, radius))
@@ -164,7 +148,7 @@ fn wgsl_trace_functions_match_their_rust_twins() {
                     pixel_offset(x, y),
                     &[0; MASK_WORDS],
                 ));
-            (hidden, mask_visibility(&mask, &pattern), boxes, chord)
+            (hidden, mask_visibility(&mask, &pattern), boxes)
         });
         rust.push((expected, tri.one_side(receiver, 0.0, centre, size)));
     }
@@ -172,30 +156,15 @@ fn wgsl_trace_functions_match_their_rust_twins() {
     let source = compose(&[COMMON, SOFT_TRACE, KERNEL]);
     // The hierarchy's bindings are unused here (the walk is the next test's).
     let inputs = [(0, bytemuck::cast_slice(&cases)), (2, bytemuck::cast_slice(&patterns))];
-    let out = crate::twin_kernel::run(&ctx, "traced twins", &source, &inputs, 5 * cases.len())
+    let out = crate::twin_kernel::run(&ctx, "traced twins", &source, &inputs, 4 * cases.len())
         .expect("GPU twin run");
     let (mut hidden_off, mut partial, mut worst) = (0usize, 0usize, 0.0f32);
-    let (mut chords, mut chord_off) = (0usize, 0usize);
     for (i, (expected, one_side)) in rust.iter().enumerate() {
-        let g = &out[5 * i..5 * i + 5];
+        let g = &out[4 * i..4 * i + 4];
         assert_eq!(g[3] == 1.0, *one_side, "case {i}: one_side");
         match expected {
             None => assert_eq!(g[0], -1.0, "case {i}: the lamp has no frame on the CPU"),
-            Some((hidden, vis, boxes, chord)) => {
-                match chord {
-                    None => assert_eq!(g[4], -1.0, "case {i}: a chord for another shape than the segment"),
-                    Some(chord) => {
-                        // As occlude: a sample within rounding of either end may go either way.
-                        chords += 1;
-                        let off = (g[4] - *chord as f32).abs();
-                        chord_off += usize::from(off > 0.0);
-                        assert!(
-                            off <= 2.0,
-                            "case {i}: the chord hides {} on the GPU, {chord} on the CPU",
-                            g[4]
-                        );
-                    }
-                }
+            Some((hidden, vis, boxes)) => {
                 assert!(g[0] >= 0.0, "case {i}: the lamp has a frame on the CPU");
                 let n = patterns[i].rows * patterns[i].per_row;
                 if *hidden > 0 && *hidden < n {
@@ -230,9 +199,6 @@ fn wgsl_trace_functions_match_their_rust_twins() {
     );
     assert!(partial > 300, "only {partial} cases hide part of the lamp");
     assert!(hidden_off * 100 <= cases.len(), "{hidden_off} cases differ");
-    eprintln!("{chords} segment cases, {chord_off} with another chord count");
-    assert!(chords > 500, "only {chords} segment cases");
-    assert!(chord_off * 100 <= chords, "{chord_off} chords differ");
 }
 
 /// The walk (`pixel_visibility`): the plaster cast's hierarchy (the figure and the wall), the

@@ -231,6 +231,14 @@ fn box_beside_segment_plane(f: LampFrame, lo: vec3<f32>, hi: vec3<f32>, margin: 
     return abs(dot3(f.v, c - f.origin)) > reach + margin;
 }
 
+// Twin of hadou_math::soft::LampFrame::beside_segment_plane for a triangle's three corners.
+fn tri_beside_segment_plane(f: LampFrame, t: BvhTri, margin: f32) -> bool {
+    let da = dot3(f.v, t.a.xyz - f.origin);
+    let db = dot3(f.v, t.b.xyz - f.origin);
+    let dc = dot3(f.v, t.c.xyz - f.origin);
+    return min(min(da, db), dc) > margin || max(max(da, db), dc) < -margin;
+}
+
 // Twin of hadou_math::soft::BvhTri::one_side with a receiver ball of radius 0 at p and the lamp's
 // ball (l, rl).
 fn one_side(t: BvhTri, p: vec3<f32>, l: vec3<f32>, rl: f32) -> bool {
@@ -365,89 +373,6 @@ fn occlude(f: LampFrame, o: f32, t: BvhTri, mask: ptr<function, Mask>) -> u32 {
     var added = 0u;
     if (na >= 3u) {
         added = occlude_polygon(f, o, a, ha, na, mask);
-    }
-    return added;
-}
-
-// Twin of hadou_math::soft::occlude_segment, for the segment lamp: the samples the triangle's
-// chord across the plane through f.origin and the segment hides (every sample ray lies in that
-// plane, normal f.v), the chord in the plane's coordinates (u·(X − L), h) clipped to
-// 0 ≤ h ≤ top and its two ends projected as occlude projects a corner: occlude's set, better
-// conditioned and cheaper. A triangle lying in the plane goes to occlude.
-fn occlude_segment(f: LampFrame, o: f32, t: BvhTri, mask: ptr<function, Mask>) -> u32 {
-    var c: array<vec3<f32>, 3>;
-    c[0] = t.a.xyz;
-    c[1] = t.b.xyz;
-    c[2] = t.c.xyz;
-    var d: array<f32, 3>;
-    var ah: array<vec2<f32>, 3>;
-    for (var i = 0u; i < 3u; i++) {
-        d[i] = dot3(f.v, c[i] - f.origin);
-        let e = c[i] - f.centre;
-        ah[i] = vec2<f32>(dot3(f.u, e), dot3(f.n, e));
-    }
-    if ((d[0] > 0.0 && d[1] > 0.0 && d[2] > 0.0) || (d[0] < 0.0 && d[1] < 0.0 && d[2] < 0.0)) {
-        return 0u;
-    }
-    // The triangle's points on the plane: at most two, or three when it lies in it.
-    var pts: array<vec2<f32>, 3>;
-    var np = 0u;
-    for (var i = 0u; i < 3u; i++) {
-        let j = (i + 1u) % 3u;
-        if (d[i] == 0.0) {
-            pts[min(np, 2u)] = ah[i];
-            np += 1u;
-        }
-        if ((d[i] < 0.0 && d[j] > 0.0) || (d[i] > 0.0 && d[j] < 0.0)) {
-            let s = d[i] / (d[i] - d[j]);
-            pts[min(np, 2u)] = vec2<f32>(ah[i].x + (ah[j].x - ah[i].x) * s, ah[i].y + (ah[j].y - ah[i].y) * s);
-            np += 1u;
-        }
-    }
-    if (np == 0u) {
-        return 0u;
-    }
-    if (np >= 3u) {
-        return occlude(f, o, t, mask);
-    }
-    let hp = f.height;
-    let top = hp * (1.0 - T_MIN);
-    var p = pts[0];
-    var q = pts[np - 1u];
-    // Clip the chord to h ≥ 0, then to h ≤ top (a crossing point takes the bound's h exactly).
-    for (var k = 0u; k < 2u; k++) {
-        let below = k == 1u;
-        let bound = select(0.0, top, below);
-        let po = select((p.y < bound), (p.y > bound), below);
-        let qo = select((q.y < bound), (q.y > bound), below);
-        if (po && qo) {
-            return 0u;
-        }
-        if (po != qo) {
-            let s = (p.y - bound) / (p.y - q.y);
-            let x = vec2<f32>(p.x + (q.x - p.x) * s, bound);
-            if (po) {
-                p = x;
-            } else {
-                q = x;
-            }
-        }
-    }
-    let ar = dot3(f.u, f.origin - f.centre);
-    let inv_r = 1.0 / f.radius;
-    let xp = (ar + (p.x - ar) * (hp / max(hp - p.y, hp * T_MIN))) * inv_r;
-    let xq = (ar + (q.x - ar) * (hp / max(hp - q.y, hp * T_MIN))) * inv_r;
-    let lo = min(xp, xq);
-    let hi = max(xp, xq);
-    // LampPattern::samples_within of row 0 (chord half-length 1).
-    let m = f32(traced.per_row);
-    let oj = row_offset(o, 0u);
-    let scale = m / 2.0;
-    let i0 = max(ceil_small(clamp((lo + 1.0) * scale - oj, -1.0, m + 1.0)), 0.0);
-    let i1 = min(floor_small(clamp((hi + 1.0) * scale - oj, -1.0, m + 1.0)), m - 1.0);
-    var added = 0u;
-    if (lo == lo && hi == hi && lo <= hi && i0 <= i1) {
-        added = set_bits(mask, u32(i0), u32(i1) + 1u);
     }
     return added;
 }
@@ -624,11 +549,7 @@ fn pixel_visibility(r: vec3<f32>, x: u32, y: u32) -> f32 {
             var k = first;
             while (k < first + count && !full) {
                 let t = tris[k];
-                if (segment) {
-                    // The chord's three products do what the plane and side tests would.
-                    hidden += occlude_segment(f, o, t, &mask);
-                    full = hidden >= all;
-                } else if (!one_side(t, r, l, size)) {
+                if (!(segment && tri_beside_segment_plane(f, t, margin)) && !one_side(t, r, l, size)) {
                     hidden += occlude(f, o, t, &mask);
                     full = hidden >= all;
                 }
