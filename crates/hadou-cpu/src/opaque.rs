@@ -46,7 +46,9 @@ pub(crate) struct OpaqueBuffers {
     /// written, for the samples of a pixel [`ShadedOnce::centred`] marks).
     pub shadow: Vec<u32>,
     /// With an `[area_light]`: each pixel's visible point for the soft shadows (`None` for the
-    /// background and outline hulls); empty without one.
+    /// background and outline hulls; not written for the samples of a pixel
+    /// [`ShadedOnce::centred`] marks, whose one point is [`ShadedOnce::soft`]'s); empty without
+    /// one.
     pub soft: Vec<Option<SoftPoint>>,
     /// The soft-shadow visibility per pixel once resolved (empty before, and without an area
     /// light).
@@ -77,9 +79,11 @@ pub(crate) struct OpaqueBuffers {
 /// show one triangle (not an outline hull), the surface is shaded once, at the pixel's centre,
 /// and every sample takes that colour and, with an `[area_light]`, that unshadowed lamp term (its
 /// own hard shadow, soft-shadow visibility, depth and edge data stay per sample); coverage and
-/// depth stay per sample. In a frame without hard or soft shadows, whose samples need no visible
-/// point of their own, such a pixel's samples also take the centre's surface (its normal, for the
-/// edge pass) without an interpolation of their own: a sample's eye distance is its view depth
+/// depth stay per sample. In a frame without hard shadows, and with soft shadows only under the
+/// traced resolve, whose samples need no visible point of their own, such a pixel's samples also
+/// take the centre's surface (its normal, for the edge pass) without an interpolation of their
+/// own (the traced resolve traces the pixel once from its centre, and its samples, where they
+/// see the lamp differently, from their own eye distances: `traced::Centred`): a sample's eye distance is its view depth
 /// from the raster times its ray's length (so the waves' clipping and the outlines' depth tests
 /// keep each sample's depth), and the outline's reach stays the sample's own. Where the shading changes across the
 /// pixel — a toon band's, a texture's or a wave light's edge — the centre colour differs from a
@@ -98,6 +102,10 @@ pub(crate) struct ShadedOnce {
     /// share one triangle (`shading::area_term`; every sample takes it, as it takes the centre
     /// colour); empty without one.
     term: Vec<[f32; 3]>,
+    /// With a traced `[area_light]` and the pixels centred ([`ShadedOnce::centred`]), per pixel:
+    /// the soft-shadow point at its centre where it is centred (its samples' entries of
+    /// [`OpaqueBuffers::soft`] are then not written), `None` elsewhere; empty otherwise.
+    pub(crate) soft: Vec<Option<SoftPoint>>,
     /// Per sample: the plane shadows' choice (for the samples a refinement shades again); empty
     /// in a frame without plane shadows, where every choice is [`NO_SHADOW`].
     best: Vec<crate::shadows::Choice>,
@@ -152,6 +160,7 @@ struct OnceBand<'a> {
     centre: &'a mut [[f32; 3]],
     tri: &'a mut [u32],
     term: &'a mut [[f32; 3]],
+    soft: &'a mut [Option<SoftPoint>],
     best: &'a mut [crate::shadows::Choice],
     keys: &'a mut [u64],
     seen: &'a mut [f32],
@@ -232,9 +241,15 @@ pub(crate) fn draw_opaque_into(
     // `x / k` as a shift where shading once (k is 2 or 4 there): a division a sample costs more
     // than the rest of what a sample of a pixel shaded once does.
     let k_shift = k.trailing_zeros();
-    // Whether a sample needs its own visible point (its hard shadows or soft shadows are its
-    // own); otherwise a sample of a pixel shaded once takes its pixel's centre geometry too.
-    let point_per_sample = frame.area_light.is_some() || shadows.any();
+    // Whether a sample needs its own visible point (its hard shadows are its own, and the soft
+    // shadows' resolves other than the traced one map every sample's point); otherwise a sample
+    // of a pixel shaded once takes its pixel's centre geometry too (the traced resolve traces
+    // such a pixel once from its centre, or its samples from their own depths).
+    let point_per_sample = shadows.any()
+        || frame
+            .area_light
+            .as_ref()
+            .is_some_and(|a| !matches!(a.resolve, hadou_scene::SoftResolve::Traced { .. }));
     let once = k > 1
         && k.is_power_of_two()
         && !out.once.every_sample
@@ -271,10 +286,11 @@ pub(crate) fn draw_opaque_into(
         return;
     }
     // Without shading once every band gets empty slices.
-    let (centre, once_tri, once_term, once_best, keys, seen, centred) = (
+    let (centre, once_tri, once_term, once_soft, once_best, keys, seen, centred) = (
         &mut kept.centre,
         &mut kept.tri,
         &mut kept.term,
+        &mut kept.soft,
         &mut kept.best,
         &mut kept.keys,
         &mut kept.seen,
@@ -296,10 +312,12 @@ pub(crate) fn draw_opaque_into(
     let centring = once && !point_per_sample;
     centred.clear();
     centred.resize(if centring { pixels } else { 0 }, false);
+    once_soft.resize(if centring && area.is_some() { pixels } else { 0 }, None);
     kept.grid = if once { k } else { 1 };
     let band_pixels = BAND * w / (k * k);
     let mut once_chunks: Vec<OnceBand<'_>> = if once {
         let mut terms = once_term.chunks_mut(band_pixels);
+        let mut softs = once_soft.chunks_mut(band_pixels);
         let mut bests = once_best.chunks_mut(BAND * w);
         let mut marks = centred.chunks_mut(band_pixels);
         centre
@@ -311,6 +329,7 @@ pub(crate) fn draw_opaque_into(
                 centre,
                 tri,
                 term: terms.next().unwrap_or_default(),
+                soft: softs.next().unwrap_or_default(),
                 best: bests.next().unwrap_or_default(),
                 keys,
                 seen,
@@ -323,6 +342,7 @@ pub(crate) fn draw_opaque_into(
                 centre: &mut [],
                 tri: &mut [],
                 term: &mut [],
+                soft: &mut [],
                 best: &mut [],
                 keys: &mut [],
                 seen: &mut [],
@@ -366,8 +386,16 @@ pub(crate) fn draw_opaque_into(
             .zip(once_batch.into_par_iter())
             .enumerate()
             .for_each(|(j, ((((((((col, surf), obj), shad), nrm), mat), rch), soft), once_band))| {
-                let OnceBand { centre, tri: once_tri, term: once_term, best: once_best, keys, seen, centred } =
-                    once_band;
+                let OnceBand {
+                    centre,
+                    tri: once_tri,
+                    term: once_term,
+                    soft: once_soft,
+                    best: once_best,
+                    keys,
+                    seen,
+                    centred,
+                } = once_band;
                 let b = first + j;
                 let mine = || list.iter().copied().filter(|&ti| bands.reaches(ti, b));
                 let mine_shadows = || shadow_list.iter().copied().filter(|&si| shadow_bands.reaches(si, b));
@@ -385,6 +413,7 @@ pub(crate) fn draw_opaque_into(
                     soft.fill(None);
                     centre.fill([f32::NAN; 3]);
                     once_tri.fill(u32::MAX);
+                    once_soft.fill(None);
                     keys.fill(u64::MAX);
                     seen.fill(0.0);
                     centred.fill(false);
@@ -506,7 +535,8 @@ pub(crate) fn draw_opaque_into(
                                 let d = q * len / (nz + nx * ax + ny * ay);
                                 let d = if d.is_finite() && d > 0.0 { d } else { zbuf[i] * len };
                                 // (The point itself is read by nothing: such a frame has no
-                                // shadows.)
+                                // hard shadows, and the traced soft shadows take a sample's
+                                // point from its eye distance where they need it.)
                                 surf[i] = if d.is_finite() { d } else { 0.0 };
                                 obj[i] = t.object;
                                 rch[i] = reach_of(i, x, r, ti);
@@ -577,12 +607,19 @@ pub(crate) fn draw_opaque_into(
                                 if let Some(al) = area {
                                     let a = shading::area_term(al, material, &s, frame.time);
                                     once_term[py * pw + px] = a;
+                                    if let Some(p) = once_soft.get_mut(py * pw + px) {
+                                        let normal = s.normal.normalize_or(Vec3f::ZERO);
+                                        *p = Some(SoftPoint { world: s.world, normal, term: a });
+                                    }
                                     for (ch, v) in a.into_iter().enumerate() {
                                         seen[(py * channels + 3 + ch) * pw + px] = root(v);
                                     }
                                 }
                             } else {
                                 centre[py * pw + px] = [f32::NAN; 3];
+                                if let Some(p) = once_soft.get_mut(py * pw + px) {
+                                    *p = None;
+                                }
                                 keys[py * pw + px] = u64::MAX;
                                 for ch in 0..channels {
                                     seen[(py * channels + ch) * pw + px] = 0.0;
@@ -776,8 +813,13 @@ fn refine(
                         let choice = best.get((py * k + j) * w + x).copied().unwrap_or(NO_SHADOW);
                         let (c, si) = setup.shadows.resolve(frame, t.object, s.world, choice, c);
                         (col[i], shad[i]) = (c, si.unwrap_or(NONE));
-                        if let (Some(al), Some(Some(p))) = (area, soft.get_mut(i)) {
-                            p.term = shading::area_term(al, material, &s, frame.time);
+                        if let (Some(al), Some(p)) = (area, soft.get_mut(i)) {
+                            // (The whole point: a centred pixel's samples kept none.)
+                            *p = Some(SoftPoint {
+                                world: s.world,
+                                normal: s.normal.normalize_or(Vec3f::ZERO),
+                                term: shading::area_term(al, material, &s, frame.time),
+                            });
                         }
                     }
                 }

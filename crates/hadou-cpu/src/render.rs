@@ -663,14 +663,88 @@ pub(crate) fn opaque_pass(
         points: std::mem::take(&mut opaque.soft),
         grid: k,
     };
-    let vis = soft::visibility(frame, light, &input, light.resolve);
-    opaque.color.par_iter_mut().zip(&input.points).zip(&vis).for_each(|((c, p), &v)| {
-        if let Some(p) = p {
-            for (ck, tk) in c.iter_mut().zip(p.term) {
-                *ck = hadou_math::energy::saturate(*ck + v * tk);
-            }
+    let add = |c: &mut [f32; 3], v: f32, term: [f32; 3]| {
+        for (ck, tk) in c.iter_mut().zip(term) {
+            *ck = hadou_math::energy::saturate(*ck + v * tk);
         }
-    });
+    };
+    let vis = match light.resolve {
+        // Pixels centred under a traced lamp (`opaque::ShadedOnce::soft`): traced from their
+        // centres, their one colour lit once where their samples agree.
+        SoftResolve::Traced { samples } if !opaque.once.soft.is_empty() => {
+            let (w, h) = (frame.width, frame.height);
+            let (basis, surface) = (&setup.basis, &opaque.surface);
+            let sample_world = |j: usize| {
+                let (x, y) = ((j % w as usize) as f32, (j / w as usize) as f32);
+                let d = basis.pixel_dir(x, y, w, h);
+                basis.eye + d * (surface[j] / d.length())
+            };
+            let bvh = hadou_math::soft::Bvh::build(&crate::traced::caster_triangles(frame, &light.casters));
+            let once = &mut opaque.once;
+            let centred = crate::traced::Centred {
+                marks: &once.centred,
+                pixels: &once.soft,
+                sample_world: &sample_world,
+            };
+            let (vis, _) = crate::traced::traced_grid_of(
+                &bvh,
+                light,
+                &input.points,
+                Some(&centred),
+                w as usize,
+                samples,
+                k,
+            );
+            let pw = w as usize / k;
+            opaque
+                .color
+                .par_chunks_mut(k * w as usize)
+                .zip(opaque.shadow.par_chunks_mut(k * w as usize))
+                .zip(input.points.par_chunks(k * w as usize))
+                .zip(vis.par_chunks(k * w as usize))
+                .zip(once.centred.par_chunks_mut(pw))
+                .zip(once.centre.par_chunks_mut(pw))
+                .zip(once.soft.par_chunks(pw))
+                .for_each(|((((((col, shad), pts), vis), marks), centre), soft)| {
+                    let sw = k * pw;
+                    for px in 0..pw {
+                        if let (true, Some(p)) = (marks[px], soft[px]) {
+                            let v = vis[px * k];
+                            let same = (0..k).all(|j| vis[j * sw + px * k..][..k].iter().all(|&u| u == v));
+                            if same {
+                                add(&mut centre[px], v, p.term);
+                                continue;
+                            }
+                            // Its samples see the lamp differently: each takes its own.
+                            crate::opaque::expand(&mut marks[px], centre[px], k, sw, px, col, shad);
+                            for j in 0..k {
+                                for i in j * sw + px * k..j * sw + px * k + k {
+                                    add(&mut col[i], vis[i], p.term);
+                                }
+                            }
+                            continue;
+                        }
+                        for j in 0..k {
+                            for i in j * sw + px * k..j * sw + px * k + k {
+                                if let Some(p) = pts[i] {
+                                    add(&mut col[i], vis[i], p.term);
+                                }
+                            }
+                        }
+                    }
+                });
+            vis
+        }
+        resolve => {
+            let vis = soft::visibility(frame, light, &input, resolve);
+            opaque.color.par_iter_mut().zip(&input.points).zip(&vis).for_each(|((c, p), &v)| {
+                if let Some(p) = p {
+                    add(c, v, p.term);
+                }
+            });
+            vis
+        }
+    };
     opaque.soft = input.points;
     opaque.visibility = vis;
     edges::close_outlines(frame, &setup.basis, 0, opaque);

@@ -131,9 +131,21 @@ fn traced_where(
     wanted: impl Fn(usize) -> bool + Sync,
     tile: impl Fn(usize, usize) -> bool + Sync,
 ) -> Vec<f32> {
-    let point = |i: usize| if wanted(i) { points[i] } else { None };
-    let w = width;
-    let h = points.len().checked_div(w).unwrap_or(0);
+    let h = points.len().checked_div(width).unwrap_or(0);
+    traced_points(bvh, light, width, h, samples, |i| if wanted(i) { points[i] } else { None }, tile)
+}
+
+/// [`traced_where`] of the points `point(i)` of a `width × height` image (`None`: no point, 0).
+fn traced_points(
+    bvh: &Bvh,
+    light: &AreaLight,
+    width: usize,
+    height: usize,
+    samples: u32,
+    point: impl Fn(usize) -> Option<SoftPoint> + Sync,
+    tile: impl Fn(usize, usize) -> bool + Sync,
+) -> Vec<f32> {
+    let (w, h) = (width, height);
     let lamp = Lamp::of(light);
     let pat = LampPattern::new(lamp.shape, samples);
     let mut out = vec![0.0f32; w * h];
@@ -296,7 +308,40 @@ pub fn traced_grid_counted(
         let pixels = points.iter().filter(|p| p.is_some()).count();
         return (traced_with(bvh, light, points, width, samples), GridCount { pixels, settled: 0 });
     }
+    traced_grid_of(bvh, light, points, None, width, samples, k)
+}
+
+/// The pixels of an anti-aliased frame whose samples take their centre's surface (the opaque
+/// pass's `ShadedOnce::centred` under a traced area light, a frame without hard shadows): the
+/// samples of such a pixel keep no point of their own.
+pub(crate) struct Centred<'a> {
+    /// Per image pixel: whether it is centred (its samples' entries of the sample points are then
+    /// not read) …
+    pub marks: &'a [bool],
+    /// … and, where it is, the point at its centre.
+    pub pixels: &'a [Option<SoftPoint>],
+    /// A sample's world position (index into the sample frame), for a centred pixel whose samples
+    /// are traced one by one after all: where its ray meets the pixel's surface.
+    pub sample_world: &'a (dyn Fn(usize) -> Vec3f + Sync),
+}
+
+/// [`traced_grid_counted`] of a sample frame `width` wide (`k × k` samples a pixel, whole
+/// pixels), with the pixels `centred` names given by their centre's point: such a pixel is traced
+/// once from it (instead of its samples' mean point), and where its value is not settled its
+/// samples are traced at their own positions with the centre's normal and term. A centred pixel's
+/// samples all get its value where settled; the caller adds it once.
+pub(crate) fn traced_grid_of(
+    bvh: &Bvh,
+    light: &AreaLight,
+    points: &[Option<SoftPoint>],
+    centred: Option<&Centred<'_>>,
+    width: usize,
+    samples: u32,
+    k: usize,
+) -> (Vec<f32>, GridCount) {
+    let sh = points.len() / width;
     let (w, h) = (width / k, sh / k);
+    let centre = |p: usize| centred.and_then(|c| if c.marks[p] { c.pixels[p] } else { None });
     // Step 1's points, and how many pixels show anything, row by row.
     let mut reps: Vec<Option<SoftPoint>> = vec![None; w * h];
     let drawn: usize = reps
@@ -305,6 +350,12 @@ pub fn traced_grid_counted(
         .map(|(py, row)| {
             let mut drawn = 0;
             for (px, rep) in row.iter_mut().enumerate() {
+                if let Some(c) = centre(py * w + px) {
+                    // (Traced whether or not the lamp adds light there, as `grid_point`'s.)
+                    *rep = Some(SoftPoint { term: [1.0; 3], ..c });
+                    drawn += 1;
+                    continue;
+                }
                 *rep = grid_point(points, width, k, px, py);
                 let any = || (0..k * k).any(|s| points[(k * py + s / k) * width + k * px + s % k].is_some());
                 drawn += usize::from(rep.is_some() || any());
@@ -327,14 +378,6 @@ pub fn traced_grid_counted(
             }
         })
         .collect();
-    // Each point's pixel's verdict, spread row by row (no division per point).
-    let mut settled_at = vec![false; points.len()];
-    settled_at.par_chunks_mut(width).enumerate().for_each(|(sy, row)| {
-        let py = sy / k;
-        for (px, cell) in row.chunks_mut(k).enumerate() {
-            cell.fill(settled[py * w + px]);
-        }
-    });
     // The sample frame's tiles that hold a pixel left to trace sample by sample.
     let (tw, th) = (width.div_ceil(TILE), sh.div_ceil(TILE));
     let mut open = vec![false; tw * th];
@@ -348,13 +391,28 @@ pub fn traced_grid_counted(
             }
         }
     }
-    let mut out =
-        traced_where(bvh, light, points, width, samples, |j| !settled_at[j], |tx, ty| open[ty * tw + tx]);
+    // A sample's pixel (read only in the open tiles).
+    let pixel_of = |j: usize| ((j / width) / k) * w + (j % width) / k;
+    let point = |j: usize| {
+        let p = pixel_of(j);
+        if settled[p] {
+            return None;
+        }
+        match centre(p) {
+            Some(c) => centred.map(|cs| SoftPoint { world: (cs.sample_world)(j), ..c }),
+            None => points[j],
+        }
+    };
+    let mut out = traced_points(bvh, light, width, sh, samples, point, |tx, ty| open[ty * tw + tx]);
     out.par_chunks_mut(width).zip(points.par_chunks(width)).enumerate().for_each(|(sy, (o, p))| {
         let py = sy / k;
         for (px, (o, p)) in o.chunks_mut(k).zip(p.chunks(k)).enumerate() {
             let i = py * w + px;
             if settled[i] {
+                if let Some(c) = centre(i) {
+                    o.fill(if lit_at_all(c.term) { once[i] } else { 0.0 });
+                    continue;
+                }
                 for (o, p) in o.iter_mut().zip(p) {
                     // A point the lamp adds nothing to stays 0, as [`traced_with`] gives it.
                     *o = if p.is_some_and(|p| lit_at_all(p.term)) { once[i] } else { 0.0 };
